@@ -1,0 +1,45 @@
+"""Small argument checks shared by the public functions (validate once at the boundary)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pushrecovery.errors import InvalidParameterError
+
+
+def finite_float(name: str, value: object, unit: str = "") -> float:
+    """Return ``value`` as a finite float or raise naming ``name``."""
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"{name} must be a finite number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise InvalidParameterError(f"{name} must be a finite number{_unit(unit)}, got {number}")
+    return number
+
+
+def positive_float(name: str, value: object, unit: str = "") -> float:
+    """Return ``value`` as a finite float > 0 or raise naming ``name`` and the range."""
+    number = finite_float(name, value, unit)
+    if number <= 0.0:
+        raise InvalidParameterError(f"{name} must be > 0{_unit(unit)}, got {name}={number:g}")
+    return number
+
+
+def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
+    """Return ``value`` as a float64 array with only finite entries, or raise naming ``name``."""
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"{name} must be numeric, got {value!r}") from None
+    if not np.isfinite(array).all():
+        bad = int(np.size(array) - np.count_nonzero(np.isfinite(array)))
+        raise InvalidParameterError(f"{name} must be finite, got {bad} non-finite value(s)")
+    return array
+
+
+def _unit(unit: str) -> str:
+    return f" [{unit}]" if unit else ""

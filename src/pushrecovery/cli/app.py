@@ -1,0 +1,269 @@
+"""The ``pushrecovery`` commands. Heavy modules are imported inside each command."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+
+from pushrecovery import __version__
+from pushrecovery.cli.options import body_options, emit, params_from
+
+MODEL_CHOICES = ("lipm", "pendulum")
+CONTROLLER_CHOICES = ("ankle-saturated", "ankle-pd")
+
+
+@click.group(
+    no_args_is_help=True,
+    context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100},
+)
+@click.version_option(__version__, prog_name="pushrecovery")
+def cli() -> None:
+    """Predict whether a pushed humanoid falls, and recover it (Stephens, Humanoid Push Recovery).
+
+    SI units throughout; x is forward, positions are relative to the ankle. Every command
+    takes the body-parameter flags and --json.
+    """
+
+
+@cli.command()
+@body_options
+def bounds(as_json: bool, **kwargs: Any) -> None:
+    """Capture-point bounds of each balance strategy (Eq. 4)."""
+    from pushrecovery.surfaces.cop import cop_region
+
+    params = params_from(kwargs)
+    region = cop_region(params)
+    emit(
+        {
+            "params": params.to_dict(),
+            "omega": params.omega,
+            "cop": {"lower": region.lower, "upper": region.upper},
+        },
+        as_json,
+    )
+
+
+@cli.command()
+@click.option("--x", "x", type=float, required=True, help="CoM position relative to the ankle [m].")
+@click.option("--xdot", type=float, required=True, help="CoM velocity [m/s].")
+@body_options
+def classify(x: float, xdot: float, as_json: bool, **kwargs: Any) -> None:
+    """Which strategy the CoM state (x, xdot) needs: ankle, hip, step or fall."""
+    from pushrecovery.surfaces.classify import classify as classify_state
+
+    params = params_from(kwargs)
+    result = classify_state(x, xdot, params).to_dict()
+    emit({**result, "state": {"x": x, "xdot": xdot}}, as_json)
+
+
+def _push_velocity(xdot: float | None, impulse: float | None, mass: float) -> float:
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.sim.push import Push
+
+    if xdot is not None and impulse is not None:
+        raise InvalidParameterError("give either --xdot [m/s] or --impulse [N s], not both")
+    if impulse is not None:
+        return Push.from_impulse(impulse, mass).delta_velocity
+    return 0.0 if xdot is None else xdot
+
+
+def _controller_options(kp: float | None, kd: float | None) -> dict[str, float]:
+    options = {"stiffness": kp, "damping": kd}
+    return {k: v for k, v in options.items() if v is not None}
+
+
+_model = click.option(
+    "--model",
+    type=click.Choice(MODEL_CHOICES),
+    default="lipm",
+    show_default=True,
+    help="Plant: linear inverted pendulum or nonlinear pendulum.",
+)
+_controller = click.option(
+    "--controller",
+    type=click.Choice(CONTROLLER_CHOICES),
+    default="ankle-pd",
+    show_default=True,
+    help="Controller.",
+)
+_gains = (
+    click.option("--kp", type=float, default=None, help="ankle-pd stiffness [N m/rad]."),
+    click.option("--kd", type=float, default=None, help="ankle-pd damping [N m s/rad]."),
+)
+
+
+def _with(*decorators: Any) -> Any:
+    def apply(func: Any) -> Any:
+        for decorator in reversed(decorators):
+            func = decorator(func)
+        return func
+
+    return apply
+
+
+@cli.command()
+@_with(_model, _controller, *_gains)
+@click.option(
+    "--x", "x", type=float, default=0.0, show_default=True, help="CoM position before the push [m]."
+)
+@click.option("--xdot", type=float, default=None, help="CoM velocity just after the push [m/s].")
+@click.option(
+    "--impulse",
+    type=float,
+    default=None,
+    help="Push as an impulse on the CoM [N s] (instead of --xdot).",
+)
+@click.option(
+    "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
+)
+@click.option(
+    "--control-period", type=float, default=1e-3, show_default=True, help="Controller period [s]."
+)
+@click.option(
+    "--plot",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Write a plot of the run (PNG, SVG or PDF by extension).",
+)
+@body_options
+def simulate(
+    model: str,
+    controller: str,
+    kp: float | None,
+    kd: float | None,
+    x: float,
+    xdot: float | None,
+    impulse: float | None,
+    duration: float,
+    control_period: float,
+    plot: str | None,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Simulate a push on a model with a controller; report recovered or fell."""
+    import numpy as np
+
+    from pushrecovery.control.base import make_controller
+    from pushrecovery.sim.plants import make_plant
+    from pushrecovery.sim.simulate import simulate as run
+    from pushrecovery.surfaces.classify import classify as classify_state
+
+    params = params_from(kwargs)
+    velocity = _push_velocity(xdot, impulse, params.mass)
+    predicted = classify_state(x, velocity, params)
+    result = run(
+        make_plant(model, params),
+        make_controller(controller, params, **_controller_options(kp, kd)),
+        np.array([x, velocity]),
+        duration=duration,
+        control_period=control_period,
+    )
+    data = result.to_dict()
+    data["initial_state"] = {"x": x, "xdot": velocity}
+    data["predicted"] = predicted.to_dict()
+    if plot:
+        from pushrecovery.plots.runs import save_run
+
+        data["plot"] = str(save_run(result, params, Path(plot)))
+    emit(data, as_json)
+
+
+@cli.command("critical-push")
+@_with(_model, _controller, *_gains)
+@click.option(
+    "--x",
+    "x",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="CoM position before the push, on the foot [m].",
+)
+@click.option(
+    "--direction", type=click.Choice(("forward", "backward")), default="forward", show_default=True
+)
+@click.option(
+    "--tolerance",
+    type=float,
+    default=1e-4,
+    show_default=True,
+    help="Width of the final velocity bracket [m/s].",
+)
+@click.option(
+    "--duration",
+    type=float,
+    default=10.0,
+    show_default=True,
+    help="Longest simulated time per push [s].",
+)
+@body_options
+def critical_push(
+    model: str,
+    controller: str,
+    kp: float | None,
+    kd: float | None,
+    x: float,
+    direction: str,
+    tolerance: float,
+    duration: float,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Largest recoverable push from x by bisection, against Eq. 4's prediction."""
+    from pushrecovery.sim.critical import critical_push as search
+
+    params = params_from(kwargs)
+    found = search(
+        params,
+        model,
+        controller,
+        x,
+        direction,
+        tolerance=tolerance,
+        duration=duration,
+        controller_options=_controller_options(kp, kd),
+    )
+    emit(
+        {
+            "velocity": found.velocity,
+            "impulse": params.mass * found.velocity,
+            "predicted_velocity": found.predicted_velocity,
+            "predicted_impulse": params.mass * found.predicted_velocity,
+            "relative_error": found.relative_error(),
+            "bracket": list(found.bracket),
+            "simulations": found.iterations,
+            "model": model,
+            "controller": controller,
+            "x": x,
+            "direction": direction,
+        },
+        as_json,
+    )
+
+
+@cli.command()
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False),
+    default="out/figures",
+    show_default=True,
+    help="Directory for the figures.",
+)
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    default=("png", "svg"),
+    show_default=True,
+    type=click.Choice(("png", "svg", "pdf")),
+    help="File formats (repeatable).",
+)
+@body_options
+def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) -> None:
+    """Reproduce the paper's figures (Fig. 3a, 3b) into a directory."""
+    from pushrecovery.plots.figures import write_figures
+
+    params = params_from(kwargs)
+    files = write_figures(params, Path(out), formats)
+    emit({"files": [str(f) for f in files]}, as_json)

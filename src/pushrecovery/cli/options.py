@@ -1,0 +1,78 @@
+"""Options every command shares: the body parameters and ``--json``."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+import click
+
+from pushrecovery.params import BodyParams, load_params
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+#: (flag, field, help) for each body parameter; SI units.
+PARAM_FLAGS: tuple[tuple[str, str, str], ...] = (
+    ("--mass", "mass", "Body mass m [kg]."),
+    ("--com-height", "com_height", "CoM height L above the ankle [m]."),
+    ("--gravity", "gravity", "Gravity g [m/s^2]."),
+    ("--heel", "heel", "Heel edge δ⁻ relative to the ankle, < 0 [m]."),
+    ("--toe", "toe", "Toe edge δ⁺ relative to the ankle, > 0 [m]."),
+    ("--flywheel-inertia", "flywheel_inertia", "Upper-body inertia I [kg m^2]."),
+    ("--torque-max", "torque_max", "Hip torque limit τmax [N m]."),
+    ("--flywheel-angle-max", "flywheel_angle_max", "Hip joint limit θmax [rad]."),
+    ("--leg-length", "leg_length", "Leg length for stepping [m] (default: CoM height)."),
+)
+
+
+def body_options(func: F) -> F:
+    """Add ``--preset``, ``--params FILE``, one flag per parameter and ``--json``."""
+    for flag, field, text in reversed(PARAM_FLAGS):
+        func = click.option(flag, field, type=float, default=None, help=text)(func)
+    func = click.option(
+        "--params",
+        "params_file",
+        type=click.Path(dir_okay=False),
+        default=None,
+        help="TOML file of parameters (overrides the preset).",
+    )(func)
+    func = click.option("--preset", default="paper", show_default=True, help="Built-in preset.")(
+        func
+    )
+    return click.option("--json", "as_json", is_flag=True, help="Print JSON.")(func)
+
+
+def params_from(kwargs: dict[str, Any]) -> BodyParams:
+    """Pop the parameter options out of a command's kwargs and build the parameter set."""
+    overrides = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
+    return load_params(kwargs.pop("preset"), kwargs.pop("params_file"), overrides)
+
+
+def emit(data: dict[str, Any], as_json: bool) -> None:
+    """Print ``data`` as JSON or as an aligned ``key: value`` table."""
+    if as_json:
+        click.echo(json.dumps(data, indent=2, allow_nan=False))
+        return
+    for line in _table(data):
+        click.echo(line)
+
+
+def _table(data: dict[str, Any], indent: str = "") -> list[str]:
+    width = max((len(str(k)) for k in data), default=0)
+    lines: list[str] = []
+    for key, value in data.items():
+        if isinstance(value, dict):
+            lines.append(f"{indent}{key}:")
+            lines.extend(_table(value, indent + "  "))
+        else:
+            lines.append(f"{indent}{key:<{width}}  {_fmt(value)}")
+    return lines
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_fmt(v) for v in value) + "]"
+    return str(value)

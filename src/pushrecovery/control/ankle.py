@@ -1,0 +1,120 @@
+"""Ankle-strategy (CoP balancing) controllers of Fig. 3.
+
+Both command a CoP on the foot; on the pendulum model the CoP becomes the exact ankle torque
+that puts it there (:mod:`pushrecovery.models.pendulum`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery._validate import finite_float
+from pushrecovery.control.base import Command, Controller, register
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+
+__all__ = ["AnklePD", "AnkleSaturated", "default_pd_gains"]
+
+
+@register
+class AnkleSaturated(Controller):
+    """Saturated ankle torque of Fig. 3(a): the CoP on the edge that opposes the push.
+
+    At reset the controller notes the direction of the CoM velocity. While the CoM still moves
+    that way it holds the CoP on that edge (the toe for a forward push): the open-loop,
+    maximal braking of Eq. (3). Once the CoM has stopped it places the CoP at the capture
+    point ξ = x + ẋ/ω (clipped to the foot), under which the CoM comes to rest, so that a
+    stopped body stays stopped. States inside Eq. (4) therefore end at rest over the foot.
+    """
+
+    name = "ankle-saturated"
+
+    def __init__(self, params: BodyParams) -> None:
+        super().__init__(params)
+        self._direction = 0.0
+        self._inv_omega = 1.0 / params.omega
+
+    def reset(self, state: NDArray[np.float64]) -> None:
+        """Record the push direction from the initial CoM velocity."""
+        xdot = float(state[len(state) // 2])
+        self._direction = math.copysign(1.0, xdot) if xdot != 0.0 else 0.0
+
+    def compute(self, t: float, state: NDArray[np.float64]) -> Command:
+        """CoP on the braking edge until the CoM stops, then at the capture point [m]."""
+        x, xdot = float(state[0]), float(state[len(state) // 2])
+        if self._direction != 0.0 and xdot * self._direction > 0.0:
+            edge = self.params.toe if self._direction > 0.0 else self.params.heel
+            return Command(edge, saturated=True)
+        self._direction = 0.0
+        cop, clipped = self.clip_cop(x + xdot * self._inv_omega)
+        return Command(cop, saturated=clipped)
+
+
+def default_pd_gains(params: BodyParams) -> tuple[float, float]:
+    """Default ankle PD gains (stiffness [N m/rad], damping [N m s/rad]).
+
+    Stiffness 3 m g L and the damping that makes the linearised closed loop critically damped:
+    m L² θ̈ = −(k_p − m g L) θ − k_d θ̇ gives k_d = 2 sqrt((k_p − m g L) m L²). See
+    ``docs/ankle_pd.md`` for how the gains move the critical push.
+    """
+    mgl = params.weight * params.com_height
+    stiffness = 3.0 * mgl
+    damping = 2.0 * math.sqrt((stiffness - mgl) * params.mass * params.com_height**2)
+    return stiffness, damping
+
+
+@register
+class AnklePD(Controller):
+    """Saturated PD controller on the ankle joint, Fig. 3(b).
+
+    The ankle torque τ = k_p θ + k_d θ̇, with the lean angle θ = asin(x / L) and rate
+    θ̇ = ẋ / (L cos θ), is commanded as the CoP it produces in quasi-static stance,
+    δ = τ / (m g) (Eq. 2 with F_z = m g), clipped to the foot: the torque limit of Fig. 3(b).
+    Positive τ is plantar flexion (pushes the body backward).
+
+    Parameters
+    ----------
+    params : BodyParams
+        Body parameters.
+    stiffness : float, optional
+        k_p [N m/rad], > m g L so that the upright stance is stable; default
+        :func:`default_pd_gains`.
+    damping : float, optional
+        k_d [N m s/rad], >= 0; default :func:`default_pd_gains`.
+    """
+
+    name = "ankle-pd"
+
+    def __init__(
+        self, params: BodyParams, stiffness: float | None = None, damping: float | None = None
+    ) -> None:
+        super().__init__(params)
+        default_kp, default_kd = default_pd_gains(params)
+        kp = default_kp if stiffness is None else finite_float("stiffness", stiffness, "N m/rad")
+        kd = default_kd if damping is None else finite_float("damping", damping, "N m s/rad")
+        mgl = params.weight * params.com_height
+        if kp <= mgl:
+            raise InvalidParameterError(
+                f"stiffness must be > m g L = {mgl:g} N m/rad for a stable stance, got {kp:g}"
+            )
+        if kd < 0.0:
+            raise InvalidParameterError(f"damping must be >= 0 N m s/rad, got {kd:g}")
+        self.stiffness, self.damping = kp, kd
+        self._inv_weight = 1.0 / params.weight
+        self._length = params.com_height
+
+    def reset(self, state: NDArray[np.float64]) -> None:
+        """The PD controller has no internal state."""
+
+    def compute(self, t: float, state: NDArray[np.float64]) -> Command:
+        """CoP τ / (m g) of the PD ankle torque, clipped to the foot [m]."""
+        x, xdot = float(state[0]), float(state[len(state) // 2])
+        lean = math.asin(max(-1.0, min(1.0, x / self._length)))
+        cos = math.cos(lean)
+        lean_rate = xdot / (self._length * cos) if cos > 0.0 else 0.0
+        torque = self.stiffness * lean + self.damping * lean_rate
+        cop, clipped = self.clip_cop(torque * self._inv_weight)
+        return Command(cop, saturated=clipped)

@@ -1,0 +1,106 @@
+"""The controller contract every balance strategy implements.
+
+Contract (what the simulators, the CLI and a robot's control loop may rely on):
+
+1. ``reset(state)`` is called once with the initial state before the first ``compute``.
+2. ``compute(t, state)`` is called once per control tick with the time [s] since reset and the
+   current state, and returns a :class:`Command` held constant until the next tick.
+3. ``state`` is a 1-D float array, positions then velocities; its first entry is the CoM
+   position x relative to the ankle [m] and entry ``len(state) // 2`` the CoM velocity ẋ
+   [m/s] (``[x, xdot]`` for the ankle models; the flywheel model appends θ and θ̇).
+4. The command is always finite and within the body's limits: ``cop`` on the foot
+   [heel, toe] [m], ``flywheel_torque`` within ±torque_max [N m]. A controller that cannot
+   meet its goal (the state is beyond what it can recover) still returns a saturated finite
+   command and sets ``saturated=True``; it never raises inside the loop.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+
+__all__ = ["CONTROLLERS", "Command", "Controller", "make_controller", "register"]
+
+
+@dataclass(frozen=True, slots=True)
+class Command:
+    """One control command, the input U = (δ, τ) of Eq. (16).
+
+    Parameters
+    ----------
+    cop : float
+        Centre of pressure δ relative to the ankle [m], x forward; on the foot.
+    flywheel_torque : float
+        Hip (flywheel) torque τ on the upper body [N m], positive pitches it forward; 0 for
+        the ankle strategy.
+    saturated : bool
+        True when a limit is active because the controller's goal is out of reach.
+    """
+
+    cop: float
+    flywheel_torque: float = 0.0
+    saturated: bool = False
+
+
+class Controller(ABC):
+    """Base class of all controllers; see the module docstring for the contract."""
+
+    #: Name used by the CLI and the registry.
+    name: ClassVar[str]
+
+    def __init__(self, params: BodyParams) -> None:
+        self.params = params
+
+    @abstractmethod
+    def reset(self, state: NDArray[np.float64]) -> None:
+        """Prepare for a new run starting at ``state``."""
+
+    @abstractmethod
+    def compute(self, t: float, state: NDArray[np.float64]) -> Command:
+        """Return the command for time ``t`` [s] and ``state``."""
+
+    def clip_cop(self, cop: float) -> tuple[float, bool]:
+        """Clip a CoP to the foot [heel, toe]; also return whether it was clipped."""
+        heel, toe = self.params.heel, self.params.toe
+        if cop > toe:
+            return toe, True
+        if cop < heel:
+            return heel, True
+        return cop, False
+
+
+ControllerFactory = Callable[..., Controller]
+
+#: Controller name -> class, filled by :func:`register`.
+CONTROLLERS: dict[str, type[Controller]] = {}
+
+
+def register(cls: type[Controller]) -> type[Controller]:
+    """Class decorator adding a controller to :data:`CONTROLLERS` under ``cls.name``."""
+    CONTROLLERS[cls.name] = cls
+    return cls
+
+
+def make_controller(name: str, params: BodyParams, **options: Any) -> Controller:
+    """Build the registered controller ``name`` for ``params``.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``name`` is not registered.
+    """
+    try:
+        cls = CONTROLLERS[name]
+    except KeyError:
+        raise InvalidParameterError(
+            f"controller must be one of {sorted(CONTROLLERS)}, got controller={name!r}"
+        ) from None
+    return cls(params, **options)

@@ -1,0 +1,1 @@
+"""Dynamics of the simple balance models, with their closed forms (no simulator code here)."""

@@ -1,0 +1,129 @@
+"""Linear inverted pendulum model (LIPM) with a movable centre of pressure, Sec. II.
+
+The CoM moves at constant height L; with the CoP at δ the horizontal dynamics are
+
+.. math:: \\ddot x = \\omega^2 (x - \\delta), \\qquad \\omega^2 = g / L,
+
+which is Eq. (3) with the CoP anywhere on the foot and Eq. (23) with f = -ω² δ. All functions
+broadcast over arrays of states. State order is ``[x, xdot]``: CoM position relative to the
+ankle [m] and CoM velocity [m/s], x forward.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["lipm_acceleration", "lipm_propagate", "lipm_state", "lipm_transition"]
+
+FloatArray = NDArray[np.float64]
+
+
+def lipm_acceleration(x: ArrayLike, cop: ArrayLike, omega: float) -> FloatArray:
+    """CoM acceleration of the LIPM, Eq. (3) with the CoP at ``cop``.
+
+    Parameters
+    ----------
+    x : array_like
+        CoM position relative to the ankle [m].
+    cop : array_like
+        CoP position δ relative to the ankle [m].
+    omega : float
+        LIPM natural frequency sqrt(g / L) [1/s].
+
+    Returns
+    -------
+    ndarray
+        ẍ = ω² (x − δ) [m/s²]; positive accelerates the CoM forward.
+    """
+    return omega**2 * (np.asarray(x, dtype=np.float64) - np.asarray(cop, dtype=np.float64))
+
+
+def lipm_state(
+    t: ArrayLike, x0: ArrayLike, xdot0: ArrayLike, cop: ArrayLike, omega: float
+) -> tuple[FloatArray, FloatArray]:
+    """Closed-form LIPM state at time t with the CoP held at δ, Eq. (24).
+
+    Eq. (24) with f / ω² = −δ reads
+
+    .. math:: x(t) = \\delta + (x_0 - \\delta)\\cosh\\omega t + \\frac{\\dot x_0}{\\omega}\\sinh\\omega t,
+
+    and its derivative gives the velocity
+    :math:`\\dot x(t) = \\omega (x_0 - \\delta)\\sinh\\omega t + \\dot x_0\\cosh\\omega t`.
+
+    Parameters
+    ----------
+    t : array_like
+        Time since (x0, xdot0) [s].
+    x0, xdot0 : array_like
+        Initial CoM position [m] and velocity [m/s].
+    cop : array_like
+        Constant CoP δ [m].
+    omega : float
+        sqrt(g / L) [1/s].
+
+    Returns
+    -------
+    x, xdot : ndarray
+        CoM position [m] and velocity [m/s] at t, broadcast over the inputs.
+    """
+    wt = omega * np.asarray(t, dtype=np.float64)
+    offset = np.asarray(x0, dtype=np.float64) - np.asarray(cop, dtype=np.float64)
+    xdot0 = np.asarray(xdot0, dtype=np.float64)
+    cosh, sinh = np.cosh(wt), np.sinh(wt)
+    x = np.asarray(cop, dtype=np.float64) + offset * cosh + xdot0 / omega * sinh
+    xdot = omega * offset * sinh + xdot0 * cosh
+    return x, xdot
+
+
+def lipm_transition(omega: float, dt: float) -> tuple[FloatArray, FloatArray]:
+    """Exact zero-order-hold discretisation of the LIPM over one step dt.
+
+    With the CoP held constant over the step, Eq. (24) is linear in (x, ẋ, δ):
+    ``X[k+1] = A X[k] + B δ[k]`` with
+
+    .. math:: A = \\begin{bmatrix} c & s/\\omega \\\\ \\omega s & c \\end{bmatrix},\\quad
+              B = \\begin{bmatrix} 1 - c \\\\ -\\omega s \\end{bmatrix},\\quad
+              c = \\cosh\\omega\\,dt,\\ s = \\sinh\\omega\\,dt.
+
+    Parameters
+    ----------
+    omega : float
+        sqrt(g / L) [1/s].
+    dt : float
+        Step length [s].
+
+    Returns
+    -------
+    A : ndarray, shape (2, 2)
+    B : ndarray, shape (2,)
+    """
+    c, s = np.cosh(omega * dt), np.sinh(omega * dt)
+    return np.array([[c, s / omega], [omega * s, c]]), np.array([1.0 - c, -omega * s])
+
+
+def lipm_propagate(
+    x: ArrayLike, xdot: ArrayLike, cop: ArrayLike, omega: float, dt: float
+) -> tuple[FloatArray, FloatArray]:
+    """Advance arrays of LIPM states by dt with the CoP held (exact, vectorised).
+
+    Same as :func:`lipm_state` at t = dt, written with the transition of
+    :func:`lipm_transition` so that many states advance in one call.
+
+    Parameters
+    ----------
+    x, xdot : array_like
+        CoM positions [m] and velocities [m/s].
+    cop : array_like
+        CoP held over the step [m].
+    omega : float
+        sqrt(g / L) [1/s].
+    dt : float
+        Step length [s].
+
+    Returns
+    -------
+    x, xdot : ndarray
+        The states after dt.
+    """
+    return lipm_state(dt, x, xdot, cop, omega)

@@ -1,0 +1,124 @@
+"""Nonlinear single inverted pendulum on a foot, Fig. 3(b).
+
+A point mass m on a massless rod of length L pivots about the ankle, which sits on the floor
+(zero ankle height) on a massless foot spanning [δ⁻, δ⁺]. The lean angle θ is positive
+forward, so the CoM is at x = L sin θ, z = L cos θ. The ankle torque τ is the torque the foot
+exerts on the body, positive for plantar flexion (it pushes the body backward and moves the
+CoP forward). Angular momentum about the ankle gives
+
+.. math:: m L^2 \\ddot\\theta = m g L \\sin\\theta - \\tau .
+
+Torque limit. Moments on the massless foot give τ = δ F_z with the exact normal force
+F_z = m (g + z̈) = A + τ sinθ / L, A = m g cos²θ − m L cosθ θ̇². Solving for τ,
+
+.. math:: \\tau(\\delta) = \\frac{\\delta A}{1 - \\delta\\sin\\theta / L},
+
+which increases with δ while A > 0 and |δ| < L. A CoP command is therefore clipped to the foot
+and turned into exactly the torque that puts the CoP there, including the vertical acceleration
+of the CoM that the LIPM neglects. When A ≤ 0 the foot is unloaded and no torque can be
+transmitted (τ = 0). This is how the ankle torque is limited so that the CoP stays on the foot.
+"""
+
+from __future__ import annotations
+
+import math
+
+__all__ = [
+    "ankle_torque_for_cop",
+    "com_from_lean",
+    "lean_from_com",
+    "pendulum_acceleration",
+    "pendulum_step",
+]
+
+
+def ankle_torque_for_cop(
+    theta: float, theta_rate: float, cop: float, mass: float, length: float, gravity: float
+) -> float:
+    """Exact ankle torque that places the CoP at ``cop`` (module docstring) [N m].
+
+    Parameters
+    ----------
+    theta : float
+        Lean angle, positive forward [rad].
+    theta_rate : float
+        Lean rate [rad/s].
+    cop : float
+        Desired CoP relative to the ankle, already on the foot [m]; |cop| < length.
+    mass, length, gravity : float
+        m [kg], L [m], g [m/s²].
+
+    Returns
+    -------
+    float
+        τ = δ A / (1 − δ sinθ / L), or 0 when the foot is unloaded (A ≤ 0).
+    """
+    cos = math.cos(theta)
+    load = mass * cos * (gravity * cos - length * theta_rate * theta_rate)
+    if load <= 0.0:
+        return 0.0
+    return cop * load / (1.0 - cop * math.sin(theta) / length)
+
+
+def pendulum_acceleration(
+    theta: float, theta_rate: float, cop: float, mass: float, length: float, gravity: float
+) -> float:
+    """Lean acceleration θ̈ = g sinθ / L − τ / (m L²) with τ from the CoP [rad/s²]."""
+    torque = ankle_torque_for_cop(theta, theta_rate, cop, mass, length, gravity)
+    return gravity * math.sin(theta) / length - torque / (mass * length * length)
+
+
+def lean_from_com(x: float, xdot: float, length: float) -> tuple[float, float]:
+    """Lean angle and rate (θ, θ̇) from the CoM state (x, ẋ); needs |x| < L."""
+    theta = math.asin(x / length)
+    return theta, xdot / (length * math.cos(theta))
+
+
+def com_from_lean(theta: float, theta_rate: float, length: float) -> tuple[float, float]:
+    """CoM state (x, ẋ) = (L sinθ, L cosθ θ̇) from the lean angle and rate."""
+    return length * math.sin(theta), length * math.cos(theta) * theta_rate
+
+
+def pendulum_step(
+    theta: float,
+    theta_rate: float,
+    cop: float,
+    dt: float,
+    mass: float,
+    length: float,
+    gravity: float,
+    substeps: int = 1,
+) -> tuple[float, float]:
+    """Advance (θ, θ̇) by dt with the CoP held, classical Runge-Kutta (RK4).
+
+    Parameters
+    ----------
+    theta, theta_rate : float
+        Lean angle [rad] and rate [rad/s].
+    cop : float
+        CoP held over the step, on the foot [m].
+    dt : float
+        Step [s].
+    mass, length, gravity : float
+        m [kg], L [m], g [m/s²].
+    substeps : int
+        RK4 substeps per dt.
+
+    Returns
+    -------
+    theta, theta_rate : float
+        The state after dt.
+    """
+    h = dt / substeps
+    args = (cop, mass, length, gravity)
+    for _ in range(substeps):
+        k1a = pendulum_acceleration(theta, theta_rate, *args)
+        k2q = theta_rate + 0.5 * h * k1a
+        k2a = pendulum_acceleration(theta + 0.5 * h * theta_rate, k2q, *args)
+        k3q = theta_rate + 0.5 * h * k2a
+        k3a = pendulum_acceleration(theta + 0.5 * h * k2q, k3q, *args)
+        k4q = theta_rate + h * k3a
+        k4a = pendulum_acceleration(theta + h * k3q, k4q, *args)
+        theta += h / 6.0 * (theta_rate + 2.0 * k2q + 2.0 * k3q + k4q)
+        theta_rate += h / 6.0 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a)
+    return theta, theta_rate

@@ -1,0 +1,214 @@
+"""Parameters of one balancing body, validated once, and the built-in presets.
+
+A :class:`BodyParams` holds everything the decision surfaces, models and controllers need.
+Lengths are signed x-coordinates relative to the ankle, x forward (see ``docs/conventions.md``).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from pushrecovery._validate import finite_float, positive_float
+from pushrecovery.errors import InputFileError, InvalidParameterError
+
+__all__ = ["PRESETS", "BodyParams", "load_params"]
+
+
+@dataclass(frozen=True, slots=True)
+class BodyParams:
+    """Physical parameters of one balancing body (sagittal plane, SI units).
+
+    Parameters
+    ----------
+    mass : float
+        Total mass m [kg], > 0.
+    com_height : float
+        Height L of the centre of mass above the ankle, constant in the LIPM [m], > 0.
+    gravity : float
+        Gravitational acceleration g [m/s^2], > 0.
+    heel : float
+        Back edge of the support δ⁻, x-coordinate relative to the ankle [m], < 0.
+    toe : float
+        Front edge of the support δ⁺, x-coordinate relative to the ankle [m], > 0.
+    flywheel_inertia : float
+        Upper-body (flywheel) inertia I of Eq. (7) [kg m^2], > 0.
+    torque_max : float
+        Hip (flywheel) torque limit τmax of Eq. (5) [N m], >= 0.
+    flywheel_angle_max : float
+        Flywheel joint limit θmax of Eq. (11) [rad], > 0.
+    leg_length : float or None
+        Leg length for stepping, Sec. IV [m], > 0; ``None`` means equal to ``com_height``.
+
+    Raises
+    ------
+    InvalidParameterError
+        If any value is non-finite or outside its range; the message names the field.
+    """
+
+    mass: float
+    com_height: float
+    gravity: float
+    heel: float
+    toe: float
+    flywheel_inertia: float
+    torque_max: float
+    flywheel_angle_max: float
+    leg_length: float = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        for name, unit in (("mass", "kg"), ("com_height", "m"), ("gravity", "m/s^2")):
+            set_(self, name, positive_float(name, getattr(self, name), unit))
+        heel = finite_float("heel", self.heel, "m")
+        toe = finite_float("toe", self.toe, "m")
+        if heel >= toe:
+            raise InvalidParameterError(
+                f"heel must be < toe (an empty or inverted foot), got heel={heel:g} m, toe={toe:g} m"
+            )
+        if heel >= 0.0:
+            raise InvalidParameterError(f"heel must be < 0 m (behind the ankle), got heel={heel:g}")
+        if toe <= 0.0:
+            raise InvalidParameterError(f"toe must be > 0 m (ahead of the ankle), got toe={toe:g}")
+        # The CoP <-> ankle-torque map of the pendulum divides by (1 - δ sinθ / L): keep |δ| < L.
+        if max(-heel, toe) >= self.com_height:
+            raise InvalidParameterError(
+                "foot edges must lie closer to the ankle than com_height, got "
+                f"heel={heel:g} m, toe={toe:g} m, com_height={self.com_height:g} m"
+            )
+        set_(self, "heel", heel)
+        set_(self, "toe", toe)
+        set_(self, "flywheel_inertia", positive_float("flywheel_inertia", self.flywheel_inertia))
+        torque_max = finite_float("torque_max", self.torque_max, "N m")
+        if torque_max < 0.0:
+            raise InvalidParameterError(
+                f"torque_max must be >= 0 N m, got torque_max={torque_max:g}"
+            )
+        set_(self, "torque_max", torque_max)
+        set_(
+            self,
+            "flywheel_angle_max",
+            positive_float("flywheel_angle_max", self.flywheel_angle_max),
+        )
+        leg = self.com_height if self.leg_length is None else self.leg_length
+        set_(self, "leg_length", positive_float("leg_length", leg, "m"))
+
+    @property
+    def omega(self) -> float:
+        """Natural frequency ω = sqrt(g / L) of the LIPM, Eq. (4) [1/s]."""
+        return math.sqrt(self.gravity / self.com_height)
+
+    @property
+    def weight(self) -> float:
+        """Body weight m g [N]; the vertical ground reaction force of the LIPM."""
+        return self.mass * self.gravity
+
+    def to_dict(self) -> dict[str, float]:
+        """Return the parameters as a plain dict (the ``params`` object of the JSON contract)."""
+        return asdict(self)
+
+
+FIELD_NAMES: tuple[str, ...] = tuple(f.name for f in fields(BodyParams))
+
+#: Built-in presets. ``paper``: the flywheel values of Fig. 5(b) (I, τmax, θmax); the body and
+#: foot are our documented choice (a 72 kg adult, CoM 1 m above the ankle, 20 cm foot with the
+#: ankle 5 cm in front of the heel).
+PRESETS: Mapping[str, Mapping[str, float | None]] = MappingProxyType(
+    {
+        "paper": MappingProxyType(
+            {
+                "mass": 72.0,
+                "com_height": 1.0,
+                "gravity": 9.81,
+                "heel": -0.05,
+                "toe": 0.15,
+                "flywheel_inertia": 10.0,
+                "torque_max": 100.0,
+                "flywheel_angle_max": 1.0,
+                "leg_length": None,
+            }
+        )
+    }
+)
+
+
+def load_params(
+    preset: str = "paper",
+    file: str | Path | None = None,
+    overrides: Mapping[str, Any] | None = None,
+) -> BodyParams:
+    """Build parameters from a preset, then a TOML file, then explicit overrides (later wins).
+
+    Parameters
+    ----------
+    preset : str
+        Name of a built-in preset (see :data:`PRESETS`). A TOML file may name its own with a
+        top-level ``preset = "..."`` key.
+    file : str or Path, optional
+        TOML file with any of the field names of :class:`BodyParams` as top-level keys, in SI
+        units (optionally under a ``[body]`` table).
+    overrides : mapping, optional
+        Field values that win over the preset and the file; ``None`` values are ignored.
+
+    Returns
+    -------
+    BodyParams
+        The validated parameter set.
+
+    Raises
+    ------
+    InvalidParameterError
+        Unknown preset or field, or a value out of range.
+    InputFileError
+        Missing, unreadable or malformed TOML file.
+    """
+    values: dict[str, Any] = {}
+    from_file: dict[str, Any] = _read_toml(Path(file)) if file is not None else {}
+    preset = str(from_file.pop("preset", preset))
+    if preset not in PRESETS:
+        raise InvalidParameterError(
+            f"preset must be one of {sorted(PRESETS)}, got preset={preset!r}"
+        )
+    values.update(PRESETS[preset])
+    values.update(from_file)
+    values.update({k: v for k, v in (overrides or {}).items() if v is not None})
+    unknown = sorted(set(values) - set(FIELD_NAMES))
+    if unknown:
+        raise InvalidParameterError(
+            f"unknown parameter {unknown[0]!r}; known parameters: {', '.join(FIELD_NAMES)}"
+        )
+    if (
+        overrides
+        and overrides.get("com_height") is not None
+        and "leg_length"
+        not in ({k for k, v in overrides.items() if v is not None} | set(from_file))
+    ):
+        # The presets tie the leg to the CoM height; keep that tie when only L changes.
+        values["leg_length"] = PRESETS[preset].get("leg_length")
+    for name, value in values.items():
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)):
+            raise InvalidParameterError(f"{name} must be a number, got {value!r}")
+    return BodyParams(**values)
+
+
+def _read_toml(path: Path) -> dict[str, Any]:
+    try:
+        with path.open("rb") as handle:
+            data = tomllib.load(handle)
+    except FileNotFoundError:
+        raise InputFileError(f"parameter file not found: {path}") from None
+    except OSError as exc:
+        raise InputFileError(f"cannot read parameter file {path}: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputFileError(f"malformed TOML in {path}: {exc}") from None
+    body = data.pop("body", None)
+    if body is not None:
+        if not isinstance(body, dict):
+            raise InputFileError(f"[body] in {path} must be a table")
+        data.update(body)
+    return data

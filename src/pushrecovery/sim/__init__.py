@@ -1,0 +1,1 @@
+"""Simulators: plants (the models behind one small protocol), pushes, outcomes, campaigns."""

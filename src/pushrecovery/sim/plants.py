@@ -1,0 +1,122 @@
+"""Plants: the models behind one small stepping protocol the simulator drives.
+
+A plant advances a state by one control period with the command held (zero-order hold), and
+returns the CoP it actually applied (a command is clipped to the foot: physics, not politeness).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.control.base import Command
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.models.pendulum import com_from_lean, lean_from_com, pendulum_step
+from pushrecovery.params import BodyParams
+
+__all__ = ["MODELS", "LipmPlant", "PendulumPlant", "Plant", "make_plant"]
+
+FloatArray = NDArray[np.float64]
+
+
+class Plant(Protocol):
+    """What the simulator needs of a model."""
+
+    name: ClassVar[str]
+    params: BodyParams
+
+    def check_state(self, state: FloatArray) -> None:
+        """Raise :class:`InvalidParameterError` if the model cannot start from ``state``."""
+
+    def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, float]:
+        """Advance ``state`` by ``dt`` [s]; return the new state and the applied CoP [m]."""
+        ...
+
+
+class _AnklePlant:
+    """Shared parts of the ankle-only plants (state ``[x, xdot]``)."""
+
+    name: ClassVar[str]
+
+    def __init__(self, params: BodyParams) -> None:
+        self.params = params
+
+    def check_state(self, state: FloatArray) -> None:
+        if state.shape != (2,):
+            raise InvalidParameterError(f"state must be [x, xdot], got shape {state.shape}")
+
+    def applied_cop(self, command: Command) -> float:
+        if command.flywheel_torque != 0.0:
+            raise InvalidParameterError(
+                f"the {self.name} model has no upper body: flywheel_torque must be 0, "
+                f"got {command.flywheel_torque:g} N m"
+            )
+        return min(self.params.toe, max(self.params.heel, command.cop))
+
+
+class LipmPlant(_AnklePlant):
+    """LIPM (Eq. 3) advanced exactly with Eq. (24)."""
+
+    name = "lipm"
+
+    def __init__(self, params: BodyParams) -> None:
+        super().__init__(params)
+        self._dt = -1.0
+        self._cosh = self._sinh = 1.0
+
+    def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, float]:
+        cop = self.applied_cop(command)
+        if dt != self._dt:
+            omega = self.params.omega
+            self._dt, self._cosh, self._sinh = dt, math.cosh(omega * dt), math.sinh(omega * dt)
+        omega, c, s = self.params.omega, self._cosh, self._sinh
+        offset, xdot = float(state[0]) - cop, float(state[1])
+        # Eq. (24) at t = dt, and its derivative.
+        return np.array([cop + offset * c + xdot / omega * s, omega * offset * s + xdot * c]), cop
+
+
+class PendulumPlant(_AnklePlant):
+    """Nonlinear inverted pendulum with the exact CoP-limited ankle torque (RK4)."""
+
+    name = "pendulum"
+
+    #: Largest RK4 substep [s]; ω h ≈ 0.003 keeps the local error far below 1e-12.
+    max_substep: ClassVar[float] = 1e-3
+
+    def check_state(self, state: FloatArray) -> None:
+        super().check_state(state)
+        if abs(float(state[0])) >= self.params.com_height:
+            raise InvalidParameterError(
+                f"x must satisfy |x| < com_height = {self.params.com_height:g} m for the pendulum, "
+                f"got x={float(state[0]):g}"
+            )
+
+    def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, float]:
+        cop = self.applied_cop(command)
+        p = self.params
+        theta, rate = lean_from_com(float(state[0]), float(state[1]), p.com_height)
+        substeps = max(1, math.ceil(dt / self.max_substep - 1e-9))
+        theta, rate = pendulum_step(
+            theta, rate, cop, dt, p.mass, p.com_height, p.gravity, substeps=substeps
+        )
+        return np.array(com_from_lean(theta, rate, p.com_height)), cop
+
+
+#: Model name -> plant class.
+MODELS: dict[str, type[LipmPlant] | type[PendulumPlant]] = {
+    LipmPlant.name: LipmPlant,
+    PendulumPlant.name: PendulumPlant,
+}
+
+
+def make_plant(name: str, params: BodyParams) -> Plant:
+    """Build the plant registered as ``name``; unknown names raise."""
+    try:
+        return MODELS[name](params)
+    except KeyError:
+        raise InvalidParameterError(
+            f"model must be one of {sorted(MODELS)}, got model={name!r}"
+        ) from None

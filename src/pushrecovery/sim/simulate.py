@@ -1,0 +1,112 @@
+"""Closed-loop simulation of any plant with any controller, and the critical push."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pushrecovery._validate import finite_float, positive_float
+from pushrecovery.control.base import Controller
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.plants import Plant
+from pushrecovery.sim.result import Outcome, SimulationResult, is_falling
+
+__all__ = ["RestCriterion", "simulate"]
+
+
+@dataclass(frozen=True, slots=True)
+class RestCriterion:
+    """When a run counts as recovered: at rest, standing, for long enough.
+
+    Parameters
+    ----------
+    speed : float
+        Largest |ẋ| that counts as at rest [m/s].
+    duration : float
+        How long the CoM must stay at rest over the foot (heel < x < toe) [s].
+    """
+
+    speed: float = 1e-3
+    duration: float = 0.5
+
+
+def simulate(
+    plant: Plant,
+    controller: Controller,
+    initial_state: np.ndarray,
+    *,
+    duration: float = 10.0,
+    control_period: float = 1e-3,
+    rest: RestCriterion | None = None,
+) -> SimulationResult:
+    """Simulate ``controller`` on ``plant`` from ``initial_state`` (sampled-data, ZOH).
+
+    Every ``control_period`` the controller computes a command that the plant holds until the
+    next tick. The run ends as ``fell`` as soon as the CoM is beyond a foot edge and moving away
+    from the foot (:func:`~pushrecovery.sim.result.is_falling`, an absorbing set), as
+    ``recovered`` once the CoM has stayed at rest over the foot for ``rest.duration``, and as
+    ``undecided`` if neither happens within ``duration``.
+
+    Parameters
+    ----------
+    plant : Plant
+        The model (see :mod:`pushrecovery.sim.plants`).
+    controller : Controller
+        Any controller; ``reset`` is called here.
+    initial_state : ndarray
+        Start state, e.g. ``[x, xdot]`` just after the push [m, m/s].
+    duration : float
+        Longest simulated time [s], > 0.
+    control_period : float
+        Controller period [s], in (0, duration].
+    rest : RestCriterion, optional
+        Recovery criterion; default ``RestCriterion()``.
+
+    Returns
+    -------
+    SimulationResult
+    """
+    duration = positive_float("duration", duration, "s")
+    dt = positive_float("control_period", control_period, "s")
+    if dt > duration:
+        raise InvalidParameterError(
+            f"control_period must be <= duration = {duration:g} s, got {dt:g}"
+        )
+    state = np.array(initial_state, dtype=np.float64)
+    for i, value in enumerate(state):
+        finite_float(f"initial_state[{i}]", value)
+    plant.check_state(state)
+    rest = rest or RestCriterion()
+    heel, toe = plant.params.heel, plant.params.toe
+    steps = math.ceil(duration / dt - 1e-9)
+    rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))
+    vel = len(state) // 2
+
+    states = np.empty((steps + 1, len(state)))
+    cops = np.empty(steps)
+    states[0] = state
+    controller.reset(state)
+    outcome, at_rest, k = Outcome.UNDECIDED, 0, 0
+    while k < steps:
+        command = controller.compute(k * dt, state)
+        state, cops[k] = plant.step(state, command, dt)
+        k += 1
+        states[k] = state
+        x, xdot = state[0], state[vel]
+        if is_falling(x, xdot, heel, toe):
+            outcome = Outcome.FELL
+            break
+        at_rest = at_rest + 1 if abs(xdot) <= rest.speed and heel < x < toe else 0
+        if at_rest >= rest_ticks:
+            outcome = Outcome.RECOVERED
+            break
+    return SimulationResult(
+        time=np.arange(k + 1) * dt,
+        states=states[: k + 1],
+        cops=cops[:k],
+        outcome=outcome,
+        model=plant.name,
+        controller=controller.name,
+    )

@@ -1,0 +1,1 @@
+"""Decision surfaces: which states each balance strategy can recover (pure, vectorised)."""

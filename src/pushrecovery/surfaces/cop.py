@@ -1,0 +1,170 @@
+"""CoP-balancing (ankle strategy) decision surface, Eq. (4) of [Stephens07].
+
+A state (x, ẋ) of the LIPM can be brought to rest with the CoP on the foot if and only if its
+capture point ξ = x + ẋ/ω lies strictly between the foot edges:
+
+.. math:: \\delta^- < x + \\frac{\\dot x}{\\omega} < \\delta^+ .
+
+Derivation (docs/errata.md, E1): ξ obeys ξ̇ = ω (ξ − δ), so with the CoP saturated at δ⁺ a
+capture point below δ⁺ moves back and one above it runs away as e^{ωt}; the boundary
+ξ = δ± is the stable manifold of the equilibrium with the CoP on the edge, reached only as
+t → ∞, hence the strict inequalities.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pushrecovery._validate import finite_array
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+
+__all__ = ["CaptureInterval", "capture_point", "cop_margin", "cop_region", "critical_velocity"]
+
+# Below this size numexpr's call overhead outweighs its single fused pass.
+_NUMEXPR_MIN_SIZE = 1 << 15
+
+
+@dataclass(frozen=True, slots=True)
+class CaptureInterval:
+    """Open interval (lower, upper) of capture points a strategy can recover [m]."""
+
+    lower: float
+    upper: float
+
+    @property
+    def centre(self) -> float:
+        """Midpoint of the interval [m]."""
+        return 0.5 * (self.lower + self.upper)
+
+    @property
+    def half_width(self) -> float:
+        """Half the interval width [m]."""
+        return 0.5 * (self.upper - self.lower)
+
+
+def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> NDArray[np.float64]:
+    """Capture point ξ = x + ẋ/ω, the middle term of Eq. (4) [m].
+
+    Parameters
+    ----------
+    x : array_like
+        CoM position relative to the ankle [m], x forward.
+    xdot : array_like
+        CoM velocity [m/s].
+    omega : float
+        LIPM natural frequency sqrt(g / L) [1/s], > 0.
+
+    Returns
+    -------
+    ndarray
+        ξ [m], where the CoP would have to be for the CoM to come to rest over it.
+    """
+    return np.asarray(x, dtype=np.float64) + np.asarray(xdot, dtype=np.float64) / omega
+
+
+def cop_region(params: BodyParams) -> CaptureInterval:
+    """Capture-point bounds of CoP balancing, Eq. (4): the foot itself, (δ⁻, δ⁺) [m]."""
+    return CaptureInterval(params.heel, params.toe)
+
+
+def cop_margin(
+    x: ArrayLike,
+    xdot: ArrayLike,
+    params: BodyParams,
+    *,
+    out: NDArray[np.float64] | None = None,
+) -> NDArray[np.float64]:
+    """Signed margin of the states to the CoP-balancing surface, Eq. (4) [m].
+
+    margin = min(ξ − δ⁻, δ⁺ − ξ) = w − |ξ − c| with c the foot centre and w its half length:
+    positive inside the region (ankle torque alone recovers), zero on the surface, negative
+    outside; its magnitude is the distance of the capture point to the nearer foot edge.
+
+    Parameters
+    ----------
+    x : array_like
+        CoM positions relative to the ankle [m].
+    xdot : array_like
+        CoM velocities [m/s]; broadcast against ``x``.
+    params : BodyParams
+        Body parameters (uses g, L, heel, toe).
+    out : ndarray, optional
+        Float64 array of the broadcast shape to write the margins into (saves an allocation).
+
+    Returns
+    -------
+    ndarray
+        Margins [m], float64, of the broadcast shape of ``x`` and ``xdot``.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a state is NaN or infinite.
+    """
+    region = cop_region(params)
+    x = np.asarray(x, dtype=np.float64)
+    xdot = np.asarray(xdot, dtype=np.float64)
+    inv_omega = 1.0 / params.omega
+    centre, half = region.centre, region.half_width
+    if x.size >= _NUMEXPR_MIN_SIZE:
+        import numexpr
+
+        # One fused, multithreaded pass instead of five numpy passes.
+        margin = numexpr.evaluate(
+            "half - abs(x + xdot * inv_omega - centre)",
+            local_dict={
+                "x": x,
+                "xdot": xdot,
+                "inv_omega": inv_omega,
+                "centre": centre,
+                "half": half,
+            },
+            out=out,
+            casting="same_kind",
+        )
+    else:
+        margin = np.subtract(half, np.abs(x + xdot * inv_omega - centre), out=out)
+    # NaN and -inf propagate into the minimum: one reduction instead of two isfinite passes.
+    lowest = float(np.min(margin)) if margin.size else 0.0
+    if not math.isfinite(lowest):
+        _raise_non_finite(x, xdot)
+    return margin
+
+
+def _raise_non_finite(x: NDArray[np.float64], xdot: NDArray[np.float64]) -> None:
+    finite_array("x", x)
+    finite_array("xdot", xdot)
+    raise InvalidParameterError("states are too large: the margin overflows")  # pragma: no cover
+
+
+def critical_velocity(
+    x: ArrayLike, direction: ArrayLike, params: BodyParams
+) -> NDArray[np.float64]:
+    """Largest CoM velocity that CoP balancing recovers from position x, Eq. (4) [m/s].
+
+    Solving Eq. (4) for ẋ: forward (direction +1) ẋ < ω (δ⁺ − x), backward (direction −1)
+    ẋ > −ω (x − δ⁻). The result is signed like the velocity (negative backward).
+
+    Parameters
+    ----------
+    x : array_like
+        CoM position relative to the ankle [m], inside the foot.
+    direction : array_like
+        +1 for a forward push, −1 for a backward push.
+    params : BodyParams
+        Body parameters.
+
+    Returns
+    -------
+    ndarray
+        Critical velocity [m/s] (the supremum: the boundary itself is not recoverable).
+    """
+    x = np.asarray(x, dtype=np.float64)
+    direction = np.asarray(direction, dtype=np.float64)
+    edge = np.where(direction > 0.0, params.toe, params.heel)
+    return params.omega * (edge - x)
