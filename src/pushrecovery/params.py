@@ -69,7 +69,8 @@ class BodyParams:
         toe = finite_float("toe", self.toe, "m")
         if heel >= toe:
             raise InvalidParameterError(
-                f"heel must be < toe (an empty or inverted foot), got heel={heel:g} m, toe={toe:g} m"
+                "heel must be < toe (an empty or inverted foot), "
+                f"got heel={heel:g} m, toe={toe:g} m"
             )
         if heel >= 0.0:
             raise InvalidParameterError(f"heel must be < 0 m (behind the ankle), got heel={heel:g}")

@@ -107,7 +107,7 @@ class AnklePD(Controller):
         self._length = params.com_height
 
     def reset(self, state: NDArray[np.float64]) -> None:
-        """The PD controller has no internal state."""
+        """Do nothing: the PD controller has no internal state."""
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """CoP τ / (m g) of the PD ankle torque, clipped to the foot [m]."""

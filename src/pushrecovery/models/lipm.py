@@ -1,4 +1,4 @@
-"""Linear inverted pendulum model (LIPM) with a movable centre of pressure, Sec. II.
+r"""Linear inverted pendulum model (LIPM) with a movable centre of pressure, Sec. II.
 
 The CoM moves at constant height L; with the CoP at δ the horizontal dynamics are
 
@@ -42,11 +42,12 @@ def lipm_acceleration(x: ArrayLike, cop: ArrayLike, omega: float) -> FloatArray:
 def lipm_state(
     t: ArrayLike, x0: ArrayLike, xdot0: ArrayLike, cop: ArrayLike, omega: float
 ) -> tuple[FloatArray, FloatArray]:
-    """Closed-form LIPM state at time t with the CoP held at δ, Eq. (24).
+    r"""Closed-form LIPM state at time t with the CoP held at δ, Eq. (24).
 
     Eq. (24) with f / ω² = −δ reads
 
-    .. math:: x(t) = \\delta + (x_0 - \\delta)\\cosh\\omega t + \\frac{\\dot x_0}{\\omega}\\sinh\\omega t,
+    .. math:: x(t) = \\delta + (x_0 - \\delta)\\cosh\\omega t
+              + \\frac{\\dot x_0}{\\omega}\\sinh\\omega t,
 
     and its derivative gives the velocity
     :math:`\\dot x(t) = \\omega (x_0 - \\delta)\\sinh\\omega t + \\dot x_0\\cosh\\omega t`.
@@ -77,7 +78,7 @@ def lipm_state(
 
 
 def lipm_transition(omega: float, dt: float) -> tuple[FloatArray, FloatArray]:
-    """Exact zero-order-hold discretisation of the LIPM over one step dt.
+    r"""Exact zero-order-hold discretisation of the LIPM over one step dt.
 
     With the CoP held constant over the step, Eq. (24) is linear in (x, ẋ, δ):
     ``X[k+1] = A X[k] + B δ[k]`` with

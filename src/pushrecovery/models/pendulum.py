@@ -1,4 +1,4 @@
-"""Nonlinear single inverted pendulum on a foot, Fig. 3(b).
+r"""Nonlinear single inverted pendulum on a foot, Fig. 3(b).
 
 A point mass m on a massless rod of length L pivots about the ankle, which sits on the floor
 (zero ankle height) on a massless foot spanning [δ⁻, δ⁺]. The lean angle θ is positive

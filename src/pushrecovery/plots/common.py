@@ -22,7 +22,7 @@ FALL_COLOUR = "#c62828"
 
 
 def new_figure(width: float = 6.4, height: float = 4.8) -> tuple[Figure, Axes]:
-    """A figure with one axes, drawn off-screen (Agg)."""
+    """Create a figure with one axes, drawn off-screen (Agg)."""
     import matplotlib
 
     matplotlib.use("Agg")

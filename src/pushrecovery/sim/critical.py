@@ -43,7 +43,7 @@ class CriticalPush:
     predicted_velocity: float = float("nan")
 
     def relative_error(self) -> float:
-        """(|velocity| − |predicted|) / |predicted|; negative when the body does worse than Eq. 4."""
+        """Return (|velocity| − |predicted|) / |predicted|; < 0 when doing worse than Eq. 4."""
         predicted = abs(self.predicted_velocity)
         return (abs(self.velocity) - predicted) / predicted
 

@@ -68,6 +68,7 @@ class LipmPlant(_AnklePlant):
         self._cosh = self._sinh = 1.0
 
     def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, float]:
+        """Advance exactly by dt with the CoP held (Eq. 24); return state and applied CoP."""
         cop = self.applied_cop(command)
         if dt != self._dt:
             omega = self.params.omega
@@ -87,6 +88,7 @@ class PendulumPlant(_AnklePlant):
     max_substep: ClassVar[float] = 1e-3
 
     def check_state(self, state: FloatArray) -> None:
+        """Also require |x| < L: the CoM must be above the ankle's horizon."""
         super().check_state(state)
         if abs(float(state[0])) >= self.params.com_height:
             raise InvalidParameterError(
@@ -95,6 +97,7 @@ class PendulumPlant(_AnklePlant):
             )
 
     def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, float]:
+        """Advance by dt with RK4 (substeps <= ``max_substep``); return state and applied CoP."""
         cop = self.applied_cop(command)
         p = self.params
         theta, rate = lean_from_com(float(state[0]), float(state[1]), p.com_height)

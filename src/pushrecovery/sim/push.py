@@ -45,5 +45,5 @@ class Push:
         return cls(finite_float("impulse", impulse, "N s") / positive_float("mass", mass, "kg"))
 
     def impulse(self, mass: float) -> float:
-        """The impulse J = m Δẋ [N s] of this push on a body of mass m [kg]."""
+        """Return the impulse J = m Δẋ [N s] of this push on a body of mass m [kg]."""
         return mass * self.delta_velocity

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
+from enum import StrEnum
 
 import numpy as np
 from numpy.typing import NDArray
@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 __all__ = ["Outcome", "SimulationResult", "is_falling"]
 
 
-class Outcome(str, Enum):
+class Outcome(StrEnum):
     """How a simulated push ended (docs/conventions.md, "Outcome")."""
 
     RECOVERED = "recovered"
@@ -20,7 +20,7 @@ class Outcome(str, Enum):
 
 
 def is_falling(x: float, xdot: float, heel: float, toe: float) -> bool:
-    """True once the CoM is beyond a foot edge and moving away from the foot.
+    """Tell whether the CoM is beyond a foot edge and moving away from the foot.
 
     The state is then lost for any CoP on the foot: for the LIPM ẍ = ω² (x − δ) > 0 when
     x > δ⁺ ≥ δ; for the pendulum m L² θ̈ = m g L sinθ − τ and τ ≤ τ(δ⁺) < m g L sinθ when

@@ -103,7 +103,7 @@ def simulate(
             outcome = Outcome.RECOVERED
             break
     return SimulationResult(
-        time=np.arange(k + 1) * dt,
+        time=np.arange(k + 1, dtype=np.float64) * dt,
         states=states[: k + 1],
         cops=cops[:k],
         outcome=outcome,

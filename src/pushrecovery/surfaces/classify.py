@@ -9,7 +9,7 @@ land, every state outside the CoP region is reported as ``step``: Sec. II's own 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -21,7 +21,7 @@ from pushrecovery.surfaces.cop import capture_point, cop_margin
 __all__ = ["STRATEGY_CODES", "Classification", "Strategy", "classify", "classify_states"]
 
 
-class Strategy(str, Enum):
+class Strategy(StrEnum):
     """Balance strategies, in the order the paper escalates them (Sec. I-B)."""
 
     ANKLE = "ankle"

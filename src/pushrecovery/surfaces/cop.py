@@ -1,4 +1,4 @@
-"""CoP-balancing (ankle strategy) decision surface, Eq. (4) of [Stephens07].
+r"""CoP-balancing (ankle strategy) decision surface, Eq. (4) of [Stephens07].
 
 A state (x, ẋ) of the LIPM can be brought to rest with the CoP on the foot if and only if its
 capture point ξ = x + ẋ/ω lies strictly between the foot edges:
