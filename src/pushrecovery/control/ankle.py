@@ -56,14 +56,13 @@ class AnkleSaturated(Controller):
 def default_pd_gains(params: BodyParams) -> tuple[float, float]:
     """Default ankle PD gains (stiffness [N m/rad], damping [N m s/rad]).
 
-    Stiffness 3 m g L and the damping that makes the linearised closed loop critically damped:
-    m L² θ̈ = −(k_p − m g L) θ − k_d θ̇ gives k_d = 2 sqrt((k_p − m g L) m L²). See
-    ``docs/ankle_pd.md`` for how the gains move the critical push.
+    Capture-point gains: k_p = 3 m g L and k_d = k_p / ω. Linearised (θ ≈ x/L), the commanded
+    CoP is then δ = (k_p / m g L) ξ, a multiple > 1 of the capture point, so ξ̇ = ω (ξ − δ)
+    moves ξ monotonically back to 0 and, on the LIPM, every state inside Eq. (4) is
+    recovered, exactly as predicted. ``docs/ankle_pd.md`` measures other gains.
     """
-    mgl = params.weight * params.com_height
-    stiffness = 3.0 * mgl
-    damping = 2.0 * math.sqrt((stiffness - mgl) * params.mass * params.com_height**2)
-    return stiffness, damping
+    stiffness = 3.0 * params.weight * params.com_height
+    return stiffness, stiffness / params.omega
 
 
 @register

@@ -17,7 +17,12 @@ from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.cop import critical_velocity
 
-__all__ = ["CriticalPush", "critical_push", "find_critical_velocity"]
+__all__ = ["CriticalPush", "NotRecoverableError", "critical_push", "find_critical_velocity"]
+
+
+class NotRecoverableError(InvalidParameterError):
+    """The start state is lost even without a push, so there is no critical push."""
+
 
 #: Pushes beyond this [m/s] are not searched: at sqrt(g L) the stance foot already unloads.
 MAX_SEARCH_VELOCITY = 20.0
@@ -84,8 +89,11 @@ def find_critical_velocity(
     tolerance = positive_float("tolerance", tolerance, "m/s")
     guess = abs(finite_float("guess", guess, "m/s"))
     runs = 1
-    if outcome_of(0.0) is not Outcome.RECOVERED:
-        raise InvalidParameterError("the body does not recover even without a push from this x")
+    at_rest = outcome_of(0.0)
+    if at_rest is not Outcome.RECOVERED:
+        raise NotRecoverableError(
+            f"the body does not recover even without a push (outcome: {at_rest.value})"
+        )
     low, high = 0.0, max(1.25 * guess, 4.0 * tolerance)
     while True:
         runs += 1

@@ -1,0 +1,167 @@
+"""The CLI: JSON contract keys, readable tables, and one-line errors with exit status 2."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+from click.testing import CliRunner
+
+from pushrecovery.cli import main
+from pushrecovery.cli.app import cli
+
+
+def invoke(*args):
+    result = CliRunner().invoke(cli, list(args), catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+def run_json(*args):
+    return json.loads(invoke(*args, "--json"))
+
+
+def test_bounds_contract():
+    data = run_json("bounds")
+    assert set(data) >= {"params", "omega", "cop"}
+    assert data["cop"] == {"lower": -0.05, "upper": 0.15}
+    assert data["params"]["mass"] == 72.0
+    assert data["omega"] == pytest.approx(9.81**0.5)
+
+
+def test_parameter_flags_override(tmp_path):
+    data = run_json("bounds", "--toe", "0.2", "--com-height", "0.81")
+    assert data["cop"]["upper"] == 0.2
+    assert data["params"]["leg_length"] == 0.81
+    assert data["omega"] == pytest.approx((9.81 / 0.81) ** 0.5)
+    toml = tmp_path / "p.toml"
+    toml.write_text("heel = -0.1\n")
+    assert run_json("bounds", "--params", str(toml))["cop"]["lower"] == -0.1
+
+
+def test_classify_contract():
+    inside = run_json("classify", "--x", "0", "--xdot", "0.3")
+    assert set(inside) >= {"capture_point", "strategy", "margins"}
+    assert inside["strategy"] == "ankle"
+    assert inside["margins"]["cop"] > 0
+    outside = run_json("classify", "--x", "0", "--xdot", "0.6")
+    assert outside["strategy"] != "ankle" and outside["margins"]["cop"] < 0
+
+
+def test_simulate_contract_and_plot(tmp_path):
+    plot = tmp_path / "run.png"
+    data = run_json(
+        "simulate",
+        "--model",
+        "pendulum",
+        "--controller",
+        "ankle-pd",
+        "--x",
+        "0",
+        "--xdot",
+        "0.3",
+        "--duration",
+        "5",
+        "--plot",
+        str(plot),
+    )
+    assert data["recovered"] is True
+    assert set(data["final_state"]) == {"x", "xdot"}
+    assert data["predicted"]["strategy"] == "ankle"
+    assert plot.stat().st_size > 0
+    fell = run_json(
+        "simulate", "--model", "lipm", "--controller", "ankle-saturated", "--impulse", "40"
+    )
+    assert fell["recovered"] is False and fell["initial_state"]["xdot"] == pytest.approx(40 / 72)
+
+
+def test_critical_push_contract():
+    data = run_json(
+        "critical-push",
+        "--model",
+        "lipm",
+        "--controller",
+        "ankle-pd",
+        "--x",
+        "0.0",
+        "--direction",
+        "backward",
+        "--tolerance",
+        "1e-4",
+    )
+    assert set(data) >= {"velocity", "impulse", "predicted_velocity"}
+    assert data["velocity"] == pytest.approx(data["predicted_velocity"], abs=1e-4)
+    assert data["impulse"] == pytest.approx(72 * data["velocity"])
+
+
+def test_figures(tmp_path):
+    files = run_json("figures", "--out", str(tmp_path))["files"]
+    assert sorted(p.rsplit("/", 1)[1] for p in files) == [
+        "fig3a.png",
+        "fig3a.svg",
+        "fig3b.png",
+        "fig3b.svg",
+    ]
+
+
+def test_table_output_is_readable():
+    text = invoke("classify", "--x", "0", "--xdot", "0.3")
+    assert "strategy" in text and "ankle" in text and "{" not in text
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["bounds", "--mass", "-1"], "mass must be > 0"),
+        (["bounds", "--mass", "nan"], "mass must be a finite number"),
+        (["bounds", "--com-height", "0"], "com_height must be > 0"),
+        (["bounds", "--heel", "0.2"], "heel must be < toe"),
+        (["bounds", "--preset", "moon"], "preset must be one of"),
+        (["bounds", "--frobnicate"], "No such option"),
+        (["bounds", "--mass", "heavy"], "not a valid float"),
+        (["classify", "--x", "inf", "--xdot", "0"], "x must be a finite number"),
+        (["classify", "--x", "0"], "Missing option '--xdot'"),
+        (["simulate", "--xdot", "0.1", "--impulse", "3"], "either --xdot"),
+        (["simulate", "--duration", "-1"], "duration must be > 0"),
+        (["simulate", "--model", "biped"], "Invalid value for '--model'"),
+        (["simulate", "--xdot", "0.1", "--plot", "run.gif"], "plot must end in one of"),
+        (["critical-push", "--x", "0.3"], "x must lie on the foot"),
+        (["critical-push", "--kp", "100"], "stiffness must be > m g L"),
+        (["bounds", "--params", "/nonexistent.toml"], "not found"),
+        (["nonsense"], "No such command"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(capsys, args, words):
+    with pytest.raises(SystemExit) as exit_info:
+        main(args)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("pushrecovery: error: ")
+    assert words in err
+    assert "Traceback" not in err
+
+
+def test_malformed_toml(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("mass = [\n")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["bounds", "--params", str(bad)])
+    assert exit_info.value.code == 2
+    assert "malformed TOML" in capsys.readouterr().err
+
+
+def test_real_subprocess_and_module_entry_point():
+    done = subprocess.run(
+        [sys.executable, "-m", "pushrecovery", "bounds", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert json.loads(done.stdout)["cop"]["upper"] == 0.15
+    bad = subprocess.run(
+        [sys.executable, "-m", "pushrecovery", "bounds", "--toe", "-1"],
+        capture_output=True,
+        text=True,
+    )
+    assert bad.returncode == 2 and bad.stdout == ""
+    assert bad.stderr.strip().startswith("pushrecovery: error: ")

@@ -1,0 +1,81 @@
+"""The nonlinear pendulum: integrator, exact CoP-limited ankle torque, the fall criterion."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from scipy.integrate import solve_ivp
+
+from pushrecovery.models.pendulum import (
+    ankle_torque_for_cop,
+    pendulum_acceleration,
+    pendulum_step,
+)
+from pushrecovery.sim.result import is_falling
+
+M, L, G = 72.0, 1.0, 9.81
+
+
+def test_rk4_matches_adaptive_integrator():
+    cop, theta0, rate0 = 0.1, 0.05, 0.3
+    sol = solve_ivp(
+        lambda _, s: [s[1], pendulum_acceleration(s[0], s[1], cop, M, L, G)],
+        (0, 1.0),
+        [theta0, rate0],
+        rtol=1e-12,
+        atol=1e-14,
+        method="DOP853",
+    )
+    theta, rate = theta0, rate0
+    for _ in range(1000):
+        theta, rate = pendulum_step(theta, rate, cop, 1e-3, M, L, G)
+    # RK4 with h = 1 ms: global error ~ (ωh)^4 ~ 1e-10 of the state.
+    assert abs(theta - sol.y[0, -1]) < 1e-9
+    assert abs(rate - sol.y[1, -1]) < 1e-9
+
+
+def test_zero_cop_conserves_energy():
+    theta, rate = 0.1, -0.8  # swings up over the ankle and back down
+    energy0 = 0.5 * M * L**2 * rate**2 + M * G * L * math.cos(theta)
+    for _ in range(2000):
+        theta, rate = pendulum_step(theta, rate, 0.0, 1e-3, M, L, G)
+    energy = 0.5 * M * L**2 * rate**2 + M * G * L * math.cos(theta)
+    assert energy == pytest.approx(energy0, rel=1e-10)
+
+
+@given(
+    theta=st.floats(-0.6, 0.6),
+    rate=st.floats(-1.5, 1.5),
+    cop=st.floats(-0.05, 0.15),
+)
+def test_torque_puts_the_cop_exactly_where_asked(theta, rate, cop):
+    # CoP = τ / F_z with F_z = m (g + z̈), z = L cosθ: recompute z̈ from the dynamics.
+    tau = ankle_torque_for_cop(theta, rate, cop, M, L, G)
+    accel = pendulum_acceleration(theta, rate, cop, M, L, G)
+    z_ddot = -L * (math.sin(theta) * accel + math.cos(theta) * rate**2)
+    normal = M * (G + z_ddot)
+    if normal <= 0.0:
+        assert tau == 0.0
+    else:
+        assert tau / normal == pytest.approx(cop, abs=1e-12)
+
+
+@given(
+    x=st.floats(0.1501, 0.9),
+    rate=st.floats(0.0, 3.0),
+    cop=st.floats(-0.05, 0.15),
+)
+def test_fall_criterion_is_absorbing_for_pendulum(x, rate, cop):
+    # Beyond the toe and moving forward, no CoP on the foot can decelerate the lean.
+    theta = math.asin(x / L)
+    assert is_falling(x, rate, -0.05, 0.15)
+    assert pendulum_acceleration(theta, rate, cop, M, L, G) > 0.0
+
+
+def test_fall_criterion_mirror():
+    assert is_falling(-0.06, -0.1, -0.05, 0.15)
+    assert not is_falling(-0.06, 0.1, -0.05, 0.15)  # outside but coming back
+    assert not is_falling(0.0, 5.0, -0.05, 0.15)
+    assert np.isfinite(ankle_torque_for_cop(0.0, 10.0, 0.1, M, L, G))  # unloaded foot: no torque

@@ -1,0 +1,182 @@
+"""Simulator, plants, controllers' contract and the critical-push search."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from pushrecovery import InvalidParameterError, load_params
+from pushrecovery.control import CONTROLLERS, AnklePD, Command, Controller, make_controller
+from pushrecovery.models.lipm import lipm_state
+from pushrecovery.sim.critical import NotRecoverableError, critical_push
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.push import Push
+from pushrecovery.sim.simulate import simulate
+
+PARAMS = load_params()
+
+
+class FixedCop(Controller):
+    name = "fixed"
+
+    def __init__(self, params, cop):
+        super().__init__(params)
+        self.cop = cop
+
+    def reset(self, state):
+        pass
+
+    def compute(self, t, state):
+        return Command(self.cop)
+
+
+def test_lipm_plant_is_exact_zoh():
+    run = simulate(
+        make_plant("lipm", PARAMS),
+        FixedCop(PARAMS, 0.1),
+        np.array([0.02, 0.3]),
+        duration=0.5,
+        control_period=0.01,
+    )
+    x, v = lipm_state(run.time, 0.02, 0.3, 0.1, PARAMS.omega)
+    np.testing.assert_allclose(run.states[:, 0], x, rtol=1e-12)
+    np.testing.assert_allclose(run.states[:, 1], v, rtol=1e-12)
+
+
+def test_plant_clips_cop_to_the_foot():
+    run = simulate(
+        make_plant("pendulum", PARAMS), FixedCop(PARAMS, 0.5), np.array([0.0, 0.0]), duration=0.1
+    )
+    assert np.all(run.cops == PARAMS.toe)
+
+
+def test_lipm_rejects_flywheel_torque():
+    class Hip(FixedCop):
+        def compute(self, t, state):
+            return Command(0.0, flywheel_torque=5.0)
+
+    with pytest.raises(InvalidParameterError, match="flywheel_torque must be 0"):
+        simulate(make_plant("lipm", PARAMS), Hip(PARAMS, 0.0), np.array([0.0, 0.0]))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"duration": 0.0}, "duration must be > 0"),
+        ({"duration": math.nan}, "duration must be a finite number"),
+        ({"control_period": -1e-3}, "control_period must be > 0"),
+        ({"duration": 1.0, "control_period": 2.0}, "control_period must be <= duration"),
+    ],
+)
+def test_bad_simulation_options(kwargs, words):
+    with pytest.raises(InvalidParameterError, match=words):
+        simulate(
+            make_plant("lipm", PARAMS),
+            make_controller("ankle-pd", PARAMS),
+            np.array([0.0, 0.1]),
+            **kwargs,
+        )
+
+
+@pytest.mark.parametrize(
+    ("state", "words"),
+    [
+        ([math.nan, 0.0], "initial_state"),
+        ([0.0, math.inf], "initial_state"),
+        ([0.0, 0.0, 0.0], "state must be"),
+    ],
+)
+def test_bad_initial_state(state, words):
+    with pytest.raises(InvalidParameterError, match=words):
+        simulate(make_plant("lipm", PARAMS), make_controller("ankle-pd", PARAMS), np.array(state))
+
+
+def test_pendulum_needs_com_above_ankle_horizon():
+    with pytest.raises(InvalidParameterError, match=r"\|x\| < com_height"):
+        simulate(
+            make_plant("pendulum", PARAMS),
+            make_controller("ankle-pd", PARAMS),
+            np.array([1.2, 0.0]),
+        )
+
+
+def test_outcomes():
+    plant, ctrl = make_plant("lipm", PARAMS), make_controller("ankle-pd", PARAMS)
+    assert simulate(plant, ctrl, np.array([0.0, 0.2])).outcome.value == "recovered"
+    assert simulate(plant, ctrl, np.array([0.0, 0.6])).outcome.value == "fell"
+    # Too short to settle or fall.
+    assert simulate(plant, ctrl, np.array([0.0, 0.2]), duration=0.05).outcome.value == "undecided"
+
+
+def test_unknown_names():
+    with pytest.raises(InvalidParameterError, match="model must be one of"):
+        make_plant("biped", PARAMS)
+    with pytest.raises(InvalidParameterError, match="controller must be one of"):
+        make_controller("hip", PARAMS)
+
+
+def test_pd_gain_validation():
+    mgl = PARAMS.weight * PARAMS.com_height
+    with pytest.raises(InvalidParameterError, match="stiffness must be > m g L"):
+        AnklePD(PARAMS, stiffness=0.9 * mgl)
+    with pytest.raises(InvalidParameterError, match="damping must be >= 0"):
+        AnklePD(PARAMS, damping=-1.0)
+    with pytest.raises(InvalidParameterError, match="stiffness must be a finite number"):
+        AnklePD(PARAMS, stiffness=math.nan)
+
+
+@pytest.mark.parametrize("name", sorted(CONTROLLERS))
+@given(x=st.floats(-0.9, 0.9), v=st.floats(-5, 5), t=st.floats(0, 10))
+def test_controller_contract(name, x, v, t):
+    controller = make_controller(name, PARAMS)
+    state = np.array([x, v])
+    controller.reset(state)
+    command = controller.compute(t, state)
+    assert math.isfinite(command.cop)
+    assert PARAMS.heel <= command.cop <= PARAMS.toe
+    assert command.flywheel_torque == 0.0
+
+
+def test_saturated_controller_brakes_on_the_edge_then_holds():
+    controller = make_controller("ankle-saturated", PARAMS)
+    controller.reset(np.array([0.0, 0.3]))
+    assert controller.compute(0.0, np.array([0.0, 0.3])).cop == PARAMS.toe
+    stopped = controller.compute(1.0, np.array([0.05, -1e-4]))
+    assert stopped.cop == pytest.approx(0.05 - 1e-4 / PARAMS.omega)
+    backward = make_controller("ankle-saturated", PARAMS)
+    backward.reset(np.array([0.0, -0.1]))
+    assert backward.compute(0.0, np.array([0.0, -0.1])).cop == PARAMS.heel
+
+
+def test_impulse_push():
+    assert Push.from_impulse(36.0, 72.0).delta_velocity == 0.5
+    assert Push(0.5).impulse(72.0) == 36.0
+    with pytest.raises(InvalidParameterError, match="impulse must be a finite number"):
+        Push.from_impulse(math.nan, 72.0)
+
+
+def test_critical_push_lipm_matches_eq4_to_tolerance():
+    found = critical_push(PARAMS, "lipm", "ankle-saturated", 0.02, "forward", tolerance=1e-5)
+    low, high = found.bracket
+    assert low < found.predicted_velocity <= high + 1e-12
+    assert high - low <= 1e-5
+
+
+def test_critical_push_rejects_bad_start():
+    with pytest.raises(InvalidParameterError, match="x must lie on the foot"):
+        critical_push(PARAMS, "lipm", "ankle-pd", 0.2, "forward")
+    with pytest.raises(InvalidParameterError, match="direction must be"):
+        critical_push(PARAMS, "lipm", "ankle-pd", 0.0, "up")
+    mgl = PARAMS.weight * PARAMS.com_height
+    # A soft, under-damped PD cannot even hold a standing body near the toe.
+    with pytest.raises(NotRecoverableError, match="without a push"):
+        critical_push(
+            PARAMS,
+            "lipm",
+            "ankle-pd",
+            0.14,
+            "forward",
+            controller_options={"stiffness": 1.25 * mgl, "damping": 68.0},
+        )
