@@ -72,11 +72,11 @@ def test_critical_velocity_is_on_the_surface():
         assert np.all(np.sign(v) == direction)
 
 
-def test_numexpr_path_matches_numpy_path(monkeypatch):
+def test_fused_path_matches_numpy_path(monkeypatch):
     rng = np.random.default_rng(7)
     x, v = rng.normal(0.05, 0.1, size=(2, 50_000))
     fast = cop_margin(x, v, PARAMS)
-    monkeypatch.setattr(cop_module, "_NUMEXPR_MIN_SIZE", 10**9)
+    monkeypatch.setattr(cop_module, "_FUSED_MIN_SIZE", 10**9)
     slow = cop_margin(x, v, PARAMS)
     np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-15)
     reference = np.minimum(

@@ -1,0 +1,88 @@
+"""Benchmarks, each reported as a ratio to a baseline measured in the same run.
+
+1. The CoP decision surface (Eq. 4 margins) on 10**7 states vs ``numpy.add(a, b, out=c)`` on the
+   same arrays. Target: <= 2x.
+2. ``pushrecovery --help`` start-up vs a bare ``python -c pass``. Target: < 0.3 s absolute.
+3. One simulated push (pendulum + PD, 1 kHz control) vs the simulated time (real-time factor).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import timeit
+from pathlib import Path
+
+import numpy as np
+
+from pushrecovery import load_params
+from pushrecovery.control import make_controller
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.cop import cop_margin
+
+N = 10**7
+REPEAT = 7
+
+
+def best(func, number=1):
+    return min(timeit.repeat(func, number=number, repeat=REPEAT)) / number
+
+
+def surface() -> float:
+    params = load_params()
+    rng = np.random.default_rng(0)
+    x, xdot = rng.normal(0.05, 0.1, N), rng.normal(0.0, 0.3, N)
+    out = np.empty(N)
+    baseline = best(lambda: np.add(x, xdot, out=out))
+    margin = best(lambda: cop_margin(x, xdot, params, out=out))
+    ratio = margin / baseline
+    print(
+        f"surface on 1e7 states: {margin * 1e3:.1f} ms; numpy.add {baseline * 1e3:.1f} ms; "
+        f"ratio {ratio:.2f} (target <= 2)"
+    )
+    return ratio
+
+
+def startup() -> float:
+    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+    exe = Path(sys.executable).with_name("pushrecovery")
+
+    def run(cmd):
+        return lambda: subprocess.run(cmd, check=True, capture_output=True, env=env)
+
+    bare = min(timeit.repeat(run([sys.executable, "-c", "pass"]), number=1, repeat=REPEAT))
+    cli = min(timeit.repeat(run([str(exe), "--help"]), number=1, repeat=REPEAT))
+    print(
+        f"pushrecovery --help: {cli * 1e3:.0f} ms; bare python {bare * 1e3:.0f} ms; "
+        f"ratio {cli / bare:.1f} (target < 300 ms)"
+    )
+    return cli
+
+
+def realtime() -> float:
+    params = load_params()
+    plant, ctrl = make_plant("pendulum", params), make_controller("ankle-pd", params)
+    state = np.array([0.0, 0.3])
+    run = simulate(plant, ctrl, state)
+    wall = best(lambda: simulate(plant, ctrl, state))
+    factor = run.time[-1] / wall
+    print(
+        f"pendulum + PD push, {run.time[-1]:.2f} s simulated at 1 kHz: {wall * 1e3:.1f} ms "
+        f"({factor:.0f}x faster than real time)"
+    )
+    return factor
+
+
+def main() -> int:
+    ratio = surface()
+    cli = startup()
+    realtime()
+    failed = ratio > 2.0 or cli > 0.3
+    print("targets met" if not failed else "TARGET MISSED")
+    return int(failed)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
