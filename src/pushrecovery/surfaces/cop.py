@@ -155,7 +155,7 @@ def _fused_margin_kernel() -> Callable[..., int]:
                 bad += 1
         return bad
 
-    return kernel  # type: ignore[no-any-return]
+    return kernel
 
 
 def _raise_non_finite(x: NDArray[np.float64], xdot: NDArray[np.float64]) -> None:
