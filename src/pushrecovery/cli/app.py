@@ -27,7 +27,7 @@ def cli() -> None:
     """
 
 
-@cli.command()
+@cli.command(short_help="Capture-point bounds of each strategy.")
 @body_options
 def bounds(as_json: bool, **kwargs: Any) -> None:
     """Capture-point bounds of each balance strategy (Eq. 4)."""
@@ -45,7 +45,7 @@ def bounds(as_json: bool, **kwargs: Any) -> None:
     )
 
 
-@cli.command()
+@cli.command(short_help="Strategy a CoM state needs: ankle, hip, step or fall.")
 @click.option("--x", "x", type=float, required=True, help="CoM position relative to the ankle [m].")
 @click.option("--xdot", type=float, required=True, help="CoM velocity [m/s].")
 @body_options
@@ -103,7 +103,7 @@ def _with(*decorators: Any) -> Any:
     return apply
 
 
-@cli.command()
+@cli.command(short_help="Simulate a push; report recovered or fell.")
 @_with(_model, _controller, *_gains)
 @click.option(
     "--x", "x", type=float, default=0.0, show_default=True, help="CoM position before the push [m]."
@@ -170,7 +170,7 @@ def simulate(
     emit(data, as_json)
 
 
-@cli.command("critical-push")
+@cli.command("critical-push", short_help="Largest recoverable push, vs Eq. 4.")
 @_with(_model, _controller, *_gains)
 @click.option(
     "--x",
@@ -242,7 +242,7 @@ def critical_push(
     )
 
 
-@cli.command()
+@cli.command(short_help="Reproduce the paper's figures.")
 @click.option(
     "--out",
     type=click.Path(file_okay=False),
