@@ -180,3 +180,10 @@ def test_critical_push_rejects_bad_start():
             "forward",
             controller_options={"stiffness": 1.25 * mgl, "damping": 68.0},
         )
+
+
+def test_summary_reports_the_applied_cop_range():
+    run = simulate(
+        make_plant("lipm", PARAMS), FixedCop(PARAMS, 0.1), np.array([0.1, 0.0]), duration=0.2
+    )
+    assert run.to_dict()["peak_cop"] == {"min": 0.1, "max": 0.1}

@@ -10,20 +10,21 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.errors import InvalidParameterError
 
 
-def finite_float(name: str, value: object, unit: str = "") -> float:
-    """Return ``value`` as a finite float or raise naming ``name``."""
+def finite_float(name: str, value: object, unit: str = "", allowed: str = "") -> float:
+    """Return ``value`` as a finite float or raise naming ``name`` (and ``allowed``, e.g. "> 0")."""
+    what = f"{name} must be a finite number{' ' + allowed if allowed else ''}{_unit(unit)}"
     try:
         number = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
-        raise InvalidParameterError(f"{name} must be a finite number, got {value!r}") from None
+        raise InvalidParameterError(f"{what}, got {value!r}") from None
     if not math.isfinite(number):
-        raise InvalidParameterError(f"{name} must be a finite number{_unit(unit)}, got {number}")
+        raise InvalidParameterError(f"{what}, got {number}")
     return number
 
 
 def positive_float(name: str, value: object, unit: str = "") -> float:
     """Return ``value`` as a finite float > 0 or raise naming ``name`` and the range."""
-    number = finite_float(name, value, unit)
+    number = finite_float(name, value, unit, allowed="> 0")
     if number <= 0.0:
         raise InvalidParameterError(f"{name} must be > 0{_unit(unit)}, got {name}={number:g}")
     return number
