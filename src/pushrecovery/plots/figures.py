@@ -18,6 +18,7 @@ from pushrecovery.plots.common import (
 )
 from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.cop import critical_velocity
 
 __all__ = ["fig3a", "fig3b", "write_figures"]
 
@@ -68,13 +69,19 @@ def fig3b(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     fig, ax = new_figure()
     xlim, ylim = _limits(params)
     shade_cop_region(ax, params, xlim, ylim)
+    # From three positions: pushes 15 % inside and outside Eq. (4) in both directions.
     starts = [
-        (x0, v0)
+        (float(x0), float(fraction * critical_velocity(x0, direction, params)))
         for x0 in np.linspace(params.heel, params.toe, 5)[1:-1]
-        for v0 in np.linspace(0.85 * ylim[0], 0.85 * ylim[1], 9)
+        for direction in (1.0, -1.0)
+        for fraction in (0.5, 0.85, 1.15)
     ]
     _draw_runs(ax, params, "pendulum", "ankle-pd", starts)
-    ax.set_title("Fig. 3(b): saturated PD ankle control, nonlinear pendulum")
+    ax.set_title(
+        "Fig. 3(b): saturated PD ankle control, nonlinear pendulum\n"
+        "(pushes 15 % inside / outside Eq. (4); falls drawn until certain)",
+        fontsize=10,
+    )
     return save_figure(fig, out / "fig3b", formats)
 
 
