@@ -55,6 +55,10 @@ class Controller(ABC):
 
     #: Name used by the CLI and the registry.
     name: ClassVar[str]
+    #: Strategy whose decision surface predicts this controller (``ankle`` or ``hip``).
+    strategy: ClassVar[str] = "ankle"
+    #: Period the controller is designed for [s]; ``None`` lets the simulator choose.
+    control_period: float | None = None
 
     def __init__(self, params: BodyParams) -> None:
         self.params = params

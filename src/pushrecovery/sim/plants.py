@@ -1,7 +1,9 @@
 """Plants: the models behind one small stepping protocol the simulator drives.
 
 A plant advances a state by one control period with the command held (zero-order hold), and
-returns the CoP it actually applied (a command is clipped to the foot: physics, not politeness).
+returns the CoP and hip torque it actually applied (commands are clipped to the foot and the
+torque limit: physics, not politeness). ``fall_limits`` are the CoM positions beyond which a CoM
+moving outward can no longer be stopped by any admissible input (docs/conventions.md).
 """
 
 from __future__ import annotations
@@ -14,10 +16,11 @@ from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.models.pendulum import com_from_lean, lean_from_com, pendulum_step
 from pushrecovery.params import BodyParams
 
-__all__ = ["MODELS", "LipmPlant", "PendulumPlant", "Plant", "make_plant"]
+__all__ = ["MODELS", "FlywheelPlant", "LipmPlant", "PendulumPlant", "Plant", "make_plant"]
 
 FloatArray = NDArray[np.float64]
 
@@ -27,12 +30,15 @@ class Plant(Protocol):
 
     name: ClassVar[str]
     params: BodyParams
+    fall_limits: tuple[float, float]
 
     def check_state(self, state: FloatArray) -> None:
         """Raise :class:`InvalidParameterError` if the model cannot start from ``state``."""
 
-    def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, float]:
-        """Advance ``state`` by ``dt`` [s]; return the new state and the applied CoP [m]."""
+    def step(
+        self, state: FloatArray, command: Command, dt: float
+    ) -> tuple[FloatArray, float, float]:
+        """Advance ``state`` by ``dt`` [s]; return it, the applied CoP [m] and torque [N m]."""
         ...
 
 
@@ -43,6 +49,8 @@ class _AnklePlant:
 
     def __init__(self, params: BodyParams) -> None:
         self.params = params
+        # Beyond a foot edge, moving outward: lost for any CoP (docs/conventions.md).
+        self.fall_limits = (params.heel, params.toe)
 
     def check_state(self, state: FloatArray) -> None:
         if state.shape != (2,):
@@ -67,8 +75,10 @@ class LipmPlant(_AnklePlant):
         self._dt = -1.0
         self._cosh = self._sinh = 1.0
 
-    def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, float]:
-        """Advance exactly by dt with the CoP held (Eq. 24); return state and applied CoP."""
+    def step(
+        self, state: FloatArray, command: Command, dt: float
+    ) -> tuple[FloatArray, float, float]:
+        """Advance exactly by dt with the CoP held (Eq. 24); return state, CoP, torque (0)."""
         cop = self.applied_cop(command)
         if dt != self._dt:
             omega = self.params.omega
@@ -76,7 +86,8 @@ class LipmPlant(_AnklePlant):
         omega, c, s = self.params.omega, self._cosh, self._sinh
         offset, xdot = float(state[0]) - cop, float(state[1])
         # Eq. (24) at t = dt, and its derivative.
-        return np.array([cop + offset * c + xdot / omega * s, omega * offset * s + xdot * c]), cop
+        state = np.array([cop + offset * c + xdot / omega * s, omega * offset * s + xdot * c])
+        return state, cop, 0.0
 
 
 class PendulumPlant(_AnklePlant):
@@ -96,8 +107,10 @@ class PendulumPlant(_AnklePlant):
                 f"got x={float(state[0]):g}"
             )
 
-    def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, float]:
-        """Advance by dt with RK4 (substeps <= ``max_substep``); return state and applied CoP."""
+    def step(
+        self, state: FloatArray, command: Command, dt: float
+    ) -> tuple[FloatArray, float, float]:
+        """Advance by dt with RK4 (substeps <= ``max_substep``); return state, CoP, torque (0)."""
         cop = self.applied_cop(command)
         p = self.params
         theta, rate = lean_from_com(float(state[0]), float(state[1]), p.com_height)
@@ -105,13 +118,64 @@ class PendulumPlant(_AnklePlant):
         theta, rate = pendulum_step(
             theta, rate, cop, dt, p.mass, p.com_height, p.gravity, substeps=substeps
         )
-        return np.array(com_from_lean(theta, rate, p.com_height)), cop
+        return np.array(com_from_lean(theta, rate, p.com_height)), cop, 0.0
+
+
+class FlywheelPlant:
+    """LIPM plus flywheel (Eqs. 6, 7, 16), advanced exactly with the ZOH transition.
+
+    State ``[x, theta, xdot, theta_dot]``. The hip joint limit |θ| ≤ θmax is a hard stop: a
+    step that would cross it ends with the flywheel on the stop and at rest, and the stopping
+    torque impulse P = −I θ̇ reacts on the CoM (Δẋ = −P / (m L), from Eqs. 6-7). Controllers
+    that respect the limit (bang-bang with T ≤ T_max, the MPC) never touch it.
+    """
+
+    name: ClassVar[str] = "flywheel"
+
+    def __init__(self, params: BodyParams) -> None:
+        self.params = params
+        reach = params.torque_max / params.weight
+        # Beyond δ± ± τmax/(m g), moving outward, no CMP on offer can stop the CoM.
+        self.fall_limits = (params.heel - reach, params.toe + reach)
+        self._dt = -1.0
+        self._a = self._b = np.empty(0)
+
+    def check_state(self, state: FloatArray) -> None:
+        """Require ``[x, theta, xdot, theta_dot]`` with |θ| ≤ θmax."""
+        if state.shape != (4,):
+            raise InvalidParameterError(
+                f"state must be [x, theta, xdot, theta_dot], got shape {state.shape}"
+            )
+        if abs(float(state[1])) > self.params.flywheel_angle_max:
+            raise InvalidParameterError(
+                f"theta must satisfy |theta| <= flywheel_angle_max = "
+                f"{self.params.flywheel_angle_max:g} rad, got {float(state[1]):g}"
+            )
+
+    def step(
+        self, state: FloatArray, command: Command, dt: float
+    ) -> tuple[FloatArray, float, float]:
+        """Advance exactly by dt with (δ, τ) held; return state, applied CoP and torque."""
+        p = self.params
+        cop = min(p.toe, max(p.heel, command.cop))
+        torque = min(p.torque_max, max(-p.torque_max, command.flywheel_torque))
+        if dt != self._dt:
+            self._dt = dt
+            self._a, self._b = flywheel_discrete(p, dt)
+        new = self._a @ state + self._b @ np.array([cop, torque])
+        limit = p.flywheel_angle_max
+        if abs(new[1]) > limit:
+            new[1] = math.copysign(limit, new[1])
+            new[2] += p.flywheel_inertia * new[3] / (p.mass * p.com_height)
+            new[3] = 0.0
+        return new, cop, torque
 
 
 #: Model name -> plant class.
-MODELS: dict[str, type[LipmPlant] | type[PendulumPlant]] = {
+MODELS: dict[str, type[LipmPlant] | type[PendulumPlant] | type[FlywheelPlant]] = {
     LipmPlant.name: LipmPlant,
     PendulumPlant.name: PendulumPlant,
+    FlywheelPlant.name: FlywheelPlant,
 }
 
 

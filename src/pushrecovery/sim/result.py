@@ -19,14 +19,16 @@ class Outcome(StrEnum):
     UNDECIDED = "undecided"
 
 
-def is_falling(x: float, xdot: float, heel: float, toe: float) -> bool:
-    """Tell whether the CoM is beyond a foot edge and moving away from the foot.
+def is_falling(x: float, xdot: float, lower: float, upper: float) -> bool:
+    """Tell whether the CoM is beyond a fall limit and moving away from the support.
 
-    The state is then lost for any CoP on the foot: for the LIPM ẍ = ω² (x − δ) > 0 when
-    x > δ⁺ ≥ δ; for the pendulum m L² θ̈ = m g L sinθ − τ and τ ≤ τ(δ⁺) < m g L sinθ when
-    L sinθ > δ⁺ and θ̇ ≥ 0 (docs/conventions.md). Mirror for the heel.
+    With the limits at the foot edges (ankle models) the state is then lost for any CoP on the
+    foot: for the LIPM ẍ = ω² (x − δ) > 0 when x > δ⁺ ≥ δ; for the pendulum
+    m L² θ̈ = m g L sinθ − τ and τ ≤ τ(δ⁺) < m g L sinθ when L sinθ > δ⁺ and θ̇ ≥ 0. With the
+    limits at δ± ± τmax/(m g) the same holds for every CMP the flywheel model can produce
+    (docs/conventions.md). Mirror for the lower limit.
     """
-    return (x > toe and xdot >= 0.0) or (x < heel and xdot <= 0.0)
+    return (x > upper and xdot >= 0.0) or (x < lower and xdot <= 0.0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,8 +41,8 @@ class SimulationResult:
         Sample times [s].
     states : ndarray, shape (n, d)
         States at those times (``[x, xdot]`` for the ankle models) [m, m/s].
-    cops : ndarray, shape (n - 1,)
-        CoP applied over each control period [m].
+    inputs : ndarray, shape (n - 1, 2)
+        CoP [m] and hip (flywheel) torque [N m] applied over each control period.
     outcome : Outcome
         ``recovered``, ``fell`` or ``undecided`` (neither within the duration).
     model, controller : str
@@ -49,10 +51,20 @@ class SimulationResult:
 
     time: NDArray[np.float64]
     states: NDArray[np.float64]
-    cops: NDArray[np.float64]
+    inputs: NDArray[np.float64]
     outcome: Outcome
     model: str
     controller: str
+
+    @property
+    def cops(self) -> NDArray[np.float64]:
+        """CoP applied over each control period [m]."""
+        return self.inputs[:, 0]
+
+    @property
+    def torques(self) -> NDArray[np.float64]:
+        """Hip (flywheel) torque applied over each control period [N m]."""
+        return self.inputs[:, 1]
 
     @property
     def recovered(self) -> bool:
@@ -77,4 +89,5 @@ class SimulationResult:
             # simulate() always runs at least one control tick, so cops is never empty.
             "peak_cop": {"min": float(self.cops.min()), "max": float(self.cops.max())},
             "max_excursion": float(np.abs(self.states[:, 0]).max()),
+            "peak_torque": float(np.abs(self.torques).max()),
         }

@@ -13,7 +13,10 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.result import Outcome, SimulationResult, is_falling
 
-__all__ = ["RestCriterion", "simulate"]
+__all__ = ["DEFAULT_CONTROL_PERIOD", "RestCriterion", "simulate"]
+
+#: Control period when neither the caller nor the controller sets one [s].
+DEFAULT_CONTROL_PERIOD = 1e-3
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,7 +41,7 @@ def simulate(
     initial_state: np.ndarray,
     *,
     duration: float = 10.0,
-    control_period: float = 1e-3,
+    control_period: float | None = None,
     rest: RestCriterion | None = None,
 ) -> SimulationResult:
     """Simulate ``controller`` on ``plant`` from ``initial_state`` (sampled-data, ZOH).
@@ -59,8 +62,9 @@ def simulate(
         Start state, e.g. ``[x, xdot]`` just after the push [m, m/s].
     duration : float
         Longest simulated time [s], > 0.
-    control_period : float
-        Controller period [s], in (0, duration].
+    control_period : float, optional
+        Controller period [s], in (0, duration]; default the controller's own
+        ``control_period`` (the MPC's dt), else 1 ms.
     rest : RestCriterion, optional
         Recovery criterion; default ``RestCriterion()``.
 
@@ -69,6 +73,8 @@ def simulate(
     SimulationResult
     """
     duration = positive_float("duration", duration, "s")
+    if control_period is None:
+        control_period = controller.control_period or DEFAULT_CONTROL_PERIOD
     dt = positive_float("control_period", control_period, "s")
     if dt > duration:
         raise InvalidParameterError(
@@ -80,22 +86,23 @@ def simulate(
     plant.check_state(state)
     rest = rest or RestCriterion()
     heel, toe = plant.params.heel, plant.params.toe
+    fall_low, fall_high = plant.fall_limits
     steps = math.ceil(duration / dt - 1e-9)
     rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))
     vel = len(state) // 2
 
     states = np.empty((steps + 1, len(state)))
-    cops = np.empty(steps)
+    inputs = np.empty((steps, 2))
     states[0] = state
     controller.reset(state)
     outcome, at_rest, k = Outcome.UNDECIDED, 0, 0
     while k < steps:
         command = controller.compute(k * dt, state)
-        state, cops[k] = plant.step(state, command, dt)
+        state, inputs[k, 0], inputs[k, 1] = plant.step(state, command, dt)
         k += 1
         states[k] = state
         x, xdot = state[0], state[vel]
-        if is_falling(x, xdot, heel, toe):
+        if is_falling(x, xdot, fall_low, fall_high):
             outcome = Outcome.FELL
             break
         at_rest = at_rest + 1 if abs(xdot) <= rest.speed and heel < x < toe else 0
@@ -105,7 +112,7 @@ def simulate(
     return SimulationResult(
         time=np.arange(k + 1, dtype=np.float64) * dt,
         states=states[: k + 1],
-        cops=cops[:k],
+        inputs=inputs[:k],
         outcome=outcome,
         model=plant.name,
         controller=controller.name,

@@ -25,7 +25,14 @@ from pushrecovery._validate import finite_array
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
-__all__ = ["CaptureInterval", "capture_point", "cop_margin", "cop_region", "critical_velocity"]
+__all__ = [
+    "CaptureInterval",
+    "capture_margin",
+    "capture_point",
+    "cop_margin",
+    "cop_region",
+    "critical_velocity",
+]
 
 # From this size on, one fused, multithreaded numba pass beats five numpy passes; below it the
 # numpy path avoids compiling the kernel at all.
@@ -84,9 +91,25 @@ def cop_margin(
 ) -> NDArray[np.float64]:
     """Signed margin of the states to the CoP-balancing surface, Eq. (4) [m].
 
-    margin = min(ξ − δ⁻, δ⁺ − ξ) = w − |ξ − c| with c the foot centre and w its half length:
-    positive inside the region (ankle torque alone recovers), zero on the surface, negative
-    outside; its magnitude is the distance of the capture point to the nearer foot edge.
+    margin = min(ξ − δ⁻, δ⁺ − ξ): positive inside the region (ankle torque alone recovers),
+    zero on the surface, negative outside; its magnitude is the distance of the capture point
+    to the nearer foot edge. See :func:`capture_margin` for the arguments.
+    """
+    return capture_margin(x, xdot, params.omega, cop_region(params), out=out)
+
+
+def capture_margin(
+    x: ArrayLike,
+    xdot: ArrayLike,
+    omega: float,
+    region: CaptureInterval,
+    *,
+    out: NDArray[np.float64] | None = None,
+) -> NDArray[np.float64]:
+    """Signed distance of the capture points to the edges of a capture interval [m].
+
+    margin = min(ξ − lower, upper − ξ) = w − |ξ − c|, with c the centre and w the half width of
+    the interval: positive inside.
 
     Parameters
     ----------
@@ -94,8 +117,10 @@ def cop_margin(
         CoM positions relative to the ankle [m].
     xdot : array_like
         CoM velocities [m/s]; broadcast against ``x``.
-    params : BodyParams
-        Body parameters (uses g, L, heel, toe).
+    omega : float
+        sqrt(g / L) [1/s].
+    region : CaptureInterval
+        Capture-point interval of a strategy [m].
     out : ndarray, optional
         Float64 array of the broadcast shape to write the margins into (saves an allocation).
 
@@ -109,10 +134,9 @@ def cop_margin(
     InvalidParameterError
         If a state is NaN or infinite.
     """
-    region = cop_region(params)
     x = np.asarray(x, dtype=np.float64)
     xdot = np.asarray(xdot, dtype=np.float64)
-    inv_omega = 1.0 / params.omega
+    inv_omega = 1.0 / omega
     centre, half = region.centre, region.half_width
     if _fusable(x, xdot, out):
         margin = np.empty_like(x) if out is None else out
@@ -165,28 +189,35 @@ def _raise_non_finite(x: NDArray[np.float64], xdot: NDArray[np.float64]) -> None
 
 
 def critical_velocity(
-    x: ArrayLike, direction: ArrayLike, params: BodyParams
+    x: ArrayLike,
+    direction: ArrayLike,
+    params: BodyParams,
+    *,
+    region: CaptureInterval | None = None,
 ) -> NDArray[np.float64]:
-    """Largest CoM velocity that CoP balancing recovers from position x, Eq. (4) [m/s].
+    """Largest CoM velocity a strategy recovers from position x, Eq. (4) by default [m/s].
 
-    Solving Eq. (4) for ẋ: forward (direction +1) ẋ < ω (δ⁺ − x), backward (direction −1)
-    ẋ > −ω (x − δ⁻). The result is signed like the velocity (negative backward).
+    Solving lower < x + ẋ/ω < upper for ẋ: forward (direction +1) ẋ < ω (upper − x),
+    backward (direction −1) ẋ > ω (lower − x). Signed like the velocity (negative backward).
 
     Parameters
     ----------
     x : array_like
-        CoM position relative to the ankle [m], inside the foot.
+        CoM position relative to the ankle [m].
     direction : array_like
         +1 for a forward push, −1 for a backward push.
     params : BodyParams
         Body parameters.
+    region : CaptureInterval, optional
+        Capture-point interval of the strategy; default the CoP region (Eq. 4).
 
     Returns
     -------
     ndarray
         Critical velocity [m/s] (the supremum: the boundary itself is not recoverable).
     """
+    region = cop_region(params) if region is None else region
     x = np.asarray(x, dtype=np.float64)
     direction = np.asarray(direction, dtype=np.float64)
-    edge = np.where(direction > 0.0, params.toe, params.heel)
+    edge = np.where(direction > 0.0, region.upper, region.lower)
     return params.omega * (edge - x)

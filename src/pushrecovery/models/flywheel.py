@@ -1,0 +1,173 @@
+r"""LIPM plus flywheel (upper body), Sec. III: Eqs. (6), (7) and (16) as corrected.
+
+State ``[x, theta, xdot, theta_dot]``: CoM position relative to the ankle [m], flywheel
+(upper-body pitch) angle [rad], and their rates. Input ``[cop, torque]``: the CoP δ [m] and the
+hip torque τ on the flywheel [N m], positive pitching the upper body forward. The reaction of τ
+on the legs moves the centroidal moment pivot (CMP) to δ + τ/(m g):
+
+.. math:: \ddot x = \omega^2 \left(x - \delta - \frac{\tau}{m g}\right), \qquad
+          I \ddot\theta = \tau,
+
+which is Eq. (6) (ω²/(m g) = 1/(m L)) and Eq. (7). The state derivative on the left of the
+printed Eq. (16) repeats (ẋ, θ̇); it is (ẋ, θ̇, ẍ, θ̈) (docs/errata.md, E9).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pushrecovery.params import BodyParams
+
+__all__ = [
+    "bang_bang_end_state",
+    "bang_bang_torque",
+    "flywheel_continuous",
+    "flywheel_discrete",
+    "flywheel_propagate",
+    "max_spin_up_time",
+]
+
+FloatArray = NDArray[np.float64]
+
+
+def max_spin_up_time(params: BodyParams) -> float:
+    """T_max = sqrt(I θmax / τmax), Eq. (12) [s]: the longest bang-bang half period.
+
+    Returns ``inf`` when τmax = 0 (no hip torque: the flywheel never reaches its limit).
+    """
+    if params.torque_max == 0.0:
+        return math.inf
+    return math.sqrt(params.flywheel_inertia * params.flywheel_angle_max / params.torque_max)
+
+
+def flywheel_continuous(params: BodyParams) -> tuple[FloatArray, FloatArray]:
+    """Continuous-time matrices (A, B) of Eq. (16): Ẋ = A X + B U, X = (x, θ, ẋ, θ̇), U = (δ, τ)."""
+    w2 = params.omega**2
+    a = np.zeros((4, 4))
+    a[0, 2] = a[1, 3] = 1.0
+    a[2, 0] = w2
+    b = np.zeros((4, 2))
+    b[2, 0] = -w2
+    b[2, 1] = -1.0 / (params.mass * params.com_height)
+    b[3, 1] = 1.0 / params.flywheel_inertia
+    return a, b
+
+
+def flywheel_discrete(params: BodyParams, dt: float) -> tuple[FloatArray, FloatArray]:
+    r"""Exact zero-order-hold discretisation X[k+1] = A X[k] + B U[k] of Eq. (16).
+
+    The CoM part is Eq. (24) with the CMP c = δ + τ/(m g) held; the flywheel is a double
+    integrator. With ch = cosh ω dt, sh = sinh ω dt:
+
+    .. math::
+        A = \begin{bmatrix} ch & 0 & sh/\omega & 0 \\ 0 & 1 & 0 & dt \\
+                            \omega sh & 0 & ch & 0 \\ 0 & 0 & 0 & 1 \end{bmatrix},\quad
+        B = \begin{bmatrix} 1 - ch & (1 - ch)/(m g) \\ 0 & dt^2/(2I) \\
+                            -\omega sh & -\omega sh/(m g) \\ 0 & dt/I \end{bmatrix}.
+
+    Parameters
+    ----------
+    params : BodyParams
+        Body parameters.
+    dt : float
+        Step [s].
+
+    Returns
+    -------
+    A : ndarray, shape (4, 4)
+    B : ndarray, shape (4, 2)
+    """
+    omega, weight, inertia = params.omega, params.weight, params.flywheel_inertia
+    ch, sh = math.cosh(omega * dt), math.sinh(omega * dt)
+    a = np.array(
+        [
+            [ch, 0.0, sh / omega, 0.0],
+            [0.0, 1.0, 0.0, dt],
+            [omega * sh, 0.0, ch, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
+    b = np.array(
+        [
+            [1.0 - ch, (1.0 - ch) / weight],
+            [0.0, 0.5 * dt * dt / inertia],
+            [-omega * sh, -omega * sh / weight],
+            [0.0, dt / inertia],
+        ]
+    )
+    return a, b
+
+
+def flywheel_propagate(
+    states: ArrayLike, inputs: ArrayLike, params: BodyParams, dt: float
+) -> FloatArray:
+    """Advance arrays of states (..., 4) with inputs (..., 2) held for dt (exact, vectorised)."""
+    a, b = flywheel_discrete(params, dt)
+    return np.asarray(states, dtype=np.float64) @ a.T + np.asarray(inputs, dtype=np.float64) @ b.T
+
+
+def bang_bang_torque(t: ArrayLike, switch_time: float, torque_max: float) -> FloatArray:
+    """Bang-bang flywheel torque, Eq. (8) as corrected (errata E8) [N m].
+
+    τ = +τmax on [0, T), −τmax on [T, 2T), 0 afterwards, i.e.
+    τ(t) = τmax (1 − 2 u(t − T) + u(t − 2T)) with u the unit step.
+    """
+    t = np.asarray(t, dtype=np.float64)
+    return torque_max * np.where(t < switch_time, 1.0, np.where(t < 2.0 * switch_time, -1.0, 0.0))
+
+
+def bang_bang_end_state(
+    x0: ArrayLike,
+    xdot0: ArrayLike,
+    params: BodyParams,
+    *,
+    switch_time: float,
+    cop: float,
+    direction: float = 1.0,
+) -> tuple[FloatArray, FloatArray, float, float]:
+    r"""State at t = 2T under bang-bang torque and a constant CoP, from θ(0) = θ̇(0) = 0.
+
+    With a = direction · τmax/(m g) the CMP offset and T the switch time (errata E10):
+
+    .. math::
+        x(2T) = \delta + (x_0 - \delta)\cosh 2\omega T + \frac{\dot x_0}{\omega}\sinh 2\omega T
+                + a(-\cosh 2\omega T + 2\cosh\omega T - 1),
+
+        \dot x(2T) = \omega(x_0 - \delta)\sinh 2\omega T + \dot x_0\cosh 2\omega T
+                + a\omega(-\sinh 2\omega T + 2\sinh\omega T),
+
+    θ(2T) = direction · τmax T² / I (Eq. 11) and θ̇(2T) = 0 (Eq. 10).
+
+    Parameters
+    ----------
+    x0, xdot0 : array_like
+        CoM state at t = 0 [m, m/s].
+    params : BodyParams
+        Body parameters.
+    switch_time : float
+        T [s], at most :func:`max_spin_up_time` to respect the joint limit.
+    cop : float
+        CoP δ held on [0, 2T] [m].
+    direction : float
+        +1 spins the flywheel forward first (for a forward push), −1 backward.
+
+    Returns
+    -------
+    x, xdot : ndarray
+        CoM position [m] and velocity [m/s] at 2T.
+    theta, theta_dot : float
+        Flywheel angle [rad] and rate [rad/s] at 2T.
+    """
+    omega, t = params.omega, switch_time
+    a = direction * params.torque_max / params.weight
+    offset = np.asarray(x0, dtype=np.float64) - cop
+    xdot0 = np.asarray(xdot0, dtype=np.float64)
+    c1, s1 = math.cosh(omega * t), math.sinh(omega * t)
+    c2, s2 = math.cosh(2.0 * omega * t), math.sinh(2.0 * omega * t)
+    x = cop + offset * c2 + xdot0 / omega * s2 + a * (-c2 + 2.0 * c1 - 1.0)
+    xdot = omega * offset * s2 + xdot0 * c2 + a * omega * (-s2 + 2.0 * s1)
+    theta = direction * params.torque_max * t * t / params.flywheel_inertia
+    return x, xdot, theta, 0.0

@@ -1,0 +1,59 @@
+r"""CMP-balancing (hip strategy) decision surface, Eq. (15) as corrected (errata E11).
+
+With the ankle saturated (CoP on the toe) and the flywheel driven bang-bang for T = T_max from
+rest (Eqs. 8-12), the capture point obeys ξ̇ = ω (ξ − δ − τ/(m g)), so
+
+.. math:: \xi(2T) = \delta + e^{2\omega T}(\xi_0 - \delta) - a\,(e^{\omega T} - 1)^2,
+          \qquad a = \tau_{max} / (m g).
+
+Requiring ξ(2T) < δ⁺ (Eq. 9) gives Eq. (13), and dividing by e^{2ωT} the bound
+
+.. math:: \delta^- - a (1 - e^{-\omega T_{max}})^2 < x + \frac{\dot x}{\omega}
+          < \delta^+ + a (1 - e^{-\omega T_{max}})^2 .
+
+The printed Eq. (15) has (e^{ωT} − 1)² in place of (1 − e^{−ωT})², a factor e^{2ωT} (7.2 for
+the paper preset) too optimistic. This bound is also the supremum over *all* flywheel
+controllers that respect |τ| ≤ τmax and |θ| ≤ θmax from a flywheel at rest (errata E12): the
+bang-bang profile maximises θ(t) at every t, and the capturable capture point is
+δ⁺ + (ω³ I / m g) ∫ e^{−ωs} θ(s) ds.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pushrecovery.models.flywheel import max_spin_up_time
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cop import CaptureInterval, capture_margin
+
+__all__ = ["cmp_margin", "cmp_offset", "cmp_region"]
+
+
+def cmp_offset(params: BodyParams) -> float:
+    """How far the hip strategy extends the capture region past each foot edge [m].
+
+    a (1 − e^{−ω T_max})², a = τmax / (m g), corrected Eq. (15). Zero when τmax = 0.
+    """
+    if params.torque_max == 0.0:
+        return 0.0
+    spin_up = max_spin_up_time(params)
+    return params.torque_max / params.weight * (1.0 - math.exp(-params.omega * spin_up)) ** 2
+
+
+def cmp_region(params: BodyParams) -> CaptureInterval:
+    """Capture-point bounds of CMP balancing, corrected Eq. (15) [m]."""
+    offset = cmp_offset(params)
+    return CaptureInterval(params.heel - offset, params.toe + offset)
+
+
+def cmp_margin(
+    x: ArrayLike, xdot: ArrayLike, params: BodyParams, *, out: NDArray[np.float64] | None = None
+) -> NDArray[np.float64]:
+    """Signed margin of the states to the CMP-balancing surface [m], positive inside.
+
+    Vectorised like :func:`pushrecovery.surfaces.cop.cop_margin`.
+    """
+    return capture_margin(x, xdot, params.omega, cmp_region(params), out=out)
