@@ -23,6 +23,7 @@ from pushrecovery.params import BodyParams
 
 __all__ = [
     "bang_bang_end_state",
+    "bang_bang_switch_time",
     "bang_bang_torque",
     "flywheel_continuous",
     "flywheel_discrete",
@@ -171,3 +172,46 @@ def bang_bang_end_state(
     xdot = omega * offset * s2 + xdot0 * c2 + a * omega * (-s2 + 2.0 * s1)
     theta = direction * params.torque_max * t * t / params.flywheel_inertia
     return x, xdot, theta, 0.0
+
+
+def bang_bang_switch_time(
+    capture_point: float, target: float, params: BodyParams, *, cop: float, direction: float
+) -> float:
+    """Shortest bang-bang half period T that moves the capture point to ``target`` at 2T [s].
+
+    From Eq. (13): with y = e^{ωT} and a = direction · τmax/(m g), the capture point at 2T is
+    ξ(2T) = δ + y² (ξ0 − δ) − a (y − 1)². Setting ξ(2T) = target gives the quadratic
+    (ξ0 − δ − a) y² + 2 a y − (a + target − δ) = 0, whose root y ≥ 1 nearest 1 is used.
+    Returns T_max (Eq. 12) when the target cannot be reached within the joint limit, and 0
+    when no spin-up is needed.
+
+    Parameters
+    ----------
+    capture_point : float
+        ξ0 [m].
+    target : float
+        Wanted capture point at 2T [m].
+    params : BodyParams
+        Body parameters.
+    cop : float
+        CoP δ held meanwhile [m].
+    direction : float
+        +1 or −1, sign of the first torque pulse.
+    """
+    spin_up = max_spin_up_time(params)
+    a = direction * params.torque_max / params.weight
+    if a == 0.0:
+        return spin_up
+    quad, lin, const = capture_point - cop - a, 2.0 * a, -(a + target - cop)
+    if abs(quad) < 1e-15:
+        roots = [-const / lin]
+    else:
+        disc = lin * lin - 4.0 * quad * const
+        if disc < 0.0:
+            return spin_up
+        sq = math.sqrt(disc)
+        roots = [(-lin - sq) / (2.0 * quad), (-lin + sq) / (2.0 * quad)]
+    feasible = [y for y in roots if y >= 1.0]
+    if not feasible:
+        return 0.0 if (capture_point - target) * direction <= 0.0 else spin_up
+    return min(spin_up, math.log(min(feasible)) / params.omega)

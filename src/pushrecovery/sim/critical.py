@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -15,6 +16,7 @@ from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.push import direction_sign
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.classify import strategy_region
 from pushrecovery.surfaces.cop import critical_velocity
 
 __all__ = ["CriticalPush", "NotRecoverableError", "critical_push", "find_critical_velocity"]
@@ -124,19 +126,22 @@ def critical_push(
     *,
     tolerance: float = 1e-4,
     duration: float = 10.0,
-    control_period: float = 1e-3,
-    controller_options: dict[str, float] | None = None,
+    control_period: float | None = None,
+    controller_options: dict[str, Any] | None = None,
 ) -> CriticalPush:
-    """Critical push of a model + controller from CoM position ``x0``, with Eq. (4)'s prediction.
+    """Critical push of a model + controller from CoM position ``x0``, with its prediction.
+
+    The prediction is the critical velocity of the decision surface of the controller's
+    strategy: Eq. (4) for the ankle controllers, corrected Eq. (15) for the hip controllers.
 
     Parameters
     ----------
     params : BodyParams
         Body parameters.
     model : str
-        Plant name (``lipm`` or ``pendulum``).
+        Plant name (``lipm``, ``pendulum`` or ``flywheel``).
     controller : str
-        Controller name (``ankle-saturated`` or ``ankle-pd``).
+        Controller name (``ankle-saturated``, ``ankle-pd``, ``bang-bang``, ``mpc``).
     x0 : float
         CoM position before the push, strictly on the foot [m].
     direction : {"forward", "backward"}
@@ -144,14 +149,15 @@ def critical_push(
     tolerance : float
         Bracket width [m/s].
     duration, control_period : float
-        Simulation length and controller period [s], see :func:`simulate`.
+        Simulation length and controller period [s], see :func:`simulate` (the period
+        defaults to the controller's own).
     controller_options : dict, optional
         Keyword options of the controller (e.g. ``stiffness``, ``damping``).
 
     Returns
     -------
     CriticalPush
-        ``velocity`` signed like ẋ [m/s]; ``predicted_velocity`` from Eq. (4).
+        ``velocity`` signed like ẋ [m/s]; ``predicted_velocity`` from the surface.
     """
     x0 = finite_float("x", x0, "m")
     if not params.heel < x0 < params.toe:
@@ -161,11 +167,16 @@ def critical_push(
     sign = direction_sign(direction)
     plant = make_plant(model, params)
     ctrl = make_controller(controller, params, **(controller_options or {}))
-    predicted = float(critical_velocity(x0, sign, params))
+    region = strategy_region(ctrl.strategy, params)
+    predicted = float(critical_velocity(x0, sign, params, region=region))
 
     def outcome_of(velocity: float) -> Outcome:
         run = simulate(
-            plant, ctrl, np.array([x0, velocity]), duration=duration, control_period=control_period
+            plant,
+            ctrl,
+            plant.initial_state(x0, velocity),
+            duration=duration,
+            control_period=control_period,
         )
         return run.outcome
 

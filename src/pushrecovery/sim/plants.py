@@ -32,6 +32,10 @@ class Plant(Protocol):
     params: BodyParams
     fall_limits: tuple[float, float]
 
+    def initial_state(self, x: float, xdot: float) -> FloatArray:
+        """State with the CoM at x [m] moving at ẋ [m/s], everything else at rest."""
+        ...
+
     def check_state(self, state: FloatArray) -> None:
         """Raise :class:`InvalidParameterError` if the model cannot start from ``state``."""
 
@@ -52,7 +56,12 @@ class _AnklePlant:
         # Beyond a foot edge, moving outward: lost for any CoP (docs/conventions.md).
         self.fall_limits = (params.heel, params.toe)
 
+    def initial_state(self, x: float, xdot: float) -> FloatArray:
+        """``[x, xdot]``."""
+        return np.array([x, xdot], dtype=np.float64)
+
     def check_state(self, state: FloatArray) -> None:
+        """Require ``[x, xdot]``."""
         if state.shape != (2,):
             raise InvalidParameterError(f"state must be [x, xdot], got shape {state.shape}")
 
@@ -139,6 +148,10 @@ class FlywheelPlant:
         self.fall_limits = (params.heel - reach, params.toe + reach)
         self._dt = -1.0
         self._a = self._b = np.empty(0)
+
+    def initial_state(self, x: float, xdot: float) -> FloatArray:
+        """``[x, 0, xdot, 0]``: the upper body upright and at rest."""
+        return np.array([x, 0.0, xdot, 0.0])
 
     def check_state(self, state: FloatArray) -> None:
         """Require ``[x, theta, xdot, theta_dot]`` with |θ| ≤ θmax."""

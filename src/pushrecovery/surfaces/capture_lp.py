@@ -77,7 +77,7 @@ def largest_capture_point(
     from scipy.optimize import linprog
 
     dt = positive_float("dt", dt, "s")
-    steps = int(round(positive_float("horizon", horizon, "s") / dt))
+    steps = max(1, round(positive_float("horizon", horizon, "s") / dt))
     a, b = flywheel_discrete(params, dt)
     # State k is affine in the decision vector z = (ẋ0, δ_0, τ_0, ..., δ_{N-1}, τ_{N-1}):
     # X_k = S_k z. Build S_k forward with the dynamics.

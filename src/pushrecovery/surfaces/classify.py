@@ -1,13 +1,14 @@
 """The strategy a state needs, from the decision surfaces available so far.
 
 Vocabulary (stable, part of the JSON contract): ``ankle`` (CoP balancing, Eq. 4), ``hip``
-(CMP balancing, Sec. III), ``step`` (Sec. IV) and ``fall``. Until the hip and step surfaces
-land, every state outside the CoP region is reported as ``step``: Sec. II's own fallback
-("either a different balance strategy is needed or a step should be initiated").
+(CMP balancing, corrected Eq. 15), ``step`` (Sec. IV) and ``fall``. Until the stepping surface
+lands, every state outside the CMP region is reported as ``step``: the paper's own fallback
+("If the system is outside, however, it will have to take a step to avoid falling over").
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -15,10 +16,19 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery._validate import finite_float
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.cop import capture_point, cop_margin
+from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
+from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
 
-__all__ = ["STRATEGY_CODES", "Classification", "Strategy", "classify", "classify_states"]
+__all__ = [
+    "STRATEGY_CODES",
+    "Classification",
+    "Strategy",
+    "classify",
+    "classify_states",
+    "strategy_region",
+]
 
 
 class Strategy(StrEnum):
@@ -33,6 +43,21 @@ class Strategy(StrEnum):
 #: Integer codes used by the vectorised classifier, index = code.
 STRATEGY_CODES: tuple[Strategy, ...] = tuple(Strategy)
 
+_REGIONS: dict[str, Callable[[BodyParams], CaptureInterval]] = {
+    Strategy.ANKLE: cop_region,
+    Strategy.HIP: cmp_region,
+}
+
+
+def strategy_region(strategy: str, params: BodyParams) -> CaptureInterval:
+    """Capture-point interval of a balancing strategy (``ankle`` or ``hip``) [m]."""
+    try:
+        return _REGIONS[strategy](params)
+    except KeyError:
+        raise InvalidParameterError(
+            f"strategy must be one of {sorted(_REGIONS)}, got {strategy!r}"
+        ) from None
+
 
 @dataclass(frozen=True, slots=True)
 class Classification:
@@ -43,7 +68,7 @@ class Classification:
     margins: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, object]:
-        """JSON form: ``{"capture_point", "strategy", "margins": {"cop", ...}}``."""
+        """JSON form: ``{"capture_point", "strategy", "margins": {"cop", "cmp"}}``."""
         return {
             "capture_point": self.capture_point,
             "strategy": self.strategy.value,
@@ -52,7 +77,7 @@ class Classification:
 
 
 def classify(x: float, xdot: float, params: BodyParams) -> Classification:
-    """Classify one CoM state.
+    """Classify one CoM state (CoM upright upper body at rest, as the surfaces assume).
 
     Parameters
     ----------
@@ -66,17 +91,27 @@ def classify(x: float, xdot: float, params: BodyParams) -> Classification:
     Returns
     -------
     Classification
-        ``ankle`` when the capture point is strictly inside the foot (Eq. 4), else ``step``.
+        ``ankle`` when the capture point is strictly inside the foot (Eq. 4), ``hip`` when it
+        is inside the CMP region (corrected Eq. 15), else ``step``.
     """
     x = finite_float("x", x, "m")
     xdot = finite_float("xdot", xdot, "m/s")
-    margin = float(cop_margin(x, xdot, params))
-    strategy = Strategy.ANKLE if margin > 0.0 else Strategy.STEP
-    return Classification(float(capture_point(x, xdot, params.omega)), strategy, {"cop": margin})
+    cop = float(cop_margin(x, xdot, params))
+    cmp = float(cmp_margin(x, xdot, params))
+    if cop > 0.0:
+        strategy = Strategy.ANKLE
+    elif cmp > 0.0:
+        strategy = Strategy.HIP
+    else:
+        strategy = Strategy.STEP
+    capture = float(capture_point(x, xdot, params.omega))
+    return Classification(capture, strategy, {"cop": cop, "cmp": cmp})
 
 
 def classify_states(x: ArrayLike, xdot: ArrayLike, params: BodyParams) -> NDArray[np.int8]:
     """Vectorised :func:`classify`: integer codes into :data:`STRATEGY_CODES`."""
-    margin = cop_margin(x, xdot, params)
-    ankle, step = STRATEGY_CODES.index(Strategy.ANKLE), STRATEGY_CODES.index(Strategy.STEP)
-    return np.where(margin > 0.0, ankle, step).astype(np.int8)
+    step = STRATEGY_CODES.index(Strategy.STEP)
+    codes = np.full(np.broadcast_shapes(np.shape(x), np.shape(xdot)), step, dtype=np.int8)
+    codes[cmp_margin(x, xdot, params) > 0.0] = STRATEGY_CODES.index(Strategy.HIP)
+    codes[cop_margin(x, xdot, params) > 0.0] = STRATEGY_CODES.index(Strategy.ANKLE)
+    return codes

@@ -1,0 +1,8 @@
+"""Receding-horizon CMP balancing, Sec. III-B (Eqs. 16-17)."""
+
+from pushrecovery.control.mpc.controller import MPCController
+from pushrecovery.control.mpc.plan import Plan
+from pushrecovery.control.mpc.problem import MPCSettings
+from pushrecovery.control.mpc.qp import CondensedQP
+
+__all__ = ["CondensedQP", "MPCController", "MPCSettings", "Plan"]

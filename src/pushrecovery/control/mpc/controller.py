@@ -1,0 +1,113 @@
+"""The receding-horizon controller: solve the QP each tick, apply the first input."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.control.base import Command, Controller, register
+from pushrecovery.control.mpc.plan import Plan
+from pushrecovery.control.mpc.problem import MPCSettings
+from pushrecovery.control.mpc.qp import CondensedQP
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+
+__all__ = ["MPCController"]
+
+
+@register
+class MPCController(Controller):
+    """Receding-horizon CMP balancing (Eqs. 16-17), the paper's settings by default.
+
+    Each tick solves the condensed QP (:class:`CondensedQP`) from the measured state
+    ``[x, θ, ẋ, θ̇]`` and returns its first input. If the QP is infeasible (the flywheel cannot
+    avoid its joint limit) the command is a saturated fallback, ``saturated=True``, and
+    ``last_plan.feasible`` is False: CoP at the capture point clipped to the foot, full torque
+    braking the flywheel. It never raises inside the loop.
+
+    Parameters
+    ----------
+    params : BodyParams
+        Body parameters.
+    settings : MPCSettings, optional
+        Horizon, weights, γ, dt and solver; keyword overrides of the defaults may be passed
+        instead (``dt=``, ``horizon=``, ...).
+    """
+
+    name = "mpc"
+    strategy = "hip"
+
+    def __init__(
+        self, params: BodyParams, settings: MPCSettings | None = None, **overrides: Any
+    ) -> None:
+        super().__init__(params)
+        settings = settings or MPCSettings(**overrides)
+        from qpsolvers import available_solvers
+
+        if settings.solver not in available_solvers:
+            raise InvalidParameterError(
+                f"solver must be one of {sorted(available_solvers)}, got {settings.solver!r}"
+            )
+        self.settings = settings
+        self.control_period = settings.dt
+        self.qp = CondensedQP(params, settings)
+        self.last_plan: Plan | None = None
+
+    def reset(self, state: NDArray[np.float64]) -> None:
+        """Forget the last plan; the MPC is otherwise stateless."""
+        self._check(state)
+        self.last_plan = None
+
+    def plan(self, state: NDArray[np.float64]) -> Plan:
+        """Solve the QP from ``state``; the fallback plan if it is infeasible."""
+        from qpsolvers import solve_qp
+
+        qp = self.qp
+        q, h = qp.vectors(state)
+        try:
+            solution = solve_qp(
+                qp.scaled_hessian,
+                q,
+                qp.scaled_inequality,
+                h,
+                lb=qp.scaled_lower,
+                ub=qp.scaled_upper,
+                solver=self.settings.solver,
+            )
+        except ValueError:  # some back-ends raise on infeasible problems
+            solution = None
+        if solution is None or not np.all(np.isfinite(solution)):
+            inputs = np.tile(self._fallback(state), (self.settings.horizon, 1))
+            return Plan(inputs, qp.predict(state, inputs), feasible=False)
+        inputs = qp.unscale(solution)
+        return Plan(inputs, qp.predict(state, inputs), feasible=True)
+
+    def compute(self, t: float, state: NDArray[np.float64]) -> Command:
+        """First input of the plan from ``state`` (δ [m], τ [N m])."""
+        plan = self.plan(np.asarray(state, dtype=np.float64))
+        self.last_plan = plan
+        cop, torque = plan.first_input
+        p = self.params
+        # Clip what the solver's tolerance may leave a hair outside the limits.
+        cop = min(p.toe, max(p.heel, float(cop)))
+        torque = min(p.torque_max, max(-p.torque_max, float(torque)))
+        at_limit = cop in (p.heel, p.toe) or abs(torque) >= p.torque_max * (1 - 1e-9)
+        return Command(cop, torque, saturated=at_limit or not plan.feasible)
+
+    def _fallback(self, state: NDArray[np.float64]) -> NDArray[np.float64]:
+        p = self.params
+        capture = state[0] + state[2] / p.omega
+        cop = min(p.toe, max(p.heel, capture))
+        rate = state[3]
+        torque = -math.copysign(p.torque_max, rate) if rate != 0.0 else 0.0
+        return np.array([cop, torque])
+
+    def _check(self, state: NDArray[np.float64]) -> None:
+        if np.shape(state) != (4,):
+            raise InvalidParameterError(
+                f"the mpc controller needs the flywheel state [x, theta, xdot, theta_dot], "
+                f"got shape {np.shape(state)}"
+            )
