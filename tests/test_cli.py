@@ -29,6 +29,50 @@ def test_bounds_contract():
     assert data["omega"] == pytest.approx(9.81**0.5)
 
 
+def test_bounds_cmp_keys():
+    cmp = run_json("bounds")["cmp"]
+    assert set(cmp) >= {"lower", "upper", "margin", "t_max"}
+    assert cmp["t_max"] == pytest.approx((10.0 * 1.0 / 100.0) ** 0.5)
+    assert cmp["upper"] == pytest.approx(0.15 + cmp["margin"])
+    assert cmp["lower"] == pytest.approx(-0.05 - cmp["margin"])
+    assert run_json("bounds", "--torque-max", "0")["cmp"]["t_max"] is None
+
+
+def test_choices_match_the_registries():
+    from pushrecovery.cli.app import CONTROLLER_CHOICES, MODEL_CHOICES
+    from pushrecovery.control import CONTROLLERS
+    from pushrecovery.sim.plants import MODELS
+
+    assert set(MODEL_CHOICES) == set(MODELS)
+    assert set(CONTROLLER_CHOICES) == set(CONTROLLERS)
+
+
+def test_hip_commands():
+    hip = run_json("classify", "--x", "0", "--xdot", "0.55")
+    assert hip["strategy"] == "hip" and set(hip["margins"]) == {"cop", "cmp"}
+    run = run_json("simulate", "--model", "flywheel", "--controller", "mpc", "--xdot", "0.6")
+    assert run["recovered"] is True and set(run["final_state"]) >= {"x", "xdot", "theta"}
+    assert run["peak_torque"] == pytest.approx(100.0)
+    found = run_json(
+        "critical-push", "--model", "flywheel", "--controller", "bang-bang", "--tolerance", "1e-3"
+    )
+    assert found["velocity"] == pytest.approx(found["predicted_velocity"], abs=1e-3)
+    short = run_json(
+        "simulate",
+        "--model",
+        "flywheel",
+        "--controller",
+        "mpc",
+        "--xdot",
+        "0.3",
+        "--option",
+        "horizon=20",
+        "--option",
+        "gamma=1",
+    )
+    assert short["recovered"] is True
+
+
 def test_parameter_flags_override(tmp_path):
     data = run_json("bounds", "--toe", "0.2", "--com-height", "0.81")
     assert data["cop"]["upper"] == 0.2
@@ -129,6 +173,24 @@ def test_table_output_is_readable():
         (["critical-push", "--kp", "100"], "stiffness must be > m g L"),
         (["bounds", "--params", "/nonexistent.toml"], "not found"),
         (["nonsense"], "No such command"),
+        (["simulate", "--model", "lipm", "--controller", "mpc"], "use the flywheel model"),
+        (
+            ["simulate", "--model", "flywheel", "--controller", "mpc", "--option", "horizon=x"],
+            "must be a number",
+        ),
+        (
+            ["simulate", "--model", "flywheel", "--controller", "mpc", "--option", "horizon"],
+            "NAME=VALUE",
+        ),
+        (
+            ["simulate", "--model", "flywheel", "--controller", "mpc", "--option", "gamma=2"],
+            "gamma must be in",
+        ),
+        (
+            ["simulate", "--model", "flywheel", "--controller", "mpc", "--option", "bogus=1"],
+            "has no option 'bogus'",
+        ),
+        (["simulate", "--controller", "ankle-saturated", "--kp", "2000"], "apply to ankle-pd"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(capsys, args, words):

@@ -128,15 +128,24 @@ def test_pd_gain_validation():
 
 
 @pytest.mark.parametrize("name", sorted(CONTROLLERS))
-@given(x=st.floats(-0.9, 0.9), v=st.floats(-5, 5), t=st.floats(0, 10))
-def test_controller_contract(name, x, v, t):
+@given(
+    x=st.floats(-0.9, 0.9),
+    v=st.floats(-5, 5),
+    t=st.floats(0, 10),
+    theta=st.floats(-1.0, 1.0),
+    rate=st.floats(-20, 20),
+)
+def test_controller_contract(name, x, v, t, theta, rate):
     controller = make_controller(name, PARAMS)
-    state = np.array([x, v])
+    hip = controller.strategy == "hip"
+    state = np.array([x, theta, v, rate]) if hip else np.array([x, v])
     controller.reset(state)
     command = controller.compute(t, state)
-    assert math.isfinite(command.cop)
+    assert math.isfinite(command.cop) and math.isfinite(command.flywheel_torque)
     assert PARAMS.heel <= command.cop <= PARAMS.toe
-    assert command.flywheel_torque == 0.0
+    assert abs(command.flywheel_torque) <= PARAMS.torque_max
+    if not hip:
+        assert command.flywheel_torque == 0.0
 
 
 def test_saturated_controller_brakes_on_the_edge_then_holds():

@@ -10,8 +10,10 @@ import click
 from pushrecovery import __version__
 from pushrecovery.cli.options import body_options, emit, params_from
 
-MODEL_CHOICES = ("lipm", "pendulum")
-CONTROLLER_CHOICES = ("ankle-saturated", "ankle-pd")
+# Kept literal so that --help does not import the models; a test checks them against the
+# registries.
+MODEL_CHOICES = ("lipm", "pendulum", "flywheel")
+CONTROLLER_CHOICES = ("ankle-saturated", "ankle-pd", "bang-bang", "mpc")
 
 
 @click.group(
@@ -30,16 +32,26 @@ def cli() -> None:
 @cli.command(short_help="Capture-point bounds of each strategy.")
 @body_options
 def bounds(as_json: bool, **kwargs: Any) -> None:
-    """Capture-point bounds of each balance strategy (Eq. 4)."""
+    """Capture-point bounds of each balance strategy (Eq. 4, corrected Eq. 15)."""
+    from pushrecovery.models.flywheel import max_spin_up_time
+    from pushrecovery.surfaces.cmp import cmp_offset, cmp_region
     from pushrecovery.surfaces.cop import cop_region
 
     params = params_from(kwargs)
-    region = cop_region(params)
+    cop, cmp = cop_region(params), cmp_region(params)
+    spin_up = max_spin_up_time(params)
     emit(
         {
             "params": params.to_dict(),
             "omega": params.omega,
-            "cop": {"lower": region.lower, "upper": region.upper},
+            "cop": {"lower": cop.lower, "upper": cop.upper},
+            "cmp": {
+                "lower": cmp.lower,
+                "upper": cmp.upper,
+                "margin": cmp_offset(params),
+                # JSON has no infinity: without hip torque there is no spin-up at all.
+                "t_max": spin_up if spin_up != float("inf") else None,
+            },
         },
         as_json,
     )
@@ -69,9 +81,33 @@ def _push_velocity(xdot: float | None, impulse: float | None, mass: float) -> fl
     return 0.0 if xdot is None else xdot
 
 
-def _controller_options(kp: float | None, kd: float | None) -> dict[str, float]:
-    options = {"stiffness": kp, "damping": kd}
+def _controller_options(
+    kp: float | None, kd: float | None, pairs: tuple[str, ...] = ()
+) -> dict[str, Any]:
+    from pushrecovery.errors import InvalidParameterError
+
+    options: dict[str, Any] = {"stiffness": kp, "damping": kd}
+    for pair in pairs:
+        name, sep, text = pair.partition("=")
+        if not sep or not name:
+            raise InvalidParameterError(f"--option must be NAME=VALUE, got {pair!r}")
+        try:
+            value: Any = int(text) if text.lstrip("+-").isdigit() else float(text)
+        except ValueError:
+            raise InvalidParameterError(f"--option {name} must be a number, got {text!r}") from None
+        options[name.replace("-", "_")] = value
     return {k: v for k, v in options.items() if v is not None}
+
+
+def _options_for(controller: str, options: dict[str, Any]) -> dict[str, Any]:
+    """Drop the ankle-pd gain flags for other controllers (they default to None anyway)."""
+    if controller != "ankle-pd":
+        for gain in ("stiffness", "damping"):
+            if gain in options:
+                from pushrecovery.errors import InvalidParameterError
+
+                raise InvalidParameterError(f"--kp/--kd apply to ankle-pd, not {controller!r}")
+    return options
 
 
 _model = click.option(
@@ -91,6 +127,14 @@ _controller = click.option(
 _gains = (
     click.option("--kp", type=float, default=None, help="ankle-pd stiffness [N m/rad]."),
     click.option("--kd", type=float, default=None, help="ankle-pd damping [N m s/rad]."),
+    click.option(
+        "--option",
+        "options",
+        multiple=True,
+        metavar="NAME=VALUE",
+        help="Controller option, repeatable: e.g. horizon=30, gamma=1, dt=0.01 (mpc); "
+        "switch_time=0.2 (bang-bang).",
+    ),
 )
 
 
@@ -133,18 +177,17 @@ def simulate(
     controller: str,
     kp: float | None,
     kd: float | None,
+    options: tuple[str, ...],
     x: float,
     xdot: float | None,
     impulse: float | None,
     duration: float,
-    control_period: float,
+    control_period: float | None,
     plot: str | None,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
     """Simulate a push on a model with a controller; report recovered or fell."""
-    import numpy as np
-
     from pushrecovery.control.base import make_controller
     from pushrecovery.sim.plants import make_plant
     from pushrecovery.sim.simulate import simulate as run
@@ -153,10 +196,13 @@ def simulate(
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)
     predicted = classify_state(x, velocity, params)
+    plant = make_plant(model, params)
     result = run(
-        make_plant(model, params),
-        make_controller(controller, params, **_controller_options(kp, kd)),
-        np.array([x, velocity]),
+        plant,
+        make_controller(
+            controller, params, **_options_for(controller, _controller_options(kp, kd, options))
+        ),
+        plant.initial_state(x, velocity),
         duration=duration,
         control_period=control_period,
     )
@@ -203,6 +249,7 @@ def critical_push(
     controller: str,
     kp: float | None,
     kd: float | None,
+    options: tuple[str, ...],
     x: float,
     direction: str,
     tolerance: float,
@@ -210,7 +257,7 @@ def critical_push(
     as_json: bool,
     **kwargs: Any,
 ) -> None:
-    """Largest recoverable push from x by bisection, against Eq. 4's prediction."""
+    """Largest recoverable push from x by bisection, against the strategy's surface."""
     from pushrecovery.sim.critical import critical_push as search
 
     params = params_from(kwargs)
@@ -222,7 +269,7 @@ def critical_push(
         direction,
         tolerance=tolerance,
         duration=duration,
-        controller_options=_controller_options(kp, kd),
+        controller_options=_options_for(controller, _controller_options(kp, kd, options)),
     )
     emit(
         {
@@ -261,7 +308,7 @@ def critical_push(
 )
 @body_options
 def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) -> None:
-    """Reproduce the paper's figures (Fig. 3a, 3b) into a directory."""
+    """Reproduce the paper's figures (Fig. 3, 5, 6) into a directory."""
     from pushrecovery.plots.figures import write_figures
 
     params = params_from(kwargs)

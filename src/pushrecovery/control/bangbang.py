@@ -54,6 +54,9 @@ class BangBang(Controller):
                     f"switch_time must be <= T_max = {spin_up:g} s (Eq. 12), got {switch_time:g}"
                 )
         self.fixed_switch_time = switch_time
+        # Its own period puts T_max on a whole number of ticks (about 1 ms), so that both
+        # torque pulses last equally long and the flywheel ends at rest (Eq. 10).
+        self.control_period = spin_up / math.ceil(spin_up / 1e-3)
         self.switch_time = 0.0
         self._inv_omega = 1.0 / params.omega
         self._direction = 0.0
@@ -72,13 +75,16 @@ class BangBang(Controller):
         if self.fixed_switch_time is not None:
             self.switch_time = self.fixed_switch_time
         else:
-            self.switch_time = bang_bang_switch_time(
+            switch = bang_bang_switch_time(
                 capture, 0.5 * (p.heel + p.toe), p, cop=edge, direction=self._direction
             )
+            tick = self.control_period
+            self.switch_time = round(switch / tick) * tick
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """Bang-bang on [0, 2T) with the CoP on the edge, then CoP at the capture point."""
-        direction, switch = self._direction, self.switch_time
+        # Half a microsecond of slack so that t = k dt lands on the intended side of a switch.
+        direction, switch = self._direction, self.switch_time - 5e-7
         if direction != 0.0 and t < 2.0 * switch:
             edge = self.params.toe if direction > 0.0 else self.params.heel
             sign = direction if t < switch else -direction

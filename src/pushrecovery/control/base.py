@@ -16,6 +16,7 @@ Contract (what the simulators, the CLI and a robot's control loop may rely on):
 
 from __future__ import annotations
 
+import inspect
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -71,6 +72,12 @@ class Controller(ABC):
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """Return the command for time ``t`` [s] and ``state``."""
 
+    @classmethod
+    def option_names(cls) -> tuple[str, ...]:
+        """Keyword options the constructor takes besides ``params``."""
+        signature = inspect.signature(cls.__init__)
+        return tuple(name for name in signature.parameters if name not in ("self", "params"))
+
     def clip_cop(self, cop: float) -> tuple[float, bool]:
         """Clip a CoP to the foot [heel, toe]; also return whether it was clipped."""
         heel, toe = self.params.heel, self.params.toe
@@ -107,4 +114,10 @@ def make_controller(name: str, params: BodyParams, **options: Any) -> Controller
         raise InvalidParameterError(
             f"controller must be one of {sorted(CONTROLLERS)}, got controller={name!r}"
         ) from None
+    unknown = sorted(set(options) - set(cls.option_names()))
+    if unknown:
+        raise InvalidParameterError(
+            f"controller {name!r} has no option {unknown[0]!r}; its options are: "
+            f"{', '.join(cls.option_names()) or 'none'}"
+        )
     return cls(params, **options)

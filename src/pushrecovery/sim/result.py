@@ -78,14 +78,18 @@ class SimulationResult:
 
     def to_dict(self) -> dict[str, object]:
         """JSON summary (the ``simulate`` contract); trajectories are not included."""
-        x, xdot = self.final_state[0], self.final_state[len(self.final_state) // 2]
+        final = self.final_state
+        x, xdot = final[0], final[len(final) // 2]
+        final_state = {"x": float(x), "xdot": float(xdot)}
+        if len(final) == 4:
+            final_state.update(theta=float(final[1]), theta_dot=float(final[3]))
         return {
             "recovered": self.recovered,
             "outcome": self.outcome.value,
             "model": self.model,
             "controller": self.controller,
             "duration": float(self.time[-1]),
-            "final_state": {"x": float(x), "xdot": float(xdot)},
+            "final_state": final_state,
             # simulate() always runs at least one control tick, so cops is never empty.
             "peak_cop": {"min": float(self.cops.min()), "max": float(self.cops.max())},
             "max_excursion": float(np.abs(self.states[:, 0]).max()),

@@ -84,6 +84,11 @@ def simulate(
     for i, value in enumerate(state):
         finite_float(f"initial_state[{i}]", value)
     plant.check_state(state)
+    if controller.strategy == "hip" and len(state) < 4:
+        raise InvalidParameterError(
+            f"controller {controller.name!r} moves the upper body: use the flywheel model, "
+            f"not {plant.name!r}"
+        )
     rest = rest or RestCriterion()
     heel, toe = plant.params.heel, plant.params.toe
     fall_low, fall_high = plant.fall_limits

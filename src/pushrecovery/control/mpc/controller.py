@@ -56,6 +56,11 @@ class MPCController(Controller):
         self.qp = CondensedQP(params, settings)
         self.last_plan: Plan | None = None
 
+    @classmethod
+    def option_names(cls) -> tuple[str, ...]:
+        """``settings`` or any field of :class:`MPCSettings`."""
+        return ("settings", *MPCSettings.__dataclass_fields__)
+
     def reset(self, state: NDArray[np.float64]) -> None:
         """Forget the last plan; the MPC is otherwise stateless."""
         self._check(state)

@@ -80,7 +80,7 @@ class CondensedQP:
         return self.scale * (self._linear @ x0), h
 
     def unscale(self, scaled_inputs: FloatArray) -> FloatArray:
-        """Inputs U = D Ũ as an (N, 2) array of (δ [m], τ [N m])."""
+        """Return the inputs U = D Ũ as an (N, 2) array of (δ [m], τ [N m])."""
         return (self.scale * scaled_inputs).reshape(-1, 2)
 
     def predict(self, x0: FloatArray, inputs: FloatArray) -> FloatArray:

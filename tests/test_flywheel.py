@@ -1,0 +1,163 @@
+"""Flywheel model (Eqs. 6, 7, 16) and bang-bang end state (Eqs. 8-12) against integration."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from scipy.integrate import solve_ivp
+from scipy.linalg import expm
+
+from pushrecovery import InvalidParameterError, load_params
+from pushrecovery.control import Command, make_controller
+from pushrecovery.models.flywheel import (
+    bang_bang_end_state,
+    bang_bang_switch_time,
+    bang_bang_torque,
+    flywheel_continuous,
+    flywheel_discrete,
+    flywheel_propagate,
+    max_spin_up_time,
+)
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.simulate import simulate
+
+P = load_params()
+T_MAX = max_spin_up_time(P)
+
+
+def test_eq12_spin_up_time():
+    assert T_MAX == pytest.approx(math.sqrt(10.0 * 1.0 / 100.0))
+
+
+def test_zoh_is_matrix_exponential_of_eq16():
+    a, b = flywheel_continuous(P)
+    block = np.zeros((6, 6))
+    block[:4, :4], block[:4, 4:] = a, b
+    phi = expm(block * 0.02)
+    ad, bd = flywheel_discrete(P, 0.02)
+    np.testing.assert_allclose(ad, phi[:4, :4], atol=1e-15)
+    np.testing.assert_allclose(bd, phi[:4, 4:], atol=1e-15)
+
+
+def test_eq6_cmp_form():
+    # ẍ = ω² (x − δ − τ/(m g)) is Eq. (16)'s third row.
+    a, b = flywheel_continuous(P)
+    x, cop, torque = 0.03, 0.1, 40.0
+    xddot = a[2] @ np.array([x, 0, 0, 0]) + b[2] @ np.array([cop, torque])
+    assert xddot == pytest.approx(P.omega**2 * (x - cop - torque / P.weight), rel=1e-14)
+
+
+def test_propagate_vectorised():
+    rng = np.random.default_rng(3)
+    states, inputs = rng.normal(size=(100, 4)), rng.normal(size=(100, 2))
+    a, b = flywheel_discrete(P, 0.01)
+    np.testing.assert_allclose(
+        flywheel_propagate(states, inputs, P, 0.01), states @ a.T + inputs @ b.T, rtol=1e-13
+    )
+
+
+def integrate_bang_bang(x0, v0, switch, cop, direction=1.0):
+    def rhs(t, s):
+        torque = direction * float(bang_bang_torque(t, switch, P.torque_max))
+        return [
+            s[2],
+            s[3],
+            P.omega**2 * (s[0] - cop - torque / P.weight),
+            torque / P.flywheel_inertia,
+        ]
+
+    # Integrate piecewise so the solver never steps across a switch.
+    state = [x0, 0.0, v0, 0.0]
+    for t0, t1 in ((0.0, switch), (switch, 2 * switch)):
+        mid = 0.5 * (t0 + t1)
+        sol = solve_ivp(
+            lambda t, s, m=mid: rhs(m, s), (t0, t1), state, rtol=1e-12, atol=1e-14, method="DOP853"
+        )
+        state = sol.y[:, -1]
+    return state
+
+
+@given(
+    x0=st.floats(-0.05, 0.15), v0=st.floats(-1, 1), frac=st.floats(0.1, 1.0), forward=st.booleans()
+)
+def test_end_state_at_2T_matches_integration(x0, v0, frac, forward):
+    direction = 1.0 if forward else -1.0
+    switch = frac * T_MAX
+    cop = P.toe if forward else P.heel
+    expected = integrate_bang_bang(x0, v0, switch, cop, direction)
+    x, xdot, theta, rate = bang_bang_end_state(
+        x0, v0, P, switch_time=switch, cop=cop, direction=direction
+    )
+    np.testing.assert_allclose([x, theta, xdot, rate], expected, atol=1e-9)
+
+
+def test_printed_x_of_2T_line_is_wrong():
+    # Errata E10: the printed line has cosh(ωT) where 2 cosh(ωT) belongs.
+    x0, v0, cop = 0.0, 0.6, P.toe
+    a, w, t = P.torque_max / P.weight, P.omega, T_MAX
+    printed = (
+        cop
+        + (x0 - cop) * math.cosh(2 * w * t)
+        + v0 / w * math.sinh(2 * w * t)
+        + a * (-math.cosh(2 * w * t) + math.cosh(w * t) - 1)
+    )
+    truth = integrate_bang_bang(x0, v0, t, cop)[0]
+    assert abs(printed - truth) > 0.1  # off by a cosh(ωT) = 0.22 m
+    assert bang_bang_end_state(x0, v0, P, switch_time=t, cop=cop)[0] == pytest.approx(
+        truth, abs=1e-9
+    )
+
+
+def test_plant_runs_bang_bang_exactly():
+    period = T_MAX / 400  # switch exactly on a tick
+    controller = make_controller("bang-bang", P, switch_time=T_MAX)
+    plant = make_plant("flywheel", P)
+    run = simulate(
+        plant, controller, plant.initial_state(0.0, 0.6), duration=2 * T_MAX, control_period=period
+    )
+    x, xdot, theta, rate = bang_bang_end_state(0.0, 0.6, P, switch_time=T_MAX, cop=P.toe)
+    np.testing.assert_allclose(run.states[800], [x, theta, xdot, rate], atol=1e-12)
+    assert theta == pytest.approx(P.flywheel_angle_max)  # Eq. (11) with T = T_max
+
+
+def test_joint_stop_conserves_generalised_momentum():
+    plant = make_plant("flywheel", P)
+    state = plant.initial_state(0.0, 0.0)
+    state[1] = 0.99
+    state[3] = 2.0
+    new, _, _ = plant.step(state, Command(0.0, 0.0), 0.01)
+    assert new[1] == P.flywheel_angle_max and new[3] == 0.0
+    # m L ẋ + I θ̇ only changes through gravity over the step, not through the stop.
+    free, _, _ = make_plant("flywheel", P).step(state, Command(0.0, 0.0), 0.01)
+    momentum = lambda s: P.mass * P.com_height * s[2] + P.flywheel_inertia * s[3]  # noqa: E731
+    assert momentum(new) == pytest.approx(momentum(free), rel=1e-12)
+
+
+@given(capture=st.floats(0.151, 0.2), target=st.floats(-0.04, 0.14))
+def test_switch_time_hits_its_target_or_caps(capture, target):
+    switch = bang_bang_switch_time(capture, target, P, cop=P.toe, direction=1.0)
+    assert 0.0 <= switch <= T_MAX
+    x, xdot, _, _ = bang_bang_end_state(0.0, capture * P.omega, P, switch_time=switch, cop=P.toe)
+    reached = x + xdot / P.omega
+    if switch < T_MAX:
+        assert reached == pytest.approx(target, abs=1e-9)
+    else:
+        assert reached >= target - 1e-9  # could not get all the way
+
+
+def test_bad_flywheel_inputs():
+    with pytest.raises(InvalidParameterError, match="switch_time must be <= T_max"):
+        make_controller("bang-bang", P, switch_time=1.0)
+    with pytest.raises(InvalidParameterError, match="theta must satisfy"):
+        simulate(
+            make_plant("flywheel", P),
+            make_controller("bang-bang", P),
+            np.array([0.0, 1.5, 0.0, 0.0]),
+        )
+    with pytest.raises(InvalidParameterError, match="state must be"):
+        simulate(make_plant("flywheel", P), make_controller("bang-bang", P), np.array([0.0, 0.0]))
+    no_hip = load_params(overrides={"torque_max": 0.0})
+    with pytest.raises(InvalidParameterError, match="torque_max > 0"):
+        make_controller("bang-bang", no_hip)
