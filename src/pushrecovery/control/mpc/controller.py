@@ -58,7 +58,7 @@ class MPCController(Controller):
 
     @classmethod
     def option_names(cls) -> tuple[str, ...]:
-        """``settings`` or any field of :class:`MPCSettings`."""
+        """Return ``settings`` and the fields of :class:`MPCSettings`."""
         return ("settings", *MPCSettings.__dataclass_fields__)
 
     def reset(self, state: NDArray[np.float64]) -> None:
