@@ -9,15 +9,24 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import cop_region
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["FALL_COLOUR", "RECOVER_COLOUR", "new_figure", "save_figure", "shade_cop_region"]
+__all__ = [
+    "FALL_COLOUR",
+    "HIP_COLOUR",
+    "RECOVER_COLOUR",
+    "new_figure",
+    "save_figure",
+    "shade_regions",
+]
 
 RECOVER_COLOUR = "#2e7d32"
+HIP_COLOUR = "#ef6c00"
 FALL_COLOUR = "#c62828"
 
 
@@ -32,26 +41,51 @@ def new_figure(width: float = 6.4, height: float = 4.8) -> tuple[Figure, Axes]:
     return fig, ax
 
 
-def shade_cop_region(
-    ax: Axes, params: BodyParams, xlim: tuple[float, float], ylim: tuple[float, float]
+def shade_regions(
+    ax: Axes,
+    params: BodyParams,
+    xlim: tuple[float, float],
+    ylim: tuple[float, float],
+    *,
+    hip: bool = False,
 ) -> None:
-    """Shade Eq. (4) in the (x, ẋ) plane: green inside, red outside; mark the foot edges."""
-    omega, region = params.omega, cop_region(params)
+    """Shade the decision surfaces in the (x, ẋ) plane and mark the foot edges.
+
+    Green: CoP balancing, Eq. (4). With ``hip``, orange: the extra states CMP balancing
+    recovers (corrected Eq. 15). Red: beyond every balancing strategy.
+    """
+    omega = params.omega
     xs = np.linspace(*xlim, 200)
-    lower, upper = omega * (region.lower - xs), omega * (region.upper - xs)
+    outer = cmp_region(params) if hip else cop_region(params)
+    ax.fill_between(xs, ylim[0], ylim[1], color=FALL_COLOUR, alpha=0.10, lw=0)
+    inner = cop_region(params)
+    if hip:
+        # Only the slivers the hip adds beyond the CoP band.
+        for low, high in ((outer.lower, inner.lower), (inner.upper, outer.upper)):
+            ax.fill_between(
+                xs,
+                omega * (low - xs),
+                omega * (high - xs),
+                color=HIP_COLOUR,
+                alpha=0.3,
+                lw=0,
+                label="CMP balancing, corrected Eq. (15)" if low == outer.lower else None,
+            )
     ax.fill_between(
         xs,
-        lower,
-        upper,
+        omega * (inner.lower - xs),
+        omega * (inner.upper - xs),
         color=RECOVER_COLOUR,
         alpha=0.15,
         lw=0,
-        label="CoP balancing region, Eq. (4)",
+        label="CoP balancing, Eq. (4)",
     )
-    ax.fill_between(xs, upper, ylim[1], color=FALL_COLOUR, alpha=0.10, lw=0)
-    ax.fill_between(xs, ylim[0], lower, color=FALL_COLOUR, alpha=0.10, lw=0)
-    for edge in (region.lower, region.upper):
-        ax.plot(xs, omega * (edge - xs), color=RECOVER_COLOUR, lw=1.0, ls="--")
+    for region, colour in ((inner, RECOVER_COLOUR), (outer, HIP_COLOUR if hip else None)):
+        if colour is None:
+            continue
+        for edge in (region.lower, region.upper):
+            ax.plot(xs, omega * (edge - xs), color=colour, lw=1.0, ls="--")
+    for edge in (params.heel, params.toe):
         ax.axvline(edge, color="0.5", lw=0.8, ls=":")
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)

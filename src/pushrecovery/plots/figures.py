@@ -1,4 +1,7 @@
-"""Reproductions of the paper's figures (Sec. II: Fig. 3a and 3b)."""
+"""Reproductions of the paper's figures: Fig. 3 (Sec. II), Fig. 5 and 6 (Sec. III).
+
+Each figure has a function that computes its runs and one that draws them.
+"""
 
 from __future__ import annotations
 
@@ -8,19 +11,23 @@ from pathlib import Path
 import numpy as np
 
 from pushrecovery.control.base import make_controller
+from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import (
     FALL_COLOUR,
+    HIP_COLOUR,
     RECOVER_COLOUR,
     new_figure,
     save_figure,
-    shade_cop_region,
+    shade_regions,
 )
 from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.result import SimulationResult
 from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import critical_velocity
 
-__all__ = ["fig3a", "fig3b", "write_figures"]
+__all__ = ["fig3a", "fig3b", "fig5", "fig6", "write_figures"]
 
 
 def _limits(params: BodyParams) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -49,7 +56,7 @@ def fig3a(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     """Fig. 3(a): open-loop saturated ankle torque on the LIPM from upright, pushed."""
     fig, ax = new_figure()
     xlim, ylim = _limits(params)
-    shade_cop_region(ax, params, xlim, ylim)
+    shade_regions(ax, params, xlim, ylim)
     # Pushes from upright spanning both boundaries: ẋ0 from 1.4x the backward to 1.4x the
     # forward critical velocity of Eq. (4).
     v_back, v_fwd = params.omega * params.heel, params.omega * params.toe
@@ -68,7 +75,7 @@ def fig3b(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     """Fig. 3(b): saturated PD ankle control of the nonlinear pendulum from many states."""
     fig, ax = new_figure()
     xlim, ylim = _limits(params)
-    shade_cop_region(ax, params, xlim, ylim)
+    shade_regions(ax, params, xlim, ylim)
     # From three positions: pushes 15 % inside and outside Eq. (4) in both directions.
     starts = [
         (float(x0), float(fraction * critical_velocity(x0, direction, params)))
@@ -90,4 +97,128 @@ def write_figures(
 ) -> list[Path]:
     """Write every reproduced figure into ``out``; return the files written."""
     formats = tuple(formats)
-    return [*fig3a(params, formats, out), *fig3b(params, formats, out)]
+    return [
+        *fig3a(params, formats, out),
+        *fig3b(params, formats, out),
+        *fig5(params, formats, out),
+        *fig6(params, formats, out),
+    ]
+
+
+def _hip_runs(
+    params: BodyParams, controller: str, fractions: Iterable[float], **options: float
+) -> list[SimulationResult]:
+    """Pushes from upright at fractions of the hip strategy's forward critical velocity."""
+    plant = make_plant("flywheel", params)
+    ctrl = make_controller(controller, params, **options)
+    limit = float(critical_velocity(0.0, 1.0, params, region=cmp_region(params)))
+    return [
+        simulate(plant, ctrl, plant.initial_state(0.0, f * limit), duration=4.0) for f in fractions
+    ]
+
+
+def _phase(
+    params: BodyParams,
+    runs: list[SimulationResult],
+    title: str,
+    stem: Path,
+    formats: tuple[str, ...],
+) -> list[Path]:
+    fig, ax = new_figure()
+    span = params.toe - params.heel
+    xlim = (params.heel - span, params.toe + span)
+    vmax = params.omega * (cmp_region(params).upper - params.heel) * 1.1
+    shade_regions(ax, params, xlim, (-0.5 * vmax, vmax), hip=True)
+    for run in runs:
+        colour = RECOVER_COLOUR if run.recovered else FALL_COLOUR
+        ax.plot(run.states[:, 0], run.states[:, 2], color=colour, lw=1.2)
+        ax.plot(run.states[0, 0], run.states[0, 2], "o", color=colour, ms=3)
+    ax.legend(loc="lower left", fontsize=8)
+    ax.set_title(title, fontsize=10)
+    return save_figure(fig, stem, formats)
+
+
+def _time_panels(
+    params: BodyParams,
+    runs: list[SimulationResult],
+    title: str,
+    stem: Path,
+    formats: tuple[str, ...],
+    mark: float | None = None,
+) -> list[Path]:
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(4, 1, figsize=(6.4, 7.5), sharex=True, layout="constrained")
+    labels = (
+        "flywheel angle θ [rad]",
+        "flywheel rate θ̇ [rad/s]",
+        "hip torque τ [N m]",
+        "CoM x [m]",
+    )
+    for run, colour in zip(runs, (RECOVER_COLOUR, HIP_COLOUR, FALL_COLOUR), strict=False):
+        t = run.time
+        axes[0].plot(t, run.states[:, 1], color=colour)
+        axes[1].plot(t, run.states[:, 3], color=colour)
+        axes[2].step(t[:-1], run.torques, where="post", color=colour)
+        axes[3].plot(
+            t,
+            run.states[:, 0],
+            color=colour,
+            label=f"push {run.states[0, 2]:.2f} m/s: {run.outcome.value}",
+        )
+    for ax, label in zip(axes, labels, strict=True):
+        ax.set_ylabel(label, fontsize=8)
+        if mark is not None:
+            ax.axvline(mark, color="0.3", ls="--", lw=0.8)
+    for limit in (params.flywheel_angle_max, -params.flywheel_angle_max):
+        axes[0].axhline(limit, color="0.5", ls=":", lw=0.8)
+    axes[3].legend(fontsize=8)
+    axes[3].set_xlabel("time [s]")
+    axes[0].set_title(title, fontsize=10)
+    return save_figure(fig, stem, formats)
+
+
+def fig5(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
+    """Fig. 5: bang-bang flywheel control. (a) phase plot; (b) flywheel and torque vs time."""
+    formats = tuple(formats)
+    runs = _hip_runs(params, "bang-bang", (0.3, 0.6, 0.85, 0.99, 1.05))
+    files = _phase(
+        params,
+        runs,
+        "Fig. 5(a): bang-bang hip torque + saturated ankle\n(orange band: corrected Eq. (15))",
+        out / "fig5a",
+        formats,
+    )
+    spin_up = max_spin_up_time(params)
+    worst = _hip_runs(params, "bang-bang", (0.99,), switch_time=spin_up)
+    files += _time_panels(
+        params,
+        worst,
+        f"Fig. 5(b): bang-bang with T = T_max = {spin_up:.3f} s (dashed)",
+        out / "fig5b",
+        formats,
+        mark=spin_up,
+    )
+    return files
+
+
+def fig6(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
+    """Fig. 6: receding-horizon control (Eqs. 16-17). (a) phase plot; (b) time plots."""
+    formats = tuple(formats)
+    runs = _hip_runs(params, "mpc", (0.3, 0.6, 0.85, 0.99, 1.05))
+    files = _phase(
+        params,
+        runs,
+        "Fig. 6(a): receding-horizon control, paper's weights\n(orange band: corrected Eq. (15))",
+        out / "fig6a",
+        formats,
+    )
+    small_large = [runs[0], runs[3], runs[4]]
+    files += _time_panels(
+        params,
+        small_large,
+        "Fig. 6(b): MPC, 1 s horizon; small, large and too-large push",
+        out / "fig6b",
+        formats,
+    )
+    return files

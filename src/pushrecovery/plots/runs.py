@@ -6,7 +6,7 @@ from pathlib import Path
 
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
-from pushrecovery.plots.common import FALL_COLOUR, RECOVER_COLOUR, save_figure, shade_cop_region
+from pushrecovery.plots.common import FALL_COLOUR, RECOVER_COLOUR, save_figure, shade_regions
 from pushrecovery.sim.result import SimulationResult
 
 __all__ = ["save_run"]
@@ -39,7 +39,7 @@ def save_run(result: SimulationResult, params: BodyParams, path: Path) -> Path:
     span = max(abs(params.heel), params.toe)
     xlim = (min(x.min(), params.heel) - 0.5 * span, max(x.max(), params.toe) + 0.5 * span)
     vmax = max(abs(xdot).max(), params.omega * span) * 1.2
-    shade_cop_region(right, params, xlim, (-vmax, vmax))
+    shade_regions(right, params, xlim, (-vmax, vmax))
     right.plot(x, xdot, color=colour)
     right.plot(x[0], xdot[0], "o", color=colour)
     return save_figure(fig, path.with_suffix(""), [path.suffix.lstrip(".")])[0]
