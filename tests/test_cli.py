@@ -140,12 +140,12 @@ def test_critical_push_contract():
 
 def test_figures(tmp_path):
     files = run_json("figures", "--out", str(tmp_path))["files"]
-    assert sorted(p.rsplit("/", 1)[1] for p in files) == [
-        "fig3a.png",
-        "fig3a.svg",
-        "fig3b.png",
-        "fig3b.svg",
+    names = sorted(p.rsplit("/", 1)[1] for p in files)
+    expected = [
+        f"fig{n}.{ext}" for n in ("3a", "3b", "5a", "5b", "6a", "6b") for ext in ("png", "svg")
     ]
+    assert names == sorted(expected)
+    assert all((tmp_path / name).stat().st_size > 1000 for name in names)
 
 
 def test_table_output_is_readable():
