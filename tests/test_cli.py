@@ -173,6 +173,20 @@ def test_table_output_is_readable():
         (["critical-push", "--kp", "100"], "stiffness must be > m g L"),
         (["bounds", "--params", "/nonexistent.toml"], "not found"),
         (["nonsense"], "No such command"),
+        (["simulate", "--duration", "1e12"], "must be <= 1e+07 steps"),
+        (["simulate", "--x", "1.79e308"], "x must satisfy |x| < com_height"),
+        (["simulate", "--xdot", "3000"], "xdot must satisfy"),
+        (
+            ["classify", "--x", "0", "--xdot", "0", "--com-height", "1e308", "--gravity", "5e-324"],
+            "g / com_height must be finite",
+        ),
+        (["classify", "--x", "1.7e308", "--xdot", "1e308"], "too large"),
+        (["simulate", "--mass", "1e308"], "mass * gravity must be finite"),
+        (["critical-push", "--tolerance", "100"], "tolerance must be in"),
+        (["critical-push", "--tolerance", "1e-300"], "tolerance must be in"),
+        (["critical-push", "--gravity", "1e6"], "control_period must be <="),
+        (["simulate", "--xdot", "0.1", "--plot", "/proc/version/x.png"], "cannot write"),
+        (["figures", "--out", "/proc/version/sub"], "cannot write"),
         (["simulate", "--model", "lipm", "--controller", "mpc"], "use the flywheel model"),
         (
             ["simulate", "--model", "flywheel", "--controller", "mpc", "--option", "horizon=x"],
@@ -201,6 +215,35 @@ def test_bad_input_is_one_line_exit_2(capsys, args, words):
     assert err.count("\n") == 1 and err.startswith("pushrecovery: error: ")
     assert words in err
     assert "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("content", "words"),
+    [
+        (b"\xff\xfe=1", "not UTF-8"),
+        (b"mass = 1" + b"0" * 400, "mass must be a finite number"),
+        (b"mass = [", "malformed TOML"),
+        (b"[body]\nmass = {a = 1}", "mass must be a number"),
+        (b"", None),  # an empty file keeps the preset
+    ],
+)
+def test_parameter_files(tmp_path, capsys, content, words):
+    path = tmp_path / "p.toml"
+    path.write_bytes(content)
+    if words is None:
+        assert run_json("bounds", "--params", str(path))["params"]["mass"] == 72.0
+        return
+    with pytest.raises(SystemExit) as exit_info:
+        main(["bounds", "--params", str(path)])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert words in err and err.count("\n") == 1
+
+
+def test_parameter_file_is_a_directory(tmp_path, capsys):
+    with pytest.raises(SystemExit):
+        main(["bounds", "--params", str(tmp_path)])
+    assert capsys.readouterr().err.startswith("pushrecovery: error: ")
 
 
 def test_malformed_toml(tmp_path, capsys):

@@ -56,6 +56,25 @@ def test_eq4_random_states(x0, margin, forward):
     assert outside.outcome.value == "fell"
 
 
+@pytest.mark.parametrize("gap", [1e-6, 1e-5])
+@pytest.mark.parametrize("x0", [0.1497, 0.1, 0.0])
+def test_no_false_recovery_a_hair_outside(gap, x0):
+    # A CoM resting against a saturated CoP can look still for a long time while it creeps
+    # over the edge: such runs must not count as recovered.
+    v0 = OMEGA * (PARAMS.toe + gap - x0)
+    for controller in ("ankle-saturated", "ankle-pd"):
+        assert not run("lipm", controller, x0, v0).recovered
+
+
+def test_lipm_critical_push_never_exceeds_eq4():
+    from pushrecovery.sim.critical import critical_push
+
+    for direction in ("forward", "backward"):
+        found = critical_push(PARAMS, "lipm", "ankle-saturated", 0.1, direction, tolerance=1e-9)
+        assert abs(found.velocity) <= abs(found.predicted_velocity)
+        assert abs(found.bracket[1]) >= abs(found.predicted_velocity) - 1e-12
+
+
 def test_margin_values():
     # ξ = 0 is 0.05 m from the heel and 0.15 m from the toe.
     assert float(cop_margin(0.0, 0.0, PARAMS)) == pytest.approx(0.05)

@@ -74,6 +74,43 @@ def test_fall_criterion_is_absorbing_for_pendulum(x, rate, cop):
     assert pendulum_acceleration(theta, rate, cop, M, L, G) > 0.0
 
 
+@given(
+    x=st.floats(-0.9, -0.0501),
+    rate=st.floats(-3.0, 0.0),
+    cop=st.floats(-0.05, 0.15),
+)
+def test_fall_criterion_is_absorbing_at_the_heel(x, rate, cop):
+    theta = math.asin(x / L)
+    assert is_falling(x, rate, -0.05, 0.15)
+    assert pendulum_acceleration(theta, rate, cop, M, L, G) < 0.0
+
+
+def test_unloaded_foot_transmits_no_torque():
+    # A = m cos(theta) (g cos(theta) - L rate^2) <= 0: the swing is fast enough to unload the foot.
+    rate = math.sqrt(G / L) * 1.01
+    assert ankle_torque_for_cop(0.0, rate, 0.15, M, L, G) == 0.0
+    assert pendulum_acceleration(0.1, rate, 0.15, M, L, G) == pytest.approx(G * math.sin(0.1) / L)
+
+
+def test_cop_from_newton_euler_on_the_simulated_trajectory():
+    # Independent of the model's formulas: differentiate the simulated CoM path numerically
+    # and recover the CoP from Newton-Euler about the ankle,
+    # p F_z = dH/dt + m g x with H = m (x zdot - z xdot) and F_z = m (zddot + g).
+    cop, h = 0.12, 1e-3
+    theta, rate = 0.02, 0.4
+    path = []
+    for _ in range(400):
+        path.append((L * math.sin(theta), L * math.cos(theta)))
+        theta, rate = pendulum_step(theta, rate, cop, h, M, L, G, substeps=4)
+    x, z = np.array(path).T
+    xdd = (x[2:] - 2 * x[1:-1] + x[:-2]) / h**2
+    zdd = (z[2:] - 2 * z[1:-1] + z[:-2]) / h**2
+    xm, zm = x[1:-1], z[1:-1]
+    recovered = (xm * zdd - zm * xdd + G * xm) / (zdd + G)
+    # Central differences: error ~ h^2 / 12 times the fourth derivative, ~1e-7 m here.
+    np.testing.assert_allclose(recovered, cop, atol=1e-6)
+
+
 def test_fall_criterion_mirror():
     assert is_falling(-0.06, -0.1, -0.05, 0.15)
     assert not is_falling(-0.06, 0.1, -0.05, 0.15)  # outside but coming back

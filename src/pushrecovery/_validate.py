@@ -15,8 +15,8 @@ def finite_float(name: str, value: object, unit: str = "", allowed: str = "") ->
     what = f"{name} must be a finite number{' ' + allowed if allowed else ''}{_unit(unit)}"
     try:
         number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{what}, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidParameterError(f"{what}, got {str(value)[:40]!r}") from None
     if not math.isfinite(number):
         raise InvalidParameterError(f"{what}, got {number}")
     return number

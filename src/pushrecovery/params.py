@@ -96,6 +96,15 @@ class BodyParams:
             "flywheel_angle_max",
             positive_float("flywheel_angle_max", self.flywheel_angle_max),
         )
+        for derived, value in (
+            ("g / com_height", self.gravity / self.com_height),
+            ("mass * gravity", self.mass * self.gravity),
+        ):
+            if not (math.isfinite(value) and value > 0.0):
+                raise InvalidParameterError(
+                    f"{derived} must be finite and > 0, got {value:g} (mass={self.mass:g} kg, "
+                    f"com_height={self.com_height:g} m, gravity={self.gravity:g} m/s^2)"
+                )
         leg = self.com_height if self.leg_length is None else self.leg_length
         set_(self, "leg_length", positive_float("leg_length", leg, "m"))
 
@@ -207,6 +216,10 @@ def _read_toml(path: Path) -> dict[str, Any]:
         raise InputFileError(f"cannot read parameter file {path}: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
         raise InputFileError(f"malformed TOML in {path}: {exc}") from None
+    except UnicodeDecodeError:
+        raise InputFileError(f"parameter file {path} is not UTF-8 text (TOML)") from None
+    except IsADirectoryError:
+        raise InputFileError(f"parameter file {path} is a directory") from None
     body = data.pop("body", None)
     if body is not None:
         if not isinstance(body, dict):

@@ -26,6 +26,9 @@ def main(argv: list[str] | None = None) -> None:
         _fail(exc.format_message())
     except PushRecoveryError as exc:
         _fail(str(exc))
+    except (OSError, ValueError, ArithmeticError, MemoryError) as exc:
+        # Last resort: a user-facing tool reports, it does not dump a traceback.
+        _fail(f"{type(exc).__name__}: {exc}")
     except click.Abort:
         sys.exit(130)
     sys.exit(code if isinstance(code, int) else 0)

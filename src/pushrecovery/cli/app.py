@@ -243,6 +243,12 @@ def simulate(
     show_default=True,
     help="Longest simulated time per push [s].",
 )
+@click.option(
+    "--control-period",
+    type=float,
+    default=None,
+    help="Controller period [s] (default: the controller's own, else 0.001).",
+)
 @body_options
 def critical_push(
     model: str,
@@ -254,6 +260,7 @@ def critical_push(
     direction: str,
     tolerance: float,
     duration: float,
+    control_period: float | None,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
@@ -269,6 +276,7 @@ def critical_push(
         direction,
         tolerance=tolerance,
         duration=duration,
+        control_period=control_period,
         controller_options=_options_for(controller, _controller_options(kp, kd, options)),
     )
     emit(

@@ -56,7 +56,8 @@ class BangBang(Controller):
         self.fixed_switch_time = switch_time
         # Its own period puts T_max on a whole number of ticks (about 1 ms), so that both
         # torque pulses last equally long and the flywheel ends at rest (Eq. 10).
-        self.control_period = spin_up / math.ceil(spin_up / 1e-3)
+        self._tick = spin_up / math.ceil(spin_up / 1e-3)
+        self.control_period = self._tick
         self.switch_time = 0.0
         self._inv_omega = 1.0 / params.omega
         self._direction = 0.0
@@ -78,8 +79,7 @@ class BangBang(Controller):
             switch = bang_bang_switch_time(
                 capture, 0.5 * (p.heel + p.toe), p, cop=edge, direction=self._direction
             )
-            tick = self.control_period
-            self.switch_time = round(switch / tick) * tick
+            self.switch_time = round(switch / self._tick) * self._tick
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """Bang-bang on [0, 2T) with the CoP on the edge, then CoP at the capture point."""

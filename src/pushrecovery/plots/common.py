@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from pushrecovery.errors import InputFileError
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import cop_region
@@ -97,11 +98,15 @@ def save_figure(fig: Figure, stem: Path, formats: Iterable[str]) -> list[Path]:
     """Save ``fig`` as ``stem.<fmt>`` for each format; close it; return the paths."""
     import matplotlib.pyplot as plt
 
-    stem.parent.mkdir(parents=True, exist_ok=True)
     paths = []
-    for fmt in formats:
-        path = stem.with_suffix(f".{fmt}")
-        fig.savefig(path, dpi=150)
-        paths.append(path)
-    plt.close(fig)
+    try:
+        stem.parent.mkdir(parents=True, exist_ok=True)
+        for fmt in formats:
+            path = stem.with_suffix(f".{fmt}")
+            fig.savefig(path, dpi=150)
+            paths.append(path)
+    except OSError as exc:
+        raise InputFileError(f"cannot write {stem.parent}: {exc.strerror or exc}") from None
+    finally:
+        plt.close(fig)
     return paths

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -19,15 +20,30 @@ from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import strategy_region
 from pushrecovery.surfaces.cop import critical_velocity
 
-__all__ = ["CriticalPush", "NotRecoverableError", "critical_push", "find_critical_velocity"]
+__all__ = [
+    "Bracket",
+    "CriticalPush",
+    "NotRecoverableError",
+    "critical_push",
+    "find_critical_velocity",
+]
 
 
 class NotRecoverableError(InvalidParameterError):
     """The start state is lost even without a push, so there is no critical push."""
 
 
-#: Pushes beyond this [m/s] are not searched: at sqrt(g L) the stance foot already unloads.
-MAX_SEARCH_VELOCITY = 20.0
+#: Tightest and loosest search tolerance [m/s].
+TOLERANCE_RANGE = (1e-9, 0.1)
+
+
+@dataclass(frozen=True, slots=True)
+class Bracket:
+    """Outcome of a bisection: the largest recovered and smallest failed velocity [m/s]."""
+
+    recovered: float
+    failed: float
+    simulations: int
 
 
 @dataclass(frozen=True, slots=True)
@@ -42,12 +58,14 @@ class CriticalPush:
         (recovered, not recovered) velocities that bound the true critical velocity [m/s].
     iterations : int
         Simulations run.
+    predicted_velocity : float
+        Critical velocity of the controller's decision surface, signed like ẋ [m/s].
     """
 
     velocity: float
     bracket: tuple[float, float]
     iterations: int
-    predicted_velocity: float = float("nan")
+    predicted_velocity: float
 
     def relative_error(self) -> float:
         """Return (|velocity| − |predicted|) / |predicted|; < 0 when doing worse than Eq. 4."""
@@ -61,7 +79,8 @@ def find_critical_velocity(
     *,
     guess: float,
     tolerance: float = 1e-4,
-) -> CriticalPush:
+    max_velocity: float,
+) -> Bracket:
     """Bisect the velocity at which ``outcome_of`` stops returning ``recovered``.
 
     Assumes the recovered velocities in a direction form an interval starting at 0 (a harder
@@ -76,19 +95,27 @@ def find_critical_velocity(
     guess : float
         Expected magnitude of the critical velocity [m/s] (e.g. Eq. 4's), >= 0.
     tolerance : float
-        Width of the final bracket [m/s], > 0.
+        Width of the final bracket [m/s], in [1e-9, 0.1].
+    max_velocity : float
+        Largest push searched [m/s].
 
     Returns
     -------
-    CriticalPush
+    Bracket
+        Signed like the push.
 
     Raises
     ------
     InvalidParameterError
-        If the body falls without a push, or no push below 20 m/s makes it fall.
+        If the body falls without a push, or no push below ``max_velocity`` makes it fall.
     """
     sign = direction_sign(direction)
     tolerance = positive_float("tolerance", tolerance, "m/s")
+    if not TOLERANCE_RANGE[0] <= tolerance <= TOLERANCE_RANGE[1]:
+        raise InvalidParameterError(
+            f"tolerance must be in [{TOLERANCE_RANGE[0]:g}, {TOLERANCE_RANGE[1]:g}] m/s, "
+            f"got {tolerance:g}"
+        )
     guess = abs(finite_float("guess", guess, "m/s"))
     runs = 1
     at_rest = outcome_of(0.0)
@@ -101,20 +128,22 @@ def find_critical_velocity(
         runs += 1
         if outcome_of(sign * high) is not Outcome.RECOVERED:
             break
-        low, high = high, 2.0 * high
-        if high > MAX_SEARCH_VELOCITY:
+        if high >= max_velocity:
             raise InvalidParameterError(
-                f"no push up to {MAX_SEARCH_VELOCITY:g} m/s makes the body fall; "
+                f"no push up to {max_velocity:g} m/s makes the body fall; "
                 "is the controller or model unbounded?"
             )
+        low, high = high, min(2.0 * high, max_velocity)
     while high - low > tolerance:
         middle = 0.5 * (low + high)
+        if middle in (low, high):  # float resolution reached
+            break
         runs += 1
         if outcome_of(sign * middle) is Outcome.RECOVERED:
             low = middle
         else:
             high = middle
-    return CriticalPush(float(np.copysign(low, sign)), (sign * low, sign * high), runs)
+    return Bracket(float(np.copysign(low, sign)), float(np.copysign(high, sign)), runs)
 
 
 def critical_push(
@@ -180,5 +209,11 @@ def critical_push(
         )
         return run.outcome
 
-    found = find_critical_velocity(outcome_of, direction, guess=predicted, tolerance=tolerance)
-    return CriticalPush(found.velocity, found.bracket, found.iterations, predicted)
+    # Just below the models' validity limit (check_com_state).
+    limit = 9.99 * math.sqrt(params.gravity * params.com_height)
+    found = find_critical_velocity(
+        outcome_of, direction, guess=predicted, tolerance=tolerance, max_velocity=limit
+    )
+    return CriticalPush(
+        found.recovered, (found.recovered, found.failed), found.simulations, predicted
+    )

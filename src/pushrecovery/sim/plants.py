@@ -46,6 +46,23 @@ class Plant(Protocol):
         ...
 
 
+def check_com_state(x: float, xdot: float, params: BodyParams) -> None:
+    """Reject CoM states outside every model's validity.
+
+    |x| < L (the CoM above the ankle's horizon) and |ẋ| < 10 sqrt(g L): ten times the speed at
+    which an upright pendulum's foot unloads (docs/conventions.md).
+    """
+    if abs(x) >= params.com_height:
+        raise InvalidParameterError(
+            f"x must satisfy |x| < com_height = {params.com_height:g} m, got x={x:g}"
+        )
+    speed = 10.0 * math.sqrt(params.gravity * params.com_height)
+    if abs(xdot) >= speed:
+        raise InvalidParameterError(
+            f"xdot must satisfy |xdot| < 10 sqrt(g L) = {speed:g} m/s, got xdot={xdot:g}"
+        )
+
+
 class _AnklePlant:
     """Shared parts of the ankle-only plants (state ``[x, xdot]``)."""
 
@@ -61,9 +78,10 @@ class _AnklePlant:
         return np.array([x, xdot], dtype=np.float64)
 
     def check_state(self, state: FloatArray) -> None:
-        """Require ``[x, xdot]``."""
+        """Require ``[x, xdot]`` within the models' validity (:func:`check_com_state`)."""
         if state.shape != (2,):
             raise InvalidParameterError(f"state must be [x, xdot], got shape {state.shape}")
+        check_com_state(float(state[0]), float(state[1]), self.params)
 
     def applied_cop(self, command: Command) -> float:
         if command.flywheel_torque != 0.0:
@@ -107,15 +125,6 @@ class PendulumPlant(_AnklePlant):
     #: Largest RK4 substep [s]; ω h ≈ 0.003 keeps the local error far below 1e-12.
     max_substep: ClassVar[float] = 1e-3
 
-    def check_state(self, state: FloatArray) -> None:
-        """Also require |x| < L: the CoM must be above the ankle's horizon."""
-        super().check_state(state)
-        if abs(float(state[0])) >= self.params.com_height:
-            raise InvalidParameterError(
-                f"x must satisfy |x| < com_height = {self.params.com_height:g} m for the pendulum, "
-                f"got x={float(state[0]):g}"
-            )
-
     def step(
         self, state: FloatArray, command: Command, dt: float
     ) -> tuple[FloatArray, float, float]:
@@ -127,6 +136,9 @@ class PendulumPlant(_AnklePlant):
         theta, rate = pendulum_step(
             theta, rate, cop, dt, p.mass, p.com_height, p.gravity, substeps=substeps
         )
+        if abs(theta) >= 0.5 * math.pi:
+            # Lying on the floor: x = ±L, at rest. (x, ẋ) cannot describe θ past horizontal.
+            theta, rate = math.copysign(0.5 * math.pi, theta), 0.0
         return np.array(com_from_lean(theta, rate, p.com_height)), cop, 0.0
 
 
@@ -159,6 +171,7 @@ class FlywheelPlant:
             raise InvalidParameterError(
                 f"state must be [x, theta, xdot, theta_dot], got shape {state.shape}"
             )
+        check_com_state(float(state[0]), float(state[2]), self.params)
         if abs(float(state[1])) > self.params.flywheel_angle_max:
             raise InvalidParameterError(
                 f"theta must satisfy |theta| <= flywheel_angle_max = "

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pushrecovery._validate import finite_float, positive_float
+from pushrecovery.errors import InvalidParameterError
 
 __all__ = ["Direction", "Push", "direction_sign"]
 
@@ -13,8 +14,6 @@ Direction = str  # "forward" or "backward"
 
 def direction_sign(direction: str) -> float:
     """+1.0 for ``"forward"`` (+x), −1.0 for ``"backward"``; anything else raises."""
-    from pushrecovery.errors import InvalidParameterError
-
     if direction == "forward":
         return 1.0
     if direction == "backward":

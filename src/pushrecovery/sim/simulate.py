@@ -17,11 +17,19 @@ __all__ = ["DEFAULT_CONTROL_PERIOD", "RestCriterion", "simulate"]
 
 #: Control period when neither the caller nor the controller sets one [s].
 DEFAULT_CONTROL_PERIOD = 1e-3
+#: Longest run, in control ticks (memory for the trajectory: 8e7 floats at most).
+MAX_STEPS = 10_000_000
+#: Largest ω · control_period: beyond it the hold between ticks dominates the dynamics.
+MAX_OMEGA_DT = 0.1
 
 
 @dataclass(frozen=True, slots=True)
 class RestCriterion:
-    """When a run counts as recovered: at rest, standing, for long enough.
+    """When a run counts as recovered: at rest, standing, unsaturated, for long enough.
+
+    Rest only counts while the controller's command is unsaturated: a CoM resting against a
+    CoP pinned to a foot edge may be creeping over it (capture point a hair beyond the edge),
+    while an unsaturated command means the controller still has authority in both directions.
 
     Parameters
     ----------
@@ -47,10 +55,10 @@ def simulate(
     """Simulate ``controller`` on ``plant`` from ``initial_state`` (sampled-data, ZOH).
 
     Every ``control_period`` the controller computes a command that the plant holds until the
-    next tick. The run ends as ``fell`` as soon as the CoM is beyond a foot edge and moving away
-    from the foot (:func:`~pushrecovery.sim.result.is_falling`, an absorbing set), as
-    ``recovered`` once the CoM has stayed at rest over the foot for ``rest.duration``, and as
-    ``undecided`` if neither happens within ``duration``.
+    next tick. The run ends as ``fell`` as soon as the CoM is beyond the plant's fall limit and
+    moving away from the foot (:func:`~pushrecovery.sim.result.is_falling`, an absorbing set),
+    as ``recovered`` once the CoM has stayed at rest over the foot with an unsaturated command
+    for ``rest.duration``, and as ``undecided`` if neither happens within ``duration``.
 
     Parameters
     ----------
@@ -93,6 +101,16 @@ def simulate(
     heel, toe = plant.params.heel, plant.params.toe
     fall_low, fall_high = plant.fall_limits
     steps = math.ceil(duration / dt - 1e-9)
+    if steps > MAX_STEPS:
+        raise InvalidParameterError(
+            f"duration / control_period must be <= {MAX_STEPS:g} steps, got {steps:g}"
+        )
+    if plant.params.omega * dt > MAX_OMEGA_DT:
+        raise InvalidParameterError(
+            f"control_period must be <= {MAX_OMEGA_DT:g} / omega = "
+            f"{MAX_OMEGA_DT / plant.params.omega:g} s for a faithful sampled-data loop, "
+            f"got {dt:g}"
+        )
     rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))
     vel = len(state) // 2
 
@@ -110,7 +128,8 @@ def simulate(
         if is_falling(x, xdot, fall_low, fall_high):
             outcome = Outcome.FELL
             break
-        at_rest = at_rest + 1 if abs(xdot) <= rest.speed and heel < x < toe else 0
+        resting = abs(xdot) <= rest.speed and heel < x < toe and not command.saturated
+        at_rest = at_rest + 1 if resting else 0
         if at_rest >= rest_ticks:
             outcome = Outcome.RECOVERED
             break

@@ -144,7 +144,8 @@ def capture_margin(
             x.reshape(-1), xdot.reshape(-1), inv_omega, centre, half, margin.reshape(-1)
         )
     else:
-        margin = np.subtract(half, np.abs(x + xdot * inv_omega - centre), out=out)
+        with np.errstate(over="ignore", invalid="ignore"):  # reported below, as one error
+            margin = np.subtract(half, np.abs(x + xdot * inv_omega - centre), out=out)
         # NaN and -inf propagate into the minimum: one reduction, not two isfinite passes.
         bad = 0 if margin.size == 0 or math.isfinite(float(np.min(margin))) else 1
     if bad:
