@@ -9,7 +9,11 @@ import math
 import numpy as np
 
 from pushrecovery import load_params
+from pushrecovery.control import make_controller
+from pushrecovery.models.pendulum import ankle_torque_for_cop, lean_from_com
 from pushrecovery.sim.critical import NotRecoverableError, critical_push
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.simulate import simulate
 
 
 def gain_sets(params):
@@ -62,6 +66,22 @@ def main():
         params, "pendulum", kp_default, kp_default / params.omega, positions, tolerance
     ):
         print(f"| {direction} | {x:+.3f} | {v:+.5f} | {predicted:+.5f} | {error:+.2%} |")
+
+    print("\n### Applied over commanded torque on the pendulum (errata E7)\n")
+    plant, controller = make_plant("pendulum", params), make_controller("ankle-pd", params)
+    ratios = []
+    for _, x, v, _, _ in sweep(
+        params, "pendulum", kp_default, kp_default / params.omega, positions, 1e-3
+    ):
+        run = simulate(plant, controller, np.array([x, 0.999 * v]))
+        for (cx, cv), cop in zip(run.states[:-1], run.cops, strict=True):
+            if cop != 0.0:
+                lean, rate = lean_from_com(cx, cv, params.com_height)
+                torque = ankle_torque_for_cop(
+                    lean, rate, cop, params.mass, params.com_height, params.gravity
+                )
+                ratios.append(torque / (cop * params.weight))
+    print(f"F_z / (m g) at 99.9 % of each critical push: {min(ratios):.3f} … {max(ratios):.3f}")
 
     print("\n### Worst error over the foot and both directions, per gain set\n")
     print(
