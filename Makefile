@@ -21,7 +21,9 @@ demo: $(STAMP)
 	$(BIN)/pushrecovery bounds
 	$(BIN)/pushrecovery classify --x 0.0 --xdot 0.3
 	$(BIN)/pushrecovery classify --x 0.0 --xdot 0.6
+	$(BIN)/pushrecovery classify --x 0.0 --xdot 0.7
 	$(BIN)/pushrecovery critical-push --model pendulum --controller ankle-pd --x 0.0 --direction forward
+	$(BIN)/pushrecovery critical-push --model flywheel --controller mpc --x 0.0 --direction forward
 	$(BIN)/pushrecovery figures --out $(OUT)/figures
 
 test: $(STAMP)

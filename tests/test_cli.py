@@ -57,6 +57,10 @@ def test_hip_commands():
         "critical-push", "--model", "flywheel", "--controller", "bang-bang", "--tolerance", "1e-3"
     )
     assert found["velocity"] == pytest.approx(found["predicted_velocity"], abs=1e-3)
+    # The MPC runs at its own dt = 0.02 s unless told otherwise: 1 tick per 20 ms.
+    assert run["duration"] == pytest.approx(round(run["duration"] / 0.02) * 0.02, abs=1e-9)
+    bang = run_json("simulate", "--model", "flywheel", "--controller", "bang-bang", "--xdot", "0.6")
+    assert abs(bang["final_state"]["theta_dot"]) < 1e-12  # both pulses equally long (Eq. 10)
     short = run_json(
         "simulate",
         "--model",

@@ -163,7 +163,10 @@ def _with(*decorators: Any) -> Any:
     "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
 )
 @click.option(
-    "--control-period", type=float, default=1e-3, show_default=True, help="Controller period [s]."
+    "--control-period",
+    type=float,
+    default=None,
+    help="Controller period [s] (default: the controller's own, else 0.001).",
 )
 @click.option(
     "--plot",
