@@ -88,8 +88,10 @@ def mpc() -> float:
         controller.reset(state)
         timings[solver] = best(lambda c=controller: c.compute(0.0, state), number=20)
     factor = 0.02 / timings["daqp"]
-    print(f"MPC tick (daqp): {timings['daqp'] * 1e3:.2f} ms per 20 ms period "
-          f"({factor:.0f}x faster than real time); quadprog {timings['quadprog'] * 1e3:.2f} ms")
+    print(
+        f"MPC tick (daqp): {timings['daqp'] * 1e3:.2f} ms per 20 ms period "
+        f"({factor:.0f}x faster than real time); quadprog {timings['quadprog'] * 1e3:.2f} ms"
+    )
     return factor
 
 
