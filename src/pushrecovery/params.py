@@ -44,6 +44,9 @@ class BodyParams:
         Flywheel joint limit θmax of Eq. (11) [rad], > 0.
     leg_length : float or None
         Leg length for stepping, Sec. IV [m], > 0; ``None`` means equal to ``com_height``.
+    max_step_length : float or None
+        Longest step the legs can take, foot to foot [m], in (0, 2 leg_length); ``None``
+        means equal to ``leg_length`` (a 30° stance-leg angle at impact).
 
     Raises
     ------
@@ -60,6 +63,7 @@ class BodyParams:
     torque_max: float
     flywheel_angle_max: float
     leg_length: float = field(default=None)  # type: ignore[assignment]
+    max_step_length: float = field(default=None)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -106,7 +110,15 @@ class BodyParams:
                     f"com_height={self.com_height:g} m, gravity={self.gravity:g} m/s^2)"
                 )
         leg = self.com_height if self.leg_length is None else self.leg_length
-        set_(self, "leg_length", positive_float("leg_length", leg, "m"))
+        leg = positive_float("leg_length", leg, "m")
+        set_(self, "leg_length", leg)
+        reach = leg if self.max_step_length is None else self.max_step_length
+        reach = positive_float("max_step_length", reach, "m")
+        if reach >= 2.0 * leg:
+            raise InvalidParameterError(
+                f"max_step_length must be < 2 leg_length = {2 * leg:g} m, got {reach:g}"
+            )
+        set_(self, "max_step_length", reach)
 
     @property
     def omega(self) -> float:
@@ -141,6 +153,7 @@ PRESETS: Mapping[str, Mapping[str, float | None]] = MappingProxyType(
                 "torque_max": 100.0,
                 "flywheel_angle_max": 1.0,
                 "leg_length": None,
+                "max_step_length": None,
             }
         )
     }
@@ -192,14 +205,13 @@ def load_params(
         raise InvalidParameterError(
             f"unknown parameter {unknown[0]!r}; known parameters: {', '.join(FIELD_NAMES)}"
         )
-    if (
-        overrides
-        and overrides.get("com_height") is not None
-        and "leg_length"
-        not in ({k for k, v in overrides.items() if v is not None} | set(from_file))
-    ):
-        # The presets tie the leg to the CoM height; keep that tie when only L changes.
+    given = {k for k, v in (overrides or {}).items() if v is not None} | set(from_file)
+    # The presets tie the leg to the CoM height and the reach to the leg; keep those ties when
+    # only the quantity they follow changes.
+    if "com_height" in given and "leg_length" not in given:
         values["leg_length"] = PRESETS[preset].get("leg_length")
+    if {"com_height", "leg_length"} & given and "max_step_length" not in given:
+        values["max_step_length"] = PRESETS[preset].get("max_step_length")
     for name, value in values.items():
         if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)):
             raise InvalidParameterError(f"{name} must be a number, got {value!r}")

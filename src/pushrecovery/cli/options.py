@@ -23,6 +23,7 @@ PARAM_FLAGS: tuple[tuple[str, str, str], ...] = (
     ("--torque-max", "torque_max", "Hip torque limit τmax [N m]."),
     ("--flywheel-angle-max", "flywheel_angle_max", "Hip joint limit θmax [rad]."),
     ("--leg-length", "leg_length", "Leg length for stepping [m] (default: CoM height)."),
+    ("--max-step-length", "max_step_length", "Longest step, foot to foot [m] (default: leg)."),
 )
 
 

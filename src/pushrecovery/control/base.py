@@ -60,6 +60,8 @@ class Controller(ABC):
     strategy: ClassVar[str] = "ankle"
     #: Period the controller is designed for [s]; ``None`` lets the simulator choose.
     control_period: float | None = None
+    #: True when the controller's internal model assumes exactly ``control_period``.
+    fixed_period: ClassVar[bool] = False
 
     def __init__(self, params: BodyParams) -> None:
         self.params = params

@@ -19,6 +19,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.models.pendulum import com_from_lean, lean_from_com, pendulum_step
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.result import is_falling
 
 __all__ = ["MODELS", "FlywheelPlant", "LipmPlant", "PendulumPlant", "Plant", "make_plant"]
 
@@ -31,6 +32,12 @@ class Plant(Protocol):
     name: ClassVar[str]
     params: BodyParams
     fall_limits: tuple[float, float]
+    #: Times the flywheel hit its joint stop at speed (always 0 for models without one).
+    stop_impacts: int
+
+    def falling(self, state: FloatArray) -> bool:
+        """Whether ``state`` is in the plant's absorbing fall set (docs/conventions.md)."""
+        ...
 
     def initial_state(self, x: float, xdot: float) -> FloatArray:
         """State with the CoM at x [m] moving at ẋ [m/s], everything else at rest."""
@@ -72,6 +79,11 @@ class _AnklePlant:
         self.params = params
         # Beyond a foot edge, moving outward: lost for any CoP (docs/conventions.md).
         self.fall_limits = (params.heel, params.toe)
+        self.stop_impacts = 0
+
+    def falling(self, state: FloatArray) -> bool:
+        """Beyond a foot edge and moving outward (absorbing for every CoP on the foot)."""
+        return is_falling(float(state[0]), float(state[1]), *self.fall_limits)
 
     def initial_state(self, x: float, xdot: float) -> FloatArray:
         """``[x, xdot]``."""
@@ -146,9 +158,12 @@ class FlywheelPlant:
     """LIPM plus flywheel (Eqs. 6, 7, 16), advanced exactly with the ZOH transition.
 
     State ``[x, theta, xdot, theta_dot]``. The hip joint limit |θ| ≤ θmax is a hard stop: a
-    step that would cross it ends with the flywheel on the stop and at rest, and the stopping
-    torque impulse P = −I θ̇ reacts on the CoM (Δẋ = −P / (m L), from Eqs. 6-7). Controllers
-    that respect the limit (bang-bang with T ≤ T_max, the MPC) never touch it.
+    step that ends past it puts the flywheel on the stop, at rest, and the stopping torque
+    impulse P = −I θ̇ reacts on the CoM (Δẋ = −P / (m L), from Eqs. 6-7; m L ẋ + I θ̇ is
+    conserved). The stop is checked at the end of each step with the end-of-step rate, an
+    approximation of order dt. An impact is a torque far beyond τmax, outside the model of
+    Sec. III (errata E12): each one is counted in ``stop_impacts`` and reported with the run.
+    Controllers that respect the limit (bang-bang with T ≤ T_max, the MPC) never touch it.
     """
 
     name: ClassVar[str] = "flywheel"
@@ -158,6 +173,8 @@ class FlywheelPlant:
         reach = params.torque_max / params.weight
         # Beyond δ± ± τmax/(m g), moving outward, no CMP on offer can stop the CoM.
         self.fall_limits = (params.heel - reach, params.toe + reach)
+        self._momentum = np.array([params.mass * params.com_height, params.flywheel_inertia])
+        self.stop_impacts = 0
         self._dt = -1.0
         self._a = self._b = np.empty(0)
 
@@ -194,7 +211,21 @@ class FlywheelPlant:
             new[1] = math.copysign(limit, new[1])
             new[2] += p.flywheel_inertia * new[3] / (p.mass * p.com_height)
             new[3] = 0.0
+            self.stop_impacts += 1
         return new, cop, torque
+
+    def falling(self, state: FloatArray) -> bool:
+        """Beyond δ± ± τmax/(m g), moving outward, with H = m L ẋ + I θ̇ outward too.
+
+        dH/dt = m g (x − δ) > 0 there whatever the hip torque, and a stop impact conserves H,
+        so ẋ can never turn back: the set is absorbing even with the joint stop.
+        """
+        x, xdot = float(state[0]), float(state[2])
+        momentum = float(self._momentum @ state[2:])
+        lower, upper = self.fall_limits
+        return (x > upper and xdot >= 0.0 and momentum >= 0.0) or (
+            x < lower and xdot <= 0.0 and momentum <= 0.0
+        )
 
 
 #: Model name -> plant class.

@@ -47,6 +47,8 @@ class SimulationResult:
         ``recovered``, ``fell`` or ``undecided`` (neither within the duration).
     model, controller : str
         Registry names of the plant and the controller.
+    stop_impacts : int
+        Times the flywheel hit its joint stop at speed (a torque beyond τmax; errata E12).
     """
 
     time: NDArray[np.float64]
@@ -55,6 +57,7 @@ class SimulationResult:
     outcome: Outcome
     model: str
     controller: str
+    stop_impacts: int = 0
 
     @property
     def cops(self) -> NDArray[np.float64]:
@@ -94,4 +97,5 @@ class SimulationResult:
             "peak_cop": {"min": float(self.cops.min()), "max": float(self.cops.max())},
             "max_excursion": float(np.abs(self.states[:, 0]).max()),
             "peak_torque": float(np.abs(self.torques).max()),
+            "stop_impacts": self.stop_impacts,
         }

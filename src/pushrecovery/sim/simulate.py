@@ -11,7 +11,7 @@ from pushrecovery._validate import finite_float, positive_float
 from pushrecovery.control.base import Controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.plants import Plant
-from pushrecovery.sim.result import Outcome, SimulationResult, is_falling
+from pushrecovery.sim.result import Outcome, SimulationResult
 
 __all__ = ["DEFAULT_CONTROL_PERIOD", "RestCriterion", "simulate"]
 
@@ -83,6 +83,11 @@ def simulate(
     duration = positive_float("duration", duration, "s")
     if control_period is None:
         control_period = controller.control_period or DEFAULT_CONTROL_PERIOD
+    elif controller.fixed_period and control_period != controller.control_period:
+        raise InvalidParameterError(
+            f"controller {controller.name!r} predicts with its own period "
+            f"{controller.control_period:g} s; control_period must match it, got {control_period:g}"
+        )
     dt = positive_float("control_period", control_period, "s")
     if dt > duration:
         raise InvalidParameterError(
@@ -99,7 +104,7 @@ def simulate(
         )
     rest = rest or RestCriterion()
     heel, toe = plant.params.heel, plant.params.toe
-    fall_low, fall_high = plant.fall_limits
+    plant.stop_impacts = 0
     steps = math.ceil(duration / dt - 1e-9)
     if steps > MAX_STEPS:
         raise InvalidParameterError(
@@ -125,7 +130,7 @@ def simulate(
         k += 1
         states[k] = state
         x, xdot = state[0], state[vel]
-        if is_falling(x, xdot, fall_low, fall_high):
+        if plant.falling(state):
             outcome = Outcome.FELL
             break
         resting = abs(xdot) <= rest.speed and heel < x < toe and not command.saturated
@@ -140,4 +145,5 @@ def simulate(
         outcome=outcome,
         model=plant.name,
         controller=controller.name,
+        stop_impacts=plant.stop_impacts,
     )

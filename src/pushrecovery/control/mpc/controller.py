@@ -39,6 +39,7 @@ class MPCController(Controller):
 
     name = "mpc"
     strategy = "hip"
+    fixed_period = True
 
     def __init__(
         self, params: BodyParams, settings: MPCSettings | None = None, **overrides: Any
@@ -82,7 +83,7 @@ class MPCController(Controller):
                 ub=qp.scaled_upper,
                 solver=self.settings.solver,
             )
-        except ValueError:  # some back-ends raise on infeasible problems
+        except Exception:
             solution = None
         if solution is None or not np.all(np.isfinite(solution)):
             inputs = np.tile(self._fallback(state), (self.settings.horizon, 1))
@@ -99,7 +100,9 @@ class MPCController(Controller):
         # Clip what the solver's tolerance may leave a hair outside the limits.
         cop = min(p.toe, max(p.heel, float(cop)))
         torque = min(p.torque_max, max(-p.torque_max, float(torque)))
-        at_limit = cop in (p.heel, p.toe) or abs(torque) >= p.torque_max * (1 - 1e-9)
+        at_limit = cop in (p.heel, p.toe) or (
+            p.torque_max > 0.0 and abs(torque) >= p.torque_max * (1 - 1e-9)
+        )
         return Command(cop, torque, saturated=at_limit or not plan.feasible)
 
     def _fallback(self, state: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -54,8 +54,9 @@ class MPCSettings:
             ("state_weights", self.state_weights, 4),
             ("input_weights", self.input_weights, 2),
         ):
-            if len(values) != size:
-                raise InvalidParameterError(f"{name} must have {size} entries, got {len(values)}")
+            if not isinstance(values, tuple | list) or len(values) != size:
+                got = len(values) if isinstance(values, tuple | list) else repr(values)
+                raise InvalidParameterError(f"{name} must have {size} entries, got {got}")
             checked = tuple(finite_float(name, v) for v in values)
             if min(checked) < 0.0 or (name == "input_weights" and min(checked) <= 0.0):
                 bound = "> 0" if name == "input_weights" else ">= 0"

@@ -1,0 +1,276 @@
+r"""Stepping model of Sec. IV (Hofmann): a point mass on massless legs of length L.
+
+The CoM starts above the stance ankle moving forward at v0 and falls as an inverted pendulum
+about it, with no ankle torque. Our angle θ is the stance leg's lean from vertical, **positive
+forward** (CoM ahead of the stance foot), like the pendulum of Sec. II; the paper's θ in
+Eqs. (18)-(22) is the opposite, −θ (docs/errata.md, E14). The swing leg lands symmetrically, at
+L sin θ ahead of the CoM, so the step is 2 L sin θ foot to foot.
+
+Energy gives the fall rate in closed form:
+
+.. math:: \dot\theta(\theta)^2 = \frac{v_0^2}{L^2} + 2\omega^2 (1 - \cos\theta),
+          \qquad \omega^2 = g / L.
+
+Velocities before impact (Eq. 18, our sign): v_x = L cos θ θ̇, v_z = −L sin θ θ̇. The impact
+impulse acts along the new leg and removes v_z (Eqs. 19-20), so
+
+.. math:: v_x^+ = L\dot\theta\,\frac{\cos 2\theta}{\cos\theta}, \qquad v_z^+ = 0,
+
+and the CoM then moves as a LIPM at height z = L cos θ, with ω⁺ = sqrt(g/z), starting
+L sin θ *behind* the new ankle. Its capture point relative to the new ankle is
+
+.. math:: \xi^+(\theta) = -L\sin\theta + \frac{v_x^+}{\omega^+}
+          = L\left(-\sin\theta + \frac{\dot\theta}{\omega}
+            \frac{\cos 2\theta}{\sqrt{\cos\theta}}\right),
+
+which decreases monotonically from v0/ω at θ = 0 to −L/√2 at θ = π/4 (checked on a dense grid,
+``tests/test_stepping.py``). Eq. (21) asks for ξ⁺ = 0 (Eq. 22 is the same condition written as
+θ̇(θ)); any θ with δ⁻ < ξ⁺ < δ⁺ leaves the body recoverable by the new foot's ankle (Eq. 4).
+Every such condition is therefore a 1-D root of ξ⁺(θ) = target on (0, π/4), solved here with a
+safeguarded Newton iteration in a compiled, vectorised kernel.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = [
+    "StepSolution",
+    "fall_rate",
+    "impact_velocities",
+    "post_impact_capture_point",
+    "solve_step_angle",
+    "step_solution",
+    "time_to_angle",
+]
+
+FloatArray = NDArray[np.float64]
+#: Largest step angle: at π/4 the impact absorbs all horizontal velocity (cos 2θ = 0).
+MAX_STEP_ANGLE = 0.25 * math.pi
+
+
+def fall_rate(theta: ArrayLike, v0: ArrayLike, length: float, gravity: float) -> FloatArray:
+    """Stance-leg rate θ̇ [rad/s] at lean θ [rad], from energy, starting at θ = 0 with v0 [m/s]."""
+    theta = np.asarray(theta, dtype=np.float64)
+    v0 = np.asarray(v0, dtype=np.float64)
+    return np.sqrt((v0 / length) ** 2 + 2.0 * gravity / length * (1.0 - np.cos(theta)))
+
+
+def time_to_angle(theta: ArrayLike, v0: ArrayLike, length: float, gravity: float) -> FloatArray:
+    """Time [s] for the stance leg to lean from 0 to θ, in closed form.
+
+    t = ∫₀^θ dφ / θ̇(φ) = (2 / √a) F(θ/2 | −4ω²/a), a = v0²/L², with F the incomplete elliptic
+    integral of the first kind (``scipy.special.ellipkinc``). Needs v0 > 0.
+    """
+    from scipy.special import ellipkinc
+
+    theta = np.asarray(theta, dtype=np.float64)
+    a = (np.asarray(v0, dtype=np.float64) / length) ** 2
+    return 2.0 / np.sqrt(a) * ellipkinc(0.5 * theta, -4.0 * gravity / length / a)
+
+
+def impact_velocities(
+    theta: ArrayLike, theta_rate: ArrayLike, length: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """CoM velocities at impact: before (v_x, v_z), Eq. (18), and after v_x⁺, Eqs. (19)-(20).
+
+    Returns
+    -------
+    vx_before, vz_before, vx_after : ndarray
+        [m/s]; v_z after the impact is 0 by assumption.
+    """
+    theta = np.asarray(theta, dtype=np.float64)
+    theta_rate = np.asarray(theta_rate, dtype=np.float64)
+    cos = np.cos(theta)
+    return (
+        length * cos * theta_rate,
+        -length * np.sin(theta) * theta_rate,
+        length * theta_rate * np.cos(2.0 * theta) / cos,
+    )
+
+
+def post_impact_capture_point(
+    theta: ArrayLike, v0: ArrayLike, length: float, gravity: float
+) -> FloatArray:
+    """Capture point after landing at step angle θ, relative to the new ankle, ξ⁺(θ) [m]."""
+    theta = np.asarray(theta, dtype=np.float64)
+    rate = fall_rate(theta, v0, length, gravity)
+    omega = math.sqrt(gravity / length)
+    return length * (-np.sin(theta) + rate / omega * np.cos(2.0 * theta) / np.sqrt(np.cos(theta)))
+
+
+def solve_step_angle(v0: ArrayLike, target: ArrayLike, length: float, gravity: float) -> FloatArray:
+    """Step angle θ in [0, π/4] whose post-impact capture point is ``target`` [rad].
+
+    Solves ξ⁺(θ) = target (module docstring) for arrays of v0 [m/s] and targets [m]
+    (broadcast). Returns 0 when even θ → 0 leaves the capture point behind the target (no step
+    needed for it) and π/4 when the target lies below −L/√2 (unreachable).
+    """
+    v0, target = np.broadcast_arrays(
+        np.asarray(v0, dtype=np.float64), np.asarray(target, dtype=np.float64)
+    )
+    flat_v0 = np.ascontiguousarray(v0).reshape(-1)
+    flat_target = np.ascontiguousarray(target).reshape(-1)
+    out = np.empty_like(flat_v0)
+    _step_angle_kernel()(flat_v0, flat_target, float(length), float(gravity), out)
+    return out.reshape(v0.shape)
+
+
+@functools.cache
+def _step_angle_kernel() -> Callable[..., None]:
+    """Compile (once, cached on disk) the safeguarded Newton solve of ξ⁺(θ) = target."""
+    import numba
+
+    @numba.njit(cache=True, inline="always")
+    def residual(theta, a, w2, w, length, target):  # type: ignore[no-untyped-def]
+        s, c = math.sin(theta), math.cos(theta)
+        rate = math.sqrt(a + 2.0 * w2 * (1.0 - c))
+        c2 = math.cos(2.0 * theta)
+        root_c = math.sqrt(c)
+        value = length * (-s + rate / w * c2 / root_c) - target
+        d_rate = w2 * s / rate
+        slope = length * (
+            -c
+            + (
+                d_rate * c2 / root_c
+                - 2.0 * rate * math.sin(2.0 * theta) / root_c
+                + 0.5 * rate * c2 * s / (c * root_c)
+            )
+            / w
+        )
+        return value, slope
+
+    @numba.njit(parallel=True, cache=True, nogil=True)
+    def kernel(v0, target, length, gravity, out):  # type: ignore[no-untyped-def]
+        w2 = gravity / length
+        w = math.sqrt(w2)
+        top = 0.25 * math.pi
+        for i in numba.prange(v0.shape[0]):
+            a = (v0[i] / length) ** 2
+            goal = target[i]
+            if v0[i] / w <= goal:  # ξ⁺(0) = v0/ω already at or behind the target
+                out[i] = 0.0
+                continue
+            if -length * math.sqrt(0.5) >= goal:
+                out[i] = top
+                continue
+            low, high = 0.0, top
+            # Small-angle start for the Eq. (21) root: θ⁴ ≈ v0² / (3.58 g L).
+            theta = min(0.5 * top, (a / w2 / 3.5833) ** 0.25)
+            for _ in range(100):
+                value, slope = residual(theta, a, w2, w, length, goal)
+                if value > 0.0:  # ξ⁺ decreases with θ: the root lies above
+                    low = theta
+                else:
+                    high = theta
+                step = theta - value / slope if slope < 0.0 else -1.0
+                if not low < step < high:
+                    step = 0.5 * (low + high)
+                if abs(step - theta) <= 1e-15 * max(1.0, theta) or high - low <= 1e-15:
+                    theta = step
+                    break
+                theta = step
+            out[i] = theta
+
+    return kernel
+
+
+@dataclass(frozen=True, slots=True)
+class StepSolution:
+    """Steps for arrays of initial CoM velocities v0 (module docstring); all arrays broadcast.
+
+    Attributes
+    ----------
+    v0 : ndarray
+        Initial CoM velocity, CoM above the stance ankle [m/s], > 0.
+    theta, theta_rate : ndarray
+        Eq. (21) step: stance-leg angle [rad] and rate [rad/s] at impact.
+    time_to_impact : ndarray
+        [s].
+    step_length, com_to_foot : ndarray
+        2 L sin θ (foot to foot) and L sin θ (CoM to new foot) [m].
+    velocity_before_x, velocity_before_z, velocity_after, height_after : ndarray
+        Eq. (18) velocities before impact, Eq. (20) after [m/s]; CoM height after [m].
+    theta_low, theta_high : ndarray
+        Step angles whose post-impact capture point is on the new foot's toe / heel edge: every
+        angle strictly between them leaves a state inside Eq. (4) on the new foot [rad].
+    centred_theta : ndarray
+        Step angle that puts the capture point at the middle of the new foot [rad].
+    stance_leg_in_compression : ndarray of bool
+        False where the stance leg would have to pull to keep the mass on its circle before
+        impact (L θ̇² > g cos θ): the model is no longer physical there.
+    """
+
+    v0: FloatArray
+    theta: FloatArray
+    theta_rate: FloatArray
+    time_to_impact: FloatArray
+    step_length: FloatArray
+    com_to_foot: FloatArray
+    velocity_before_x: FloatArray
+    velocity_before_z: FloatArray
+    velocity_after: FloatArray
+    height_after: FloatArray
+    theta_low: FloatArray
+    theta_high: FloatArray
+    centred_theta: FloatArray
+    length: float
+    stance_leg_in_compression: NDArray[np.bool_]
+
+    def step_length_of(self, theta: ArrayLike) -> FloatArray:
+        """Foot-to-foot step length 2 L sin θ [m] of step angles θ [rad]."""
+        return 2.0 * self.length * np.sin(np.asarray(theta, dtype=np.float64))
+
+
+def step_solution(
+    v0: ArrayLike, length: float, gravity: float, heel: float, toe: float
+) -> StepSolution:
+    """Optimal (Eq. 21), centred and admissible steps for initial velocities v0 [m/s].
+
+    Parameters
+    ----------
+    v0 : array_like
+        CoM velocity with the CoM above the stance ankle [m/s], > 0 (forward; mirror the foot
+        for backward pushes).
+    length : float
+        Leg length L [m].
+    gravity : float
+        g [m/s²].
+    heel, toe : float
+        Edges of the new foot relative to its ankle [m].
+
+    Returns
+    -------
+    StepSolution
+    """
+    v0 = np.asarray(v0, dtype=np.float64)
+    targets = np.stack(np.broadcast_arrays(0.0, toe, heel, 0.5 * (heel + toe)))
+    angles = solve_step_angle(
+        v0[None, ...], targets.reshape((4,) + (1,) * v0.ndim), length, gravity
+    )
+    theta, low, high, centred = angles
+    rate = fall_rate(theta, v0, length, gravity)
+    vx, vz, after = impact_velocities(theta, rate, length)
+    return StepSolution(
+        v0=v0,
+        theta=theta,
+        theta_rate=rate,
+        time_to_impact=time_to_angle(theta, v0, length, gravity),
+        step_length=2.0 * length * np.sin(theta),
+        com_to_foot=length * np.sin(theta),
+        velocity_before_x=vx,
+        velocity_before_z=vz,
+        velocity_after=after,
+        height_after=length * np.cos(theta),
+        theta_low=low,
+        theta_high=high,
+        centred_theta=centred,
+        length=length,
+        stance_leg_in_compression=length * rate**2 <= gravity * np.cos(theta),
+    )
