@@ -36,10 +36,12 @@ def bounds(as_json: bool, **kwargs: Any) -> None:
     from pushrecovery.models.flywheel import max_spin_up_time
     from pushrecovery.surfaces.cmp import cmp_offset, cmp_region
     from pushrecovery.surfaces.cop import cop_region
+    from pushrecovery.surfaces.step import step_thresholds
 
     params = params_from(kwargs)
     cop, cmp = cop_region(params), cmp_region(params)
     spin_up = max_spin_up_time(params)
+    omega = params.omega
     emit(
         {
             "params": params.to_dict(),
@@ -51,6 +53,12 @@ def bounds(as_json: bool, **kwargs: Any) -> None:
                 "margin": cmp_offset(params),
                 # JSON has no infinity: without hip torque there is no spin-up at all.
                 "t_max": spin_up if spin_up != float("inf") else None,
+            },
+            # Largest recoverable CoM velocity from x = 0, [backward, forward], per strategy.
+            "thresholds": {
+                "ankle": [omega * cop.lower, omega * cop.upper],
+                "hip": [omega * cmp.lower, omega * cmp.upper],
+                "step": list(step_thresholds(params)),
             },
         },
         as_json,
@@ -325,3 +333,90 @@ def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) ->
     params = params_from(kwargs)
     files = write_figures(params, Path(out), formats)
     emit({"files": [str(f) for f in files]}, as_json)
+
+
+@cli.command(short_help="Optimal step after a push (Sec. IV, Eq. 21).")
+@click.option(
+    "--v0",
+    "speeds",
+    type=float,
+    multiple=True,
+    help="CoM velocity with the CoM above the stance ankle [m/s], > 0 (repeatable).",
+)
+@click.option(
+    "--v0-range",
+    nargs=3,
+    type=float,
+    default=None,
+    metavar="START STOP STEP",
+    help="Velocities START, START+STEP, ... up to STOP (inclusive) [m/s].",
+)
+@body_options
+def step(
+    speeds: tuple[float, ...],
+    v0_range: tuple[float, float, float] | None,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Optimal step (Eq. 21) and the range of recovering steps for initial CoM velocities."""
+    import numpy as np
+
+    from pushrecovery._validate import finite_array
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.models.stepping import step_solution
+
+    params = params_from(kwargs)
+    values = list(speeds)
+    if v0_range is not None:
+        start, stop, increment = (float(v) for v in finite_array("--v0-range", v0_range))
+        if increment <= 0.0 or stop < start:
+            raise InvalidParameterError(
+                f"--v0-range needs START <= STOP and STEP > 0, got {start:g} {stop:g} {increment:g}"
+            )
+        count = int(np.floor((stop - start) / increment + 1e-9)) + 1
+        if count > 100_000:
+            raise InvalidParameterError(f"--v0-range gives {count} velocities; at most 100000")
+        values.extend(start + increment * np.arange(count))
+    if not values:
+        raise InvalidParameterError("give --v0 V (repeatable) or --v0-range START STOP STEP")
+    v0 = finite_array("v0", values)
+    if np.any(v0 <= 0.0):
+        raise InvalidParameterError(
+            "v0 must be > 0 m/s (a forward push; backward steps are the mirror image)"
+        )
+    sol = step_solution(v0, params.leg_length, params.gravity, params.heel, params.toe)
+    reach = params.max_step_length
+    rows = [
+        {
+            "v0": float(sol.v0[i]),
+            "theta": float(sol.theta[i]),
+            "theta_rate": float(sol.theta_rate[i]),
+            "time_to_impact": float(sol.time_to_impact[i]),
+            "step_length": float(sol.step_length[i]),
+            "com_to_foot": float(sol.com_to_foot[i]),
+            "velocity_before": {
+                "x": float(sol.velocity_before_x[i]),
+                "z": float(sol.velocity_before_z[i]),
+            },
+            "velocity_after": float(sol.velocity_after[i]),
+            "height_after": float(sol.height_after[i]),
+            "theta_range": [float(sol.theta_low[i]), float(sol.theta_high[i])],
+            "step_length_range": [
+                float(sol.step_length_of(sol.theta_low[i])),
+                float(sol.step_length_of(sol.theta_high[i])),
+            ],
+            "centred_theta": float(sol.centred_theta[i]),
+            "centred_step_length": float(sol.step_length_of(sol.centred_theta[i])),
+            "stance_leg_in_compression": bool(sol.stance_leg_in_compression[i]),
+            "within_reach": bool(sol.step_length[i] <= reach),
+        }
+        for i in range(len(v0))
+    ]
+    if as_json:
+        import json
+
+        click.echo(json.dumps(rows[0] if len(rows) == 1 else rows, indent=2, allow_nan=False))
+        return
+    for row in rows:
+        emit(row, False)
+        click.echo("")
