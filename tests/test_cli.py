@@ -49,7 +49,7 @@ def test_choices_match_the_registries():
 
 def test_hip_commands():
     hip = run_json("classify", "--x", "0", "--xdot", "0.55")
-    assert hip["strategy"] == "hip" and set(hip["margins"]) == {"cop", "cmp"}
+    assert hip["strategy"] == "hip" and set(hip["margins"]) >= {"cop", "cmp"}
     run = run_json("simulate", "--model", "flywheel", "--controller", "mpc", "--xdot", "0.6")
     assert run["recovered"] is True and set(run["final_state"]) >= {"x", "xdot", "theta"}
     assert run["peak_torque"] == pytest.approx(100.0)

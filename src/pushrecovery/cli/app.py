@@ -13,7 +13,7 @@ from pushrecovery.cli.options import body_options, emit, params_from
 # Kept literal so that --help does not import the models; a test checks them against the
 # registries.
 MODEL_CHOICES = ("lipm", "pendulum", "flywheel")
-CONTROLLER_CHOICES = ("ankle-saturated", "ankle-pd", "bang-bang", "mpc")
+CONTROLLER_CHOICES = ("ankle-saturated", "ankle-pd", "ankle-capture-point", "bang-bang", "mpc")
 
 
 @click.group(

@@ -16,7 +16,7 @@ from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
-__all__ = ["AnklePD", "AnkleSaturated", "default_pd_gains"]
+__all__ = ["AnkleCapturePoint", "AnklePD", "AnkleSaturated", "default_pd_gains"]
 
 
 @register
@@ -27,7 +27,9 @@ class AnkleSaturated(Controller):
     that way it holds the CoP on that edge (the toe for a forward push): the open-loop,
     maximal braking of Eq. (3). Once the CoM has stopped it places the CoP at the capture
     point ξ = x + ẋ/ω (clipped to the foot), under which the CoM comes to rest, so that a
-    stopped body stays stopped. States inside Eq. (4) therefore end at rest over the foot.
+    stopped body stays stopped. States inside Eq. (4) with the CoM over the foot therefore end
+    at rest. (A CoM outside the foot moving back toward it, as after a step, needs the CoP on
+    the *other* edge; :class:`AnklePD` with its default gains recovers all of Eq. (4).)
     """
 
     name = "ankle-saturated"
@@ -116,4 +118,34 @@ class AnklePD(Controller):
         lean_rate = xdot / (self._length * cos) if cos > 0.0 else 0.0
         torque = self.stiffness * lean + self.damping * lean_rate
         cop, clipped = self.clip_cop(torque * self._inv_weight)
+        return Command(cop, saturated=clipped)
+
+
+@register
+class AnkleCapturePoint(Controller):
+    """CoP at the capture point, clipped to the foot: the exact controller of Eq. (4).
+
+    With δ = ξ, ξ̇ = ω (ξ − δ) = 0, so a capture point on the foot stays put and the CoM
+    converges to rest above it (ẋ = ω (ξ − x)); one beyond an edge gets the edge, the best any
+    CoP can do, and runs away only if Eq. (4) says so. It recovers exactly the states inside
+    Eq. (4), wherever the CoM starts. ``omega`` [1/s] defaults to sqrt(g / L); pass the one of
+    another CoM height (e.g. after a step).
+    """
+
+    name = "ankle-capture-point"
+
+    def __init__(self, params: BodyParams, omega: float | None = None) -> None:
+        super().__init__(params)
+        omega = params.omega if omega is None else finite_float("omega", omega, "1/s")
+        if omega <= 0.0:
+            raise InvalidParameterError(f"omega must be > 0 1/s, got {omega:g}")
+        self._inv_omega = 1.0 / omega
+
+    def reset(self, state: NDArray[np.float64]) -> None:
+        """Do nothing: the controller has no internal state."""
+
+    def compute(self, t: float, state: NDArray[np.float64]) -> Command:
+        """CoP at ξ = x + ẋ/ω, clipped to the foot [m]."""
+        x, xdot = float(state[0]), float(state[len(state) // 2])
+        cop, clipped = self.clip_cop(x + xdot * self._inv_omega)
         return Command(cop, saturated=clipped)
