@@ -146,7 +146,9 @@ def test_figures(tmp_path):
     files = run_json("figures", "--out", str(tmp_path))["files"]
     names = sorted(p.rsplit("/", 1)[1] for p in files)
     expected = [
-        f"fig{n}.{ext}" for n in ("3a", "3b", "5a", "5b", "6a", "6b") for ext in ("png", "svg")
+        f"fig{n}.{ext}"
+        for n in ("3a", "3b", "5a", "5b", "6a", "6b", "9", "10")
+        for ext in ("png", "svg")
     ]
     assert names == sorted(expected)
     assert all((tmp_path / name).stat().st_size > 1000 for name in names)

@@ -1,10 +1,11 @@
-"""Reproductions of the paper's figures: Fig. 3 (Sec. II), Fig. 5 and 6 (Sec. III).
+"""Reproductions of the paper's figures: Fig. 3 (Sec. II), 5 and 6 (Sec. III), 9 and 10 (Sec. IV).
 
 Each figure has a function that computes its runs and one that draws them.
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -27,7 +28,7 @@ from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import critical_velocity
 
-__all__ = ["fig3a", "fig3b", "fig5", "fig6", "write_figures"]
+__all__ = ["fig3a", "fig3b", "fig5", "fig6", "fig9", "fig10", "write_figures"]
 
 
 def _limits(params: BodyParams) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -102,6 +103,8 @@ def write_figures(
         *fig3b(params, formats, out),
         *fig5(params, formats, out),
         *fig6(params, formats, out),
+        *fig9(params, formats, out),
+        *fig10(params, formats, out),
     ]
 
 
@@ -222,3 +225,101 @@ def fig6(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
         formats,
     )
     return files
+
+
+def fig9(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
+    """Fig. 9: the stance pendulum, the coordinate jump to the new foot, and the impact.
+
+    Velocities are divided by ω(z) = sqrt(g / z) of the current CoM height (the paper scales
+    by √z), so every height shares the capture-point line ẋ/ω = −x of Eq. (21).
+    """
+    from pushrecovery.models.stepping import step_solution
+
+    length, gravity = params.leg_length, params.gravity
+    speeds = np.array([0.6, 0.9, 1.2, 1.5, 1.8])
+    sol = step_solution(speeds, length, gravity, params.heel, params.toe)
+    fig, ax = new_figure()
+    xs = np.linspace(-0.6, 0.6, 200)
+    ax.fill_between(
+        xs,
+        params.heel - xs,
+        params.toe - xs,
+        color=RECOVER_COLOUR,
+        alpha=0.15,
+        lw=0,
+        label="new foot's CoP region, Eq. (4)",
+    )
+    ax.plot(xs, -xs, "k--", lw=1.0, label="Eq. (21): capture point on the new ankle")
+    for i, v0 in enumerate(speeds):
+        theta = np.linspace(0.0, sol.theta[i], 100)
+        rate = np.sqrt((v0 / length) ** 2 + 2 * gravity / length * (1 - np.cos(theta)))
+        z = length * np.cos(theta)
+        scaled = length * np.cos(theta) * rate / np.sqrt(gravity / z)
+        ax.plot(length * np.sin(theta), scaled, color=HIP_COLOUR, lw=1.2)
+        x_hit = length * np.sin(sol.theta[i])
+        before, after = scaled[-1], sol.velocity_after[i] / np.sqrt(gravity / z[-1])
+        ax.plot([x_hit, -x_hit], [before, before], ":", color="0.4", lw=1.0)
+        ax.plot([-x_hit, -x_hit], [before, after], color=FALL_COLOUR, lw=1.2)
+        ax.plot(-x_hit, after, "o", color=RECOVER_COLOUR, ms=4)
+    ax.set_xlim(-0.6, 0.6)
+    ax.set_ylim(-0.2, 0.8)
+    ax.set_xlabel("CoM x relative to the stance ankle [m] (new ankle after the step)")
+    ax.set_ylabel("ẋ / ω(z) [m]  (ω(z) = sqrt(g / z))")
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title(
+        "Fig. 9: falling (orange), re-referencing to the new foot (dotted),\n"
+        "impact (red) onto Eq. (21)",
+        fontsize=10,
+    )
+    return save_figure(fig, out / "fig9", formats)
+
+
+def fig10(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
+    """Fig. 10: optimal step length vs initial CoM velocity, with the admissible range."""
+    from pushrecovery.models.stepping import step_solution
+    from pushrecovery.surfaces.step import step_thresholds
+
+    sol = step_solution(
+        np.linspace(0.1, 3.0, 30), params.leg_length, params.gravity, params.heel, params.toe
+    )
+    fig, ax = new_figure()
+    omega = params.omega
+    edges = [0.0, omega * params.toe, omega * cmp_region(params).upper, step_thresholds(params)[1]]
+    names = ("ankle", "hip", "step")
+    for (low, high), colour, name in zip(
+        itertools.pairwise(edges),
+        (RECOVER_COLOUR, HIP_COLOUR, "#1565c0"),
+        names,
+        strict=True,
+    ):
+        ax.axvspan(low, high, color=colour, alpha=0.12, lw=0, label=name)
+    ax.axvspan(edges[-1], 3.1, color=FALL_COLOUR, alpha=0.12, lw=0, label="fall")
+    low = sol.step_length_of(sol.theta_low)
+    high = sol.step_length_of(sol.theta_high)
+    ok = sol.stance_leg_in_compression
+    ax.errorbar(
+        sol.v0,
+        sol.step_length,
+        yerr=[sol.step_length - low, high - sol.step_length],
+        fmt="none",
+        ecolor="0.3",
+        capsize=2,
+        lw=0.8,
+    )
+    ax.plot(sol.v0[ok], sol.step_length[ok], "o", color="k", ms=4, label="Eq. (21) step")
+    ax.plot(
+        sol.v0[~ok],
+        sol.step_length[~ok],
+        "o",
+        mfc="none",
+        color="k",
+        ms=4,
+        label="stance leg would pull",
+    )
+    ax.axhline(params.max_step_length, color="0.3", ls="--", lw=0.8, label="max step length")
+    ax.set_xlim(0.0, 3.1)
+    ax.set_xlabel("initial CoM velocity v0 [m/s] (CoM above the stance ankle)")
+    ax.set_ylabel("step length, foot to foot [m]")
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title("Fig. 10: optimal step vs push; bars: steps that land inside Eq. (4)", fontsize=10)
+    return save_figure(fig, out / "fig10", formats)
