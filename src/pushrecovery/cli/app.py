@@ -12,8 +12,15 @@ from pushrecovery.cli.options import body_options, emit, params_from
 
 # Kept literal so that --help does not import the models; a test checks them against the
 # registries.
-MODEL_CHOICES = ("lipm", "pendulum", "flywheel")
-CONTROLLER_CHOICES = ("ankle-saturated", "ankle-pd", "ankle-capture-point", "bang-bang", "mpc")
+MODEL_CHOICES = ("lipm", "pendulum", "flywheel", "stepping")
+CONTROLLER_CHOICES = (
+    "ankle-saturated",
+    "ankle-pd",
+    "ankle-capture-point",
+    "bang-bang",
+    "mpc",
+    "recovery",
+)
 
 
 @click.group(

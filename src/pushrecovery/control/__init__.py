@@ -4,6 +4,7 @@ from pushrecovery.control.ankle import AnkleCapturePoint, AnklePD, AnkleSaturate
 from pushrecovery.control.bangbang import BangBang
 from pushrecovery.control.base import CONTROLLERS, Command, Controller, make_controller
 from pushrecovery.control.mpc import MPCController
+from pushrecovery.control.recovery import RecoveryController
 
 __all__ = [
     "CONTROLLERS",
@@ -14,5 +15,6 @@ __all__ = [
     "Command",
     "Controller",
     "MPCController",
+    "RecoveryController",
     "make_controller",
 ]

@@ -44,11 +44,15 @@ class Command:
         the ankle strategy.
     saturated : bool
         True when a limit is active because the controller's goal is out of reach.
+    step_length : float or None
+        Take a step now: foot-to-foot length, signed (positive forward) [m]. Only the stepping
+        model has legs to do it; ``None`` keeps the stance.
     """
 
     cop: float
     flywheel_torque: float = 0.0
     saturated: bool = False
+    step_length: float | None = None
 
 
 class Controller(ABC):
@@ -56,7 +60,7 @@ class Controller(ABC):
 
     #: Name used by the CLI and the registry.
     name: ClassVar[str]
-    #: Strategy whose decision surface predicts this controller (``ankle`` or ``hip``).
+    #: Strategy whose decision surface predicts this controller (``ankle``, ``hip``, ``step``).
     strategy: ClassVar[str] = "ankle"
     #: Period the controller is designed for [s]; ``None`` lets the simulator choose.
     control_period: float | None = None

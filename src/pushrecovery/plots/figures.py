@@ -286,13 +286,13 @@ def fig10(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     omega = params.omega
     edges = [0.0, omega * params.toe, omega * cmp_region(params).upper, step_thresholds(params)[1]]
     names = ("ankle", "hip", "step")
-    for (low, high), colour, name in zip(
+    for (start, stop), colour, name in zip(
         itertools.pairwise(edges),
         (RECOVER_COLOUR, HIP_COLOUR, "#1565c0"),
         names,
         strict=True,
     ):
-        ax.axvspan(low, high, color=colour, alpha=0.12, lw=0, label=name)
+        ax.axvspan(start, stop, color=colour, alpha=0.12, lw=0, label=name)
     ax.axvspan(edges[-1], 3.1, color=FALL_COLOUR, alpha=0.12, lw=0, label="fall")
     low = sol.step_length_of(sol.theta_low)
     high = sol.step_length_of(sol.theta_high)

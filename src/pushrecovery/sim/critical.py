@@ -19,6 +19,7 @@ from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import strategy_region
 from pushrecovery.surfaces.cop import critical_velocity
+from pushrecovery.surfaces.step import step_critical_velocity
 
 __all__ = [
     "Bracket",
@@ -161,7 +162,8 @@ def critical_push(
     """Critical push of a model + controller from CoM position ``x0``, with its prediction.
 
     The prediction is the critical velocity of the decision surface of the controller's
-    strategy: Eq. (4) for the ankle controllers, corrected Eq. (15) for the hip controllers.
+    strategy: Eq. (4) for the ankle controllers, corrected Eq. (15) for the hip controllers, the
+    single-step limit of :mod:`pushrecovery.surfaces.step` for the recovery controller.
 
     Parameters
     ----------
@@ -196,8 +198,11 @@ def critical_push(
     sign = direction_sign(direction)
     plant = make_plant(model, params)
     ctrl = make_controller(controller, params, **(controller_options or {}))
-    region = strategy_region(ctrl.strategy, params)
-    predicted = float(critical_velocity(x0, sign, params, region=region))
+    if ctrl.strategy == "step":
+        predicted = step_critical_velocity(x0, sign, params)
+    else:
+        region = strategy_region(ctrl.strategy, params)
+        predicted = float(critical_velocity(x0, sign, params, region=region))
 
     def outcome_of(velocity: float) -> Outcome:
         run = simulate(

@@ -49,6 +49,8 @@ class SimulationResult:
         Registry names of the plant and the controller.
     stop_impacts : int
         Times the flywheel hit its joint stop at speed (a torque beyond τmax; errata E12).
+    footholds : tuple of float
+        World x of every stance foot, the first at 0 [m] (more than one after steps).
     """
 
     time: NDArray[np.float64]
@@ -58,6 +60,7 @@ class SimulationResult:
     model: str
     controller: str
     stop_impacts: int = 0
+    footholds: tuple[float, ...] = (0.0,)
 
     @property
     def cops(self) -> NDArray[np.float64]:
@@ -84,8 +87,11 @@ class SimulationResult:
         final = self.final_state
         x, xdot = final[0], final[len(final) // 2]
         final_state = {"x": float(x), "xdot": float(xdot)}
-        if len(final) == 4:
-            final_state.update(theta=float(final[1]), theta_dot=float(final[3]))
+        if len(final) in (4, 6):
+            half = len(final) // 2
+            final_state.update(theta=float(final[1]), theta_dot=float(final[half + 1]))
+        if len(final) == 6:
+            final_state.update(z=float(final[2]))
         return {
             "recovered": self.recovered,
             "outcome": self.outcome.value,
@@ -98,4 +104,5 @@ class SimulationResult:
             "max_excursion": float(np.abs(self.states[:, 0]).max()),
             "peak_torque": float(np.abs(self.torques).max()),
             "stop_impacts": self.stop_impacts,
+            "footholds": list(self.footholds),
         }

@@ -97,9 +97,14 @@ def simulate(
     for i, value in enumerate(state):
         finite_float(f"initial_state[{i}]", value)
     plant.check_state(state)
-    if controller.strategy == "hip" and len(state) < 4:
+    if controller.strategy == "hip" and len(state) != 4:
         raise InvalidParameterError(
             f"controller {controller.name!r} moves the upper body: use the flywheel model, "
+            f"not {plant.name!r}"
+        )
+    if controller.strategy == "step" and len(state) != 6:
+        raise InvalidParameterError(
+            f"controller {controller.name!r} takes steps: use the stepping model, "
             f"not {plant.name!r}"
         )
     rest = rest or RestCriterion()
@@ -146,4 +151,5 @@ def simulate(
         model=plant.name,
         controller=controller.name,
         stop_impacts=plant.stop_impacts,
+        footholds=tuple(getattr(plant, "footholds", (0.0,))),
     )

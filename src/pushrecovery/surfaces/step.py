@@ -10,8 +10,9 @@ the ankle with
 so :mod:`pushrecovery.models.stepping` applies with that v0, the step being taken at an angle
 θ ≥ θ0. A step at θ recovers when the post-impact capture point lies inside the new foot
 (θ_low < θ < θ_high), the foot lands within reach (2 L sin θ ≤ max_step_length) and the stance
-leg is still in compression. The recommended step is Eq. (21)'s θ*, moved into that feasible
-interval if needed. Backward steps are the mirror image (heel and toe swapped).
+leg is still in compression at the landing (L θ̇² ≤ g cos θ). The recommended step is
+Eq. (21)'s θ*, moved into that feasible interval if needed. Backward steps are the mirror
+image (heel and toe swapped).
 """
 
 from __future__ import annotations
@@ -22,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.models.stepping import MAX_STEP_ANGLE, fall_rate, solve_step_angle
+from pushrecovery.models.stepping import MAX_STEP_ANGLE, solve_step_angle
 from pushrecovery.params import BodyParams
 
-__all__ = ["StepPlan", "plan_steps", "step_thresholds"]
+__all__ = ["StepPlan", "plan_steps", "step_critical_velocity", "step_thresholds"]
 
 FloatArray = NDArray[np.float64]
 
@@ -93,10 +94,13 @@ def plan_steps(x: ArrayLike, xdot: ArrayLike, params: BodyParams) -> StepPlan:
     targets = np.stack([np.zeros_like(v0), toe, heel])
     best, low, high = solve_step_angle(v0[None], targets, length, gravity)
     reach = math.asin(min(1.0, params.max_step_length / (2.0 * length)))
+    # The stance leg stays in compression up to the angle where L θ̇² = g cos θ, i.e.
+    # cos θ_c = (v0²/L + 2g) / (3g); beyond it the foot would have to be pulled down.
+    cos_limit = (v0**2 / length + 2.0 * gravity) / (3.0 * gravity)
+    compression_limit = np.arccos(np.clip(cos_limit, -1.0, 1.0))
     low = np.maximum(low, lean)
-    high = np.minimum(high, min(reach, MAX_STEP_ANGLE))
-    # The stance leg stays in compression up to the angle where L θ̇² = g cos θ.
-    in_compression = length * fall_rate(low, v0, length, gravity) ** 2 <= gravity * np.cos(low)
+    high = np.minimum(np.minimum(high, min(reach, MAX_STEP_ANGLE)), compression_limit)
+    in_compression = (cos_limit < 1.0) & (low <= compression_limit)
     feasible = moving_on & (low < high) & in_compression
     theta = np.where(feasible, np.clip(best, low, high), np.nan)
     shortest = np.where(moving_on, 2.0 * length * np.sin(low), np.nan)
@@ -113,24 +117,34 @@ def plan_steps(x: ArrayLike, xdot: ArrayLike, params: BodyParams) -> StepPlan:
     )
 
 
+def step_critical_velocity(
+    x: float, direction: float, params: BodyParams, *, tolerance: float = 1e-9
+) -> float:
+    """Largest CoM velocity from position x [m] that one step recovers, signed [m/s].
+
+    Found by bisection on :func:`plan_steps` (feasibility is monotone in the push: a harder push
+    needs a longer step and loads the stance leg less).
+    """
+    sign = 1.0 if direction > 0.0 else -1.0
+    low, high = 0.0, math.sqrt(params.gravity * params.leg_length)
+    while high - low > tolerance:
+        middle = 0.5 * (low + high)
+        if bool(plan_steps(x, sign * middle, params).feasible):
+            low = middle
+        else:
+            high = middle
+    return sign * low
+
+
 def step_thresholds(params: BodyParams, *, tolerance: float = 1e-9) -> tuple[float, float]:
     """Largest backward and forward CoM velocity from x = 0 that one step recovers [m/s].
-
-    Found by bisection on :func:`plan_steps` (whose feasibility is monotone in the push).
 
     Returns
     -------
     (v_back, v_fwd) : tuple of float
         Signed: v_back < 0 < v_fwd.
     """
-    limits = []
-    for sign in (-1.0, 1.0):
-        low, high = 0.0, math.sqrt(params.gravity * params.leg_length)
-        while high - low > tolerance:
-            middle = 0.5 * (low + high)
-            if bool(plan_steps(0.0, sign * middle, params).feasible):
-                low = middle
-            else:
-                high = middle
-        limits.append(sign * low)
-    return limits[0], limits[1]
+    return (
+        step_critical_velocity(0.0, -1.0, params, tolerance=tolerance),
+        step_critical_velocity(0.0, 1.0, params, tolerance=tolerance),
+    )

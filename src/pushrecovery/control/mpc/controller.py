@@ -40,6 +40,8 @@ class MPCController(Controller):
     name = "mpc"
     strategy = "hip"
     fixed_period = True
+    #: The paper's prediction step [s].
+    default_dt = MPCSettings().dt
 
     def __init__(
         self, params: BodyParams, settings: MPCSettings | None = None, **overrides: Any

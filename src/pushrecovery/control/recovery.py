@@ -1,0 +1,132 @@
+"""The push-recovery controller: ankle, then hip, then a step, as Sec. I-B proposes."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.control.base import Command, Controller, register
+from pushrecovery.control.mpc import MPCController
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cmp import cmp_region
+from pushrecovery.surfaces.step import plan_steps
+
+__all__ = ["RecoveryController"]
+
+# Flywheel angle [rad] and rate [rad/s] below which the upper body counts as upright and still.
+_UPRIGHT = 1e-4
+
+
+@register
+class RecoveryController(Controller):
+    """Watch the state against the decision surfaces and escalate ankle → hip → step.
+
+    For the stepping model, state ``[x, θ, z, ẋ, θ̇, ż]`` relative to the current stance ankle.
+    Each stance starts in **ankle** mode: the CoP at the capture point ξ = x + ẋ/ω(z), ω(z) =
+    sqrt(g/z) of the current height (exact for Eq. 4). When ξ leaves the foot (or the upper body
+    is not upright and still) it escalates to **hip**: the paper's MPC (Eqs. 16-17) for the
+    current height, recomputed every MPC dt and held in between. It escalates to **step** when
+    the hip provably cannot recover any more, or has nothing left: the QP is infeasible; the
+    flywheel is parked at its limit with the capture point off the foot; or the flywheel-aware
+    capture point ξ + (I/(m g))(ω θ̇ + ω² θ) lies beyond δ± ± ω² I θmax/(m g), outside which no
+    admissible hip torque can capture the state (errata E12, step 3, with θ ≤ θmax). It then
+    takes the Eq. (21) step of :func:`~pushrecovery.surfaces.step.plan_steps`
+    (moved within reach if needed; the longest step as a last resort), braking the flywheel
+    during the swing. After the landing it starts again in ankle mode on the new foot.
+    Modes only escalate within a stance, so the controller does not chatter between surfaces.
+    """
+
+    name = "recovery"
+    strategy = "step"
+
+    def __init__(self, params: BodyParams) -> None:
+        super().__init__(params)
+        self.control_period = 1e-3
+        self.mode = "ankle"
+        self._bodies: dict[float, tuple[BodyParams, MPCController]] = {}
+        self._swing_height: float | None = None
+        self._held: Command | None = None
+        self._held_until = -1.0
+
+    def reset(self, state: NDArray[np.float64]) -> None:
+        """Start in ankle mode on the current foot."""
+        if np.shape(state) != (6,):
+            raise InvalidParameterError(
+                "the recovery controller needs the stepping model's state "
+                f"[x, theta, z, xdot, theta_dot, zdot], got shape {np.shape(state)}"
+            )
+        self.mode, self._swing_height, self._held = "ankle", None, None
+
+    def _body(self, height: float) -> tuple[BodyParams, MPCController]:
+        entry = self._bodies.get(height)
+        if entry is None:
+            body = dataclasses.replace(self.params, com_height=height)
+            # The MPC bounds θ only at its samples; between them θ is a parabola that can
+            # overshoot by u dt² / 8. Give it that much margin so the body never meets the stop.
+            dt = MPCController.default_dt
+            margin = body.torque_max / body.flywheel_inertia * dt * dt / 8.0
+            limited = dataclasses.replace(body, flywheel_angle_max=body.flywheel_angle_max - margin)
+            entry = self._bodies[height] = (limited, MPCController(limited))
+        return entry
+
+    def compute(self, t: float, state: NDArray[np.float64]) -> Command:
+        """Command for the current mode (escalating first if the state calls for it)."""
+        x, theta, z, xdot, theta_rate, zdot = (float(v) for v in state)
+        p = self.params
+        if self._swing_height is not None:  # swinging: wait for the landing
+            if zdot != 0.0 or z >= self._swing_height - 1e-12:
+                brake = -p.flywheel_inertia * theta_rate / self.control_period  # type: ignore[operator]
+                return Command(0.0, max(-p.torque_max, min(p.torque_max, brake)))
+            self._swing_height, self.mode, self._held = None, "ankle", None
+        body, mpc = self._body(z)
+        omega = math.sqrt(p.gravity / z)
+        capture = x + xdot / omega
+        upright = abs(theta) < _UPRIGHT and abs(theta_rate) < _UPRIGHT
+        if self.mode == "ankle" and not (p.heel < capture < p.toe and upright):
+            region = cmp_region(body)
+            self.mode = "hip" if region.lower < capture < region.upper else "step"
+        if self.mode == "hip":
+            exhausted = (
+                abs(theta) >= body.flywheel_angle_max - _UPRIGHT
+                and abs(theta_rate) < 1e-2
+                and not p.heel < capture < p.toe
+            )
+            scale = p.flywheel_inertia / p.weight
+            effective = capture + scale * (omega * theta_rate + omega**2 * theta)
+            reserve = scale * omega**2 * p.flywheel_angle_max
+            hopeless = not p.heel - reserve < effective < p.toe + reserve
+            command = None if exhausted or hopeless else self._hip(t, state, mpc)
+            if command is not None:
+                return command
+            self.mode = "step"
+        if self.mode == "step":
+            return self._step(x, xdot, z, body)
+        cop, clipped = self.clip_cop(capture)
+        return Command(cop, saturated=clipped)
+
+    def _hip(self, t: float, state: NDArray[np.float64], mpc: MPCController) -> Command | None:
+        if self._held is not None and t < self._held_until - 1e-9:
+            return self._held
+        plan = mpc.plan(state[[0, 1, 3, 4]])
+        if not plan.feasible:
+            return None
+        cop, torque = (float(v) for v in plan.first_input)
+        self._held = Command(
+            min(self.params.toe, max(self.params.heel, cop)),
+            max(-self.params.torque_max, min(self.params.torque_max, torque)),
+        )
+        self._held_until = t + mpc.settings.dt
+        return self._held
+
+    def _step(self, x: float, xdot: float, z: float, body: BodyParams) -> Command:
+        plan = plan_steps(x, xdot, body)
+        if bool(plan.feasible):
+            length, saturated = float(plan.step_length), False
+        else:  # nothing recovers for sure: the longest step is the best bet
+            length, saturated = float(plan.direction) * body.max_step_length, True
+        self._swing_height = z
+        return Command(0.0, step_length=length, saturated=saturated)
