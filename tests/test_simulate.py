@@ -137,11 +137,16 @@ def test_pd_gain_validation():
 )
 def test_controller_contract(name, x, v, t, theta, rate):
     controller = make_controller(name, PARAMS)
-    hip = controller.strategy == "hip"
-    state = np.array([x, theta, v, rate]) if hip else np.array([x, v])
+    hip = controller.strategy in ("hip", "step")
+    state = {
+        "ankle": np.array([x, v]),
+        "hip": np.array([x, theta, v, rate]),
+        "step": np.array([x, theta, PARAMS.com_height, v, rate, 0.0]),
+    }[controller.strategy]
     controller.reset(state)
     command = controller.compute(t, state)
     assert math.isfinite(command.cop) and math.isfinite(command.flywheel_torque)
+    assert command.step_length is None or abs(command.step_length) <= PARAMS.max_step_length
     assert PARAMS.heel <= command.cop <= PARAMS.toe
     assert abs(command.flywheel_torque) <= PARAMS.torque_max
     if not hip:

@@ -1,0 +1,93 @@
+"""The push-recovery controller on the stepping model: one test per strategy region, and the
+behaviour at the single-step limit."""
+
+import numpy as np
+import pytest
+
+from pushrecovery import InvalidParameterError, load_params
+from pushrecovery.control import make_controller
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.classify import classify
+from pushrecovery.surfaces.step import step_thresholds
+
+P = load_params()
+BACK, FORWARD = step_thresholds(P)
+
+
+def push(v, x=0.0, params=P):
+    plant = make_plant("stepping", params)
+    run = simulate(plant, make_controller("recovery", params), plant.initial_state(x, v))
+    return run
+
+
+@pytest.mark.parametrize("v", [0.3, -0.1])
+def test_ankle_region_no_hip_no_step(v):
+    assert classify(0.0, v, P).strategy == "ankle"
+    run = push(v)
+    assert run.recovered and len(run.footholds) == 1
+    assert np.abs(run.torques).max() == 0.0
+
+
+@pytest.mark.parametrize("v", [0.6, -0.3])
+def test_hip_region_uses_the_hip_without_stepping(v):
+    assert classify(0.0, v, P).strategy == "hip"
+    run = push(v)
+    assert run.recovered and len(run.footholds) == 1
+    assert np.abs(run.torques).max() == pytest.approx(P.torque_max)
+    assert run.stop_impacts == 0
+    assert abs(run.final_state[1]) < 1e-3  # the upper body is upright again
+
+
+@pytest.mark.parametrize("v", [0.7, 1.5, -0.5, -1.5])
+def test_step_region_takes_the_recommended_step(v):
+    decision = classify(0.0, v, P)
+    assert decision.strategy == "step"
+    run = push(v)
+    assert run.recovered and len(run.footholds) == 2
+    assert run.footholds[1] == pytest.approx(decision.step["step_length"], abs=1e-12)
+    # It ends at rest over the new foot, lower: the CoM height after Eq. (20).
+    assert run.final_state[2] < P.com_height
+
+
+@pytest.mark.parametrize(("v", "limit"), [(FORWARD, FORWARD), (BACK, BACK)])
+def test_just_below_the_step_limit_recovers_just_above_falls(v, limit):
+    below, above = push(0.999 * limit), push(1.001 * limit)
+    assert below.recovered and len(below.footholds) == 2
+    assert classify(0.0, 1.001 * limit, P).strategy == "fall"
+    # Above the limit the longest step within reach needs a stance leg that pulls: the body
+    # falls during the swing, before the foot lands.
+    assert above.outcome.value == "fell" and len(above.footholds) == 1
+    assert above.time[-1] < 0.3
+
+
+def test_with_a_short_reach_the_hip_finishes_what_the_step_began():
+    # The step surface assumes ankle balancing after landing. When the reach, not the stance
+    # leg, sets the limit, the longest step lands the capture point off the new foot but inside
+    # its CMP region, and the controller recovers with the hip on the new foot.
+    short = load_params(overrides={"max_step_length": 0.7})
+    _, forward = step_thresholds(short)
+    assert forward < FORWARD
+    below, above = push(0.99 * forward, params=short), push(1.02 * forward, params=short)
+    assert below.recovered and np.abs(below.torques).max() == 0.0
+    assert above.recovered and above.footholds == (0.0, 0.7)
+    assert np.abs(above.torques).max() > 0.0
+
+
+def test_recovery_needs_the_stepping_model():
+    plant = make_plant("flywheel", P)
+    with pytest.raises(InvalidParameterError, match="use the stepping model"):
+        simulate(plant, make_controller("recovery", P), plant.initial_state(0.0, 1.0))
+    lipm = make_plant("lipm", P)
+    with pytest.raises(InvalidParameterError, match="no legs"):
+        from pushrecovery.control import Command
+
+        lipm.step(np.array([0.0, 0.0]), Command(0.0, step_length=0.3), 1e-3)
+
+
+def test_critical_push_is_the_step_limit():
+    from pushrecovery.sim.critical import critical_push
+
+    found = critical_push(P, "stepping", "recovery", 0.0, "forward", tolerance=1e-3)
+    assert found.predicted_velocity == pytest.approx(FORWARD, abs=1e-8)
+    assert -0.001 < found.relative_error() <= 0.0
