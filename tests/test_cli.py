@@ -38,6 +38,47 @@ def test_bounds_cmp_keys():
     assert run_json("bounds", "--torque-max", "0")["cmp"]["t_max"] is None
 
 
+def test_step_contract():
+    one = run_json("step", "--v0", "1.0")
+    keys = {
+        "theta",
+        "theta_rate",
+        "time_to_impact",
+        "step_length",
+        "com_to_foot",
+        "velocity_before",
+        "velocity_after",
+        "height_after",
+        "theta_range",
+        "step_length_range",
+        "centred_step_length",
+        "stance_leg_in_compression",
+    }
+    assert set(one) >= keys and set(one["velocity_before"]) == {"x", "z"}
+    low, high = one["step_length_range"]
+    assert low < one["step_length"] < high
+    assert one["step_length"] == pytest.approx(2 * one["com_to_foot"])
+    several = run_json("step", "--v0", "0.5", "--v0", "1.5")
+    assert [row["v0"] for row in several] == [0.5, 1.5]
+    ranged = run_json("step", "--v0-range", "0.5", "1.5", "0.25")
+    assert [row["v0"] for row in ranged] == pytest.approx([0.5, 0.75, 1.0, 1.25, 1.5])
+
+
+def test_bounds_thresholds_and_classify_step():
+    thresholds = run_json("bounds")["thresholds"]
+    assert set(thresholds) >= {"ankle", "hip"}
+    for name in ("ankle", "hip", "step"):
+        back, forward = thresholds[name]
+        assert back < 0 < forward
+    assert thresholds["ankle"][1] < thresholds["hip"][1] < thresholds["step"][1]
+    stepped = run_json("classify", "--x", "0", "--xdot", "1.2")
+    assert stepped["strategy"] == "step" and stepped["step_length"] > 0.5
+    assert run_json("classify", "--x", "0", "--xdot", "2.7")["strategy"] == "fall"
+    run = run_json("simulate", "--model", "stepping", "--controller", "recovery", "--xdot", "1.2")
+    assert run["recovered"] and len(run["footholds"]) == 2
+    assert run["footholds"][1] == pytest.approx(stepped["step_length"])
+
+
 def test_choices_match_the_registries():
     from pushrecovery.cli.app import CONTROLLER_CHOICES, MODEL_CHOICES
     from pushrecovery.control import CONTROLLERS
@@ -179,6 +220,13 @@ def test_table_output_is_readable():
         (["critical-push", "--kp", "100"], "stiffness must be > m g L"),
         (["bounds", "--params", "/nonexistent.toml"], "not found"),
         (["nonsense"], "No such command"),
+        (["step"], "give --v0"),
+        (["step", "--v0", "-1"], "v0 must be > 0"),
+        (["step", "--v0", "nan"], "v0 must be finite"),
+        (["step", "--v0-range", "1", "0", "0.1"], "START <= STOP"),
+        (["step", "--v0-range", "0.1", "1e9", "1e-9"], "at most 100000"),
+        (["bounds", "--max-step-length", "3"], "max_step_length must be < 2 leg_length"),
+        (["simulate", "--model", "flywheel", "--controller", "recovery"], "stepping model"),
         (["simulate", "--duration", "1e12"], "must be <= 1e+07 steps"),
         (["simulate", "--x", "1.79e308"], "x must satisfy |x| < com_height"),
         (["simulate", "--xdot", "3000"], "xdot must satisfy"),
