@@ -119,14 +119,22 @@ def stepping() -> tuple[float, float]:
     event.terminal = True
 
     def ode(v0):
-        return solve_ivp(lambda t, y: [y[1], gravity / length * math.sin(y[0])], (0.0, 10.0),
-                         [0.0, v0 / length], events=event, rtol=1e-10, atol=1e-12)
+        return solve_ivp(
+            lambda t, y: [y[1], gravity / length * math.sin(y[0])],
+            (0.0, 10.0),
+            [0.0, v0 / length],
+            events=event,
+            rtol=1e-10,
+            atol=1e-12,
+        )
 
     sample = speeds[:50]
     slow = best(lambda: [ode(v) for v in sample], number=1) / sample.size
     ratio = slow * rate
-    print(f"optimal step: {rate:.3g} queries/s on 1e5 velocities; solve_ivp with events "
-          f"{1 / slow:.3g} queries/s; ratio {ratio:.0f}x (targets >= 2e6/s, >= 1000x)")
+    print(
+        f"optimal step: {rate:.3g} queries/s on 1e5 velocities; solve_ivp with events "
+        f"{1 / slow:.3g} queries/s; ratio {ratio:.0f}x (targets >= 2e6/s, >= 1000x)"
+    )
     return rate, ratio
 
 
