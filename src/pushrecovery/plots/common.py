@@ -58,7 +58,8 @@ def shade_regions(
     omega = params.omega
     xs = np.linspace(*xlim, 200)
     outer = cmp_region(params) if hip else cop_region(params)
-    ax.fill_between(xs, ylim[0], ylim[1], color=FALL_COLOUR, alpha=0.10, lw=0)
+    ax.fill_between(xs, omega * (outer.upper - xs), ylim[1], color=FALL_COLOUR, alpha=0.10, lw=0)
+    ax.fill_between(xs, ylim[0], omega * (outer.lower - xs), color=FALL_COLOUR, alpha=0.10, lw=0)
     inner = cop_region(params)
     if hip:
         # Only the slivers the hip adds beyond the CoP band.
