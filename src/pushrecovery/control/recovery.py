@@ -111,16 +111,12 @@ class RecoveryController(Controller):
     def _hip(self, t: float, state: NDArray[np.float64], mpc: MPCController) -> Command | None:
         if self._held is not None and t < self._held_until - 1e-9:
             return self._held
-        plan = mpc.plan(state[[0, 1, 3, 4]])
-        if not plan.feasible:
+        # The MPC's own command, with its clipping and saturation flag (rest criterion).
+        command = mpc.compute(t, state[[0, 1, 3, 4]])
+        if mpc.last_plan is None or not mpc.last_plan.feasible:
             return None
-        cop, torque = (float(v) for v in plan.first_input)
-        self._held = Command(
-            min(self.params.toe, max(self.params.heel, cop)),
-            max(-self.params.torque_max, min(self.params.torque_max, torque)),
-        )
-        self._held_until = t + mpc.settings.dt
-        return self._held
+        self._held, self._held_until = command, t + mpc.settings.dt
+        return command
 
     def _step(self, x: float, xdot: float, z: float, body: BodyParams) -> Command:
         plan = plan_steps(x, xdot, body)
