@@ -50,15 +50,24 @@ def test_step_region_takes_the_recommended_step(v):
     assert run.final_state[2] < P.com_height
 
 
-@pytest.mark.parametrize(("v", "limit"), [(FORWARD, FORWARD), (BACK, BACK)])
-def test_just_below_the_step_limit_recovers_just_above_falls(v, limit):
-    below, above = push(0.999 * limit), push(1.001 * limit)
+@pytest.mark.parametrize("limit", [FORWARD, BACK])
+def test_around_the_single_step_limit(limit):
+    # Just below: one step, as classify recommends. Just above, classify says "fall" (no single
+    # step lands the capture point on the new foot with the stance leg in compression), but the
+    # controller takes the best admissible step, at the compression limit, and then recovers
+    # with the hip on the new foot or with further steps.
+    below, above = push(0.999 * limit), push(1.01 * limit)
     assert below.recovered and len(below.footholds) == 2
-    assert classify(0.0, 1.001 * limit, P).strategy == "fall"
-    # Above the limit the longest step within reach needs a stance leg that pulls: the body
-    # falls during the swing, before the foot lands.
-    assert above.outcome.value == "fell" and len(above.footholds) == 1
-    assert above.time[-1] < 0.3
+    assert classify(0.0, 1.01 * limit, P).strategy == "fall"
+    assert above.recovered
+    assert np.abs(above.torques).max() > 0.0 or len(above.footholds) > 2
+
+
+def test_several_steps_beyond_the_single_step_limit():
+    # Each best-effort step lands at the stance leg's compression limit; harder pushes need
+    # more of them (docs/stepping.md).
+    counts = [len(push(v).footholds) - 1 for v in (2.8, 3.0, 3.1)]
+    assert counts == sorted(counts) and counts[-1] >= 3
 
 
 def test_with_a_short_reach_the_hip_finishes_what_the_step_began():
@@ -85,9 +94,42 @@ def test_recovery_needs_the_stepping_model():
         lipm.step(np.array([0.0, 0.0]), Command(0.0, step_length=0.3), 1e-3)
 
 
-def test_critical_push_is_the_step_limit():
+def test_critical_push_beyond_the_single_step_prediction():
     from pushrecovery.sim.critical import critical_push
 
     found = critical_push(P, "stepping", "recovery", 0.0, "forward", tolerance=1e-3)
     assert found.predicted_velocity == pytest.approx(FORWARD, abs=1e-8)
-    assert -0.001 < found.relative_error() <= 0.0
+    # Several steps take the controller past the single-step surface (measured 3.26 m/s).
+    assert found.velocity > 1.1 * FORWARD
+
+
+def test_away_from_upright_the_prediction_is_never_optimistic():
+    # From CoM positions across and beyond the foot, both directions: every state classify
+    # calls recoverable is recovered. The converse may fail on the safe side only (a best-effort
+    # step, then the hip): measured 4 of 99 on a finer grid.
+    optimistic, cautious = [], 0
+    for x0 in (-0.3, -0.04, 0.1, 0.3):
+        for v in (-2.0, -0.5, 0.6, 1.5, 2.4):
+            predicted = classify(x0, v, P).strategy != "fall"
+            recovered = push(v, x=x0).recovered
+            if predicted and not recovered:
+                optimistic.append((x0, v))
+            cautious += recovered and not predicted
+    assert optimistic == []
+    assert cautious <= 2
+
+
+def test_immediate_step_lands_and_recovers():
+    # Leaning 0.3 m forward at 1 m/s the Eq. (21) angle is already behind: step at once.
+    decision = classify(0.3, 1.0, P)
+    run = push(1.0, x=0.3)
+    assert decision.strategy == "step" and run.recovered
+    assert run.footholds[1] == pytest.approx(decision.step["step_length"], abs=1e-9)
+
+
+def test_planner_and_plant_share_the_leg_geometry():
+    tall_leg = load_params(overrides={"leg_length": 1.2})
+    decision = classify(0.0, 2.0, tall_leg)
+    run = push(2.0, params=tall_leg)
+    assert decision.strategy == "step" and run.recovered
+    assert run.footholds[1] == pytest.approx(decision.step["step_length"], abs=1e-9)

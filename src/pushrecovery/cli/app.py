@@ -387,9 +387,9 @@ def step(
     if not values:
         raise InvalidParameterError("give --v0 V (repeatable) or --v0-range START STOP STEP")
     v0 = finite_array("v0", values)
-    if np.any(v0 <= 0.0):
+    if np.any(v0 < 1e-6):
         raise InvalidParameterError(
-            "v0 must be > 0 m/s (a forward push; backward steps are the mirror image)"
+            "v0 must be >= 1e-6 m/s (a forward push; backward steps are the mirror image)"
         )
     sol = step_solution(v0, params.leg_length, params.gravity, params.heel, params.toe)
     reach = params.max_step_length

@@ -19,6 +19,8 @@ __all__ = ["RecoveryController"]
 
 # Flywheel angle [rad] and rate [rad/s] below which the upper body counts as upright and still.
 _UPRIGHT = 1e-4
+# During a swing the flywheel is braked to rest over about this time [s].
+STEP_BRAKE_TIME = 1e-2
 
 
 @register
@@ -48,7 +50,7 @@ class RecoveryController(Controller):
         self.control_period = 1e-3
         self.mode = "ankle"
         self._bodies: dict[float, tuple[BodyParams, MPCController]] = {}
-        self._swing_height: float | None = None
+        self._swing_start: float | None = None
         self._held: Command | None = None
         self._held_until = -1.0
 
@@ -59,7 +61,7 @@ class RecoveryController(Controller):
                 "the recovery controller needs the stepping model's state "
                 f"[x, theta, z, xdot, theta_dot, zdot], got shape {np.shape(state)}"
             )
-        self.mode, self._swing_height, self._held = "ankle", None, None
+        self.mode, self._swing_start, self._held = "ankle", None, None
 
     def _body(self, height: float) -> tuple[BodyParams, MPCController]:
         entry = self._bodies.get(height)
@@ -68,7 +70,10 @@ class RecoveryController(Controller):
             # The MPC bounds θ only at its samples; between them θ is a parabola that can
             # overshoot by u dt² / 8. Give it that much margin so the body never meets the stop.
             dt = MPCController.default_dt
-            margin = body.torque_max / body.flywheel_inertia * dt * dt / 8.0
+            margin = min(
+                body.torque_max / body.flywheel_inertia * dt * dt / 8.0,
+                0.5 * body.flywheel_angle_max,
+            )
             limited = dataclasses.replace(body, flywheel_angle_max=body.flywheel_angle_max - margin)
             entry = self._bodies[height] = (limited, MPCController(limited))
         return entry
@@ -77,11 +82,12 @@ class RecoveryController(Controller):
         """Command for the current mode (escalating first if the state calls for it)."""
         x, theta, z, xdot, theta_rate, zdot = (float(v) for v in state)
         p = self.params
-        if self._swing_height is not None:  # swinging: wait for the landing
-            if zdot != 0.0 or z >= self._swing_height - 1e-12:
-                brake = -p.flywheel_inertia * theta_rate / self.control_period  # type: ignore[operator]
+        if self._swing_start is not None:  # swinging: wait for the landing
+            # The plant keeps ż = 0 only in stance: the first such tick after the step landed.
+            if zdot != 0.0 or t <= self._swing_start:
+                brake = -p.flywheel_inertia * theta_rate / STEP_BRAKE_TIME
                 return Command(0.0, max(-p.torque_max, min(p.torque_max, brake)))
-            self._swing_height, self.mode, self._held = None, "ankle", None
+            self._swing_start, self.mode, self._held = None, "ankle", None
         body, mpc = self._body(z)
         omega = math.sqrt(p.gravity / z)
         capture = x + xdot / omega
@@ -104,7 +110,9 @@ class RecoveryController(Controller):
                 return command
             self.mode = "step"
         if self.mode == "step":
-            return self._step(x, xdot, z, body)
+            command = self._step(t, x, xdot, body)
+            if command is not None:
+                return command
         cop, clipped = self.clip_cop(capture)
         return Command(cop, saturated=clipped)
 
@@ -118,11 +126,11 @@ class RecoveryController(Controller):
         self._held, self._held_until = command, t + mpc.settings.dt
         return command
 
-    def _step(self, x: float, xdot: float, z: float, body: BodyParams) -> Command:
+    def _step(self, t: float, x: float, xdot: float, body: BodyParams) -> Command | None:
         plan = plan_steps(x, xdot, body)
-        if bool(plan.feasible):
-            length, saturated = float(plan.step_length), False
-        else:  # nothing recovers for sure: the longest step is the best bet
-            length, saturated = float(plan.direction) * body.max_step_length, True
-        self._swing_height = z
-        return Command(0.0, step_length=length, saturated=saturated)
+        if not bool(plan.ready):
+            return None  # the CoM is not yet falling toward the step: keep balancing meanwhile
+        # Feasible: the recommended step; otherwise the best effort, the admissible step whose
+        # capture point lands nearest the new foot.
+        self._swing_start = t
+        return Command(0.0, step_length=float(plan.step_length), saturated=not plan.feasible)

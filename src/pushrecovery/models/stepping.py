@@ -105,21 +105,36 @@ def post_impact_capture_point(
     return length * (-np.sin(theta) + rate / omega * np.cos(2.0 * theta) / np.sqrt(np.cos(theta)))
 
 
-def solve_step_angle(v0: ArrayLike, target: ArrayLike, length: float, gravity: float) -> FloatArray:
-    """Step angle θ in [0, π/4] whose post-impact capture point is ``target`` [rad].
+def solve_step_angle(
+    v0: ArrayLike,
+    target: ArrayLike,
+    length: float,
+    gravity: float,
+    *,
+    lean: ArrayLike = 0.0,
+    lean_rate: ArrayLike | None = None,
+) -> FloatArray:
+    """Step angle θ in [lean, π/4] whose post-impact capture point is ``target`` [rad].
 
     Solves ξ⁺(θ) = target (module docstring) for arrays of v0 [m/s] and targets [m]
-    (broadcast). Returns 0 when even θ → 0 leaves the capture point behind the target (no step
-    needed for it) and π/4 when the target lies below −L/√2 (unreachable).
+    (broadcast). By default the fall starts upright with v0; with ``lean`` [rad] and
+    ``lean_rate`` [rad/s] it starts from that lean instead (v0 is then ignored), which covers
+    slow falls whose energy is below the top of the pendulum. Returns ``lean`` when even an
+    immediate step leaves the capture point behind the target, and π/4 when the target lies
+    below −L/√2 (unreachable).
     """
-    v0, target = np.broadcast_arrays(
-        np.asarray(v0, dtype=np.float64), np.asarray(target, dtype=np.float64)
-    )
-    flat_v0 = np.ascontiguousarray(v0).reshape(-1)
-    flat_target = np.ascontiguousarray(target).reshape(-1)
-    out = np.empty_like(flat_v0)
-    _step_angle_kernel()(flat_v0, flat_target, float(length), float(gravity), out)
-    return out.reshape(v0.shape)
+    omega2 = gravity / length
+    lean = np.asarray(lean, dtype=np.float64)
+    if lean_rate is None:
+        energy = (np.asarray(v0, dtype=np.float64) / length) ** 2  # θ̇² at θ = 0
+    else:
+        rate = np.asarray(lean_rate, dtype=np.float64)
+        energy = rate**2 - 2.0 * omega2 * (1.0 - np.cos(lean))
+    energy, lean, target = np.broadcast_arrays(energy, lean, np.asarray(target, dtype=np.float64))
+    flat = [np.ascontiguousarray(a, dtype=np.float64).reshape(-1) for a in (energy, lean, target)]
+    out = np.empty_like(flat[0])
+    _step_angle_kernel()(*flat, float(length), float(gravity), out)
+    return out.reshape(energy.shape)
 
 
 @functools.cache
@@ -130,10 +145,12 @@ def _step_angle_kernel() -> Callable[..., None]:
     @numba.njit(cache=True, inline="always")
     def residual(theta, a, w2, w, length, target):  # type: ignore[no-untyped-def]
         s, c = math.sin(theta), math.cos(theta)
-        rate = math.sqrt(a + 2.0 * w2 * (1.0 - c))
+        rate = math.sqrt(max(0.0, a + 2.0 * w2 * (1.0 - c)))
         c2 = math.cos(2.0 * theta)
         root_c = math.sqrt(c)
         value = length * (-s + rate / w * c2 / root_c) - target
+        if rate == 0.0:
+            return value, -1.0
         d_rate = w2 * s / rate
         slope = length * (
             -c
@@ -147,22 +164,23 @@ def _step_angle_kernel() -> Callable[..., None]:
         return value, slope
 
     @numba.njit(parallel=True, cache=True, nogil=True)
-    def kernel(v0, target, length, gravity, out):  # type: ignore[no-untyped-def]
+    def kernel(energy, lean, target, length, gravity, out):  # type: ignore[no-untyped-def]
         w2 = gravity / length
         w = math.sqrt(w2)
         top = 0.25 * math.pi
-        for i in numba.prange(v0.shape[0]):
-            a = (v0[i] / length) ** 2
-            goal = target[i]
-            if v0[i] / w <= goal:  # ξ⁺(0) = v0/ω already at or behind the target
-                out[i] = 0.0
+        for i in numba.prange(energy.shape[0]):
+            a, goal, low = energy[i], target[i], max(0.0, lean[i])
+            if low >= top or residual(low, a, w2, w, length, goal)[0] <= 0.0:
+                out[i] = min(low, top)  # an immediate step already lands at or behind the goal
                 continue
             if -length * math.sqrt(0.5) >= goal:
                 out[i] = top
                 continue
-            low, high = 0.0, top
+            high = top
             # Small-angle start for the Eq. (21) root: θ⁴ ≈ v0² / (3.58 g L).
-            theta = min(0.5 * top, (a / w2 / 3.5833) ** 0.25)
+            theta = min(0.5 * (low + top), max(low, (max(a, 0.0) / w2 / 3.5833) ** 0.25))
+            if theta <= low:
+                theta = 0.5 * (low + high)
             for _ in range(100):
                 value, slope = residual(theta, a, w2, w, length, goal)
                 if value > 0.0:  # ξ⁺ decreases with θ: the root lies above

@@ -334,9 +334,10 @@ class SteppingPlant:
         x, z, xdot = float(state[0]), float(state[2]), float(state[3])
         length = math.hypot(x, z)
         sign = 1.0 if step_length > 0.0 else -1.0
-        landing = math.asin(min(1.0, abs(step_length) / (2.0 * length)))
-        self._swing = (length, landing, sign)
         lean = math.atan2(x, z)
+        # The foot cannot land behind the current lean: at the earliest it lands right away.
+        landing = max(math.asin(min(1.0, abs(step_length) / (2.0 * length))), sign * lean)
+        self._swing = (length, landing, sign)
         # The locked leg keeps only the tangential part of the CoM velocity.
         rate = xdot * math.cos(lean) / length
         state = state.copy()
