@@ -212,7 +212,7 @@ class FlywheelPlant:
         p = self.params
         cop = min(p.toe, max(p.heel, command.cop))
         torque = min(p.torque_max, max(-p.torque_max, command.flywheel_torque))
-        if command.step_length is not None and self.name == "flywheel":
+        if command.step_length is not None:
             raise InvalidParameterError("the flywheel model has no legs to step with")
         if dt != self._dt:
             self._dt = dt
@@ -290,7 +290,10 @@ class SteppingPlant:
         return np.array([x, 0.0, self.params.com_height, xdot, 0.0, 0.0])
 
     def check_state(self, state: FloatArray) -> None:
-        """Require ``[x, theta, z, xdot, theta_dot, zdot]`` standing (ż = 0, 0 < z)."""
+        """Require ``[x, theta, z, xdot, theta_dot, zdot]`` standing (ż = 0, 0 < z).
+
+        Called by the simulator before every run, it also starts a new record of footholds.
+        """
         if state.shape != (6,):
             raise InvalidParameterError(
                 f"state must be [x, theta, z, xdot, theta_dot, zdot], got shape {state.shape}"
