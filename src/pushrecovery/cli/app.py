@@ -125,9 +125,16 @@ def _options_for(controller: str, options: dict[str, Any]) -> dict[str, Any]:
     return options
 
 
+_backend = click.option(
+    "--backend",
+    type=click.Choice(("analytic", "mujoco")),
+    default="analytic",
+    show_default=True,
+    help="Physics: the analytic models, or MuJoCo (model 'foot' so far).",
+)
 _model = click.option(
     "--model",
-    type=click.Choice(MODEL_CHOICES),
+    type=click.Choice((*MODEL_CHOICES, "foot")),
     default="lipm",
     show_default=True,
     help="Plant: linear inverted pendulum or nonlinear pendulum.",
@@ -163,7 +170,7 @@ def _with(*decorators: Any) -> Any:
 
 
 @cli.command(short_help="Simulate a push; report recovered or fell.")
-@_with(_model, _controller, *_gains)
+@_with(_backend, _model, _controller, *_gains)
 @click.option(
     "--x", "x", type=float, default=0.0, show_default=True, help="CoM position before the push [m]."
 )
@@ -191,6 +198,7 @@ def _with(*decorators: Any) -> Any:
 )
 @body_options
 def simulate(
+    backend: str,
     model: str,
     controller: str,
     kp: float | None,
@@ -214,13 +222,19 @@ def simulate(
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)
     predicted = classify_state(x, velocity, params)
-    plant = make_plant(model, params)
+    plant = make_plant(model, params, backend)
+    if backend == "mujoco" and impulse is not None:
+        # A real force at the CoM, over 10 ms, instead of a velocity jump.
+        initial = plant.initial_state(x, 0.0)
+        plant.schedule_push(impulse)  # type: ignore[attr-defined]
+    else:
+        initial = plant.initial_state(x, velocity)
     result = run(
         plant,
         make_controller(
             controller, params, **_options_for(controller, _controller_options(kp, kd, options))
         ),
-        plant.initial_state(x, velocity),
+        initial,
         duration=duration,
         control_period=control_period,
     )
@@ -235,7 +249,7 @@ def simulate(
 
 
 @cli.command("critical-push", short_help="Largest recoverable push, vs Eq. 4.")
-@_with(_model, _controller, *_gains)
+@_with(_backend, _model, _controller, *_gains)
 @click.option(
     "--x",
     "x",
@@ -269,6 +283,7 @@ def simulate(
 )
 @body_options
 def critical_push(
+    backend: str,
     model: str,
     controller: str,
     kp: float | None,
@@ -296,6 +311,7 @@ def critical_push(
         duration=duration,
         control_period=control_period,
         controller_options=_options_for(controller, _controller_options(kp, kd, options)),
+        backend=backend,
     )
     emit(
         {

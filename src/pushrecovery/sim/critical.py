@@ -158,6 +158,7 @@ def critical_push(
     duration: float = 10.0,
     control_period: float | None = None,
     controller_options: dict[str, Any] | None = None,
+    backend: str = "analytic",
 ) -> CriticalPush:
     """Critical push of a model + controller from CoM position ``x0``, with its prediction.
 
@@ -184,6 +185,8 @@ def critical_push(
         defaults to the controller's own).
     controller_options : dict, optional
         Keyword options of the controller (e.g. ``stiffness``, ``damping``).
+    backend : {"analytic", "mujoco"}
+        Physics of the plant (``mujoco`` has the model ``foot``).
 
     Returns
     -------
@@ -196,7 +199,7 @@ def critical_push(
             f"x must lie on the foot, heel={params.heel:g} < x < toe={params.toe:g} m, got x={x0:g}"
         )
     sign = direction_sign(direction)
-    plant = make_plant(model, params)
+    plant = make_plant(model, params, backend)
     ctrl = make_controller(controller, params, **(controller_options or {}))
     if ctrl.strategy == "step":
         predicted = step_critical_velocity(x0, sign, params)

@@ -244,14 +244,29 @@ class FlywheelPlant:
 MODELS: dict[str, type[Any]] = {}
 
 
-def make_plant(name: str, params: BodyParams) -> Plant:
-    """Build the plant registered as ``name``; unknown names raise."""
+#: Models of the MuJoCo backend (:mod:`pushrecovery.sim.mujoco`).
+MUJOCO_MODELS = ("foot",)
+
+
+def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plant:
+    """Build the plant ``name`` of ``backend`` (``analytic`` or ``mujoco``); unknown names raise."""
+    if backend == "mujoco":
+        if name not in MUJOCO_MODELS:
+            raise InvalidParameterError(
+                f"model must be one of {list(MUJOCO_MODELS)} for the mujoco backend, got {name!r}"
+            )
+        from pushrecovery.sim.mujoco.plant import MujocoFootPlant
+
+        return MujocoFootPlant(params)
+    if backend != "analytic":
+        raise InvalidParameterError(f"backend must be 'analytic' or 'mujoco', got {backend!r}")
     try:
-        return MODELS[name](params)
+        plant: Plant = MODELS[name](params)
     except KeyError:
         raise InvalidParameterError(
             f"model must be one of {sorted(MODELS)}, got model={name!r}"
         ) from None
+    return plant
 
 
 class SteppingPlant:

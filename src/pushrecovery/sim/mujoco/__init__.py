@@ -1,0 +1,1 @@
+"""MuJoCo physics backend: models generated from the parameters, behind the Plant protocol."""
