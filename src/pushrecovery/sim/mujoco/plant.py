@@ -67,6 +67,7 @@ class MujocoFootPlant:
         self._floor = self.model.geom("floor").id
         self._sole = self.model.geom("sole").id
         self._pitch = self.model.joint("foot_pitch").qposadr[0]
+        self._ankle = self.model.joint("ankle").id
         self._force = np.zeros(6)
         self._mass_body = self.model.body("body").id
         self._push_force = 0.0
@@ -91,7 +92,7 @@ class MujocoFootPlant:
         """``[x, xdot]`` of the CoM above the ankle, relative to the ankle [m, m/s]."""
         mj, d = self._mj, self.data
         mj.mj_subtreeVel(self.model, d)
-        ankle = d.xanchor[self.model.joint("ankle").id]
+        ankle = d.xanchor[self._ankle]
         com = d.subtree_com[self._body]
         return np.array([com[0] - ankle[0], d.subtree_linvel[self._body][0]])
 
@@ -122,20 +123,10 @@ class MujocoFootPlant:
             raise InvalidParameterError(f"state must be [x, xdot], got shape {state.shape}")
 
     # --- dynamics --------------------------------------------------------------------------
-    def normal_force(self) -> float:
-        """Sum of the floor's normal forces on the sole [N]."""
-        total = 0.0
-        for i in range(self.data.ncon):
-            contact = self.data.contact[i]
-            if {contact.geom1, contact.geom2} == {self._floor, self._sole}:
-                self._mj.mj_contactForce(self.model, self.data, i, self._force)
-                total += self._force[0]
-        return total
-
     def measured_cop(self) -> float:
         """CoP of the floor's normal forces on the sole, relative to the ankle [m]."""
         moment = total = 0.0
-        ankle_x = self.data.xanchor[self.model.joint("ankle").id][0]
+        ankle_x = self.data.xanchor[self._ankle][0]
         for i in range(self.data.ncon):
             contact = self.data.contact[i]
             if {contact.geom1, contact.geom2} == {self._floor, self._sole}:
