@@ -90,13 +90,14 @@ class FixedCop:
     ("x0", "v0", "cop"), [(0.05, 0.0, 0.05), (0.0, 0.3, 0.10), (0.0, -0.1, -0.03)]
 )
 def test_commanded_cop_is_where_mujoco_puts_it(x0, v0, cop):
-    # The CoP → ankle torque map (errata E3) against MuJoCo's own contact forces. Tolerance:
-    # the friction force acts 1 cm below the ankle, shifting the CoP by h F_x / F_z, i.e.
-    # 0.01 m × |x − δ| / L ≤ 1.5 mm for these states. Checked once the soft contact has
-    # followed the load shift (time constant 2 ms; it rings for ~10 ms: checked from 20 ms).
+    # The CoP → ankle torque map (errata E3, with the 1 cm ankle height and its friction
+    # lever) against MuJoCo's own contact forces: within 0.3 mm once the soft contact has
+    # followed the load shift (time constant 2 ms; it rings for ~30 ms after the lean and push
+    # are applied, up to 1 mm: checked loosely from 20 ms, tightly from 40 ms).
     plant = make_plant("foot", P, "mujoco")
     state = plant.initial_state(x0, v0)
     for tick in range(60):  # 60 ms
         state, applied, _ = plant.step(state, FixedCop(cop).compute(0.0, state), 1e-3)
         if tick >= 20:
-            assert plant.measured_cop() == pytest.approx(applied, abs=1.5e-3), tick
+            tolerance = 3e-4 if tick >= 40 else 1.5e-3
+            assert plant.measured_cop() == pytest.approx(applied, abs=tolerance), tick

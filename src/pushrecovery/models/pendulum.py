@@ -17,6 +17,11 @@ which increases with δ while A > 0 and |δ| < L. A CoP command is therefore cli
 and turned into exactly the torque that puts the CoP there, including the vertical acceleration
 of the CoM that the LIPM neglects. When A ≤ 0 the foot is unloaded and no torque can be
 transmitted (τ = 0). This is how the ankle torque is limited so that the CoP stays on the foot.
+
+With an upper body on a hip joint whose centre of mass is at the hip (the flywheel of Sec. III),
+the hip torque τ_h (positive pitching the upper body forward) reacts on the leg:
+m L² θ̈ = m g L sinθ − τ − τ_h, hence F_z (1 − δ sinθ / L) = A + τ_h sinθ / L and
+τ(δ) = δ (A + τ_h sinθ / L) / (1 − δ sinθ / L) (docs/errata.md, E3).
 """
 
 from __future__ import annotations
@@ -33,7 +38,14 @@ __all__ = [
 
 
 def ankle_torque_for_cop(
-    theta: float, theta_rate: float, cop: float, mass: float, length: float, gravity: float
+    theta: float,
+    theta_rate: float,
+    cop: float,
+    mass: float,
+    length: float,
+    gravity: float,
+    hip_torque: float = 0.0,
+    ankle_height: float = 0.0,
 ) -> float:
     """Exact ankle torque that places the CoP at ``cop`` (module docstring) [N m].
 
@@ -46,18 +58,35 @@ def ankle_torque_for_cop(
     cop : float
         Desired CoP relative to the ankle, already on the foot [m]; |cop| < length.
     mass, length, gravity : float
-        m [kg], L [m], g [m/s²].
+        m [kg], L [m] (ankle to CoM), g [m/s²].
+    hip_torque : float
+        Torque on an upper body whose CoM is at the top of the rod [N m], positive pitching
+        it forward; 0 for the plain pendulum.
+    ankle_height : float
+        Height h of the ankle above the sole [m]; 0 in the paper. The friction force then
+        has a lever arm too: τ = δ F_z + h F_x.
 
     Returns
     -------
     float
-        τ = δ A / (1 − δ sinθ / L), or 0 when the foot is unloaded (A ≤ 0).
+        With h = 0, τ = δ A' / (1 − δ sinθ / L), A' = A + τ_h sinθ / L; in general
+        τ = [B + k (m g sinθ − τ_h / L)] / (1 + k / L), k = h cosθ − δ sinθ,
+        B = δ m (g − L cosθ θ̇²) − h m L sinθ θ̇² (docs/errata.md, E3). 0 when the foot is
+        unloaded (F_z ≤ 0).
     """
-    cos = math.cos(theta)
-    load = mass * cos * (gravity * cos - length * theta_rate * theta_rate)
-    if load <= 0.0:
-        return 0.0
-    return cop * load / (1.0 - cop * math.sin(theta) / length)
+    cos, sin = math.cos(theta), math.sin(theta)
+    spin = length * theta_rate * theta_rate
+    # Moments about the ankle: m L² θ̈ = m g L sinθ − τ − τ_h, with F_z = m (g + z̈), F_x = m ẍ.
+    lever = ankle_height * cos - cop * sin
+    torque = (
+        cop * mass * (gravity - cos * spin)
+        - ankle_height * mass * sin * spin
+        + lever * (mass * gravity * sin - hip_torque / length)
+    ) / (1.0 + lever / length)
+    # The vertical load this torque implies; none can be transmitted by an unloaded foot.
+    accel = (mass * gravity * length * sin - torque - hip_torque) / (mass * length * length)
+    load = mass * (gravity - length * (sin * accel + cos * theta_rate * theta_rate))
+    return torque if load > 0.0 else 0.0
 
 
 def pendulum_acceleration(

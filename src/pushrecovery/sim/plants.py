@@ -245,7 +245,7 @@ MODELS: dict[str, type[Any]] = {}
 
 
 #: Models of the MuJoCo backend (:mod:`pushrecovery.sim.mujoco`).
-MUJOCO_MODELS = ("foot",)
+MUJOCO_MODELS = ("foot", "torso")
 
 
 def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plant:
@@ -255,9 +255,10 @@ def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plan
             raise InvalidParameterError(
                 f"model must be one of {list(MUJOCO_MODELS)} for the mujoco backend, got {name!r}"
             )
-        from pushrecovery.sim.mujoco.plant import MujocoFootPlant
+        from pushrecovery.sim.mujoco import PLANTS
 
-        return MujocoFootPlant(params)
+        mujoco_plant: Plant = PLANTS[name](params)
+        return mujoco_plant
     if backend != "analytic":
         raise InvalidParameterError(f"backend must be 'analytic' or 'mujoco', got {backend!r}")
     try:

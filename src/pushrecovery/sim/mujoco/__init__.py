@@ -1,1 +1,12 @@
-"""MuJoCo physics backend: models generated from the parameters, behind the Plant protocol."""
+"""MuJoCo backend: models generated from the parameters and plants behind the Plant protocol."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pushrecovery.sim.mujoco.plant import MujocoFootPlant, MujocoTorsoPlant
+
+__all__ = ["PLANTS"]
+
+#: MuJoCo model name -> plant class (the names of ``plants.MUJOCO_MODELS``).
+PLANTS: dict[str, type[Any]] = {"foot": MujocoFootPlant, "torso": MujocoTorsoPlant}

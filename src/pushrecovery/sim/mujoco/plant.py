@@ -1,80 +1,119 @@
-"""The MuJoCo ``foot`` model behind the :class:`~pushrecovery.sim.plants.Plant` protocol.
+"""MuJoCo models behind the :class:`~pushrecovery.sim.plants.Plant` protocol.
 
-State handed to controllers: ``[x, xdot]``, the CoM position relative to the ankle and its
-velocity, estimated from MuJoCo's data (subtree CoM of the body above the ankle). A CoP command δ
-becomes the ankle torque that puts the CoP there on the pendulum, τ(δ) = δ A / (1 − δ sinθ / L)
-with A = m g cos²θ − m L cosθ θ̇² (errata E3), from the estimated lean and rate (plantar flexion
-positive; MuJoCo's hinge is positive leaning forward, hence the sign). Closing the loop on the
-*measured* normal force instead is unstable at the foot edge: a slight tip raises F_z, which
+The controllers see the same state as on the analytic models and send the same commands; the
+plants turn them into joint torques every physics step (1 ms) and estimate the state from
+MuJoCo's joints:
+
+- ``foot`` (:class:`MujocoFootPlant`): state ``[x, xdot]``, the CoM (the mass at the top of the
+  rod) relative to the ankle, x = L sinφ with φ the body's absolute pitch (foot pitch + ankle).
+- ``torso`` (:class:`MujocoTorsoPlant`): state ``[x, theta, xdot, theta_dot]`` as the flywheel
+  model, with θ the upper body's absolute pitch (the flywheel angle of Eq. 7).
+
+A CoP command δ becomes the ankle torque that puts the CoP there on a pendulum whose hip carries
+the commanded hip torque τ_h, τ(δ) = δ (A + τ_h sinφ/L) / (1 − δ sinφ/L) with
+A = m g cos²φ − m L cosφ φ̇² (errata E3), from the current lean and rate. Plantar flexion is
+positive in the paper and negative about MuJoCo's +y hinge, hence the sign. Closing the loop on
+the *measured* normal force instead is unstable at the foot edge: a slight tip raises F_z, which
 raises the torque, which tips the foot further.
 """
 
 from __future__ import annotations
 
 import math
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.models.pendulum import ankle_torque_for_cop, lean_from_com
+from pushrecovery.models.pendulum import ankle_torque_for_cop
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, foot_model
+from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, MODEL_BUILDERS
 
-__all__ = ["MujocoFootPlant"]
+__all__ = [
+    "DEFAULT_COP_MARGIN",
+    "FOOT_TIP_LIMIT",
+    "PUSH_DURATION",
+    "SETTLE_TIME",
+    "MujocoFootPlant",
+    "MujocoPlant",
+    "MujocoTorsoPlant",
+    "RecordedFrame",
+]
 
-#: Time the foot settles on the floor before a run starts [s].
+#: Time the feet settle on the floor before a run starts [s].
 SETTLE_TIME = 0.3
 #: Default CoP margin inside the foot edges [m].
 DEFAULT_COP_MARGIN = 0.002
 #: Default duration of a force push [s].
 PUSH_DURATION = 0.01
+#: Foot pitch beyond which a foot counts as tipped over [rad].
+FOOT_TIP_LIMIT = 0.2
 
 FloatArray = NDArray[np.float64]
 
+#: One recorded instant: time [s], qpos, CoM (x, z) [m], capture point x [m], CoP x [m] (world).
+RecordedFrame = tuple[float, FloatArray, tuple[float, float], float, float]
 
-class MujocoFootPlant:
-    """Rigid body on a tipping foot, in MuJoCo (model ``foot``).
 
-    The CoP command is clipped to the foot shortened by ``cop_margin`` [m] (default 2 mm): on
-    a real (soft-contact) foot the CoP can reach an edge only as the other edge lifts, i.e. as
-    the foot starts to tip (docs/validation.md). A push can be a velocity jump
-    (:meth:`initial_state`) or a real force: :meth:`schedule_push` applies an impulse [N s]
-    at the CoM over a short duration at the start of the run.
+class MujocoPlant:
+    """What every MuJoCo plant shares: the model, pushes, measured CoP, falls, recording.
 
-    Fall: anything but the foot touches the floor, or the CoM drops below half its standing
-    height, or the foot tips by more than 0.2 rad. The rest criterion of the simulator
-    (CoM at rest over the foot, unsaturated command) decides recovery, as for the analytic
-    models.
+    Subclasses set ``model_name`` and the names of the pushed body and of the CoM body, and
+    implement :meth:`read_state` (joint readings → the controller's state) and
+    :meth:`actuate` (command → ``data.ctrl``, called before every physics step).
+
+    Parameters
+    ----------
+    params : BodyParams
+        The body; the model is generated from it (:mod:`pushrecovery.sim.mujoco.models`).
+    cop_margin : float
+        The CoP command is clipped to the foot shortened by this much at each edge [m],
+        in [0, (toe − heel)/4]: with soft contacts the CoP reaches an edge only as the other
+        edge lifts, i.e. as the foot starts to tip (docs/validation.md).
     """
 
-    name: ClassVar[str] = "mujoco-foot"
+    name: ClassVar[str]
+    model_name: ClassVar[str]
+    #: Body the push force acts on (at its centre of mass).
+    pushed_body: ClassVar[str]
 
     def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:
         import mujoco
 
-        self._mj = mujoco
+        widest = 0.25 * (params.toe - params.heel)
+        if not (math.isfinite(cop_margin) and 0.0 <= cop_margin <= widest):
+            raise InvalidParameterError(
+                f"cop_margin must be in [0, (toe - heel)/4] m, got {cop_margin:g}"
+            )
+        self._mj: Any = mujoco
         self.params = params
         self.cop_margin = cop_margin
-        self.model = mujoco.MjModel.from_xml_string(foot_model(params))
+        self.model = mujoco.MjModel.from_xml_string(MODEL_BUILDERS[self.model_name](params))
         self.data = mujoco.MjData(self.model)
         self.fall_limits = (params.heel, params.toe)
         self.stop_impacts = 0
-        self._body = self.model.body("body").id
-        self._foot = self.model.body("foot").id
-        self._floor = self.model.geom("floor").id
-        self._sole = self.model.geom("sole").id
-        self._pitch = self.model.joint("foot_pitch").qposadr[0]
-        self._ankle = self.model.joint("ankle").id
+        self.time = 0.0
+        #: Frames recorded by :meth:`step` after :meth:`record` (for rendering), else None.
+        self.frames: list[RecordedFrame] | None = None
+        model = self.model
+        self._floor = model.geom("floor").id
+        self._soles = frozenset(
+            i for i in range(model.ngeom) if model.geom(i).name.endswith("sole")
+        )
+        self._pushed = model.body(self.pushed_body).id
+        self._qpos: FloatArray = self.data.qpos
+        self._qvel: FloatArray = self.data.qvel
+        self._ctrl: FloatArray = self.data.ctrl
         self._force = np.zeros(6)
-        self._mass_body = self.model.body("body").id
         self._push_force = 0.0
         self._push_left = 0.0
+        self._substep = model.opt.timestep
 
+    # --- pushes and recording ------------------------------------------------------------
     def schedule_push(self, impulse: float, duration: float = PUSH_DURATION) -> None:
-        """Push the body at its CoM with ``impulse`` [N s] spread over ``duration`` [s].
+        """Push the body at its CoM with ``impulse`` [N s] (+x forward) over ``duration`` [s].
 
         Applied from the next :meth:`step` on (call after :meth:`initial_state`).
         """
@@ -84,90 +123,248 @@ class MujocoFootPlant:
             )
         self._push_force, self._push_left = impulse / duration, duration
 
-    # --- state ---------------------------------------------------------------------------
-    def _settle(self) -> None:
-        self._mj.mj_forward(self.model, self.data)
+    def record(self) -> None:
+        """Record a frame at every :meth:`step` from now on (see :attr:`frames`)."""
+        self.frames = []
 
-    def com_state(self) -> FloatArray:
-        """``[x, xdot]`` of the CoM above the ankle, relative to the ankle [m, m/s]."""
-        mj, d = self._mj, self.data
-        mj.mj_subtreeVel(self.model, d)
-        ankle = d.xanchor[self._ankle]
-        com = d.subtree_com[self._body]
-        return np.array([com[0] - ankle[0], d.subtree_linvel[self._body][0]])
+    # --- state ---------------------------------------------------------------------------
+    def read_state(self) -> FloatArray:
+        """Return the controller's state from the current joint positions and velocities."""
+        raise NotImplementedError
+
+    def actuate(self, cop: float, command: Command) -> float:
+        """Set ``data.ctrl`` for this physics step; return the applied hip torque [N m]."""
+        raise NotImplementedError
+
+    def pose(self, x: float, xdot: float) -> None:
+        """Set the joints for a CoM at x [m] moving at ẋ [m/s] after settling (subclasses)."""
+        raise NotImplementedError
+
+    def ankle_x(self) -> float:
+        """World x of the stance ankle [m]."""
+        raise NotImplementedError
 
     def initial_state(self, x: float, xdot: float) -> FloatArray:
-        """Lean the body so the CoM is x ahead of the ankle, moving at ẋ; foot flat at rest.
+        """Lean so the CoM is x ahead of the ankle, moving at ẋ; feet flat, upper body upright.
 
         The body first stands upright (an exact balance, no torque) for ``SETTLE_TIME`` so
-        that the foot's contact is at equilibrium when the lean and the push are applied.
+        that the contacts are at equilibrium when the lean and the push are applied.
         """
-        d, length = self.data, self.params.com_height
-        self._mj.mj_resetData(self.model, d)
+        mj, d = self._mj, self.data
+        mj.mj_resetData(self.model, d)
         self._push_left = 0.0
-        lean = math.asin(max(-0.99, min(0.99, x / length)))
-        ankle_q = self.model.joint("ankle").qposadr[0]
-        ankle_v = self.model.joint("ankle").dofadr[0]
-        d.ctrl[0] = 0.0
-        for _ in range(round(SETTLE_TIME / self.model.opt.timestep)):
-            self._mj.mj_step(self.model, d)
-        d.qpos[ankle_q] = lean
+        d.ctrl[:] = 0.0
+        mj.mj_step(self.model, d, nstep=round(SETTLE_TIME / self._substep))
         d.qvel[:] = 0.0
-        d.qvel[ankle_v] = xdot / (length * math.cos(lean))
-        self._settle()
-        return self.com_state()
+        self.pose(x, xdot)
+        mj.mj_forward(self.model, d)
+        self.time = 0.0
+        if self.frames is not None:
+            self.frames = []
+            self._record(None)
+        return self.read_state()
 
     def check_state(self, state: FloatArray) -> None:
-        """Require ``[x, xdot]`` (set with :meth:`initial_state`)."""
-        if state.shape != (2,):
-            raise InvalidParameterError(f"state must be [x, xdot], got shape {state.shape}")
+        """Require the state shape of the model (set it with :meth:`initial_state`)."""
+        size = len(self.read_state())
+        if state.shape != (size,):
+            raise InvalidParameterError(
+                f"state must have shape ({size},) for {self.name}, got {state.shape}"
+            )
 
-    # --- dynamics --------------------------------------------------------------------------
-    def measured_cop(self) -> float:
-        """CoP of the floor's normal forces on the sole, relative to the ankle [m]."""
+    # --- dynamics ------------------------------------------------------------------------
+    def measured_cop_world(self) -> float:
+        """World x of the CoP of the floor's normal forces on the soles [m]; NaN if airborne."""
         moment = total = 0.0
-        ankle_x = self.data.xanchor[self._ankle][0]
-        for i in range(self.data.ncon):
-            contact = self.data.contact[i]
-            if {contact.geom1, contact.geom2} == {self._floor, self._sole}:
-                self._mj.mj_contactForce(self.model, self.data, i, self._force)
-                moment += self._force[0] * (contact.pos[0] - ankle_x)
+        d = self.data
+        for i in range(d.ncon):
+            contact = d.contact[i]
+            pair = (contact.geom1, contact.geom2)
+            if self._floor in pair and (pair[0] in self._soles or pair[1] in self._soles):
+                self._mj.mj_contactForce(self.model, d, i, self._force)
+                moment += self._force[0] * contact.pos[0]
                 total += self._force[0]
         return moment / total if total > 0.0 else math.nan
+
+    def measured_cop(self) -> float:
+        """CoP of the floor's normal forces on the soles, relative to the stance ankle [m]."""
+        return self.measured_cop_world() - self.ankle_x()
 
     def step(
         self, state: FloatArray, command: Command, dt: float
     ) -> tuple[FloatArray, float, float]:
-        """Hold the ankle torque for the CoP command over dt; return the estimated state."""
-        if command.flywheel_torque != 0.0 or command.step_length is not None:
-            raise InvalidParameterError("the mujoco foot model has only an ankle")
-        p = self.params
-        cop = min(p.toe - self.cop_margin, max(p.heel + self.cop_margin, command.cop))
-        steps = max(1, round(dt / self.model.opt.timestep))
-        for _ in range(steps):
-            x, xdot = self.com_state()
-            lean, rate = lean_from_com(
-                max(-0.99, min(0.99, x / p.com_height)) * p.com_height, xdot, p.com_height
-            )
-            torque = ankle_torque_for_cop(lean, rate, cop, p.mass, p.com_height, p.gravity)
-            self.data.ctrl[0] = -torque
-            pushing = self._push_left > 0.0
-            # The push acts at the subtree CoM (xfrc_applied acts at the body's CoM).
-            self.data.xfrc_applied[self._mass_body, 0] = self._push_force if pushing else 0.0
-            self._push_left -= self.model.opt.timestep
-            self._mj.mj_step(self.model, self.data)
-        return self.com_state(), cop, 0.0
+        """Hold ``command`` over dt (torques refreshed every physics step); return the state.
+
+        Returns the estimated state, the commanded CoP after clipping [m] and the hip torque
+        [N m].
+        """
+        p, margin = self.params, self.cop_margin
+        cop = min(p.toe - margin, max(p.heel + margin, command.cop))
+        mj, model, d, h = self._mj, self.model, self.data, self._substep
+        torque = 0.0
+        for _ in range(max(1, round(dt / h))):
+            torque = self.actuate(cop, command)
+            if self._push_left > 0.0:
+                d.xfrc_applied[self._pushed, 0] = self._push_force
+                self._push_left -= h
+            else:
+                d.xfrc_applied[self._pushed, 0] = 0.0
+            mj.mj_step(model, d)
+        self.time += dt
+        if self.frames is not None:
+            self._record(cop)
+        return self.read_state(), cop, torque
+
+    def _record(self, cop: float | None) -> None:
+        assert self.frames is not None
+        d = self.data
+        self._mj.mj_forward(self.model, d)
+        state = self.read_state()
+        half = len(state) // 2
+        com = d.subtree_com[0]
+        capture = self.ankle_x() + state[0] + state[half] / self.params.omega
+        measured = self.measured_cop_world() if cop is not None else math.nan
+        self.frames.append((self.time, d.qpos.copy(), (com[0], com[2]), capture, measured))
 
     def falling(self, state: FloatArray) -> bool:
-        """Anything but the sole on the floor, the CoM below half height, or a tipped foot."""
-        d = self.data
-        for i in range(d.ncon):
-            contact = d.contact[i]
-            geoms = {contact.geom1, contact.geom2}
-            if self._floor in geoms and self._sole not in geoms:
+        """Anything but a sole on the floor, the CoM below half height, or a tipped foot."""
+        d, floor = self.data, self._floor
+        for g1, g2 in d.contact.geom.tolist():
+            other = g2 if g1 == floor else g1 if g2 == floor else -1
+            if other >= 0 and other not in self._soles:
                 return True
-        com_height = d.subtree_com[self._body][2]
         return bool(
-            com_height < 0.5 * (self.params.com_height + ANKLE_HEIGHT)
-            or abs(d.qpos[self._pitch]) > 0.2
+            d.subtree_com[0][2] < 0.5 * (self.params.com_height + ANKLE_HEIGHT)
+            or self.foot_tipped()
         )
+
+    def foot_tipped(self) -> bool:
+        """Whether the stance foot has tipped beyond ``FOOT_TIP_LIMIT``."""
+        raise NotImplementedError
+
+
+class MujocoFootPlant(MujocoPlant):
+    """Rigid body on a tipping foot, in MuJoCo (model ``foot``): the pendulum of Fig. 3(b).
+
+    A push can be a velocity jump (:meth:`initial_state`) or a real force:
+    :meth:`schedule_push` applies an impulse [N s] at the CoM over a short duration at the
+    start of the run. The rest criterion of the simulator (CoM at rest over the foot,
+    unsaturated command) decides recovery, as for the analytic models.
+    """
+
+    name: ClassVar[str] = "mujoco-foot"
+    model_name: ClassVar[str] = "foot"
+    pushed_body: ClassVar[str] = "body"
+
+    def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:
+        super().__init__(params, cop_margin)
+        model = self.model
+        self._pitch = int(model.joint("foot_pitch").qposadr[0])
+        self._pitch_v = int(model.joint("foot_pitch").dofadr[0])
+        self._ankle = int(model.joint("ankle").qposadr[0])
+        self._ankle_v = int(model.joint("ankle").dofadr[0])
+        self._ankle_id = model.joint("ankle").id
+
+    def lean(self) -> tuple[float, float]:
+        """Absolute pitch φ of the body above the ankle and its rate [rad, rad/s]."""
+        q, v = self._qpos, self._qvel
+        return q[self._pitch] + q[self._ankle], v[self._pitch_v] + v[self._ankle_v]
+
+    def read_state(self) -> FloatArray:
+        """``[x, xdot]`` = (L sinφ, L cosφ φ̇) of the CoM relative to the ankle [m, m/s]."""
+        lean, rate = self.lean()
+        length = self.params.com_height
+        return np.array([length * math.sin(lean), length * math.cos(lean) * rate])
+
+    def pose(self, x: float, xdot: float) -> None:
+        """Lean the body above the ankle; the foot stays as it settled."""
+        length = self.params.com_height
+        lean = math.asin(max(-0.99, min(0.99, x / length)))
+        self._qpos[self._ankle] = lean - self._qpos[self._pitch]
+        self._qvel[self._ankle_v] = xdot / (length * math.cos(lean))
+
+    def ankle_x(self) -> float:
+        """World x of the ankle [m]."""
+        return float(self.data.xanchor[self._ankle_id][0])
+
+    def foot_tipped(self) -> bool:
+        """Foot pitch beyond ``FOOT_TIP_LIMIT``."""
+        return bool(abs(self._qpos[self._pitch]) > FOOT_TIP_LIMIT)
+
+    def ankle_torque(self, cop: float, hip_torque: float = 0.0) -> float:
+        """Ankle torque (paper's sign) that puts the CoP at ``cop`` now [N m] (errata E3)."""
+        p = self.params
+        lean, rate = self.lean()
+        return ankle_torque_for_cop(
+            lean,
+            rate,
+            cop,
+            p.mass,
+            p.com_height,
+            p.gravity,
+            hip_torque=hip_torque,
+            ankle_height=ANKLE_HEIGHT,
+        )
+
+    def actuate(self, cop: float, command: Command) -> float:
+        """Ankle torque for the CoP; the model has nothing else to move."""
+        if command.flywheel_torque != 0.0 or command.step_length is not None:
+            raise InvalidParameterError("the mujoco foot model has only an ankle")
+        self._ctrl[0] = -self.ankle_torque(cop)
+        return 0.0
+
+
+class MujocoTorsoPlant(MujocoFootPlant):
+    """Pendulum + upper body on a hip limited to ±θmax, in MuJoCo (model ``torso``).
+
+    State ``[x, theta, xdot, theta_dot]`` as :class:`~pushrecovery.sim.plants.FlywheelPlant`:
+    θ is the upper body's absolute pitch (I θ̈ = τ_h, Eq. 7). The joint limit acts on the hip
+    angle θ − φ; a run that hits it at speed counts one ``stop_impacts``.
+    """
+
+    name: ClassVar[str] = "mujoco-torso"
+    model_name: ClassVar[str] = "torso"
+    pushed_body: ClassVar[str] = "torso"
+
+    def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:
+        super().__init__(params, cop_margin)
+        reach = params.torque_max / params.weight
+        # As the flywheel model: beyond δ± ± τmax/(m g) no CMP stops an outgoing CoM.
+        self.fall_limits = (params.heel - reach, params.toe + reach)
+        self._hip = int(self.model.joint("hip").qposadr[0])
+        self._hip_v = int(self.model.joint("hip").dofadr[0])
+        self._at_stop = False
+
+    def read_state(self) -> FloatArray:
+        """``[x, theta, xdot, theta_dot]`` [m, rad, m/s, rad/s]."""
+        lean, rate = self.lean()
+        length = self.params.com_height
+        return np.array(
+            [
+                length * math.sin(lean),
+                lean + self._qpos[self._hip],
+                length * math.cos(lean) * rate,
+                rate + self._qvel[self._hip_v],
+            ]
+        )
+
+    def pose(self, x: float, xdot: float) -> None:
+        """Lean the legs; the upper body stays upright and at rest (hip = −lean)."""
+        super().pose(x, xdot)
+        lean, rate = self.lean()
+        self._qpos[self._hip] = -lean
+        self._qvel[self._hip_v] = -rate
+
+    def actuate(self, cop: float, command: Command) -> float:
+        """Hip torque (clipped to τmax) and the ankle torque for the CoP under it."""
+        if command.step_length is not None:
+            raise InvalidParameterError("the mujoco torso model has no legs to step with")
+        limit = self.params.torque_max
+        torque = min(limit, max(-limit, command.flywheel_torque))
+        self._ctrl[0] = -self.ankle_torque(cop, torque)
+        self._ctrl[1] = torque
+        at_stop = abs(self._qpos[self._hip]) >= self.params.flywheel_angle_max - 1e-3
+        if at_stop and not self._at_stop:
+            self.stop_impacts += 1
+        self._at_stop = at_stop
+        return torque
