@@ -90,7 +90,7 @@ class MujocoPlant:
         self._mj: Any = mujoco
         self.params = params
         self.cop_margin = cop_margin
-        self.model = mujoco.MjModel.from_xml_string(MODEL_BUILDERS[self.model_name](params))
+        self.model = mujoco.MjModel.from_xml_string(self.xml(params))
         self.data = mujoco.MjData(self.model)
         self.fall_limits = (params.heel, params.toe)
         self.stop_impacts = 0
@@ -110,6 +110,11 @@ class MujocoPlant:
         self._push_force = 0.0
         self._push_left = 0.0
         self._substep = model.opt.timestep
+
+    @classmethod
+    def xml(cls, params: BodyParams) -> str:
+        """MJCF text of the model for ``params`` (:data:`~.models.MODEL_BUILDERS`)."""
+        return MODEL_BUILDERS[cls.model_name](params)
 
     # --- pushes and recording ------------------------------------------------------------
     def schedule_push(self, impulse: float, duration: float = PUSH_DURATION) -> None:
