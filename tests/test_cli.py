@@ -214,7 +214,7 @@ def test_table_output_is_readable():
         (["classify", "--x", "0"], "Missing option '--xdot'"),
         (["simulate", "--xdot", "0.1", "--impulse", "3"], "either --xdot"),
         (["simulate", "--duration", "-1"], "duration must be > 0"),
-        (["simulate", "--model", "biped"], "Invalid value for '--model'"),
+        (["simulate", "--model", "humanoid"], "Invalid value for '--model'"),
         (["simulate", "--xdot", "0.1", "--plot", "run.gif"], "plot must end in one of"),
         (["critical-push", "--x", "0.3"], "x must lie on the foot"),
         (["critical-push", "--kp", "100"], "stiffness must be > m g L"),

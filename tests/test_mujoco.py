@@ -1,5 +1,5 @@
-"""MuJoCo backend (model ``foot``): standing, pushes as forces, controllers unchanged, and the
-ankle strategy's critical push against Eq. (4)."""
+"""MuJoCo backend (models ``foot`` and ``torso``): standing, pushes as forces, controllers
+unchanged, and the critical pushes against the surfaces."""
 
 import numpy as np
 import pytest
@@ -7,22 +7,25 @@ import pytest
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import make_controller
 from pushrecovery.sim.critical import critical_push
+from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, PUSH_DURATION
 from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.simulate import simulate
+from pushrecovery.sim.validation import corrected_critical_velocity
 
 P = load_params()
 
 
-def run(controller, v=0.0, impulse=None, duration=6.0):
-    plant = make_plant("foot", P, "mujoco")
+def run(controller, v=0.0, impulse=None, duration=6.0, model="foot"):
+    plant = make_plant(model, P, "mujoco")
     state = plant.initial_state(0.0, v if impulse is None else 0.0)
     if impulse is not None:
-        plant.schedule_push(impulse)
+        state = plant.push(impulse)
     return plant, simulate(plant, make_controller(controller, P), state, duration=duration)
 
 
-def test_stands_still_for_two_seconds():
-    plant, result = run("ankle-pd", duration=2.0)
+@pytest.mark.parametrize(("model", "controller"), [("foot", "ankle-pd"), ("torso", "mpc")])
+def test_stands_still_for_two_seconds(model, controller):
+    plant, result = run(controller, duration=2.0, model=model)
     assert result.outcome.value != "fell"
     assert np.abs(result.states[:, 0]).max() < 1e-3  # CoM stays over the ankle [m]
     assert abs(plant.data.qpos[plant._pitch]) < 1e-3  # the foot stays flat [rad]
@@ -30,12 +33,33 @@ def test_stands_still_for_two_seconds():
 
 @pytest.mark.parametrize("controller", ["ankle-pd", "ankle-saturated", "ankle-capture-point"])
 def test_inside_recovers_outside_falls_same_as_analytic(controller):
+    # Eq. (4) from x = 0: −0.157 … 0.470 m/s.
     for v, expected in ((0.3, True), (0.7, False), (-0.1, True), (-0.3, False)):
         _, mujoco_run = run(controller, v=v)
         analytic = simulate(
             make_plant("pendulum", P), make_controller(controller, P), np.array([0.0, v])
         )
         assert mujoco_run.recovered == expected == analytic.recovered, (controller, v)
+
+
+@pytest.mark.parametrize("controller", ["mpc", "bang-bang"])
+def test_torso_hip_strategy_same_as_analytic(controller):
+    # Corrected Eq. (15) from x = 0: −0.332 … 0.645 m/s; Eq. (4): −0.157 … 0.470 m/s.
+    for v, expected in ((0.55, True), (0.8, False), (-0.25, True), (-0.45, False)):
+        _, mujoco_run = run(controller, v=v, model="torso")
+        analytic = simulate(
+            make_plant("flywheel", P),
+            make_controller(controller, P),
+            np.array([0.0, 0.0, v, 0.0]),
+        )
+        assert mujoco_run.recovered == expected == analytic.recovered, (controller, v)
+        assert mujoco_run.stop_impacts == 0
+
+
+def test_torso_without_hip_torque_is_the_ankle_strategy():
+    # 0.55 m/s needs the hip: the ankle alone cannot hold it, on the torso model too.
+    _, result = run("ankle-pd", v=0.55, model="torso")
+    assert result.outcome.value == "fell"
 
 
 def test_push_as_a_real_force():
@@ -45,15 +69,38 @@ def test_push_as_a_real_force():
     assert inside.recovered and outside.outcome.value == "fell"
     _, back = run("ankle-pd", impulse=-5.0)
     assert back.recovered
+    # 40 N s (0.56 m/s) needs the hip: the MPC recovers it on the torso model.
+    _, hip = run("mpc", impulse=40.0, model="torso")
+    assert hip.recovered
 
 
-def test_critical_push_within_5_percent_of_eq4():
-    # docs/validation.md: with the 2 mm CoP margin, −4.2 % … −0.2 % of Eq. (4).
-    for direction in ("forward", "backward"):
-        found = critical_push(
-            P, "foot", "ankle-pd", 0.0, direction, tolerance=2e-3, duration=6.0, backend="mujoco"
-        )
-        assert -0.05 < found.relative_error() < 0.01, (direction, found)
+def test_push_ends_with_the_momentum_of_the_impulse():
+    plant = make_plant("torso", P, "mujoco")
+    plant.initial_state(0.0, 0.0)
+    state = plant.push(36.0)
+    # The contact pushes back only through the ankle torque holding the CoP under the CoM:
+    # over 10 ms the CoM gains J / m = 0.5 m/s to within the gravity moment's share (< 1 %).
+    assert state[2] == pytest.approx(0.5, rel=0.01)
+    # It travels v D / 2, plus half a 1 ms step from the semi-implicit integrator [m].
+    assert state[0] == pytest.approx(0.5 * (0.01 + 0.001) / 2, rel=0.02)
+
+
+@pytest.mark.parametrize(
+    ("model", "controller", "strategy"), [("foot", "ankle-pd", "ankle"), ("torso", "mpc", "hip")]
+)
+@pytest.mark.parametrize("direction", ["forward", "backward"])
+def test_critical_push_against_the_surfaces(model, controller, strategy, direction):
+    # docs/validation.md. The corrected prediction (2 mm CoP margin, CoM travel during the
+    # 10 ms push) within 1.5 %; the paper's surface within 6 % (the correction's size).
+    found = critical_push(
+        P, model, controller, 0.0, direction, tolerance=2e-3, duration=6.0, backend="mujoco"
+    )
+    sign = 1.0 if direction == "forward" else -1.0
+    corrected = corrected_critical_velocity(
+        strategy, 0.0, sign, P, cop_margin=DEFAULT_COP_MARGIN, push_duration=PUSH_DURATION
+    )
+    assert abs(found.velocity) == pytest.approx(abs(corrected), rel=0.015), found
+    assert -0.06 < found.relative_error() < 0.0, found
 
 
 def test_bad_mujoco_requests():

@@ -13,6 +13,7 @@ from pushrecovery.cli.options import body_options, emit, params_from
 # Kept literal so that --help does not import the models; a test checks them against the
 # registries.
 MODEL_CHOICES = ("lipm", "pendulum", "flywheel", "stepping")
+MUJOCO_MODEL_CHOICES = ("foot", "torso", "biped")
 CONTROLLER_CHOICES = (
     "ankle-saturated",
     "ankle-pd",
@@ -96,6 +97,16 @@ def _push_velocity(xdot: float | None, impulse: float | None, mass: float) -> fl
     return 0.0 if xdot is None else xdot
 
 
+def _measured_cop(cops: list[float]) -> dict[str, float | None]:
+    """Range of the CoP MuJoCo measured from the contact forces, relative to the ankle [m]."""
+    import math
+
+    finite = [cop for cop in cops if not math.isnan(cop)]
+    if not finite:
+        return {"min": None, "max": None}
+    return {"min": min(finite), "max": max(finite)}
+
+
 def _controller_options(
     kp: float | None, kd: float | None, pairs: tuple[str, ...] = ()
 ) -> dict[str, Any]:
@@ -130,14 +141,15 @@ _backend = click.option(
     type=click.Choice(("analytic", "mujoco")),
     default="analytic",
     show_default=True,
-    help="Physics: the analytic models, or MuJoCo (model 'foot' so far).",
+    help="Physics: the analytic models, or MuJoCo (models foot, torso, biped).",
 )
 _model = click.option(
     "--model",
-    type=click.Choice((*MODEL_CHOICES, "foot")),
+    type=click.Choice((*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES)),
     default="lipm",
     show_default=True,
-    help="Plant: linear inverted pendulum or nonlinear pendulum.",
+    help="Plant. Analytic: lipm, pendulum, flywheel, stepping; MuJoCo: foot (ankle), torso "
+    "(hip), biped (stepping).",
 )
 _controller = click.option(
     "--controller",
@@ -196,6 +208,13 @@ def _with(*decorators: Any) -> Any:
     default=None,
     help="Write a plot of the run (PNG, SVG or PDF by extension).",
 )
+@click.option(
+    "--render",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="MuJoCo only: write a filmstrip PNG of the run to this file and an animated GIF "
+    "beside it (CoM, capture point and CoP drawn).",
+)
 @body_options
 def simulate(
     backend: str,
@@ -210,10 +229,15 @@ def simulate(
     duration: float,
     control_period: float | None,
     plot: str | None,
+    render: str | None,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
-    """Simulate a push on a model with a controller; report recovered or fell."""
+    """Simulate a push on a model with a controller; report recovered or fell.
+
+    With --backend mujoco, --impulse is a real force at the CoM over 10 ms (the body holding
+    still meanwhile) and the run starts as the push ends.
+    """
     from pushrecovery.control.base import make_controller
     from pushrecovery.sim.plants import make_plant
     from pushrecovery.sim.simulate import simulate as run
@@ -222,11 +246,18 @@ def simulate(
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)
     predicted = classify_state(x, velocity, params)
+    if render and backend != "mujoco":
+        from pushrecovery.errors import InvalidParameterError
+
+        raise InvalidParameterError("--render needs --backend mujoco")
     plant = make_plant(model, params, backend)
+    physics: Any = plant  # the MuJoCo plant's extras (push, record, measured CoP)
+    if backend == "mujoco":
+        physics.record()
     if backend == "mujoco" and impulse is not None:
         # A real force at the CoM, over 10 ms, instead of a velocity jump.
-        initial = plant.initial_state(x, 0.0)
-        plant.schedule_push(impulse)  # type: ignore[attr-defined]
+        plant.initial_state(x, 0.0)
+        initial = physics.push(impulse)
     else:
         initial = plant.initial_state(x, velocity)
     result = run(
@@ -241,6 +272,15 @@ def simulate(
     data = result.to_dict()
     data["initial_state"] = {"x": x, "xdot": velocity}
     data["predicted"] = predicted.to_dict()
+    if backend == "mujoco":
+        half = len(initial) // 2
+        data["after_push"] = {"x": float(initial[0]), "xdot": float(initial[half])}
+        data["measured_cop"] = _measured_cop(physics.measured_cops)
+    if render:
+        from pushrecovery.sim.mujoco.render import render_run
+
+        files = render_run(physics.model, physics.frames, Path(render))
+        data["render"] = [str(f) for f in files]
     if plot:
         from pushrecovery.plots.runs import save_run
 
@@ -326,9 +366,188 @@ def critical_push(
             "controller": controller,
             "x": x,
             "direction": direction,
+            "backend": backend,
+            "predicted": _critical_prediction(params, controller, x, direction, backend),
         },
         as_json,
     )
+
+
+def _critical_prediction(
+    params: Any, controller: str, x: float, direction: str, backend: str
+) -> dict[str, Any]:
+    """Return the surface's critical push (and the corrected one on MuJoCo)."""
+    from pushrecovery.control.base import make_controller
+    from pushrecovery.sim.critical import predicted_critical_velocity
+
+    strategy = make_controller(controller, params).strategy
+    surface = {"ankle": "Eq. 4", "hip": "corrected Eq. 15", "step": "single-step limit"}[strategy]
+    velocity = predicted_critical_velocity(params, strategy, x, direction)
+    data: dict[str, Any] = {
+        "strategy": strategy,
+        "surface": surface,
+        "velocity": velocity,
+        "impulse": params.mass * velocity,
+    }
+    if backend == "mujoco" and strategy != "step":
+        from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, PUSH_DURATION
+        from pushrecovery.sim.validation import corrected_critical_velocity
+
+        corrected = corrected_critical_velocity(
+            strategy,
+            x,
+            1.0 if direction == "forward" else -1.0,
+            params,
+            cop_margin=DEFAULT_COP_MARGIN,
+            push_duration=PUSH_DURATION,
+        )
+        data["corrected_velocity"] = corrected
+        data["corrected_impulse"] = params.mass * corrected
+    return data
+
+
+@cli.command(short_help="Critical pushes and a confusion matrix in simulation vs the surfaces.")
+@click.option(
+    "--backend",
+    type=click.Choice(("analytic", "mujoco")),
+    default="mujoco",
+    show_default=True,
+    help="Physics (MuJoCo pushes with real forces).",
+)
+@click.option(
+    "--strategy",
+    "strategies",
+    type=click.Choice(("ankle", "hip", "step")),
+    multiple=True,
+    help="Strategies to validate (repeatable; default all three).",
+)
+@click.option(
+    "--x0",
+    "x0s",
+    type=float,
+    multiple=True,
+    help="CoM positions before the push [m] (repeatable; default 0 and 0.05).",
+)
+@click.option(
+    "--tolerance",
+    type=float,
+    default=2e-3,
+    show_default=True,
+    help="Width of each critical-push bracket [m/s].",
+)
+@click.option(
+    "--duration", type=float, default=6.0, show_default=True, help="Longest run per push [s]."
+)
+@click.option(
+    "--grid",
+    nargs=3,
+    type=float,
+    default=(-1.0, 2.0, 0.25),
+    show_default=True,
+    metavar="START STOP STEP",
+    help="Push velocities of the confusion matrix [m/s], from each --x0.",
+)
+@click.option(
+    "--confusion/--no-confusion",
+    default=True,
+    show_default=True,
+    help="Also simulate the grid of pushes for the confusion matrix.",
+)
+@body_options
+def validate(
+    backend: str,
+    strategies: tuple[str, ...],
+    x0s: tuple[float, ...],
+    tolerance: float,
+    duration: float,
+    grid: tuple[float, float, float],
+    confusion: bool,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Critical push of each strategy in simulation against its surface, and a confusion matrix.
+
+    For each strategy (ankle: foot + ankle-pd; hip: torso + mpc; step: biped + recovery on
+    MuJoCo, or the analytic models) the critical push by bisection, both directions, from each
+    --x0, next to the surface's prediction (and, on MuJoCo, the prediction corrected for the CoP
+    margin and the push's duration). The confusion matrix compares the strategy the surfaces
+    predict for each push of the grid with the least strategy that recovers it in simulation.
+    """
+    import sys
+
+    import numpy as np
+
+    from pushrecovery._validate import finite_array
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.sim.validation import confusion_matrix, critical_table
+
+    params = params_from(kwargs)
+    strategies = strategies or ("ankle", "hip", "step")
+    x0s = tuple(finite_array("--x0", x0s)) if x0s else (0.0, 0.05)
+    for x0 in x0s:
+        if not params.heel < x0 < params.toe:
+            raise InvalidParameterError(
+                f"--x0 must lie on the foot, {params.heel:g} < x0 < {params.toe:g} m, got {x0:g}"
+            )
+    start, stop, increment = (float(v) for v in finite_array("--grid", grid))
+    if increment <= 0.0 or stop < start:
+        raise InvalidParameterError(
+            f"--grid needs START <= STOP and STEP > 0, got {start:g} {stop:g} {increment:g}"
+        )
+    velocities = start + increment * np.arange(int(np.floor((stop - start) / increment + 1e-9)) + 1)
+    rows_total = len(strategies) * len(x0s) * 2
+    total = rows_total + (len(x0s) * len(velocities) if confusion else 0)
+    with click.progressbar(length=total, label="validating", file=sys.stderr) as bar:
+        rows = critical_table(
+            params,
+            backend=backend,
+            strategies=strategies,
+            x0s=x0s,
+            tolerance=tolerance,
+            duration=duration,
+            progress=bar.update,
+        )
+        matrix = (
+            confusion_matrix(
+                params,
+                x0s,
+                velocities,
+                backend=backend,
+                strategies=strategies,
+                duration=duration,
+                progress=bar.update,
+            )
+            if confusion
+            else None
+        )
+    data: dict[str, Any] = {
+        "backend": backend,
+        "params": params.to_dict(),
+        "critical": [row.to_dict(params.mass) for row in rows],
+    }
+    if matrix is not None:
+        data["confusion"] = matrix.to_dict()
+    if as_json:
+        emit(data, True)
+        return
+    click.echo(
+        f"{'strategy':<9}{'dir':<9}{'x0':>7}{'predicted':>11}{'corrected':>11}"
+        f"{'measured':>10}{'error':>9}{'corr.err':>10}"
+    )
+    for row in rows:
+        corrected = "" if np.isnan(row.corrected) else f"{row.corrected:.4f}"
+        error = "" if np.isnan(row.corrected) else f"{100 * row.corrected_error:+.1f}%"
+        click.echo(
+            f"{row.strategy:<9}{row.direction:<9}{row.x0:>7.3f}{row.predicted:>11.4f}"
+            f"{corrected:>11}{row.measured:>10.4f}{100 * row.relative_error:>+8.1f}%{error:>10}"
+        )
+    if matrix is not None:
+        from pushrecovery.sim.validation import LABELS
+
+        click.echo(f"\nconfusion (rows predicted, columns needed), accuracy {matrix.accuracy:.3f}")
+        click.echo(" " * 10 + "".join(f"{label:>7}" for label in LABELS))
+        for label, counts in zip(LABELS, matrix.counts, strict=True):
+            click.echo(f"{label:<10}" + "".join(f"{count:>7}" for count in counts))
 
 
 @cli.command(short_help="Reproduce the paper's figures.")

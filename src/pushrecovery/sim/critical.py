@@ -1,4 +1,8 @@
-"""The critical push: the largest CoM velocity jump a model + controller recovers from."""
+"""The critical push: the largest CoM velocity jump a model + controller recovers from.
+
+On the MuJoCo backend the push is a real force at the CoM (an impulse J over 10 ms) and the
+search runs on the equivalent velocity J / m, so that it compares with the surfaces directly.
+"""
 
 from __future__ import annotations
 
@@ -27,6 +31,7 @@ __all__ = [
     "NotRecoverableError",
     "critical_push",
     "find_critical_velocity",
+    "predicted_critical_velocity",
 ]
 
 
@@ -147,6 +152,21 @@ def find_critical_velocity(
     return Bracket(float(np.copysign(low, sign)), float(np.copysign(high, sign)), runs)
 
 
+def predicted_critical_velocity(
+    params: BodyParams, strategy: str, x0: float, direction: str
+) -> float:
+    """Critical push of a strategy's decision surface from ``x0`` [m], signed like ẋ [m/s].
+
+    Eq. (4) for ``ankle``, corrected Eq. (15) for ``hip``, the single-step limit of
+    :mod:`pushrecovery.surfaces.step` for ``step``.
+    """
+    sign = direction_sign(direction)
+    if strategy == "step":
+        return step_critical_velocity(x0, sign, params)
+    region = strategy_region(strategy, params)
+    return float(critical_velocity(x0, sign, params, region=region))
+
+
 def critical_push(
     params: BodyParams,
     model: str,
@@ -159,6 +179,7 @@ def critical_push(
     control_period: float | None = None,
     controller_options: dict[str, Any] | None = None,
     backend: str = "analytic",
+    force: bool | None = None,
 ) -> CriticalPush:
     """Critical push of a model + controller from CoM position ``x0``, with its prediction.
 
@@ -171,9 +192,10 @@ def critical_push(
     params : BodyParams
         Body parameters.
     model : str
-        Plant name (``lipm``, ``pendulum`` or ``flywheel``).
+        Plant name (analytic: ``lipm``, ``pendulum``, ``flywheel``, ``stepping``; mujoco:
+        ``foot``, ``torso``, ``biped``).
     controller : str
-        Controller name (``ankle-saturated``, ``ankle-pd``, ``bang-bang``, ``mpc``).
+        Controller name (``ankle-pd``, ``bang-bang``, ``mpc``, ``recovery``, ...).
     x0 : float
         CoM position before the push, strictly on the foot [m].
     direction : {"forward", "backward"}
@@ -186,7 +208,10 @@ def critical_push(
     controller_options : dict, optional
         Keyword options of the controller (e.g. ``stiffness``, ``damping``).
     backend : {"analytic", "mujoco"}
-        Physics of the plant (``mujoco`` has the model ``foot``).
+        Physics of the plant (``mujoco`` has the models ``foot``, ``torso`` and ``biped``).
+    force : bool, optional
+        Push with a real force (impulse m v over 10 ms at the CoM) instead of a velocity
+        jump; only on the ``mujoco`` backend, where it is the default.
 
     Returns
     -------
@@ -198,23 +223,20 @@ def critical_push(
         raise InvalidParameterError(
             f"x must lie on the foot, heel={params.heel:g} < x < toe={params.toe:g} m, got x={x0:g}"
         )
-    sign = direction_sign(direction)
+    direction_sign(direction)  # validates it before any simulation
+    if force is None:
+        force = backend == "mujoco"
+    if force and backend != "mujoco":
+        raise InvalidParameterError("force pushes need backend='mujoco'")
     plant = make_plant(model, params, backend)
     ctrl = make_controller(controller, params, **(controller_options or {}))
-    if ctrl.strategy == "step":
-        predicted = step_critical_velocity(x0, sign, params)
-    else:
-        region = strategy_region(ctrl.strategy, params)
-        predicted = float(critical_velocity(x0, sign, params, region=region))
+    predicted = predicted_critical_velocity(params, ctrl.strategy, x0, direction)
 
     def outcome_of(velocity: float) -> Outcome:
-        run = simulate(
-            plant,
-            ctrl,
-            plant.initial_state(x0, velocity),
-            duration=duration,
-            control_period=control_period,
-        )
+        start = plant.initial_state(x0, 0.0 if force else velocity)
+        if force:
+            start = plant.push(params.mass * velocity)  # type: ignore[attr-defined]
+        run = simulate(plant, ctrl, start, duration=duration, control_period=control_period)
         return run.outcome
 
     # Just below the models' validity limit (check_com_state).

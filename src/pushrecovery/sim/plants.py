@@ -264,8 +264,10 @@ def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plan
     try:
         plant: Plant = MODELS[name](params)
     except KeyError:
+        hint = " (a MuJoCo model: use backend 'mujoco')" if name in MUJOCO_MODELS else ""
         raise InvalidParameterError(
-            f"model must be one of {sorted(MODELS)}, got model={name!r}"
+            f"model must be one of {sorted(MODELS)} for the analytic backend, "
+            f"got model={name!r}{hint}"
         ) from None
     return plant
 

@@ -97,6 +97,9 @@ class MujocoPlant:
         self.time = 0.0
         #: Frames recorded by :meth:`step` after :meth:`record` (for rendering), else None.
         self.frames: list[RecordedFrame] | None = None
+        #: CoP measured from the contact forces at each recorded step, relative to the stance
+        #: ankle [m] (NaN while no sole touches the floor).
+        self.measured_cops: list[float] = []
         model = self.model
         self._floor = model.geom("floor").id
         self._soles = frozenset(
@@ -128,9 +131,28 @@ class MujocoPlant:
             )
         self._push_force, self._push_left = impulse / duration, duration
 
+    def push(self, impulse: float, duration: float = PUSH_DURATION) -> FloatArray:
+        """Push now with ``impulse`` [N s] (+x forward) over ``duration`` [s]; return the state.
+
+        The force acts at the CoM while the body holds still: the CoP under the CoM, no hip
+        torque. The returned state is the state just after the push, the moment the paper's
+        velocity jump stands for; a controller started on it sees the push as it ends.
+        """
+        self.schedule_push(impulse, duration)
+        state = self.read_state()
+        while self._push_left > 0.5 * self._substep:
+            self.step(state, Command(float(state[0])), self._substep)
+            state = self.read_state()
+        self.data.xfrc_applied[self._pushed, 0] = 0.0
+        self.time = 0.0
+        if self.frames is not None:
+            self.record()
+            self._record(None)
+        return state
+
     def record(self) -> None:
         """Record a frame at every :meth:`step` from now on (see :attr:`frames`)."""
-        self.frames = []
+        self.frames, self.measured_cops = [], []
 
     # --- state ---------------------------------------------------------------------------
     def read_state(self) -> FloatArray:
@@ -165,7 +187,7 @@ class MujocoPlant:
         mj.mj_forward(self.model, d)
         self.time = 0.0
         if self.frames is not None:
-            self.frames = []
+            self.record()
             self._record(None)
         return self.read_state()
 
@@ -230,6 +252,8 @@ class MujocoPlant:
         capture = self.ankle_x() + state[0] + state[half] / self.params.omega
         measured = self.measured_cop_world() if cop is not None else math.nan
         self.frames.append((self.time, d.qpos.copy(), (com[0], com[2]), capture, measured))
+        if cop is not None:
+            self.measured_cops.append(measured - self.ankle_x())
 
     def falling(self, state: FloatArray) -> bool:
         """Anything but a sole on the floor, the CoM below half height, or a tipped foot."""

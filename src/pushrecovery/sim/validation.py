@@ -1,0 +1,326 @@
+"""Validation of the decision surfaces against simulation: critical pushes and a confusion matrix.
+
+Each strategy runs on the model built for it, with the paper's controller for it:
+
+========  ======================  ==========================  =========================
+strategy  MuJoCo model            analytic model              controller
+========  ======================  ==========================  =========================
+ankle     ``foot``                ``pendulum``                ``ankle-pd``
+hip       ``torso``               ``flywheel``                ``mpc`` (Eqs. 16-17)
+step      ``biped``               ``stepping``                ``recovery``
+========  ======================  ==========================  =========================
+
+On MuJoCo a push is a real force at the CoM (an impulse over ``PUSH_DURATION``, the body holding
+still meanwhile), so the prediction is offered twice: the paper's surface at the pre-push
+position, and a *corrected* one for the two things the physics adds to the ankle and hip
+surfaces: the CoP margin the feet need (docs/validation.md) and the CoM's travel during the push
+(x moves by v D / 2 under a constant force of duration D).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.control.base import make_controller
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+from pushrecovery.sim.critical import critical_push
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.classify import classify, strategy_region
+
+__all__ = [
+    "LABELS",
+    "SETUPS",
+    "ConfusionMatrix",
+    "CriticalRow",
+    "confusion_matrix",
+    "corrected_critical_velocity",
+    "critical_table",
+    "needed_strategy",
+]
+
+#: backend -> strategy -> (model, controller).
+SETUPS: dict[str, dict[str, tuple[str, str]]] = {
+    "mujoco": {
+        "ankle": ("foot", "ankle-pd"),
+        "hip": ("torso", "mpc"),
+        "step": ("biped", "recovery"),
+    },
+    "analytic": {
+        "ankle": ("pendulum", "ankle-pd"),
+        "hip": ("flywheel", "mpc"),
+        "step": ("stepping", "recovery"),
+    },
+}
+#: Rows and columns of the confusion matrix, the strategies in escalating order.
+LABELS = ("ankle", "hip", "step", "fall")
+
+
+def _setup(backend: str, strategy: str) -> tuple[str, str]:
+    try:
+        return SETUPS[backend][strategy]
+    except KeyError:
+        raise InvalidParameterError(
+            f"backend must be one of {sorted(SETUPS)} and strategy one of {list(LABELS[:3])}, "
+            f"got backend={backend!r}, strategy={strategy!r}"
+        ) from None
+
+
+def corrected_critical_velocity(
+    strategy: str,
+    x0: float,
+    direction: float,
+    params: BodyParams,
+    *,
+    cop_margin: float,
+    push_duration: float,
+) -> float:
+    """Critical push of the ankle or hip surface on a real foot, pushed by a real force [m/s].
+
+    The foot is shortened by ``cop_margin`` [m] at each edge, and the CoM travels v D / 2
+    during a push of duration D [s] (constant force, the body holding still), so the capture
+    point after the push is x0 + v (D/2 + 1/ω). Solving for the region's edge e:
+    v = (e − x0) / (1/ω + D/2), signed like the push.
+    """
+    if strategy not in ("ankle", "hip"):
+        raise InvalidParameterError(f"strategy must be 'ankle' or 'hip', got {strategy!r}")
+    shortened = dataclasses.replace(
+        params, heel=params.heel + cop_margin, toe=params.toe - cop_margin
+    )
+    region = strategy_region(strategy, shortened)
+    edge = region.upper if direction > 0.0 else region.lower
+    return (edge - x0) / (1.0 / params.omega + 0.5 * push_duration)
+
+
+@dataclass(frozen=True, slots=True)
+class CriticalRow:
+    """One line of the critical-push table (velocities signed like ẋ, [m/s]).
+
+    ``corrected`` is :func:`corrected_critical_velocity` (NaN where no correction is
+    offered: the step strategy, or the analytic backend where nothing needs correcting).
+    """
+
+    strategy: str
+    model: str
+    controller: str
+    direction: str
+    x0: float
+    predicted: float
+    corrected: float
+    measured: float
+    bracket: tuple[float, float]
+    simulations: int
+
+    @property
+    def relative_error(self) -> float:
+        """(|measured| − |predicted|) / |predicted|; negative when the body does worse."""
+        return (abs(self.measured) - abs(self.predicted)) / abs(self.predicted)
+
+    @property
+    def corrected_error(self) -> float:
+        """(|measured| − |corrected|) / |corrected|, NaN without a corrected prediction."""
+        return (abs(self.measured) - abs(self.corrected)) / abs(self.corrected)
+
+    def to_dict(self, mass: float) -> dict[str, Any]:
+        """JSON form; impulses [N s] from the body ``mass`` [kg]; NaN becomes null."""
+
+        def clean(value: float) -> float | None:
+            return None if math.isnan(value) else value
+
+        return {
+            "strategy": self.strategy,
+            "model": self.model,
+            "controller": self.controller,
+            "direction": self.direction,
+            "x0": self.x0,
+            "predicted": self.predicted,
+            "predicted_impulse": mass * self.predicted,
+            "corrected": clean(self.corrected),
+            "measured": self.measured,
+            "measured_impulse": mass * self.measured,
+            "relative_error": self.relative_error,
+            "corrected_error": clean(self.corrected_error),
+            "bracket": list(self.bracket),
+            "simulations": self.simulations,
+        }
+
+
+def critical_table(
+    params: BodyParams,
+    *,
+    backend: str = "mujoco",
+    strategies: Sequence[str] = ("ankle", "hip", "step"),
+    x0s: Sequence[float] = (0.0, 0.05),
+    directions: Sequence[str] = ("forward", "backward"),
+    tolerance: float = 2e-3,
+    duration: float = 6.0,
+    progress: Callable[[int], None] | None = None,
+) -> list[CriticalRow]:
+    """Critical push of every strategy, direction and start position against its surface.
+
+    Parameters
+    ----------
+    params : BodyParams
+        Body parameters (the models are generated from them).
+    backend : {"mujoco", "analytic"}
+        Physics; MuJoCo pushes with real forces (module docstring).
+    strategies : sequence of str
+        Among ``ankle``, ``hip``, ``step``.
+    x0s : sequence of float
+        CoM positions before the push, on the foot [m].
+    directions : sequence of str
+        ``forward`` and/or ``backward``.
+    tolerance : float
+        Width of each bisection bracket [m/s].
+    duration : float
+        Longest simulated time per push [s].
+    progress : callable, optional
+        Called with 1 after each row (e.g. a progress bar's ``update``).
+
+    Returns
+    -------
+    list of CriticalRow
+    """
+    from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, PUSH_DURATION
+
+    rows = []
+    for strategy in strategies:
+        model, controller = _setup(backend, strategy)
+        for x0 in x0s:
+            for direction in directions:
+                found = critical_push(
+                    params,
+                    model,
+                    controller,
+                    x0,
+                    direction,
+                    tolerance=tolerance,
+                    duration=duration,
+                    backend=backend,
+                )
+                sign = 1.0 if direction == "forward" else -1.0
+                corrected = math.nan
+                if backend == "mujoco" and strategy != "step":
+                    corrected = corrected_critical_velocity(
+                        strategy,
+                        x0,
+                        sign,
+                        params,
+                        cop_margin=DEFAULT_COP_MARGIN,
+                        push_duration=PUSH_DURATION,
+                    )
+                rows.append(
+                    CriticalRow(
+                        strategy,
+                        model,
+                        controller,
+                        direction,
+                        x0,
+                        found.predicted_velocity,
+                        corrected,
+                        found.velocity,
+                        found.bracket,
+                        found.iterations,
+                    )
+                )
+                if progress is not None:
+                    progress(1)
+    return rows
+
+
+def needed_strategy(
+    params: BodyParams,
+    x0: float,
+    velocity: float,
+    *,
+    backend: str = "mujoco",
+    strategies: Sequence[str] = ("ankle", "hip", "step"),
+    duration: float = 6.0,
+) -> str:
+    """Return the least strategy that recovers a push in simulation, or ``fall``.
+
+    Tries each strategy's model and controller in escalating order (ankle, hip, step); a push
+    of ``velocity`` [m/s] from ``x0`` [m], as a real force on MuJoCo.
+    """
+    for strategy in LABELS[:3]:
+        if strategy not in strategies:
+            continue
+        model, controller = _setup(backend, strategy)
+        plant = make_plant(model, params, backend)
+        if backend == "mujoco":
+            plant.initial_state(x0, 0.0)
+            start = plant.push(params.mass * velocity)  # type: ignore[attr-defined]
+        else:
+            start = plant.initial_state(x0, velocity)
+        run = simulate(plant, make_controller(controller, params), start, duration=duration)
+        if run.recovered:
+            return strategy
+    return "fall"
+
+
+@dataclass(frozen=True, slots=True)
+class ConfusionMatrix:
+    """Predicted strategy (rows) against the strategy simulation needed (columns).
+
+    ``counts[i, j]`` counts pushes predicted ``LABELS[i]`` that needed ``LABELS[j]``;
+    ``cases`` lists (x0 [m], velocity [m/s], predicted, needed) for every push.
+    """
+
+    counts: NDArray[np.int64]
+    cases: list[tuple[float, float, str, str]] = field(default_factory=list)
+
+    @property
+    def accuracy(self) -> float:
+        """Fraction of pushes whose predicted strategy is the one simulation needed."""
+        total = int(self.counts.sum())
+        return float(np.trace(self.counts)) / total if total else math.nan
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: labels, counts (rows predicted, columns needed), accuracy, cases."""
+        return {
+            "labels": list(LABELS),
+            "counts": self.counts.tolist(),
+            "accuracy": self.accuracy,
+            "cases": [
+                {"x0": x0, "xdot": v, "predicted": predicted, "needed": needed}
+                for x0, v, predicted, needed in self.cases
+            ],
+        }
+
+
+def confusion_matrix(
+    params: BodyParams,
+    x0s: Sequence[float],
+    velocities: Sequence[float],
+    *,
+    backend: str = "mujoco",
+    strategies: Sequence[str] = ("ankle", "hip", "step"),
+    duration: float = 6.0,
+    progress: Callable[[int], None] | None = None,
+) -> ConfusionMatrix:
+    """Classify every push of the grid ``x0s`` × ``velocities`` and simulate what it needs.
+
+    The prediction is :func:`~pushrecovery.surfaces.classify.classify` of the state after
+    the push (x0, v); a strategy left out of ``strategies`` counts as failing.
+    """
+    counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)
+    cases = []
+    for x0 in x0s:
+        for velocity in velocities:
+            predicted = str(classify(x0, velocity, params).strategy)
+            needed = needed_strategy(
+                params, x0, velocity, backend=backend, strategies=strategies, duration=duration
+            )
+            counts[LABELS.index(predicted), LABELS.index(needed)] += 1
+            cases.append((float(x0), float(velocity), predicted, needed))
+            if progress is not None:
+                progress(1)
+    return ConfusionMatrix(counts, cases)
