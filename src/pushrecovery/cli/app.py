@@ -250,6 +250,10 @@ def simulate(
         from pushrecovery.errors import InvalidParameterError
 
         raise InvalidParameterError("--render needs --backend mujoco")
+    if render:
+        from pushrecovery.sim.mujoco.render import require_offscreen_gl
+
+        require_offscreen_gl()  # fail before the run, not after it
     plant = make_plant(model, params, backend)
     physics: Any = plant  # the MuJoCo plant's extras (push, record, measured CoP)
     if backend == "mujoco":
@@ -511,7 +515,7 @@ def validate(
             confusion_matrix(
                 params,
                 x0s,
-                velocities,
+                velocities.tolist(),
                 backend=backend,
                 strategies=strategies,
                 duration=duration,
