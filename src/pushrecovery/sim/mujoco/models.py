@@ -53,7 +53,8 @@ def header(name: str, params: BodyParams) -> str:
     return f"""
 <mujoco model="pushrecovery-{name}">
   <compiler angle="radian"/>
-  <option timestep="{TIMESTEP}" gravity="0 0 {-params.gravity}" integrator="implicitfast"/>
+  <option timestep="{TIMESTEP}" gravity="0 0 {-params.gravity}" integrator="implicitfast"
+          cone="pyramidal"/>
   <visual><global offwidth="640" offheight="480"/></visual>
   <default>
     <geom contype="1" conaffinity="1" friction="1.0 0.005 0.0001"
