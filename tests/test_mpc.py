@@ -93,6 +93,38 @@ def test_constrained_solution_satisfies_kkt(x0):
     )
 
 
+def test_daqp_workspace_matches_qpsolvers():
+    # The default route keeps the QP in a DAQP workspace warm-started tick to tick; replay
+    # pushed runs that saturate the inputs (one recovers, one falls), then infeasible states,
+    # through it and through qpsolvers' cold solve_qp (the route of the other solvers).
+    plant = make_plant("flywheel", P)
+    runs = [simulate(plant, MPCController(P), plant.initial_state(0.0, v)) for v in (0.64, -0.5)]
+    infeasible = [np.array([0.0, 0.9, 0.0, 5.0]), np.array([0.05, -0.95, 0.1, -3.0])]
+    start = runs[0].states[:2]
+    states = [*runs[0].states, *runs[1].states, *infeasible, *start]
+    fast, slow = MPCController(P), MPCController(P)
+    slow.workspace = None
+    assert fast.workspace is not None
+    fast.reset(states[0])
+    scale = np.array([P.toe - P.heel, P.torque_max])
+    feasible, saturated = [], False
+    for x in states:
+        a, b = fast.plan(x), slow.plan(x)
+        assert a.feasible == b.feasible
+        feasible.append(a.feasible)
+        saturated |= bool(np.any(np.abs(b.inputs[:, 1]) >= P.torque_max - 1e-9))
+        # Late-horizon torques are defined to ~1e-9 τmax only (an ulp of q̃ moves them that much).
+        np.testing.assert_allclose(a.first_input / scale, b.first_input / scale, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(a.inputs / scale, b.inputs / scale, rtol=0, atol=1e-8)
+        np.testing.assert_allclose(a.states, b.states, rtol=0, atol=1e-8)
+    assert saturated
+    assert feasible[-4:] == [False, False, True, True]  # and a cold restart after a failure
+    assert all(feasible[:-4])
+    # Exact where DAQP's default tolerance (1e-6) stops with θ over its limit by ~8e-7.
+    plan = fast.plan(np.array([0.0653135, 0.72597072, 0.78963742, 0.0]))
+    assert plan.feasible and np.abs(plan.states[1:, 1]).max() <= P.flywheel_angle_max + 1e-12
+
+
 @given(
     x=st.floats(-0.1, 0.2),
     theta=st.floats(-0.9, 0.9),

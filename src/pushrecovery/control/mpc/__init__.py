@@ -4,5 +4,6 @@ from pushrecovery.control.mpc.controller import MPCController
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.qp import CondensedQP
+from pushrecovery.control.mpc.workspace import DaqpWorkspace
 
-__all__ = ["CondensedQP", "MPCController", "MPCSettings", "Plan"]
+__all__ = ["CondensedQP", "DaqpWorkspace", "MPCController", "MPCSettings", "Plan"]

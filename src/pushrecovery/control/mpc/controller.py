@@ -12,6 +12,7 @@ from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.qp import CondensedQP
+from pushrecovery.control.mpc.workspace import DaqpWorkspace
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
@@ -27,6 +28,11 @@ class MPCController(Controller):
     avoid its joint limit) the command is a saturated fallback, ``saturated=True``, and
     ``last_plan.feasible`` is False: CoP at the capture point clipped to the foot, full torque
     braking the flywheel. It never raises inside the loop.
+
+    With the default ``daqp`` solver the QP lives in a DAQP workspace (:class:`DaqpWorkspace`,
+    the attribute ``workspace``), set up once and warm-started from the previous tick's active
+    set: the same solution up to rounding, roughly ten times faster than through qpsolvers.
+    Other solvers, or ``workspace = None``, go through ``qpsolvers.solve_qp``.
 
     Parameters
     ----------
@@ -57,6 +63,12 @@ class MPCController(Controller):
         self.settings = settings
         self.control_period = settings.dt
         self.qp = CondensedQP(params, settings)
+        self.workspace: DaqpWorkspace | None = None
+        if settings.solver == "daqp":
+            try:
+                self.workspace = DaqpWorkspace(self.qp)
+            except (ImportError, RuntimeError):
+                pass  # an old daqp or a setup it rejects: qpsolvers' route still works
         self.last_plan: Plan | None = None
 
     @classmethod
@@ -65,33 +77,43 @@ class MPCController(Controller):
         return ("settings", *MPCSettings.__dataclass_fields__)
 
     def reset(self, state: NDArray[np.float64]) -> None:
-        """Forget the last plan; the MPC is otherwise stateless."""
+        """Forget the last plan and the solver's warm start; the MPC is otherwise stateless."""
         self._check(state)
         self.last_plan = None
+        if self.workspace is not None:
+            self.workspace.reset()
 
     def plan(self, state: NDArray[np.float64]) -> Plan:
         """Solve the QP from ``state``; the fallback plan if it is infeasible."""
-        from qpsolvers import solve_qp
-
         qp = self.qp
-        q, h = qp.vectors(state)
         try:
-            solution = solve_qp(
-                qp.scaled_hessian,
-                q,
-                qp.scaled_inequality,
-                h,
-                lb=qp.scaled_lower,
-                ub=qp.scaled_upper,
-                solver=self.settings.solver,
-            )
+            if self.workspace is not None:
+                solution = self.workspace.solve(state)
+            else:
+                solution = self._solve_qpsolvers(state)
         except Exception:
             solution = None
-        if solution is None or not np.all(np.isfinite(solution)):
+        if solution is None or not np.isfinite(solution).all():
             inputs = np.tile(self._fallback(state), (self.settings.horizon, 1))
             return Plan(inputs, qp.predict(state, inputs), feasible=False)
         inputs = qp.unscale(solution)
         return Plan(inputs, qp.predict(state, inputs), feasible=True)
+
+    def _solve_qpsolvers(self, state: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        from qpsolvers import solve_qp
+
+        qp = self.qp
+        q, h = qp.vectors(state)
+        solution: NDArray[np.float64] | None = solve_qp(
+            qp.scaled_hessian,
+            q,
+            qp.scaled_inequality,
+            h,
+            lb=qp.scaled_lower,
+            ub=qp.scaled_upper,
+            solver=self.settings.solver,
+        )
+        return solution
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """First input of the plan from ``state`` (δ [m], τ [N m])."""

@@ -79,11 +79,30 @@ class CondensedQP:
         h = np.concatenate([self._limit - theta_free, self._limit + theta_free])
         return self.scale * (self._linear @ x0), h
 
+    def vectors_into(self, x0: FloatArray, linear: FloatArray, rhs: FloatArray) -> None:
+        """Write :meth:`vectors` of x0 into preallocated ``linear`` and ``rhs``.
+
+        Both are contiguous float64 arrays of shape (2N,). The operations are those of
+        :meth:`vectors` in the same order, so the results are bit for bit the same, without
+        the temporaries.
+        """
+        horizon = self._limit.size
+        np.dot(self._linear, x0, out=linear)
+        np.multiply(self.scale, linear, out=linear)
+        free = rhs[:horizon]
+        np.dot(self._theta_free, x0, out=free)
+        np.add(self._limit, free, out=rhs[horizon:])
+        np.subtract(self._limit, free, out=free)
+
     def unscale(self, scaled_inputs: FloatArray) -> FloatArray:
         """Return the inputs U = D Ũ as an (N, 2) array of (δ [m], τ [N m])."""
         return (self.scale * scaled_inputs).reshape(-1, 2)
 
     def predict(self, x0: FloatArray, inputs: FloatArray) -> FloatArray:
         """Predicted states X_0..X_N, shape (N + 1, 4), for inputs of shape (N, 2)."""
-        future = (self.phi @ x0 + self.gamma @ inputs.reshape(-1)).reshape(-1, 4)
-        return np.vstack([x0, future])
+        states = np.empty((self._limit.size + 1, 4))
+        states[0] = x0
+        future = states[1:].reshape(-1)  # a view: the rows are contiguous
+        np.dot(self.gamma, inputs.reshape(-1), out=future)
+        future += self.phi @ x0  # the same sum as Φ x0 + Γ U, without the temporaries
+        return states
