@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from pushrecovery import InvalidParameterError, load_params
-from pushrecovery.control import make_controller
+from pushrecovery.control import Command, make_controller
 from pushrecovery.sim.critical import critical_push
 from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, PUSH_DURATION
 from pushrecovery.sim.plants import make_plant
@@ -113,38 +113,25 @@ def test_bad_mujoco_requests():
         plant.schedule_push(float("nan"))
 
 
-class FixedCop:
-    """A controller that holds one CoP (the ankle-strategy command currency)."""
-
-    name = "fixed-cop"
-    strategy = "ankle"
-    control_period = None
-    fixed_period = False
-
-    def __init__(self, cop):
-        self.cop = cop
-
-    def reset(self, state):
-        pass
-
-    def compute(self, t, state):
-        from pushrecovery.control import Command
-
-        return Command(self.cop)
-
-
 @pytest.mark.parametrize(
-    ("x0", "v0", "cop"), [(0.05, 0.0, 0.05), (0.0, 0.3, 0.10), (0.0, -0.1, -0.03)]
+    ("model", "x0", "v0", "cop", "hip_torque"),
+    [
+        ("foot", 0.05, 0.0, 0.05, 0.0),
+        ("foot", 0.0, 0.3, 0.10, 0.0),
+        ("foot", 0.0, -0.1, -0.03, 0.0),
+        ("torso", 0.0, 0.5, 0.10, 100.0),  # a hip strategy's start: CoP forward, τmax
+        ("torso", 0.02, -0.3, -0.02, -100.0),
+        ("torso", 0.05, 0.0, 0.05, 40.0),
+    ],
 )
-def test_commanded_cop_is_where_mujoco_puts_it(x0, v0, cop):
-    # The CoP → ankle torque map (errata E3, with the 1 cm ankle height and its friction
-    # lever) against MuJoCo's own contact forces: within 0.3 mm once the soft contact has
-    # followed the load shift (time constant 2 ms; it rings for ~30 ms after the lean and push
-    # are applied, up to 1 mm: checked loosely from 20 ms, tightly from 40 ms).
-    plant = make_plant("foot", P, "mujoco")
+def test_commanded_cop_is_where_mujoco_puts_it(model, x0, v0, cop, hip_torque):
+    # The CoP → ankle torque map (errata E3, with the hip torque and the 1 cm ankle height and
+    # its friction lever) against MuJoCo's own contact forces: within 0.3 mm once the soft
+    # contact has followed the torque step at t = 0 (contact time constant 2 ms; the foot
+    # rocks for ~35 ms, the CoP up to 9 mm off for a 70 N m step: checked from 40 ms on).
+    plant = make_plant(model, P, "mujoco")
     state = plant.initial_state(x0, v0)
-    for tick in range(60):  # 60 ms
-        state, applied, _ = plant.step(state, FixedCop(cop).compute(0.0, state), 1e-3)
-        if tick >= 20:
-            tolerance = 3e-4 if tick >= 40 else 1.5e-3
-            assert plant.measured_cop() == pytest.approx(applied, abs=tolerance), tick
+    for tick in range(80):  # 80 ms
+        state, applied, _ = plant.step(state, Command(cop, hip_torque), 1e-3)
+        if tick >= 40:
+            assert plant.measured_cop() == pytest.approx(applied, abs=3e-4), tick
