@@ -63,6 +63,30 @@ def test_torque_puts_the_cop_exactly_where_asked(theta, rate, cop):
 
 
 @given(
+    theta=st.floats(-0.6, 0.6),
+    rate=st.floats(-1.5, 1.5),
+    cop=st.floats(-0.05, 0.15),
+    hip=st.floats(-100.0, 100.0),
+    height=st.floats(0.0, 0.1),
+)
+def test_torque_with_hip_torque_and_ankle_height(theta, rate, cop, hip, height):
+    # Errata E3, generalised: from the torque, recompute the motion of the point mass
+    # (m L² θ̈ = m g L sinθ − τ − τ_h), the ground force it needs (F_x = m ẍ, F_z = m (g + z̈))
+    # and the CoP that force puts under a foot whose ankle is h above the sole:
+    # δ = (τ − h F_x) / F_z.
+    tau = ankle_torque_for_cop(theta, rate, cop, M, L, G, hip_torque=hip, ankle_height=height)
+    accel = (M * G * L * math.sin(theta) - tau - hip) / (M * L * L)
+    sin, cos = math.sin(theta), math.cos(theta)
+    x_ddot = L * (cos * accel - sin * rate**2)
+    z_ddot = -L * (sin * accel + cos * rate**2)
+    normal, friction = M * (G + z_ddot), M * x_ddot
+    if normal <= 0.0:
+        assert tau == 0.0
+    else:
+        assert (tau - height * friction) / normal == pytest.approx(cop, abs=1e-12)
+
+
+@given(
     x=st.floats(0.1501, 0.9),
     rate=st.floats(0.0, 3.0),
     cop=st.floats(-0.05, 0.15),

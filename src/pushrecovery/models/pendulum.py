@@ -76,6 +76,10 @@ def ankle_torque_for_cop(
     """
     cos, sin = math.cos(theta), math.sin(theta)
     spin = length * theta_rate * theta_rate
+    if ankle_height == 0.0 and hip_torque == 0.0:
+        # The pendulum of Fig. 3(b) (the simulators' hot path): τ = δ A / (1 − δ sinθ / L).
+        load = mass * cos * (gravity * cos - spin)
+        return cop * load / (1.0 - cop * sin / length) if load > 0.0 else 0.0
     # Moments about the ankle: m L² θ̈ = m g L sinθ − τ − τ_h, with F_z = m (g + z̈), F_x = m ẍ.
     lever = ankle_height * cos - cop * sin
     torque = (
