@@ -7,10 +7,9 @@ import pytest
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import Command, make_controller
 from pushrecovery.sim.critical import critical_push
-from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, PUSH_DURATION
 from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.simulate import simulate
-from pushrecovery.sim.validation import corrected_critical_velocity
+from pushrecovery.sim.validation import mujoco_corrected_prediction
 
 P = load_params()
 
@@ -89,16 +88,15 @@ def test_push_ends_with_the_momentum_of_the_impulse():
     ("model", "controller", "strategy"), [("foot", "ankle-pd", "ankle"), ("torso", "mpc", "hip")]
 )
 @pytest.mark.parametrize("direction", ["forward", "backward"])
-def test_critical_push_against_the_surfaces(model, controller, strategy, direction):
+@pytest.mark.parametrize("x0", [0.0, 0.1])
+def test_critical_push_against_the_surfaces(model, controller, strategy, direction, x0):
     # docs/validation.md. The corrected prediction (2 mm CoP margin, CoM travel during the
     # 10 ms push) within 1.5 %; the paper's surface within 6 % (the correction's size).
     found = critical_push(
-        P, model, controller, 0.0, direction, tolerance=2e-3, duration=6.0, backend="mujoco"
+        P, model, controller, x0, direction, tolerance=2e-3, duration=6.0, backend="mujoco"
     )
     sign = 1.0 if direction == "forward" else -1.0
-    corrected = corrected_critical_velocity(
-        strategy, 0.0, sign, P, cop_margin=DEFAULT_COP_MARGIN, push_duration=PUSH_DURATION
-    )
+    corrected = mujoco_corrected_prediction(strategy, x0, sign, P)
     assert abs(found.velocity) == pytest.approx(abs(corrected), rel=0.015), found
     assert -0.06 < found.relative_error() < 0.0, found
 
@@ -109,7 +107,7 @@ def test_bad_mujoco_requests():
     with pytest.raises(InvalidParameterError, match="backend must be"):
         make_plant("foot", P, "bullet")
     plant = make_plant("foot", P, "mujoco")
-    with pytest.raises(InvalidParameterError, match="impulse must be finite"):
+    with pytest.raises(InvalidParameterError, match="impulse and duration must be finite"):
         plant.schedule_push(float("nan"))
 
 

@@ -67,23 +67,42 @@ def test_torque_puts_the_cop_exactly_where_asked(theta, rate, cop):
     rate=st.floats(-1.5, 1.5),
     cop=st.floats(-0.05, 0.15),
     hip=st.floats(-100.0, 100.0),
+    push=st.floats(-5000.0, 5000.0),
     height=st.floats(0.0, 0.1),
+    foot=st.floats(0.0, 2.0),
 )
-def test_torque_with_hip_torque_and_ankle_height(theta, rate, cop, hip, height):
+def test_torque_with_hip_torque_push_and_a_real_foot(theta, rate, cop, hip, push, height, foot):
     # Errata E3, generalised: from the torque, recompute the motion of the point mass
-    # (m L² θ̈ = m g L sinθ − τ − τ_h), the ground force it needs (F_x = m ẍ, F_z = m (g + z̈))
-    # and the CoP that force puts under a foot whose ankle is h above the sole:
-    # δ = (τ − h F_x) / F_z.
-    tau = ankle_torque_for_cop(theta, rate, cop, M, L, G, hip_torque=hip, ankle_height=height)
-    accel = (M * G * L * math.sin(theta) - tau - hip) / (M * L * L)
+    # (m L² θ̈ = m g L sinθ + P L cosθ − τ − τ_h), the ground force it needs (F_x = m ẍ − P,
+    # F_z = m (g + z̈)) and the CoP of the floor's force on a foot of mass m_f centred at c_f,
+    # whose ankle is h above the sole: moments about the ankle give
+    # δ (F_z + m_f g) = τ − h F_x + c_f m_f g.
+    centre = 0.05
+    tau = ankle_torque_for_cop(
+        theta,
+        rate,
+        cop,
+        M,
+        L,
+        G,
+        hip_torque=hip,
+        push_force=push,
+        ankle_height=height,
+        foot_mass=foot,
+        foot_centre=centre,
+    )
     sin, cos = math.sin(theta), math.cos(theta)
+    accel = (M * G * L * sin + push * L * cos - tau - hip) / (M * L * L)
     x_ddot = L * (cos * accel - sin * rate**2)
     z_ddot = -L * (sin * accel + cos * rate**2)
-    normal, friction = M * (G + z_ddot), M * x_ddot
+    normal, friction = M * (G + z_ddot), M * x_ddot - push
     if normal <= 0.0:
         assert tau == 0.0
     else:
-        assert (tau - height * friction) / normal == pytest.approx(cop, abs=1e-12)
+        floor = normal + foot * G
+        assert (tau - height * friction + centre * foot * G) / floor == pytest.approx(
+            cop, abs=1e-12
+        )
 
 
 @given(

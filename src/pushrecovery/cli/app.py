@@ -257,7 +257,8 @@ def simulate(
     plant = make_plant(model, params, backend)
     physics: Any = plant  # the MuJoCo plant's extras (push, record, measured CoP)
     if backend == "mujoco":
-        physics.record()
+        # Frames (an extra forward pass per tick) only for the pictures.
+        physics.record() if render else physics.measure()
     if backend == "mujoco" and impulse is not None:
         # A real force at the CoM, over 10 ms, instead of a velocity jump.
         plant.initial_state(x, 0.0)
@@ -394,17 +395,10 @@ def _critical_prediction(
         "impulse": params.mass * velocity,
     }
     if backend == "mujoco" and strategy != "step":
-        from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, PUSH_DURATION
-        from pushrecovery.sim.validation import corrected_critical_velocity
+        from pushrecovery.sim.validation import mujoco_corrected_prediction
 
-        corrected = corrected_critical_velocity(
-            strategy,
-            x,
-            1.0 if direction == "forward" else -1.0,
-            params,
-            cop_margin=DEFAULT_COP_MARGIN,
-            push_duration=PUSH_DURATION,
-        )
+        sign = 1.0 if direction == "forward" else -1.0
+        corrected = mujoco_corrected_prediction(strategy, x, sign, params)
         data["corrected_velocity"] = corrected
         data["corrected_impulse"] = params.mass * corrected
     return data

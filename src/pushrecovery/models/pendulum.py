@@ -44,8 +44,12 @@ def ankle_torque_for_cop(
     mass: float,
     length: float,
     gravity: float,
+    *,
     hip_torque: float = 0.0,
+    push_force: float = 0.0,
     ankle_height: float = 0.0,
+    foot_mass: float = 0.0,
+    foot_centre: float = 0.0,
 ) -> float:
     """Exact ankle torque that places the CoP at ``cop`` (module docstring) [N m].
 
@@ -62,33 +66,42 @@ def ankle_torque_for_cop(
     hip_torque : float
         Torque on an upper body whose CoM is at the top of the rod [N m], positive pitching
         it forward; 0 for the plain pendulum.
+    push_force : float
+        Horizontal force P pushing the CoM [N], positive forward.
     ankle_height : float
         Height h of the ankle above the sole [m]; 0 in the paper. The friction force then
-        has a lever arm too: τ = δ F_z + h F_x.
+        has a lever arm too.
+    foot_mass, foot_centre : float
+        Mass of the foot [kg] (0 in the paper) and the x of its centre of mass relative to
+        the ankle [m]: its weight loads the floor too.
 
     Returns
     -------
     float
-        With h = 0, τ = δ A' / (1 − δ sinθ / L), A' = A + τ_h sinθ / L; in general
-        τ = [B + k (m g sinθ − τ_h / L)] / (1 + k / L), k = h cosθ − δ sinθ,
-        B = δ m (g − L cosθ θ̇²) − h m L sinθ θ̇² (docs/errata.md, E3). 0 when the foot is
-        unloaded (F_z ≤ 0).
+        With h = P = m_f = 0, τ = δ A' / (1 − δ sinθ / L), A' = A + τ_h sinθ / L; in general
+        τ = [B − h P + m_f g (δ − c_f) + k (m g sinθ + P cosθ − τ_h / L)] / (1 + k / L),
+        k = h cosθ − δ sinθ, B = δ m (g − L cosθ θ̇²) − h m L sinθ θ̇² (docs/errata.md, E3).
+        0 when the foot is unloaded (F_z ≤ 0).
     """
     cos, sin = math.cos(theta), math.sin(theta)
     spin = length * theta_rate * theta_rate
-    if ankle_height == 0.0 and hip_torque == 0.0:
+    if ankle_height == 0.0 and hip_torque == 0.0 and push_force == 0.0 and foot_mass == 0.0:
         # The pendulum of Fig. 3(b) (the simulators' hot path): τ = δ A / (1 − δ sinθ / L).
         load = mass * cos * (gravity * cos - spin)
         return cop * load / (1.0 - cop * sin / length) if load > 0.0 else 0.0
-    # Moments about the ankle: m L² θ̈ = m g L sinθ − τ − τ_h, with F_z = m (g + z̈), F_x = m ẍ.
+    # Moments about the ankle: m L² θ̈ = m g L sinθ + P L cosθ − τ − τ_h; on the foot,
+    # τ = δ F_z + h F_x + m_f g (δ − c_f) with F_z = m (g + z̈), F_x = m ẍ − P.
     lever = ankle_height * cos - cop * sin
     torque = (
         cop * mass * (gravity - cos * spin)
-        - ankle_height * mass * sin * spin
-        + lever * (mass * gravity * sin - hip_torque / length)
+        - ankle_height * (mass * sin * spin + push_force)
+        + foot_mass * gravity * (cop - foot_centre)
+        + lever * (mass * gravity * sin + push_force * cos - hip_torque / length)
     ) / (1.0 + lever / length)
     # The vertical load this torque implies; none can be transmitted by an unloaded foot.
-    accel = (mass * gravity * length * sin - torque - hip_torque) / (mass * length * length)
+    accel = (mass * gravity * length * sin + push_force * length * cos - torque - hip_torque) / (
+        mass * length * length
+    )
     load = mass * (gravity - length * (sin * accel + cos * theta_rate * theta_rate))
     return torque if load > 0.0 else 0.0
 

@@ -44,6 +44,7 @@ __all__ = [
     "confusion_matrix",
     "corrected_critical_velocity",
     "critical_table",
+    "mujoco_corrected_prediction",
     "needed_strategy",
 ]
 
@@ -82,13 +83,17 @@ def corrected_critical_velocity(
     *,
     cop_margin: float,
     push_duration: float,
+    timestep: float = 0.0,
 ) -> float:
     """Critical push of the ankle or hip surface on a real foot, pushed by a real force [m/s].
 
-    The foot is shortened by ``cop_margin`` [m] at each edge, and the CoM travels v D / 2
-    during a push of duration D [s] (constant force, the body holding still), so the capture
-    point after the push is x0 + v (D/2 + 1/ω). Solving for the region's edge e:
-    v = (e − x0) / (1/ω + D/2), signed like the push.
+    Three corrections, each from the physics of a push J = m v at the CoM of a pendulum leaning
+    φ0 = asin(x0 / L) that holds still meanwhile: the foot is shortened by ``cop_margin`` [m]
+    at each edge; the leg takes only the tangential part of the impulse, so the CoM leaves at
+    ẋ = v cos²φ0; and it travels ẋ (D + h)/2 during a push of duration D [s] integrated in
+    steps of h = ``timestep`` [s] (semi-implicit Euler adds half a step to the exact D/2). The
+    capture point after the push is x0 + v cos²φ0 ((D + h)/2 + 1/ω); solving for the region's
+    edge e: v = (e − x0) / (cos²φ0 (1/ω + (D + h)/2)), signed like the push.
     """
     if strategy not in ("ankle", "hip"):
         raise InvalidParameterError(f"strategy must be 'ankle' or 'hip', got {strategy!r}")
@@ -97,7 +102,26 @@ def corrected_critical_velocity(
     )
     region = strategy_region(strategy, shortened)
     edge = region.upper if direction > 0.0 else region.lower
-    return (edge - x0) / (1.0 / params.omega + 0.5 * push_duration)
+    tangential = 1.0 - (x0 / params.com_height) ** 2  # cos² φ0
+    return (edge - x0) / (tangential * (1.0 / params.omega + 0.5 * (push_duration + timestep)))
+
+
+def mujoco_corrected_prediction(
+    strategy: str, x0: float, direction: float, params: BodyParams
+) -> float:
+    """:func:`corrected_critical_velocity` for the MuJoCo plants' CoP margin, push and step."""
+    from pushrecovery.sim.mujoco.models import TIMESTEP
+    from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, PUSH_DURATION
+
+    return corrected_critical_velocity(
+        strategy,
+        x0,
+        direction,
+        params,
+        cop_margin=DEFAULT_COP_MARGIN,
+        push_duration=PUSH_DURATION,
+        timestep=TIMESTEP,
+    )
 
 
 @dataclass(frozen=True, slots=True)
@@ -189,8 +213,6 @@ def critical_table(
     -------
     list of CriticalRow
     """
-    from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, PUSH_DURATION
-
     rows = []
     for strategy in strategies:
         model, controller = _setup(backend, strategy)
@@ -209,14 +231,7 @@ def critical_table(
                 sign = 1.0 if direction == "forward" else -1.0
                 corrected = math.nan
                 if backend == "mujoco" and strategy != "step":
-                    corrected = corrected_critical_velocity(
-                        strategy,
-                        x0,
-                        sign,
-                        params,
-                        cop_margin=DEFAULT_COP_MARGIN,
-                        push_duration=PUSH_DURATION,
-                    )
+                    corrected = mujoco_corrected_prediction(strategy, x0, sign, params)
                 rows.append(
                     CriticalRow(
                         strategy,

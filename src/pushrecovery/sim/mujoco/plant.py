@@ -26,10 +26,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.models.pendulum import ankle_torque_for_cop
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, MODEL_BUILDERS
+from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, FOOT_MASS, MODEL_BUILDERS
+from pushrecovery.sim.plants import check_com_state
 
 __all__ = [
     "DEFAULT_COP_MARGIN",
@@ -112,8 +113,13 @@ class MujocoPlant:
         self._xfrc: FloatArray = self.data.xfrc_applied
         self._force = np.zeros(6)
         self._push_force = 0.0
-        self._push_left = 0.0
+        self._push_steps = 0
+        #: Horizontal force on the pushed body during this physics step [N].
+        self.push_now = 0.0
         self._substep = model.opt.timestep
+        self._steps_done = 0
+        self._measuring = False
+        self._unstable = int(mujoco.mjtWarning.mjWARN_BADQACC)
 
     @classmethod
     def xml(cls, params: BodyParams) -> str:
@@ -124,13 +130,22 @@ class MujocoPlant:
     def schedule_push(self, impulse: float, duration: float = PUSH_DURATION) -> None:
         """Push the body at its CoM with ``impulse`` [N s] (+x forward) over ``duration`` [s].
 
-        Applied from the next :meth:`step` on (call after :meth:`initial_state`).
+        Applied from the next :meth:`step` on (call after :meth:`initial_state`), over the
+        whole physics steps nearest to ``duration`` (at least one), with the force that makes
+        their total exactly ``impulse``. The velocity jump it stands for, J/m, must satisfy
+        the models' validity (|J/m| < 10 sqrt(g L)).
         """
-        if not (math.isfinite(impulse) and math.isfinite(duration) and duration > 0.0):
+        if not (math.isfinite(impulse) and math.isfinite(duration)):
             raise InvalidParameterError(
-                f"impulse must be finite and duration > 0 s, got {impulse:g}, {duration:g}"
+                f"impulse and duration must be finite, got {impulse:g} N s, {duration:g} s"
             )
-        self._push_force, self._push_left = impulse / duration, duration
+        if duration < self._substep:
+            raise InvalidParameterError(
+                f"duration must be >= the MuJoCo step {self._substep:g} s, got {duration:g}"
+            )
+        check_com_state(0.0, impulse / self.params.mass, self.params)
+        self._push_steps = round(duration / self._substep)
+        self._push_force = impulse / (self._push_steps * self._substep)
 
     def push(self, impulse: float, duration: float = PUSH_DURATION) -> FloatArray:
         """Push now with ``impulse`` [N s] (+x forward) over ``duration`` [s]; return the state.
@@ -141,19 +156,25 @@ class MujocoPlant:
         """
         self.schedule_push(impulse, duration)
         state = self.read_state()
-        while self._push_left > 0.5 * self._substep:
-            self.step(state, Command(float(state[0])), self._substep)
-            state = self.read_state()
-        self._xfrc[self._pushed, 0] = 0.0
-        self.time = 0.0
-        if self.frames is not None:
-            self.record()
-            self._record(None)
+        while self._push_steps > 0:
+            state, _, _ = self.step(state, Command(float(state[0])), self._substep)
+        self._start_clock()
         return state
 
     def record(self) -> None:
         """Record a frame at every :meth:`step` from now on (see :attr:`frames`)."""
-        self.frames, self.measured_cops = [], []
+        self.frames, self.measured_cops, self._measuring = [], [], True
+
+    def measure(self) -> None:
+        """Record only the measured CoP at every :meth:`step` (:attr:`measured_cops`)."""
+        self.frames, self.measured_cops, self._measuring = None, [], True
+
+    def _start_clock(self) -> None:
+        self.time, self._steps_done = 0.0, 0
+        self.measured_cops = []
+        if self.frames is not None:
+            self.frames = []
+            self._record(None)
 
     # --- state ---------------------------------------------------------------------------
     def read_state(self) -> FloatArray:
@@ -178,18 +199,16 @@ class MujocoPlant:
         The body first stands upright (an exact balance, no torque) for ``SETTLE_TIME`` so
         that the contacts are at equilibrium when the lean and the push are applied.
         """
+        check_com_state(x, xdot, self.params)
         mj, d = self._mj, self.data
         mj.mj_resetData(self.model, d)
-        self._push_left = 0.0
+        self._push_steps, self.push_now, self.stop_impacts = 0, 0.0, 0
         d.ctrl[:] = 0.0
         mj.mj_step(self.model, d, nstep=round(SETTLE_TIME / self._substep))
         d.qvel[:] = 0.0
         self.pose(x, xdot)
         mj.mj_forward(self.model, d)
-        self.time = 0.0
-        if self.frames is not None:
-            self.record()
-            self._record(None)
+        self._start_clock()
         return self.read_state()
 
     def check_state(self, state: FloatArray) -> None:
@@ -229,27 +248,43 @@ class MujocoPlant:
         p, margin = self.params, self.cop_margin
         cop = min(p.toe - margin, max(p.heel + margin, command.cop))
         mj_step, model, d, h = self._mj.mj_step, self.model, self.data, self._substep
+        if dt < 0.5 * h:
+            raise InvalidParameterError(
+                f"control_period must be >= half the MuJoCo step, {0.5 * h:g} s, got {dt:g}"
+            )
         actuate, torque = self.actuate, 0.0
-        steps = max(1, round(dt / h))
-        while steps and self._push_left > 0.0:
-            self._xfrc[self._pushed, 0] = self._push_force
-            self._push_left -= h
+        # Whole physics steps that keep the physics clock on the control clock (a period
+        # that is not a multiple of the step, e.g. bang-bang's, is rounded per tick).
+        self.time += dt
+        steps = round(self.time / h) - self._steps_done
+        self._steps_done += steps
+        while steps and self._push_steps:
+            self.push_now = self._push_force
+            self._xfrc[self._pushed, 0] = self.push_now
             torque = actuate(cop, command)
             mj_step(model, d)
+            self._push_steps -= 1
             steps -= 1
-        self._xfrc[self._pushed, 0] = 0.0
+        if self.push_now:
+            self.push_now = self._xfrc[self._pushed, 0] = 0.0
         # The hot loop: about 2 µs of Python around each MuJoCo step.
         for _ in range(steps):
             torque = actuate(cop, command)
             mj_step(model, d)
-        self.time += dt
-        if self.frames is not None:
+        if d.warning[self._unstable].number:
+            raise PushRecoveryError(
+                "MuJoCo's simulation became unstable (accelerations blew up); "
+                "the push or the state is beyond what the model can simulate"
+            )
+        if self._measuring:
             self._record(cop)
         return self.read_state(), cop, torque
 
     def _record(self, cop: float | None) -> None:
-        assert self.frames is not None
         d = self.data
+        if self.frames is None:  # the CoP only, from the last step's contacts
+            self.measured_cops.append(self.measured_cop_world() - self.ankle_x())
+            return
         self._mj.mj_forward(self.model, d)
         state = self.read_state()
         half = len(state) // 2
@@ -298,6 +333,7 @@ class MujocoFootPlant(MujocoPlant):
         self._ankle = int(model.joint("ankle").qposadr[0])
         self._ankle_v = int(model.joint("ankle").dofadr[0])
         self._ankle_id = model.joint("ankle").id
+        self._foot_centre = 0.5 * (params.heel + params.toe)
 
     def lean(self) -> tuple[float, float]:
         """Absolute pitch φ of the body above the ankle and its rate [rad, rad/s]."""
@@ -313,7 +349,7 @@ class MujocoFootPlant(MujocoPlant):
     def pose(self, x: float, xdot: float) -> None:
         """Lean the body above the ankle; the foot stays as it settled."""
         length = self.params.com_height
-        lean = math.asin(max(-0.99, min(0.99, x / length)))
+        lean = math.asin(x / length)  # |x| < L: checked by initial_state
         self._qpos[self._ankle] = lean - self._qpos[self._pitch]
         self._qvel[self._ankle_v] = xdot / (length * math.cos(lean))
 
@@ -337,7 +373,10 @@ class MujocoFootPlant(MujocoPlant):
             p.com_height,
             p.gravity,
             hip_torque=hip_torque,
+            push_force=self.push_now,
             ankle_height=ANKLE_HEIGHT,
+            foot_mass=FOOT_MASS,
+            foot_centre=self._foot_centre,
         )
 
     def actuate(self, cop: float, command: Command) -> float:
@@ -353,7 +392,7 @@ class MujocoTorsoPlant(MujocoFootPlant):
 
     State ``[x, theta, xdot, theta_dot]`` as :class:`~pushrecovery.sim.plants.FlywheelPlant`:
     θ is the upper body's absolute pitch (I θ̈ = τ_h, Eq. 7). The joint limit acts on the hip
-    angle θ − φ; a run that hits it at speed counts one ``stop_impacts``.
+    angle θ − φ; every time the hip reaches the stop counts one ``stop_impacts``.
     """
 
     name: ClassVar[str] = "mujoco-torso"
