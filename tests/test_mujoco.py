@@ -133,3 +133,90 @@ def test_commanded_cop_is_where_mujoco_puts_it(model, x0, v0, cop, hip_torque):
         state, applied, _ = plant.step(state, Command(cop, hip_torque), 1e-3)
         if tick >= 40:
             assert plant.measured_cop() == pytest.approx(applied, abs=3e-4), tick
+
+
+def cli_json(*args):
+    import json
+
+    from click.testing import CliRunner
+
+    from pushrecovery.cli.app import cli
+
+    result = CliRunner().invoke(cli, [*args, "--json"], catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    return json.loads(result.stdout)
+
+
+def test_cli_validate_json():
+    data = cli_json(
+        "validate",
+        "--strategy",
+        "ankle",
+        "--x0",
+        "0",
+        "--tolerance",
+        "0.01",
+        "--grid",
+        "0.2",
+        "0.6",
+        "0.4",
+    )
+    assert [row["direction"] for row in data["critical"]] == ["forward", "backward"]
+    row = data["critical"][0]
+    assert row["predicted"] == pytest.approx(0.4698, abs=1e-4)  # Eq. (4) from x0 = 0
+    assert abs(row["measured"] - row["corrected"]) < 0.01
+    assert data["confusion"]["labels"] == ["ankle", "hip", "step", "fall"]
+    # 0.2 m/s: ankle, as predicted; 0.6 m/s: the hip surface says hip, but --strategy ankle
+    # leaves only the ankle to try, so it falls.
+    assert data["confusion"]["counts"][0][0] == 1 and data["confusion"]["counts"][1][3] == 1
+
+
+def test_cli_simulate_mujoco_render_and_measured_cop(tmp_path):
+    data = cli_json(
+        "simulate",
+        "--backend",
+        "mujoco",
+        "--model",
+        "torso",
+        "--controller",
+        "mpc",
+        "--impulse",
+        "40",
+        "--render",
+        str(tmp_path / "run.png"),
+    )
+    assert data["recovered"] and data["predicted"]["strategy"] == "hip"
+    assert data["after_push"]["xdot"] == pytest.approx(40 / 72, rel=0.01)
+    # The measured CoP reaches the toe the controller asks for (2 mm inside the edge).
+    assert data["measured_cop"]["max"] == pytest.approx(0.148, abs=2e-3)
+    assert {p.split("/")[-1] for p in data["render"]} == {"run.png", "run.gif"}
+    assert (tmp_path / "run.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["simulate", "--render", "x.png"], "--render needs --backend mujoco"),
+        (["simulate", "--backend", "mujoco", "--model", "foot", "--x", "1.5"], "|x| < com_height"),
+        (["simulate", "--backend", "mujoco", "--model", "foot", "--impulse", "1e6"], "xdot"),
+        (["validate", "--strategy", "step"], "no mujoco model"),
+        (["validate", "--x0", "0.2"], "--x0 must lie on the foot"),
+        (["validate", "--grid", "1", "0", "0.1"], "--grid needs START <= STOP"),
+        (
+            ["simulate", "--backend", "mujoco", "--model", "foot", "--control-period", "0.0004"],
+            "control_period must be >= half the MuJoCo step",
+        ),
+        (
+            ["simulate", "--backend", "mujoco", "--model", "foot", "--controller", "mpc"],
+            "use the flywheel model",
+        ),
+    ],
+)
+def test_cli_mujoco_bad_input_is_one_line(capsys, args, words):
+    from pushrecovery.cli import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(args)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err, err

@@ -417,7 +417,7 @@ def _critical_prediction(
     "strategies",
     type=click.Choice(("ankle", "hip", "step")),
     multiple=True,
-    help="Strategies to validate (repeatable; default all three).",
+    help="Strategies to validate (repeatable; default all the backend has models for).",
 )
 @click.option(
     "--x0",
@@ -477,10 +477,20 @@ def validate(
 
     from pushrecovery._validate import finite_array
     from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.sim.validation import confusion_matrix, critical_table
+    from pushrecovery.sim.validation import (
+        available_strategies,
+        confusion_matrix,
+        critical_table,
+    )
 
     params = params_from(kwargs)
-    strategies = strategies or ("ankle", "hip", "step")
+    strategies = strategies or available_strategies(backend)
+    missing = set(strategies) - set(available_strategies(backend))
+    if missing:
+        raise InvalidParameterError(
+            f"--strategy {sorted(missing)[0]} has no {backend} model yet; "
+            f"available: {list(available_strategies(backend))}"
+        )
     x0s = tuple(finite_array("--x0", x0s)) if x0s else (0.0, 0.05)
     for x0 in x0s:
         if not params.heel < x0 < params.toe:

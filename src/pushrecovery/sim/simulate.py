@@ -99,12 +99,14 @@ def simulate(
     plant.check_state(state)
     if controller.strategy == "hip" and len(state) != 4:
         raise InvalidParameterError(
-            f"controller {controller.name!r} moves the upper body: use the flywheel model, "
+            f"controller {controller.name!r} moves the upper body: use the flywheel model "
+            "(or torso on mujoco), "
             f"not {plant.name!r}"
         )
     if controller.strategy == "step" and len(state) != 6:
         raise InvalidParameterError(
-            f"controller {controller.name!r} takes steps: use the stepping model, "
+            f"controller {controller.name!r} takes steps: use the stepping model "
+            "(or biped on mujoco), "
             f"not {plant.name!r}"
         )
     rest = rest or RestCriterion()

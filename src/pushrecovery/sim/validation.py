@@ -32,7 +32,7 @@ from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import critical_push
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.plants import MUJOCO_MODELS, make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify, strategy_region
 
@@ -41,6 +41,7 @@ __all__ = [
     "SETUPS",
     "ConfusionMatrix",
     "CriticalRow",
+    "available_strategies",
     "confusion_matrix",
     "corrected_critical_velocity",
     "critical_table",
@@ -67,12 +68,28 @@ LABELS = ("ankle", "hip", "step", "fall")
 
 def _setup(backend: str, strategy: str) -> tuple[str, str]:
     try:
-        return SETUPS[backend][strategy]
+        model, controller = SETUPS[backend][strategy]
     except KeyError:
         raise InvalidParameterError(
             f"backend must be one of {sorted(SETUPS)} and strategy one of {list(LABELS[:3])}, "
             f"got backend={backend!r}, strategy={strategy!r}"
         ) from None
+    if backend == "mujoco" and model not in MUJOCO_MODELS:
+        raise InvalidParameterError(
+            f"strategy {strategy!r} needs the MuJoCo model {model!r}, not available; "
+            f"available: {list(MUJOCO_MODELS)}"
+        )
+    return model, controller
+
+
+def available_strategies(backend: str) -> tuple[str, ...]:
+    """Return the strategies whose model exists on ``backend``."""
+    models = MUJOCO_MODELS if backend == "mujoco" else None
+    return tuple(
+        strategy
+        for strategy, (model, _) in SETUPS[backend].items()
+        if models is None or model in models
+    )
 
 
 def corrected_critical_velocity(
@@ -213,6 +230,8 @@ def critical_table(
     -------
     list of CriticalRow
     """
+    for strategy in strategies:
+        _setup(backend, strategy)  # every strategy checked before any simulation
     rows = []
     for strategy in strategies:
         model, controller = _setup(backend, strategy)
@@ -326,6 +345,8 @@ def confusion_matrix(
     The prediction is :func:`~pushrecovery.surfaces.classify.classify` of the state after
     the push (x0, v); a strategy left out of ``strategies`` counts as failing.
     """
+    for strategy in strategies:
+        _setup(backend, strategy)
     counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)
     cases = []
     for x0 in x0s:
