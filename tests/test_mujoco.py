@@ -199,7 +199,7 @@ def test_cli_simulate_mujoco_render_and_measured_cop(tmp_path):
         (["simulate", "--render", "x.png"], "--render needs --backend mujoco"),
         (["simulate", "--backend", "mujoco", "--model", "foot", "--x", "1.5"], "|x| < com_height"),
         (["simulate", "--backend", "mujoco", "--model", "foot", "--impulse", "1e6"], "xdot"),
-        (["validate", "--strategy", "step"], "no mujoco model"),
+        (["validate", "--strategy", "ankle", "--tolerance", "0"], "tolerance must be"),
         (["validate", "--x0", "0.2"], "--x0 must lie on the foot"),
         (["validate", "--grid", "1", "0", "0.1"], "--grid needs START <= STOP"),
         (

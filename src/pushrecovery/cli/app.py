@@ -505,7 +505,10 @@ def validate(
     velocities = start + increment * np.arange(int(np.floor((stop - start) / increment + 1e-9)) + 1)
     rows_total = len(strategies) * len(x0s) * 2
     total = rows_total + (len(x0s) * len(velocities) if confusion else 0)
-    with click.progressbar(length=total, label="validating", file=sys.stderr) as bar:
+    # On a terminal only: a piped stderr keeps its one-line errors.
+    with click.progressbar(
+        length=total, label="validating", file=sys.stderr, hidden=not sys.stderr.isatty()
+    ) as bar:
         rows = critical_table(
             params,
             backend=backend,

@@ -245,7 +245,7 @@ MODELS: dict[str, type[Any]] = {}
 
 
 #: Models of the MuJoCo backend (:mod:`pushrecovery.sim.mujoco`).
-MUJOCO_MODELS = ("foot", "torso")
+MUJOCO_MODELS = ("foot", "torso", "biped")
 
 
 def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plant:

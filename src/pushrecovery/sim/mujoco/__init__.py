@@ -4,9 +4,14 @@ from __future__ import annotations
 
 from typing import Any
 
+from pushrecovery.sim.mujoco.biped import MujocoBipedPlant
 from pushrecovery.sim.mujoco.plant import MujocoFootPlant, MujocoTorsoPlant
 
 __all__ = ["PLANTS"]
 
 #: MuJoCo model name -> plant class (the names of ``plants.MUJOCO_MODELS``).
-PLANTS: dict[str, type[Any]] = {"foot": MujocoFootPlant, "torso": MujocoTorsoPlant}
+PLANTS: dict[str, type[Any]] = {
+    "foot": MujocoFootPlant,
+    "torso": MujocoTorsoPlant,
+    "biped": MujocoBipedPlant,
+}

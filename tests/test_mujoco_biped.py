@@ -1,0 +1,141 @@
+"""MuJoCo biped (model ``biped``): the recovery controller unchanged on a planar biped that
+steps, against the analytic stepping model."""
+
+import dataclasses
+
+import mujoco
+import numpy as np
+import pytest
+
+from pushrecovery import InvalidParameterError, load_params
+from pushrecovery.control import make_controller
+from pushrecovery.sim.mujoco.biped import LEG_MASS, MujocoBipedPlant, biped_model
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.simulate import RestCriterion, simulate
+from pushrecovery.surfaces.step import step_thresholds
+
+P = load_params()
+# Landing vs commanded step length [m]. The swing foot lands where the leg geometry puts it;
+# what separates the two is the swing leg's tracking at touchdown (≤ 2 mrad of leg angle: 2 mm
+# at the foot) and the foot's pitch then (a few mrad: its toe or heel meets the floor ≤ 1 mm
+# early). Measured: ≤ 1 mm for the pushes here, ≤ 3 mm up to ±2 m/s, 7.6 mm at −2.4 m/s.
+LANDING_TOLERANCE = 5e-3
+
+
+def recovery(params=P, first_step=None):
+    """The recovery controller, recording its step commands (optionally replacing the first)."""
+    controller = make_controller("recovery", params)
+    controller.steps = []
+    compute = controller.compute
+
+    def recorded(t, state):
+        command = compute(t, state)
+        if command.step_length is not None:
+            if first_step is not None and not controller.steps:
+                command = dataclasses.replace(command, step_length=first_step)
+            controller.steps.append(command.step_length)
+        return command
+
+    controller.compute = recorded
+    return controller
+
+
+def run(v=0.0, impulse=None, duration=5.0, rest=None, first_step=None):
+    plant = MujocoBipedPlant(P)
+    state = plant.initial_state(0.0, v if impulse is None else 0.0)
+    if impulse is not None:
+        plant.schedule_push(impulse)
+    controller = recovery(first_step=first_step)
+    result = simulate(plant, controller, state, duration=duration, rest=rest)
+    return plant, controller, result
+
+
+def analytic(v, duration=5.0):
+    plant = make_plant("stepping", P)
+    state = plant.initial_state(0.0, v)
+    return simulate(plant, make_controller("recovery", P), state, duration=duration)
+
+
+def test_model_maps_the_paper_parameters():
+    plant = MujocoBipedPlant(P)
+    model, data = plant.model, plant.data
+    mujoco.mj_forward(model, data)
+    assert model.body_subtreemass[0] == pytest.approx(P.mass)
+    torso = model.body("torso")
+    assert torso.mass[0] == pytest.approx(P.mass - 2 * LEG_MASS)
+    assert 2 * LEG_MASS / P.mass < 0.03  # light legs: the paper's are massless
+    # The torso is the flywheel: its CoM at the hip, inertia I about it.
+    assert np.allclose(torso.ipos, 0.0) and torso.inertia[1] == pytest.approx(P.flywheel_inertia)
+    # Standing straight, the hip is L above the ankles.
+    for leg in ("left", "right"):
+        ankle = data.xanchor[model.joint(f"{leg}_ankle").id]
+        assert data.xpos[torso.id][2] - ankle[2] == pytest.approx(P.com_height)
+    with pytest.raises(InvalidParameterError, match="leg_length must equal com_height"):
+        biped_model(load_params(overrides={"leg_length": 0.9}))
+
+
+def test_stands_still_for_two_seconds():
+    # At rest for the whole 2 s: the run is "recovered" only when the rest lasted 2 s.
+    _, controller, result = run(duration=2.5, rest=RestCriterion(duration=2.0))
+    assert result.recovered and result.time[-1] == pytest.approx(2.0)
+    assert controller.steps == [] and len(result.footholds) == 1
+    assert np.abs(result.states[:, 0]).max() < 1e-3  # CoM over the ankles [m]
+    assert np.abs(result.torques).max() == 0.0  # no hip
+
+
+def test_push_inside_the_ankle_region_needs_no_step():
+    _, controller, result = run(0.2)
+    assert result.recovered and controller.steps == [] and len(result.footholds) == 1
+    assert np.abs(result.torques).max() == 0.0
+    assert analytic(0.2).recovered
+
+
+@pytest.mark.parametrize("v", [1.0, -0.8])
+def test_push_beyond_the_hip_takes_one_step_as_commanded(v):
+    back, forward = step_thresholds(P)
+    assert back < v < forward  # one step recovers ...
+    plant, controller, result = run(v)
+    assert result.recovered
+    assert len(controller.steps) == 1 and len(result.footholds) == 2
+    landed = result.footholds[1] - result.footholds[0]
+    assert landed == pytest.approx(controller.steps[0], abs=LANDING_TOLERANCE)
+    assert np.sign(landed) == np.sign(v)
+    # It ends at rest over the new foot, lower (Eq. 20), with the trailing leg lifted.
+    assert result.final_state[2] < plant._standing_height() and result.final_state[5] == 0.0
+    reference = analytic(v)  # ... and so it does in the analytic stepping model
+    assert reference.recovered and len(reference.footholds) == 2
+
+
+def test_push_as_a_real_force():
+    # 72 N s over 10 ms on the torso: 1 m/s for 72 kg, beyond the hip region.
+    _, controller, result = run(impulse=72.0)
+    assert result.recovered and len(controller.steps) == 1
+    landed = result.footholds[1] - result.footholds[0]
+    assert landed == pytest.approx(controller.steps[0], abs=LANDING_TOLERANCE)
+    _, controller, small = run(impulse=-7.2)  # −0.1 m/s: the ankle alone
+    assert small.recovered and controller.steps == []
+
+
+def test_push_far_beyond_the_step_limit_falls():
+    for v in (4.0, -4.0):
+        _, _, result = run(v)
+        assert result.outcome.value == "fell"
+        assert analytic(v).outcome.value == "fell"
+
+
+def test_a_second_step_swaps_the_legs():
+    # A first step forced short of Eq. (21) leaves the capture point ahead of the new foot:
+    # the controller steps again, with the other leg, as the analytic model would.
+    plant, controller, result = run(1.0, first_step=0.3)
+    assert result.recovered and len(controller.steps) == 2 and len(result.footholds) == 3
+    steps = np.diff(result.footholds)
+    assert steps == pytest.approx(controller.steps, abs=LANDING_TOLERANCE)
+    assert plant._stance == (0,)  # right leg first, then left
+
+
+def test_bad_states():
+    plant = MujocoBipedPlant(P)
+    with pytest.raises(InvalidParameterError, match="state must be"):
+        plant.check_state(np.zeros(4))
+    with pytest.raises(InvalidParameterError, match="zdot = 0"):
+        plant.check_state(np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.1]))
