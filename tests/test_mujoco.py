@@ -220,3 +220,14 @@ def test_cli_mujoco_bad_input_is_one_line(capsys, args, words):
     assert exit_info.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and words in err, err
+
+
+def test_push_a_named_body():
+    plant = make_plant("torso", P, "mujoco")
+    plant.initial_state(0.0, 0.0)
+    at_com = plant.push(20.0)
+    plant.initial_state(0.0, 0.0)
+    named = plant.push(20.0, body="torso")  # the CoM body by name: the same push
+    np.testing.assert_array_equal(at_com, named)
+    with pytest.raises(InvalidParameterError, match="body must be one of"):
+        plant.push(20.0, body="head")

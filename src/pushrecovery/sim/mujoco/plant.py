@@ -107,6 +107,7 @@ class MujocoPlant:
             i for i in range(model.ngeom) if model.geom(i).name.endswith("sole")
         )
         self._pushed = model.body(self.pushed_body).id
+        self._push_target = -1
         self._qpos: FloatArray = self.data.qpos
         self._qvel: FloatArray = self.data.qvel
         self._ctrl: FloatArray = self.data.ctrl
@@ -127,8 +128,13 @@ class MujocoPlant:
         return MODEL_BUILDERS[cls.model_name](params)
 
     # --- pushes and recording ------------------------------------------------------------
-    def schedule_push(self, impulse: float, duration: float = PUSH_DURATION) -> None:
+    def schedule_push(
+        self, impulse: float, duration: float = PUSH_DURATION, body: str | None = None
+    ) -> None:
         """Push the body at its CoM with ``impulse`` [N s] (+x forward) over ``duration`` [s].
+
+        ``body`` names another MuJoCo body to push (at that body's own centre of mass, e.g.
+        ``"foot"``); the CoP map then does not know the push, so the CoP wanders during it.
 
         Applied from the next :meth:`step` on (call after :meth:`initial_state`), over the
         whole physics steps nearest to ``duration`` (at least one), with the force that makes
@@ -144,17 +150,25 @@ class MujocoPlant:
                 f"duration must be >= the MuJoCo step {self._substep:g} s, got {duration:g}"
             )
         check_com_state(0.0, impulse / self.params.mass, self.params)
+        target = self.pushed_body if body is None else body
+        try:
+            self._push_target = self.model.body(target).id
+        except KeyError:
+            names = [self.model.body(i).name for i in range(1, self.model.nbody)]
+            raise InvalidParameterError(f"body must be one of {names}, got {body!r}") from None
         self._push_steps = round(duration / self._substep)
         self._push_force = impulse / (self._push_steps * self._substep)
 
-    def push(self, impulse: float, duration: float = PUSH_DURATION) -> FloatArray:
+    def push(
+        self, impulse: float, duration: float = PUSH_DURATION, body: str | None = None
+    ) -> FloatArray:
         """Push now with ``impulse`` [N s] (+x forward) over ``duration`` [s]; return the state.
 
         The force acts at the CoM while the body holds still: the CoP under the CoM, no hip
         torque. The returned state is the state just after the push, the moment the paper's
         velocity jump stands for; a controller started on it sees the push as it ends.
         """
-        self.schedule_push(impulse, duration)
+        self.schedule_push(impulse, duration, body)
         state = self.read_state()
         while self._push_steps > 0:
             state, _, _ = self.step(state, Command(float(state[0])), self._substep)
@@ -203,6 +217,7 @@ class MujocoPlant:
         mj, d = self._mj, self.data
         mj.mj_resetData(self.model, d)
         self._push_steps, self.push_now, self.stop_impacts = 0, 0.0, 0
+        self._push_target = -1
         d.ctrl[:] = 0.0
         mj.mj_step(self.model, d, nstep=round(SETTLE_TIME / self._substep))
         d.qvel[:] = 0.0
@@ -259,14 +274,16 @@ class MujocoPlant:
         steps = round(self.time / h) - self._steps_done
         self._steps_done += steps
         while steps and self._push_steps:
-            self.push_now = self._push_force
-            self._xfrc[self._pushed, 0] = self.push_now
+            self._xfrc[self._push_target, 0] = self._push_force
+            # The CoP map accounts for a push at the CoM only.
+            self.push_now = self._push_force if self._push_target == self._pushed else 0.0
             torque = actuate(cop, command)
             mj_step(model, d)
             self._push_steps -= 1
             steps -= 1
-        if self.push_now:
-            self.push_now = self._xfrc[self._pushed, 0] = 0.0
+        if self._push_target >= 0 and not self._push_steps:
+            self.push_now = self._xfrc[self._push_target, 0] = 0.0
+            self._push_target = -1
         # The hot loop: about 2 µs of Python around each MuJoCo step.
         for _ in range(steps):
             torque = actuate(cop, command)
