@@ -107,6 +107,8 @@ def test_bad_mujoco_requests():
     with pytest.raises(InvalidParameterError, match="backend must be"):
         make_plant("foot", P, "bullet")
     plant = make_plant("foot", P, "mujoco")
+    with pytest.raises(InvalidParameterError, match="duration must be >= the MuJoCo step"):
+        plant.schedule_push(10.0, duration=4e-4)
     with pytest.raises(InvalidParameterError, match="impulse and duration must be finite"):
         plant.schedule_push(float("nan"))
 
@@ -202,6 +204,7 @@ def test_cli_simulate_mujoco_render_and_measured_cop(tmp_path):
         (["validate", "--strategy", "ankle", "--tolerance", "0"], "tolerance must be"),
         (["validate", "--x0", "0.2"], "--x0 must lie on the foot"),
         (["validate", "--grid", "1", "0", "0.1"], "--grid needs START <= STOP"),
+        (["validate", "--grid", "0", "1", "1e-6"], "--grid gives 1000001 values; at most"),
         (
             ["simulate", "--backend", "mujoco", "--model", "foot", "--control-period", "0.0004"],
             "control_period must be >= half the MuJoCo step",

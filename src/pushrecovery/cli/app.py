@@ -107,6 +107,24 @@ def _measured_cop(cops: list[float]) -> dict[str, float | None]:
     return {"min": min(finite), "max": max(finite)}
 
 
+def _value_range(option: str, triple: tuple[float, float, float], limit: int) -> Any:
+    """START, START+STEP, ... up to STOP (inclusive) as an array; at most ``limit`` values."""
+    import numpy as np
+
+    from pushrecovery._validate import finite_array
+    from pushrecovery.errors import InvalidParameterError
+
+    start, stop, increment = (float(v) for v in finite_array(option, triple))
+    if increment <= 0.0 or stop < start:
+        raise InvalidParameterError(
+            f"{option} needs START <= STOP and STEP > 0, got {start:g} {stop:g} {increment:g}"
+        )
+    count = int(np.floor((stop - start) / increment + 1e-9)) + 1
+    if count > limit:
+        raise InvalidParameterError(f"{option} gives {count} values; at most {limit}")
+    return start + increment * np.arange(count)
+
+
 def _controller_options(
     kp: float | None, kd: float | None, pairs: tuple[str, ...] = ()
 ) -> dict[str, Any]:
@@ -497,12 +515,7 @@ def validate(
             raise InvalidParameterError(
                 f"--x0 must lie on the foot, {params.heel:g} < x0 < {params.toe:g} m, got {x0:g}"
             )
-    start, stop, increment = (float(v) for v in finite_array("--grid", grid))
-    if increment <= 0.0 or stop < start:
-        raise InvalidParameterError(
-            f"--grid needs START <= STOP and STEP > 0, got {start:g} {stop:g} {increment:g}"
-        )
-    velocities = start + increment * np.arange(int(np.floor((stop - start) / increment + 1e-9)) + 1)
+    velocities = _value_range("--grid", grid, limit=10_000)
     rows_total = len(strategies) * len(x0s) * 2
     total = rows_total + (len(x0s) * len(velocities) if confusion else 0)
     # On a terminal only: a piped stderr keeps its one-line errors.
@@ -621,15 +634,7 @@ def step(
     params = params_from(kwargs)
     values = list(speeds)
     if v0_range is not None:
-        start, stop, increment = (float(v) for v in finite_array("--v0-range", v0_range))
-        if increment <= 0.0 or stop < start:
-            raise InvalidParameterError(
-                f"--v0-range needs START <= STOP and STEP > 0, got {start:g} {stop:g} {increment:g}"
-            )
-        count = int(np.floor((stop - start) / increment + 1e-9)) + 1
-        if count > 100_000:
-            raise InvalidParameterError(f"--v0-range gives {count} velocities; at most 100000")
-        values.extend(start + increment * np.arange(count))
+        values.extend(_value_range("--v0-range", v0_range, limit=100_000))
     if not values:
         raise InvalidParameterError("give --v0 V (repeatable) or --v0-range START STOP STEP")
     v0 = finite_array("v0", values)

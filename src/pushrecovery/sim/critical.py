@@ -12,12 +12,13 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pushrecovery._validate import finite_float, positive_float
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.plants import Plant, make_plant
 from pushrecovery.sim.push import direction_sign
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
@@ -32,6 +33,7 @@ __all__ = [
     "critical_push",
     "find_critical_velocity",
     "predicted_critical_velocity",
+    "pushed_state",
 ]
 
 
@@ -152,6 +154,21 @@ def find_critical_velocity(
     return Bracket(float(np.copysign(low, sign)), float(np.copysign(high, sign)), runs)
 
 
+def pushed_state(plant: Plant, x0: float, velocity: float, *, force: bool) -> NDArray[np.float64]:
+    """State just after a push of ``velocity`` [m/s] from the CoM at rest at ``x0`` [m].
+
+    A velocity jump, or with ``force`` a real force at the CoM delivering the impulse m v
+    (MuJoCo plants' :meth:`push`).
+    """
+    if not force:
+        return plant.initial_state(x0, velocity)
+    plant.initial_state(x0, 0.0)
+    pushed: NDArray[np.float64] = plant.push(  # type: ignore[attr-defined]
+        plant.params.mass * velocity
+    )
+    return pushed
+
+
 def predicted_critical_velocity(
     params: BodyParams, strategy: str, x0: float, direction: str
 ) -> float:
@@ -233,9 +250,7 @@ def critical_push(
     predicted = predicted_critical_velocity(params, ctrl.strategy, x0, direction)
 
     def outcome_of(velocity: float) -> Outcome:
-        start = plant.initial_state(x0, 0.0 if force else velocity)
-        if force:
-            start = plant.push(params.mass * velocity)  # type: ignore[attr-defined]
+        start = pushed_state(plant, x0, velocity, force=force)
         run = simulate(plant, ctrl, start, duration=duration, control_period=control_period)
         return run.outcome
 

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.critical import critical_push
+from pushrecovery.sim.critical import critical_push, pushed_state
 from pushrecovery.sim.plants import MUJOCO_MODELS, make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify, strategy_region
@@ -84,11 +84,10 @@ def _setup(backend: str, strategy: str) -> tuple[str, str]:
 
 def available_strategies(backend: str) -> tuple[str, ...]:
     """Return the strategies whose model exists on ``backend``."""
-    models = MUJOCO_MODELS if backend == "mujoco" else None
     return tuple(
         strategy
         for strategy, (model, _) in SETUPS[backend].items()
-        if models is None or model in models
+        if backend != "mujoco" or model in MUJOCO_MODELS
     )
 
 
@@ -289,11 +288,7 @@ def needed_strategy(
             continue
         model, controller = _setup(backend, strategy)
         plant = make_plant(model, params, backend)
-        if backend == "mujoco":
-            plant.initial_state(x0, 0.0)
-            start = plant.push(params.mass * velocity)  # type: ignore[attr-defined]
-        else:
-            start = plant.initial_state(x0, velocity)
+        start = pushed_state(plant, x0, velocity, force=backend == "mujoco")
         run = simulate(plant, make_controller(controller, params), start, duration=duration)
         if run.recovered:
             return strategy
