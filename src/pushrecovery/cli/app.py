@@ -109,20 +109,9 @@ def _measured_cop(cops: list[float]) -> dict[str, float | None]:
 
 def _value_range(option: str, triple: tuple[float, float, float], limit: int) -> Any:
     """START, START+STEP, ... up to STOP (inclusive) as an array; at most ``limit`` values."""
-    import numpy as np
+    from pushrecovery.campaign.spec import value_range
 
-    from pushrecovery._validate import finite_array
-    from pushrecovery.errors import InvalidParameterError
-
-    start, stop, increment = (float(v) for v in finite_array(option, triple))
-    if increment <= 0.0 or stop < start:
-        raise InvalidParameterError(
-            f"{option} needs START <= STOP and STEP > 0, got {start:g} {stop:g} {increment:g}"
-        )
-    count = int(np.floor((stop - start) / increment + 1e-9)) + 1
-    if count > limit:
-        raise InvalidParameterError(f"{option} gives {count} values; at most {limit}")
-    return start + increment * np.arange(count)
+    return value_range(option, triple, limit)
 
 
 def _controller_options(
@@ -678,3 +667,13 @@ def step(
     for row in rows:
         emit(row, False)
         click.echo("")
+
+
+def _register() -> None:
+    from pushrecovery.cli.campaign import campaign, report
+
+    cli.add_command(campaign)
+    cli.add_command(report)
+
+
+_register()

@@ -1,0 +1,280 @@
+"""Run a campaign's batches on this process, local worker processes or a Dask cluster.
+
+Files in the campaign's directory:
+
+- ``spec.json``: the spec (:meth:`CampaignSpec.to_dict`), written first;
+- ``batches/batch-NNNNNN.parquet``: each finished batch, written by this process as soon as a
+  worker returns it (to a temporary name, then renamed: a file there is always complete);
+- ``pushes.parquet``: every push in index order, once all batches are there;
+- ``summary.json``: :func:`~pushrecovery.campaign.summary.summarize` of the pushes.
+
+An interrupted campaign (Ctrl-C, a lost worker, a killed process) keeps every finished batch;
+``resume`` runs only the missing ones. Each push depends on the spec and its index only, so the
+result is the same whatever the number of workers and the order batches finish in.
+
+Workers: ``workers=1`` runs in this process; otherwise ``workers`` local processes
+(``concurrent.futures.ProcessPoolExecutor``, default: all cores), or, with ``scheduler``, the
+workers of a running ``dask.distributed`` scheduler at that address (``tcp://host:port``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from collections.abc import Callable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pushrecovery.campaign.pushes import COLUMNS, run_batch
+from pushrecovery.campaign.spec import CampaignSpec
+from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+
+__all__ = ["CampaignError", "CampaignResult", "missing_batches", "read_spec", "run_campaign"]
+
+SPEC_FILE = "spec.json"
+PUSHES_FILE = "pushes.parquet"
+SUMMARY_FILE = "summary.json"
+BATCH_DIR = "batches"
+_BATCH = re.compile(r"batch-(\d{6})\.parquet")
+#: Seconds to wait for a Dask scheduler to answer.
+CONNECT_TIMEOUT = 10.0
+
+
+class CampaignError(PushRecoveryError):
+    """A campaign cannot run: unreachable scheduler, a directory holding another campaign."""
+
+
+@dataclass(frozen=True)
+class CampaignResult:
+    """A finished campaign: its spec, the pushes (an Arrow table), the summary and files."""
+
+    spec: CampaignSpec
+    table: Any  # pyarrow.Table
+    summary: dict[str, Any]
+    directory: Path
+    ran: int  # batches simulated by this call (the rest were on disk)
+
+    @property
+    def pushes_file(self) -> Path:
+        """The Parquet file of every push."""
+        return self.directory / PUSHES_FILE
+
+
+def schema(spec: CampaignSpec) -> Any:
+    """Arrow schema of the pushes of ``spec``."""
+    import pyarrow as pa
+
+    types = {
+        "float64": pa.float64(),
+        "int64": pa.int64(),
+        "string": pa.string(),
+        "bool": pa.bool_(),
+    }
+    return pa.schema(
+        [("index", pa.int64())]
+        + [(f"param_{name}", pa.float64()) for name in spec.sweeps]
+        + [(name, types[kind]) for name, kind in COLUMNS]
+    )
+
+
+def read_spec(directory: Path) -> CampaignSpec:
+    """Return the spec of the campaign in ``directory``."""
+    path = Path(directory) / SPEC_FILE
+    try:
+        data = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise CampaignError(f"no campaign in {directory} (no {SPEC_FILE})") from None
+    except (OSError, ValueError) as exc:
+        raise CampaignError(f"cannot read {path}: {exc}") from None
+    return CampaignSpec.from_dict(data)
+
+
+def missing_batches(spec: CampaignSpec, directory: Path) -> list[int]:
+    """Batch numbers of ``spec`` with no finished file in ``directory``."""
+    done = set()
+    folder = Path(directory) / BATCH_DIR
+    if folder.is_dir():
+        for path in folder.iterdir():
+            match = _BATCH.fullmatch(path.name)
+            if match:
+                done.add(int(match.group(1)))
+    return [b for b in spec.batch_indices() if b not in done]
+
+
+def _batch_path(directory: Path, batch: int) -> Path:
+    return directory / BATCH_DIR / f"batch-{batch:06d}.parquet"
+
+
+def _write_batch(spec: CampaignSpec, directory: Path, batch: int, rows: list[dict]) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pylist(rows, schema=schema(spec))
+    path = _batch_path(directory, batch)
+    partial = path.with_suffix(".partial")
+    pq.write_table(table, partial)
+    os.replace(partial, path)  # atomic: a batch file is complete or absent
+
+
+def _prepare(spec: CampaignSpec, directory: Path, resume: bool) -> None:
+    """Write the spec into a new directory, or check it against the stored one."""
+    stored = directory / SPEC_FILE
+    if stored.exists():
+        if not resume:
+            raise CampaignError(
+                f"{directory} already holds a campaign; pass --resume to complete it or "
+                "choose another --out"
+            )
+        previous = read_spec(directory).to_dict()
+        if previous != spec.to_dict():
+            changed = sorted(k for k in previous if previous[k] != spec.to_dict().get(k))
+            raise CampaignError(
+                f"--resume: the campaign in {directory} differs in {', '.join(changed)}"
+            )
+        return
+    (directory / BATCH_DIR).mkdir(parents=True, exist_ok=True)
+    partial = stored.with_suffix(".partial")
+    partial.write_text(json.dumps(spec.to_dict(), indent=2) + "\n")
+    os.replace(partial, stored)
+
+
+def _serial(spec: CampaignSpec, batches: list[int]) -> Iterator[tuple[int, list[dict]]]:
+    for batch in batches:
+        yield run_batch(spec, batch)
+
+
+def _processes(
+    spec: CampaignSpec, batches: list[int], workers: int
+) -> Iterator[tuple[int, list[dict]]]:
+    import multiprocessing
+    from concurrent.futures.process import BrokenProcessPool
+
+    # Not fork: the parent may already run OpenMP threads (numba's parallel surfaces), which a
+    # forked child cannot use.
+    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+    try:
+        pending: set[Future[tuple[int, list[dict]]]] = {
+            pool.submit(run_batch, spec, batch) for batch in batches
+        }
+        while pending:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for future in done:
+                try:
+                    yield future.result()
+                except BrokenProcessPool:
+                    raise CampaignError(
+                        "a worker process died; the finished batches are saved, rerun with --resume"
+                    ) from None
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _dask(
+    spec: CampaignSpec, batches: list[int], scheduler: str
+) -> Iterator[tuple[int, list[dict]]]:
+    from distributed import Client, as_completed
+
+    try:
+        client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise CampaignError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+    try:
+        # pure=False: every batch runs, even if an identical task ran before on the cluster.
+        futures = [client.submit(run_batch, spec, batch, pure=False) for batch in batches]
+        try:
+            for future in as_completed(futures, loop=client.loop):
+                yield future.result()
+        finally:
+            client.cancel(futures)
+    finally:
+        client.close()
+
+
+def run_campaign(
+    spec: CampaignSpec,
+    directory: Path | str,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    max_batches: int | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> CampaignResult | None:
+    """Run ``spec`` into ``directory``; return the result, or None if stopped by ``max_batches``.
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+        The campaign.
+    directory : path
+        Where its files go (module docstring); created if missing.
+    workers : int, optional
+        Local worker processes (1: this process); default all cores. Ignored with
+        ``scheduler``.
+    scheduler : str, optional
+        Address of a running ``dask.distributed`` scheduler to send the batches to.
+    resume : bool
+        Complete the campaign already in ``directory`` (same spec), running only the batches
+        that have no file yet.
+    max_batches : int, optional
+        Run at most this many batches now (the rest stays missing, for a later ``resume``).
+    progress : callable, optional
+        Called with the number of pushes of each batch as it finishes (a progress bar's
+        ``update``); first with the pushes already on disk.
+
+    Raises
+    ------
+    CampaignError
+        A directory holding another campaign, an unreachable scheduler, a dead worker.
+    """
+    directory = Path(directory)
+    if workers is not None and workers < 1:
+        raise InvalidParameterError(f"workers must be >= 1, got {workers}")
+    if max_batches is not None and max_batches < 0:
+        raise InvalidParameterError(f"max_batches must be >= 0, got {max_batches}")
+    _prepare(spec, directory, resume)
+    todo = missing_batches(spec, directory)
+    if progress is not None:
+        done_pushes = spec.size - sum(len(spec.pushes(b)) for b in todo)
+        if done_pushes:
+            progress(done_pushes)
+    stopped = max_batches is not None and max_batches < len(todo)
+    if stopped:
+        todo = todo[:max_batches]
+    if scheduler is not None:
+        results = _dask(spec, todo, scheduler)
+    elif (workers or os.cpu_count() or 1) == 1 or len(todo) <= 1:
+        results = _serial(spec, todo)
+    else:
+        results = _processes(spec, todo, min(workers or os.cpu_count() or 1, len(todo)))
+    for batch, rows in results:
+        _write_batch(spec, directory, batch, rows)
+        if progress is not None:
+            progress(len(rows))
+    if stopped:
+        return None
+    return finish(spec, directory, ran=len(todo))
+
+
+def finish(spec: CampaignSpec, directory: Path, ran: int = 0) -> CampaignResult:
+    """Join the batch files into ``pushes.parquet`` and write ``summary.json``."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from pushrecovery.campaign.summary import summarize
+
+    missing = missing_batches(spec, directory)
+    if missing:
+        raise CampaignError(f"{len(missing)} batches missing in {directory}; rerun with --resume")
+    parts = [pq.read_table(_batch_path(directory, b)) for b in spec.batch_indices()]
+    table = pa.concat_tables(parts) if parts else schema(spec).empty_table()
+    partial = directory / (PUSHES_FILE + ".partial")
+    pq.write_table(table, partial)
+    os.replace(partial, directory / PUSHES_FILE)
+    summary = summarize(spec, table)
+    (directory / SUMMARY_FILE).write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    return CampaignResult(spec, table, summary, directory, ran)

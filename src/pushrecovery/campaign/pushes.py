@@ -1,0 +1,129 @@
+"""Simulate the pushes of one batch and record each as one row (runs on the workers).
+
+Every row records the push's inputs, what the paper's surfaces predict for the state just after
+it, and what the simulation did. Columns, SI units, positions relative to the stance ankle:
+
+=====================  ======================================================================
+``index``              push number in the campaign
+``param_<name>``       each swept body parameter
+``x0``                 CoM position before the push [m]
+``xdot``               CoM velocity the push gives, J/m [m/s]
+``impulse``            the push, J [N s]
+``predicted``          strategy the surfaces give for (x0, ẋ): ankle, hip, step or fall
+``capture_point``      x0 + ẋ/ω [m]
+``cop_margin``         signed distance of the capture point inside the CoP region, Eq. (4) [m]
+``cmp_margin``         the same for the CMP region, corrected Eq. (15) [m]
+``step_margin``        reach left beyond the shortest recovering step [m]; −inf: none recovers
+``predicted_recovers`` the predicted strategy is within the controller's (ankle < hip < step)
+``outcome``            recovered, fell or undecided
+``used``               strategy the run used: ankle (CoP only), hip (hip torque), step, or fall
+``steps``              steps taken
+``peak_hip_torque``    largest |hip torque| applied [N m]
+``peak_ankle_torque``  m g max|δ|: the ankle torque of the largest CoP offset (LIPM, Eq. 1) [N m]
+``cop_min, cop_max``   CoP excursion commanded over the run [m]
+``time``               simulated time to the outcome [s]
+``stop_impacts``       times the upper body hit its joint stop
+=====================  ======================================================================
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from pushrecovery.campaign.spec import CampaignSpec, Push
+from pushrecovery.control.base import make_controller
+from pushrecovery.params import BodyParams
+from pushrecovery.sim.critical import pushed_state
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.classify import Strategy, classify
+
+__all__ = ["COLUMNS", "run_batch", "run_push"]
+
+#: Strategies in escalating order (a controller of one recovers the pushes of the lesser).
+ORDER = (Strategy.ANKLE, Strategy.HIP, Strategy.STEP, Strategy.FALL)
+
+#: Fixed columns after the ``param_<name>`` ones, with their Arrow type names.
+COLUMNS: tuple[tuple[str, str], ...] = (
+    ("x0", "float64"),
+    ("xdot", "float64"),
+    ("impulse", "float64"),
+    ("predicted", "string"),
+    ("capture_point", "float64"),
+    ("cop_margin", "float64"),
+    ("cmp_margin", "float64"),
+    ("step_margin", "float64"),
+    ("predicted_recovers", "bool"),
+    ("outcome", "string"),
+    ("used", "string"),
+    ("steps", "int64"),
+    ("peak_hip_torque", "float64"),
+    ("peak_ankle_torque", "float64"),
+    ("cop_min", "float64"),
+    ("cop_max", "float64"),
+    ("time", "float64"),
+    ("stop_impacts", "int64"),
+)
+
+
+def run_push(spec: CampaignSpec, push: Push, cache: dict[BodyParams, Any] | None = None) -> dict:
+    """Simulate one push; return its row (module docstring).
+
+    ``cache`` keeps one plant and controller per body across the pushes of a batch (MuJoCo
+    compiles a model per plant).
+    """
+    cache = {} if cache is None else cache
+    if push.params not in cache:
+        cache[push.params] = (
+            make_plant(spec.model, push.params, spec.backend),
+            make_controller(spec.controller, push.params),
+        )
+    plant, controller = cache[push.params]
+    params = push.params
+    state = pushed_state(plant, push.x0, push.xdot, force=spec.backend == "mujoco")
+    run = simulate(plant, controller, state, duration=spec.duration)
+    found = classify(push.x0, push.xdot, params)
+    reach = ORDER.index(Strategy(controller.strategy))
+    steps = len(run.footholds) - 1
+    hip = float(abs(run.torques).max()) if run.torques.size else 0.0
+    cops = run.cops
+    if not run.recovered:
+        used = Strategy.FALL
+    elif steps:
+        used = Strategy.STEP
+    elif hip > 0.0:
+        used = Strategy.HIP
+    else:
+        used = Strategy.ANKLE
+    row: dict[str, Any] = {
+        f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
+    }
+    row.update(
+        index=push.index,
+        x0=push.x0,
+        xdot=push.xdot,
+        impulse=push.impulse,
+        predicted=found.strategy.value,
+        capture_point=found.capture_point,
+        cop_margin=found.margins["cop"],
+        cmp_margin=found.margins["cmp"],
+        step_margin=found.margins["step"],
+        predicted_recovers=ORDER.index(found.strategy) <= reach,
+        outcome=run.outcome.value,
+        used=used.value,
+        steps=steps,
+        peak_hip_torque=hip,
+        peak_ankle_torque=params.weight * float(abs(cops).max()) if cops.size else 0.0,
+        cop_min=float(cops.min()) if cops.size else math.nan,
+        cop_max=float(cops.max()) if cops.size else math.nan,
+        time=float(run.time[-1]),
+        stop_impacts=run.stop_impacts,
+    )
+    return row
+
+
+def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict]]:
+    """Simulate batch number ``batch`` of ``spec``; return it with its rows, in push order."""
+    cache: dict[BodyParams, Any] = {}
+    return batch, [run_push(spec, push, cache) for push in spec.pushes(batch)]

@@ -1,0 +1,257 @@
+"""The ``campaign`` and ``report`` commands (registered on the group in :mod:`.app`)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+
+from pushrecovery.cli.options import body_options, emit, params_from
+
+__all__ = ["campaign", "report"]
+
+_triple: dict[str, Any] = {"nargs": 3, "type": float, "metavar": "START STOP STEP", "default": None}
+
+
+def _sweeps(pairs: tuple[str, ...]) -> dict[str, tuple[float, float, float]]:
+    """``NAME=START:STOP:STEP`` options as {name: (start, stop, step)}."""
+    from pushrecovery.errors import InvalidParameterError
+
+    sweeps = {}
+    for pair in pairs:
+        name, _, text = pair.partition("=")
+        parts = text.split(":")
+        try:
+            if not name or len(parts) != 3:
+                raise ValueError
+            values = tuple(float(p) for p in parts)
+        except ValueError:
+            raise InvalidParameterError(
+                f"--param needs NAME=START:STOP:STEP (e.g. torque_max=50:150:25), got {pair!r}"
+            ) from None
+        if name in sweeps:
+            raise InvalidParameterError(f"--param {name} given twice")
+        sweeps[name] = values
+    return sweeps  # type: ignore[return-value]
+
+
+class _Progress:
+    """A tqdm bar over the pushes (rate and ETA), drawn on a terminal only."""
+
+    def __init__(self, total: int, label: str) -> None:
+        from tqdm import tqdm
+
+        # A piped stderr keeps its one-line errors.
+        self.bar = tqdm(
+            total=total, desc=label, unit="push", file=sys.stderr, disable=not sys.stderr.isatty()
+        )
+
+    def update(self, count: int) -> None:
+        self.bar.update(count)
+
+    def close(self) -> None:
+        self.bar.close()
+
+
+@click.command(short_help="Sweep pushes over starts, push sizes and parameters, at scale.")
+@click.option(
+    "--backend",
+    type=click.Choice(("analytic", "mujoco")),
+    default="analytic",
+    show_default=True,
+    help="Physics: velocity jumps on the analytic models, real forces on MuJoCo.",
+)
+@click.option(
+    "--model",
+    default=None,
+    help="Plant (default: stepping on analytic, torso on mujoco).",
+)
+@click.option("--controller", default=None, help="Controller (default: recovery / mpc).")
+@click.option("--x0", "x0", **_triple, help="CoM positions before the push [m].")
+@click.option("--xdot", **_triple, help="Pushes as CoM velocities [m/s].")
+@click.option("--impulse", **_triple, help="Pushes as impulses at the CoM [N s].")
+@click.option(
+    "--param",
+    "sweep_pairs",
+    multiple=True,
+    metavar="NAME=START:STOP:STEP",
+    help="Sweep a body parameter (SI units), repeatable: e.g. torque_max=50:150:25.",
+)
+@click.option(
+    "--samples",
+    type=int,
+    default=None,
+    help="Draw this many pushes uniformly from the ranges (with --seed) instead of the grid.",
+)
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of --samples.")
+@click.option(
+    "--duration", type=float, default=6.0, show_default=True, help="Longest time per push [s]."
+)
+@click.option(
+    "--batch-size", type=int, default=None, help="Pushes per task (default 100 / 10 MuJoCo)."
+)
+@click.option(
+    "--out", type=click.Path(file_okay=False), required=True, help="Directory of the campaign."
+)
+@click.option(
+    "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Send the batches to a running dask.distributed scheduler (tcp://host:port).",
+)
+@click.option(
+    "--resume",
+    is_flag=True,
+    help="Complete the campaign in --out, running only the missing batches.",
+)
+@click.option("--plot/--no-plot", default=True, show_default=True, help="Write the plots.")
+@body_options
+def campaign(
+    backend: str,
+    model: str | None,
+    controller: str | None,
+    x0: tuple[float, float, float] | None,
+    xdot: tuple[float, float, float] | None,
+    impulse: tuple[float, float, float] | None,
+    sweep_pairs: tuple[str, ...],
+    samples: int | None,
+    seed: int,
+    duration: float,
+    batch_size: int | None,
+    out: str,
+    workers: int | None,
+    scheduler: str | None,
+    resume: bool,
+    plot: bool,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Simulate every push of a sweep and compare each with the surfaces' prediction.
+
+    Each push records its inputs, the predicted strategy and margins, the outcome, the peak
+    torques and the CoP excursion (OUT/pushes.parquet, one row per push); OUT/summary.json has
+    the counts, the accuracy of the prediction, the confusion matrix (predicted strategy vs the
+    one used) and the empirical critical pushes against the analytic ones. Every finished
+    batch is kept in OUT/batches: an interrupted campaign continues with --resume. The
+    result does not depend on the number of workers.
+    """
+    from pushrecovery.campaign import CampaignSpec, read_spec, run_campaign
+    from pushrecovery.errors import InvalidParameterError
+
+    params = params_from(kwargs)
+    directory = Path(out)
+    if resume and x0 is None and xdot is None and impulse is None:
+        spec = read_spec(directory)  # the stored campaign, as it was asked for
+    else:
+        if x0 is None or (xdot is None and impulse is None):
+            raise InvalidParameterError("campaign needs --x0 and one of --xdot, --impulse")
+        spec = CampaignSpec(
+            backend=backend,
+            model=model or ("stepping" if backend == "analytic" else "torso"),
+            controller=controller or ("recovery" if backend == "analytic" else "mpc"),
+            params=params,
+            x0=x0,
+            xdot=xdot,
+            impulse=impulse,
+            sweeps=_sweeps(sweep_pairs),
+            samples=samples,
+            seed=seed,
+            duration=duration,
+            batch_size=batch_size,
+        )
+    bar = _Progress(spec.size, "campaign")
+    try:
+        result = run_campaign(
+            spec,
+            directory,
+            workers=workers,
+            scheduler=scheduler,
+            resume=resume,
+            progress=bar.update,
+        )
+    except KeyboardInterrupt:
+        bar.close()
+        click.echo(
+            f"pushrecovery: interrupted; the finished batches are in {directory}; "
+            "rerun with --resume to complete the campaign",
+            err=True,
+        )
+        sys.exit(130)
+    bar.close()
+    assert result is not None  # no max_batches
+    files = {"pushes": str(result.pushes_file), "summary": str(directory / "summary.json")}
+    if plot:
+        from pushrecovery.plots.campaign import plot_critical_vs_parameter, plot_outcome_map
+
+        files["outcome_map"] = str(
+            plot_outcome_map(result.table, spec, directory / "outcome_map.png")
+        )
+        if len(spec.sweeps) == 1 and result.summary["boundary"]:
+            files["critical_vs_parameter"] = str(
+                plot_critical_vs_parameter(result.summary, directory / "critical_vs_parameter.png")
+            )
+    summary = {**result.summary, "files": files}
+    if as_json:
+        emit(summary, True)
+        return
+    outcomes = summary["outcomes"]
+    click.echo(
+        f"{summary['pushes']} pushes ({result.ran} batches run now): "
+        f"{outcomes['recovered']} recovered, {outcomes['fell']} fell, "
+        f"{outcomes['undecided']} undecided; prediction accuracy {summary['accuracy']:.3f}"
+    )
+    labels = summary["confusion"]["labels"]
+    click.echo("confusion (rows predicted, columns used):")
+    click.echo(" " * 10 + "".join(f"{label:>7}" for label in labels))
+    for label, counts in zip(labels, summary["confusion"]["counts"], strict=True):
+        click.echo(f"{label:<10}" + "".join(f"{count:>7}" for count in counts))
+    for name, path in files.items():
+        click.echo(f"{name:<22}{path}")
+
+
+@click.command(short_help="The HTML report of a parameter set (the main job).")
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False),
+    default="out/report",
+    show_default=True,
+    help="Directory of the report (index.html and the campaigns).",
+)
+@click.option(
+    "--full",
+    is_flag=True,
+    help="Larger campaigns and finer critical pushes (minutes instead of about two).",
+)
+@click.option(
+    "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Run the campaigns on a running dask.distributed scheduler.",
+)
+@body_options
+def report(
+    out: str,
+    full: bool,
+    workers: int | None,
+    scheduler: str | None,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Write one self-contained HTML page about a parameter set.
+
+    Parameters, bounds, the strategy map, every paper figure, an analytic and a MuJoCo
+    campaign, the MuJoCo critical pushes and a filmstrip per strategy.
+    """
+    from pushrecovery.report import write_report
+
+    params = params_from(kwargs)
+    path = write_report(params, Path(out), full=full, workers=workers, scheduler=scheduler)
+    emit({"report": str(path)}, as_json)
