@@ -12,7 +12,7 @@ from pushrecovery.control import make_controller
 from pushrecovery.sim.mujoco.biped import LEG_MASS, MujocoBipedPlant, biped_model
 from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.simulate import RestCriterion, simulate
-from pushrecovery.surfaces.step import step_thresholds
+from pushrecovery.surfaces.step import step_critical_velocity, step_thresholds
 
 P = load_params()
 # Landing vs commanded step length [m]. The swing foot lands where the leg geometry puts it;
@@ -139,3 +139,20 @@ def test_bad_states():
         plant.check_state(np.zeros(4))
     with pytest.raises(InvalidParameterError, match="zdot = 0"):
         plant.check_state(np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.1]))
+
+
+@pytest.mark.parametrize("v", [1.6, 2.0, 2.4])
+def test_forward_pushes_from_ahead_of_the_ankle_recover(v):
+    # From x0 = 0.05 a 10 ms push of m v along the leaning legs lifts the feet (its component
+    # along them, m v / 10 ms · sin α, is about the weight at 2 m/s), and the landing's contact
+    # builds a step after the sole reaches the floor: these pushes used to fall (the
+    # bisection found 1.89 m/s against the single-step limit 2.60 m/s).
+    assert v < step_critical_velocity(0.05, 1.0, P)  # one step recovers it (2.60 m/s)
+    plant = MujocoBipedPlant(P)
+    plant.initial_state(0.05, 0.0)
+    state = plant.push(P.mass * v)
+    controller = recovery()
+    result = simulate(plant, controller, state, duration=3.0)
+    assert result.recovered and len(controller.steps) == 1
+    landed = result.footholds[1] - result.footholds[0]
+    assert landed == pytest.approx(controller.steps[0], abs=LANDING_TOLERANCE)

@@ -51,9 +51,20 @@ Control: commands → joint torques, every 1 ms physics step
   steps but the first from straight legs, where it is about 4 mrad later). The swing hip's
   reaction goes to the torso, which the controller brakes (it is what the flywheel is for): the
   stance pendulum feels the flywheel command only, as with the paper's massless swing leg.
-- **Landing**: the first contact of the swing sole (its lowest corner reaches the floor, where
-  MuJoCo's contact starts: margin 0) after it has lifted ``ARM_HEIGHT``. From then on the state
-  is relative to the new ankle and ``footholds`` has the new ankle's world x.
+  That brake needs a stance foot on the floor: one that is off it (no normal force in the last
+  physics step) would only swing the light leg and kick the foot back, so its hip holds the leg
+  over the stance ankle's place at the swing's start instead, where the foot lands again. The
+  foot leaves the floor after a hard push from a CoM ahead of the ankle: the 10 ms push's
+  component along the leaning legs, m v / 10 ms · sin α, lifts the body (about the weight at
+  2 m/s from x0 = 0.05 m): with the brake on the airborne leg, such pushes used to fall before
+  the step. It also leaves the floor for moments when the pendulum's load is small (fast
+  pushes).
+- **Landing**: the first contact of the swing sole that carries a normal force (its lowest
+  corner below the floor, where MuJoCo's contact starts, margin 0, and a force in the last
+  physics step) after it has lifted ``ARM_HEIGHT``. A corner that only grazes the floor, or a
+  contact whose force builds a step later, is no landing yet: the stance torques below on a
+  foot still in the air tipped it heel or toe first, bounced it off and the body fell. From
+  then on the state is relative to the new ankle and ``footholds`` has the new ankle's world x.
 - **Stance after a landing**: the paper's LIPM at the landing height (Eq. 20), held by a height
   servo on the hip, the forces mapped to joint torques with the statics of a massless leg:
   a floor force F at the CoP δ with F_z = m (g + k_p Δz − k_d ż) and F_x from the moments about
@@ -302,6 +313,7 @@ class MujocoBipedPlant(MujocoPlant):
             float(shank.mass[0]) / total,
             float(foot.mass[0]) / total,
         )
+        self._sole_ids = tuple(model.geom(f"{leg}_sole").id for leg in LEGS)
         self._reset_phase()
 
     def _reset_phase(self) -> None:
@@ -313,6 +325,7 @@ class MujocoBipedPlant(MujocoPlant):
         # Swing: leg, direction ±1, touchdown angle [rad], touchdown length [m].
         self._swing: tuple[int, float, float, float] | None = None
         self._armed = False
+        self._anchor = 0.0  # world x of the stance ankle when the swing started [m]
         self._lock = 0.0  # stance knee angle locked during the swing [rad]
         self._at_stop = False
         self._ticks = 0  # physics steps since the reset
@@ -501,6 +514,7 @@ class MujocoBipedPlant(MujocoPlant):
         self._swing = (swing, sign, target, reach)
         self._lock = kappa
         self._armed = self._sole_height(q, swing) > ARM_HEIGHT
+        self._anchor = q[_X] - length * math.sin(lean)
         # The pendulum's time to the landing lean, from its energy (trapezoid on the rate).
         x, z = length * math.sin(lean), length * math.cos(lean)
         rate = sign * (v[_X] * z - v[_Z] * x) / (length * length)
@@ -523,6 +537,10 @@ class MujocoBipedPlant(MujocoPlant):
             self._armed = height > ARM_HEIGHT
             return
         if height > 0.0:
+            return
+        if self._sole_load(leg) <= 0.0:
+            # Not yet pressed on the floor (or grazing it on the way up): the stance torques
+            # would act on a leg in the air, tip the foot heel or toe first and bounce it.
             return
         old = self._stance[0]
         rate = self._leg_rate(v, old)
@@ -603,7 +621,18 @@ class MujocoBipedPlant(MujocoPlant):
             # Passive ankle; the knee locked against the pendulum's load along the leg.
             load = p.mass * (g * cos - length * rate * rate)
             for i in stance:
-                ctrl[3 * i] = hip
+                if self._sole_load(i) > 0.0:
+                    ctrl[3 * i] = hip
+                else:
+                    # A stance foot off the floor (after a push along the leaning leg lifted
+                    # the body, or as the contact chatters) cannot hold the hip torque: it
+                    # would swing the light leg and kick the foot back. The hip holds the
+                    # leg over the foothold instead, where the foot lands again.
+                    hp, hd = HIP_GAINS
+                    over = math.asin(max(-0.99, min(0.99, (q[_X] - self._anchor) / length)))
+                    over_rate = v[_X] / (length * math.cos(over))
+                    error_rate = self._leg_rate(v, i) - over_rate
+                    ctrl[3 * i] = -hp * (alpha - over) - hd * error_rate
                 ctrl[3 * i + 1] = self._knee_lock(q, v, i, self._lock, load)
         elif not self._lipm:
             cx, cz, cvx, cvz = self._com(q, v, stance[0])
@@ -643,6 +672,16 @@ class MujocoBipedPlant(MujocoPlant):
             self.stop_impacts += 1
         self._at_stop = at_stop
         return fly
+
+    def _sole_load(self, i: int) -> float:
+        """Return the floor's normal force on leg i's sole in the last physics step [N]."""
+        d, sole = self.data, self._sole_ids[i]
+        total = 0.0
+        for k, (g1, g2) in enumerate(d.contact.geom.tolist()):
+            if sole in (g1, g2):
+                self._mj.mj_contactForce(self.model, d, k, self._force)
+                total += float(self._force[0])
+        return total
 
     def _foot(self, q: list[float], i: int) -> float:
         """Ankle torque the stance foot i itself takes off the CoP map [N m].
