@@ -15,6 +15,11 @@
    >= 150x real time (above that ceiling on this machine, docs/validation.md).
 7. Pushes per second for a batch (20 pushes, each to recovery or fall) on MuJoCo, ``foot`` +
    ankle PD and ``torso`` + MPC, against the same batch on the analytic pendulum / flywheel.
+8. Campaigns (``pushrecovery campaign``): pushes per second on the analytic and MuJoCo backends
+   with 1 and 2 local worker processes and 2 workers of a Dask ``LocalCluster``, and the
+   scheduling overhead per batch (wall time x workers minus the serial time, per batch) as a
+   ratio to the work per batch (the serial time per batch). The machine has 2 cores: 2 workers
+   can at best halve the wall time.
 """
 
 from __future__ import annotations
@@ -229,6 +234,58 @@ def batch() -> None:
         )
 
 
+def campaigns() -> None:
+    """Pushes per second of a campaign on 1 and 2 local workers and on a Dask LocalCluster."""
+    import shutil
+    import tempfile
+    import time
+
+    from distributed import LocalCluster
+
+    from pushrecovery.campaign import CampaignSpec, run_campaign
+
+    params = load_params()
+    specs = {
+        "analytic pendulum + ankle-pd": CampaignSpec(
+            "analytic", "pendulum", "ankle-pd", params,
+            x0=(-0.03, 0.12, 0.01), xdot=(-0.6, 0.9, 0.05), batch_size=50,
+        ),
+        "mujoco torso + mpc": CampaignSpec(
+            "mujoco", "torso", "mpc", params,
+            x0=(0.0, 0.1, 0.05), xdot=(-0.5, 0.9, 0.1), batch_size=5,
+        ),
+    }  # fmt: skip
+    root = Path(tempfile.mkdtemp(prefix="pushrecovery-bench-"))
+    try:
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+            for label, spec in specs.items():
+                walls = {}
+                for name, kwargs in (
+                    ("1 worker", {"workers": 1}),
+                    ("2 workers", {"workers": 2}),
+                    ("dask 2 workers", {"scheduler": cluster.scheduler_address}),
+                ):
+                    run_campaign(spec, root / "warm", workers=1, max_batches=1)  # imports, JIT
+                    shutil.rmtree(root / "warm")
+                    start = time.perf_counter()
+                    run_campaign(spec, root / name, **kwargs)
+                    walls[name] = time.perf_counter() - start
+                    shutil.rmtree(root / name)
+                work = walls["1 worker"] / spec.batches
+                rates = ", ".join(f"{n} {spec.size / w:.0f}/s" for n, w in walls.items())
+                # Time the 2 workers spend beyond half the serial work, per batch.
+                local, dask = (
+                    (2 * walls[n] - walls["1 worker"]) / spec.batches / work
+                    for n in ("2 workers", "dask 2 workers")
+                )
+                print(
+                    f"campaign {label}, {spec.size} pushes in {spec.batches} batches: {rates}; "
+                    f"overhead per batch / work per batch: processes {local:.2f}, dask {dask:.2f}"
+                )
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
 def main() -> int:
     ratio = surface()
     cli = startup()
@@ -237,6 +294,7 @@ def main() -> int:
     step_rate, step_ratio = stepping()
     physics = mujoco_realtime()
     batch()
+    campaigns()
     failed = ratio > 2.0 or cli > 0.3 or step_rate < 2e6 or step_ratio < 1000 or physics < 150
     print("targets met" if not failed else "TARGET MISSED")
     return int(failed)
