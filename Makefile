@@ -19,15 +19,9 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	@mkdir -p $(OUT)
 	$(BIN)/pushrecovery bounds
-	$(BIN)/pushrecovery classify --x 0.0 --xdot 0.3
-	$(BIN)/pushrecovery classify --x 0.0 --xdot 0.6
 	$(BIN)/pushrecovery classify --x 0.0 --xdot 0.7
-	$(BIN)/pushrecovery classify --x 0.0 --xdot 2.7
-	$(BIN)/pushrecovery step --v0 1.2
-	$(BIN)/pushrecovery simulate --model stepping --controller recovery --xdot 1.2 --plot $(OUT)/recovery.png
-	$(BIN)/pushrecovery critical-push --model pendulum --controller ankle-pd --x 0.0 --direction forward
-	$(BIN)/pushrecovery critical-push --model flywheel --controller mpc --x 0.0 --direction forward
-	$(BIN)/pushrecovery figures --out $(OUT)/figures
+	$(BIN)/pushrecovery report --out $(OUT)/report
+	@echo "open $(OUT)/report/index.html"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2

@@ -41,36 +41,9 @@ def cli() -> None:
 @body_options
 def bounds(as_json: bool, **kwargs: Any) -> None:
     """Capture-point bounds of each balance strategy (Eq. 4, corrected Eq. 15)."""
-    from pushrecovery.models.flywheel import max_spin_up_time
-    from pushrecovery.surfaces.cmp import cmp_offset, cmp_region
-    from pushrecovery.surfaces.cop import cop_region
-    from pushrecovery.surfaces.step import step_thresholds
+    from pushrecovery.surfaces.bounds import bounds_data
 
-    params = params_from(kwargs)
-    cop, cmp = cop_region(params), cmp_region(params)
-    spin_up = max_spin_up_time(params)
-    omega = params.omega
-    emit(
-        {
-            "params": params.to_dict(),
-            "omega": params.omega,
-            "cop": {"lower": cop.lower, "upper": cop.upper},
-            "cmp": {
-                "lower": cmp.lower,
-                "upper": cmp.upper,
-                "margin": cmp_offset(params),
-                # JSON has no infinity: without hip torque there is no spin-up at all.
-                "t_max": spin_up if spin_up != float("inf") else None,
-            },
-            # Largest recoverable CoM velocity from x = 0, [backward, forward], per strategy.
-            "thresholds": {
-                "ankle": [omega * cop.lower, omega * cop.upper],
-                "hip": [omega * cmp.lower, omega * cmp.upper],
-                "step": list(step_thresholds(params)),
-            },
-        },
-        as_json,
-    )
+    emit(bounds_data(params_from(kwargs)), as_json)
 
 
 @cli.command(short_help="Strategy a CoM state needs: ankle, hip, step or fall.")

@@ -253,5 +253,9 @@ def report(
     from pushrecovery.report import write_report
 
     params = params_from(kwargs)
-    path = write_report(params, Path(out), full=full, workers=workers, scheduler=scheduler)
+    # Each section's start and end on a terminal only: a piped stderr keeps its one-line errors.
+    progress = (lambda line: click.echo(line, err=True)) if sys.stderr.isatty() else None
+    path = write_report(
+        params, Path(out), full=full, workers=workers, scheduler=scheduler, progress=progress
+    )
     emit({"report": str(path)}, as_json)
