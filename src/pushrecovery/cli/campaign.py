@@ -37,6 +37,17 @@ def _sweeps(pairs: tuple[str, ...]) -> dict[str, tuple[float, float, float]]:
     return sweeps  # type: ignore[return-value]
 
 
+_workers = click.option(
+    "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
+)
+_scheduler = click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Run the batches on a running dask.distributed scheduler (tcp://host:port).",
+)
+
+
 class _Progress:
     """A tqdm bar over the pushes (rate and ETA), drawn on a terminal only."""
 
@@ -95,15 +106,8 @@ class _Progress:
 @click.option(
     "--out", type=click.Path(file_okay=False), required=True, help="Directory of the campaign."
 )
-@click.option(
-    "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
-)
-@click.option(
-    "--scheduler",
-    default=None,
-    metavar="ADDRESS",
-    help="Send the batches to a running dask.distributed scheduler (tcp://host:port).",
-)
+@_workers
+@_scheduler
 @click.option(
     "--resume",
     is_flag=True,
@@ -227,15 +231,8 @@ def campaign(
     is_flag=True,
     help="Larger campaigns and finer critical pushes (minutes instead of about two).",
 )
-@click.option(
-    "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
-)
-@click.option(
-    "--scheduler",
-    default=None,
-    metavar="ADDRESS",
-    help="Run the campaigns on a running dask.distributed scheduler.",
-)
+@_workers
+@_scheduler
 @body_options
 def report(
     out: str,
