@@ -24,6 +24,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import subprocess
 import sys
@@ -252,35 +253,43 @@ def campaigns() -> None:
         ),
         "mujoco torso + mpc": CampaignSpec(
             "mujoco", "torso", "mpc", params,
-            x0=(0.0, 0.1, 0.05), xdot=(-0.5, 0.9, 0.1), batch_size=5,
+            x0=(-0.03, 0.12, 0.03), xdot=(-0.6, 0.9, 0.1), batch_size=10,
         ),
     }  # fmt: skip
     root = Path(tempfile.mkdtemp(prefix="pushrecovery-bench-"))
+
+    def wall(spec, name, **kwargs):
+        start = time.perf_counter()
+        run_campaign(spec, root / name, **kwargs)
+        elapsed = time.perf_counter() - start
+        shutil.rmtree(root / name)
+        return elapsed
+
     try:
         with LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
             for label, spec in specs.items():
-                walls = {}
-                for name, kwargs in (
-                    ("1 worker", {"workers": 1}),
-                    ("2 workers", {"workers": 2}),
-                    ("dask 2 workers", {"scheduler": cluster.scheduler_address}),
-                ):
-                    run_campaign(spec, root / "warm", workers=1, max_batches=1)  # imports, JIT
-                    shutil.rmtree(root / "warm")
-                    start = time.perf_counter()
-                    run_campaign(spec, root / name, **kwargs)
-                    walls[name] = time.perf_counter() - start
-                    shutil.rmtree(root / name)
+                # Imports, compiled kernels and the Dask workers warm; then the start-up of a
+                # local process pool on its own: a campaign of 2 one-push batches.
+                wall(spec, "warm", workers=1, max_batches=1)
+                wall(spec, "warm", scheduler=cluster.scheduler_address, max_batches=2)
+                tiny = dataclasses.replace(spec, samples=2, batch_size=1)
+                pool = wall(tiny, "pool", workers=2) - wall(tiny, "one", workers=1) / 2
+                walls = {
+                    "1 worker": wall(spec, "one", workers=1),
+                    "2 workers": wall(spec, "two", workers=2),
+                    "dask 2 workers": wall(spec, "dask", scheduler=cluster.scheduler_address),
+                }
                 work = walls["1 worker"] / spec.batches
                 rates = ", ".join(f"{n} {spec.size / w:.0f}/s" for n, w in walls.items())
-                # Time the 2 workers spend beyond half the serial work, per batch.
-                local, dask = (
-                    (2 * walls[n] - walls["1 worker"]) / spec.batches / work
-                    for n in ("2 workers", "dask 2 workers")
-                )
+                # Time the 2 workers spend beyond half the serial work, per batch (the local
+                # pool's start-up apart).
+                local = (2 * (walls["2 workers"] - pool) - walls["1 worker"]) / spec.batches
+                dask = (2 * walls["dask 2 workers"] - walls["1 worker"]) / spec.batches
                 print(
-                    f"campaign {label}, {spec.size} pushes in {spec.batches} batches: {rates}; "
-                    f"overhead per batch / work per batch: processes {local:.2f}, dask {dask:.2f}"
+                    f"campaign {label}, {spec.size} pushes in {spec.batches} batches "
+                    f"({work:.2f} s of work each): {rates}; local pool start-up {pool:.2f} s; "
+                    f"overhead per batch / work per batch: processes {local / work:.2f}, "
+                    f"dask {dask / work:.2f}"
                 )
     finally:
         shutil.rmtree(root, ignore_errors=True)
