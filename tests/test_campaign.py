@@ -197,6 +197,7 @@ def test_unreachable_scheduler(tmp_path, monkeypatch):
         CampaignError, match=r"cannot reach the Dask scheduler at tcp://127\.0\.0\.1:9"
     ):
         run_campaign(tiny(), tmp_path / "c", scheduler="tcp://127.0.0.1:9")
+    assert not (tmp_path / "c").exists()  # nothing written: the same command can run again
 
 
 def test_bad_library_arguments(tmp_path):

@@ -173,25 +173,26 @@ def _processes(
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _dask(
-    spec: CampaignSpec, batches: list[int], scheduler: str
-) -> Iterator[tuple[int, list[dict]]]:
-    from distributed import Client, as_completed
+def _connect(scheduler: str) -> Any:
+    """Connect to the scheduler at ``scheduler`` (a client that is not made the default)."""
+    from distributed import Client
 
     try:
-        client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
+        return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         raise CampaignError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+
+
+def _dask(spec: CampaignSpec, batches: list[int], client: Any) -> Iterator[tuple[int, list[dict]]]:
+    from distributed import as_completed
+
+    # pure=False: every batch runs, even if an identical task ran before on the cluster.
+    futures = [client.submit(run_batch, spec, batch, pure=False) for batch in batches]
     try:
-        # pure=False: every batch runs, even if an identical task ran before on the cluster.
-        futures = [client.submit(run_batch, spec, batch, pure=False) for batch in batches]
-        try:
-            for future in as_completed(futures, loop=client.loop):
-                yield future.result()
-        finally:
-            client.cancel(futures)
+        for future in as_completed(futures, loop=client.loop):
+            yield future.result()
     finally:
-        client.close()
+        client.cancel(futures)
 
 
 def run_campaign(
@@ -236,6 +237,24 @@ def run_campaign(
         raise InvalidParameterError(f"workers must be >= 1, got {workers}")
     if max_batches is not None and max_batches < 0:
         raise InvalidParameterError(f"max_batches must be >= 0, got {max_batches}")
+    # Connect first: an unreachable scheduler leaves no directory behind.
+    client = _connect(scheduler) if scheduler is not None else None
+    try:
+        return _run(spec, directory, workers, client, resume, max_batches, progress)
+    finally:
+        if client is not None:
+            client.close()
+
+
+def _run(
+    spec: CampaignSpec,
+    directory: Path,
+    workers: int | None,
+    client: Any,
+    resume: bool,
+    max_batches: int | None,
+    progress: Callable[[int], None] | None,
+) -> CampaignResult | None:
     _prepare(spec, directory, resume)
     todo = missing_batches(spec, directory)
     if progress is not None:
@@ -245,8 +264,8 @@ def run_campaign(
     stopped = max_batches is not None and max_batches < len(todo)
     if stopped:
         todo = todo[:max_batches]
-    if scheduler is not None:
-        results = _dask(spec, todo, scheduler)
+    if client is not None:
+        results = _dask(spec, todo, client)
     elif (workers or os.cpu_count() or 1) == 1 or len(todo) <= 1:
         results = _serial(spec, todo)
     else:

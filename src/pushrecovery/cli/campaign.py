@@ -205,7 +205,7 @@ def campaign(
         return
     outcomes = summary["outcomes"]
     click.echo(
-        f"{summary['pushes']} pushes ({result.ran} batches run now): "
+        f"{summary['pushes']} pushes ({result.ran} of {spec.batches} batches run now): "
         f"{outcomes['recovered']} recovered, {outcomes['fell']} fell, "
         f"{outcomes['undecided']} undecided; prediction accuracy {summary['accuracy']:.3f}"
     )
