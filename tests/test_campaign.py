@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
@@ -212,3 +213,38 @@ def test_bad_library_arguments(tmp_path):
 
         read_spec(tmp_path / "nothing")
     assert os.listdir(tmp_path) == []  # nothing written for a bad request
+
+
+def test_sweep_order_is_part_of_the_campaign(tmp_path):
+    first = {"torque_max": (50.0, 100.0, 50.0), "flywheel_inertia": (8.0, 10.0, 2.0)}
+    spec = CampaignSpec(
+        "analytic", "flywheel", "mpc", P, x0=(0.0, 0.0, 1.0), xdot=(0.5, 0.5, 1.0), sweeps=first
+    )
+    run_campaign(spec, tmp_path / "c", workers=1, max_batches=0)
+    swapped = dataclasses.replace(spec, sweeps=dict(reversed(list(first.items()))))
+    with pytest.raises(CampaignError, match="differs in sweeps"):
+        run_campaign(swapped, tmp_path / "c", workers=1, resume=True)
+
+
+def test_spec_checks_are_fast_and_complete(tmp_path):
+    start = time.monotonic()
+    with pytest.raises(InvalidParameterError, match="at most 1000000"):
+        tiny(sweeps={"torque_max": (50.0, 150.0, 1e-3), "mass": (60.0, 70.0, 1e-3)})
+    assert time.monotonic() - start < 5.0
+    # Random draws cover the whole interval: a heel swept past x0 is caught at its corner.
+    with pytest.raises(InvalidParameterError, match="x0 must lie on the foot"):
+        tiny(x0=(-0.04, -0.04, 1.0), sweeps={"heel": (-0.1, -0.001, 0.5)}, samples=20)
+    # Grid values are the decimal ones, never beyond STOP.
+    spec = tiny(x0=(0.0, 0.149999999999, 0.05))
+    assert [spec.push(i * 13).x0 for i in range(3)] == [0.0, 0.05, 0.1]
+    assert spec.push(4).xdot == 0.0 and spec.push(7).xdot == 0.3
+    with pytest.raises(InvalidParameterError, match="moves the upper body: use the flywheel"):
+        CampaignSpec("analytic", "lipm", "mpc", P, x0=(0.0, 0.0, 1.0), xdot=(0.0, 1.0, 1.0))
+    with pytest.raises(InvalidParameterError, match="seed must be an integer"):
+        tiny(seed=1.5)
+
+
+def test_malformed_scheduler_address(tmp_path):
+    with pytest.raises(CampaignError, match="--scheduler must be an address"):
+        run_campaign(tiny(), tmp_path / "c", scheduler="foo bar")
+    assert not (tmp_path / "c").exists()

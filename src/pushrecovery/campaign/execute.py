@@ -141,6 +141,13 @@ def _prepare(spec: CampaignSpec, directory: Path, resume: bool) -> None:
     os.replace(partial, stored)
 
 
+def _cores() -> int:
+    """Cores this process may run on (its CPU affinity where the OS has one)."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
+
+
 def _serial(spec: CampaignSpec, batches: list[int]) -> Iterator[tuple[int, list[dict]]]:
     for batch in batches:
         yield run_batch(spec, batch)
@@ -176,7 +183,14 @@ def _processes(
 def _connect(scheduler: str) -> Any:
     """Connect to the scheduler at ``scheduler`` (a client that is not made the default)."""
     from distributed import Client
+    from distributed.comm import parse_address
 
+    try:
+        parse_address(scheduler, strict=True)
+    except ValueError:
+        raise CampaignError(
+            f"--scheduler must be an address such as tcp://HOST:PORT, got {scheduler!r}"
+        ) from None
     try:
         return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
@@ -190,7 +204,16 @@ def _dask(spec: CampaignSpec, batches: list[int], client: Any) -> Iterator[tuple
     futures = [client.submit(run_batch, spec, batch, pure=False) for batch in batches]
     try:
         for future in as_completed(futures, loop=client.loop):
-            yield future.result()
+            try:
+                result = future.result()
+            except Exception as exc:  # a lost worker's KilledWorker, a failed task
+                if isinstance(exc, PushRecoveryError):
+                    raise
+                raise CampaignError(
+                    f"a batch failed on the Dask cluster ({type(exc).__name__}: {exc}); the "
+                    "finished batches are saved, rerun with --resume"
+                ) from None
+            yield result
     finally:
         client.cancel(futures)
 
@@ -258,7 +281,7 @@ def _run(
     _prepare(spec, directory, resume)
     todo = missing_batches(spec, directory)
     if progress is not None:
-        done_pushes = spec.size - sum(len(spec.pushes(b)) for b in todo)
+        done_pushes = spec.size - sum(min(spec.batch, spec.size - b * spec.batch) for b in todo)
         if done_pushes:
             progress(done_pushes)
     stopped = max_batches is not None and max_batches < len(todo)
@@ -266,10 +289,10 @@ def _run(
         todo = todo[:max_batches]
     if client is not None:
         results = _dask(spec, todo, client)
-    elif (workers or os.cpu_count() or 1) == 1 or len(todo) <= 1:
+    elif (workers or _cores()) == 1 or len(todo) <= 1:
         results = _serial(spec, todo)
     else:
-        results = _processes(spec, todo, min(workers or os.cpu_count() or 1, len(todo)))
+        results = _processes(spec, todo, min(workers or _cores(), len(todo)))
     for batch, rows in results:
         _write_batch(spec, directory, batch, rows)
         if progress is not None:
@@ -295,5 +318,7 @@ def finish(spec: CampaignSpec, directory: Path, ran: int = 0) -> CampaignResult:
     pq.write_table(table, partial)
     os.replace(partial, directory / PUSHES_FILE)
     summary = summarize(spec, table)
-    (directory / SUMMARY_FILE).write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    partial = directory / (SUMMARY_FILE + ".partial")
+    partial.write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    os.replace(partial, directory / SUMMARY_FILE)
     return CampaignResult(spec, table, summary, directory, ran)

@@ -67,7 +67,9 @@ COLUMNS: tuple[tuple[str, str], ...] = (
 )
 
 
-def run_push(spec: CampaignSpec, push: Push, cache: dict[BodyParams, Any] | None = None) -> dict:
+def run_push(
+    spec: CampaignSpec, push: Push, cache: dict[BodyParams, Any] | None = None
+) -> dict[str, Any]:
     """Simulate one push; return its row (module docstring).
 
     ``cache`` keeps one plant and controller per body across the pushes of a batch (MuJoCo
@@ -123,7 +125,7 @@ def run_push(spec: CampaignSpec, push: Push, cache: dict[BodyParams, Any] | None
     return row
 
 
-def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict]]:
+def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]]:
     """Simulate batch number ``batch`` of ``spec``; return it with its rows, in push order.
 
     numba's parallel kernels run on one thread meanwhile: a push queries one state at a time,

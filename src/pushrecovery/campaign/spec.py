@@ -11,6 +11,7 @@ depends on how the pushes are split into batches or spread over workers.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import math
 from collections.abc import Iterator, Mapping
@@ -64,7 +65,19 @@ def value_range(name: str, triple: Range, limit: int = MAX_PUSHES) -> np.ndarray
     count = int(np.floor((stop - start) / increment + 1e-9)) + 1
     if count > limit:
         raise InvalidParameterError(f"{name} gives {count} values; at most {limit}")
-    return start + increment * np.arange(count)
+    # Rounded to 12 digits: 0.1 * 3 is 0.3 in the results, not 0.30000000000000004; never
+    # beyond STOP.
+    return np.minimum(np.round(start + increment * np.arange(count), 12), stop)
+
+
+def _interval(name: str, triple: Range) -> tuple[float, float]:
+    """START and STOP of a range whose STEP is not used (random samples): finite, ordered."""
+    if len(triple) != 3:
+        raise InvalidParameterError(f"{name} needs START STOP STEP, got {triple!r}")
+    start, stop = float(triple[0]), float(triple[1])
+    if not (math.isfinite(start) and math.isfinite(stop)) or stop < start:
+        raise InvalidParameterError(f"{name} needs finite START <= STOP, got {start:g} {stop:g}")
+    return start, stop
 
 
 @dataclass(frozen=True, slots=True)
@@ -147,6 +160,13 @@ class CampaignSpec:
                 raise InvalidParameterError(
                     f"unknown parameter {name!r}; sweepable: {sorted(fields)}"
                 )
+        for label, value in (
+            ("samples", self.samples),
+            ("seed", self.seed),
+            ("batch_size", self.batch_size),
+        ):
+            if value is not None and (isinstance(value, bool) or not isinstance(value, int)):
+                raise InvalidParameterError(f"{label} must be an integer, got {value!r}")
         if self.samples is not None and not 1 <= self.samples <= MAX_PUSHES:
             raise InvalidParameterError(f"samples must be in [1, {MAX_PUSHES}], got {self.samples}")
         if self.seed < 0:
@@ -155,19 +175,42 @@ class CampaignSpec:
             raise InvalidParameterError(f"duration must be > 0 s, got {self.duration:g}")
         if self.batch_size is not None and self.batch_size < 1:
             raise InvalidParameterError(f"batch_size must be >= 1, got {self.batch_size}")
-        # Every range and every body it sweeps is checked now, before any simulation.
-        self._axes()
-        for values in itertools.product(*self._sweep_values()):
+        # Every range, every body it sweeps and the setup are checked now, before any
+        # simulation and before anything is written.
+        if self.samples is None:
+            sweeps, x0s, _ = self._axes
+            if self.size > MAX_PUSHES:
+                raise InvalidParameterError(
+                    f"the campaign has {self.size} pushes; at most {MAX_PUSHES}"
+                )
+            x0_ends = (float(x0s[0]), float(x0s[-1]))
+            bodies = list(itertools.product(*sweeps))
+        else:
+            # The draws cover each whole interval; the constraints of a body are intervals or
+            # linear (max_step_length < 2 leg_length): its corners stand for the whole box.
+            corners = [_interval(f"--param {n}", r) for n, r in self.sweeps.items()]
+            _interval(f"--{self.push_name}", self.push_range)
+            x0_ends = _interval("--x0", self.x0)
+            bodies = list(itertools.product(*corners))
+        for values in bodies:
             body = self.body(values)
-            for x0 in (min(self.x0[:2]), max(self.x0[:2])):
+            for x0 in x0_ends:
                 if not body.heel < x0 < body.toe:
                     raise InvalidParameterError(
                         f"x0 must lie on the foot, {body.heel:g} < x0 < {body.toe:g} m, got {x0:g}"
                     )
-        if self.size > MAX_PUSHES:
-            raise InvalidParameterError(
-                f"the campaign has {self.size} pushes; at most {MAX_PUSHES}"
-            )
+        self._check_setup()
+
+    def _check_setup(self) -> None:
+        """Check that the model, controller and duration work together (:func:`check_run`)."""
+        from pushrecovery.control.base import make_controller
+        from pushrecovery.sim.plants import make_plant
+        from pushrecovery.sim.simulate import check_run
+
+        first = self.push(0)
+        plant = make_plant(self.model, first.params, self.backend)
+        controller = make_controller(self.controller, first.params)
+        check_run(plant, controller, plant.initial_state(first.x0, 0.0), self.duration)
 
     # --- the pushes -----------------------------------------------------------------------
     @property
@@ -182,22 +225,22 @@ class CampaignSpec:
         assert push is not None  # checked in __post_init__
         return push
 
-    def _sweep_values(self) -> list[np.ndarray]:
-        return [value_range(f"--param {name}", r) for name, r in self.sweeps.items()]
-
+    @functools.cached_property
     def _axes(self) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+        """The grid's values: each swept parameter's, the starts' and the pushes'."""
         return (
-            self._sweep_values(),
+            [value_range(f"--param {name}", r) for name, r in self.sweeps.items()],
             value_range("--x0", self.x0),
             value_range(f"--{self.push_name}", self.push_range),
         )
 
-    @property
+    @functools.cached_property
     def size(self) -> int:
         """Number of pushes."""
         if self.samples is not None:
             return self.samples
-        sweeps, x0s, pushes = self._axes()
+        sweeps, x0s, pushes = self._axes
+        # Python ints: no overflow however large the grid.
         return math.prod(len(v) for v in sweeps) * len(x0s) * len(pushes)
 
     @property
@@ -220,6 +263,8 @@ class CampaignSpec:
 
     def _push(self, index: int, swept: tuple[float, ...], x0: float, push: float) -> Push:
         body = self.body(swept)
+        if not body.heel < x0 < body.toe:  # a bug, not input: the spec checked the box
+            raise InvalidParameterError(f"x0 = {x0:g} m is off the foot of push {index}")
         xdot = push if self.xdot is not None else push / body.mass
         return Push(index, body, tuple(float(v) for v in swept), float(x0), float(xdot))
 
@@ -232,7 +277,7 @@ class CampaignSpec:
             ranges = [*self.sweeps.values(), self.x0, self.push_range]
             draws = [rng.uniform(r[0], r[1]) if r[1] > r[0] else r[0] for r in ranges]
             return self._push(index, tuple(draws[:-2]), draws[-2], draws[-1])
-        sweeps, x0s, pushes = self._axes()
+        sweeps, x0s, pushes = self._axes
         shape = [len(v) for v in sweeps] + [len(x0s), len(pushes)]
         position = np.unravel_index(index, shape)
         swept = tuple(v[k] for v, k in zip(sweeps, position[:-2], strict=True))
@@ -258,7 +303,8 @@ class CampaignSpec:
             "x0": list(self.x0),
             "xdot": None if self.xdot is None else list(self.xdot),
             "impulse": None if self.impulse is None else list(self.impulse),
-            "sweeps": {name: list(r) for name, r in self.sweeps.items()},
+            # Pairs, in order: the order of the sweeps is the order of the grid and the columns.
+            "sweeps": [[name, list(r)] for name, r in self.sweeps.items()],
             "samples": self.samples,
             "seed": self.seed,
             "duration": self.duration,
@@ -278,11 +324,11 @@ class CampaignSpec:
                 x0=tuple(data["x0"]),
                 xdot=None if data["xdot"] is None else tuple(data["xdot"]),
                 impulse=None if data["impulse"] is None else tuple(data["impulse"]),
-                sweeps={k: tuple(v) for k, v in data["sweeps"].items()},
+                sweeps={str(k): tuple(v) for k, v in data["sweeps"]},
                 samples=data["samples"],
                 seed=data["seed"],
                 duration=data["duration"],
                 batch_size=data["batch_size"],
             )
-        except (KeyError, TypeError) as exc:
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InvalidParameterError(f"malformed campaign spec: {exc}") from None

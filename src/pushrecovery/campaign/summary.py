@@ -53,9 +53,10 @@ def boundary(spec: CampaignSpec, columns: dict[str, np.ndarray]) -> list[dict[st
             recovered = [columns["outcome"][i] == "recovered" for i in picked]
             speeds = [float(columns["xdot"][i]) for i in picked]
             first_fail = recovered.index(False) if False in recovered else len(picked)
-            low = speeds[first_fail - 1] if first_fail > 0 else 0.0
+            # None when even the smallest push of the grid fell: no push is known to recover.
+            low = speeds[first_fail - 1] if first_fail > 0 else math.nan
             high = speeds[first_fail] if first_fail < len(picked) else math.nan
-            empirical = 0.5 * (low + high) if first_fail < len(picked) else math.nan
+            empirical = 0.5 * (low + high) if 0 < first_fail < len(picked) else math.nan
             analytic = predicted_critical_velocity(params, strategy, x0, direction)
             error = (abs(empirical) - abs(analytic)) / abs(analytic) if analytic else math.nan
             rows.append(

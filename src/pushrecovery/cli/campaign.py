@@ -150,6 +150,10 @@ def campaign(
     params = params_from(kwargs)
     directory = Path(out)
     if resume and x0 is None and xdot is None and impulse is None:
+        if sweep_pairs or samples is not None or model or controller:
+            raise InvalidParameterError(
+                "--resume without --x0 runs the stored campaign: give its whole spec or none"
+            )
         spec = read_spec(directory)  # the stored campaign, as it was asked for
     else:
         if x0 is None or (xdot is None and impulse is None):

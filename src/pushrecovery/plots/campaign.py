@@ -381,7 +381,7 @@ def plot_critical_vs_parameter(summary: Mapping[str, Any], path: Path) -> Path:
     import matplotlib.pyplot as plt
 
     path = _check_path(path)
-    sweeps = list(summary["spec"]["sweeps"])
+    sweeps = [name for name, _ in summary["spec"]["sweeps"]]
     if len(sweeps) != 1:
         raise InvalidParameterError(
             f"the critical push vs a parameter needs a campaign sweeping one parameter, "

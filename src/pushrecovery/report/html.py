@@ -245,7 +245,7 @@ def _confusion_table(summary: Mapping[str, Any], ident: str) -> str:
 
 
 def _boundary_table(summary: Mapping[str, Any]) -> str:
-    sweeps = list(summary["spec"]["sweeps"])
+    sweeps = [name for name, _ in summary["spec"]["sweeps"]]
     rows = []
     for r in summary["boundary"]:
         low, high = r["bracket"]

@@ -13,7 +13,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.result import Outcome, SimulationResult
 
-__all__ = ["DEFAULT_CONTROL_PERIOD", "RestCriterion", "simulate"]
+__all__ = ["DEFAULT_CONTROL_PERIOD", "RestCriterion", "check_run", "simulate"]
 
 #: Control period when neither the caller nor the controller sets one [s].
 DEFAULT_CONTROL_PERIOD = 1e-3
@@ -80,49 +80,10 @@ def simulate(
     -------
     SimulationResult
     """
-    duration = positive_float("duration", duration, "s")
-    if control_period is None:
-        control_period = controller.control_period or DEFAULT_CONTROL_PERIOD
-    elif controller.fixed_period and control_period != controller.control_period:
-        raise InvalidParameterError(
-            f"controller {controller.name!r} predicts with its own period "
-            f"{controller.control_period:g} s; control_period must match it, got {control_period:g}"
-        )
-    dt = positive_float("control_period", control_period, "s")
-    if dt > duration:
-        raise InvalidParameterError(
-            f"control_period must be <= duration = {duration:g} s, got {dt:g}"
-        )
-    state = np.array(initial_state, dtype=np.float64)
-    for i, value in enumerate(state):
-        finite_float(f"initial_state[{i}]", value)
-    plant.check_state(state)
-    if controller.strategy == "hip" and len(state) != 4:
-        raise InvalidParameterError(
-            f"controller {controller.name!r} moves the upper body: use the flywheel model "
-            "(or torso on mujoco), "
-            f"not {plant.name!r}"
-        )
-    if controller.strategy == "step" and len(state) != 6:
-        raise InvalidParameterError(
-            f"controller {controller.name!r} takes steps: use the stepping model "
-            "(or biped on mujoco), "
-            f"not {plant.name!r}"
-        )
+    state, dt, steps = check_run(plant, controller, initial_state, duration, control_period)
     rest = rest or RestCriterion()
     heel, toe = plant.params.heel, plant.params.toe
     plant.stop_impacts = 0
-    steps = math.ceil(duration / dt - 1e-9)
-    if steps > MAX_STEPS:
-        raise InvalidParameterError(
-            f"duration / control_period must be <= {MAX_STEPS:g} steps, got {steps:g}"
-        )
-    if plant.params.omega * dt > MAX_OMEGA_DT:
-        raise InvalidParameterError(
-            f"control_period must be <= {MAX_OMEGA_DT:g} / omega = "
-            f"{MAX_OMEGA_DT / plant.params.omega:g} s for a faithful sampled-data loop, "
-            f"got {dt:g}"
-        )
     rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))
     vel = len(state) // 2
 
@@ -155,3 +116,60 @@ def simulate(
         stop_impacts=plant.stop_impacts,
         footholds=tuple(getattr(plant, "footholds", (0.0,))),
     )
+
+
+def check_run(
+    plant: Plant,
+    controller: Controller,
+    initial_state: np.ndarray,
+    duration: float,
+    control_period: float | None = None,
+) -> tuple[np.ndarray, float, int]:
+    """Check a run of :func:`simulate` without running it.
+
+    Returns the start state as a float array, the control period [s] and the number of control
+    ticks. Raises :class:`InvalidParameterError` naming what is wrong: a non-finite state, a
+    controller that needs another model, a period that does not fit the controller, the
+    duration or the dynamics.
+    """
+    duration = positive_float("duration", duration, "s")
+    if control_period is None:
+        control_period = controller.control_period or DEFAULT_CONTROL_PERIOD
+    elif controller.fixed_period and control_period != controller.control_period:
+        raise InvalidParameterError(
+            f"controller {controller.name!r} predicts with its own period "
+            f"{controller.control_period:g} s; control_period must match it, got {control_period:g}"
+        )
+    dt = positive_float("control_period", control_period, "s")
+    if dt > duration:
+        raise InvalidParameterError(
+            f"control_period must be <= duration = {duration:g} s, got {dt:g}"
+        )
+    state = np.array(initial_state, dtype=np.float64)
+    for i, value in enumerate(state):
+        finite_float(f"initial_state[{i}]", value)
+    plant.check_state(state)
+    if controller.strategy == "hip" and len(state) != 4:
+        raise InvalidParameterError(
+            f"controller {controller.name!r} moves the upper body: use the flywheel model "
+            "(or torso on mujoco), "
+            f"not {plant.name!r}"
+        )
+    if controller.strategy == "step" and len(state) != 6:
+        raise InvalidParameterError(
+            f"controller {controller.name!r} takes steps: use the stepping model "
+            "(or biped on mujoco), "
+            f"not {plant.name!r}"
+        )
+    steps = math.ceil(duration / dt - 1e-9)
+    if steps > MAX_STEPS:
+        raise InvalidParameterError(
+            f"duration / control_period must be <= {MAX_STEPS:g} steps, got {steps:g}"
+        )
+    if plant.params.omega * dt > MAX_OMEGA_DT:
+        raise InvalidParameterError(
+            f"control_period must be <= {MAX_OMEGA_DT:g} / omega = "
+            f"{MAX_OMEGA_DT / plant.params.omega:g} s for a faithful sampled-data loop, "
+            f"got {dt:g}"
+        )
+    return state, dt, steps
