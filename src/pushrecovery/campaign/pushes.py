@@ -37,12 +37,10 @@ from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import pushed_state
 from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.simulate import simulate
-from pushrecovery.surfaces.classify import Strategy, classify
+from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify
 
 __all__ = ["COLUMNS", "run_batch", "run_push"]
 
-#: Strategies in escalating order (a controller of one recovers the pushes of the lesser).
-ORDER = (Strategy.ANKLE, Strategy.HIP, Strategy.STEP, Strategy.FALL)
 
 #: Fixed columns after the ``param_<name>`` ones, with their Arrow type names.
 COLUMNS: tuple[tuple[str, str], ...] = (
@@ -86,7 +84,8 @@ def run_push(
     state = pushed_state(plant, push.x0, push.xdot, force=spec.backend == "mujoco")
     run = simulate(plant, controller, state, duration=spec.duration)
     found = classify(push.x0, push.xdot, params)
-    reach = ORDER.index(Strategy(controller.strategy))
+    # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
+    reach = STRATEGY_CODES.index(Strategy(controller.strategy))
     steps = len(run.footholds) - 1
     hip = float(abs(run.torques).max()) if run.torques.size else 0.0
     cops = run.cops
@@ -111,7 +110,7 @@ def run_push(
         cop_margin=found.margins["cop"],
         cmp_margin=found.margins["cmp"],
         step_margin=found.margins["step"],
-        predicted_recovers=ORDER.index(found.strategy) <= reach,
+        predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
         outcome=run.outcome.value,
         used=used.value,
         steps=steps,

@@ -23,10 +23,12 @@ import numpy as np
 from pushrecovery.campaign.spec import CampaignSpec
 from pushrecovery.control.base import CONTROLLERS
 from pushrecovery.sim.critical import predicted_critical_velocity
+from pushrecovery.sim.validation import LABELS as VALIDATION_LABELS
 
 __all__ = ["LABELS", "boundary", "summarize"]
 
-LABELS = ("ankle", "hip", "step", "fall")
+#: Rows and columns of the confusion matrix: the strategies, escalating (as ``validate``'s).
+LABELS = VALIDATION_LABELS
 
 
 def _clean(value: float) -> float | None:

@@ -8,7 +8,7 @@ from typing import Any
 import click
 
 from pushrecovery import __version__
-from pushrecovery.cli.options import body_options, emit, params_from
+from pushrecovery.cli.options import body_options, echo_confusion, emit, params_from
 
 # Kept literal so that --help does not import the models; a test checks them against the
 # registries.
@@ -530,10 +530,11 @@ def validate(
     if matrix is not None:
         from pushrecovery.sim.validation import LABELS
 
-        click.echo(f"\nconfusion (rows predicted, columns needed), accuracy {matrix.accuracy:.3f}")
-        click.echo(" " * 10 + "".join(f"{label:>7}" for label in LABELS))
-        for label, counts in zip(LABELS, matrix.counts, strict=True):
-            click.echo(f"{label:<10}" + "".join(f"{count:>7}" for count in counts))
+        echo_confusion(
+            f"\nconfusion (rows predicted, columns needed), accuracy {matrix.accuracy:.3f}",
+            LABELS,
+            matrix.counts.tolist(),
+        )
 
 
 @cli.command(short_help="Reproduce the paper's figures.")

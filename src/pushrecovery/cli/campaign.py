@@ -8,7 +8,7 @@ from typing import Any
 
 import click
 
-from pushrecovery.cli.options import body_options, emit, params_from
+from pushrecovery.cli.options import body_options, echo_confusion, emit, params_from
 
 __all__ = ["campaign", "report"]
 
@@ -213,11 +213,10 @@ def campaign(
         f"{outcomes['recovered']} recovered, {outcomes['fell']} fell, "
         f"{outcomes['undecided']} undecided; prediction accuracy {summary['accuracy']:.3f}"
     )
-    labels = summary["confusion"]["labels"]
-    click.echo("confusion (rows predicted, columns used):")
-    click.echo(" " * 10 + "".join(f"{label:>7}" for label in labels))
-    for label, counts in zip(labels, summary["confusion"]["counts"], strict=True):
-        click.echo(f"{label:<10}" + "".join(f"{count:>7}" for count in counts))
+    confusion = summary["confusion"]
+    echo_confusion(
+        "confusion (rows predicted, columns used):", confusion["labels"], confusion["counts"]
+    )
     for name, path in files.items():
         click.echo(f"{name:<22}{path}")
 
@@ -233,7 +232,7 @@ def campaign(
 @click.option(
     "--full",
     is_flag=True,
-    help="Larger campaigns and finer critical pushes (minutes instead of about two).",
+    help="Larger campaigns and finer critical pushes (about 3 minutes instead of half of one).",
 )
 @_workers
 @_scheduler

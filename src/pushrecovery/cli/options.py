@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
 import click
@@ -57,6 +57,14 @@ def emit(data: dict[str, Any], as_json: bool) -> None:
         return
     for line in _table(data):
         click.echo(line)
+
+
+def echo_confusion(title: str, labels: Sequence[str], counts: Sequence[Sequence[int]]) -> None:
+    """Print a confusion matrix under ``title``: one row and one column per label."""
+    click.echo(title)
+    click.echo(" " * 10 + "".join(f"{label:>7}" for label in labels))
+    for label, row in zip(labels, counts, strict=True):
+        click.echo(f"{label:<10}" + "".join(f"{count:>7}" for count in row))
 
 
 def _table(data: dict[str, Any], indent: str = "") -> list[str]:
