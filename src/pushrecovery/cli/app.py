@@ -644,10 +644,12 @@ def step(
 
 
 def _register() -> None:
+    from pushrecovery.cli.analyze import analyze
     from pushrecovery.cli.campaign import campaign, report
 
     cli.add_command(campaign)
     cli.add_command(report)
+    cli.add_command(analyze)
 
 
 _register()

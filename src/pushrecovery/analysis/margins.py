@@ -1,0 +1,176 @@
+r"""Per-frame balance margins of measured states, in one horizontal direction.
+
+The decision surfaces of the paper are stated for a foot [δ⁻, δ⁺] around the ankle. A measured
+base of support may be wider (both feet on the floor) and moves with the feet, so here the
+region edges are arrays (one value per frame), in the lab frame:
+
+- capture point (Hof's extrapolated CoM), ξ = x + ẋ/ω, Eq. (4);
+- CoP margin, min(ξ − lower, upper − ξ): Hof's margin of stability, positive when the ankle
+  strategy alone recovers (Eq. 4);
+- CMP margin, the CoP margin plus the hip strategy's reach a (1 − e^{−ω T_max})², corrected
+  Eq. (15) (errata E11);
+- step: :func:`pushrecovery.surfaces.step.plan_steps` for the state relative to the stance
+  ankle, with the single foot's own edges (the foot that lands after the step);
+- time to leave: with the CoP (or the CMP) held where it is, ξ − p grows as e^{ωt}
+  (ξ̇ = ω (ξ − p), the LIPM), so a capture point inside (lower, upper) reaches the edge on its
+  side after
+
+  .. math:: t = \frac{1}{\omega} \ln \frac{\text{edge} - p}{\xi - p},
+
+  0 when it is already outside and +inf when ξ = p.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy
+from pushrecovery.surfaces.cmp import cmp_offset
+from pushrecovery.surfaces.cop import capture_point
+from pushrecovery.surfaces.step import plan_steps
+
+__all__ = ["DirectionMargins", "direction_margins", "time_to_leave"]
+
+FloatArray = NDArray[np.float64]
+
+_ANKLE, _HIP, _STEP, _FALL = (STRATEGY_CODES.index(s) for s in Strategy)
+
+
+@dataclass(frozen=True, slots=True)
+class DirectionMargins:
+    """Margins of n frames in one direction; arrays of shape (n,), NaN where invalid.
+
+    Attributes
+    ----------
+    capture_point : ndarray
+        ξ = x + ẋ/ω, lab frame [m].
+    cop, cmp, step : ndarray
+        Margins to the CoP region, the CMP region, and the reach left for a step [m]
+        (−inf when no single step recovers).
+    strategy : ndarray of int8
+        Codes into :data:`~pushrecovery.surfaces.classify.STRATEGY_CODES`, −1 where invalid.
+    time_to_leave_cop, time_to_leave_cmp : ndarray
+        Time until ξ leaves the CoP (CMP) region with the CoP (CMP) held [s].
+    step_length : ndarray
+        Recommended step, foot to foot, signed along the axis [m], where a step is needed.
+    step_shortest, step_longest : ndarray
+        Admissible recovering step lengths, unsigned [m], where a step is needed.
+    """
+
+    capture_point: FloatArray
+    cop: FloatArray
+    cmp: FloatArray
+    step: FloatArray
+    strategy: NDArray[np.int8]
+    time_to_leave_cop: FloatArray
+    time_to_leave_cmp: FloatArray
+    step_length: FloatArray
+    step_shortest: FloatArray
+    step_longest: FloatArray
+
+
+def time_to_leave(
+    capture: FloatArray, anchor: FloatArray, lower: FloatArray, upper: FloatArray, omega: float
+) -> FloatArray:
+    """Time until the capture point leaves (lower, upper) with the CoP/CMP held at ``anchor``.
+
+    Parameters
+    ----------
+    capture : ndarray
+        Capture points ξ [m].
+    anchor : ndarray
+        Where the CoP (or CMP) stays [m]; clipped into [lower, upper] (a measured CoP a hair
+        beyond an edge of the measured base is on it).
+    lower, upper : ndarray
+        Region edges [m].
+    omega : float
+        sqrt(g / L) [1/s].
+
+    Returns
+    -------
+    ndarray
+        Time [s] (module docstring): 0 outside the region, +inf when ξ equals the anchor, NaN
+        where an input is NaN.
+    """
+    anchor = np.clip(anchor, lower, upper)
+    ahead = capture - anchor
+    edge = np.where(ahead > 0.0, upper, lower) - anchor
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = edge / ahead
+        time = np.where(ratio > 1.0, np.log(ratio) / omega, 0.0)
+    time = np.where(ahead == 0.0, np.inf, time)
+    inside = (capture > lower) & (capture < upper)
+    time = np.where(inside, time, 0.0)
+    missing = ~(np.isfinite(capture) & np.isfinite(anchor) & np.isfinite(lower + upper))
+    return np.where(missing, np.nan, time)
+
+
+def direction_margins(
+    com: FloatArray,
+    velocity: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    ankle: FloatArray,
+    params: BodyParams,
+    *,
+    cop: FloatArray | None = None,
+    cmp: FloatArray | None = None,
+) -> DirectionMargins:
+    """Margins, strategy and step of each frame (module docstring).
+
+    Parameters
+    ----------
+    com, velocity : ndarray, shape (n,)
+        CoM position, lab frame [m], and velocity [m/s] along the axis; NaN where missing.
+    lower, upper : ndarray, shape (n,)
+        Base of support along the axis, lab frame [m].
+    ankle : ndarray, shape (n,)
+        Stance ankle (the pivot of the stepping model), lab frame [m].
+    params : BodyParams
+        The body; ``heel`` and ``toe`` are the single foot's edges relative to its ankle along
+        this axis (the foot a step lands on), ``com_height`` sets ω.
+    cop : ndarray, optional
+        Measured CoP [m] for the time to leave the CoP region; default: none (NaN times).
+    cmp : ndarray, optional
+        Measured CMP [m] for the time to leave the CMP region; default the CoP.
+
+    Returns
+    -------
+    DirectionMargins
+    """
+    omega = params.omega
+    capture = capture_point(com, velocity, omega)
+    cop_margin = np.minimum(capture - lower, upper - capture)
+    reach = cmp_offset(params)
+    cmp_margin = cop_margin + reach
+    valid = np.isfinite(cop_margin)
+    lean = com - ankle
+    # The stepping model holds for a CoM above the ankle's horizon only (|x| < leg).
+    plannable = valid & (np.abs(np.where(valid, lean, 0.0)) < params.leg_length)
+    plan = plan_steps(np.where(plannable, lean, 0.0), np.where(plannable, velocity, 0.0), params)
+    feasible = plannable & plan.feasible
+    strategy = np.full(len(com), _FALL, dtype=np.int8)
+    strategy[feasible] = _STEP
+    strategy[cmp_margin > 0.0] = _HIP
+    strategy[cop_margin > 0.0] = _ANKLE
+    strategy[~valid] = -1
+    stepping = strategy == _STEP
+    nan = np.full(len(com), np.nan)
+    cop_anchor = nan if cop is None else cop
+    cmp_anchor = cop_anchor if cmp is None else cmp
+    return DirectionMargins(
+        capture_point=capture,
+        cop=cop_margin,
+        cmp=cmp_margin,
+        step=np.where(plannable, plan.margin, np.where(valid, -np.inf, np.nan)),
+        strategy=strategy,
+        time_to_leave_cop=time_to_leave(capture, cop_anchor, lower, upper, omega),
+        time_to_leave_cmp=time_to_leave(capture, cmp_anchor, lower - reach, upper + reach, omega),
+        step_length=np.where(stepping, plan.step_length, np.nan),
+        step_shortest=np.where(stepping, plan.shortest, np.nan),
+        step_longest=np.where(stepping, plan.longest, np.nan),
+    )

@@ -1,0 +1,77 @@
+"""Write an analysed trial: ``frames.parquet``, ``frames.csv`` and ``summary.json``."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pushrecovery.analysis.trial import TrialAnalysis
+
+__all__ = ["FRAME_FILES", "SUMMARY_FILE", "json_safe", "write_analysis"]
+
+#: Per-frame tables written into the output directory.
+FRAME_FILES = ("frames.parquet", "frames.csv")
+#: The summary written into the output directory.
+SUMMARY_FILE = "summary.json"
+
+
+def json_safe(value: Any) -> Any:
+    """Replace non-finite floats by None (JSON has no NaN or infinity), recursively."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: json_safe(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_safe(item) for item in value]
+    return value
+
+
+def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Path]:
+    """Write the frames (Parquet and CSV) and the summary (JSON) into ``out_dir``.
+
+    Columns of the frame tables are those of :attr:`TrialAnalysis.columns` (docs/analysis.md):
+    lengths in m, velocities in m/s, times in s; missing values are empty in the CSV and null
+    in Parquet; a time to leave of +inf (never) is written as ``inf``.
+
+    Returns
+    -------
+    dict
+        ``frames_parquet``, ``frames_csv`` and ``summary`` paths.
+    """
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    arrays = {}
+    for name, values in analysis.columns.items():
+        if values.dtype == object:
+            arrays[name] = pa.array(list(values), type=pa.string())
+        elif values.dtype == bool:
+            arrays[name] = pa.array(values)
+        else:
+            arrays[name] = pa.array(values, mask=np.isnan(values))
+    table = pa.table(arrays)
+    paths = {
+        "frames_parquet": out / FRAME_FILES[0],
+        "frames_csv": out / FRAME_FILES[1],
+        "summary": out / SUMMARY_FILE,
+    }
+    _atomic(paths["frames_parquet"], lambda p: pq.write_table(table, p))
+    _atomic(paths["frames_csv"], lambda p: pacsv.write_csv(table, p))
+    text = json.dumps(json_safe(analysis.summary), indent=2, allow_nan=False)
+    _atomic(paths["summary"], lambda p: p.write_text(text + "\n"))
+    return paths
+
+
+def _atomic(path: Path, write: Any) -> None:
+    """Write through a temporary file, so a reader never sees half a file."""
+    temporary = path.with_name(f".{path.name}.tmp")
+    write(temporary)
+    os.replace(temporary, path)

@@ -1,0 +1,200 @@
+"""A measured trial in body axes, and the base of support it implies.
+
+Body axes: **ap** (anterior-posterior, forward positive), **ml** (medio-lateral, positive to
+the subject's left, so that ap, ml, up is right-handed) and **up**. Every length is in metres in
+the lab frame, rotated onto those axes; forces are the ground reaction force *on the subject*
+[N]. A reader (:mod:`pushrecovery.analysis.readers`) turns a CSV or C3D file into a
+:class:`Recording`; :mod:`pushrecovery.analysis.trial` analyses it.
+
+Base of support. From foot markers (heel, toe and ankle of each foot), a foot supports in a
+frame when its lower marker is within ``contact_height`` of the lowest that marker gets in the
+trial (the foot is on the floor). Along ap the base spans the rearmost supporting heel marker
+to the foremost supporting toe marker; along ml it spans the supporting feet's markers widened
+by half the foot width on each side (the markers sit on the foot's midline). The stance ankle of
+the stepping model is the supporting ankle nearest the capture point.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError
+
+__all__ = ["AXES", "Foot", "Recording", "Support", "fixed_feet", "support_from_feet"]
+
+FloatArray = NDArray[np.float64]
+
+#: The two horizontal body axes, in output order.
+AXES: tuple[str, str] = ("ap", "ml")
+
+
+@dataclass(frozen=True, slots=True)
+class Foot:
+    """Heel, toe and ankle positions of one foot, (n, 3) arrays in body axes [m]."""
+
+    name: str
+    heel: FloatArray
+    toe: FloatArray
+    ankle: FloatArray
+
+
+@dataclass(frozen=True, slots=True)
+class Recording:
+    """A measured trial, body axes, SI units; NaN marks missing samples.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n,)
+        Frame times of the kinematics [s], constant rate.
+    com : ndarray, shape (n, 3) or None
+        CoM position [m]; None when only force plates were recorded.
+    com_velocity : ndarray, shape (n, 2) or None
+        Measured CoM velocity (ap, ml) [m/s]; None to differentiate the position.
+    feet : tuple of Foot
+        Foot markers at the frame times (empty when the file has none).
+    base : dict
+        Explicit base of support per axis, (n, 2) [min, max] [m] (CSV columns).
+    ankle : dict
+        Explicit stance ankle per axis, (n,) [m] (CSV columns).
+    force_time : ndarray, shape (m,) or None
+        Sample times of the force-plate signals [s].
+    force : ndarray, shape (m, 3) or None
+        Ground reaction force on the subject (ap, ml, up) [N].
+    cop : ndarray, shape (m, 2) or None
+        Centre of pressure (ap, ml) [m].
+    mass : float or None
+        Subject mass stored in the file [kg].
+    com_height : float or None
+        CoM height above the ankle measured in the file [m].
+    source : str
+        File the trial came from.
+    notes : list of str
+        What the reader repaired or assumed.
+    """
+
+    time: FloatArray
+    com: FloatArray | None = None
+    com_velocity: FloatArray | None = None
+    feet: tuple[Foot, ...] = ()
+    base: dict[str, FloatArray] = field(default_factory=dict)
+    ankle: dict[str, FloatArray] = field(default_factory=dict)
+    force_time: FloatArray | None = None
+    force: FloatArray | None = None
+    cop: FloatArray | None = None
+    mass: float | None = None
+    com_height: float | None = None
+    source: str = ""
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def rate(self) -> float:
+        """Frame rate of the kinematics [Hz]."""
+        return (len(self.time) - 1) / (self.time[-1] - self.time[0])
+
+
+@dataclass(frozen=True, slots=True)
+class Support:
+    """Base of support per frame and the single foot's extents.
+
+    Attributes
+    ----------
+    lower, upper : dict
+        Per axis, (n,) base edges [m] (NaN where no foot supports).
+    ankles : dict
+        Per axis, (n, k) ankle positions of the k feet, NaN where a foot does not support.
+    foot : dict
+        Per axis, (heel, toe): the edges of one foot relative to its ankle [m].
+    supporting : ndarray, shape (n, k) of bool
+        Which feet support in each frame.
+    """
+
+    lower: dict[str, FloatArray]
+    upper: dict[str, FloatArray]
+    ankles: dict[str, FloatArray]
+    foot: dict[str, tuple[float, float]]
+    supporting: NDArray[np.bool_]
+
+    def stance_ankle(self, axis: str, capture: FloatArray) -> FloatArray:
+        """Return the supporting ankle nearest the capture point on ``axis`` [m], NaN if none."""
+        ankles = self.ankles[axis]
+        distance = np.abs(ankles - capture[:, None])
+        missing = ~np.isfinite(distance).any(axis=1)
+        nearest = np.argmin(np.where(np.isfinite(distance), distance, np.inf), axis=1)
+        chosen = ankles[np.arange(len(ankles)), nearest]
+        return np.where(missing, np.nan, chosen)
+
+
+def support_from_feet(
+    feet: tuple[Foot, ...], *, contact_height: float, foot_width: float
+) -> Support:
+    """Find the base of support from foot markers (module docstring).
+
+    Parameters
+    ----------
+    feet : tuple of Foot
+        At least one foot.
+    contact_height : float
+        A foot supports while its lower marker is within this of its lowest [m], > 0.
+    foot_width : float
+        Width of a foot across its markers' line [m], > 0.
+
+    Returns
+    -------
+    Support
+    """
+    if not feet:
+        raise InvalidParameterError("feet must name at least one foot")
+    heel = np.stack([f.heel for f in feet], axis=1)  # (n, k, 3)
+    toe = np.stack([f.toe for f in feet], axis=1)
+    ankle = np.stack([f.ankle for f in feet], axis=1)
+    low = np.fmin(heel[..., 2], toe[..., 2])
+    with np.errstate(invalid="ignore"):
+        floor = np.nanmin(low, axis=0)
+        supporting = low <= floor + contact_height
+    ap = (heel[..., 0], toe[..., 0])
+    ml = np.stack([heel[..., 1], toe[..., 1], ankle[..., 1]], axis=-1)
+    hide = ~supporting
+    with warnings.catch_warnings():  # frames with no supporting foot stay NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        lower = {
+            "ap": np.nanmin(np.where(hide, np.nan, ap[0]), axis=1),
+            "ml": np.nanmin(np.where(hide[..., None], np.nan, ml), axis=(1, 2)) - foot_width / 2,
+        }
+        upper = {
+            "ap": np.nanmax(np.where(hide, np.nan, ap[1]), axis=1),
+            "ml": np.nanmax(np.where(hide[..., None], np.nan, ml), axis=(1, 2)) + foot_width / 2,
+        }
+        rel_heel = np.nanmedian(np.where(hide, np.nan, heel[..., 0] - ankle[..., 0]))
+        rel_toe = np.nanmedian(np.where(hide, np.nan, toe[..., 0] - ankle[..., 0]))
+    if not (np.isfinite(rel_heel) and np.isfinite(rel_toe) and rel_heel < 0.0 < rel_toe):
+        raise InvalidParameterError(
+            "the heel markers must lie behind and the toe markers ahead of the ankle markers "
+            f"along ap (got heel {rel_heel:+.3f} m, toe {rel_toe:+.3f} m from the ankle); "
+            "check --ap-axis"
+        )
+    ankles = {axis: np.where(hide, np.nan, ankle[..., i]) for i, axis in enumerate(AXES)}
+    foot = {"ap": (float(rel_heel), float(rel_toe)), "ml": (-foot_width / 2, foot_width / 2)}
+    return Support(lower, upper, ankles, foot, supporting)
+
+
+def fixed_feet(
+    n: int, ankle_ap: float, ankle_ml: float, heel: float, toe: float, stance_width: float
+) -> tuple[Foot, ...]:
+    """Two flat feet that never move: ankles ``stance_width`` apart around (ankle_ap, ankle_ml).
+
+    Parameters are lab positions along the body axes and the foot's edges relative to the
+    ankle [m]; markers are placed on the floor (up = 0).
+    """
+    feet = []
+    for name, side in (("left", 0.5), ("right", -0.5)):
+        ml = ankle_ml + side * stance_width
+
+        def at(ap: float, ml: float = ml) -> FloatArray:
+            return np.tile([ap, ml, 0.0], (n, 1))
+
+        feet.append(Foot(name, at(ankle_ap + heel), at(ankle_ap + toe), at(ankle_ap)))
+    return tuple(feet)

@@ -1,0 +1,157 @@
+"""Plots of an analysed trial: time series with the regions shaded, and the phase portrait."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from pushrecovery.analysis.recording import AXES
+from pushrecovery.analysis.trial import TrialAnalysis
+from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR, save_figure
+from pushrecovery.surfaces.classify import Strategy
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+__all__ = ["STRATEGY_COLOURS", "plot_phase_portrait", "plot_time_series"]
+
+STEP_COLOUR = "#1565c0"
+#: One colour per strategy, shared by the bands and the phase-portrait points.
+STRATEGY_COLOURS = {
+    Strategy.ANKLE.value: RECOVER_COLOUR,
+    Strategy.HIP.value: HIP_COLOUR,
+    Strategy.STEP.value: STEP_COLOUR,
+    Strategy.FALL.value: FALL_COLOUR,
+}
+_TITLES = {"ap": "anterior-posterior (forward +)", "ml": "medio-lateral (left +)"}
+
+
+def _figure(rows: int, cols: int, width: float, height: float):  # type: ignore[no-untyped-def]
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(rows, cols, figsize=(width, height), layout="constrained", squeeze=False)
+
+
+def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
+    """Draw CoM, CoP, CMP and capture point over time, per axis, with the regions shaded.
+
+    Green band: the base of support (CoP region, Eq. 4); orange: what the hip strategy adds
+    (corrected Eq. 15); the strip under each panel shows the strategy each frame needs.
+    Positions are relative to the mean ankle along the axis [m].
+    """
+    columns, summary = analysis.columns, analysis.summary
+    time = columns["time"]
+    fig, axes = _figure(2, 1, 9.0, 6.4)
+    for ax, axis in zip(axes[:, 0], AXES, strict=True):
+        origin = float(np.nanmedian(columns[f"{axis}_ankle"]))
+        lower = columns[f"{axis}_base_min"] - origin
+        upper = columns[f"{axis}_base_max"] - origin
+        reach = columns[f"{axis}_margin_cmp"] - columns[f"{axis}_margin_cop"]
+        ax.fill_between(
+            time,
+            lower - reach,
+            upper + reach,
+            color=HIP_COLOUR,
+            alpha=0.15,
+            lw=0,
+            label="CMP region (hip), corr. Eq. (15)",
+        )
+        ax.fill_between(
+            time,
+            lower,
+            upper,
+            color=RECOVER_COLOUR,
+            alpha=0.18,
+            lw=0,
+            label="base of support (CoP region, Eq. 4)",
+        )
+        ax.plot(time, columns[f"{axis}_com"] - origin, color="0.2", lw=1.0, label="CoM")
+        ax.plot(time, columns[f"{axis}_cop"] - origin, color="0.55", lw=0.7, label="CoP")
+        if np.isfinite(columns[f"{axis}_cmp"]).any():
+            ax.plot(
+                time, columns[f"{axis}_cmp"] - origin, color=HIP_COLOUR, lw=0.6, ls=":", label="CMP"
+            )
+        ax.plot(
+            time,
+            columns[f"{axis}_capture_point"] - origin,
+            color="#6a1b9a",
+            lw=1.2,
+            label="capture point ξ (XCoM)",
+        )
+        _strategy_strip(ax, time, columns[f"{axis}_strategy"])
+        ax.set_title(
+            f"{_TITLES[axis]}: needs {summary['directions'][axis]['most_demanding']}", fontsize=10
+        )
+        ax.set_ylabel(f"{axis} position − ankle [m]")
+        _limit(ax, columns, axis, origin)
+    axes[-1, 0].set_xlabel("time [s]")
+    axes[0, 0].legend(loc="upper right", fontsize=7, ncols=3)
+    return save_figure(fig, path.with_suffix(""), [path.suffix.lstrip(".") or "png"])[0]
+
+
+def _limit(ax: Axes, columns: dict[str, np.ndarray], axis: str, origin: float) -> None:
+    """Zoom on the base and the capture point, not on a fall's runaway tail."""
+    spans = [columns[f"{axis}_base_min"], columns[f"{axis}_base_max"], columns[f"{axis}_com"]]
+    values = np.concatenate([np.asarray(s, dtype=float) for s in spans]) - origin
+    values = values[np.isfinite(values)]
+    if len(values):
+        low, high = float(values.min()), float(values.max())
+        pad = 0.6 * (high - low) + 0.02
+        ax.set_ylim(low - pad, high + pad)
+
+
+def _strategy_strip(ax: Axes, time: np.ndarray, strategy: np.ndarray) -> None:
+    """Colour the bottom of a panel by the strategy each frame needs."""
+    from matplotlib.transforms import blended_transform_factory
+
+    transform = blended_transform_factory(ax.transData, ax.transAxes)
+    for name, colour in STRATEGY_COLOURS.items():
+        mask = strategy == name
+        if mask.any():
+            ax.fill_between(
+                time, 0.0, 0.04, where=mask, color=colour, transform=transform, lw=0, step="mid"
+            )
+
+
+def plot_phase_portrait(analysis: TrialAnalysis, path: Path) -> Path:
+    """Plot CoM velocity against CoM position relative to the stance ankle, per axis.
+
+    Points are coloured by the strategy the frame needs; the lines ẋ = ω (edge − x) are the
+    capture-point edges of the median base (Eq. 4) and of the CMP region (corrected Eq. 15).
+    """
+    columns, summary = analysis.columns, analysis.summary
+    omega = summary["body"]["omega"]
+    fig, axes = _figure(1, 2, 10.0, 4.6)
+    for ax, axis in zip(axes[0], AXES, strict=True):
+        ankle = columns[f"{axis}_ankle"]
+        x = columns[f"{axis}_com"] - ankle
+        xdot = columns[f"{axis}_com_velocity"]
+        strategy = columns[f"{axis}_strategy"]
+        for name, colour in STRATEGY_COLOURS.items():
+            mask = strategy == name
+            if mask.any():
+                ax.plot(x[mask], xdot[mask], ".", ms=2.5, color=colour, label=name)
+        finite = np.isfinite(x) & np.isfinite(xdot)
+        if finite.any():
+            span = max(float(np.abs(x[finite]).max()), 0.05) * 1.3
+            xs = np.linspace(-span, span, 50)
+            reach = float(
+                np.nanmedian(columns[f"{axis}_margin_cmp"] - columns[f"{axis}_margin_cop"])
+            )
+            for end, sign in (("min", -1.0), ("max", 1.0)):
+                edge = float(np.nanmedian(columns[f"{axis}_base_{end}"] - ankle))
+                ax.plot(xs, omega * (edge - xs), color=RECOVER_COLOUR, lw=1.0, ls="--")
+                ax.plot(xs, omega * (edge + sign * reach - xs), color=HIP_COLOUR, lw=1.0, ls=":")
+            ax.set_xlim(-span, span)
+            vmax = max(float(np.abs(xdot[finite]).max()), 0.05) * 1.3
+            ax.set_ylim(-vmax, vmax)
+        ax.set_title(_TITLES[axis], fontsize=10)
+        ax.set_xlabel(f"CoM − stance ankle along {axis} [m]")
+        ax.set_ylabel("CoM velocity [m/s]")
+        ax.legend(loc="upper right", fontsize=7, markerscale=3)
+    return save_figure(fig, path.with_suffix(""), [path.suffix.lstrip(".") or "png"])[0]
