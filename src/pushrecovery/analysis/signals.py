@@ -1,7 +1,8 @@
 """Measured signals: gaps, zero-lag low-pass filtering and differentiation (scipy.signal).
 
 A gap is a run of missing (NaN) samples. Gaps up to ``max_gap`` seconds inside a signal are
-filled by shape-preserving cubic interpolation (PCHIP) and reported; longer gaps, and missing
+filled by a cubic spline through the valid samples (as motion-capture software fills
+marker gaps) and reported; longer gaps, and missing
 samples at either end of a recording (nothing to interpolate from), are left missing and split
 the signal into segments that are filtered and differentiated on their own, so that neither
 the filter nor the derivative ever reaches across a gap.
@@ -20,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import PchipInterpolator
+from scipy.interpolate import CubicSpline
 from scipy.signal import butter, sosfiltfilt
 
 from pushrecovery.errors import InvalidParameterError
@@ -101,7 +102,7 @@ def repair_gaps(
     Returns
     -------
     (values, gaps)
-        A copy with the short inner gaps filled (PCHIP through all the valid samples), and the
+        A copy with the short inner gaps filled (a not-a-knot cubic spline through all the valid samples), and the
         list of gaps in time order.
     """
     values = np.array(values, dtype=np.float64)
@@ -111,7 +112,7 @@ def repair_gaps(
     if not missing.any():
         return values, gaps
     valid = np.flatnonzero(~missing)
-    spline = PchipInterpolator(time[valid], flat[valid], axis=0) if len(valid) >= 2 else None
+    spline = CubicSpline(time[valid], flat[valid], axis=0) if len(valid) >= 4 else None
     for start, stop in find_gaps(missing):
         inner = start > 0 and stop < len(time)
         # The gap's length: the time with no data, between the valid samples either side.
