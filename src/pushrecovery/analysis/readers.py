@@ -88,6 +88,7 @@ def read_recording(path: str | Path, **options: object) -> Recording:
     Options are passed to :func:`read_csv_recording` or :func:`read_c3d_recording`.
     """
     path = Path(path)
+    _check_file(path)
     suffix = path.suffix.lower()
     if suffix == ".csv":
         return read_csv_recording(path, **options)  # type: ignore[arg-type]

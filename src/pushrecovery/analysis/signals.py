@@ -102,8 +102,8 @@ def repair_gaps(
     Returns
     -------
     (values, gaps)
-        A copy with the short inner gaps filled (a not-a-knot cubic spline through all the valid samples), and the
-        list of gaps in time order.
+        A copy with the short inner gaps filled (a not-a-knot cubic spline through all the
+        valid samples), and the list of gaps in time order.
     """
     values = np.array(values, dtype=np.float64)
     flat = values.reshape(len(values), -1)

@@ -1,0 +1,136 @@
+"""``pushrecovery analyze``: files written, the JSON contract, one-line errors with exit 2."""
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from pushrecovery.analysis.readers import AP_AXES, LENGTH_UNITS
+from pushrecovery.cli import main
+from pushrecovery.cli.analyze import _AP_AXES, _UNITS
+from pushrecovery.cli.app import cli
+
+#: Keys of the summary other tools read (add keys, never rename or drop).
+SUMMARY_KEYS = {
+    "source",
+    "frames",
+    "valid_frames",
+    "excluded_frames",
+    "excluded",
+    "rate",
+    "duration",
+    "body",
+    "params",
+    "com_source",
+    "support_source",
+    "filter",
+    "gaps",
+    "interpolated_frames",
+    "strategy",
+    "directions",
+    "step_events",
+    "notes",
+}
+DIRECTION_KEYS = {
+    "most_demanding",
+    "time_in_strategy",
+    "min_margin",
+    "min_time_to_leave",
+    "capture_point_range",
+    "foot",
+}
+
+
+def _trial(path, push=0.3):
+    """A LIPM push in mm, the CoP on a capture-point law (Euler at 1 ms, sampled at 100 Hz)."""
+    omega, heel, toe = 9.81**0.5, -0.05, 0.15
+    x, v, rows = 0.02, 0.0, ["time,com_ap,com_ml,cop_ap,cop_ml"]
+    for k in range(2500):
+        if abs(x) > 0.6:  # on the floor: the recording ends
+            break
+        if k == 1000:
+            v += push
+        capture = x + v / omega
+        cop = min(toe, max(heel, 2 * capture - 0.02))
+        if k % 10 == 0:
+            rows.append(f"{k / 1000:.3f},{x * 1000:.4f},3.0,{cop * 1000:.4f},2.0")
+        x, v = x + v * 1e-3, v + omega**2 * (x - cop) * 1e-3
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+def test_choices_match_the_readers():
+    assert set(_UNITS) == set(LENGTH_UNITS)
+    assert set(_AP_AXES) == set(AP_AXES)
+
+
+def test_analyze_csv_writes_frames_summary_and_plots(tmp_path):
+    trial = _trial(tmp_path / "trial.csv")
+    out = tmp_path / "out"
+    args = ["analyze", str(trial), "--units", "mm", "--out", str(out), "--json"]
+    result = CliRunner().invoke(cli, args, catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    assert set(data) >= SUMMARY_KEYS | {"files"}
+    for axis in ("ap", "ml"):
+        assert set(data["directions"][axis]) >= DIRECTION_KEYS
+    assert data["strategy"]["most_demanding"] == "ankle"
+    assert data["body"]["mass_source"] == "preset"
+    for name in ("frames.parquet", "frames.csv", "summary.json", "time_series.png"):
+        assert (out / name).stat().st_size > 0
+    assert json.loads((out / "summary.json").read_text())["frames"] == 250
+    import pyarrow.parquet as pq
+
+    frames = pq.read_table(out / "frames.parquet").to_pydict()
+    assert len(frames["time"]) == 250
+    assert set(frames) >= {
+        "time",
+        "strategy",
+        "valid",
+        "ap_capture_point",
+        "ap_margin_cop",
+        "ap_margin_cmp",
+        "ap_time_to_leave_cop",
+        "ml_margin_cop",
+        "ap_step_length",
+    }
+    # ml: the CoM 3 mm, the CoP 2 mm left of the assumed feet's centre.
+    assert np.nanmax(np.abs(np.array(frames["ml_com"]) - 0.003)) < 1e-9
+
+
+def test_analyze_table_output(tmp_path):
+    trial = _trial(tmp_path / "trial.csv", push=0.8)
+    args = ["analyze", str(trial), "--units", "mm", "--out", str(tmp_path / "o"), "--no-plot"]
+    result = CliRunner().invoke(cli, args, catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert "needs" in result.output and "step_events" in result.output
+    assert not (tmp_path / "o" / "time_series.png").exists()
+
+
+def _fail(capsys, *args):
+    with pytest.raises(SystemExit) as info:
+        main(list(args))
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pushrecovery: error: ") and err.count("\n") == 1, err
+    return err
+
+
+def test_bad_inputs_are_one_line(tmp_path, capsys):
+    trial = _trial(tmp_path / "trial.csv")
+    out = str(tmp_path / "o")
+    assert "not found" in _fail(capsys, "analyze", str(tmp_path / "none.csv"), "--out", out)
+    assert "directory" in _fail(capsys, "analyze", str(tmp_path), "--out", out)
+    assert "'furlongs'" in _fail(capsys, "analyze", str(trial), "--units", "furlongs", "--out", out)
+    assert "units" in _fail(capsys, "analyze", str(trial), "--out", out)  # mm read as m
+    text = tmp_path / "trial.txt"
+    text.write_text("hello")
+    assert "expected .csv or .c3d" in _fail(capsys, "analyze", str(text), "--out", out)
+    err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--cutoff", "-1", "--out", out)
+    assert "cutoff" in err
+    err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--cutoff", "80", "--out", out)
+    assert "cutoff must be in (0, 50)" in err
+    err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--mass", "-3", "--out", out)
+    assert "mass" in err
+    assert "--out" in _fail(capsys, "analyze", str(trial))
