@@ -104,7 +104,9 @@ def test_zero_point_integration_recovers_the_com():
     assert inside.mean() > 0.9
     # Sway of 3 cm; the pins are the samples nearest each zero (1 ms apart).
     assert np.abs(com[inside] - x[inside]).max() < 5e-4
-    assert np.abs(velocity[inside] - xdot[inside]).max() < 1e-3
+    # A pin where |F| <= 0.02 % of the weight is within 0.2 mm of the CoM; over the shortest
+    # interval (0.1 s) that is 2 mm/s of velocity, 0.6 mm of capture point.
+    assert np.abs(velocity[inside] - xdot[inside]).max() < 3e-3
 
 
 def test_zero_point_integration_removes_the_drift_of_a_force_bias():

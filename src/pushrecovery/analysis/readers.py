@@ -53,6 +53,8 @@ FOOT_MARKERS: tuple[tuple[str, str, str, str], ...] = (
     ("left", "LHEE", "LTOE", "LANK"),
     ("right", "RHEE", "RTOE", "RANK"),
 )
+#: Percentile of the CoM height above the ankles taken as the standing CoM height.
+STANDING_PERCENTILE = 95.0
 #: Default CoM marker (Plug-in Gait's model output).
 COM_MARKER = "CentreOfMass"
 
@@ -377,7 +379,8 @@ def read_c3d_recording(
         ankle_height = np.nanmean([foot.ankle[:, 2] for foot in found_feet], axis=0)
         height = com[:, 2] - ankle_height
         if np.isfinite(height).any():
-            com_height = float(np.nanmedian(height))
+            # Standing height: a step or a crouch lowers the CoM for part of a trial.
+            com_height = float(np.nanpercentile(height, STANDING_PERCENTILE))
     force = cop = force_time = None
     if content.plates:
         force_time = content.analog_time

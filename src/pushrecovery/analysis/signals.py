@@ -107,7 +107,7 @@ def repair_gaps(
     """
     values = np.array(values, dtype=np.float64)
     flat = values.reshape(len(values), -1)
-    missing = ~np.isfinite(flat).all(axis=1)
+    missing = np.asarray(~np.isfinite(flat).all(axis=1))
     gaps: list[Gap] = []
     if not missing.any():
         return values, gaps
@@ -187,7 +187,8 @@ def smooth_and_differentiate(
     flat = values.reshape(len(values), -1)
     smooth = np.full_like(flat, np.nan)
     slope = np.full_like(flat, np.nan)
-    for part in segments(np.isfinite(flat).all(axis=1), shortest=3):
+    finite = np.asarray(np.isfinite(flat).all(axis=1))
+    for part in segments(finite, shortest=3):
         smooth[part] = lowpass(flat[part], rate, cutoff)
         slope[part] = np.gradient(smooth[part], time[part], axis=0)
     return smooth.reshape(values.shape), slope.reshape(values.shape)

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from pushrecovery.analysis.margins import DirectionMargins, direction_margins
 from pushrecovery.analysis.recording import (
     AXES,
+    Foot,
     Recording,
     Support,
     fixed_feet,
@@ -343,7 +344,7 @@ def _support(
     """Build the base of support from the feet, CSV columns, or two assumed fixed feet."""
     gaps: list[Gap] = []
     if recording.feet:
-        feet = []
+        measured: list[Foot] = []
         for foot in recording.feet:
             parts = []
             for part in ("heel", "toe", "ankle"):
@@ -351,9 +352,9 @@ def _support(
                 values, found = repair_gaps(time, values, settings.max_gap, f"{foot.name} {part}")
                 gaps += found
                 parts.append(values)
-            feet.append(type(foot)(foot.name, *parts))
+            measured.append(Foot(foot.name, *parts))
         support = support_from_feet(
-            tuple(feet),
+            tuple(measured),
             contact_height=settings.contact_height,
             foot_width=settings.foot_width,
         )

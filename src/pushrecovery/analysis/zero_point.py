@@ -4,9 +4,11 @@ When only force plates were recorded, the horizontal CoM motion follows from New
 m ẍ = F_x, by double integration. Plain integration drifts: a bias of 1 N in F_x moves a 70 kg
 body's CoM by 0.7 m in 10 s. Zatsiorsky & King (1998, J. Biomech. 31:161-164) remove the two
 unknown integration constants in every interval between consecutive instants where the
-horizontal force is zero. At such an instant the ground reaction force is vertical; with no
-change of the body's angular momentum about its CoM the force then passes through the CoM,
-so the CoM lies above the CoP: x(t_i) = p(t_i). Between two zero points t_i < t_j,
+horizontal force is zero (crosses zero, or stays within ``ZERO_FORCE`` = 0.02 % of the body
+weight, as a body standing still may never cross). At such an instant the ground reaction
+force is vertical; with no change of the body's angular momentum about its CoM the force then
+passes through the CoM, so the CoM lies above the CoP: x(t_i) = p(t_i). Between two zero
+points t_i < t_j,
 
 .. math:: x(t) = p(t_i) + v_i (t - t_i) + \int_{t_i}^{t} \int_{t_i}^{s} \frac{F_x(u)}{m}
           \,du\,ds,
@@ -28,34 +30,66 @@ from scipy.integrate import cumulative_trapezoid
 from pushrecovery._validate import positive_float
 from pushrecovery.errors import InvalidParameterError
 
-__all__ = ["com_from_force", "zero_points"]
+__all__ = ["ZERO_FORCE", "com_from_force", "zero_points"]
+
+#: Horizontal force counted as zero, as a fraction of the body weight.
+ZERO_FORCE = 2e-4
+STANDARD_GRAVITY = 9.80665
+#: Shortest interval between two zero points [s].
+MIN_SPACING = 0.1
 
 FloatArray = NDArray[np.float64]
 
 
-def zero_points(force: FloatArray) -> NDArray[np.intp]:
-    """Find where the horizontal force crosses zero (the sample nearer zero of each pair).
+def zero_points(
+    time: FloatArray, force: FloatArray, tolerance: float = 0.0, spacing: float = 0.0
+) -> NDArray[np.intp]:
+    """Find where the horizontal force is zero: sign changes and runs within ``tolerance``.
 
     Parameters
     ----------
+    time : ndarray, shape (n,)
+        Sample times [s].
     force : ndarray, shape (n,)
         Horizontal ground reaction force [N], filtered (noise makes spurious crossings); NaN
-        samples never count as crossings.
+        samples never count.
+    tolerance : float
+        |F| up to this counts as zero [N], >= 0: a body standing still may never cross.
+    spacing : float
+        Shortest time between two zero points [s]: of closer ones only the first is kept (the
+        velocity of an interval is a difference quotient over it, noisy when short).
 
     Returns
     -------
     ndarray of int
-        Increasing indices, each an exact zero or the sample of smaller |F| of a sign change.
+        Increasing indices: of each sign change the sample of smaller |F|, and the first and
+        last sample of each run with |F| <= tolerance.
     """
     sign = np.sign(force)
-    exact = np.flatnonzero(sign == 0.0)
+    small = np.abs(force) <= tolerance
+    edges = np.diff(np.concatenate(([0], small.astype(np.int8), [0])))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     change = np.flatnonzero(sign[:-1] * sign[1:] < 0.0)
     nearer = np.where(np.abs(force[change]) <= np.abs(force[change + 1]), change, change + 1)
-    return np.unique(np.concatenate((exact, nearer)))
+    # A run of near-zero force pins both its ends (the CoM stays above the CoP throughout).
+    pins = np.unique(np.concatenate((starts, stops - 1, nearer)))
+    if spacing > 0.0 and len(pins) > 1:
+        kept = [pins[0]]
+        for pin in pins[1:]:
+            if time[pin] - time[kept[-1]] >= spacing:
+                kept.append(pin)
+        pins = np.array(kept, dtype=np.intp)
+    return pins
 
 
 def com_from_force(
-    time: FloatArray, force: FloatArray, cop: FloatArray, mass: float
+    time: FloatArray,
+    force: FloatArray,
+    cop: FloatArray,
+    mass: float,
+    *,
+    tolerance: float | None = None,
+    spacing: float = MIN_SPACING,
 ) -> tuple[FloatArray, FloatArray]:
     """Horizontal CoM position and velocity by zero-point-to-zero-point integration.
 
@@ -70,6 +104,11 @@ def com_from_force(
         CoP along the same axis [m], lab frame.
     mass : float
         Body mass [kg], > 0.
+    tolerance : float, optional
+        |F| that counts as zero [N]; default ``ZERO_FORCE`` of the body weight (the CoM then
+        lies within that fraction of its height of the point above the CoP: 0.2 mm per metre).
+    spacing : float
+        Shortest interval between zero points [s] (:func:`zero_points`).
 
     Returns
     -------
@@ -84,7 +123,9 @@ def com_from_force(
     """
     mass = positive_float("mass", mass, "kg")
     force = np.asarray(force, dtype=np.float64)
-    pins = zero_points(np.where(np.isfinite(force), force, np.nan))
+    if tolerance is None:
+        tolerance = ZERO_FORCE * mass * STANDARD_GRAVITY
+    pins = zero_points(time, np.where(np.isfinite(force), force, np.nan), tolerance, spacing)
     pins = pins[np.isfinite(cop[pins])]
     if len(pins) < 2:
         raise InvalidParameterError(

@@ -1,0 +1,123 @@
+"""Known truth: MuJoCo pushes written as C3D files (markers + force plates), analysed back.
+
+The analysis sees only the C3D file; the truth is what the simulation did: the strategy it used
+(ankle torque, hip torque, a step) and the step it took.
+"""
+
+import functools
+
+import numpy as np
+import pytest
+
+from pushrecovery.analysis.c3d import write_c3d
+from pushrecovery.analysis.readers import read_c3d_recording
+from pushrecovery.analysis.trial import AnalysisSettings, analyze, body_for
+from pushrecovery.params import load_params
+from pushrecovery.sim.mujoco.mocap import record_push
+
+PARAMS = load_params()
+SETTINGS = AnalysisSettings()
+
+#: name -> (model, push velocity [m/s], duration [s]) chosen well inside each strategy's band.
+CASES = {
+    "ankle": ("foot", 0.30, 4.0),
+    "hip": ("torso", 0.55, 4.0),
+    "step": ("biped", 1.30, 2.5),
+}
+
+
+@functools.cache
+def _recorded(case):
+    model, velocity, duration = CASES[case]
+    return record_push(model, PARAMS, impulse=velocity * PARAMS.mass, duration=duration)
+
+
+def _c3d(tmp_path, recording, *, com=True):
+    markers = dict(recording.markers)
+    if not com:
+        del markers["CentreOfMass"]
+    path = tmp_path / "trial.c3d"
+    write_c3d(
+        path,
+        point_rate=recording.point_rate,
+        markers=markers,
+        analog_rate=recording.analog_rate,
+        plates=recording.plates,
+        mass=recording.mass,
+    )
+    return path
+
+
+def _analyse(path):
+    trial = read_c3d_recording(path)
+    found, sources = body_for(trial, mass=None, com_height=None, gravity=PARAMS.gravity)
+    params = load_params(overrides=found)
+    return trial, params, analyze(trial, params, SETTINGS, sources=sources)
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_analysis_needs_what_the_simulation_used(tmp_path, case):
+    recording = _recorded(case)
+    truth = recording.truth
+    assert truth["used"] == case and truth["outcome"] == "recovered"
+    assert truth["predicted"]["strategy"] == case
+    _, params, result = _analyse(_c3d(tmp_path, recording))
+    summary = result.summary
+    assert summary["body"]["mass_source"] == "file"
+    assert summary["body"]["mass"] == pytest.approx(recording.mass, rel=1e-6)
+    assert summary["body"]["com_height_source"] == "file"
+    # The ankle marker sits at the hinge: the standing CoM above it is the model's L (the
+    # biped's 1.6 kg legs put its whole-body CoM 1.5 cm lower).
+    assert params.com_height == pytest.approx(PARAMS.com_height, abs=0.02)
+    assert summary["support_source"] == "foot markers"
+    assert summary["directions"]["ap"]["most_demanding"] == case
+    if case != "step":
+        assert summary["directions"]["ml"]["most_demanding"] == "ankle"
+    # else: the planar biped's feet are drawn 0.1 m either side of its CoM and its joints hold
+    # it in the sagittal plane; in single support the markers rightly say that a free body
+    # would need more than its ankle medio-laterally (the CoM 5.5 cm beyond the stance foot).
+    assert summary["excluded_frames"] == 0
+    # Before the push: quiet standing, ankle.
+    time, strategy = result.columns["time"], result.columns["ap_strategy"]
+    assert (strategy[time < truth["push_time"] - 0.1] == "ankle").all()
+
+
+def test_the_predicted_step_is_the_step_taken(tmp_path):
+    recording = _recorded("step")
+    truth = recording.truth
+    assert truth["steps"] == 1
+    taken = truth["step_lengths"][0]
+    _, _, result = _analyse(_c3d(tmp_path, recording))
+    events = result.summary["step_events"]
+    assert events and events[0]["axis"] == "ap"
+    assert abs(events[0]["time"] - truth["push_time"]) < 0.05
+    # From the end of the filter's transient to the landing the stance leg falls as a
+    # pendulum, whose recommended step stays the one the controller took.
+    time = result.columns["time"]
+    landing = recording.analog_time[np.argmax(recording.plates[1][0][:, 2] > 20.0)]
+    window = (time > truth["push_time"] + 0.1) & (time < landing - 0.02)
+    lengths = result.columns["ap_step_length"][window]
+    assert np.isfinite(lengths).mean() > 0.9
+    assert np.nanmedian(lengths) == pytest.approx(taken, rel=0.05)
+
+
+def test_force_plates_alone_give_the_same_strategy(tmp_path):
+    """No CoM marker: the CoM comes from the plates by zero-point integration.
+
+    A push is an external force that is no ground reaction: the plates cannot see it, so the
+    interval between the zero points around the push misses its impulse. Everywhere else the
+    integrated CoM is the marker's.
+    """
+    recording = _recorded("ankle")
+    _, _, result = _analyse(_c3d(tmp_path, recording, com=False))
+    summary = result.summary
+    assert summary["com_source"].startswith("zero-point")
+    assert summary["directions"]["ap"]["most_demanding"] == "ankle"
+    time = result.columns["time"]
+    marker_com = np.interp(time, recording.point_time, recording.markers["CentreOfMass"][:, 0])
+    error = np.abs(result.columns["ap_com"] - marker_com)
+    assert np.isfinite(error).mean() > 0.9
+    push = recording.truth["push_time"]
+    away = (time < push - 0.3) | (time > push + 1.0)
+    assert np.nanmax(error[away]) < 0.002
+    assert np.nanmax(error) > 0.01  # the push itself is invisible to the plates
