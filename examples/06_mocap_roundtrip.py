@@ -35,5 +35,5 @@ print(f"wrote {path}: {len(trial.time)} marker frames, {len(recording.plates)} f
 print(f"simulation used:   {truth['used']}, step {truth['step_lengths'][0]:.3f} m")
 print(
     f"analysis needs:    {summary['strategy']['most_demanding']}, "
-    f"step {event['step_length']:.3f} m recommended at t = {event['time']:.2f} s"
+    f"step {event['step_length']:.3f} m recommended from t = {event['time']:.2f} s"
 )

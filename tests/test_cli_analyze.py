@@ -134,3 +134,22 @@ def test_bad_inputs_are_one_line(tmp_path, capsys):
     err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--mass", "-3", "--out", out)
     assert "mass" in err
     assert "--out" in _fail(capsys, "analyze", str(trial))
+    fake = tmp_path / "fake.c3d"
+    fake.write_text("time,com_ap\n0,0\n")
+    _fail(capsys, "analyze", str(fake), "--out", out)
+    kistler = _kistler()
+    cut = tmp_path / "cut.c3d"
+    cut.write_bytes(kistler.read_bytes()[:30_000])
+    _fail(capsys, "analyze", str(cut), "--out", out)
+    err = _fail(capsys, "analyze", str(kistler), "--com-marker", "C7", "--out", out)
+    assert "'C7'" in err
+    err = _fail(capsys, "analyze", str(kistler), "--foot", "left=LHEE", "--out", out)
+    assert "NAME=HEEL,TOE,ANKLE" in err
+
+
+def _kistler():
+    import pathlib
+
+    import biomdp
+
+    return pathlib.Path(biomdp.__file__).parent / "tests" / "datasets" / "kistler_COP.c3d"

@@ -99,6 +99,7 @@ def test_the_predicted_step_is_the_step_taken(tmp_path):
     lengths = result.columns["ap_step_length"][window]
     assert np.isfinite(lengths).mean() > 0.9
     assert np.nanmedian(lengths) == pytest.approx(taken, rel=0.05)
+    assert events[0]["step_length"] == pytest.approx(taken, rel=0.05)
 
 
 def test_force_plates_alone_give_the_same_strategy(tmp_path):

@@ -465,21 +465,28 @@ def _most_demanding(codes: NDArray[np.int8]) -> str | None:
 
 
 def _step_events(time: FloatArray, per_axis: dict[str, DirectionMargins]) -> list[dict[str, Any]]:
-    """Every run of frames that needs a step, per axis: onset, end and the recommended step."""
+    """Every run of frames that needs a step, per axis, with the recommended step.
+
+    The recommended step of an event is the median over its frames: along a fall the stance
+    leg swings as a pendulum whose recovering step stays the same, while the first frames are
+    marginal (and, after a short push, still inside the filter's transient).
+    """
     step = STRATEGY_CODES.index(Strategy.STEP)
     events = []
     for axis, margins in per_axis.items():
         for start, stop in find_gaps(margins.strategy == step):
+            span = slice(start, stop)
             events.append(
                 {
                     "axis": axis,
                     "time": float(time[start]),
                     "end": float(time[stop - 1]),
-                    "step_length": float(margins.step_length[start]),
+                    "step_length": float(np.median(margins.step_length[span])),
                     "step_length_range": [
-                        float(margins.step_shortest[start]),
-                        float(margins.step_longest[start]),
+                        float(np.median(margins.step_shortest[span])),
+                        float(np.median(margins.step_longest[span])),
                     ],
+                    "step_length_onset": float(margins.step_length[start]),
                     "capture_point": float(margins.capture_point[start]),
                 }
             )
