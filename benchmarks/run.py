@@ -20,6 +20,9 @@
    scheduling overhead per batch (wall time x workers minus the serial time, per batch) as a
    ratio to the work per batch (the serial time per batch). The machine has 2 cores: 2 workers
    can at best halve the wall time.
+9. Measured-trial analysis (``pushrecovery.analysis``): the real Kistler quiet-standing trial
+   (10 s at 1 kHz, force plates only: zero-point integration, filters, margins, strategies) as
+   a multiple of real time, and per frame against reading the file alone.
 """
 
 from __future__ import annotations
@@ -295,6 +298,31 @@ def campaigns() -> None:
         shutil.rmtree(root, ignore_errors=True)
 
 
+def analysis() -> None:
+    import biomdp
+
+    from pushrecovery.analysis.readers import read_c3d_recording
+    from pushrecovery.analysis.trial import analyze, body_for
+
+    path = Path(biomdp.__file__).parent / "tests" / "datasets" / "kistler_COP.c3d"
+    params = load_params()
+
+    def whole():
+        trial = read_c3d_recording(path)
+        found, _ = body_for(trial, mass=None, com_height=None, gravity=params.gravity)
+        return analyze(trial, load_params(overrides=found))
+
+    read = best(lambda: read_c3d_recording(path), number=1)
+    total = best(whole, number=1)
+    frames = len(whole().time)
+    duration = frames / 1000.0
+    print(
+        f"analysis: Kistler trial ({frames} frames, {duration:g} s) in {total * 1e3:.0f} ms: "
+        f"{duration / total:.0f}x real time, {frames / total:.3g} frames/s; "
+        f"reading the file alone {read * 1e3:.0f} ms (ratio {total / read:.1f})"
+    )
+
+
 def main() -> int:
     ratio = surface()
     cli = startup()
@@ -304,6 +332,7 @@ def main() -> int:
     physics = mujoco_realtime()
     batch()
     campaigns()
+    analysis()
     failed = ratio > 2.0 or cli > 0.3 or step_rate < 2e6 or step_ratio < 1000 or physics < 150
     print("targets met" if not failed else "TARGET MISSED")
     return int(failed)
