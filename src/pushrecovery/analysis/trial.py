@@ -227,7 +227,10 @@ def analyze(
         com = np.empty((len(time), 2))
         velocity = np.empty((len(time), 2))
         for i in range(2):
-            com[:, i], velocity[:, i] = com_from_force(time, force[:, i], cop[:, i], params.mass)
+            com[:, i], _ = com_from_force(time, force[:, i], cop[:, i], params.mass)
+        # Each interval's velocity has its own constant: it jumps at the zero points. The
+        # integrated position is continuous; low-pass it like a measured CoM and differentiate.
+        com, velocity = smooth_and_differentiate(time, com, settings.cutoff)
         com_source = "zero-point-to-zero-point integration of the ground reaction force"
 
     if force is not None and force_time is not None:

@@ -42,13 +42,15 @@ def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
 
     Green band: the base of support (CoP region, Eq. 4); orange: what the hip strategy adds
     (corrected Eq. 15); the strip under each panel shows the strategy each frame needs.
-    Positions are relative to the mean ankle along the axis [m].
+    Positions [m] are relative to the median stance ankle (ap) or base centre (ml).
     """
     columns, summary = analysis.columns, analysis.summary
     time = columns["time"]
     fig, axes = _figure(2, 1, 9.0, 6.4)
     for ax, axis in zip(axes[:, 0], AXES, strict=True):
-        origin = float(np.nanmedian(columns[f"{axis}_ankle"]))
+        # ap relative to the ankle (the paper's origin); ml to the middle of the base.
+        centre = 0.5 * (columns[f"{axis}_base_min"] + columns[f"{axis}_base_max"])
+        origin = float(np.nanmedian(columns[f"{axis}_ankle"] if axis == "ap" else centre))
         lower = columns[f"{axis}_base_min"] - origin
         upper = columns[f"{axis}_base_max"] - origin
         reach = columns[f"{axis}_margin_cmp"] - columns[f"{axis}_margin_cop"]
@@ -87,7 +89,9 @@ def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
         ax.set_title(
             f"{_TITLES[axis]}: needs {summary['directions'][axis]['most_demanding']}", fontsize=10
         )
-        ax.set_ylabel(f"{axis} position − ankle [m]")
+        ax.set_ylabel(
+            "ap position − ankle [m]" if axis == "ap" else "ml position − base centre [m]"
+        )
         _limit(ax, columns, axis, origin)
     axes[-1, 0].set_xlabel("time [s]")
     axes[0, 0].legend(loc="upper right", fontsize=7, ncols=3)
