@@ -358,18 +358,44 @@ def test_gaps_are_interpolated_or_excluded_and_reported(tmp_path):
     assert result.summary["excluded"] == {"no CoM": 50}
 
 
+def _table(header, row=lambda i: f"{i / 100:.2f},0,0", n=12, change=None):
+    """A CSV text of ``n`` rows made by ``row(i)``; ``change`` maps row index -> its text."""
+    rows = [row(i) for i in range(n)]
+    for i, text in (change or {}).items():
+        rows[i] = text
+    return "\n".join([header, *rows]) + "\n"
+
+
 MALFORMED = {
-    "no time": ("com_ap,com_ml\n0,0\n0,0\n", "missing column 'time'"),
-    "no com": ("time,cop_ap,cop_ml\n0,0,0\n0.01,0,0\n", "no CoM"),
-    "half a pair": ("time,com_ap\n0,0\n0.01,0\n", "com_ml"),
-    "text": ("time,com_ap,com_ml\n0,0,0\n0.01,abc,0\n", "row 3 is not a number"),
-    "backwards": ("time,com_ap,com_ml\n0,0,0\n0.02,0,0\n0.01,0,0\n", "increase"),
-    "uneven": ("time,com_ap,com_ml\n0,0,0\n0.01,0,0\n0.02,0,0\n0.05,0,0\n", "evenly"),
-    "ms": ("time,com_ap,com_ml\n0,0,0\n10,0,0\n20,0,0\n", "seconds"),
-    "one row": ("time,com_ap,com_ml\n0,0,0\n", "at least 2 rows"),
+    "no time": (_table("com_ap,com_ml", lambda i: "0,0"), "missing column 'time'"),
+    "no com": (_table("time,cop_ap,cop_ml"), "no CoM"),
+    "half a pair": (_table("time,com_ap", lambda i: f"{i / 100:.2f},0"), "com_ml"),
+    "text": (_table("time,com_ap,com_ml", change={1: "0.01,abc,0"}), "row 3 is not a number"),
+    "backwards": (_table("time,com_ap,com_ml", change={2: "0.005,0,0"}), "increase"),
+    "uneven": (_table("time,com_ap,com_ml", change={11: "0.5,0,0"}), "evenly"),
+    "ms": (_table("time,com_ap,com_ml", lambda i: f"{10 * i},0,0"), "seconds"),
+    "one row": ("time,com_ap,com_ml\n0,0,0\n", "at least 10 rows"),
     "empty": ("", "empty"),
-    "base": ("time,com_ap,com_ml,base_ap_min\n0,0,0,0\n0.01,0,0,0\n", "base_ap_max"),
-    "ragged": ("time,com_ap,com_ml\n0,0,0\n0.01,0\n", "malformed CSV"),
+    "base": (_table("time,com_ap,com_ml,base_ap_min", lambda i: f"{i / 100},0,0,0"), "base_ap_max"),
+    "ragged": (_table("time,com_ap,com_ml", change={3: "0.03,0"}), "malformed CSV"),
+    "no values": (
+        _table("time,com_ap,com_ml", lambda i: f"{i / 100},,0"),
+        "'com_ap' has no values",
+    ),
+    "force on the plate": (
+        _table(
+            "time,com_ap,com_ml,cop_ap,cop_ml,force_ap,force_ml,force_v",
+            lambda i: f"{i / 100},0,0,0,0,0,0,-700",
+        ),
+        "on the subject",
+    ),
+    "inverted base": (
+        _table(
+            "time,com_ap,com_ml,base_ap_min,base_ap_max,base_ml_min,base_ml_max",
+            lambda i: f"{i / 100},0,0,0.2,-0.05,-0.1,0.1",
+        ),
+        "inverted",
+    ),
 }
 
 
@@ -423,3 +449,35 @@ def test_force_plate_only_csv_integrates_the_com(tmp_path):
     assert inside.mean() > 0.8
     assert np.abs(com[inside] - x[inside]).max() < 2e-3
     assert result.summary["strategy"]["most_demanding"] == "ankle"
+
+
+def test_a_foot_without_markers_leaves_the_base_unknown():
+    n = 4
+    left = _foot("left", 0.0, 0.1, np.zeros(n), n)
+    right = _foot("right", 0.0, -0.1, np.zeros(n), n)
+    for part in (right.heel, right.toe, right.ankle):
+        part[1:3] = np.nan  # the right foot's markers drop out in frames 1 and 2
+    support = support_from_feet((left, right), contact_height=0.02, foot_width=0.09)
+    assert np.isnan(support.lower["ml"][1:3]).all() and np.isnan(support.upper["ap"][1:3]).all()
+    assert support.lower["ml"][[0, 3]].tolist() == pytest.approx([-0.145, -0.145])
+
+
+def test_the_lateral_malleolus_marker_does_not_widen_the_base():
+    n = 2
+    foot = _foot("left", 0.0, 0.1, np.zeros(n), n)
+    foot.ankle[:, 1] = 0.135  # Plug-in Gait's LANK, 3.5 cm lateral of the midline
+    support = support_from_feet((foot,), contact_height=0.02, foot_width=0.09)
+    assert support.upper["ml"].tolist() == pytest.approx([0.145, 0.145])
+    assert support.stance_ankle("ml", np.array([0.1, 0.1])).tolist() == pytest.approx([0.1, 0.1])
+
+
+def test_body_axes_follow_the_files_up_axis():
+    from pushrecovery.analysis.readers import body_rotation
+
+    assert body_rotation("x").tolist() == [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+    y_up = np.array([0.0, 1.0, 0.0])
+    rotation = body_rotation("z", y_up)
+    assert rotation.tolist() == [[0, 0, 1], [1, 0, 0], [0, 1, 0]]  # ml = up x ap = +x
+    assert np.linalg.det(rotation) == pytest.approx(1.0)
+    with pytest.raises(InvalidParameterError, match="horizontal"):
+        body_rotation("y", y_up)

@@ -99,6 +99,30 @@ def test_analyze_csv_writes_frames_summary_and_plots(tmp_path):
     assert np.nanmax(np.abs(np.array(frames["ml_com"]) - 0.003)) < 1e-9
 
 
+def test_gaps_reach_the_json_and_the_files(tmp_path):
+    trial = _trial(tmp_path / "trial.csv")
+    lines = trial.read_text().splitlines()
+    for i in (*range(51, 54), *range(121, 171)):  # 3 and 50 frames without a CoM
+        cells = lines[i].split(",")
+        cells[1] = ""
+        lines[i] = ",".join(cells)
+    trial.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "out"
+    args = ["analyze", str(trial), "--units", "mm", "--out", str(out), "--json", "--no-plot"]
+    result = CliRunner().invoke(cli, args, catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+
+    def no_constant(text):
+        raise AssertionError(f"non-JSON constant {text}")
+
+    data = json.loads(result.output, parse_constant=no_constant)
+    assert [(g["samples"], g["filled"]) for g in data["gaps"]] == [(3, True), (50, False)]
+    assert data["excluded_frames"] == 50
+    assert json.loads((out / "summary.json").read_text(), parse_constant=no_constant) == {
+        k: v for k, v in data.items() if k != "files"
+    }
+
+
 def test_analyze_table_output(tmp_path):
     trial = _trial(tmp_path / "trial.csv", push=0.8)
     args = ["analyze", str(trial), "--units", "mm", "--out", str(tmp_path / "o"), "--no-plot"]

@@ -4,6 +4,7 @@ import json
 import pathlib
 
 import biomdp
+import numpy as np
 
 from pushrecovery.cli import main
 
@@ -30,3 +31,13 @@ def test_quiet_standing_needs_the_ankle_throughout(tmp_path, capsys):
         assert summary["directions"][axis]["min_margin"]["cop"]["value"] > 0.02
     assert summary["strategy"]["time_in_strategy"]["ankle"] == summary["valid_frames"] / 1000.0
     assert summary["step_events"] == []
+    # Quiet standing: the CoP sways about the CoM, wider than it (the CoP drives the CoM).
+    import pyarrow.parquet as pq
+
+    frames = pq.read_table(tmp_path / "k" / "frames.parquet").to_pydict()
+    for axis in ("ap", "ml"):
+        com = np.array(frames[f"{axis}_com"], dtype=float)
+        cop = np.array(frames[f"{axis}_cop"], dtype=float)
+        both = np.isfinite(com) & np.isfinite(cop)
+        assert abs(np.mean(com[both]) - np.mean(cop[both])) < 0.002
+        assert 0.2 < np.std(com[both]) / np.std(cop[both]) < 1.0

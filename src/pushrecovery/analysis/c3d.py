@@ -202,6 +202,8 @@ class C3DContent:
         Number of marker frames (0 without markers).
     n_analog : int
         Number of analog samples (0 without analog channels).
+    up : ndarray, shape (3,)
+        The lab's up axis (``POINT:Y_SCREEN``, default +z).
     """
 
     point_rate: float | None
@@ -213,6 +215,7 @@ class C3DContent:
     first_time: float
     n_points: int = field(default=0)
     n_analog: int = field(default=0)
+    up: FloatArray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
 
     @property
     def point_time(self) -> FloatArray:
@@ -503,6 +506,7 @@ def _content(file: Path, c3d: Any, threshold: float) -> C3DContent:
         first_time=first_time,
         n_points=n_frames if n_markers else 0,
         n_analog=n_analog,
+        up=_lab_up(params),
     )
 
 

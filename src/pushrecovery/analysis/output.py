@@ -21,7 +21,9 @@ SUMMARY_FILE = "summary.json"
 
 
 def json_safe(value: Any) -> Any:
-    """Replace non-finite floats by None (JSON has no NaN or infinity), recursively."""
+    """Plain Python values, non-finite floats as None (JSON has no NaN or infinity)."""
+    if isinstance(value, np.generic):
+        value = value.item()
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, dict):

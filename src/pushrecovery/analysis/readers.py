@@ -46,8 +46,12 @@ FloatArray = NDArray[np.float64]
 
 #: Length units a file may use, in metres.
 LENGTH_UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001}
+#: Fewest frames a trial may have (a filter and a derivative need a few).
+MIN_FRAMES = 10
+#: Vertical force below which a plate counts as unloaded [N].
+LOADED_FORCE = 20.0
 #: Lab axis that points forward (anterior) in a C3D file; the lab's z is up.
-AP_AXES: tuple[str, ...] = ("x", "-x", "y", "-y")
+AP_AXES: tuple[str, ...] = ("x", "-x", "y", "-y", "z", "-z")
 #: Plug-in Gait foot markers: (foot, heel, toe, ankle).
 FOOT_MARKERS: tuple[tuple[str, str, str, str], ...] = (
     ("left", "LHEE", "LTOE", "LANK"),
@@ -142,6 +146,27 @@ def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
             f"cop_ap and cop_ml; columns found: {', '.join(table) or '(none)'}"
         )
 
+    for name in ("com_ap", "com_ml", "cop_ap", "cop_ml", *_FORCES):
+        if name in data and not np.isfinite(data[name]).any():
+            raise InputFileError(f"{path}: column {name!r} has no values")
+    if "force_v" in data and np.nanmedian(data["force_v"]) < -LOADED_FORCE:
+        raise InputFileError(
+            f"{path}: force_v is mostly negative (median {np.nanmedian(data['force_v']):.4g} N): "
+            "give the ground reaction force on the subject, up positive (negate a force on "
+            "the plate)"
+        )
+    for axis in AXES:
+        low, high = data.get(f"base_{axis}_min"), data.get(f"base_{axis}_max")
+        if low is not None and high is not None:
+            with np.errstate(invalid="ignore"):
+                inverted = high <= low
+            if inverted.any():
+                row = int(np.flatnonzero(inverted)[0]) + 2
+                raise InputFileError(
+                    f"{path}: base_{axis}_max must be > base_{axis}_min (an empty or inverted "
+                    f"base of support), row {row}"
+                )
+
     def pair(first: str, second: str) -> FloatArray | None:
         return np.column_stack([data[first], data[second]]) if first in data else None
 
@@ -211,8 +236,10 @@ def _read_table(path: Path) -> dict[str, FloatArray]:
         raise InputFileError(
             f"{path}: missing column 'time' [s]; columns found: {', '.join(names) or '(none)'}"
         )
-    if table.num_rows < 2:
-        raise InputFileError(f"{path}: needs at least 2 rows of data, got {table.num_rows}")
+    if table.num_rows < MIN_FRAMES:
+        raise InputFileError(
+            f"{path}: needs at least {MIN_FRAMES} rows of data, got {table.num_rows}"
+        )
     columns: dict[str, FloatArray] = {}
     for name, column in zip(names, table.columns, strict=True):
         if name not in CSV_COLUMNS:
@@ -311,14 +338,32 @@ def _largest(values: FloatArray | None) -> FloatArray | None:
 
 
 # --- C3D ---------------------------------------------------------------------------------
-def body_rotation(ap_axis: str) -> FloatArray:
-    """Rows ap, ml, up of the body axes in lab coordinates, z up (ml = up × ap, left)."""
+def body_rotation(ap_axis: str, up: FloatArray | None = None) -> FloatArray:
+    """Rows ap, ml, up of the body axes in lab coordinates (ml = up × ap: left).
+
+    Parameters
+    ----------
+    ap_axis : str
+        Lab axis pointing forward: ``x``, ``-x``, ``y``, ``-y``, ``z`` or ``-z``.
+    up : ndarray, optional
+        The lab's up axis (unit, along a lab axis); default +z.
+    """
     if ap_axis not in AP_AXES:
         raise InvalidParameterError(f"ap_axis must be one of {', '.join(AP_AXES)}, got {ap_axis!r}")
+    vertical = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, dtype=np.float64)
     sign = -1.0 if ap_axis.startswith("-") else 1.0
-    ap = sign * (np.eye(3)[0] if ap_axis.endswith("x") else np.eye(3)[1])
-    up = np.eye(3)[2]
-    return np.stack([ap, np.cross(up, ap), up])
+    ap = sign * np.eye(3)["xyz".index(ap_axis[-1])]
+    if abs(float(ap @ vertical)) > 1e-9:
+        raise InvalidParameterError(
+            f"--ap-axis must be horizontal: the file's up axis is {_axis_name(vertical)}, "
+            f"got {ap_axis}"
+        )
+    return np.stack([ap, np.cross(vertical, ap), vertical])
+
+
+def _axis_name(vector: FloatArray) -> str:
+    index = int(np.argmax(np.abs(vector)))
+    return ("+" if vector[index] > 0 else "-") + "xyz"[index]
 
 
 def read_c3d_recording(
@@ -335,7 +380,8 @@ def read_c3d_recording(
     path : str or Path
         The file.
     ap_axis : str
-        Lab axis pointing forward: ``x``, ``-x``, ``y`` or ``-y`` (z is up).
+        Lab axis pointing forward: ``x``, ``-x``, ``y``, ``-y``, ``z`` or ``-z``; it must be
+        horizontal (the file's ``POINT:Y_SCREEN`` names the up axis, default +z).
     com_markers : sequence of str, optional
         Markers whose mean is the CoM; default ``CentreOfMass`` when the file has it, else the
         CoM comes from the force plates.
@@ -351,8 +397,9 @@ def read_c3d_recording(
     from pushrecovery.analysis.c3d import read_c3d
 
     path = Path(path)
-    rotation = body_rotation(ap_axis)
+    body_rotation(ap_axis)  # a bad axis name fails before the file is read
     content = read_c3d(path)
+    rotation = body_rotation(ap_axis, content.up)
     markers = {name: values @ rotation.T for name, values in content.markers.items()}
     notes: list[str] = []
     if com_markers is None:

@@ -10,8 +10,10 @@ Base of support. From foot markers (heel, toe and ankle of each foot), a foot su
 frame when its lower marker is within ``contact_height`` of the lowest that marker gets in the
 trial (the foot is on the floor). Along ap the base spans the rearmost supporting heel marker
 to the foremost supporting toe marker; along ml it spans the supporting feet's markers widened
-by half the foot width on each side (the markers sit on the foot's midline). The stance ankle of
-the stepping model is the supporting ankle nearest the capture point.
+by half the foot width on each side (heel and toe markers sit on the foot's midline; the ankle
+marker, on the lateral malleolus, is left out). The stance ankle of the stepping model is the
+supporting ankle nearest the capture point (across: the foot's midline). A frame in which any
+foot's markers are missing has no known base.
 """
 
 from __future__ import annotations
@@ -152,11 +154,16 @@ def support_from_feet(
     toe = np.stack([f.toe for f in feet], axis=1)
     ankle = np.stack([f.ankle for f in feet], axis=1)
     low = np.fmin(heel[..., 2], toe[..., 2])
-    with np.errstate(invalid="ignore"):
+    with warnings.catch_warnings():  # a foot never seen stays NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
         floor = np.nanmin(low, axis=0)
+    with np.errstate(invalid="ignore"):
         supporting = low <= floor + contact_height
+    # A foot whose markers are missing may be on the floor or not: the base is unknown.
+    unknown = ~np.isfinite(low).all(axis=1)
     ap = (heel[..., 0], toe[..., 0])
-    ml = np.stack([heel[..., 1], toe[..., 1], ankle[..., 1]], axis=-1)
+    # Across, heel and toe only: Plug-in Gait's ankle marker sits on the lateral malleolus.
+    ml = np.stack([heel[..., 1], toe[..., 1]], axis=-1)
     hide = ~supporting
     with warnings.catch_warnings():  # frames with no supporting foot stay NaN
         warnings.simplefilter("ignore", RuntimeWarning)
@@ -176,7 +183,14 @@ def support_from_feet(
             f"along ap (got heel {rel_heel:+.3f} m, toe {rel_toe:+.3f} m from the ankle); "
             "check --ap-axis"
         )
-    ankles = {axis: np.where(hide, np.nan, ankle[..., i]) for i, axis in enumerate(AXES)}
+    for edges in (lower, upper):
+        for axis in AXES:
+            edges[axis][unknown] = np.nan
+    midline = 0.5 * (heel[..., 1] + toe[..., 1])
+    ankles = {
+        "ap": np.where(hide, np.nan, ankle[..., 0]),
+        "ml": np.where(hide, np.nan, midline),
+    }
     foot = {"ap": (float(rel_heel), float(rel_toe)), "ml": (-foot_width / 2, foot_width / 2)}
     return Support(lower, upper, ankles, foot, supporting)
 

@@ -122,7 +122,7 @@ def repair_gaps(
         if filled:
             assert spline is not None
             flat[start:stop] = spline(time[start:stop])
-        gaps.append(Gap(name, float(time[start]), float(time[stop - 1]), stop - start, filled))
+        gaps.append(Gap(name, float(time[start]), float(time[stop - 1]), int(stop - start), filled))
     return flat.reshape(values.shape), gaps
 
 

@@ -194,6 +194,7 @@ def analyze(
     """
     settings = settings or AnalysisSettings()
     gaps: list[Gap] = []
+    notes = list(recording.notes)
     force_time = recording.force_time
     force = cop = None
     if recording.force is not None and force_time is not None:
@@ -232,6 +233,10 @@ def analyze(
         # integrated position is continuous; low-pass it like a measured CoM and differentiate.
         com, velocity = smooth_and_differentiate(time, com, settings.cutoff)
         com_source = "zero-point-to-zero-point integration of the ground reaction force"
+        notes.append(
+            "CoM integrated from the force plates: an external push is no ground reaction "
+            "force, so its impulse is missing between the zero points around it"
+        )
 
     if force is not None and force_time is not None:
         force = _resample(force_time, force, time)
@@ -310,6 +315,7 @@ def analyze(
         sources=sources or {},
         com_source=com_source,
         support_source=support_source,
+        notes=notes,
         reasons=_exclusions(com, velocity, support, invalid),
     )
     return TrialAnalysis(columns, summary)
@@ -365,6 +371,11 @@ def _support(
     if recording.base:
         return _explicit_support(recording, time, params, settings), "base columns", gaps
     centre = cop if cop is not None and np.isfinite(cop).any() else com
+    if not np.isfinite(centre).any():
+        raise InvalidParameterError(
+            "nothing locates the feet: the trial has no CoP and no CoM values; give "
+            "--ankle-ap and --ankle-ml"
+        )
     ankle_ap = settings.ankle_ap
     ankle_ml = settings.ankle_ml
     assumed = []
@@ -511,6 +522,7 @@ def _summary(
     com_source: str,
     support_source: str,
     reasons: dict[str, int],
+    notes: list[str],
 ) -> dict[str, Any]:
     period = (time[-1] - time[0]) / max(len(time) - 1, 1)
     directions = {}
@@ -565,5 +577,5 @@ def _summary(
         },
         "directions": directions,
         "step_events": _step_events(time, per_axis),
-        "notes": list(recording.notes),
+        "notes": notes,
     }

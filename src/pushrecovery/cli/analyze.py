@@ -13,7 +13,7 @@ __all__ = ["analyze"]
 
 # Literal so that --help imports nothing heavy; a test checks them against the readers.
 _UNITS = ("m", "cm", "mm")
-_AP_AXES = ("x", "-x", "y", "-y")
+_AP_AXES = ("x", "-x", "y", "-y", "z", "-z")
 
 
 def _foot(text: str) -> tuple[str, str, str, str]:
