@@ -25,12 +25,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.analysis.recording import AXES, Foot, Recording
+from pushrecovery.analysis.recording import AXES, LOADED, Foot, Recording
+from pushrecovery.analysis.signals import resample
 from pushrecovery.errors import InputFileError, InvalidParameterError
+
+if TYPE_CHECKING:
+    from pushrecovery.analysis.c3d import ForcePlate
 
 __all__ = [
     "AP_AXES",
@@ -48,8 +53,6 @@ FloatArray = NDArray[np.float64]
 LENGTH_UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 #: Fewest frames a trial may have (a filter and a derivative need a few).
 MIN_FRAMES = 10
-#: Vertical force below which a plate counts as unloaded [N].
-LOADED_FORCE = 20.0
 #: Lab axis that points forward (anterior) in a C3D file; the lab's z is up.
 AP_AXES: tuple[str, ...] = ("x", "-x", "y", "-y", "z", "-z")
 #: Plug-in Gait foot markers: (foot, heel, toe, ankle).
@@ -149,7 +152,7 @@ def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
     for name in ("com_ap", "com_ml", "cop_ap", "cop_ml", *_FORCES):
         if name in data and not np.isfinite(data[name]).any():
             raise InputFileError(f"{path}: column {name!r} has no values")
-    if "force_v" in data and np.nanmedian(data["force_v"]) < -LOADED_FORCE:
+    if "force_v" in data and np.nanmedian(data["force_v"]) < -LOADED:
         raise InputFileError(
             f"{path}: force_v is mostly negative (median {np.nanmedian(data['force_v']):.4g} N): "
             "give the ground reaction force on the subject, up positive (negate a force on "
@@ -398,7 +401,7 @@ def read_c3d_recording(
 
     path = Path(path)
     body_rotation(ap_axis)  # a bad axis name fails before the file is read
-    content = read_c3d(path)
+    content = read_c3d(path, threshold=LOADED)
     rotation = body_rotation(ap_axis, content.up)
     markers = {name: values @ rotation.T for name, values in content.markers.items()}
     notes: list[str] = []
@@ -463,23 +466,22 @@ def read_c3d_recording(
 
 
 def _resampled(foot: Foot, source: FloatArray, target: FloatArray) -> Foot:
-    """Resample a foot's markers to other times (linear; NaN beyond the ends, next to gaps)."""
+    """Resample a foot's markers to other times (:func:`~.signals.resample`)."""
+    return Foot(
+        foot.name,
+        resample(source, foot.heel, target),
+        resample(source, foot.toe, target),
+        resample(source, foot.ankle, target),
+    )
 
-    def at(values: FloatArray) -> FloatArray:
-        return np.column_stack(
-            [np.interp(target, source, values[:, j], left=np.nan, right=np.nan) for j in range(3)]
-        )
 
-    return Foot(foot.name, at(foot.heel), at(foot.toe), at(foot.ankle))
-
-
-def _combined_cop(plates: Sequence[object]) -> FloatArray:
+def _combined_cop(plates: Sequence[ForcePlate]) -> FloatArray:
     """CoP of several plates at one height: the vertical-force-weighted mean of their CoPs."""
     weights = []
     points = []
     for plate in plates:
-        vertical = plate.force[:, 2]  # type: ignore[attr-defined]
-        cop = plate.cop  # type: ignore[attr-defined]
+        vertical = plate.force[:, 2]
+        cop = plate.cop
         loaded = np.isfinite(cop).all(axis=1) & (vertical > 0.0)
         weights.append(np.where(loaded, vertical, 0.0))
         points.append(np.where(loaded[:, None], cop, 0.0))

@@ -26,10 +26,12 @@ from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
 
-__all__ = ["AXES", "Foot", "Recording", "Support", "fixed_feet", "support_from_feet"]
+__all__ = ["AXES", "LOADED", "Foot", "Recording", "Support", "fixed_feet", "support_from_feet"]
 
 FloatArray = NDArray[np.float64]
 
+#: Vertical force below which a plate counts as unloaded: CoP and CMP undefined [N].
+LOADED = 20.0
 #: The two horizontal body axes, in output order.
 AXES: tuple[str, str] = ("ap", "ml")
 
@@ -91,11 +93,6 @@ class Recording:
     com_height: float | None = None
     source: str = ""
     notes: list[str] = field(default_factory=list)
-
-    @property
-    def rate(self) -> float:
-        """Frame rate of the kinematics [Hz]."""
-        return (len(self.time) - 1) / (self.time[-1] - self.time[0])
 
 
 @dataclass(frozen=True, slots=True)

@@ -32,6 +32,7 @@ __all__ = [
     "find_gaps",
     "lowpass",
     "repair_gaps",
+    "resample",
     "segments",
     "smooth_and_differentiate",
 ]
@@ -192,3 +193,15 @@ def smooth_and_differentiate(
         smooth[part] = lowpass(flat[part], rate, cutoff)
         slope[part] = np.gradient(smooth[part], time[part], axis=0)
     return smooth.reshape(values.shape), slope.reshape(values.shape)
+
+
+def resample(source: FloatArray, values: FloatArray, target: FloatArray) -> FloatArray:
+    """Values (n, k) at other times, linearly; NaN beyond the ends and next to missing samples."""
+    if len(source) == len(target) and np.array_equal(source, target):
+        return values
+    return np.column_stack(
+        [
+            np.interp(target, source, values[:, j], left=np.nan, right=np.nan)
+            for j in range(values.shape[1])
+        ]
+    )

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from pushrecovery.analysis.margins import DirectionMargins, direction_margins
 from pushrecovery.analysis.recording import (
     AXES,
+    LOADED,
     Foot,
     Recording,
     Support,
@@ -37,9 +38,10 @@ from pushrecovery.analysis.signals import (
     Gap,
     find_gaps,
     repair_gaps,
+    resample,
     smooth_and_differentiate,
 )
-from pushrecovery.analysis.zero_point import com_from_force
+from pushrecovery.analysis.zero_point import ZERO_FORCE, com_from_force
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy
@@ -48,8 +50,6 @@ __all__ = ["AnalysisSettings", "TrialAnalysis", "analyze", "body_for"]
 
 FloatArray = NDArray[np.float64]
 
-#: Vertical force below which the CoP and CMP are undefined [N].
-LOADED = 20.0
 #: Assumed distance of the mean CoP ahead of the ankle in quiet standing when nothing in the
 #: file locates the feet [m] (the gravity line falls a few cm in front of the ankle joint).
 COP_AHEAD_OF_ANKLE = 0.05
@@ -228,7 +228,9 @@ def analyze(
         com = np.empty((len(time), 2))
         velocity = np.empty((len(time), 2))
         for i in range(2):
-            com[:, i], _ = com_from_force(time, force[:, i], cop[:, i], params.mass)
+            com[:, i], _ = com_from_force(
+                time, force[:, i], cop[:, i], params.mass, tolerance=ZERO_FORCE * params.weight
+            )
         # Each interval's velocity has its own constant: it jumps at the zero points. The
         # integrated position is continuous; low-pass it like a measured CoM and differentiate.
         com, velocity = smooth_and_differentiate(time, com, settings.cutoff)
@@ -239,9 +241,9 @@ def analyze(
         )
 
     if force is not None and force_time is not None:
-        force = _resample(force_time, force, time)
+        force = resample(force_time, force, time)
     if cop is not None and force_time is not None:
-        cop = _resample(force_time, cop, time)
+        cop = resample(force_time, cop, time)
     support, support_source, found = _support(recording, time, com, cop, params, settings)
     gaps += found
 
@@ -332,16 +334,6 @@ def _repair_loaded(
     return repaired, gaps
 
 
-def _resample(source: FloatArray, values: FloatArray, target: FloatArray) -> FloatArray:
-    """Values at the target times by linear interpolation (NaN where a neighbour is NaN)."""
-    if len(source) == len(target) and np.array_equal(source, target):
-        return values
-    out = np.empty((len(target), values.shape[1]))
-    for j in range(values.shape[1]):
-        out[:, j] = np.interp(target, source, values[:, j], left=np.nan, right=np.nan)
-    return out
-
-
 def _support(
     recording: Recording,
     time: FloatArray,
@@ -357,7 +349,7 @@ def _support(
         for foot in recording.feet:
             parts = []
             for part in ("heel", "toe", "ankle"):
-                values = _resample(recording.time, getattr(foot, part), time)
+                values = resample(recording.time, getattr(foot, part), time)
                 values, found = repair_gaps(time, values, settings.max_gap, f"{foot.name} {part}")
                 gaps += found
                 parts.append(values)
