@@ -47,6 +47,19 @@ class BodyParams:
     max_step_length : float or None
         Longest step the legs can take, foot to foot [m], in (0, 2 leg_length); ``None``
         means equal to ``leg_length`` (a 30° stance-leg angle at impact).
+    foot_width : float
+        Width of the rectangular foot [heel, toe] × [−w/2, +w/2] [m], > 0 (paper preset 0.10).
+    stance_width : float
+        Lateral distance between the two ankles standing in double support [m], in
+        (0, 2 leg_length) (paper preset 0.20).
+    foot_polygon : tuple of (x, y) pairs or None
+        Vertices of a left foot that is not a rectangle, in the foot's frame (ankle at the
+        origin, x forward, y left) [m]: convex, non-degenerate, containing the ankle. The right
+        foot is its mirror image (y → −y). ``None``: the rectangle above. When given, ``heel``,
+        ``toe`` and ``foot_width`` must equal its extents (:func:`load_params` fills them in).
+    flywheel_inertia_roll, torque_max_roll, flywheel_angle_max_roll : float or None
+        The upper body's roll axis (CMP moved sideways, Eq. 6 in y): inertia [kg m^2], torque
+        limit [N m] and joint limit [rad]; ``None`` means equal to the pitch value.
 
     Raises
     ------
@@ -64,6 +77,12 @@ class BodyParams:
     flywheel_angle_max: float
     leg_length: float = field(default=None)  # type: ignore[assignment]
     max_step_length: float = field(default=None)  # type: ignore[assignment]
+    foot_width: float = 0.10
+    stance_width: float = 0.20
+    foot_polygon: tuple[tuple[float, float], ...] | None = None
+    flywheel_inertia_roll: float = field(default=None)  # type: ignore[assignment]
+    torque_max_roll: float = field(default=None)  # type: ignore[assignment]
+    flywheel_angle_max_roll: float = field(default=None)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -119,6 +138,45 @@ class BodyParams:
                 f"max_step_length must be < 2 leg_length = {2 * leg:g} m, got {reach:g}"
             )
         set_(self, "max_step_length", reach)
+        self._check_ground_plane(leg)
+
+    def _check_ground_plane(self, leg: float) -> None:
+        """Validate the foot width, stance width, foot polygon and the roll axis."""
+        set_ = object.__setattr__
+        set_(self, "foot_width", positive_float("foot_width", self.foot_width, "m"))
+        stance = positive_float("stance_width", self.stance_width, "m")
+        if stance >= 2.0 * leg:
+            raise InvalidParameterError(
+                f"stance_width must be < 2 leg_length = {2 * leg:g} m, got {stance:g}"
+            )
+        set_(self, "stance_width", stance)
+        if self.foot_polygon is not None:
+            from pushrecovery.ground.polygon import convex_polygon
+
+            polygon = convex_polygon("foot_polygon", self.foot_polygon, contains_origin=True)
+            set_(self, "foot_polygon", tuple((float(x), float(y)) for x, y in polygon.vertices))
+            extents = {
+                "heel": polygon.xmin,
+                "toe": polygon.xmax,
+                "foot_width": polygon.ymax - polygon.ymin,
+            }
+            for name, value in extents.items():
+                if abs(getattr(self, name) - value) > 1e-9:
+                    raise InvalidParameterError(
+                        f"{name} must equal the extent of foot_polygon ({value:g} m) or be "
+                        f"left out, got {name}={getattr(self, name):g}"
+                    )
+                set_(self, name, value)
+        for name, pitch, check in (
+            ("flywheel_inertia_roll", self.flywheel_inertia, positive_float),
+            ("torque_max_roll", self.torque_max, finite_float),
+            ("flywheel_angle_max_roll", self.flywheel_angle_max, positive_float),
+        ):
+            value = getattr(self, name)
+            value = pitch if value is None else check(name, value, "")
+            if value < 0.0:
+                raise InvalidParameterError(f"{name} must be >= 0 N m, got {name}={value:g}")
+            set_(self, name, float(value))
 
     @property
     def omega(self) -> float:
@@ -131,16 +189,23 @@ class BodyParams:
         return self.mass * self.gravity
 
     def to_dict(self) -> dict[str, float]:
-        """Return the parameters as a plain dict (the ``params`` object of the JSON contract)."""
-        return asdict(self)
+        """Return the parameters as a plain dict (the ``params`` object of the JSON contract).
+
+        ``foot_polygon`` becomes a list of [x, y] lists (what JSON reads back), or None.
+        """
+        data = asdict(self)
+        if self.foot_polygon is not None:
+            data["foot_polygon"] = [list(vertex) for vertex in self.foot_polygon]
+        return data
 
 
 FIELD_NAMES: tuple[str, ...] = tuple(f.name for f in fields(BodyParams))
 
 #: Built-in presets. ``paper``: the flywheel values of Fig. 5(b) (I, τmax, θmax); the body and
 #: foot are our documented choice (a 72 kg adult, CoM 1 m above the ankle, 20 cm foot with the
-#: ankle 5 cm in front of the heel).
-PRESETS: Mapping[str, Mapping[str, float | None]] = MappingProxyType(
+#: ankle 5 cm in front of the heel, 10 cm wide, ankles 20 cm apart; the roll axis of the upper
+#: body equal to its pitch axis).
+PRESETS: Mapping[str, Mapping[str, Any]] = MappingProxyType(
     {
         "paper": MappingProxyType(
             {
@@ -154,6 +219,12 @@ PRESETS: Mapping[str, Mapping[str, float | None]] = MappingProxyType(
                 "flywheel_angle_max": 1.0,
                 "leg_length": None,
                 "max_step_length": None,
+                "foot_width": 0.10,
+                "stance_width": 0.20,
+                "foot_polygon": None,
+                "flywheel_inertia_roll": None,
+                "torque_max_roll": None,
+                "flywheel_angle_max_roll": None,
             }
         )
     }
@@ -212,10 +283,44 @@ def load_params(
         values["leg_length"] = PRESETS[preset].get("leg_length")
     if {"com_height", "leg_length"} & given and "max_step_length" not in given:
         values["max_step_length"] = PRESETS[preset].get("max_step_length")
+    if values.get("foot_polygon") is not None:
+        values["foot_polygon"] = _polygon_value(values["foot_polygon"])
+        clash = sorted({"heel", "toe", "foot_width"} & given)
+        if clash:
+            raise InvalidParameterError(
+                f"give either foot_polygon or {clash[0]}, not both (the polygon sets heel, toe "
+                "and foot_width)"
+            )
+        xs = [x for x, _ in values["foot_polygon"]]
+        ys = [y for _, y in values["foot_polygon"]]
+        values.update(heel=min(xs), toe=max(xs), foot_width=max(ys) - min(ys))
     for name, value in values.items():
+        if name == "foot_polygon":
+            continue
         if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)):
             raise InvalidParameterError(f"{name} must be a number, got {value!r}")
     return BodyParams(**values)
+
+
+def _polygon_value(value: Any) -> tuple[tuple[float, float], ...]:
+    """``foot_polygon`` as a tuple of (x, y) pairs of numbers, or a one-line error."""
+    if not isinstance(value, list | tuple) or not value:
+        raise InvalidParameterError(
+            f"foot_polygon must be a list of [x, y] vertices in m, got {value!r:.60}"
+        )
+    pairs = []
+    for index, vertex in enumerate(value):
+        if (
+            not isinstance(vertex, list | tuple)
+            or len(vertex) != 2
+            or any(isinstance(c, bool) or not isinstance(c, int | float) for c in vertex)
+        ):
+            raise InvalidParameterError(
+                f"foot_polygon vertex {index} must be a pair of numbers [x, y] in m, "
+                f"got {vertex!r:.40}"
+            )
+        pairs.append((float(vertex[0]), float(vertex[1])))
+    return tuple(pairs)
 
 
 def _read_toml(path: Path) -> dict[str, Any]:

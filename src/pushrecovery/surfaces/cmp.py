@@ -29,18 +29,45 @@ from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cop import CaptureInterval, capture_margin
 
-__all__ = ["cmp_margin", "cmp_offset", "cmp_region"]
+__all__ = ["cmp_margin", "cmp_offset", "cmp_offset_roll", "cmp_region", "flywheel_offset"]
+
+
+def flywheel_offset(
+    torque_max: float, inertia: float, angle_max: float, weight: float, omega: float
+) -> float:
+    """How far one flywheel axis moves the capturable capture point past the CoP region [m].
+
+    a (1 − e^{−ω T_max})², a = τmax / (m g), T_max = sqrt(I θmax / τmax) (Eq. 12): corrected
+    Eq. (15) for an axis with torque limit τmax [N m], inertia I [kg m²] and joint limit θmax
+    [rad], for a body of weight m g [N] and ω = sqrt(g/L) [1/s]. Zero when τmax = 0.
+    """
+    if torque_max == 0.0:
+        return 0.0
+    spin_up = math.sqrt(inertia * angle_max / torque_max)
+    return torque_max / weight * (1.0 - math.exp(-omega * spin_up)) ** 2
 
 
 def cmp_offset(params: BodyParams) -> float:
     """How far the hip strategy extends the capture region past each foot edge [m].
 
-    a (1 − e^{−ω T_max})², a = τmax / (m g), corrected Eq. (15). Zero when τmax = 0.
+    a (1 − e^{−ω T_max})², a = τmax / (m g), corrected Eq. (15), for the pitch axis (x).
+    Zero when τmax = 0.
     """
     if params.torque_max == 0.0:
         return 0.0
     spin_up = max_spin_up_time(params)
     return params.torque_max / params.weight * (1.0 - math.exp(-params.omega * spin_up)) ** 2
+
+
+def cmp_offset_roll(params: BodyParams) -> float:
+    """:func:`cmp_offset` for the roll axis (the CMP moved sideways, y) [m]."""
+    return flywheel_offset(
+        params.torque_max_roll,
+        params.flywheel_inertia_roll,
+        params.flywheel_angle_max_roll,
+        params.weight,
+        params.omega,
+    )
 
 
 def cmp_region(params: BodyParams) -> CaptureInterval:

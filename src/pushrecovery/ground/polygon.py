@@ -1,0 +1,335 @@
+r"""Convex polygons on the ground plane: validation, hulls, signed distances, Minkowski sums.
+
+A :class:`ConvexPolygon` stores its vertices counter-clockwise and, for each edge i (vertex i to
+i + 1), the outward unit normal n_i and offset b_i = n_i · v_i, so that
+
+.. math:: P = \{p : n_i \cdot p \le b_i \ \forall i\}.
+
+The signed distance of a point p to P (positive inside) is exact:
+
+- inside, min_i (b_i − n_i · p): the disc of that radius about p lies in every half-plane and
+  touches the nearest edge line on the boundary;
+- outside, −min_i dist(p, edge_i), the Euclidean distance to the nearest edge *segment* (a
+  corner is nearer than any edge line there).
+
+Coordinates are x forward, y left [m]; yaw is counter-clockwise about z [rad]
+(``docs/conventions.md``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pushrecovery.errors import InvalidParameterError
+
+__all__ = ["ConvexPolygon", "convex_hull", "convex_polygon", "rectangle"]
+
+FloatArray = NDArray[np.float64]
+
+# Rows of a chunk for the numpy signed distance: (edges x chunk) temporaries stay small.
+_CHUNK = 1 << 16
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ConvexPolygon:
+    """A convex polygon with counter-clockwise vertices [m]; build with :func:`convex_polygon`.
+
+    Attributes
+    ----------
+    vertices : ndarray, shape (n, 2)
+        Counter-clockwise vertices (x, y) [m], no repeats, no collinear triples, n >= 3.
+    normals : ndarray, shape (n, 2)
+        Outward unit normal of edge i (from vertex i to vertex i + 1).
+    offsets : ndarray, shape (n,)
+        b_i = n_i · v_i [m]: the polygon is {p : n_i · p <= b_i}.
+    """
+
+    vertices: FloatArray
+    normals: FloatArray
+    offsets: FloatArray
+
+    @classmethod
+    def _from_ccw(cls, vertices: FloatArray) -> ConvexPolygon:
+        vertices = np.array(vertices, dtype=np.float64)
+        edges = np.roll(vertices, -1, axis=0) - vertices
+        lengths = np.hypot(edges[:, 0], edges[:, 1])
+        normals = np.column_stack([edges[:, 1], -edges[:, 0]]) / lengths[:, None]
+        offsets = np.einsum("ij,ij->i", normals, vertices)
+        for array in (vertices, normals, offsets):
+            array.flags.writeable = False
+        return cls(vertices, normals, offsets)
+
+    @property
+    def area(self) -> float:
+        """Area [m²] (shoelace formula), > 0."""
+        x, y = self.vertices[:, 0], self.vertices[:, 1]
+        return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+    @property
+    def centroid(self) -> tuple[float, float]:
+        """Area centroid (x, y) [m]."""
+        x, y = self.vertices[:, 0], self.vertices[:, 1]
+        xn, yn = np.roll(x, -1), np.roll(y, -1)
+        cross = x * yn - xn * y
+        scale = 1.0 / (6.0 * self.area)
+        return float(np.dot(x + xn, cross) * scale), float(np.dot(y + yn, cross) * scale)
+
+    @property
+    def xmin(self) -> float:
+        """Smallest x of the polygon [m]."""
+        return float(self.vertices[:, 0].min())
+
+    @property
+    def xmax(self) -> float:
+        """Largest x of the polygon [m]."""
+        return float(self.vertices[:, 0].max())
+
+    @property
+    def ymin(self) -> float:
+        """Smallest y of the polygon [m]."""
+        return float(self.vertices[:, 1].min())
+
+    @property
+    def ymax(self) -> float:
+        """Largest y of the polygon [m]."""
+        return float(self.vertices[:, 1].max())
+
+    def support(self, direction_x: float, direction_y: float) -> float:
+        """Support function h(d) = max over the polygon of d · p [m·|d|]."""
+        return float(np.max(self.vertices @ np.array([direction_x, direction_y])))
+
+    def signed_distance(self, px: ArrayLike, py: ArrayLike) -> FloatArray:
+        """Signed Euclidean distance of points to the boundary, positive inside [m].
+
+        Exact (module docstring); vectorised over broadcast arrays of x and y [m].
+        """
+        px, py = np.broadcast_arrays(
+            np.asarray(px, dtype=np.float64), np.asarray(py, dtype=np.float64)
+        )
+        out = np.empty(px.shape)
+        flat_x, flat_y, flat_out = px.reshape(-1), py.reshape(-1), out.reshape(-1)
+        for start in range(0, flat_x.size, _CHUNK):
+            part = slice(start, start + _CHUNK)
+            flat_out[part] = self._signed_distance_flat(flat_x[part], flat_y[part])
+        return out
+
+    def _signed_distance_flat(self, px: FloatArray, py: FloatArray) -> FloatArray:
+        nx, ny, b = self.normals[:, 0:1], self.normals[:, 1:2], self.offsets[:, None]
+        with np.errstate(invalid="ignore", over="ignore"):
+            excess = (nx * px + ny * py - b).max(axis=0)  # > 0 outside
+        distance = -excess
+        outside = np.flatnonzero(excess > 0.0)
+        if outside.size:
+            distance[outside] = -self._outside_distance(px[outside], py[outside])
+        return distance
+
+    def _outside_distance(self, px: FloatArray, py: FloatArray) -> FloatArray:
+        """Distance to the nearest edge segment (points outside) [m]."""
+        start = self.vertices
+        edge = np.roll(start, -1, axis=0) - start
+        length2 = np.einsum("ij,ij->i", edge, edge)
+        dx = px[None, :] - start[:, 0:1]
+        dy = py[None, :] - start[:, 1:2]
+        along = np.clip((dx * edge[:, 0:1] + dy * edge[:, 1:2]) / length2[:, None], 0.0, 1.0)
+        gap = np.hypot(dx - along * edge[:, 0:1], dy - along * edge[:, 1:2])
+        return np.asarray(gap.min(axis=0), dtype=np.float64)
+
+    def contains(self, px: ArrayLike, py: ArrayLike) -> NDArray[np.bool_]:
+        """Return True strictly inside the polygon (signed distance > 0)."""
+        return self.signed_distance(px, py) > 0.0
+
+    def transformed(self, x: float, y: float, yaw: float) -> ConvexPolygon:
+        """Rotate by ``yaw`` [rad] (counter-clockwise), then move by (x, y) [m]."""
+        c, s = math.cos(yaw), math.sin(yaw)
+        rotation = np.array([[c, -s], [s, c]])
+        return ConvexPolygon._from_ccw(self.vertices @ rotation.T + np.array([x, y]))
+
+    def mirrored(self) -> ConvexPolygon:
+        """Mirror image about the x axis (y → −y): a right foot from a left one."""
+        mirrored = self.vertices[::-1] * np.array([1.0, -1.0])
+        return ConvexPolygon._from_ccw(mirrored)
+
+    def grown(self, half_x: float, half_y: float, yaw: float = 0.0) -> ConvexPolygon:
+        """Minkowski sum with the box [−half_x, half_x] × [−half_y, half_y] [m], turned by yaw.
+
+        Its support function is h(d) + half_x |d · e_x| + half_y |d · e_y|, with e_x, e_y the
+        box's axes (yaw [rad] counter-clockwise from the world's x and y).
+        """
+        if half_x < 0.0 or half_y < 0.0:
+            raise InvalidParameterError(
+                f"box half-sizes must be >= 0 m, got half_x={half_x:g}, half_y={half_y:g}"
+            )
+        if half_x == 0.0 and half_y == 0.0:
+            return self
+        c, s = math.cos(yaw), math.sin(yaw)
+        corners = np.array(
+            [
+                [c * sx * half_x - s * sy * half_y, s * sx * half_x + c * sy * half_y]
+                for sx in (-1, 1)
+                for sy in (-1, 1)
+            ]
+        )
+        return convex_hull((self.vertices[:, None, :] + corners[None, :, :]).reshape(-1, 2))
+
+    def ray_distance(self, origin_x: float, origin_y: float, angle: float) -> float:
+        """Distance from an interior point to the boundary along the heading ``angle`` [m].
+
+        ``angle`` is measured counter-clockwise from +x [rad]; the origin must lie inside.
+        """
+        dx, dy = math.cos(angle), math.sin(angle)
+        rates = self.normals @ np.array([dx, dy])
+        gaps = self.offsets - self.normals @ np.array([origin_x, origin_y])
+        if np.any(gaps <= 0.0):
+            raise InvalidParameterError(
+                f"ray origin ({origin_x:g}, {origin_y:g}) m must lie inside the polygon"
+            )
+        ahead = rates > 0.0
+        return float(np.min(gaps[ahead] / rates[ahead]))
+
+    def to_list(self) -> list[list[float]]:
+        """Vertices as a JSON-ready list of [x, y] [m], counter-clockwise."""
+        return [[float(x), float(y)] for x, y in self.vertices]
+
+
+def rectangle(heel: float, toe: float, width: float) -> ConvexPolygon:
+    """Return the foot [heel, toe] × [−width/2, width/2] [m] in its own frame."""
+    half = 0.5 * width
+    return ConvexPolygon._from_ccw(
+        np.array([[heel, -half], [toe, -half], [toe, half], [heel, half]])
+    )
+
+
+def convex_hull(points: ArrayLike) -> ConvexPolygon:
+    """Convex hull of points (Andrew's monotone chain), collinear points dropped.
+
+    Raises
+    ------
+    InvalidParameterError
+        If the hull has zero area (fewer than three non-collinear points).
+    """
+    pts = np.unique(np.asarray(points, dtype=np.float64).reshape(-1, 2), axis=0)
+    scale = max(1.0, float(np.abs(pts).max())) if pts.size else 1.0
+    eps = 1e-12 * scale * scale
+
+    def chain(sequence: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
+        hull: list[NDArray[np.float64]] = []
+        for p in sequence:
+            while len(hull) >= 2 and _cross(hull[-2], hull[-1], p) <= eps:
+                hull.pop()
+            hull.append(p)
+        return hull
+
+    ordered = list(pts)
+    lower, upper = chain(ordered), chain(ordered[::-1])
+    hull = lower[:-1] + upper[:-1]
+    if len(hull) < 3:
+        raise InvalidParameterError("support polygon is degenerate (zero area)")
+    return ConvexPolygon._from_ccw(np.array(hull))
+
+
+def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False) -> ConvexPolygon:
+    """Validate user vertices as a convex polygon (either orientation) or raise naming them.
+
+    Collinear vertices (on the line of their neighbours) are dropped; clockwise input is
+    reversed.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name for the messages, e.g. ``"foot_polygon"``.
+    vertices : sequence of (x, y)
+        The vertices in order [m].
+    contains_origin : bool
+        Require the origin (the ankle) strictly inside.
+
+    Raises
+    ------
+    InvalidParameterError
+        Fewer than 3 vertices, a non-finite or repeated vertex, self-intersecting edges, a
+        non-convex vertex, zero area, or (with ``contains_origin``) the origin not inside.
+    """
+    try:
+        pts = np.asarray(vertices, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            f"{name} must be a list of [x, y] vertices in m, got {vertices!r:.60}"
+        ) from None
+    if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 3:
+        raise InvalidParameterError(
+            f"{name} must be at least 3 [x, y] vertices in m, got shape {pts.shape}"
+        )
+    for index, (x, y) in enumerate(pts):
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise InvalidParameterError(f"{name} vertex {index} is not finite: ({x}, {y})")
+    n = len(pts)
+    scale = max(1e-3, float(np.abs(pts).max()))
+    eps = 1e-12 * scale * scale
+    for index in range(n):
+        if np.array_equal(pts[index], pts[(index + 1) % n]):
+            raise InvalidParameterError(
+                f"{name} vertex {(index + 1) % n} repeats vertex {index} at "
+                f"({pts[index][0]:g}, {pts[index][1]:g})"
+            )
+    for i in range(n):
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue  # adjacent through the closing edge
+            if _segments_cross(pts[i], pts[(i + 1) % n], pts[j], pts[(j + 1) % n], eps):
+                raise InvalidParameterError(
+                    f"{name} is self-intersecting: edge {i}-{(i + 1) % n} crosses edge "
+                    f"{j}-{(j + 1) % n}"
+                )
+    turns = np.array([_cross(pts[i - 1], pts[i], pts[(i + 1) % n]) for i in range(n)])
+    area = 0.5 * float(
+        np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1])
+    )
+    if abs(area) <= eps:
+        raise InvalidParameterError(f"{name} is degenerate: zero area")
+    sign = 1.0 if area > 0.0 else -1.0
+    for index, turn in enumerate(turns):
+        if sign * turn < -eps:
+            x, y = pts[index]
+            raise InvalidParameterError(f"{name} is not convex at vertex {index} ({x:g}, {y:g})")
+    keep = np.abs(turns) > eps
+    ordered = pts[keep] if sign > 0.0 else pts[keep][::-1]
+    polygon = ConvexPolygon._from_ccw(ordered)
+    if contains_origin and float(polygon.signed_distance(0.0, 0.0)) <= 0.0:
+        raise InvalidParameterError(
+            f"{name} must contain the ankle (0, 0) strictly inside; it spans x in "
+            f"[{polygon.xmin:g}, {polygon.xmax:g}] m, y in [{polygon.ymin:g}, {polygon.ymax:g}] m"
+        )
+    return polygon
+
+
+def _cross(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> float:
+    """Return the z of (b − a) × (c − b): > 0 for a left (counter-clockwise) turn at b."""
+    a, b, c = (np.asarray(p, dtype=np.float64) for p in (a, b, c))
+    return float((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]))
+
+
+def _segments_cross(a: FloatArray, b: FloatArray, c: FloatArray, d: FloatArray, eps: float) -> bool:
+    """Proper or touching intersection of segments ab and cd."""
+
+    def orient(p: FloatArray, q: FloatArray, r: FloatArray) -> float:
+        return float((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
+
+    def on_segment(p: FloatArray, q: FloatArray, r: FloatArray) -> bool:
+        return bool(
+            min(p[0], q[0]) - 1e-15 <= r[0] <= max(p[0], q[0]) + 1e-15
+            and min(p[1], q[1]) - 1e-15 <= r[1] <= max(p[1], q[1]) + 1e-15
+        )
+
+    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
+    if ((o1 > eps and o2 < -eps) or (o1 < -eps and o2 > eps)) and (
+        (o3 > eps and o4 < -eps) or (o3 < -eps and o4 > eps)
+    ):
+        return True
+    return any(
+        abs(o) <= eps and on_segment(p, q, r)
+        for o, p, q, r in ((o1, a, b, c), (o2, a, b, d), (o3, c, d, a), (o4, c, d, b))
+    )

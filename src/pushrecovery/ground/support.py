@@ -1,0 +1,178 @@
+"""Feet on the ground plane and the support polygon of a stance.
+
+A foot is a convex polygon in its own frame (ankle at the origin, x forward, y left): the
+rectangle [heel, toe] × [−foot_width/2, foot_width/2] by default, or ``foot_polygon``
+(:class:`~pushrecovery.params.BodyParams`). That shape is the *left* foot; the right foot is its
+mirror image (y → −y). A :class:`FootPose` places a foot's ankle at (x, y) with a yaw. The
+support polygon is the foot in single support and the convex hull of both feet in double
+support (where the CoP can be anywhere between the feet: any convex combination of the two
+feet's CoPs).
+
+Default poses (``Support.from_params``): both ankles on the y axis, x = 0, the left at
++stance_width/2 and the right at −stance_width/2, yaw 0, so the world origin is the midpoint of
+the ankles and the sagittal model's x axis runs between the feet.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+
+import numpy as np
+
+from pushrecovery._validate import finite_float
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import ConvexPolygon, convex_hull, convex_polygon, rectangle
+from pushrecovery.params import BodyParams
+
+__all__ = ["FootPose", "Stance", "Support", "foot_shape"]
+
+
+class Stance(StrEnum):
+    """Which feet carry the body."""
+
+    DOUBLE = "double"
+    LEFT = "left"
+    RIGHT = "right"
+
+
+@dataclass(frozen=True, slots=True)
+class FootPose:
+    """Where a foot stands: its ankle at (x, y) [m] and its yaw [rad], counter-clockwise."""
+
+    x: float
+    y: float
+    yaw: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name, unit in (("x", "m"), ("y", "m"), ("yaw", "rad")):
+            object.__setattr__(
+                self, name, finite_float(f"foot pose {name}", getattr(self, name), unit)
+            )
+
+    @classmethod
+    def parse(cls, name: str, text: str) -> FootPose:
+        """Parse ``"X,Y[,YAW]"`` ([m], [m], [rad]) or raise naming ``name``."""
+        parts = [part.strip() for part in text.split(",")]
+        if len(parts) not in (2, 3):
+            raise InvalidParameterError(f"{name} must be X,Y or X,Y,YAW (m, m, rad), got {text!r}")
+        try:
+            values = [float(part) for part in parts]
+        except ValueError:
+            raise InvalidParameterError(
+                f"{name} must be X,Y or X,Y,YAW numbers (m, m, rad), got {text!r}"
+            ) from None
+        if not all(math.isfinite(value) for value in values):
+            raise InvalidParameterError(f"{name} must be finite, got {text!r}")
+        return cls(*values)
+
+
+def foot_shape(params: BodyParams) -> ConvexPolygon:
+    """Return the left foot in its own frame: ``foot_polygon`` or the heel/toe/width rectangle."""
+    if params.foot_polygon is not None:
+        return convex_polygon("foot_polygon", params.foot_polygon, contains_origin=True)
+    return rectangle(params.heel, params.toe, params.foot_width)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Support:
+    """The support polygon of a stance, with the feet that make it.
+
+    Attributes
+    ----------
+    stance : Stance
+        ``double``, ``left`` or ``right``.
+    left, right : FootPose
+        Poses of both feet (the lifted one is kept: the next issue steps with it).
+    foot : ConvexPolygon
+        The left foot in its own frame [m].
+    polygon : ConvexPolygon
+        The support polygon in the world frame [m].
+    """
+
+    stance: Stance
+    left: FootPose
+    right: FootPose
+    foot: ConvexPolygon
+    polygon: ConvexPolygon
+
+    @classmethod
+    def from_params(
+        cls,
+        params: BodyParams,
+        stance: str | Stance = Stance.DOUBLE,
+        *,
+        left: FootPose | None = None,
+        right: FootPose | None = None,
+    ) -> Support:
+        """Support polygon of ``stance`` for feet at ``left``/``right`` (default poses: module).
+
+        Raises
+        ------
+        InvalidParameterError
+            Unknown stance.
+        """
+        try:
+            stance = Stance(stance)
+        except ValueError:
+            raise InvalidParameterError(
+                f"stance must be one of {[s.value for s in Stance]}, got {stance!r}"
+            ) from None
+        half = 0.5 * params.stance_width
+        left = FootPose(0.0, half) if left is None else left
+        right = FootPose(0.0, -half) if right is None else right
+        foot = foot_shape(params)
+        placed = {
+            Stance.LEFT: foot.transformed(left.x, left.y, left.yaw),
+            Stance.RIGHT: foot.mirrored().transformed(right.x, right.y, right.yaw),
+        }
+        if stance is Stance.DOUBLE:
+            polygon = convex_hull(np.vstack([p.vertices for p in placed.values()]))
+        else:
+            polygon = placed[stance]
+        return cls(stance, left, right, foot, polygon)
+
+    @property
+    def ankle(self) -> tuple[float, float]:
+        """Reference point of the stance [m]: the stance ankle, or the ankles' midpoint."""
+        if self.stance is Stance.LEFT:
+            return self.left.x, self.left.y
+        if self.stance is Stance.RIGHT:
+            return self.right.x, self.right.y
+        return 0.5 * (self.left.x + self.right.x), 0.5 * (self.left.y + self.right.y)
+
+    @property
+    def yaw(self) -> float:
+        """Heading of the stance [rad]: the stance foot's yaw, or the mean of both (double)."""
+        if self.stance is Stance.LEFT:
+            return self.left.yaw
+        if self.stance is Stance.RIGHT:
+            return self.right.yaw
+        return math.atan2(
+            math.sin(self.left.yaw) + math.sin(self.right.yaw),
+            math.cos(self.left.yaw) + math.cos(self.right.yaw),
+        )
+
+    def landing_foot(self, direction_x: float, direction_y: float) -> tuple[float, float]:
+        """Back and front edges (heel < 0 < toe) of a landing foot along a unit direction [m].
+
+        The landing foot has the stance's yaw (the shape of the foot that would step: the
+        right foot when stepping to the right, else the left), and its edges along the step
+        line are its support function: toe = h(d), heel = −h(−d), relative to its ankle.
+        """
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        # The direction in the foot's frame.
+        fx, fy = c * direction_x + s * direction_y, -s * direction_x + c * direction_y
+        shape = self.foot.mirrored() if fy < 0.0 else self.foot
+        return -shape.support(-fx, -fy), shape.support(fx, fy)
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON form: stance, foot poses and the support polygon's vertices [m]."""
+        return {
+            "stance": self.stance.value,
+            "left": {"x": self.left.x, "y": self.left.y, "yaw": self.left.yaw},
+            "right": {"x": self.right.x, "y": self.right.y, "yaw": self.right.yaw},
+            "vertices": self.polygon.to_list(),
+            "area": self.polygon.area,
+        }
