@@ -16,13 +16,17 @@ FOOT = [[-0.05, -0.04], [0.2, -0.05], [0.24, 0.0], [0.2, 0.05], [-0.05, 0.04]]
 
 
 def brute_signed_distance(vertices, px, py, samples=4000):
-    """Distance to a densely sampled boundary, sign from the half-planes: independent of the code."""
+    """Distance to a densely sampled boundary, sign from the half-planes (independent code)."""
     v = np.asarray(vertices, float)
     t = np.linspace(0.0, 1.0, samples, endpoint=False)
-    boundary = np.vstack([a + t[:, None] * (b - a) for a, b in zip(v, np.roll(v, -1, 0))])
+    boundary = np.vstack(
+        [a + t[:, None] * (b - a) for a, b in zip(v, np.roll(v, -1, 0), strict=True)]
+    )
     distance = np.hypot(boundary[:, 0] - px, boundary[:, 1] - py).min()
     edges = np.roll(v, -1, 0) - v
-    inside = all((e[0] * (py - a[1]) - e[1] * (px - a[0])) > 0 for a, e in zip(v, edges))
+    inside = all(
+        (e[0] * (py - a[1]) - e[1] * (px - a[0])) > 0 for a, e in zip(v, edges, strict=True)
+    )
     return distance if inside else -distance
 
 
@@ -42,7 +46,7 @@ def test_signed_distance_vectorised_equals_scalar_calls():
     rng = np.random.default_rng(0)
     px, py = rng.uniform(-0.5, 0.5, 200), rng.uniform(-0.5, 0.5, 200)
     many = polygon.signed_distance(px, py)
-    one = [float(polygon.signed_distance(a, b)) for a, b in zip(px, py)]
+    one = [float(polygon.signed_distance(a, b)) for a, b in zip(px, py, strict=True)]
     np.testing.assert_array_equal(many, one)
 
 

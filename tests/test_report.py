@@ -133,9 +133,9 @@ def test_report_is_one_self_contained_page(params: BodyParams, tmp_path: Path) -
     for forbidden in ('src="http', 'href="http', "<script", "<link", "url("):
         assert forbidden not in html
     images = re.findall(r'<img src="([^"]*)"', html)
-    assert len(images) >= 8 + 3  # the paper's figures, the map, two campaign plots
+    assert len(images) >= 8 + 4  # the paper's figures, the map, the plane, two campaign plots
     assert all(src.startswith("data:image/png;base64,") for src in images)
-    for key in ("bounds", "map", "figures", "analytic", "sweep"):
+    for key in ("bounds", "map", "plane", "figures", "analytic", "sweep"):
         assert f"<h2>{SECTIONS[key].replace(chr(39), '&#x27;')}</h2>" in html
     for key in ("mujoco", "biped", "critical", "filmstrips"):
         assert f'id="{key}"' not in html
@@ -147,13 +147,13 @@ def test_report_is_one_self_contained_page(params: BodyParams, tmp_path: Path) -
     assert f"Accuracy {summary['accuracy']:.3g}" in html
     # Every section's wall time in the footer, and reported as it ran.
     footer = html[html.index("<footer>") :]
-    for key in ("bounds", "map", "figures", "analytic", "sweep"):
+    for key in ("bounds", "map", "plane", "figures", "analytic", "sweep"):
         assert SECTIONS[key].replace("'", "&#x27;") in footer
     assert any(line.startswith(SECTIONS["analytic"] + ":") for line in lines)
 
 
 def test_report_reuses_and_replaces_its_campaigns(params: BodyParams, tmp_path: Path) -> None:
-    skip = ("bounds", "map", "figures", "sweep")
+    skip = ("bounds", "map", "plane", "figures", "sweep")
     write_report(params, tmp_path, mujoco=False, skip=skip, workers=1, **TINY)
     batch = next((tmp_path / "campaign-analytic" / "batches").iterdir())
     stamp = batch.stat().st_mtime_ns

@@ -59,7 +59,9 @@ class BodyParams:
         ``toe`` and ``foot_width`` must equal its extents (:func:`load_params` fills them in).
     flywheel_inertia_roll, torque_max_roll, flywheel_angle_max_roll : float or None
         The upper body's roll axis (CMP moved sideways, Eq. 6 in y): inertia [kg m^2], torque
-        limit [N m] and joint limit [rad]; ``None`` means equal to the pitch value.
+        limit [N m] and joint limit [rad]; ``None`` means equal to the pitch value. Like
+        ``leg_length``, the value is fixed when the parameters are built: ``dataclasses.replace``
+        of a pitch value keeps the roll value (``load_params`` re-derives it).
 
     Raises
     ------

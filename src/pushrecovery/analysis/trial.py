@@ -70,10 +70,12 @@ class AnalysisSettings:
         Longest gap that is interpolated [s], >= 0; longer gaps are excluded.
     contact_height : float
         A foot supports while its lower marker is within this of its lowest [m], > 0.
-    foot_width : float
-        Foot width, for the medio-lateral base around the foot markers [m], > 0.
-    stance_width : float
-        Ankle-to-ankle distance of the fixed feet assumed without foot data [m], >= 0.
+    foot_width : float or None
+        Foot width, for the medio-lateral base around the foot markers [m], > 0; None: the
+        body's ``foot_width`` (:class:`~pushrecovery.params.BodyParams`).
+    stance_width : float or None
+        Ankle-to-ankle distance of the fixed feet assumed without foot data [m], >= 0; None:
+        the body's ``stance_width``.
     ankle_ap, ankle_ml : float or None
         Lab position of the fixed feet (midpoint of the ankles) [m]; default from the mean
         CoP (ap: ``COP_AHEAD_OF_ANKLE`` behind it) or, without a CoP, the mean CoM.
@@ -83,18 +85,29 @@ class AnalysisSettings:
     force_cutoff: float = 10.0
     max_gap: float = 0.1
     contact_height: float = 0.02
-    foot_width: float = 0.09
-    stance_width: float = 0.2
+    foot_width: float | None = None
+    stance_width: float | None = None
     ankle_ap: float | None = None
     ankle_ml: float | None = None
+
+    def widths(self, params: BodyParams) -> tuple[float, float]:
+        """Foot width and stance width [m]: these settings', else the body's."""
+        return (
+            params.foot_width if self.foot_width is None else self.foot_width,
+            params.stance_width if self.stance_width is None else self.stance_width,
+        )
 
     def __post_init__(self) -> None:
         for name in ("cutoff", "force_cutoff", "max_gap", "stance_width"):
             value = getattr(self, name)
+            if value is None:
+                continue
             if not (math.isfinite(value) and value >= 0.0):
                 raise InvalidParameterError(f"{name} must be a finite number >= 0, got {value}")
         for name in ("contact_height", "foot_width"):
             value = getattr(self, name)
+            if value is None:
+                continue
             if not (math.isfinite(value) and value > 0.0):
                 raise InvalidParameterError(f"{name} must be a finite number > 0, got {value}")
         for name in ("ankle_ap", "ankle_ml"):
@@ -357,7 +370,7 @@ def _support(
         support = support_from_feet(
             tuple(measured),
             contact_height=settings.contact_height,
-            foot_width=settings.foot_width,
+            foot_width=settings.widths(params)[0],
         )
         return support, "foot markers", gaps
     if recording.base:
@@ -378,10 +391,9 @@ def _support(
     if ankle_ml is None:
         ankle_ml = float(np.nanmean(centre[:, 1]))
         assumed.append("centred on it medio-laterally")
-    feet = fixed_feet(len(time), ankle_ap, ankle_ml, params.heel, params.toe, settings.stance_width)
-    support = support_from_feet(
-        feet, contact_height=settings.contact_height, foot_width=settings.foot_width
-    )
+    foot_width, stance_width = settings.widths(params)
+    feet = fixed_feet(len(time), ankle_ap, ankle_ml, params.heel, params.toe, stance_width)
+    support = support_from_feet(feet, contact_height=settings.contact_height, foot_width=foot_width)
     source = "fixed feet (heel/toe flags, --stance-width)"
     if assumed:
         source += ": " + ", ".join(assumed)
@@ -410,7 +422,7 @@ def _explicit_support(
         ankles[axis] = ankle[:, None]
     foot = {
         "ap": (params.heel, params.toe),
-        "ml": (-settings.foot_width / 2, settings.foot_width / 2),
+        "ml": (-settings.widths(params)[0] / 2, settings.widths(params)[0] / 2),
     }
     supporting = np.isfinite(lower["ap"])[:, None]
     return Support(lower, upper, ankles, foot, supporting)

@@ -154,7 +154,8 @@ class CampaignSpec:
             )
         if (self.xdot is None) == (self.impulse is None):
             raise InvalidParameterError("give exactly one of xdot and impulse (the pushes)")
-        fields = {f.name for f in dataclasses.fields(BodyParams)}
+        # Every number of the body can be swept; a polygon cannot.
+        fields = {f.name for f in dataclasses.fields(BodyParams)} - {"foot_polygon"}
         for name in self.sweeps:
             if name not in fields:
                 raise InvalidParameterError(
@@ -255,7 +256,7 @@ class CampaignSpec:
 
     def body(self, swept: tuple[float, ...]) -> BodyParams:
         """Return the body of one combination of the swept values (checked as any BodyParams)."""
-        changes = dict(zip(self.sweeps, (float(v) for v in swept), strict=True))
+        changes: dict[str, Any] = dict(zip(self.sweeps, (float(v) for v in swept), strict=True))
         try:
             return dataclasses.replace(self.params, **changes)
         except InvalidParameterError as exc:

@@ -97,20 +97,6 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     help="A foot supports while its lower marker is within this of its lowest [m].",
 )
 @click.option(
-    "--foot-width",
-    type=float,
-    default=0.09,
-    show_default=True,
-    help="Foot width for the medio-lateral base [m].",
-)
-@click.option(
-    "--stance-width",
-    type=float,
-    default=0.2,
-    show_default=True,
-    help="Ankle-to-ankle distance of the fixed feet assumed without foot data [m].",
-)
-@click.option(
     "--ankle-ap",
     type=float,
     default=None,
@@ -156,8 +142,6 @@ def analyze(file: Path, out: Path, as_json: bool, **kwargs: Any) -> None:
         force_cutoff=kwargs.pop("force_cutoff"),
         max_gap=kwargs.pop("max_gap"),
         contact_height=kwargs.pop("contact_height"),
-        foot_width=kwargs.pop("foot_width"),
-        stance_width=kwargs.pop("stance_width"),
         ankle_ap=kwargs.pop("ankle_ap"),
         ankle_ml=kwargs.pop("ankle_ml"),
     )

@@ -8,7 +8,14 @@ from typing import Any
 import click
 
 from pushrecovery import __version__
-from pushrecovery.cli.options import body_options, echo_confusion, emit, params_from
+from pushrecovery.cli.options import (
+    body_options,
+    echo_confusion,
+    emit,
+    params_from,
+    support_from,
+    support_options,
+)
 
 # Kept literal so that --help does not import the models; a test checks them against the
 # registries.
@@ -38,25 +45,47 @@ def cli() -> None:
 
 
 @cli.command(short_help="Capture-point bounds of each strategy.")
+@support_options
 @body_options
 def bounds(as_json: bool, **kwargs: Any) -> None:
-    """Capture-point bounds of each balance strategy (Eq. 4, corrected Eq. 15)."""
+    """Capture-point bounds of each balance strategy (Eq. 4, corrected Eq. 15).
+
+    On the sagittal line (cop, cmp, thresholds [m/s] from x = 0) and on the ground plane
+    (plane: the support polygon, the CMP region and the thresholds along forward, backward,
+    left and right for the chosen --stance).
+    """
     from pushrecovery.surfaces.bounds import bounds_data
 
-    emit(bounds_data(params_from(kwargs)), as_json)
+    params = params_from(kwargs)
+    emit(bounds_data(params, support_from(kwargs, params)), as_json)
 
 
 @cli.command(short_help="Strategy a CoM state needs: ankle, hip, step or fall.")
-@click.option("--x", "x", type=float, required=True, help="CoM position relative to the ankle [m].")
-@click.option("--xdot", type=float, required=True, help="CoM velocity [m/s].")
+@click.option(
+    "--x", "x", type=float, required=True, help="CoM position, forward, from the ankles [m]."
+)
+@click.option("--xdot", type=float, required=True, help="CoM velocity, forward [m/s].")
+@click.option(
+    "--y", "y", type=float, default=0.0, show_default=True, help="CoM position, left [m]."
+)
+@click.option(
+    "--ydot", type=float, default=0.0, show_default=True, help="CoM velocity, left [m/s]."
+)
+@support_options
 @body_options
-def classify(x: float, xdot: float, as_json: bool, **kwargs: Any) -> None:
-    """Which strategy the CoM state (x, xdot) needs: ankle, hip, step or fall."""
+def classify(x: float, xdot: float, y: float, ydot: float, as_json: bool, **kwargs: Any) -> None:
+    """Which strategy the CoM state needs: ankle, hip, step or fall.
+
+    On the ground plane: x forward, y left, from the midpoint of the ankles of the default
+    feet (or in the frame of --left-foot/--right-foot). Margins are signed distances of the
+    capture point to each region [m], positive inside.
+    """
     from pushrecovery.surfaces.classify import classify as classify_state
 
     params = params_from(kwargs)
-    result = classify_state(x, xdot, params).to_dict()
-    emit({**result, "state": {"x": x, "xdot": xdot}}, as_json)
+    support = support_from(kwargs, params)
+    result = classify_state(x, xdot, params, y=y, ydot=ydot, support=support).to_dict()
+    emit({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)
 
 
 def _push_velocity(xdot: float | None, impulse: float | None, mass: float) -> float:
@@ -537,7 +566,7 @@ def validate(
         )
 
 
-@cli.command(short_help="Reproduce the paper's figures.")
+@cli.command(short_help="Reproduce the paper's figures and the ground-plane figure.")
 @click.option(
     "--out",
     type=click.Path(file_okay=False),
@@ -556,7 +585,12 @@ def validate(
 )
 @body_options
 def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) -> None:
-    """Reproduce the paper's figures (Fig. 3, 5, 6) into a directory."""
+    """Reproduce the paper's figures (Fig. 3, 5, 6, 9, 10) into a directory.
+
+    Also plane.png/svg: the capture-point plane (x forward, y left [m]) with the support
+    polygon (ankle), the CMP region (hip) and pushes coloured by the strategy they need, in
+    double, left and right support.
+    """
     from pushrecovery.plots.figures import write_figures
 
     params = params_from(kwargs)

@@ -24,6 +24,19 @@ PARAM_FLAGS: tuple[tuple[str, str, str], ...] = (
     ("--flywheel-angle-max", "flywheel_angle_max", "Hip joint limit θmax [rad]."),
     ("--leg-length", "leg_length", "Leg length for stepping [m] (default: CoM height)."),
     ("--max-step-length", "max_step_length", "Longest step, foot to foot [m] (default: leg)."),
+    ("--foot-width", "foot_width", "Foot width [m] (rectangular foot)."),
+    ("--stance-width", "stance_width", "Ankle-to-ankle distance in double support [m]."),
+    (
+        "--flywheel-inertia-roll",
+        "flywheel_inertia_roll",
+        "Upper-body roll inertia [kg m^2] (default: pitch).",
+    ),
+    ("--torque-max-roll", "torque_max_roll", "Hip roll torque limit [N m] (default: pitch)."),
+    (
+        "--flywheel-angle-max-roll",
+        "flywheel_angle_max_roll",
+        "Hip roll joint limit [rad] (default: pitch).",
+    ),
 )
 
 
@@ -42,6 +55,33 @@ def body_options(func: F) -> F:
         func
     )
     return click.option("--json", "as_json", is_flag=True, help="Print JSON.")(func)
+
+
+def support_options(func: F) -> F:
+    """Add ``--stance``, ``--left-foot`` and ``--right-foot`` (the support on the ground plane)."""
+    for flag, text in (
+        ("--right-foot", "Right ankle pose X,Y[,YAW] [m, m, rad] (default: 0,-stance_width/2)."),
+        ("--left-foot", "Left ankle pose X,Y[,YAW] [m, m, rad] (default: 0,+stance_width/2)."),
+    ):
+        func = click.option(flag, type=str, default=None, metavar="X,Y[,YAW]", help=text)(func)
+    return click.option(
+        "--stance",
+        type=click.Choice(("double", "left", "right")),
+        default="double",
+        show_default=True,
+        help="Feet on the ground: the support polygon is the hull of both, or one foot.",
+    )(func)
+
+
+def support_from(kwargs: dict[str, Any], params: BodyParams) -> Any:
+    """Pop the support options out of a command's kwargs and build the ``Support``."""
+    from pushrecovery.ground.support import FootPose, Support
+
+    poses = {}
+    for side in ("left", "right"):
+        text = kwargs.pop(f"{side}_foot")
+        poses[side] = None if text is None else FootPose.parse(f"--{side}-foot", text)
+    return Support.from_params(params, kwargs.pop("stance"), **poses)
 
 
 def params_from(kwargs: dict[str, Any]) -> BodyParams:

@@ -65,6 +65,14 @@ class ConvexPolygon:
         return cls(vertices, normals, offsets)
 
     @property
+    def edge_table(self) -> FloatArray:
+        """One row per edge: n_x, n_y, b, start x, start y, edge x, edge y, 1/|edge|² [m]."""
+        start = self.vertices
+        edge = np.roll(start, -1, axis=0) - start
+        inverse = 1.0 / np.einsum("ij,ij->i", edge, edge)
+        return np.column_stack([self.normals, self.offsets, start, edge, inverse])
+
+    @property
     def area(self) -> float:
         """Area [m²] (shoelace formula), > 0."""
         x, y = self.vertices[:, 0], self.vertices[:, 1]
@@ -205,7 +213,7 @@ def rectangle(heel: float, toe: float, width: float) -> ConvexPolygon:
 
 
 def convex_hull(points: ArrayLike) -> ConvexPolygon:
-    """Convex hull of points (Andrew's monotone chain), collinear points dropped.
+    """Convex hull of points (Andrew's monotone chain); exactly collinear points dropped.
 
     Raises
     ------
@@ -219,7 +227,7 @@ def convex_hull(points: ArrayLike) -> ConvexPolygon:
     def chain(sequence: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
         hull: list[NDArray[np.float64]] = []
         for p in sequence:
-            while len(hull) >= 2 and _cross(hull[-2], hull[-1], p) <= eps:
+            while len(hull) >= 2 and _cross(hull[-2], hull[-1], p) <= 0.0:
                 hull.pop()
             hull.append(p)
         return hull
@@ -227,9 +235,14 @@ def convex_hull(points: ArrayLike) -> ConvexPolygon:
     ordered = list(pts)
     lower, upper = chain(ordered), chain(ordered[::-1])
     hull = lower[:-1] + upper[:-1]
+    # Vertices closer than rounding would give edges without a direction: keep one of each.
+    hull = [p for i, p in enumerate(hull) if np.hypot(*(p - hull[i - 1])) > 1e-12 * scale]
     if len(hull) < 3:
         raise InvalidParameterError("support polygon is degenerate (zero area)")
-    return ConvexPolygon._from_ccw(np.array(hull))
+    polygon = ConvexPolygon._from_ccw(np.array(hull))
+    if polygon.area <= eps:
+        raise InvalidParameterError("support polygon is degenerate (zero area)")
+    return polygon
 
 
 def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False) -> ConvexPolygon:
@@ -270,7 +283,7 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
     scale = max(1e-3, float(np.abs(pts).max()))
     eps = 1e-12 * scale * scale
     for index in range(n):
-        if np.array_equal(pts[index], pts[(index + 1) % n]):
+        if np.hypot(*(pts[index] - pts[(index + 1) % n])) <= 1e-12 * scale:
             raise InvalidParameterError(
                 f"{name} vertex {(index + 1) % n} repeats vertex {index} at "
                 f"({pts[index][0]:g}, {pts[index][1]:g})"
@@ -285,6 +298,9 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
                     f"{j}-{(j + 1) % n}"
                 )
     turns = np.array([_cross(pts[i - 1], pts[i], pts[(i + 1) % n]) for i in range(n)])
+    # A turn relative to its edges' lengths (the sine of the angle): tiny edges still turn.
+    lengths = np.hypot(*(np.roll(pts, -1, axis=0) - pts).T)
+    bends = 1e-12 * lengths * np.roll(lengths, 1)
     area = 0.5 * float(
         np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1])
     )
@@ -292,10 +308,10 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
         raise InvalidParameterError(f"{name} is degenerate: zero area")
     sign = 1.0 if area > 0.0 else -1.0
     for index, turn in enumerate(turns):
-        if sign * turn < -eps:
+        if sign * turn < -bends[index]:
             x, y = pts[index]
             raise InvalidParameterError(f"{name} is not convex at vertex {index} ({x:g}, {y:g})")
-    keep = np.abs(turns) > eps
+    keep = np.abs(turns) > bends
     ordered = pts[keep] if sign > 0.0 else pts[keep][::-1]
     polygon = ConvexPolygon._from_ccw(ordered)
     if contains_origin and float(polygon.signed_distance(0.0, 0.0)) <= 0.0:

@@ -144,15 +144,19 @@ class Support:
 
     @property
     def yaw(self) -> float:
-        """Heading of the stance [rad]: the stance foot's yaw, or the mean of both (double)."""
+        """Heading of the stance [rad]: the stance foot's yaw, or the mean of both (double).
+
+        With the feet facing opposite ways (no mean), the left foot's yaw.
+        """
         if self.stance is Stance.LEFT:
             return self.left.yaw
         if self.stance is Stance.RIGHT:
             return self.right.yaw
-        return math.atan2(
-            math.sin(self.left.yaw) + math.sin(self.right.yaw),
-            math.cos(self.left.yaw) + math.cos(self.right.yaw),
-        )
+        sin = math.sin(self.left.yaw) + math.sin(self.right.yaw)
+        cos = math.cos(self.left.yaw) + math.cos(self.right.yaw)
+        if math.hypot(sin, cos) < 1e-9:  # feet facing opposite ways: no mean heading
+            return self.left.yaw
+        return math.atan2(sin, cos)
 
     def landing_foot(self, direction_x: float, direction_y: float) -> tuple[float, float]:
         """Back and front edges (heel < 0 < toe) of a landing foot along a unit direction [m].

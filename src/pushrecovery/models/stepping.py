@@ -26,19 +26,22 @@ L sin θ *behind* the new ankle. Its capture point relative to the new ankle is
 which decreases monotonically from v0/ω at θ = 0 to −L/√2 at θ = π/4 (checked on a dense grid,
 ``tests/test_stepping.py``). Eq. (21) asks for ξ⁺ = 0 (Eq. 22 is the same condition written as
 θ̇(θ)); any θ with δ⁻ < ξ⁺ < δ⁺ leaves the body recoverable by the new foot's ankle (Eq. 4).
-Every such condition is therefore a 1-D root of ξ⁺(θ) = target on (0, π/4), solved here with a
-safeguarded Newton iteration in a compiled, vectorised kernel.
+Every such condition is therefore a 1-D root of ξ⁺(θ) = target on (0, π/4), solved with a
+safeguarded Newton iteration written once, in pure Python
+(:func:`pushrecovery.models._step_scalar.step_angle`), and compiled by numba into cached,
+vectorised loops (:mod:`pushrecovery.models._stepping_kernels`) for arrays.
 """
 
 from __future__ import annotations
 
-import functools
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from pushrecovery.models._step_scalar import MAX_STEP_ANGLE as MAX_STEP_ANGLE
+from pushrecovery.models._step_scalar import step_angle
 
 __all__ = [
     "StepSolution",
@@ -51,8 +54,9 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
-#: Largest step angle: at π/4 the impact absorbs all horizontal velocity (cos 2θ = 0).
-MAX_STEP_ANGLE = 0.25 * math.pi
+#: Up to this many angles, :func:`solve_step_angle` runs the pure-Python solver (a few µs an
+#: angle) instead of loading numba (0.4 s, once per process) and its compiled loops.
+_PYTHON_MAX_SIZE = 32
 
 
 def fall_rate(theta: ArrayLike, v0: ArrayLike, length: float, gravity: float) -> FloatArray:
@@ -131,72 +135,15 @@ def solve_step_angle(
         rate = np.asarray(lean_rate, dtype=np.float64)
         energy = rate**2 - 2.0 * omega2 * (1.0 - np.cos(lean))
     energy, lean, target = np.broadcast_arrays(energy, lean, np.asarray(target, dtype=np.float64))
-    flat = [np.ascontiguousarray(a, dtype=np.float64).reshape(-1) for a in (energy, lean, target)]
-    out = np.empty_like(flat[0])
-    _step_angle_kernel()(*flat, float(length), float(gravity), out)
+    if energy.size <= _PYTHON_MAX_SIZE:
+        rows = zip(energy.flat, lean.flat, target.flat, strict=True)
+        angles = [step_angle(float(a), float(b), float(c), length, gravity) for a, b, c in rows]
+        out = np.array(angles, dtype=np.float64)
+    else:
+        from pushrecovery.models._stepping_kernels import solve
+
+        out = solve(energy, lean, target, length, gravity)
     return out.reshape(energy.shape)
-
-
-@functools.cache
-def _step_angle_kernel() -> Callable[..., None]:
-    """Compile (once, cached on disk) the safeguarded Newton solve of ξ⁺(θ) = target."""
-    import numba
-
-    @numba.njit(cache=True, inline="always")
-    def residual(theta, a, w2, w, length, target):  # type: ignore[no-untyped-def]
-        s, c = math.sin(theta), math.cos(theta)
-        rate = math.sqrt(max(0.0, a + 2.0 * w2 * (1.0 - c)))
-        c2 = math.cos(2.0 * theta)
-        root_c = math.sqrt(c)
-        value = length * (-s + rate / w * c2 / root_c) - target
-        if rate == 0.0:
-            return value, -1.0
-        d_rate = w2 * s / rate
-        slope = length * (
-            -c
-            + (
-                d_rate * c2 / root_c
-                - 2.0 * rate * math.sin(2.0 * theta) / root_c
-                + 0.5 * rate * c2 * s / (c * root_c)
-            )
-            / w
-        )
-        return value, slope
-
-    @numba.njit(parallel=True, cache=True, nogil=True)
-    def kernel(energy, lean, target, length, gravity, out):  # type: ignore[no-untyped-def]
-        w2 = gravity / length
-        w = math.sqrt(w2)
-        top = 0.25 * math.pi
-        for i in numba.prange(energy.shape[0]):
-            a, goal, low = energy[i], target[i], max(0.0, lean[i])
-            if low >= top or residual(low, a, w2, w, length, goal)[0] <= 0.0:
-                out[i] = min(low, top)  # an immediate step already lands at or behind the goal
-                continue
-            if -length * math.sqrt(0.5) >= goal:
-                out[i] = top
-                continue
-            high = top
-            # Small-angle start for the Eq. (21) root: θ⁴ ≈ v0² / (3.58 g L).
-            theta = min(0.5 * (low + top), max(low, (max(a, 0.0) / w2 / 3.5833) ** 0.25))
-            if theta <= low:
-                theta = 0.5 * (low + high)
-            for _ in range(100):
-                value, slope = residual(theta, a, w2, w, length, goal)
-                if value > 0.0:  # ξ⁺ decreases with θ: the root lies above
-                    low = theta
-                else:
-                    high = theta
-                step = theta - value / slope if slope < 0.0 else -1.0
-                if not low < step < high:
-                    step = 0.5 * (low + high)
-                if abs(step - theta) <= 1e-15 * max(1.0, theta) or high - low <= 1e-15:
-                    theta = step
-                    break
-                theta = step
-            out[i] = theta
-
-    return kernel
 
 
 @dataclass(frozen=True, slots=True)

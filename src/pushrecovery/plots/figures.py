@@ -1,6 +1,7 @@
 """Reproductions of the paper's figures: Fig. 3 (Sec. II), 5 and 6 (Sec. III), 9 and 10 (Sec. IV).
 
-Each figure has a function that computes its runs and one that draws them.
+Each figure has a function that computes its runs and one that draws them. Besides the paper's,
+``plane``: the capture-point plane of the ground-plane model (:mod:`pushrecovery.plots.plane`).
 """
 
 from __future__ import annotations
@@ -28,7 +29,20 @@ from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import critical_velocity
 
-__all__ = ["fig3a", "fig3b", "fig5", "fig6", "fig9", "fig10", "write_figures"]
+__all__ = [
+    "PAPER_FIGURES",
+    "fig3a",
+    "fig3b",
+    "fig5",
+    "fig6",
+    "fig9",
+    "fig10",
+    "plane",
+    "write_figures",
+]
+
+#: File stems of the paper's figures (``write_figures`` adds ``plane``).
+PAPER_FIGURES = ("fig3a", "fig3b", "fig5a", "fig5b", "fig6a", "fig6b", "fig9", "fig10")
 
 
 def _limits(params: BodyParams) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -94,9 +108,17 @@ def fig3b(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
 
 
 def write_figures(
-    params: BodyParams, out: Path, formats: Iterable[str] = ("png", "svg")
+    params: BodyParams,
+    out: Path,
+    formats: Iterable[str] = ("png", "svg"),
+    *,
+    ground_plane: bool = True,
 ) -> list[Path]:
-    """Write every reproduced figure into ``out``; return the files written."""
+    """Write every reproduced figure into ``out``; return the files written.
+
+    The paper's figures (:data:`PAPER_FIGURES`) and, with ``ground_plane``, ``plane``
+    (:func:`plane`).
+    """
     formats = tuple(formats)
     return [
         *fig3a(params, formats, out),
@@ -105,7 +127,20 @@ def write_figures(
         *fig6(params, formats, out),
         *fig9(params, formats, out),
         *fig10(params, formats, out),
+        *(plane(params, formats, out) if ground_plane else []),
     ]
+
+
+def plane(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
+    """Draw the capture-point plane in double, left and right support (``plane``).
+
+    Per stance: the feet, the support polygon (ankle), the CMP region (hip) and pushes from a
+    CoM at rest above the stance's reference point, at their capture point and coloured by the
+    strategy they need (:func:`~pushrecovery.plots.plane.capture_plane_panels`).
+    """
+    from pushrecovery.plots.plane import capture_plane_panels
+
+    return save_figure(capture_plane_panels(params), out / "plane", formats)
 
 
 def _hip_runs(

@@ -9,6 +9,8 @@ Sections, in the page's order (key: content):
 
 - ``bounds``: the parameters, bounds and thresholds (``pushrecovery bounds``);
 - ``map``: the strategy map of the (x, ẋ) plane;
+- ``plane``: the capture-point plane of the ground-plane model in double and single support,
+  with the per-direction push thresholds;
 - ``figures``: every reproduced figure of the paper;
 - ``analytic``: a campaign on the analytic ``stepping`` model with the ``recovery`` controller;
 - ``sweep``: the critical push of ``flywheel`` + ``mpc`` against the hip torque limit;
@@ -54,6 +56,7 @@ Range = tuple[float, float, float]
 SECTIONS: Mapping[str, str] = {
     "bounds": "Parameters, bounds and thresholds",
     "map": "Strategy map",
+    "plane": "Ground plane",
     "figures": "The paper's figures",
     "analytic": "Push campaign on the analytic models",
     "sweep": "Critical push against the hip torque limit",
@@ -72,6 +75,7 @@ _RUN_ORDER = (
     "biped",
     "bounds",
     "map",
+    "plane",
     "figures",
     "critical",
     "filmstrips",
@@ -98,7 +102,11 @@ FIGURE_CAPTIONS: Mapping[str, str] = {
     "(Sec. IV).",
     "fig10": "Fig. 10: optimal step length against the initial CoM velocity (Eq. 21), with the "
     "range of steps that land the capture point on the new foot.",
+    "plane": "The capture-point plane in double, left and right support: support polygon "
+    "(ankle), CMP region (hip) and pushes from rest coloured by the strategy they need.",
 }
+#: Push directions of the ground-plane threshold table, in its column order.
+PLANE_DIRECTIONS = ("forward", "backward", "left", "right")
 
 
 @dataclass(frozen=True)
@@ -440,6 +448,61 @@ def _map(ctx: _Context) -> str:
     ) + figure(picture, "Strategy map (<code>surfaces.classify.classify_states</code>).")
 
 
+def _plane(ctx: _Context) -> str:
+    from pushrecovery.ground.support import Stance, Support
+    from pushrecovery.plots.figures import plane
+    from pushrecovery.plots.plane import HEADINGS, SPEEDS
+    from pushrecovery.surfaces.bounds import plane_bounds
+
+    params = ctx.params
+    rows = []
+    offsets: dict[str, float] = {}
+    for stance in Stance:
+        bounds = plane_bounds(params, Support.from_params(params, stance))
+        offsets = bounds["cmp_offset"]
+        for strategy in ("ankle", "hip", "step"):
+            speeds = bounds["thresholds"][strategy]
+            rows.append([stance.value, strategy, *(num(speeds[d], 3) for d in PLANE_DIRECTIONS)])
+    (picture,) = plane(params, ("png",), ctx.out)
+    return (
+        paragraph(
+            "The model on the ground plane (x forward, y left, in m): the capture point ξ = r + "
+            "ṙ/ω of each axis against the regions of the strategies. The support polygon (one "
+            "foot in single support, the convex hull of both feet in double support) is the "
+            "ankle strategy's region: a CoP anywhere in it captures every ξ strictly inside "
+            "(Eq. 4 in the plane). Grown by the pitch and roll flywheels' offsets (corrected "
+            f"Eq. 15: {num(offsets['pitch'], 3)} m along x and {num(offsets['roll'], 3)} m "
+            "along y of the stance) it is the hip strategy's CMP region. Beyond it the body "
+            "must step: Sec. IV's single step, taken along the capture point's excursion (the "
+            "line from the support polygon's centre through ξ) until proper two-dimensional "
+            "capture regions replace it; beyond the dashed curve no single step recovers.",
+            "lead",
+        )
+        + figure(
+            picture,
+            f"Pushes of {HEADINGS} headings and {SPEEDS} speeds from a CoM at rest above the "
+            "reference point "
+            "(×: the ankles' midpoint in double support, the stance ankle in single support), "
+            "drawn at their capture point and coloured by "
+            "<code>surfaces.classify.classify_states</code>; bottom row: close to the feet "
+            "(the dotted frame above). <code>plane.png</code>",
+        )
+        + "<h3>Largest push from rest by direction</h3>\n"
+        + paragraph(
+            "The largest push [m/s] each strategy recovers from a CoM at rest above the "
+            "reference point, by direction (<code>pushrecovery bounds --json</code>, "
+            "<code>plane</code>): ω times the distance to the region's edge for ankle and hip, "
+            "the single-step limit of Sec. IV for step."
+        )
+        + table(
+            ["support", "strategy", *(f"{d} [m/s]" for d in PLANE_DIRECTIONS)],
+            rows,
+            text_columns=2,
+            ident="plane-thresholds",
+        )
+    )
+
+
 def _figures(ctx: _Context) -> str:
     from pushrecovery.plots.figures import write_figures
 
@@ -452,7 +515,8 @@ def _figures(ctx: _Context) -> str:
         )
     ]
     with tempfile.TemporaryDirectory(prefix="pushrecovery-figures-") as tmp:
-        for path in write_figures(ctx.params, Path(tmp), ("png",)):
+        # The ground plane has its own section.
+        for path in write_figures(ctx.params, Path(tmp), ("png",), ground_plane=False):
             caption = FIGURE_CAPTIONS.get(path.stem, "")
             parts.append(figure(path, f"{esc(caption)} <code>{esc(path.name)}</code>"))
     return "".join(parts)
@@ -656,6 +720,7 @@ def _filmstrips(ctx: _Context) -> str:
 _BUILDERS: Mapping[str, Callable[[_Context], str]] = {
     "bounds": _bounds,
     "map": _map,
+    "plane": _plane,
     "figures": _figures,
     "analytic": _analytic,
     "sweep": _sweep,
@@ -687,11 +752,13 @@ def write_report(
 
     One self-contained page (figures as base64 PNG, plain CSS, no script or external
     reference): the parameters with the bounds and thresholds (Eq. 4, corrected Eq. 15,
-    Eq. 12), the strategy map, the paper's figures, push campaigns on the analytic models and in
-    MuJoCo with their accuracy, confusion matrix and outcome map, the MuJoCo critical-push table
-    and one filmstrip per strategy (module docstring). The page's footer gives each section's
-    wall time. The campaigns keep their files in ``out_dir/campaign-KEY`` (a rerun with the
-    same grid and body reuses them; another grid replaces them).
+    Eq. 12), the strategy map, the ground plane (the capture-point plane in double and single
+    support, per-direction thresholds), the paper's figures, push campaigns on the analytic
+    models and in MuJoCo with their accuracy, confusion matrix and outcome map, the MuJoCo
+    critical-push table and one filmstrip per strategy (module docstring). The page's footer
+    gives each section's wall time. The campaigns keep their files in
+    ``out_dir/campaign-KEY`` (a rerun with the same grid and body reuses them; another grid
+    replaces them).
 
     Parameters
     ----------

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 from typing import Any
 
+from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 
-__all__ = ["bounds_data"]
+__all__ = ["bounds_data", "plane_bounds"]
 
 
-def bounds_data(params: BodyParams) -> dict[str, Any]:
+def bounds_data(params: BodyParams, support: Support | None = None) -> dict[str, Any]:
     """Capture-point bounds and velocity thresholds of each strategy, as a JSON-ready dict.
 
     The same keys and numbers as ``pushrecovery bounds --json``: ``params``; ``omega`` =
@@ -18,12 +19,14 @@ def bounds_data(params: BodyParams) -> dict[str, Any]:
     ``t_max`` the longest bang-bang half period, Eq. (12) [s] (None without hip torque);
     ``thresholds`` the largest recoverable CoM velocity from x = 0, [backward, forward], per
     strategy [m/s] (ankle: ω δ±, hip: ω times the CMP bounds, step: the single-step limit of
-    Sec. IV).
+    Sec. IV); ``plane`` the ground-plane bounds of :func:`plane_bounds`.
 
     Parameters
     ----------
     params : BodyParams
         The body.
+    support : Support, optional
+        Stance and feet for ``plane``; default double support on the default feet.
 
     Returns
     -------
@@ -53,5 +56,42 @@ def bounds_data(params: BodyParams) -> dict[str, Any]:
             "ankle": [omega * cop.lower, omega * cop.upper],
             "hip": [omega * cmp.lower, omega * cmp.upper],
             "step": list(step_thresholds(params)),
+        },
+        "plane": plane_bounds(params, Support.from_params(params) if support is None else support),
+    }
+
+
+def plane_bounds(params: BodyParams, support: Support) -> dict[str, Any]:
+    """Ground-plane bounds: the support polygon, the CMP region and per-direction thresholds.
+
+    ``thresholds`` holds, per strategy, the largest push speed [m/s] (unsigned) from a CoM at
+    rest above ``support.ankle`` along ``forward`` (+x), ``backward``, ``left`` (+y) and
+    ``right``: ω times the distance to the region's edge for ankle and hip
+    (:func:`~pushrecovery.surfaces.plane.direction_thresholds`), the single-step limit for
+    step (:func:`~pushrecovery.surfaces.plane.step_threshold_xy`). ``cmp_offset`` gives the
+    hip region's growth along the pitch (x) and roll (y) axes [m].
+    """
+    from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+    from pushrecovery.surfaces.plane import (
+        DIRECTIONS,
+        cmp_polygon,
+        direction_thresholds,
+        step_threshold_xy,
+    )
+
+    hip = cmp_polygon(support, params)
+    omega = params.omega
+    return {
+        "support": support.to_dict(),
+        "reference": list(support.ankle),
+        "cmp_region": hip.to_list(),
+        "cmp_offset": {"pitch": cmp_offset(params), "roll": cmp_offset_roll(params)},
+        "thresholds": {
+            "ankle": direction_thresholds(support.polygon, support.ankle, omega),
+            "hip": direction_thresholds(hip, support.ankle, omega),
+            "step": {
+                name: step_threshold_xy(params, support, heading)
+                for name, heading in DIRECTIONS.items()
+            },
         },
     }

@@ -1,8 +1,14 @@
-"""The strategy a state needs: the complete strategy map of the paper.
+"""The strategy a state needs: the complete strategy map of the paper, on a line or the plane.
 
 Vocabulary (stable, part of the JSON contract), escalating as the paper proposes (Sec. I-B):
 ``ankle`` (CoP balancing, Eq. 4), ``hip`` (CMP balancing, corrected Eq. 15), ``step`` (a single
 step within reach recovers, Sec. IV, :mod:`pushrecovery.surfaces.step`) and ``fall``.
+
+On the ground plane (:func:`classify` with ``y``, ``ydot`` or a ``support``) the ankle and hip
+regions are the support polygon and the CMP region of :mod:`pushrecovery.surfaces.plane`; the
+step is Sec. IV's single step applied on the line through the stance ankle and the capture
+point (the direction of its excursion), which issue 14's capture regions will replace
+(``docs/plane.md``).
 """
 
 from __future__ import annotations
@@ -17,10 +23,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery._validate import finite_float
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
-from pushrecovery.surfaces.step import plan_steps
+from pushrecovery.surfaces.plane import capture_margin_xy, cmp_polygon, plan_step_xy
+from pushrecovery.surfaces.step import StepDecision, plan_step, plan_steps
 
 __all__ = [
     "STRATEGY_CODES",
@@ -69,12 +77,20 @@ class Classification:
     it), −inf when no single step recovers. ``step`` holds the recommended step for the ``step``
     strategy: ``step_length`` (foot to foot, signed like the step direction), ``com_to_foot``,
     ``theta`` (stance-leg angle at impact) and the admissible ``step_length_range``.
+
+    On the ground plane also ``capture_point_xy`` (ξ in the world frame [m]), the ``support``
+    and the CMP region's vertices (``cmp_region``); margins are then signed Euclidean
+    distances in the plane, and ``step`` adds ``direction_xy`` (the unit vector of the step
+    line, along which ``step_length`` is signed) and ``foothold_xy`` (the landing ankle [m]).
     """
 
     capture_point: float
     strategy: Strategy
     margins: dict[str, float] = field(default_factory=dict)
     step: dict[str, object] | None = None
+    capture_point_xy: tuple[float, float] | None = None
+    support: Support | None = None
+    cmp_region: list[list[float]] | None = None
 
     def to_dict(self) -> dict[str, object]:
         """JSON form: ``{"capture_point", "strategy", "margins": {...}}`` (+ ``"step"``)."""
@@ -87,60 +103,275 @@ class Classification:
         if self.step is not None:
             data["step"] = dict(self.step)
             data["step_length"] = self.step["step_length"]
+        if self.capture_point_xy is not None:
+            data["capture_point_xy"] = list(self.capture_point_xy)
+        if self.support is not None:
+            data["support"] = self.support.to_dict()
+        if self.cmp_region is not None:
+            data["cmp_region"] = self.cmp_region
         return data
 
 
-def classify(x: float, xdot: float, params: BodyParams) -> Classification:
-    """Classify one CoM state (CoM upright upper body at rest, as the surfaces assume).
+def classify(
+    x: float,
+    xdot: float,
+    params: BodyParams,
+    *,
+    y: float | None = None,
+    ydot: float | None = None,
+    support: Support | None = None,
+) -> Classification:
+    """Classify one CoM state (upper body upright and at rest, as the surfaces assume).
+
+    Without ``y``, ``ydot`` and ``support`` this is the sagittal model of the paper (the foot
+    the interval [heel, toe]); with any of them, the ground plane (module docstring), where
+    ``support`` defaults to double support on the default feet
+    (:meth:`~pushrecovery.ground.Support.from_params`). With y = ẏ = 0 and the default double
+    support of a foot no longer than the stance is wide (the paper preset), both give the same
+    verdict, capture point and margins.
 
     Parameters
     ----------
     x : float
-        CoM position relative to the ankle [m], x forward.
+        CoM position [m], x forward: relative to the ankle (sagittal), or in the world frame
+        of the support (plane).
     xdot : float
         CoM velocity [m/s].
     params : BodyParams
         Body parameters.
+    y : float, optional
+        Lateral CoM position in the world frame [m], y left (default 0).
+    ydot : float, optional
+        Lateral CoM velocity [m/s] (default 0).
+    support : Support, optional
+        Stance and feet on the ground plane.
 
     Returns
     -------
     Classification
-        ``ankle`` when the capture point is strictly inside the foot (Eq. 4), ``hip`` when it
-        is inside the CMP region (corrected Eq. 15), ``step`` when a single step within reach
+        ``ankle`` when the capture point is strictly inside the foot or support polygon
+        (Eq. 4), ``hip`` when it is inside the CMP region (corrected Eq. 15, in the plane:
+        the polygon grown by each axis's offset), ``step`` when a single step within reach
         recovers (with the recommended step), else ``fall``.
     """
     x = finite_float("x", x, "m")
     xdot = finite_float("xdot", xdot, "m/s")
+    if y is not None or ydot is not None or support is not None:
+        return _classify_plane(x, xdot, params, y, ydot, support)
     cop = float(cop_margin(x, xdot, params))
     cmp = float(cmp_margin(x, xdot, params))
-    plan = plan_steps(x, xdot, params) if abs(x) < params.leg_length else None
-    step_margin = float(plan.margin) if plan is not None else -math.inf
-    step = None
-    if cop > 0.0:
-        strategy = Strategy.ANKLE
-    elif cmp > 0.0:
-        strategy = Strategy.HIP
-    elif plan is not None and bool(plan.feasible):
-        strategy = Strategy.STEP
-        theta = float(plan.theta)
-        step = {
-            "step_length": float(plan.step_length),
-            "com_to_foot": float(plan.direction) * params.leg_length * math.sin(theta),
-            "theta": theta,
-            "step_length_range": [float(plan.shortest), float(plan.longest)],
-        }
-    else:
-        strategy = Strategy.FALL
+    plan = plan_step(x, xdot, params) if abs(x) < params.leg_length else None
     capture = float(capture_point(x, xdot, params.omega))
-    margins = {"cop": cop, "cmp": cmp, "step": step_margin}
+    strategy, step = _escalate(cop, cmp, plan, params)
+    margins = {"cop": cop, "cmp": cmp, "step": plan.margin if plan is not None else -math.inf}
     return Classification(capture, strategy, margins, step)
 
 
-def classify_states(x: ArrayLike, xdot: ArrayLike, params: BodyParams) -> NDArray[np.int8]:
-    """Vectorised :func:`classify`: integer codes into :data:`STRATEGY_CODES`."""
-    fall = STRATEGY_CODES.index(Strategy.FALL)
-    codes = np.full(np.broadcast_shapes(np.shape(x), np.shape(xdot)), fall, dtype=np.int8)
-    codes[plan_steps(x, xdot, params).feasible] = STRATEGY_CODES.index(Strategy.STEP)
-    codes[cmp_margin(x, xdot, params) > 0.0] = STRATEGY_CODES.index(Strategy.HIP)
-    codes[cop_margin(x, xdot, params) > 0.0] = STRATEGY_CODES.index(Strategy.ANKLE)
+def _escalate(
+    cop: float, cmp: float, plan: StepDecision | None, params: BodyParams
+) -> tuple[Strategy, dict[str, object] | None]:
+    """Return the first strategy whose margin is positive, and the step for ``step``."""
+    if cop > 0.0:
+        return Strategy.ANKLE, None
+    if cmp > 0.0:
+        return Strategy.HIP, None
+    if plan is None or not plan.feasible:
+        return Strategy.FALL, None
+    return Strategy.STEP, {
+        "step_length": plan.step_length,
+        "com_to_foot": plan.direction * params.leg_length * math.sin(plan.theta),
+        "theta": plan.theta,
+        "step_length_range": [plan.shortest, plan.longest],
+    }
+
+
+def _classify_plane(
+    x: float,
+    xdot: float,
+    params: BodyParams,
+    y: float | None,
+    ydot: float | None,
+    support: Support | None,
+) -> Classification:
+    """:func:`classify` on the ground plane."""
+    y = 0.0 if y is None else finite_float("y", y, "m")
+    ydot = 0.0 if ydot is None else finite_float("ydot", ydot, "m/s")
+    support = Support.from_params(params) if support is None else support
+    omega = params.omega
+    xi = (x + xdot / omega, y + ydot / omega)
+    if not (math.isfinite(xi[0]) and math.isfinite(xi[1])):
+        raise InvalidParameterError("states are too large: the capture point overflows")
+    hip_region = cmp_polygon(support, params)
+    cop = float(support.polygon.signed_distance(*xi))
+    cmp = float(hip_region.signed_distance(*xi))
+    line, plan = plan_step_xy(x, y, xdot, ydot, params, support)
+    strategy, step = _escalate(cop, cmp, plan, params)
+    if step is not None and plan is not None:
+        ankle = support.ankle
+        step["direction_xy"] = list(line)
+        step["foothold_xy"] = [
+            ankle[0] + plan.step_length * line[0],
+            ankle[1] + plan.step_length * line[1],
+        ]
+    margins = {"cop": cop, "cmp": cmp, "step": plan.margin if plan is not None else -math.inf}
+    return Classification(xi[0], strategy, margins, step, xi, support, hip_region.to_list())
+
+
+def classify_states(
+    x: ArrayLike,
+    xdot: ArrayLike,
+    params: BodyParams,
+    *,
+    y: ArrayLike | None = None,
+    ydot: ArrayLike | None = None,
+    support: Support | None = None,
+) -> NDArray[np.int8]:
+    """Vectorised :func:`classify`: integer codes into :data:`STRATEGY_CODES`.
+
+    The margins decide most states in one pass; Sec. IV's step is planned only for states
+    beyond the hip region, in chunks, so the extra memory stays a few bytes per state. With
+    ``y``, ``ydot`` or ``support`` the states are classified on the ground plane.
+
+    Parameters
+    ----------
+    x, xdot : array_like
+        CoM positions [m] and velocities [m/s], broadcast together.
+    params : BodyParams
+        Body parameters.
+    y, ydot : array_like, optional
+        Lateral positions [m] and velocities [m/s] (plane).
+    support : Support, optional
+        Stance and feet (plane; default double support).
+
+    Returns
+    -------
+    ndarray of int8
+        Codes of the broadcast shape.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a state is NaN or infinite.
+    """
+    if y is not None or ydot is not None or support is not None:
+        return _plane_codes(x, xdot, params, y, ydot, support)
+    x, xdot = np.broadcast_arrays(
+        np.asarray(x, dtype=np.float64), np.asarray(xdot, dtype=np.float64)
+    )
+    codes = np.empty(x.shape, dtype=np.int8)
+    if x.size == 0:
+        return codes
+    flat_x, flat_xdot = (np.ascontiguousarray(a).reshape(-1) for a in (x, xdot))
+    flat = codes.reshape(-1)  # a view: codes is new and contiguous
+    cop, hip = cop_region(params), cmp_region(params)
+    if flat.size >= _CHUNK:
+        from pushrecovery.surfaces._kernels import sagittal_codes
+
+        beyond, bad = sagittal_codes(
+            flat_x,
+            flat_xdot,
+            1.0 / params.omega,
+            cop.centre,
+            cop.half_width,
+            hip.centre,
+            hip.half_width,
+            flat,
+        )
+        if bad:
+            cop_margin(flat_x, flat_xdot, params)  # raises, naming the argument
+    else:
+        cop_m, hip_m = cop_margin(flat_x, flat_xdot, params), cmp_margin(flat_x, flat_xdot, params)
+        flat[...] = np.where(cop_m > 0.0, _ANKLE, np.where(hip_m > 0.0, _HIP, _FALL))
+        beyond = 1
+    if beyond:
+        _step_or_fall(flat_x, flat_xdot, flat, params)
     return codes
+
+
+def _step_or_fall(
+    x: NDArray[np.float64], xdot: NDArray[np.float64], codes: NDArray[np.int8], params: BodyParams
+) -> None:
+    """Mark ``step`` where a single step recovers the states coded ``fall``, chunk by chunk.
+
+    Only feasibility is needed, so the compiled ``feasible`` (two evaluations of ξ⁺) replaces
+    the full plan (three Newton solves) on large chunks; small ones take :func:`plan_steps`.
+    """
+    for start in range(0, codes.size, _CHUNK):
+        part = slice(start, start + _CHUNK)
+        index = np.flatnonzero(codes[part] == _FALL)
+        if not index.size:
+            continue
+        index += start
+        if index.size >= _FEASIBLE_MIN_SIZE:
+            from pushrecovery.models._stepping_kernels import feasible
+
+            steps = feasible(
+                x[index],
+                xdot[index],
+                params.heel,
+                params.toe,
+                params.com_height,
+                params.gravity,
+                params.max_step_length,
+            )
+        else:
+            steps = plan_steps(x[index], xdot[index], params).feasible
+        codes[index[steps]] = _STEP
+
+
+_ANKLE, _HIP, _STEP, _FALL = (STRATEGY_CODES.index(s) for s in Strategy)
+#: From this many undecided states on, the compiled feasibility test (numba loaded).
+_FEASIBLE_MIN_SIZE = 64
+#: States per chunk of the vectorised classifier: temporaries stay in the cache.
+_CHUNK = 1 << 16
+
+
+def _plane_codes(
+    x: ArrayLike,
+    xdot: ArrayLike,
+    params: BodyParams,
+    y: ArrayLike | None,
+    ydot: ArrayLike | None,
+    support: Support | None,
+) -> NDArray[np.int8]:
+    """:func:`classify_states` on the ground plane (the rules of :func:`_classify_plane`)."""
+    support = Support.from_params(params) if support is None else support
+    arrays = np.broadcast_arrays(
+        *(np.asarray(0.0 if a is None else a, dtype=np.float64) for a in (x, y, xdot, ydot))
+    )
+    x, y, xdot, ydot = (np.ascontiguousarray(a).reshape(-1) for a in arrays)
+    omega = params.omega
+    cop = capture_margin_xy(x, y, xdot, ydot, omega, support.polygon)
+    hip = capture_margin_xy(x, y, xdot, ydot, omega, cmp_polygon(support, params))
+    codes = np.where(cop > 0.0, _ANKLE, np.where(hip > 0.0, _HIP, _FALL)).astype(np.int8)
+    index = np.flatnonzero(codes == _FALL)
+    if index.size:
+        xs, ys, xds, yds = (a[index] for a in (x, y, xdot, ydot))
+        ax, ay = support.ankle
+        ex, ey = xs + xds / omega - ax, ys + yds / omega - ay
+        norm = np.hypot(ex, ey)
+        heading = (math.cos(support.yaw), math.sin(support.yaw))
+        ex = np.where(norm > 0.0, ex / np.where(norm > 0.0, norm, 1.0), heading[0])
+        ey = np.where(norm > 0.0, ey / np.where(norm > 0.0, norm, 1.0), heading[1])
+        flip = np.where(ex * heading[0] + ey * heading[1] < 0.0, -1.0, 1.0)
+        ex, ey = ex * flip, ey * flip
+        along = (xs - ax) * ex + (ys - ay) * ey
+        heel, toe = _landing_edges(support, ex, ey)
+        feasible = plan_steps(along, xds * ex + yds * ey, params, heel=heel, toe=toe).feasible
+        feasible &= np.abs(along) < params.leg_length
+        codes[index[feasible]] = _STEP
+    return codes.reshape(arrays[0].shape)
+
+
+def _landing_edges(
+    support: Support, ex: NDArray[np.float64], ey: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Vectorised :meth:`Support.landing_foot`: (heel, toe) along unit vectors (ex, ey) [m]."""
+    c, s = math.cos(support.yaw), math.sin(support.yaw)
+    fx, fy = c * ex + s * ey, -s * ex + c * ey
+    left, right = support.foot.vertices, support.foot.mirrored().vertices
+    shape_x = np.where(fy[:, None] < 0.0, right[None, :, 0], left[None, :, 0])
+    shape_y = np.where(fy[:, None] < 0.0, right[None, :, 1], left[None, :, 1])
+    # Both feet have the same vertex count (one is the other's mirror).
+    ahead = shape_x * fx[:, None] + shape_y * fy[:, None]
+    return np.min(ahead, axis=1), np.max(ahead, axis=1)

@@ -10,25 +10,51 @@ included). A step at θ recovers when the post-impact capture point lies inside 
 leg is still in compression at the landing (l θ̇² ≤ g cos θ). The recommended step is Eq. (21)'s
 θ*, moved into that feasible interval if needed. Backward steps are the mirror image (heel and
 toe swapped).
+
+One function decides a state: :func:`pushrecovery.models._step_scalar.decide`, plain Python
+(``math`` only). :func:`plan_step`, :func:`step_critical_velocity` and :func:`step_thresholds`
+run it as it is, with neither numba nor scipy imported; :func:`plan_steps` runs it as it is for
+a few states and compiled by numba (cached on disk, parallel for large arrays) for more;
+:func:`compiled_plan_step` hands out its compiled form for real-time loops.
 """
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.models.stepping import MAX_STEP_ANGLE, solve_step_angle
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.models._step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
+from pushrecovery.models._step_scalar import decide
 from pushrecovery.params import BodyParams
 
-__all__ = ["StepPlan", "plan_steps", "step_critical_velocity", "step_thresholds"]
+__all__ = [
+    "StepDecision",
+    "StepPlan",
+    "compiled_plan_step",
+    "plan_step",
+    "plan_steps",
+    "step_critical_velocity",
+    "step_thresholds",
+]
 
 FloatArray = NDArray[np.float64]
+#: Signature of :func:`compiled_plan_step`'s planner: (x, xdot, heel, toe, com_height, gravity,
+#: max_step_length) to (direction, ready, feasible, theta, step_length, shortest, longest,
+#: margin), the fields of :class:`StepDecision`.
+ScalarPlanner = Callable[
+    [float, float, float, float, float, float, float],
+    tuple[float, bool, bool, float, float, float, float, float],
+]
 
-#: Shortest step that counts as a step, foot to foot [m].
-MIN_STEP_LENGTH = 0.05
+#: Up to this many states, :func:`plan_steps` runs the pure-Python decision (about 20 µs a
+#: state) instead of loading numba (0.4 s, once per process) and its compiled loops.
+_PYTHON_MAX_SIZE = 32
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,13 +91,51 @@ class StepPlan:
     margin: FloatArray
 
 
-def plan_steps(x: ArrayLike, xdot: ArrayLike, params: BodyParams) -> StepPlan:
+@dataclass(frozen=True, slots=True)
+class StepDecision:
+    """Step decision for one CoM state: the fields of :class:`StepPlan` as Python scalars.
+
+    Attributes
+    ----------
+    direction : float
+        +1.0 step forward, −1.0 backward.
+    ready, feasible : bool
+        A step can be taken now; a single step within reach recovers the state.
+    theta : float
+        Recommended stance-leg angle at impact [rad] (NaN when not ready).
+    step_length : float
+        Recommended step, foot to foot, signed like ``direction`` [m] (NaN when not ready).
+    shortest, longest : float
+        Shortest and longest recovering step within reach, foot to foot [m].
+    margin : float
+        max_step_length minus the shortest recovering step [m] (−inf when none recovers).
+    """
+
+    direction: float
+    ready: bool
+    feasible: bool
+    theta: float
+    step_length: float
+    shortest: float
+    longest: float
+    margin: float
+
+
+def plan_steps(
+    x: ArrayLike,
+    xdot: ArrayLike,
+    params: BodyParams,
+    *,
+    heel: ArrayLike | None = None,
+    toe: ArrayLike | None = None,
+) -> StepPlan:
     """Plan the recovering step for arrays of CoM states (module docstring).
 
     The stance leg is the ankle-to-CoM segment as it stands, l = sqrt(x² + L²) with L =
     ``com_height``, leaning θ0 = atan2(x, L); when it locks to fall as a pendulum only the
     tangential part of the CoM velocity survives, θ̇0 = ẋ cos θ0 / l. This is exactly what
-    :class:`~pushrecovery.sim.plants.SteppingPlant` does.
+    :class:`~pushrecovery.sim.plants.SteppingPlant` does. Each state is decided by the function
+    behind :func:`plan_step`, compiled by numba (cached on disk) for more than a few states.
 
     Parameters
     ----------
@@ -81,68 +145,123 @@ def plan_steps(x: ArrayLike, xdot: ArrayLike, params: BodyParams) -> StepPlan:
         CoM velocity [m/s].
     params : BodyParams
         Body parameters (com_height, max_step_length, g, foot edges).
+    heel, toe : array_like, optional
+        Back and front edges of the new foot relative to its ankle along the step line [m]
+        (heel < toe, by convention heel < 0 < toe), broadcast with the states; default
+        ``params.heel`` and ``params.toe``. Backward steps mirror them (the foot turned round).
 
     Returns
     -------
     StepPlan
+        Arrays of the broadcast shape of the states and feet.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a heel is not behind its toe. States and edges are not checked for NaN or infinity:
+        no step is feasible there.
     """
-    x, xdot = np.broadcast_arrays(
-        np.asarray(x, dtype=np.float64), np.asarray(xdot, dtype=np.float64)
+    back, front = _edges(params, heel, toe)
+    xs, xds, backs, fronts = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (x, xdot, back, front))
     )
-    gravity, height = params.gravity, params.com_height
-    direction = np.where(x + xdot / params.omega >= 0.5 * (params.heel + params.toe), 1.0, -1.0)
-    # Mirror backward steps: positive lean toward the step, heel and toe swapped.
-    length = np.hypot(x, height)
-    lean = np.arctan2(direction * x, height)
-    lean_rate = direction * xdot * np.cos(lean) / length
-    omega2 = gravity / length
-    energy = lean_rate**2 - 2.0 * omega2 * (1.0 - np.cos(lean))  # θ̇² at θ = 0, signed
-    ready = (lean_rate > 0.0) & ((energy > 0.0) | (lean > 0.0))
-    toe = np.where(direction > 0.0, params.toe, -params.heel)
-    heel = np.where(direction > 0.0, params.heel, -params.toe)
-    # Solve in units of l (ξ⁺/l depends on θ̇/ω_l only), so each state may have its own leg.
-    scaled = np.where(ready, energy / omega2, 1.0)
-    targets = np.stack([np.zeros_like(x), toe / length, heel / length])
-    best, low, high = _solve(scaled, np.maximum(lean, 0.0), targets)
-    reach = np.arcsin(np.minimum(1.0, params.max_step_length / (2.0 * length)))
-    # The stance leg stays in compression up to the angle where l θ̇² = g cos θ, i.e.
-    # cos θ_c = (l θ̇0² + 2 g) / (3 g) with θ̇0 the upright-equivalent rate.
-    cos_limit = (length * np.where(ready, energy, 0.0) + 2.0 * gravity) / (3.0 * gravity)
-    allowed = np.minimum(
-        np.minimum(reach, MAX_STEP_ANGLE), np.arccos(np.clip(cos_limit, -1.0, 1.0))
-    )
-    # A step needs room: at least MIN_STEP_LENGTH within reach and compression (leaning past
-    # the reach, or with a leg about to pull, no step can be placed).
-    ready &= (np.maximum(lean, 0.0) <= allowed) & (
-        2.0 * length * np.sin(allowed) >= MIN_STEP_LENGTH
-    )
-    low = np.maximum(low, lean)
-    high = np.minimum(high, allowed)
-    in_compression = (cos_limit < 1.0) & (low <= allowed)
-    feasible = ready & (low < high) & in_compression
-    # Best effort where infeasible: the admissible angle nearest Eq. (21)'s.
-    lowest = np.maximum(lean, 0.0)
-    theta = np.where(ready, np.clip(best, lowest, np.maximum(allowed, lowest)), np.nan)
-    theta = np.where(feasible, np.clip(best, low, high), theta)
-    shortest = np.where(ready, 2.0 * length * np.sin(low), np.nan)
-    longest = np.where(feasible, 2.0 * length * np.sin(high), np.nan)
-    margin = np.where(ready & in_compression, params.max_step_length - shortest, -np.inf)
-    return StepPlan(
-        direction=direction,
-        ready=ready,
-        feasible=feasible,
-        theta=theta,
-        step_length=direction * 2.0 * length * np.sin(theta),
-        shortest=shortest,
-        longest=longest,
-        margin=margin,
+    shape = xs.shape
+    height, gravity, reach = params.com_height, params.gravity, params.max_step_length
+    if xs.size <= _PYTHON_MAX_SIZE:
+        rows = zip(xs.flat, xds.flat, backs.flat, fronts.flat, strict=True)
+        decisions = [
+            decide(float(a), float(b), float(c), float(d), height, gravity, reach)
+            for a, b, c, d in rows
+        ]
+        columns = list(zip(*decisions, strict=True)) or [()] * 8
+        values = np.array([columns[k] for k in (0, 3, 4, 5, 6, 7)], dtype=np.float64)
+        flags = np.array(columns[1:3], dtype=np.bool_)
+    else:
+        from pushrecovery.models._stepping_kernels import plan
+
+        values, flags = plan(xs, xds, backs, fronts, height, gravity, reach)
+    values = values.reshape((6, *shape))
+    flags = flags.reshape((2, *shape))
+    return StepPlan(  # [k, ...]: 0-d arrays, not numpy scalars, for a single state
+        direction=values[0, ...],
+        ready=flags[0, ...],
+        feasible=flags[1, ...],
+        theta=values[1, ...],
+        step_length=values[2, ...],
+        shortest=values[3, ...],
+        longest=values[4, ...],
+        margin=values[5, ...],
     )
 
 
-def _solve(scaled_energy: FloatArray, lean: FloatArray, targets: FloatArray) -> FloatArray:
-    """ξ⁺(θ) = target in units of the leg (l = 1, g = 1), from a lean and its energy."""
-    rate = np.sqrt(np.maximum(scaled_energy + 2.0 * (1.0 - np.cos(lean)), 0.0))
-    return solve_step_angle(0.0, targets, 1.0, 1.0, lean=lean, lean_rate=rate)
+def plan_step(
+    x: float,
+    xdot: float,
+    params: BodyParams,
+    *,
+    heel: float | None = None,
+    toe: float | None = None,
+) -> StepDecision:
+    """Plan the recovering step for one CoM state, in pure Python (``math`` only, no numba).
+
+    The same decision as :func:`plan_steps` for one state (see there for the arguments and the
+    model), from the same function; a few tens of µs, with nothing to load or compile.
+
+    Returns
+    -------
+    StepDecision
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``heel`` is not behind ``toe``.
+    """
+    back = params.heel if heel is None else float(heel)
+    front = params.toe if toe is None else float(toe)
+    if heel is not None or toe is not None:
+        _check_edges(not back >= front, heel, toe)
+    args = (params.com_height, params.gravity, params.max_step_length)
+    return StepDecision(*decide(float(x), float(xdot), back, front, *args))
+
+
+@functools.cache
+def compiled_plan_step() -> ScalarPlanner:
+    """Return the per-state decision of :func:`plan_step`, compiled, for real-time loops.
+
+    Loads numba and the machine code from its on-disk cache on the first call in a process
+    (compiling it only on the first run on a machine, or after the code changed); the planner
+    returned never compiles again.
+
+    Returns
+    -------
+    callable
+        ``planner(x, xdot, heel, toe, com_height, gravity, max_step_length)``, all floats in SI
+        units as in :func:`plan_steps`, returning the tuple (direction, ready, feasible, theta,
+        step_length, shortest, longest, margin) of :class:`StepDecision`'s fields. It does not
+        validate its arguments (heel < toe, finite values) and releases the GIL.
+    """
+    from pushrecovery.models._stepping_kernels import scalar_decide
+
+    return scalar_decide()
+
+
+def _edges(
+    params: BodyParams, heel: ArrayLike | None, toe: ArrayLike | None
+) -> tuple[ArrayLike, ArrayLike]:
+    """Return the new foot's edges: ``params``' unless given, checked (heel < toe)."""
+    if heel is None and toe is None:
+        return params.heel, params.toe
+    back = params.heel if heel is None else np.asarray(heel, dtype=np.float64)
+    front = params.toe if toe is None else np.asarray(toe, dtype=np.float64)
+    _check_edges(not np.any(np.greater_equal(back, front)), heel, toe)
+    return back, front
+
+
+def _check_edges(valid: bool, heel: object, toe: object) -> None:
+    if not valid:
+        raise InvalidParameterError(
+            f"heel must be < toe (the new foot's back and front edges), got heel={heel}, toe={toe}"
+        )
 
 
 def step_critical_velocity(
@@ -150,14 +269,17 @@ def step_critical_velocity(
 ) -> float:
     """Largest CoM velocity from position x [m] that one step recovers, signed [m/s].
 
-    Found by bisection on :func:`plan_steps` (feasibility is monotone in the push: a harder push
-    needs a longer step and loads the stance leg less).
+    Found by bisection on the decision of :func:`plan_step` (feasibility is monotone in the
+    push: a harder push needs a longer step and loads the stance leg less). Pure Python: no
+    numba or scipy is loaded.
     """
     sign = 1.0 if direction > 0.0 else -1.0
+    args = (params.heel, params.toe, params.com_height, params.gravity, params.max_step_length)
+    x = float(x)
     low, high = 0.0, math.sqrt(params.gravity * params.leg_length)
     while high - low > tolerance:
         middle = 0.5 * (low + high)
-        if bool(plan_steps(x, sign * middle, params).feasible):
+        if decide(x, sign * middle, *args)[2]:
             low = middle
         else:
             high = middle

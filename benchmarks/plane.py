@@ -1,0 +1,198 @@
+"""Ground-plane benchmarks (issue 13), each a ratio to a baseline measured in the same run.
+
+1. ``BalanceMonitor.query`` on one state, in a loop of 10**4 calls over a mix of states (ankle,
+   hip, step and fall): median and p99 per call. Baseline: a Python call of ``math.hypot`` on
+   the same floats in the same loop. Targets: median <= 20 µs, p99 <= 200 µs.
+2. ``pushrecovery bounds --json`` in a fresh process vs ``python -c "import numpy"`` (after a
+   first run has filled numba's on-disk cache). Target: <= 2x.
+3. 2-D margins (signed distance of ξ to the double-support polygon) on 10**7 states vs
+   ``numpy.add(a, b, out=c)`` on arrays of the same size. Target: <= 3x.
+4. ``classify_states`` on 10**7 sagittal states (quiet standing plus pushes: x ~ N(0.05, 0.1) m,
+   ẋ ~ N(0, 0.3) m/s, the distribution of ``benchmarks/run.py``'s surface benchmark, of which
+   26 % lie beyond the hip region and need the step test) vs ``numpy.add``, and its extra peak
+   memory per state: the growth of the peak RSS (VmHWM, reset just before the call) of a
+   subprocess over its RSS before the call, the result included. Targets: <= 10x and <= 100
+   bytes per state. The
+   same on 10**6 states drawn uniformly over every strategy is printed for information.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+import timeit
+from pathlib import Path
+
+import numpy as np
+
+from pushrecovery import load_params
+from pushrecovery.ground import Support
+from pushrecovery.surfaces.classify import STRATEGY_CODES, classify_states
+from pushrecovery.surfaces.monitor import BalanceMonitor
+from pushrecovery.surfaces.plane import cop_margin_xy
+
+N = 10**7
+REPEAT = 7
+
+
+def best(func, number=1):
+    return min(timeit.repeat(func, number=number, repeat=REPEAT)) / number
+
+
+def monitor_query() -> tuple[float, float]:
+    params = load_params()
+    monitor = BalanceMonitor(params)
+    rng = np.random.default_rng(3)
+    n = 10**4
+    states = np.column_stack(
+        [
+            rng.normal(0.05, 0.05, n),
+            rng.normal(0.0, 0.05, n),
+            rng.normal(0.0, 0.8, n),
+            rng.normal(0.0, 0.8, n),
+        ]
+    ).tolist()
+    query, hypot, clock = monitor.query, math.hypot, time.perf_counter_ns
+    own = np.empty(n)
+    base = np.empty(n)
+    for i, (x, y, xdot, ydot) in enumerate(states):
+        start = clock()
+        query(x, y, xdot, ydot)
+        middle = clock()
+        hypot(x + xdot, y + ydot)
+        end = clock()
+        own[i] = middle - start
+        base[i] = end - middle
+    counts = {s.value: 0 for s in STRATEGY_CODES}
+    for state in states:
+        counts[query(*state).strategy.value] += 1
+    median, p99 = np.median(own) / 1e3, np.percentile(own, 99) / 1e3
+    base_median = np.median(base) / 1e3
+    print(
+        f"BalanceMonitor.query, 10^4 calls ({counts}): median {median:.1f} µs, p99 "
+        f"{p99:.1f} µs (targets 20 / 200); math.hypot call {base_median:.2f} µs, ratio "
+        f"{median / base_median:.0f}"
+    )
+    return median, p99
+
+
+def bounds_startup() -> float:
+    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+    exe = Path(sys.executable).with_name("pushrecovery")
+
+    def run(cmd):
+        return lambda: subprocess.run(cmd, check=True, capture_output=True, env=env)
+
+    run([str(exe), "bounds", "--json"])()  # a first run on this machine fills the caches
+    numpy_import = min(
+        timeit.repeat(run([sys.executable, "-c", "import numpy"]), number=1, repeat=REPEAT)
+    )
+    bounds = min(timeit.repeat(run([str(exe), "bounds", "--json"]), number=1, repeat=REPEAT))
+    ratio = bounds / numpy_import
+    print(
+        f"pushrecovery bounds --json in a fresh process: {bounds * 1e3:.0f} ms; python -c "
+        f"'import numpy' {numpy_import * 1e3:.0f} ms; ratio {ratio:.2f} (target <= 2)"
+    )
+    return ratio
+
+
+def plane_margins() -> float:
+    params = load_params()
+    support = Support.from_params(params)
+    rng = np.random.default_rng(0)
+    x, y = rng.normal(0.05, 0.1, N), rng.normal(0.0, 0.1, N)
+    xdot, ydot = rng.normal(0.0, 0.3, N), rng.normal(0.0, 0.3, N)
+    out = np.empty(N)
+    cop_margin_xy(x[:100_000], y[:100_000], xdot[:100_000], ydot[:100_000], support, params)
+    baseline = best(lambda: np.add(x, xdot, out=out))
+    margin = best(lambda: cop_margin_xy(x, y, xdot, ydot, support, params, out=out))
+    ratio = margin / baseline
+    print(
+        f"2-D margins on 1e7 states: {margin * 1e3:.1f} ms; numpy.add {baseline * 1e3:.1f} ms; "
+        f"ratio {ratio:.2f} (target <= 3)"
+    )
+    return ratio
+
+
+_MEMORY_PROBE = """
+import json, sys
+import numpy as np
+from pushrecovery import load_params
+from pushrecovery.surfaces.classify import classify_states
+n = int(sys.argv[1])
+params = load_params()
+rng = np.random.default_rng(0)
+x, xdot = rng.normal(0.05, 0.1, n), rng.normal(0.0, 0.3, n)
+classify_states(x[:200000], xdot[:200000], params)  # loads the kernels
+
+
+def status(key):
+    for line in open("/proc/self/status"):
+        if line.startswith(key):
+            return int(line.split()[1]) * 1024
+
+
+before = status("VmRSS")
+with open("/proc/self/clear_refs", "w") as handle:
+    handle.write("5")  # reset the peak (VmHWM) to the current RSS
+codes = classify_states(x, xdot, params)
+print(json.dumps({"extra_bytes": status("VmHWM") - before}))
+"""
+
+
+def classify_many() -> tuple[float, float]:
+    params = load_params()
+    rng = np.random.default_rng(0)
+    x, xdot = rng.normal(0.05, 0.1, N), rng.normal(0.0, 0.3, N)
+    out = np.empty(N)
+    classify_states(x[:200_000], xdot[:200_000], params)
+    baseline = best(lambda: np.add(x, xdot, out=out))
+    codes = classify_states(x, xdot, params)
+    wall = best(lambda: classify_states(x, xdot, params), number=1)
+    ratio = wall / baseline
+    share = {s.value: round(float(np.mean(codes == i)), 4) for i, s in enumerate(STRATEGY_CODES)}
+    probe = subprocess.run(
+        [sys.executable, "-c", _MEMORY_PROBE, str(N)], check=True, capture_output=True, text=True
+    )
+    per_state = json.loads(probe.stdout)["extra_bytes"] / N
+    print(
+        f"classify_states on 1e7 states {share}: {wall * 1e3:.0f} ms; numpy.add "
+        f"{baseline * 1e3:.1f} ms; ratio {ratio:.1f} (target <= 10); extra peak memory "
+        f"{per_state:.1f} bytes/state (target <= 100)"
+    )
+    wide_x = rng.uniform(-0.4, 0.5, 10**6)
+    wide_xdot = rng.uniform(-3.0, 3.0, 10**6)
+    wide = best(lambda: classify_states(wide_x, wide_xdot, params), number=1)
+    small_add = best(lambda: np.add(wide_x, wide_xdot, out=out[: 10**6]))
+    codes = classify_states(wide_x, wide_xdot, params)
+    beyond = float(np.mean(codes >= 2))
+    print(
+        f"  (information) 1e6 states uniform over every strategy ({beyond:.0%} need a step "
+        f"plan): {wide * 1e3:.0f} ms, {wide / small_add:.0f}x numpy.add"
+    )
+    return ratio, per_state
+
+
+def main() -> int:
+    median, p99 = monitor_query()
+    startup = bounds_startup()
+    margins = plane_margins()
+    ratio, per_state = classify_many()
+    failed = (
+        median > 20.0
+        or p99 > 200.0
+        or startup > 2.0
+        or margins > 3.0
+        or ratio > 10.0
+        or per_state > 100.0
+    )
+    print("plane targets met" if not failed else "PLANE TARGET MISSED")
+    return int(failed)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

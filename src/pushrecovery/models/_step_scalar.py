@@ -1,0 +1,318 @@
+r"""The per-state step decision in pure Python (``math`` only): the single source of truth.
+
+Every stepping answer of the package comes from the functions below, run either as plain
+Python (:func:`pushrecovery.surfaces.step.plan_step`, the thresholds of ``pushrecovery bounds``,
+small arrays) or compiled by numba from this very code
+(:mod:`pushrecovery.models._stepping_kernels`: the vectorised :func:`plan_steps
+<pushrecovery.surfaces.step.plan_steps>` and :func:`solve_step_angle
+<pushrecovery.models.stepping.solve_step_angle>`, and the real-time
+:func:`~pushrecovery.surfaces.step.compiled_plan_step`). Hence the rules for this module:
+
+- no import but ``math`` (the bounds path must not load numpy's compiled friends, numba or
+  scipy), floats, tuples and ``range`` only, so that numba's nopython mode accepts every line;
+- a function calls the others of this module by their global names; the kernels module compiles
+  them with those names bound to the compiled versions, and with :data:`prange` bound to
+  ``numba.prange``. All compiled code is therefore cached on disk under *this* file's name and
+  invalidated by numba whenever this file changes, callees included.
+
+The model is that of :mod:`pushrecovery.models.stepping` (Hofmann's stepping pendulum, Sec. IV)
+applied to a leaning stance leg as in :mod:`pushrecovery.surfaces.step`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from numpy import bool_, float64
+    from numpy.typing import NDArray
+
+#: Largest step angle: at π/4 the impact absorbs all horizontal velocity (cos 2θ = 0) [rad].
+MAX_STEP_ANGLE = 0.25 * math.pi
+#: Shortest step that counts as a step, foot to foot [m].
+MIN_STEP_LENGTH = 0.05
+#: The loop of the parallel kernels: plain ``range`` here, ``numba.prange`` once compiled.
+prange = range
+
+Decision = tuple[float, bool, bool, float, float, float, float, float]
+
+
+def capture_residual(
+    theta: float, energy: float, omega2: float, omega: float, length: float, target: float
+) -> tuple[float, float]:
+    """ξ⁺(θ) − target [m] and its slope dξ⁺/dθ [m/rad] (stepping module docstring).
+
+    ``energy`` is the upright-equivalent θ̇² = θ̇(θ)² − 2ω²(1 − cos θ) [rad²/s²] (negative for
+    falls that start leaning, below the top of the pendulum), ω² = g/L [1/s²].
+    """
+    s, c = math.sin(theta), math.cos(theta)
+    rate = math.sqrt(max(0.0, energy + 2.0 * omega2 * (1.0 - c)))
+    c2 = math.cos(2.0 * theta)
+    root_c = math.sqrt(c)
+    value = length * (-s + rate / omega * c2 / root_c) - target
+    if rate == 0.0:
+        return value, -1.0
+    d_rate = omega2 * s / rate
+    slope = length * (
+        -c
+        + (
+            d_rate * c2 / root_c
+            - 2.0 * rate * math.sin(2.0 * theta) / root_c
+            + 0.5 * rate * c2 * s / (c * root_c)
+        )
+        / omega
+    )
+    return value, slope
+
+
+def step_angle(energy: float, lean: float, target: float, length: float, gravity: float) -> float:
+    """Step angle θ in [max(lean, 0), π/4] with ξ⁺(θ) = target, by safeguarded Newton [rad].
+
+    ξ⁺ decreases monotonically in θ, so the bracket [low, high] shrinks around the root and a
+    Newton step that leaves it is replaced by bisection; converged when the Newton step or the
+    bracket is below 1e-15 rad. Returns the lower end when even an immediate step leaves ξ⁺ at
+    or behind the target, and π/4 when the target lies below −L/√2 (unreachable). ``energy`` as
+    in :func:`capture_residual`, ``length`` L [m], ``gravity`` g [m/s²], ``target`` [m].
+    """
+    omega2 = gravity / length
+    omega = math.sqrt(omega2)
+    top = MAX_STEP_ANGLE
+    low = max(0.0, lean)
+    if low >= top or capture_residual(low, energy, omega2, omega, length, target)[0] <= 0.0:
+        return min(low, top)  # an immediate step already lands at or behind the target
+    if -length * math.sqrt(0.5) >= target:
+        return top
+    high = top
+    # Small-angle start for the Eq. (21) root: θ⁴ ≈ v0² / (3.58 g L).
+    theta = min(0.5 * (low + top), max(low, (max(energy, 0.0) / omega2 / 3.5833) ** 0.25))
+    if theta <= low:
+        theta = 0.5 * (low + high)
+    for _ in range(100):
+        value, slope = capture_residual(theta, energy, omega2, omega, length, target)
+        if value > 0.0:  # ξ⁺ decreases with θ: the root lies above
+            low = theta
+        else:
+            high = theta
+        step = theta - value / slope if slope < 0.0 else -1.0
+        if abs(step - theta) <= 1e-15 * max(1.0, theta):  # converged: Newton stands still
+            return min(max(step, low), high)
+        if not low < step < high:
+            step = 0.5 * (low + high)
+        if abs(step - theta) <= 1e-15 * max(1.0, theta) or high - low <= 1e-15:
+            return step
+        theta = step
+    return theta
+
+
+def decide(
+    x: float,
+    xdot: float,
+    heel: float,
+    toe: float,
+    height: float,
+    gravity: float,
+    reach: float,
+) -> Decision:
+    """Step decision for one CoM state, as documented in :mod:`pushrecovery.surfaces.step`.
+
+    The stance leg l = sqrt(x² + L²) falls from its lean θ0 with the tangential rate θ̇0; three
+    roots of ξ⁺(θ) = target in units of l (:func:`step_angle`) give Eq. (21)'s step (target 0)
+    and the ends of the range that keeps the post-impact capture point on the new foot (Eq. 4:
+    targets toe/l and heel/l), then clipped to the reach, π/4 and a stance leg in compression.
+
+    Parameters
+    ----------
+    x, xdot : float
+        CoM position relative to the stance ankle [m] and velocity [m/s].
+    heel, toe : float
+        Back and front edge of the new foot relative to its ankle along the step line [m];
+        mirrored for backward steps.
+    height, gravity, reach : float
+        CoM height L [m], g [m/s²] and the longest step, foot to foot [m].
+
+    Returns
+    -------
+    tuple
+        (direction, ready, feasible, theta [rad], step_length [m], shortest [m], longest [m],
+        margin [m]): the fields of :class:`~pushrecovery.surfaces.step.StepDecision`.
+    """
+    direction = 1.0 if x + xdot / math.sqrt(gravity / height) >= 0.5 * (heel + toe) else -1.0
+    # Mirror backward steps: positive lean toward the step, heel and toe swapped.
+    if direction < 0.0:
+        heel, toe = -toe, -heel
+    length = math.hypot(x, height)  # the stance leg, ankle to CoM
+    lean = math.atan2(direction * x, height)
+    lean_rate = direction * xdot * math.cos(lean) / length  # tangential part only
+    omega2 = gravity / length
+    energy = lean_rate * lean_rate - 2.0 * omega2 * (1.0 - math.cos(lean))  # θ̇² at θ = 0
+    ready = lean_rate > 0.0 and (energy > 0.0 or lean > 0.0)
+    lowest = max(lean, 0.0)
+    # Solve in units of l (ξ⁺/l depends on θ̇/ω_l only): l = 1, g = 1.
+    scaled = energy / omega2 if ready else 1.0
+    best = step_angle(scaled, lowest, 0.0, 1.0, 1.0)
+    low = max(step_angle(scaled, lowest, toe / length, 1.0, 1.0), lean)
+    high = step_angle(scaled, lowest, heel / length, 1.0, 1.0)
+    # The stance leg stays in compression up to the angle where l θ̇² = g cos θ, i.e.
+    # cos θ_c = (l θ̇0² + 2 g) / (3 g) with θ̇0 the upright-equivalent rate.
+    cos_limit = (length * (energy if ready else 0.0) + 2.0 * gravity) / (3.0 * gravity)
+    reach_angle = math.asin(min(1.0, reach / (2.0 * length)))
+    allowed = min(reach_angle, MAX_STEP_ANGLE, math.acos(min(1.0, max(-1.0, cos_limit))))
+    # A step needs room: at least MIN_STEP_LENGTH within reach and compression (leaning past
+    # the reach, or with a leg about to pull, no step can be placed).
+    ready = ready and lowest <= allowed and 2.0 * length * math.sin(allowed) >= MIN_STEP_LENGTH
+    high = min(high, allowed)
+    in_compression = cos_limit < 1.0 and low <= allowed
+    feasible = ready and low < high and in_compression
+    theta = math.nan
+    if feasible:
+        theta = min(max(best, low), high)
+    elif ready:  # best effort: the admissible angle nearest Eq. (21)'s
+        theta = min(max(best, lowest), max(allowed, lowest))
+    shortest = 2.0 * length * math.sin(low) if ready else math.nan
+    longest = 2.0 * length * math.sin(high) if feasible else math.nan
+    margin = reach - shortest if ready and in_compression else -math.inf
+    step_length = direction * 2.0 * length * math.sin(theta)
+    return direction, ready, feasible, theta, step_length, shortest, longest, margin
+
+
+def feasible(
+    x: float,
+    xdot: float,
+    heel: float,
+    toe: float,
+    height: float,
+    gravity: float,
+    reach: float,
+) -> bool:
+    """``decide(...)[2]`` (does a single step recover?) without solving for any angle.
+
+    ξ⁺(θ) decreases strictly in θ, so with f = ξ⁺/l on [lowest, π/4] the angles of
+    :func:`decide` satisfy θ_toe < θ_heel ⟺ f(lowest) > heel/l, and θ_toe < allowed ⟺
+    lowest < allowed and f(allowed) < toe/l; ``feasible`` is ``ready``, the stance leg in
+    compression, and both. Two evaluations of ξ⁺ replace three Newton solves; the answer
+    differs from :func:`decide`'s only where f(allowed) is within the solver's 1e-15 of toe/l.
+    Arguments as in :func:`decide`.
+    """
+    if x + xdot / math.sqrt(gravity / height) < 0.5 * (heel + toe):
+        x, xdot, heel, toe = -x, -xdot, -toe, -heel  # the mirror image: a forward step
+    length = math.hypot(x, height)
+    lean = math.atan2(x, height)
+    lean_rate = xdot * math.cos(lean) / length
+    omega2 = gravity / length
+    energy = lean_rate * lean_rate - 2.0 * omega2 * (1.0 - math.cos(lean))
+    if not (lean_rate > 0.0 and (energy > 0.0 or lean > 0.0)):
+        return False
+    cos_limit = (length * energy + 2.0 * gravity) / (3.0 * gravity)
+    if not cos_limit < 1.0:
+        return False
+    lowest = max(lean, 0.0)
+    reach_angle = math.asin(min(1.0, reach / (2.0 * length)))
+    allowed = min(reach_angle, MAX_STEP_ANGLE, math.acos(max(-1.0, cos_limit)))
+    if not (lowest < allowed and 2.0 * length * math.sin(allowed) >= MIN_STEP_LENGTH):
+        return False
+    scaled = energy / omega2
+    if capture_residual(lowest, scaled, 1.0, 1.0, 1.0, heel / length)[0] <= 0.0:
+        return False
+    return capture_residual(allowed, scaled, 1.0, 1.0, 1.0, toe / length)[0] < 0.0
+
+
+def feasible_serial(
+    x: NDArray[float64],
+    xdot: NDArray[float64],
+    heel: float,
+    toe: float,
+    height: float,
+    gravity: float,
+    reach: float,
+    out: NDArray[bool_],
+) -> None:
+    """:func:`feasible` for every state of flat arrays (one foot for all), into ``out``."""
+    for i in range(x.shape[0]):
+        out[i] = feasible(x[i], xdot[i], heel, toe, height, gravity, reach)
+
+
+def feasible_parallel(
+    x: NDArray[float64],
+    xdot: NDArray[float64],
+    heel: float,
+    toe: float,
+    height: float,
+    gravity: float,
+    reach: float,
+    out: NDArray[bool_],
+) -> None:
+    """:func:`feasible_serial` over threads, once compiled (``prange``)."""
+    for i in prange(x.shape[0]):
+        out[i] = feasible(x[i], xdot[i], heel, toe, height, gravity, reach)
+
+
+def _store(i: int, decision: Decision, values: NDArray[float64], flags: NDArray[bool_]) -> None:
+    """Write one decision into column i of the (6, n) floats and (2, n) flags."""
+    direction, ready, feasible, theta, step_length, shortest, longest, margin = decision
+    values[0, i] = direction
+    values[1, i] = theta
+    values[2, i] = step_length
+    values[3, i] = shortest
+    values[4, i] = longest
+    values[5, i] = margin
+    flags[0, i] = ready
+    flags[1, i] = feasible
+
+
+def decide_serial(
+    x: NDArray[float64],
+    xdot: NDArray[float64],
+    heel: NDArray[float64],
+    toe: NDArray[float64],
+    height: float,
+    gravity: float,
+    reach: float,
+    values: NDArray[float64],
+    flags: NDArray[bool_],
+) -> None:
+    """:func:`decide` for every state of flat arrays, into ``values`` and ``flags`` (_store)."""
+    for i in range(x.shape[0]):
+        _store(i, decide(x[i], xdot[i], heel[i], toe[i], height, gravity, reach), values, flags)
+
+
+def decide_parallel(
+    x: NDArray[float64],
+    xdot: NDArray[float64],
+    heel: NDArray[float64],
+    toe: NDArray[float64],
+    height: float,
+    gravity: float,
+    reach: float,
+    values: NDArray[float64],
+    flags: NDArray[bool_],
+) -> None:
+    """:func:`decide_serial` over threads, once compiled (``prange``)."""
+    for i in prange(x.shape[0]):
+        _store(i, decide(x[i], xdot[i], heel[i], toe[i], height, gravity, reach), values, flags)
+
+
+def solve_serial(
+    energy: NDArray[float64],
+    lean: NDArray[float64],
+    target: NDArray[float64],
+    length: float,
+    gravity: float,
+    out: NDArray[float64],
+) -> None:
+    """:func:`step_angle` for every element of flat arrays, into ``out`` [rad]."""
+    for i in range(energy.shape[0]):
+        out[i] = step_angle(energy[i], lean[i], target[i], length, gravity)
+
+
+def solve_parallel(
+    energy: NDArray[float64],
+    lean: NDArray[float64],
+    target: NDArray[float64],
+    length: float,
+    gravity: float,
+    out: NDArray[float64],
+) -> None:
+    """:func:`solve_serial` over threads, once compiled (``prange``)."""
+    for i in prange(energy.shape[0]):
+        out[i] = step_angle(energy[i], lean[i], target[i], length, gravity)

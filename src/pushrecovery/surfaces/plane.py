@@ -1,0 +1,281 @@
+r"""The capture point and the CoP (ankle) and CMP (hip) regions on the ground plane.
+
+The LIPM of Eq. (6) holds in each horizontal axis with the same ω = sqrt(g/L); the upper body
+torques in pitch (moving the CMP along its x axis, Eq. 6) and in roll (along its y axis):
+
+.. math:: \ddot{\mathbf r} = \omega^2 (\mathbf r - \mathbf p - \mathbf c), \qquad
+          \boldsymbol\xi = \mathbf r + \dot{\mathbf r} / \omega, \qquad
+          \dot{\boldsymbol\xi} = \omega (\boldsymbol\xi - \mathbf p - \mathbf c),
+
+with the CoP p in the support polygon P and the CMP offset c = (τ_pitch, τ_roll)/(m g) in the
+body's axes. Integrating, a state is captured (ξ stays bounded and the flywheels end at rest)
+only if
+
+.. math:: \boldsymbol\xi_0 = \omega\int_0^\infty e^{-\omega s}\,\mathbf p(s)\,ds
+          + \omega\int_0^\infty e^{-\omega s}\,\mathbf c(s)\,ds .
+
+The first term is a weighted mean of points of P (the weights integrate to 1), so it ranges over
+P; the second ranges, axis by axis, over [−a_i, a_i] with a_i the corrected Eq. (15) offset of
+that axis (errata E11, E12: bang-bang is the supremum). When the constraints on p and on each
+axis's torque and angle are independent of one another, the two terms are chosen independently
+and the capturable set is the Minkowski sum (without that independence it is still an outer
+bound)
+
+.. math:: \mathcal C_{hip} = P \oplus [-a_x, a_x] \times [-a_y, a_y],
+
+an open set (its boundary is reached only as t → ∞, as in Eq. 4). Its support function is
+h_P(d) + a_x |d_x| + a_y |d_y|, checked against a linear program over CoP and torque sequences
+(``tests/test_plane_cmp.py``). Margins are signed Euclidean distances of ξ to a region, positive
+inside (``docs/plane.md``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pushrecovery._validate import finite_array
+from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.support import Support
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+from pushrecovery.surfaces.cop import _fusable
+from pushrecovery.surfaces.step import StepDecision, plan_step
+
+__all__ = [
+    "DIRECTIONS",
+    "capture_margin_xy",
+    "capture_point_xy",
+    "cmp_margin_xy",
+    "cmp_polygon",
+    "cop_margin_xy",
+    "direction_thresholds",
+    "plan_step_xy",
+    "step_threshold_xy",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: Named push directions on the ground plane: heading [rad], counter-clockwise from +x.
+DIRECTIONS: dict[str, float] = {
+    "forward": 0.0,
+    "left": 0.5 * math.pi,
+    "backward": math.pi,
+    "right": -0.5 * math.pi,
+}
+
+
+def capture_point_xy(
+    x: ArrayLike, y: ArrayLike, xdot: ArrayLike, ydot: ArrayLike, omega: float
+) -> tuple[FloatArray, FloatArray]:
+    """Capture point ξ = r + ṙ/ω in the plane [m] (Eq. 4's middle term, per axis).
+
+    Parameters
+    ----------
+    x, y : array_like
+        CoM position in the world frame [m] (x forward, y left).
+    xdot, ydot : array_like
+        CoM velocity [m/s].
+    omega : float
+        sqrt(g / L) [1/s].
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        ξ_x and ξ_y [m].
+    """
+    inv = 1.0 / omega
+    return (
+        np.asarray(x, dtype=np.float64) + np.asarray(xdot, dtype=np.float64) * inv,
+        np.asarray(y, dtype=np.float64) + np.asarray(ydot, dtype=np.float64) * inv,
+    )
+
+
+def cmp_polygon(support: Support, params: BodyParams) -> ConvexPolygon:
+    """Capture-point region of CMP balancing: P ⊕ box(a_pitch, a_roll) [m] (module docstring).
+
+    The box is aligned with the stance's heading (the upper body's pitch and roll axes).
+    """
+    return support.polygon.grown(cmp_offset(params), cmp_offset_roll(params), support.yaw)
+
+
+def capture_margin_xy(
+    x: ArrayLike,
+    y: ArrayLike,
+    xdot: ArrayLike,
+    ydot: ArrayLike,
+    omega: float,
+    polygon: ConvexPolygon,
+    *,
+    out: NDArray[np.float64] | None = None,
+) -> FloatArray:
+    """Signed distance of the capture points ξ = r + ṙ/ω to a convex region [m], + inside.
+
+    Large same-shape C-contiguous arrays take one fused, multithreaded compiled pass (cached
+    on disk); smaller ones a chunked numpy pass.
+
+    Parameters
+    ----------
+    x, y, xdot, ydot : array_like
+        CoM positions [m] and velocities [m/s], broadcast together.
+    omega : float
+        sqrt(g / L) [1/s].
+    polygon : ConvexPolygon
+        The region, e.g. ``support.polygon`` (ankle) or :func:`cmp_polygon` (hip).
+    out : ndarray, optional
+        Float64 array of the broadcast shape for the result.
+
+    Returns
+    -------
+    ndarray
+        Margins [m].
+
+    Raises
+    ------
+    InvalidParameterError
+        If a state is NaN or infinite.
+    """
+    arrays = [np.asarray(a, dtype=np.float64) for a in (x, y, xdot, ydot)]
+    shape = np.broadcast_shapes(*(a.shape for a in arrays))
+    if (
+        all(a.shape == shape for a in arrays)
+        and _fusable(arrays[0], arrays[2], out)
+        and all(a.flags.c_contiguous for a in arrays)
+    ):
+        from pushrecovery.surfaces._kernels import polygon_margin
+
+        margin = np.empty(shape) if out is None else out
+        flat = [a.reshape(-1) for a in arrays]
+        bad = polygon_margin(  # type: ignore[call-arg]
+            *flat, 1.0 / omega, polygon.edge_table, margin.reshape(-1)
+        )
+    else:
+        with np.errstate(over="ignore", invalid="ignore"):  # reported below, as one error
+            px, py = capture_point_xy(arrays[0], arrays[1], arrays[2], arrays[3], omega)
+            margin = polygon.signed_distance(px, py)
+        if out is not None:
+            out[...] = margin
+            margin = out
+        bad = 0 if margin.size == 0 or np.isfinite(margin).all() else 1
+    if bad:
+        for name, array in zip(("x", "y", "xdot", "ydot"), arrays, strict=True):
+            finite_array(name, array)
+        finite_array("capture point", margin)  # overflow of finite states
+    return margin
+
+
+def cop_margin_xy(
+    x: ArrayLike,
+    y: ArrayLike,
+    xdot: ArrayLike,
+    ydot: ArrayLike,
+    support: Support,
+    params: BodyParams,
+    *,
+    out: NDArray[np.float64] | None = None,
+) -> FloatArray:
+    """Signed distance of ξ to the support polygon (CoP balancing, Eq. 4 in the plane) [m]."""
+    return capture_margin_xy(x, y, xdot, ydot, params.omega, support.polygon, out=out)
+
+
+def cmp_margin_xy(
+    x: ArrayLike,
+    y: ArrayLike,
+    xdot: ArrayLike,
+    ydot: ArrayLike,
+    support: Support,
+    params: BodyParams,
+    *,
+    out: NDArray[np.float64] | None = None,
+) -> FloatArray:
+    """Signed distance of ξ to the CMP region :func:`cmp_polygon` (hip strategy) [m]."""
+    polygon = cmp_polygon(support, params)
+    return capture_margin_xy(x, y, xdot, ydot, params.omega, polygon, out=out)
+
+
+def direction_thresholds(
+    polygon: ConvexPolygon, origin: tuple[float, float], omega: float
+) -> dict[str, float]:
+    """Largest push speed a region absorbs from a CoM at rest at ``origin``, per direction.
+
+    A push of speed v along heading ψ puts ξ at origin + (v/ω)(cos ψ, sin ψ): the critical
+    speed is ω times the distance from the origin to the region's boundary along ψ [m/s]
+    (unsigned; :data:`DIRECTIONS` names the headings).
+    """
+    return {
+        name: omega * polygon.ray_distance(origin[0], origin[1], heading)
+        for name, heading in DIRECTIONS.items()
+    }
+
+
+def plan_step_xy(
+    x: float, y: float, xdot: float, ydot: float, params: BodyParams, support: Support
+) -> tuple[tuple[float, float], StepDecision | None]:
+    """Sec. IV's single step on the line through the stance ankle and ξ (its excursion).
+
+    The line's unit vector e points from the stance's ankle (the stance ankle, or the ankles'
+    midpoint in double support) to ξ, turned to the stance's heading side (e · heading >= 0)
+    so that the sagittal case keeps its signs. The state is projected on it, s = (r − ankle)
+    · e, ṡ = ṙ · e, as the sagittal model measures x from the ankle, and the landing foot's
+    edges along e are its support
+    function (:meth:`~pushrecovery.ground.Support.landing_foot`); the planner then steps
+    forward or backward along e exactly as on the sagittal line
+    (:func:`~pushrecovery.surfaces.step.plan_step`). With y = ẏ = 0 and feet at yaw 0 this is
+    the sagittal plan.
+
+    Parameters
+    ----------
+    x, y : float
+        CoM position in the world frame [m].
+    xdot, ydot : float
+        CoM velocity [m/s].
+    params : BodyParams
+        Body parameters.
+    support : Support
+        Stance and feet.
+
+    Returns
+    -------
+    (tuple of float, StepDecision or None)
+        The line's unit vector e, and the plan (None when |s| >= leg_length: no step).
+    """
+    inv = 1.0 / params.omega
+    ankle = support.ankle
+    ex, ey = x + xdot * inv - ankle[0], y + ydot * inv - ankle[1]
+    norm = math.hypot(ex, ey)
+    heading = (math.cos(support.yaw), math.sin(support.yaw))
+    if norm == 0.0:
+        ex, ey = heading
+    else:
+        ex, ey = ex / norm, ey / norm
+        if ex * heading[0] + ey * heading[1] < 0.0:
+            ex, ey = -ex, -ey
+    along = (x - ankle[0]) * ex + (y - ankle[1]) * ey
+    if abs(along) >= params.leg_length:
+        return (ex, ey), None
+    heel, toe = support.landing_foot(ex, ey)
+    return (ex, ey), plan_step(along, xdot * ex + ydot * ey, params, heel=heel, toe=toe)
+
+
+def step_threshold_xy(
+    params: BodyParams, support: Support, heading: float, *, tolerance: float = 1e-9
+) -> float:
+    """Largest push speed along ``heading`` [rad] that one step recovers, CoM at the ankle [m/s].
+
+    The CoM starts at rest above ``support.ankle``; bisection on the feasibility of
+    :func:`plan_step_xy` (monotone in the push along a fixed line, as on the sagittal line).
+    Along ±x on yaw-0 feet it is :func:`~pushrecovery.surfaces.step.step_thresholds`.
+    """
+    ux, uy = math.cos(heading), math.sin(heading)
+    ax, ay = support.ankle
+    low, high = 0.0, math.sqrt(params.gravity * params.leg_length)
+    while high - low > tolerance:
+        middle = 0.5 * (low + high)
+        plan = plan_step_xy(ax, ay, middle * ux, middle * uy, params, support)[1]
+        if plan is not None and plan.feasible:
+            low = middle
+        else:
+            high = middle
+    return low
