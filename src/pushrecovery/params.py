@@ -7,7 +7,6 @@ Lengths are signed x-coordinates relative to the ankle, x forward (see ``docs/co
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
@@ -326,6 +325,8 @@ def _polygon_value(value: Any) -> tuple[tuple[float, float], ...]:
 
 
 def _read_toml(path: Path) -> dict[str, Any]:
+    import tomllib  # here, not at the top: 10-20 ms of every start-up without a file
+
     try:
         with path.open("rb") as handle:
             data = tomllib.load(handle)

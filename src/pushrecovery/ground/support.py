@@ -168,8 +168,10 @@ class Support:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         # The direction in the foot's frame.
         fx, fy = c * direction_x + s * direction_y, -s * direction_x + c * direction_y
-        shape = self.foot.mirrored() if fy < 0.0 else self.foot
-        return -shape.support(-fx, -fy), shape.support(fx, fy)
+        # The right foot is the left one mirrored: its support in (fx, fy) is the left's in
+        # (fx, −fy).
+        fy = -fy if fy < 0.0 else fy
+        return -self.foot.support(-fx, -fy), self.foot.support(fx, fy)
 
     def to_dict(self) -> dict[str, object]:
         """JSON form: stance, foot poses and the support polygon's vertices [m]."""

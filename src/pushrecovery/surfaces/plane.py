@@ -42,7 +42,7 @@ from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import _fusable
-from pushrecovery.surfaces.step import StepDecision, plan_step
+from pushrecovery.surfaces.step import StepDecision, plan_step, step_feasible
 
 __all__ = [
     "DIRECTIONS",
@@ -219,9 +219,8 @@ def plan_step_xy(
     midpoint in double support) to ξ, turned to the stance's heading side (e · heading >= 0)
     so that the sagittal case keeps its signs. The state is projected on it, s = (r − ankle)
     · e, ṡ = ṙ · e, as the sagittal model measures x from the ankle, and the landing foot's
-    edges along e are its support
-    function (:meth:`~pushrecovery.ground.Support.landing_foot`); the planner then steps
-    forward or backward along e exactly as on the sagittal line
+    edges along e are its support function (:meth:`~pushrecovery.ground.Support.landing_foot`);
+    the planner then steps forward or backward along e exactly as on the sagittal line
     (:func:`~pushrecovery.surfaces.step.plan_step`). With y = ẏ = 0 and feet at yaw 0 this is
     the sagittal plan.
 
@@ -241,6 +240,17 @@ def plan_step_xy(
     (tuple of float, StepDecision or None)
         The line's unit vector e, and the plan (None when |s| >= leg_length: no step).
     """
+    line, projected = _step_line(x, y, xdot, ydot, params, support)
+    if projected is None:
+        return line, None
+    along, speed, heel, toe = projected
+    return line, plan_step(along, speed, params, heel=heel, toe=toe)
+
+
+def _step_line(
+    x: float, y: float, xdot: float, ydot: float, params: BodyParams, support: Support
+) -> tuple[tuple[float, float], tuple[float, float, float, float] | None]:
+    """Return the step line of :func:`plan_step_xy`, the state and the foot on it (or None)."""
     inv = 1.0 / params.omega
     ankle = support.ankle
     ex, ey = x + xdot * inv - ankle[0], y + ydot * inv - ankle[1]
@@ -256,7 +266,7 @@ def plan_step_xy(
     if abs(along) >= params.leg_length:
         return (ex, ey), None
     heel, toe = support.landing_foot(ex, ey)
-    return (ex, ey), plan_step(along, xdot * ex + ydot * ey, params, heel=heel, toe=toe)
+    return (ex, ey), (along, xdot * ex + ydot * ey, heel, toe)
 
 
 def step_threshold_xy(
@@ -265,7 +275,8 @@ def step_threshold_xy(
     """Largest push speed along ``heading`` [rad] that one step recovers, CoM at the ankle [m/s].
 
     The CoM starts at rest above ``support.ankle``; bisection on the feasibility of
-    :func:`plan_step_xy` (monotone in the push along a fixed line, as on the sagittal line).
+    :func:`plan_step_xy` (monotone in the push along a fixed line, as on the sagittal line),
+    tested without solving for the step angle (:func:`~pushrecovery.surfaces.step.step_feasible`).
     Along ±x on yaw-0 feet it is :func:`~pushrecovery.surfaces.step.step_thresholds`.
     """
     ux, uy = math.cos(heading), math.sin(heading)
@@ -273,8 +284,8 @@ def step_threshold_xy(
     low, high = 0.0, math.sqrt(params.gravity * params.leg_length)
     while high - low > tolerance:
         middle = 0.5 * (low + high)
-        plan = plan_step_xy(ax, ay, middle * ux, middle * uy, params, support)[1]
-        if plan is not None and plan.feasible:
+        projected = _step_line(ax, ay, middle * ux, middle * uy, params, support)[1]
+        if projected is not None and step_feasible(*projected, params):
             low = middle
         else:
             high = middle

@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models._step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
-from pushrecovery.models._step_scalar import decide
+from pushrecovery.models._step_scalar import decide, feasible
 from pushrecovery.params import BodyParams
 
 __all__ = [
@@ -40,6 +40,7 @@ __all__ = [
     "plan_step",
     "plan_steps",
     "step_critical_velocity",
+    "step_feasible",
     "step_thresholds",
 ]
 
@@ -224,6 +225,24 @@ def plan_step(
     return StepDecision(*decide(float(x), float(xdot), back, front, *args))
 
 
+def step_feasible(x: float, xdot: float, heel: float, toe: float, params: BodyParams) -> bool:
+    """Whether a single step recovers one state: ``plan_step(...).feasible``, faster.
+
+    Pure Python, without solving for the step angle (``_step_scalar.feasible``: two
+    evaluations of the post-impact capture point instead of three Newton solves). Arguments
+    as in :func:`plan_step`, the new foot's edges ``heel`` < ``toe`` [m] given.
+    """
+    return feasible(
+        float(x),
+        float(xdot),
+        float(heel),
+        float(toe),
+        params.com_height,
+        params.gravity,
+        params.max_step_length,
+    )
+
+
 @functools.cache
 def compiled_plan_step() -> ScalarPlanner:
     """Return the per-state decision of :func:`plan_step`, compiled, for real-time loops.
@@ -269,7 +288,7 @@ def step_critical_velocity(
 ) -> float:
     """Largest CoM velocity from position x [m] that one step recovers, signed [m/s].
 
-    Found by bisection on the decision of :func:`plan_step` (feasibility is monotone in the
+    Found by bisection on the feasibility of :func:`plan_step` (monotone in the
     push: a harder push needs a longer step and loads the stance leg less). Pure Python: no
     numba or scipy is loaded.
     """
@@ -279,7 +298,7 @@ def step_critical_velocity(
     low, high = 0.0, math.sqrt(params.gravity * params.leg_length)
     while high - low > tolerance:
         middle = 0.5 * (low + high)
-        if decide(x, sign * middle, *args)[2]:
+        if feasible(x, sign * middle, *args):  # = decide(...)[2], without the angles
             low = middle
         else:
             high = middle
