@@ -176,6 +176,15 @@ def decide(
     return direction, ready, feasible, theta, step_length, shortest, longest, margin
 
 
+def _capture_at(sin: float, cos: float, energy: float, target: float) -> float:
+    """ξ⁺/l − target at the angle with this sine and cosine, l = g = 1 (:func:`capture_residual`).
+
+    cos 2θ = cos²θ − sin²θ: no trigonometric call.
+    """
+    rate = math.sqrt(max(0.0, energy + 2.0 * (1.0 - cos)))
+    return -sin + rate * (cos * cos - sin * sin) / math.sqrt(cos) - target
+
+
 def feasible(
     x: float,
     xdot: float,
@@ -190,31 +199,40 @@ def feasible(
     ξ⁺(θ) decreases strictly in θ, so with f = ξ⁺/l on [lowest, π/4] the angles of
     :func:`decide` satisfy θ_toe < θ_heel ⟺ f(lowest) > heel/l, and θ_toe < allowed ⟺
     lowest < allowed and f(allowed) < toe/l; ``feasible`` is ``ready``, the stance leg in
-    compression, and both. Two evaluations of ξ⁺ replace three Newton solves; the answer
-    differs from :func:`decide`'s only where f(allowed) is within the solver's 1e-15 of toe/l.
-    Arguments as in :func:`decide`.
+    compression, and both. Every angle involved lies in [0, π/2), where sines order angles, and
+    each is known by its sine and cosine (the lean: x/l, L/l; the reach: its half-step over l;
+    π/4; the compression limit: its cosine), so no trigonometric function is evaluated: two
+    evaluations of ξ⁺ replace three Newton solves. The answer can differ from :func:`decide`'s
+    only within rounding of the boundary (f(allowed) within ~1e-15 of toe/l). Arguments as in
+    :func:`decide`.
     """
     if x + xdot / math.sqrt(gravity / height) < 0.5 * (heel + toe):
         x, xdot, heel, toe = -x, -xdot, -toe, -heel  # the mirror image: a forward step
     length = math.hypot(x, height)
-    lean = math.atan2(x, height)
-    lean_rate = xdot * math.cos(lean) / length
+    lean_cos = height / length
+    lean_rate = xdot * lean_cos / length
     omega2 = gravity / length
-    energy = lean_rate * lean_rate - 2.0 * omega2 * (1.0 - math.cos(lean))
-    if not (lean_rate > 0.0 and (energy > 0.0 or lean > 0.0)):
+    energy = lean_rate * lean_rate - 2.0 * omega2 * (1.0 - lean_cos)
+    if not (lean_rate > 0.0 and (energy > 0.0 or x > 0.0)):
         return False
     cos_limit = (length * energy + 2.0 * gravity) / (3.0 * gravity)
     if not cos_limit < 1.0:
         return False
-    lowest = max(lean, 0.0)
-    reach_angle = math.asin(min(1.0, reach / (2.0 * length)))
-    allowed = min(reach_angle, MAX_STEP_ANGLE, math.acos(max(-1.0, cos_limit)))
-    if not (lowest < allowed and 2.0 * length * math.sin(allowed) >= MIN_STEP_LENGTH):
+    # The lowest angle (the lean, or upright) and the allowed one (reach, π/4, compression),
+    # each as (sine, cosine).
+    low_sin, low_cos = (x / length, lean_cos) if x > 0.0 else (0.0, 1.0)
+    top_sin, top_cos = math.sqrt(0.5), math.sqrt(0.5)
+    reach_sin = min(1.0, reach / (2.0 * length))
+    if reach_sin < top_sin:
+        top_sin, top_cos = reach_sin, math.sqrt(1.0 - reach_sin * reach_sin)
+    if cos_limit > top_cos:  # the compression limit comes first (cos_limit > 0 there)
+        top_sin, top_cos = math.sqrt(1.0 - cos_limit * cos_limit), cos_limit
+    if not (low_sin < top_sin and 2.0 * length * top_sin >= MIN_STEP_LENGTH):
         return False
     scaled = energy / omega2
-    if capture_residual(lowest, scaled, 1.0, 1.0, 1.0, heel / length)[0] <= 0.0:
+    if _capture_at(low_sin, low_cos, scaled, heel / length) <= 0.0:
         return False
-    return capture_residual(allowed, scaled, 1.0, 1.0, 1.0, toe / length)[0] < 0.0
+    return _capture_at(top_sin, top_cos, scaled, toe / length) < 0.0
 
 
 def feasible_serial(
