@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.ground import FootPose, Support, convex_hull, convex_polygon, rectangle
+from pushrecovery.ground.polygon import MIN_EDGE
 from pushrecovery.params import BodyParams
 
 P = load_params()
@@ -65,7 +66,10 @@ def test_clockwise_input_is_reversed_and_collinear_vertices_dropped():
         ([[0, 0], [1, 0], [1, 0], [0, 1]], "vertex 2 repeats vertex 1"),
         ([[0, 0], [1, 1], [1, 0], [0, 1]], "self-intersecting: edge 0-1 crosses edge 2-3"),
         ([[0, 0], [2, 0], [1, 0.2], [1, 2]], "not convex at vertex 2"),
-        ([[0, 0], [1, 0], [2, 0]], "zero area"),
+        ([[0, 0], [1, 0], [2, 0]], "degenerate: area 0"),
+        ([[0, 0], [1e-4, 0], [0, 1e-4]], "degenerate: area 5e-09 m², at least 1e-06"),
+        ([[0, 0], [1, 0], [1, 1e-7], [0, 1]], "vertex 2 repeats vertex 1"),
+        ([[0, 0], [1e4, 0], [0, 1]], r"vertex 1 \(10000, 0\) lies beyond ±1000 m"),
         ("abc", "must be"),
     ],
 )
@@ -162,6 +166,25 @@ def test_yawed_feet_in_double_support():
     assert support.yaw == pytest.approx(0.0)
 
 
+def test_double_support_refuses_overlapping_or_distant_feet():
+    with pytest.raises(InvalidParameterError, match=r"the feet overlap by 0\.05 m"):
+        Support.from_params(load_params(overrides={"stance_width": 0.05}))
+    with pytest.raises(InvalidParameterError, match="the feet overlap"):
+        Support.from_params(P, left=FootPose(0.0, 0.0), right=FootPose(0.0, 0.0))
+    with pytest.raises(InvalidParameterError, match="ankles are 3 m apart"):
+        Support.from_params(P, left=FootPose(3.0, 0.0), right=FootPose(0.0, 0.0))
+    # One foot on the ground: where the other hangs does not matter; touching feet are fine.
+    Support.from_params(P, "left", left=FootPose(0.0, 0.0), right=FootPose(0.0, 0.0))
+    Support.from_params(load_params(overrides={"stance_width": 0.1}))
+
+
+def test_pose_limits_and_yaw_wrap():
+    assert FootPose(0.0, 0.0, 7.0).yaw == pytest.approx(7.0 - 2 * math.pi)
+    assert FootPose(0.0, 0.0, -math.pi).yaw == -math.pi
+    with pytest.raises(InvalidParameterError, match="foot pose x must be within"):
+        FootPose(1e300, 0.0)
+
+
 def test_bad_stance_and_pose():
     with pytest.raises(InvalidParameterError, match="stance must be one of"):
         Support.from_params(P, "both")
@@ -184,8 +207,9 @@ def test_hull_contains_its_points_or_refuses(points):
         assert "degenerate" in str(error)
         return
     xs, ys = np.array(points).T
-    # Every input point is inside or on the hull (1e-12 m: rounding of the edge offsets).
-    assert (hull.signed_distance(xs, ys) >= -1e-12).all()
+    # Every input point is inside or on the hull, up to the merge of vertices closer than
+    # MIN_EDGE (1 µm): a merged point lies at most that far outside.
+    assert (hull.signed_distance(xs, ys) >= -MIN_EDGE).all()
     assert hull.area > 0
 
 

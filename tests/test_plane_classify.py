@@ -39,7 +39,7 @@ def test_sagittal_special_case_is_identical():
             line = classify(x, xdot, P)
             plane = classify(x, xdot, P, y=0.0, ydot=0.0)
             assert plane.strategy == line.strategy, (x, xdot)
-            assert plane.capture_point == line.capture_point
+            assert plane.capture_point == pytest.approx(line.capture_point, abs=1e-15)
             for key in ("cop", "cmp", "step"):
                 a, b = line.margins[key], plane.margins[key]
                 assert (a == b) or abs(a - b) <= 1e-12, (x, xdot, key, a, b)
@@ -53,17 +53,31 @@ def test_sagittal_special_case_is_identical():
 
 
 def test_sagittal_cli_numbers_unchanged():
+    # Without planar flags the CLI is the sagittal model, numbers and keys; with them the plane,
+    # whose margins equal the sagittal ones for the paper preset at y = ẏ = 0.
     runner = CliRunner()
-    out = json.loads(runner.invoke(cli, ["classify", "--x", "0", "--xdot", "1.2", "--json"]).output)
+    args = ["classify", "--x", "0", "--xdot", "1.2", "--json"]
+    out = json.loads(runner.invoke(cli, args).output)
+    assert out == {**classify(0.0, 1.2, P).to_dict(), "state": {"x": 0.0, "xdot": 1.2}}
+    long_foot = ["--heel", "-0.2", "--toe", "0.25"]
+    out = json.loads(runner.invoke(cli, [*args, *long_foot]).output)
+    body = load_params(overrides={"heel": -0.2, "toe": 0.25})
+    assert out["margins"]["cop"] == classify(0.0, 1.2, body).margins["cop"]
+    plane = json.loads(runner.invoke(cli, [*args, "--stance", "double"]).output)
     line = classify(0.0, 1.2, P).to_dict()
     for key, value in line.items():
-        if isinstance(value, dict):  # the plane adds keys inside "step", never changes one
-            assert {k: out[key][k] for k in value} == value
-        else:
-            assert out[key] == value
-    assert out["state"] == {"x": 0.0, "xdot": 1.2, "y": 0.0, "ydot": 0.0}
-    assert out["capture_point_xy"] == [out["capture_point"], 0.0]
-    assert len(out["support"]["vertices"]) == 4
+        if key == "step":  # the plane adds keys inside "step", never changes one
+            for k in ("step_length", "com_to_foot", "theta"):
+                assert plane[key][k] == pytest.approx(value[k], abs=1e-12)
+        elif key == "margins":
+            for k, margin in value.items():
+                assert plane[key][k] == pytest.approx(margin, abs=1e-12)
+        elif key != "strategy":
+            assert plane[key] == pytest.approx(value, abs=1e-12)
+    assert plane["strategy"] == line["strategy"]
+    assert plane["state"] == {"x": 0.0, "xdot": 1.2, "y": 0.0, "ydot": 0.0}
+    assert plane["capture_point_xy"] == [plane["capture_point"], 0.0]
+    assert len(plane["support"]["vertices"]) == 4
 
 
 def random_states(n, seed):

@@ -40,8 +40,11 @@ def roll_axes(draw):
 
 @st.composite
 def polygon_feet(draw, symmetric=False):
-    """A convex foot around its ankle: the hull of 8 points at jittered headings, as vertices."""
-    radii = draw(st.lists(st.floats(0.02, 0.2), min_size=8, max_size=8))
+    """A convex foot around its ankle: the hull of 8 points at jittered headings, as vertices.
+
+    Within 0.09 m of the ankle, so that feet 0.2 m apart never overlap (which is refused).
+    """
+    radii = draw(st.lists(st.floats(0.02, 0.09), min_size=8, max_size=8))
     jitter = draw(st.lists(st.floats(-0.3, 0.3), min_size=8, max_size=8))
     headings = [2 * math.pi * k / 8 + j for k, j in enumerate(jitter)]
     points = [(r * math.cos(h), r * math.sin(h)) for r, h in zip(radii, headings, strict=True)]
@@ -60,7 +63,7 @@ def margins(x, y, xdot, ydot, support, params):
 @given(
     foot=polygon_feet(),
     roll=roll_axes(),
-    stance_width=st.floats(0.05, 0.5),
+    stance_width=st.floats(0.19, 0.5),  # feet within 0.09 m of their ankles never overlap
     state=st.tuples(positions, positions, velocities, velocities),
 )
 def test_mirror_maps_left_onto_right_and_double_onto_itself(foot, roll, stance_width, state):
@@ -108,8 +111,8 @@ def test_symmetric_foot_is_mirror_symmetric_about_its_own_axis(
     foot=polygon_feet(),
     roll=roll_axes(),
     stance=stances,
-    left=st.tuples(st.floats(-0.2, 0.2), st.floats(0.05, 0.3), st.floats(-1.0, 1.0)),
-    right=st.tuples(st.floats(-0.2, 0.2), st.floats(-0.3, -0.05), st.floats(-1.0, 1.0)),
+    left=st.tuples(st.floats(-0.2, 0.2), st.floats(0.1, 0.3), st.floats(-1.0, 1.0)),
+    right=st.tuples(st.floats(-0.2, 0.2), st.floats(-0.3, -0.1), st.floats(-1.0, 1.0)),
     turn=st.floats(-math.pi, math.pi),
     state=st.tuples(positions, positions, velocities, velocities),
 )
@@ -138,8 +141,8 @@ def test_rotating_feet_and_state_together_keeps_margins(
 @given(
     heel=st.floats(-0.1, -0.01),
     toe=st.floats(0.02, 0.3),
-    width=st.floats(0.03, 0.2),
-    stance_width=st.floats(0.05, 0.5),
+    width=st.floats(0.03, 0.15),
+    stance_width=st.floats(0.26, 0.6),  # wider than the widest foot below: no overlap
     more=st.tuples(
         st.floats(0.0, 0.1), st.floats(0.0, 0.1), st.floats(0.0, 0.1), st.floats(0.0, 0.3)
     ),

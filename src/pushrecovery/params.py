@@ -18,6 +18,9 @@ from pushrecovery.errors import InputFileError, InvalidParameterError
 
 __all__ = ["PRESETS", "BodyParams", "load_params"]
 
+#: Narrowest foot [m]: a narrower one is a line, whose distances are rounding noise.
+MIN_FOOT_WIDTH = 1e-3
+
 
 @dataclass(frozen=True, slots=True)
 class BodyParams:
@@ -144,7 +147,12 @@ class BodyParams:
     def _check_ground_plane(self, leg: float) -> None:
         """Validate the foot width, stance width, foot polygon and the roll axis."""
         set_ = object.__setattr__
-        set_(self, "foot_width", positive_float("foot_width", self.foot_width, "m"))
+        width = positive_float("foot_width", self.foot_width, "m")
+        if not MIN_FOOT_WIDTH <= width < 2.0 * self.com_height:
+            raise InvalidParameterError(
+                f"foot_width must be in [{MIN_FOOT_WIDTH:g}, 2 com_height) m, got {width:g}"
+            )
+        set_(self, "foot_width", width)
         stance = positive_float("stance_width", self.stance_width, "m")
         if stance >= 2.0 * leg:
             raise InvalidParameterError(
@@ -161,6 +169,11 @@ class BodyParams:
                 "toe": polygon.xmax,
                 "foot_width": polygon.ymax - polygon.ymin,
             }
+            if max(-polygon.ymin, polygon.ymax) >= self.com_height:
+                raise InvalidParameterError(
+                    "foot_polygon must lie closer to the ankle than com_height, got y in "
+                    f"[{polygon.ymin:g}, {polygon.ymax:g}] m, com_height={self.com_height:g} m"
+                )
             for name, value in extents.items():
                 if abs(getattr(self, name) - value) > 1e-9:
                     raise InvalidParameterError(
@@ -285,7 +298,13 @@ def load_params(
     if {"com_height", "leg_length"} & given and "max_step_length" not in given:
         values["max_step_length"] = PRESETS[preset].get("max_step_length")
     if values.get("foot_polygon") is not None:
-        values["foot_polygon"] = _polygon_value(values["foot_polygon"])
+        from pushrecovery.ground.polygon import convex_polygon
+
+        # Validated before its extents become heel, toe and foot_width, so that errors name it.
+        polygon = convex_polygon(
+            "foot_polygon", _polygon_value(values["foot_polygon"]), contains_origin=True
+        )
+        values["foot_polygon"] = tuple((float(x), float(y)) for x, y in polygon.vertices)
         clash = sorted({"heel", "toe", "foot_width"} & given)
         if clash:
             raise InvalidParameterError(

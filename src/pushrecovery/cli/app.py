@@ -39,8 +39,9 @@ CONTROLLER_CHOICES = (
 def cli() -> None:
     """Predict whether a pushed humanoid falls, and recover it (Stephens, Humanoid Push Recovery).
 
-    SI units throughout; x is forward, positions are relative to the ankle. Every command
-    takes the body-parameter flags and --json.
+    SI units throughout; x is forward, y left, positions relative to the ankle (sagittal) or
+    to the ankles' midpoint (ground plane). Every command takes the body-parameter flags and
+    --json.
     """
 
 
@@ -62,27 +63,50 @@ def bounds(as_json: bool, **kwargs: Any) -> None:
 
 @cli.command(short_help="Strategy a CoM state needs: ankle, hip, step or fall.")
 @click.option(
-    "--x", "x", type=float, required=True, help="CoM position, forward, from the ankles [m]."
+    "--x", "x", type=float, required=True, help="CoM position, forward, from the ankle(s) [m]."
 )
 @click.option("--xdot", type=float, required=True, help="CoM velocity, forward [m/s].")
 @click.option(
-    "--y", "y", type=float, default=0.0, show_default=True, help="CoM position, left [m]."
+    "--y",
+    "y",
+    type=float,
+    default=None,
+    help="CoM position, left [m] (default 0); puts the state on the ground plane.",
 )
 @click.option(
-    "--ydot", type=float, default=0.0, show_default=True, help="CoM velocity, left [m/s]."
+    "--ydot",
+    type=float,
+    default=None,
+    help="CoM velocity, left [m/s] (default 0); puts the state on the ground plane.",
 )
 @support_options
 @body_options
-def classify(x: float, xdot: float, y: float, ydot: float, as_json: bool, **kwargs: Any) -> None:
+def classify(
+    x: float, xdot: float, y: float | None, ydot: float | None, as_json: bool, **kwargs: Any
+) -> None:
     """Which strategy the CoM state needs: ankle, hip, step or fall.
 
-    On the ground plane: x forward, y left, from the midpoint of the ankles of the default
-    feet (or in the frame of --left-foot/--right-foot). Margins are signed distances of the
-    capture point to each region [m], positive inside.
+    Without --y, --ydot, --stance, --left-foot or --right-foot: the paper's sagittal model, x
+    relative to the ankle of a foot [heel, toe]. With any of them: the ground plane, x forward
+    and y left in the frame of the feet (by default the ankles' midpoint is the origin, in
+    every stance), where the support polygon and the CMP region are 2-D and the margins are
+    signed distances of the capture point to them [m], positive inside.
     """
     from pushrecovery.surfaces.classify import classify as classify_state
 
     params = params_from(kwargs)
+    planar = (
+        y is not None
+        or ydot is not None
+        or any(kwargs[name] is not None for name in ("stance", "left_foot", "right_foot"))
+    )
+    if not planar:
+        for name in ("stance", "left_foot", "right_foot"):
+            kwargs.pop(name)
+        result = classify_state(x, xdot, params).to_dict()
+        emit({**result, "state": {"x": x, "xdot": xdot}}, as_json)
+        return
+    y, ydot = (0.0 if y is None else y), (0.0 if ydot is None else ydot)
     support = support_from(kwargs, params)
     result = classify_state(x, xdot, params, y=y, ydot=ydot, support=support).to_dict()
     emit({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)

@@ -67,9 +67,9 @@ def support_options(func: F) -> F:
     return click.option(
         "--stance",
         type=click.Choice(("double", "left", "right")),
-        default="double",
-        show_default=True,
-        help="Feet on the ground: the support polygon is the hull of both, or one foot.",
+        default=None,
+        help="Feet on the ground: the support polygon is the hull of both (double, the "
+        "default), or one foot.",
     )(func)
 
 
@@ -81,7 +81,7 @@ def support_from(kwargs: dict[str, Any], params: BodyParams) -> Any:
     for side in ("left", "right"):
         text = kwargs.pop(f"{side}_foot")
         poses[side] = None if text is None else FootPose.parse(f"--{side}-foot", text)
-    return Support.from_params(params, kwargs.pop("stance"), **poses)
+    return Support.from_params(params, kwargs.pop("stance") or "double", **poses)
 
 
 def params_from(kwargs: dict[str, Any]) -> BodyParams:

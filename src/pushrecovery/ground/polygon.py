@@ -33,6 +33,12 @@ FloatArray = NDArray[np.float64]
 
 # Rows of a chunk for the numpy signed distance: (edges x chunk) temporaries stay small.
 _CHUNK = 1 << 16
+#: Shortest edge of a user polygon [m] and smallest area [m²]: below, a foot is a point or a
+#: line, and its normals and distances are rounding noise.
+MIN_EDGE = 1e-6
+MIN_AREA = 1e-6
+#: Largest coordinate of a user polygon [m] (a foot, in its own frame).
+MAX_COORDINATE = 1e3
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -121,15 +127,15 @@ class ConvexPolygon:
         )
         out = np.empty(px.shape)
         flat_x, flat_y, flat_out = px.reshape(-1), py.reshape(-1), out.reshape(-1)
-        for start in range(0, flat_x.size, _CHUNK):
-            part = slice(start, start + _CHUNK)
-            flat_out[part] = self._signed_distance_flat(flat_x[part], flat_y[part])
+        with np.errstate(all="ignore"):  # a non-finite point gives a non-finite distance
+            for start in range(0, flat_x.size, _CHUNK):
+                part = slice(start, start + _CHUNK)
+                flat_out[part] = self._signed_distance_flat(flat_x[part], flat_y[part])
         return out
 
     def _signed_distance_flat(self, px: FloatArray, py: FloatArray) -> FloatArray:
         nx, ny, b = self.normals[:, 0:1], self.normals[:, 1:2], self.offsets[:, None]
-        with np.errstate(invalid="ignore", over="ignore"):
-            excess = (nx * px + ny * py - b).max(axis=0)  # > 0 outside
+        excess = (nx * px + ny * py - b).max(axis=0)  # > 0 outside
         distance = -excess
         outside = np.flatnonzero(excess > 0.0)
         if outside.size:
@@ -199,6 +205,21 @@ class ConvexPolygon:
         ahead = rates > 0.0
         return float(np.min(gaps[ahead] / rates[ahead]))
 
+    def overlap_depth(self, other: ConvexPolygon) -> float:
+        """Smallest overlap of the two polygons' projections over all edge normals [m].
+
+        By the separating-axis theorem, <= 0 when they are disjoint or only touch, > 0 when
+        their interiors intersect.
+        """
+        depth = math.inf
+        for normals in (self.normals, other.normals):
+            mine, theirs = self.vertices @ normals.T, other.vertices @ normals.T
+            overlap = np.minimum(mine.max(axis=0), theirs.max(axis=0)) - np.maximum(
+                mine.min(axis=0), theirs.min(axis=0)
+            )
+            depth = min(depth, float(overlap.min()))
+        return depth
+
     def to_list(self) -> list[list[float]]:
         """Vertices as a JSON-ready list of [x, y] [m], counter-clockwise."""
         return [[float(x), float(y)] for x, y in self.vertices]
@@ -235,8 +256,10 @@ def convex_hull(points: ArrayLike) -> ConvexPolygon:
     ordered = list(pts)
     lower, upper = chain(ordered), chain(ordered[::-1])
     hull = lower[:-1] + upper[:-1]
-    # Vertices closer than rounding would give edges without a direction: keep one of each.
-    hull = [p for i, p in enumerate(hull) if np.hypot(*(p - hull[i - 1])) > 1e-12 * scale]
+    # Vertices closer than MIN_EDGE give edges without a reliable direction: keep one of each.
+    hull = [
+        p for i, p in enumerate(hull) if np.hypot(*(p - hull[i - 1])) > max(MIN_EDGE, 1e-12 * scale)
+    ]
     if len(hull) < 3:
         raise InvalidParameterError("support polygon is degenerate (zero area)")
     polygon = ConvexPolygon._from_ccw(np.array(hull))
@@ -279,11 +302,15 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
     for index, (x, y) in enumerate(pts):
         if not (math.isfinite(x) and math.isfinite(y)):
             raise InvalidParameterError(f"{name} vertex {index} is not finite: ({x}, {y})")
+        if max(abs(x), abs(y)) > MAX_COORDINATE:
+            raise InvalidParameterError(
+                f"{name} vertex {index} ({x:g}, {y:g}) lies beyond ±{MAX_COORDINATE:g} m"
+            )
     n = len(pts)
     scale = max(1e-3, float(np.abs(pts).max()))
     eps = 1e-12 * scale * scale
     for index in range(n):
-        if np.hypot(*(pts[index] - pts[(index + 1) % n])) <= 1e-12 * scale:
+        if np.hypot(*(pts[index] - pts[(index + 1) % n])) <= max(MIN_EDGE, 1e-12 * scale):
             raise InvalidParameterError(
                 f"{name} vertex {(index + 1) % n} repeats vertex {index} at "
                 f"({pts[index][0]:g}, {pts[index][1]:g})"
@@ -304,8 +331,10 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
     area = 0.5 * float(
         np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1])
     )
-    if abs(area) <= eps:
-        raise InvalidParameterError(f"{name} is degenerate: zero area")
+    if abs(area) < max(MIN_AREA, eps):
+        raise InvalidParameterError(
+            f"{name} is degenerate: area {abs(area):.3g} m², at least {MIN_AREA:g} m² (1 mm²)"
+        )
     sign = 1.0 if area > 0.0 else -1.0
     for index, turn in enumerate(turns):
         if sign * turn < -bends[index]:

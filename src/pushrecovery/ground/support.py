@@ -28,6 +28,9 @@ from pushrecovery.params import BodyParams
 
 __all__ = ["FootPose", "Stance", "Support", "foot_shape"]
 
+#: Largest ankle coordinate of a pose [m]: far beyond any lab or map a balance query needs.
+MAX_POSE = 1e6
+
 
 class Stance(StrEnum):
     """Which feet carry the body."""
@@ -46,10 +49,17 @@ class FootPose:
     yaw: float = 0.0
 
     def __post_init__(self) -> None:
-        for name, unit in (("x", "m"), ("y", "m"), ("yaw", "rad")):
-            object.__setattr__(
-                self, name, finite_float(f"foot pose {name}", getattr(self, name), unit)
-            )
+        for name in ("x", "y"):
+            value = finite_float(f"foot pose {name}", getattr(self, name), "m")
+            if abs(value) > MAX_POSE:
+                raise InvalidParameterError(
+                    f"foot pose {name} must be within ±{MAX_POSE:g} m, got {value:g}"
+                )
+            object.__setattr__(self, name, value)
+        yaw = finite_float("foot pose yaw", self.yaw, "rad")
+        if abs(yaw) > math.pi:  # the same heading, within [−π, π]
+            yaw = math.atan2(math.sin(yaw), math.cos(yaw))
+        object.__setattr__(self, "yaw", yaw)
 
     @classmethod
     def parse(cls, name: str, text: str) -> FootPose:
@@ -128,6 +138,7 @@ class Support:
             Stance.RIGHT: foot.mirrored().transformed(right.x, right.y, right.yaw),
         }
         if stance is Stance.DOUBLE:
+            _check_double_support(params, left, right, placed[Stance.LEFT], placed[Stance.RIGHT])
             polygon = convex_hull(np.vstack([p.vertices for p in placed.values()]))
         else:
             polygon = placed[stance]
@@ -159,18 +170,20 @@ class Support:
         return math.atan2(sin, cos)
 
     def landing_foot(self, direction_x: float, direction_y: float) -> tuple[float, float]:
-        """Back and front edges (heel < 0 < toe) of a landing foot along a unit direction [m].
+        """Back and front edges (heel < toe) of the landing foot along a unit direction [m].
 
-        The landing foot has the stance's yaw (the shape of the foot that would step: the
-        right foot when stepping to the right, else the left), and its edges along the step
-        line are its support function: toe = h(d), heel = −h(−d), relative to its ankle.
+        The foot that swings lands with the stance's yaw: the right foot from left stance, the
+        left from right stance, and from double support the foot on the side of the step.
+        Its edges along the step line are its support function, toe = h(d), heel = −h(−d),
+        relative to its ankle; the right foot is the left shape mirrored, whose support in
+        (fx, fy) (the direction in the foot's frame) is the left's in (fx, −fy).
         """
         c, s = math.cos(self.yaw), math.sin(self.yaw)
-        # The direction in the foot's frame.
         fx, fy = c * direction_x + s * direction_y, -s * direction_x + c * direction_y
-        # The right foot is the left one mirrored: its support in (fx, fy) is the left's in
-        # (fx, −fy).
-        fy = -fy if fy < 0.0 else fy
+        if self.stance is Stance.LEFT:
+            fy = -fy
+        elif self.stance is Stance.DOUBLE:
+            fy = abs(fy)
         return -self.foot.support(-fx, -fy), self.foot.support(fx, fy)
 
     def to_dict(self) -> dict[str, object]:
@@ -182,3 +195,26 @@ class Support:
             "vertices": self.polygon.to_list(),
             "area": self.polygon.area,
         }
+
+
+def _check_double_support(
+    params: BodyParams,
+    left: FootPose,
+    right: FootPose,
+    left_sole: ConvexPolygon,
+    right_sole: ConvexPolygon,
+) -> None:
+    """Refuse two feet on the ground that overlap or stand farther apart than two legs."""
+    apart = math.hypot(left.x - right.x, left.y - right.y)
+    if apart >= 2.0 * params.leg_length:
+        raise InvalidParameterError(
+            f"the ankles are {apart:g} m apart in double support, beyond 2 leg_length = "
+            f"{2.0 * params.leg_length:g} m"
+        )
+    depth = left_sole.overlap_depth(right_sole)
+    if depth > 1e-9:
+        raise InvalidParameterError(
+            f"the feet overlap by {depth:g} m in double support (left ankle at "
+            f"({left.x:g}, {left.y:g}), right at ({right.x:g}, {right.y:g}); stance_width "
+            f"{params.stance_width:g} m, foot_width {params.foot_width:g} m)"
+        )

@@ -238,23 +238,23 @@ def feasible(
 def feasible_serial(
     x: NDArray[float64],
     xdot: NDArray[float64],
-    heel: float,
-    toe: float,
+    heel: NDArray[float64],
+    toe: NDArray[float64],
     height: float,
     gravity: float,
     reach: float,
     out: NDArray[bool_],
 ) -> None:
-    """:func:`feasible` for every state of flat arrays (one foot for all), into ``out``."""
+    """:func:`feasible` for every state of flat arrays (a foot per state), into ``out``."""
     for i in range(x.shape[0]):
-        out[i] = feasible(x[i], xdot[i], heel, toe, height, gravity, reach)
+        out[i] = feasible(x[i], xdot[i], heel[i], toe[i], height, gravity, reach)
 
 
 def feasible_parallel(
     x: NDArray[float64],
     xdot: NDArray[float64],
-    heel: float,
-    toe: float,
+    heel: NDArray[float64],
+    toe: NDArray[float64],
     height: float,
     gravity: float,
     reach: float,
@@ -262,7 +262,7 @@ def feasible_parallel(
 ) -> None:
     """:func:`feasible_serial` over threads, once compiled (``prange``)."""
     for i in prange(x.shape[0]):
-        out[i] = feasible(x[i], xdot[i], heel, toe, height, gravity, reach)
+        out[i] = feasible(x[i], xdot[i], heel[i], toe[i], height, gravity, reach)
 
 
 def _store(i: int, decision: Decision, values: NDArray[float64], flags: NDArray[bool_]) -> None:

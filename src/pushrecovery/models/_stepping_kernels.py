@@ -136,18 +136,21 @@ def solve(
 def feasible(
     x: NDArray[np.float64],
     xdot: NDArray[np.float64],
-    heel: float,
-    toe: float,
+    heel: NDArray[np.float64] | float,
+    toe: NDArray[np.float64] | float,
     height: float,
     gravity: float,
     reach: float,
     *,
     parallel: bool | None = None,
 ) -> NDArray[np.bool_]:
-    """Compiled ``_step_scalar.feasible`` over flat arrays of the same size (one foot)."""
+    """Compiled ``_step_scalar.feasible`` over flat arrays (``heel``/``toe`` broadcast)."""
     x, xdot = _flat(x), _flat(xdot)
+    heel, toe = (
+        _flat(np.broadcast_to(np.asarray(a, dtype=np.float64), x.shape)) for a in (heel, toe)
+    )
     out = np.empty(x.size, dtype=np.bool_)
     parallel = x.size >= PARALLEL_MIN_SIZE if parallel is None else parallel
     kernel = _feasible_parallel if parallel else _feasible_serial
-    kernel(x, xdot, float(heel), float(toe), float(height), float(gravity), float(reach), out)
+    kernel(x, xdot, heel, toe, float(height), float(gravity), float(reach), out)
     return out

@@ -69,7 +69,8 @@ def plane_bounds(params: BodyParams, support: Support) -> dict[str, Any]:
     ``right``: ω times the distance to the region's edge for ankle and hip
     (:func:`~pushrecovery.surfaces.plane.direction_thresholds`), the single-step limit for
     step (:func:`~pushrecovery.surfaces.plane.step_threshold_xy`). ``cmp_offset`` gives the
-    hip region's growth along the pitch (x) and roll (y) axes [m].
+    hip region's growth along the pitch axis (the stance's heading) and the roll axis (its
+    left) [m]; with yawed feet these are not the world's x and y.
     """
     from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
     from pushrecovery.surfaces.plane import (

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery._validate import finite_float
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.support import Support
+from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
@@ -81,7 +81,9 @@ class Classification:
     On the ground plane also ``capture_point_xy`` (ξ in the world frame [m]), the ``support``
     and the CMP region's vertices (``cmp_region``); margins are then signed Euclidean
     distances in the plane, and ``step`` adds ``direction_xy`` (the unit vector of the step
-    line, along which ``step_length`` is signed) and ``foothold_xy`` (the landing ankle [m]).
+    line, along which ``step_length`` is signed) and ``foothold_xy`` [m]: the landing ankle,
+    ``step_length`` from the stance's reference ankle (in double support the ankles' midpoint,
+    where the sagittal model puts its stance leg).
     """
 
     capture_point: float
@@ -197,21 +199,22 @@ def _classify_plane(
     y = 0.0 if y is None else finite_float("y", y, "m")
     ydot = 0.0 if ydot is None else finite_float("ydot", ydot, "m/s")
     support = Support.from_params(params) if support is None else support
-    omega = params.omega
-    xi = (x + xdot / omega, y + ydot / omega)
-    if not (math.isfinite(xi[0]) and math.isfinite(xi[1])):
-        raise InvalidParameterError("states are too large: the capture point overflows")
+    inv = 1.0 / params.omega  # ξ as the monitor and the compiled margins compute it
+    xi = (x + xdot * inv, y + ydot * inv)
     hip_region = cmp_polygon(support, params)
     cop = float(support.polygon.signed_distance(*xi))
     cmp = float(hip_region.signed_distance(*xi))
+    if not (math.isfinite(cop) and math.isfinite(cmp)):
+        raise InvalidParameterError("states are too large: the capture point overflows")
     line, plan = plan_step_xy(x, y, xdot, ydot, params, support)
     strategy, step = _escalate(cop, cmp, plan, params)
     if step is not None and plan is not None:
         ankle = support.ankle
-        step["direction_xy"] = list(line)
+        # + 0.0 turns the −0.0 of a zero component into 0.0 in the JSON.
+        step["direction_xy"] = [line[0] + 0.0, line[1] + 0.0]
         step["foothold_xy"] = [
-            ankle[0] + plan.step_length * line[0],
-            ankle[1] + plan.step_length * line[1],
+            ankle[0] + plan.step_length * line[0] + 0.0,
+            ankle[1] + plan.step_length * line[1] + 0.0,
         ]
     margins = {"cop": cop, "cmp": cmp, "step": plan.margin if plan is not None else -math.inf}
     return Classification(xi[0], strategy, margins, step, xi, support, hip_region.to_list())
@@ -334,33 +337,80 @@ def _plane_codes(
     ydot: ArrayLike | None,
     support: Support | None,
 ) -> NDArray[np.int8]:
-    """:func:`classify_states` on the ground plane (the rules of :func:`_classify_plane`)."""
+    """:func:`classify_states` on the ground plane (the rules of :func:`_classify_plane`).
+
+    Chunk by chunk: both margins (the compiled pass for large chunks), then the step test on
+    the states beyond the hip region only, on their step lines.
+    """
     support = Support.from_params(params) if support is None else support
-    arrays = np.broadcast_arrays(
-        *(np.asarray(0.0 if a is None else a, dtype=np.float64) for a in (x, y, xdot, ydot))
-    )
-    x, y, xdot, ydot = (np.ascontiguousarray(a).reshape(-1) for a in arrays)
+    inputs = [np.asarray(0.0 if a is None else a, dtype=np.float64) for a in (x, y, xdot, ydot)]
+    shape = np.broadcast_shapes(*(a.shape for a in inputs))
+    size = math.prod(shape)
+    codes = np.empty(shape, dtype=np.int8)
+    flat_codes = codes.reshape(-1)
+    hip_region = cmp_polygon(support, params)
     omega = params.omega
-    cop = capture_margin_xy(x, y, xdot, ydot, omega, support.polygon)
-    hip = capture_margin_xy(x, y, xdot, ydot, omega, cmp_polygon(support, params))
-    codes = np.where(cop > 0.0, _ANKLE, np.where(hip > 0.0, _HIP, _FALL)).astype(np.int8)
-    index = np.flatnonzero(codes == _FALL)
-    if index.size:
-        xs, ys, xds, yds = (a[index] for a in (x, y, xdot, ydot))
-        ax, ay = support.ankle
-        ex, ey = xs + xds / omega - ax, ys + yds / omega - ay
-        norm = np.hypot(ex, ey)
-        heading = (math.cos(support.yaw), math.sin(support.yaw))
-        ex = np.where(norm > 0.0, ex / np.where(norm > 0.0, norm, 1.0), heading[0])
-        ey = np.where(norm > 0.0, ey / np.where(norm > 0.0, norm, 1.0), heading[1])
-        flip = np.where(ex * heading[0] + ey * heading[1] < 0.0, -1.0, 1.0)
-        ex, ey = ex * flip, ey * flip
-        along = (xs - ax) * ex + (ys - ay) * ey
-        heel, toe = _landing_edges(support, ex, ey)
-        feasible = plan_steps(along, xds * ex + yds * ey, params, heel=heel, toe=toe).feasible
-        feasible &= np.abs(along) < params.leg_length
-        codes[index[feasible]] = _STEP
-    return codes.reshape(arrays[0].shape)
+    for start in range(0, size, _CHUNK):
+        part = slice(start, min(start + _CHUNK, size))
+        xs, ys, xds, yds = (_chunk(a, shape, part) for a in inputs)
+        cop = capture_margin_xy(xs, ys, xds, yds, omega, support.polygon)
+        hip = capture_margin_xy(xs, ys, xds, yds, omega, hip_region)
+        chunk = np.where(cop > 0.0, _ANKLE, np.where(hip > 0.0, _HIP, _FALL)).astype(np.int8)
+        index = np.flatnonzero(chunk == _FALL)
+        if index.size:
+            feasible = _plane_steps(xs[index], ys[index], xds[index], yds[index], params, support)
+            chunk[index[feasible]] = _STEP
+        flat_codes[part] = chunk
+    return codes
+
+
+def _chunk(array: NDArray[np.float64], shape: tuple[int, ...], part: slice) -> NDArray[np.float64]:
+    """Elements ``part`` of ``array`` broadcast to ``shape`` and flattened (a copy of the part)."""
+    if array.shape == shape and array.flags.c_contiguous:
+        return array.reshape(-1)[part]
+    if array.size == 1:
+        return np.full(part.stop - part.start, float(array.reshape(-1)[0]))
+    return np.ascontiguousarray(np.broadcast_to(array, shape).flat[part])
+
+
+def _plane_steps(
+    xs: NDArray[np.float64],
+    ys: NDArray[np.float64],
+    xds: NDArray[np.float64],
+    yds: NDArray[np.float64],
+    params: BodyParams,
+    support: Support,
+) -> NDArray[np.bool_]:
+    """Vectorised single-step feasibility on the step lines of :func:`plan_step_xy`."""
+    omega = params.omega
+    ax, ay = support.ankle
+    inv = 1.0 / omega
+    ex, ey = xs + xds * inv - ax, ys + yds * inv - ay
+    norm = np.hypot(ex, ey)
+    heading = (math.cos(support.yaw), math.sin(support.yaw))
+    safe = np.where(norm > 0.0, norm, 1.0)
+    ex = np.where(norm > 0.0, ex / safe, heading[0])
+    ey = np.where(norm > 0.0, ey / safe, heading[1])
+    flip = np.where(ex * heading[0] + ey * heading[1] < 0.0, -1.0, 1.0)
+    ex, ey = ex * flip, ey * flip
+    along = (xs - ax) * ex + (ys - ay) * ey
+    speed = xds * ex + yds * ey
+    heel, toe = _landing_edges(support, ex, ey)
+    if along.size >= _FEASIBLE_MIN_SIZE:
+        from pushrecovery.models._stepping_kernels import feasible
+
+        steps = feasible(
+            along,
+            speed,
+            heel,
+            toe,
+            params.com_height,
+            params.gravity,
+            params.max_step_length,
+        )
+    else:
+        steps = np.asarray(plan_steps(along, speed, params, heel=heel, toe=toe).feasible)
+    return steps & (np.abs(along) < params.leg_length)
 
 
 def _landing_edges(
@@ -369,9 +419,10 @@ def _landing_edges(
     """Vectorised :meth:`Support.landing_foot`: (heel, toe) along unit vectors (ex, ey) [m]."""
     c, s = math.cos(support.yaw), math.sin(support.yaw)
     fx, fy = c * ex + s * ey, -s * ex + c * ey
-    left, right = support.foot.vertices, support.foot.mirrored().vertices
-    shape_x = np.where(fy[:, None] < 0.0, right[None, :, 0], left[None, :, 0])
-    shape_y = np.where(fy[:, None] < 0.0, right[None, :, 1], left[None, :, 1])
-    # Both feet have the same vertex count (one is the other's mirror).
-    ahead = shape_x * fx[:, None] + shape_y * fy[:, None]
+    if support.stance is Stance.LEFT:
+        fy = -fy  # the right foot swings: the left shape mirrored
+    elif support.stance is Stance.DOUBLE:
+        fy = np.abs(fy)
+    vertices = support.foot.vertices
+    ahead = vertices[None, :, 0] * fx[:, None] + vertices[None, :, 1] * fy[:, None]
     return np.min(ahead, axis=1), np.max(ahead, axis=1)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import Support
+from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import Strategy
 from pushrecovery.surfaces.plane import cmp_polygon
@@ -124,6 +124,7 @@ class BalanceMonitor:
         "_plan",
         "_plan_args",
         "_reach",
+        "_swing",
         "params",
         "support",
     )
@@ -145,13 +146,9 @@ class BalanceMonitor:
         self._cmp = _edges(cmp_polygon(support, self.params))
         self._ankle = support.ankle
         self._heading = (math.cos(support.yaw), math.sin(support.yaw))
-        self._feet = tuple(
-            (
-                tuple(float(c) for c in shape.vertices[:, 0]),
-                tuple(float(c) for c in shape.vertices[:, 1]),
-            )
-            for shape in (support.foot, support.foot.mirrored())
-        )
+        self._feet = tuple((float(x), float(y)) for x, y in support.foot.vertices)
+        # Which foot lands (Support.landing_foot): -1 mirrors the left shape into the right.
+        self._swing = {Stance.LEFT: -1.0, Stance.RIGHT: 1.0, Stance.DOUBLE: 0.0}[support.stance]
 
     def query(self, x: float, y: float, xdot: float, ydot: float) -> Verdict:
         """Classify one CoM state on the ground plane.
@@ -208,10 +205,10 @@ class BalanceMonitor:
         if abs(along) >= self._reach:
             return -math.inf, False
         fx, fy = hx * ex + hy * ey, -hy * ex + hx * ey  # the line in the foot's frame
-        xs, ys = self._feet[1] if fy < 0.0 else self._feet[0]
+        fy = abs(fy) if self._swing == 0.0 else self._swing * fy
         toe = -math.inf
         heel = math.inf
-        for vx, vy in zip(xs, ys, strict=True):
+        for vx, vy in self._feet:
             reach = vx * fx + vy * fy
             if reach > toe:
                 toe = reach
