@@ -224,3 +224,28 @@ def test_large_sagittal_batches_equal_the_definition():
     assert len(np.unique(codes)) == 4
     with pytest.raises(InvalidParameterError, match="xdot must be finite"):
         classify_states(x, np.where(np.arange(x.size) == 7, np.nan, xdot), P)
+
+
+@pytest.mark.parametrize("name", ["double", "left", "yawed"])
+def test_large_planar_batches_equal_the_small_path(name):
+    # Above the chunk size the planar codes come from the compiled region and step tests;
+    # below it from the exact margins and the full plan: the same verdicts.
+    support = SUPPORTS[name]
+    x, y, xdot, ydot = random_states(150_000, seed=7)
+    big = classify_states(x, xdot, P, y=y, ydot=ydot, support=support)
+    pieces = [
+        classify_states(
+            x[i : i + 30_000],
+            xdot[i : i + 30_000],
+            P,
+            y=y[i : i + 30_000],
+            ydot=ydot[i : i + 30_000],
+            support=support,
+        )
+        for i in range(0, x.size, 30_000)
+    ]
+    np.testing.assert_array_equal(big, np.concatenate(pieces))
+    assert len(np.unique(big)) == 4
+    scalar_y = classify_states(x, xdot, P, y=0.05, ydot=0.0, support=support)
+    one = classify(x[3], xdot[3], P, y=0.05, ydot=0.0, support=support)
+    assert STRATEGY_CODES[scalar_y[3]] == one.strategy

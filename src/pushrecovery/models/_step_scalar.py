@@ -25,7 +25,7 @@ import math
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from numpy import bool_, float64
+    from numpy import bool_, float64, int8
     from numpy.typing import NDArray
 
 #: Largest step angle: at π/4 the impact absorbs all horizontal velocity (cos 2θ = 0) [rad].
@@ -206,33 +206,33 @@ def feasible(
     only within rounding of the boundary (f(allowed) within ~1e-15 of toe/l). Arguments as in
     :func:`decide`.
     """
-    if x + xdot / math.sqrt(gravity / height) < 0.5 * (heel + toe):
+    if x + xdot * math.sqrt(height / gravity) < 0.5 * (heel + toe):
         x, xdot, heel, toe = -x, -xdot, -toe, -heel  # the mirror image: a forward step
     length = math.hypot(x, height)
-    lean_cos = height / length
-    lean_rate = xdot * lean_cos / length
-    omega2 = gravity / length
-    energy = lean_rate * lean_rate - 2.0 * omega2 * (1.0 - lean_cos)
+    inv_length = 1.0 / length  # one division; the rest multiply (divisions are slow)
+    lean_cos = height * inv_length
+    lean_rate = xdot * lean_cos * inv_length
+    energy = lean_rate * lean_rate - 2.0 * gravity * inv_length * (1.0 - lean_cos)
     if not (lean_rate > 0.0 and (energy > 0.0 or x > 0.0)):
         return False
-    cos_limit = (length * energy + 2.0 * gravity) / (3.0 * gravity)
+    cos_limit = (length * energy + 2.0 * gravity) * (1.0 / 3.0) / gravity
     if not cos_limit < 1.0:
         return False
     # The lowest angle (the lean, or upright) and the allowed one (reach, π/4, compression),
     # each as (sine, cosine).
-    low_sin, low_cos = (x / length, lean_cos) if x > 0.0 else (0.0, 1.0)
+    low_sin, low_cos = (x * inv_length, lean_cos) if x > 0.0 else (0.0, 1.0)
     top_sin, top_cos = math.sqrt(0.5), math.sqrt(0.5)
-    reach_sin = min(1.0, reach / (2.0 * length))
+    reach_sin = min(1.0, 0.5 * reach * inv_length)
     if reach_sin < top_sin:
         top_sin, top_cos = reach_sin, math.sqrt(1.0 - reach_sin * reach_sin)
     if cos_limit > top_cos:  # the compression limit comes first (cos_limit > 0 there)
         top_sin, top_cos = math.sqrt(1.0 - cos_limit * cos_limit), cos_limit
     if not (low_sin < top_sin and 2.0 * length * top_sin >= MIN_STEP_LENGTH):
         return False
-    scaled = energy / omega2
-    if _capture_at(low_sin, low_cos, scaled, heel / length) <= 0.0:
+    scaled = energy * length / gravity  # θ̇² in units of g/l
+    if _capture_at(low_sin, low_cos, scaled, heel * inv_length) <= 0.0:
         return False
-    return _capture_at(top_sin, top_cos, scaled, toe / length) < 0.0
+    return _capture_at(top_sin, top_cos, scaled, toe * inv_length) < 0.0
 
 
 def feasible_serial(
@@ -263,6 +263,163 @@ def feasible_parallel(
     """:func:`feasible_serial` over threads, once compiled (``prange``)."""
     for i in prange(x.shape[0]):
         out[i] = feasible(x[i], xdot[i], heel[i], toe[i], height, gravity, reach)
+
+
+def feasible_xy(
+    x: float,
+    y: float,
+    xdot: float,
+    ydot: float,
+    inv_omega: float,
+    ankle_x: float,
+    ankle_y: float,
+    heading_x: float,
+    heading_y: float,
+    swing: float,
+    foot_x: NDArray[float64],
+    foot_y: NDArray[float64],
+    height: float,
+    gravity: float,
+    reach: float,
+    leg: float,
+) -> bool:
+    """:func:`feasible` for a state on the ground plane, on its step line.
+
+    The line of :func:`pushrecovery.surfaces.plane.plan_step_xy`: from the stance's ankle to
+    ξ = r + ṙ/ω, turned to the heading's side; the state projected on it; the landing foot's
+    edges along it from the foot's vertices (in its frame), ``swing`` = −1 for the right foot
+    (the left shape mirrored), +1 for the left, 0 for the one on the side of the step
+    (double support). ``leg``: no step once the CoM is a leg length along the line from the
+    ankle. Positions [m], velocities [m/s], 1/ω [s], the heading a unit vector.
+    """
+    ex = x + xdot * inv_omega - ankle_x
+    ey = y + ydot * inv_omega - ankle_y
+    norm = math.hypot(ex, ey)
+    if norm == 0.0:
+        ex, ey = heading_x, heading_y
+    else:
+        ex, ey = ex / norm, ey / norm
+        if ex * heading_x + ey * heading_y < 0.0:
+            ex, ey = -ex, -ey
+    along = (x - ankle_x) * ex + (y - ankle_y) * ey
+    if abs(along) >= leg:
+        return False
+    fx = heading_x * ex + heading_y * ey
+    fy = -heading_y * ex + heading_x * ey
+    fy = abs(fy) if swing == 0.0 else swing * fy
+    heel, toe = math.inf, -math.inf
+    for k in range(foot_x.shape[0]):
+        ahead = foot_x[k] * fx + foot_y[k] * fy
+        heel = min(heel, ahead)
+        toe = max(toe, ahead)
+    return feasible(along, xdot * ex + ydot * ey, heel, toe, height, gravity, reach)
+
+
+def feasible_xy_parallel(
+    x: NDArray[float64],
+    y: NDArray[float64],
+    xdot: NDArray[float64],
+    ydot: NDArray[float64],
+    inv_omega: float,
+    ankle_x: float,
+    ankle_y: float,
+    heading_x: float,
+    heading_y: float,
+    swing: float,
+    foot_x: NDArray[float64],
+    foot_y: NDArray[float64],
+    height: float,
+    gravity: float,
+    reach: float,
+    leg: float,
+    out: NDArray[bool_],
+) -> None:
+    """:func:`feasible_xy` for every state of flat arrays, over threads once compiled."""
+    for i in prange(x.shape[0]):
+        out[i] = feasible_xy(
+            x[i],
+            y[i],
+            xdot[i],
+            ydot[i],
+            inv_omega,
+            ankle_x,
+            ankle_y,
+            heading_x,
+            heading_y,
+            swing,
+            foot_x,
+            foot_y,
+            height,
+            gravity,
+            reach,
+            leg,
+        )
+
+
+def mark_feasible(
+    x: NDArray[float64],
+    xdot: NDArray[float64],
+    heel: float,
+    toe: float,
+    height: float,
+    gravity: float,
+    reach: float,
+    codes: NDArray[int8],
+    pending: int,
+    mark: int,
+) -> None:
+    """Set ``codes[i] = mark`` where ``codes[i] == pending`` and one step recovers state i.
+
+    :func:`feasible` in place over flat arrays with one foot, without gathering the states
+    (threads once compiled).
+    """
+    for i in prange(x.shape[0]):
+        if codes[i] == pending and feasible(x[i], xdot[i], heel, toe, height, gravity, reach):
+            codes[i] = mark
+
+
+def mark_feasible_xy(
+    x: NDArray[float64],
+    y: NDArray[float64],
+    xdot: NDArray[float64],
+    ydot: NDArray[float64],
+    inv_omega: float,
+    ankle_x: float,
+    ankle_y: float,
+    heading_x: float,
+    heading_y: float,
+    swing: float,
+    foot_x: NDArray[float64],
+    foot_y: NDArray[float64],
+    height: float,
+    gravity: float,
+    reach: float,
+    leg: float,
+    codes: NDArray[int8],
+    pending: int,
+    mark: int,
+) -> None:
+    """:func:`mark_feasible` on the ground plane (:func:`feasible_xy`)."""
+    for i in prange(x.shape[0]):
+        if codes[i] == pending and feasible_xy(
+            x[i],
+            y[i],
+            xdot[i],
+            ydot[i],
+            inv_omega,
+            ankle_x,
+            ankle_y,
+            heading_x,
+            heading_y,
+            swing,
+            foot_x,
+            foot_y,
+            height,
+            gravity,
+            reach,
+            leg,
+        ):
+            codes[i] = mark
 
 
 def _store(i: int, decision: Decision, values: NDArray[float64], flags: NDArray[bool_]) -> None:

@@ -88,3 +88,37 @@ def sagittal_codes(  # type: ignore[no-untyped-def]
             else:
                 bad += 1
     return beyond, bad
+
+
+@numba.njit(parallel=True, cache=True, nogil=True)
+def plane_codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
+    """Strategy codes decided by the planar regions alone: 0 ankle, 1 hip, 3 beyond both.
+
+    Inside a convex polygon means max_i(n_i · ξ − b_i) < 0 (``edges`` rows: n_x, n_y, b), as
+    the signed distance > 0 of :mod:`pushrecovery.ground.polygon`. Returns (states beyond the
+    hip region, non-finite states).
+    """
+    beyond = 0
+    bad = 0
+    for i in numba.prange(x.shape[0]):
+        px = x[i] + xdot[i] * inv_omega
+        py = y[i] + ydot[i] * inv_omega
+        if not (math.isfinite(px) and math.isfinite(py)):
+            out[i] = 3
+            bad += 1
+            continue
+        excess = -np.inf
+        for k in range(cop_edges.shape[0]):
+            excess = max(excess, cop_edges[k, 0] * px + cop_edges[k, 1] * py - cop_edges[k, 2])
+        if excess < 0.0:
+            out[i] = 0
+            continue
+        excess = -np.inf
+        for k in range(cmp_edges.shape[0]):
+            excess = max(excess, cmp_edges[k, 0] * px + cmp_edges[k, 1] * py - cmp_edges[k, 2])
+        if excess < 0.0:
+            out[i] = 1
+        else:
+            out[i] = 3
+            beyond += 1
+    return beyond, bad

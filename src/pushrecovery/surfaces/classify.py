@@ -21,8 +21,9 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_float
+from pushrecovery._validate import finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
@@ -282,44 +283,29 @@ def classify_states(
         )
         if bad:
             cop_margin(flat_x, flat_xdot, params)  # raises, naming the argument
-    else:
-        cop_m, hip_m = cop_margin(flat_x, flat_xdot, params), cmp_margin(flat_x, flat_xdot, params)
-        flat[...] = np.where(cop_m > 0.0, _ANKLE, np.where(hip_m > 0.0, _HIP, _FALL))
-        beyond = 1
-    if beyond:
-        _step_or_fall(flat_x, flat_xdot, flat, params)
+        if beyond:
+            _step_or_fall(flat_x, flat_xdot, flat, params)
+        return codes
+    cop_m, hip_m = cop_margin(flat_x, flat_xdot, params), cmp_margin(flat_x, flat_xdot, params)
+    flat[...] = np.where(cop_m > 0.0, _ANKLE, np.where(hip_m > 0.0, _HIP, _FALL))
+    index = np.flatnonzero(flat == _FALL)
+    if index.size:  # few states: the plan itself (pure Python up to 32 states)
+        flat[index[plan_steps(flat_x[index], flat_xdot[index], params).feasible]] = _STEP
     return codes
 
 
 def _step_or_fall(
     x: NDArray[np.float64], xdot: NDArray[np.float64], codes: NDArray[np.int8], params: BodyParams
 ) -> None:
-    """Mark ``step`` where a single step recovers the states coded ``fall``, chunk by chunk.
+    """Mark ``step`` where a single step recovers the states coded ``fall``.
 
-    Only feasibility is needed, so the compiled ``feasible`` (two evaluations of ξ⁺) replaces
-    the full plan (three Newton solves) on large chunks; small ones take :func:`plan_steps`.
+    Only feasibility is needed, so the compiled angle-free test replaces the full plan (three
+    Newton solves), in place, on the states still coded ``fall``.
     """
-    for start in range(0, codes.size, _CHUNK):
-        part = slice(start, start + _CHUNK)
-        index = np.flatnonzero(codes[part] == _FALL)
-        if not index.size:
-            continue
-        index += start
-        if index.size >= _FEASIBLE_MIN_SIZE:
-            from pushrecovery.models._stepping_kernels import feasible
+    from pushrecovery.models._stepping_kernels import mark_feasible
 
-            steps = feasible(
-                x[index],
-                xdot[index],
-                params.heel,
-                params.toe,
-                params.com_height,
-                params.gravity,
-                params.max_step_length,
-            )
-        else:
-            steps = plan_steps(x[index], xdot[index], params).feasible
-        codes[index[steps]] = _STEP
+    args = (params.heel, params.toe, params.com_height, params.gravity, params.max_step_length)
+    mark_feasible(x, xdot, *args, codes, _FALL, _STEP)
 
 
 _ANKLE, _HIP, _STEP, _FALL = (STRATEGY_CODES.index(s) for s in Strategy)
@@ -350,18 +336,65 @@ def _plane_codes(
     flat_codes = codes.reshape(-1)
     hip_region = cmp_polygon(support, params)
     omega = params.omega
-    for start in range(0, size, _CHUNK):
-        part = slice(start, min(start + _CHUNK, size))
-        xs, ys, xds, yds = (_chunk(a, shape, part) for a in inputs)
-        cop = capture_margin_xy(xs, ys, xds, yds, omega, support.polygon)
-        hip = capture_margin_xy(xs, ys, xds, yds, omega, hip_region)
-        chunk = np.where(cop > 0.0, _ANKLE, np.where(hip > 0.0, _HIP, _FALL)).astype(np.int8)
-        index = np.flatnonzero(chunk == _FALL)
-        if index.size:
-            feasible = _plane_steps(xs[index], ys[index], xds[index], yds[index], params, support)
-            chunk[index[feasible]] = _STEP
-        flat_codes[part] = chunk
+    if size >= _CHUNK:
+        _plane_codes_compiled(inputs, shape, flat_codes, params, support, hip_region)
+        return codes
+    xs, ys, xds, yds = (_chunk(a, shape, slice(0, size)) for a in inputs)
+    cop = capture_margin_xy(xs, ys, xds, yds, omega, support.polygon)
+    hip = capture_margin_xy(xs, ys, xds, yds, omega, hip_region)
+    flat_codes[...] = np.where(cop > 0.0, _ANKLE, np.where(hip > 0.0, _HIP, _FALL))
+    index = np.flatnonzero(flat_codes == _FALL)
+    if index.size:
+        feasible = _plane_steps(xs[index], ys[index], xds[index], yds[index], params, support)
+        flat_codes[index[feasible]] = _STEP
     return codes
+
+
+def _plane_codes_compiled(
+    inputs: list[NDArray[np.float64]],
+    shape: tuple[int, ...],
+    flat_codes: NDArray[np.int8],
+    params: BodyParams,
+    support: Support,
+    hip_region: ConvexPolygon,
+) -> None:
+    """Large arrays: the compiled region test, then the compiled step test, chunk by chunk."""
+    from pushrecovery.models._stepping_kernels import mark_feasible_xy
+    from pushrecovery.surfaces._kernels import plane_codes
+
+    inv = 1.0 / params.omega
+    cop_edges = np.ascontiguousarray(support.polygon.edge_table[:, :3])
+    hip_edges = np.ascontiguousarray(hip_region.edge_table[:, :3])
+    heading = (math.cos(support.yaw), math.sin(support.yaw))
+    swing = {Stance.LEFT: -1.0, Stance.RIGHT: 1.0, Stance.DOUBLE: 0.0}[support.stance]
+    body = (params.com_height, params.gravity, params.max_step_length, params.leg_length)
+    foot_x, foot_y = (np.ascontiguousarray(support.foot.vertices[:, k]) for k in (0, 1))
+    for start in range(0, flat_codes.size, _CHUNK):
+        part = slice(start, min(start + _CHUNK, flat_codes.size))
+        xs, ys, xds, yds = (_chunk(a, shape, part) for a in inputs)
+        chunk = flat_codes[part]
+        beyond, bad = plane_codes(xs, ys, xds, yds, inv, cop_edges, hip_edges, chunk)
+        if bad:
+            for name, array in zip(("x", "y", "xdot", "ydot"), (xs, ys, xds, yds), strict=True):
+                finite_array(name, array)
+            raise InvalidParameterError("states are too large: the capture point overflows")
+        if beyond:
+            mark_feasible_xy(
+                xs,
+                ys,
+                xds,
+                yds,
+                inv,
+                *support.ankle,
+                *heading,
+                swing,
+                foot_x,
+                foot_y,
+                *body,
+                chunk,
+                _FALL,
+                _STEP,
+            )
 
 
 def _chunk(array: NDArray[np.float64], shape: tuple[int, ...], part: slice) -> NDArray[np.float64]:
