@@ -90,35 +90,44 @@ def sagittal_codes(  # type: ignore[no-untyped-def]
     return beyond, bad
 
 
+#: Edge tables of :func:`plane_codes` come padded to a multiple of this many rows (repeating a
+#: row changes no maximum): the inner loop then has a fixed count and unrolls, branch-free.
+EDGE_BLOCK = 8
+
+
 @numba.njit(parallel=True, cache=True, nogil=True)
 def plane_codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
     """Strategy codes decided by the planar regions alone: 0 ankle, 1 hip, 3 beyond both.
 
-    Inside a convex polygon means max_i(n_i · ξ − b_i) < 0 (``edges`` rows: n_x, n_y, b), as
-    the signed distance > 0 of :mod:`pushrecovery.ground.polygon`. Returns (states beyond the
-    hip region, non-finite states).
+    Inside a convex polygon means max_i(n_i · ξ − b_i) < 0 (``edges`` rows: n_x, n_y, b,
+    padded to a multiple of :data:`EDGE_BLOCK`), as the signed distance > 0 of
+    :mod:`pushrecovery.ground.polygon`. Returns (states beyond the hip region, non-finite
+    states).
     """
     beyond = 0
     bad = 0
     for i in numba.prange(x.shape[0]):
         px = x[i] + xdot[i] * inv_omega
         py = y[i] + ydot[i] * inv_omega
-        if not (math.isfinite(px) and math.isfinite(py)):
-            out[i] = 3
-            bad += 1
-            continue
-        excess = -np.inf
-        for k in range(cop_edges.shape[0]):
-            excess = max(excess, cop_edges[k, 0] * px + cop_edges[k, 1] * py - cop_edges[k, 2])
-        if excess < 0.0:
-            out[i] = 0
-            continue
-        excess = -np.inf
-        for k in range(cmp_edges.shape[0]):
-            excess = max(excess, cmp_edges[k, 0] * px + cmp_edges[k, 1] * py - cmp_edges[k, 2])
-        if excess < 0.0:
-            out[i] = 1
-        else:
-            out[i] = 3
-            beyond += 1
+        cop = -np.inf
+        for start in range(0, cop_edges.shape[0], EDGE_BLOCK):
+            for k in range(start, start + EDGE_BLOCK):
+                e = cop_edges[k, 0] * px + cop_edges[k, 1] * py - cop_edges[k, 2]
+                cop = e if e > cop else cop
+        hip = -np.inf
+        for start in range(0, cmp_edges.shape[0], EDGE_BLOCK):
+            for k in range(start, start + EDGE_BLOCK):
+                e = cmp_edges[k, 0] * px + cmp_edges[k, 1] * py - cmp_edges[k, 2]
+                hip = e if e > hip else hip
+        code = 0 if cop < 0.0 else (1 if hip < 0.0 else 3)
+        out[i] = code
+        beyond += code == 3
+        bad += not (abs(px) + abs(py) < np.inf)  # NaN or infinite
     return beyond, bad
+
+
+def padded_edges(table):  # type: ignore[no-untyped-def]
+    """The (n_x, n_y, b) columns of an edge table, padded to a multiple of EDGE_BLOCK rows."""
+    rows = np.ascontiguousarray(table[:, :3])
+    missing = -len(rows) % EDGE_BLOCK
+    return np.ascontiguousarray(np.vstack([rows, np.repeat(rows[-1:], missing, axis=0)]))

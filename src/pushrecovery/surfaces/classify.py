@@ -360,11 +360,11 @@ def _plane_codes_compiled(
 ) -> None:
     """Large arrays: the compiled region test, then the compiled step test, chunk by chunk."""
     from pushrecovery.models._stepping_kernels import mark_feasible_xy
-    from pushrecovery.surfaces._kernels import plane_codes
+    from pushrecovery.surfaces._kernels import padded_edges, plane_codes
 
     inv = 1.0 / params.omega
-    cop_edges = np.ascontiguousarray(support.polygon.edge_table[:, :3])
-    hip_edges = np.ascontiguousarray(hip_region.edge_table[:, :3])
+    cop_edges = padded_edges(support.polygon.edge_table)
+    hip_edges = padded_edges(hip_region.edge_table)
     heading = (math.cos(support.yaw), math.sin(support.yaw))
     swing = {Stance.LEFT: -1.0, Stance.RIGHT: 1.0, Stance.DOUBLE: 0.0}[support.stance]
     body = (params.com_height, params.gravity, params.max_step_length, params.leg_length)
