@@ -127,7 +127,7 @@ def plane_codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type
 
 
 def padded_edges(table):  # type: ignore[no-untyped-def]
-    """The (n_x, n_y, b) columns of an edge table, padded to a multiple of EDGE_BLOCK rows."""
+    """Return the (n_x, n_y, b) columns of an edge table, padded to whole EDGE_BLOCKs."""
     rows = np.ascontiguousarray(table[:, :3])
     missing = -len(rows) % EDGE_BLOCK
     return np.ascontiguousarray(np.vstack([rows, np.repeat(rows[-1:], missing, axis=0)]))
