@@ -169,23 +169,6 @@ class Support:
             return self.left.yaw
         return math.atan2(sin, cos)
 
-    def landing_foot(self, direction_x: float, direction_y: float) -> tuple[float, float]:
-        """Back and front edges (heel < toe) of the landing foot along a unit direction [m].
-
-        The foot that swings lands with the stance's yaw: the right foot from left stance, the
-        left from right stance, and from double support the foot on the side of the step.
-        Its edges along the step line are its support function, toe = h(d), heel = −h(−d),
-        relative to its ankle; the right foot is the left shape mirrored, whose support in
-        (fx, fy) (the direction in the foot's frame) is the left's in (fx, −fy).
-        """
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        fx, fy = c * direction_x + s * direction_y, -s * direction_x + c * direction_y
-        if self.stance is Stance.LEFT:
-            fy = -fy
-        elif self.stance is Stance.DOUBLE:
-            fy = abs(fy)
-        return -self.foot.support(-fx, -fy), self.foot.support(fx, fy)
-
     def to_dict(self) -> dict[str, object]:
         """JSON form: stance, foot poses and the support polygon's vertices [m]."""
         return {

@@ -265,6 +265,56 @@ def feasible_parallel(
         out[i] = feasible(x[i], xdot[i], heel[i], toe[i], height, gravity, reach)
 
 
+def step_line(
+    x: float,
+    y: float,
+    xdot: float,
+    ydot: float,
+    inv_omega: float,
+    ankle_x: float,
+    ankle_y: float,
+    heading_x: float,
+    heading_y: float,
+    swing: float,
+    foot_x: NDArray[float64],
+    foot_y: NDArray[float64],
+) -> tuple[float, float, float, float, float, float]:
+    """Return the line a planar state steps along, and the state and landing foot on it.
+
+    The line runs from the stance's ankle to ξ = r + ṙ/ω, turned to the heading's side
+    (e · heading >= 0) so that the sagittal case keeps its signs (the heading itself when ξ is
+    at the ankle); the state is projected on it, s = (r − ankle) · e, ṡ = ṙ · e; the landing
+    foot's edges along it are its support function from the foot's vertices (in its frame, any
+    sequence), ``swing`` = −1 for the right foot (the left shape mirrored), +1 for the left,
+    0 for the one on the side of the step (double support). Positions [m], velocities [m/s],
+    1/ω [s], the heading a unit vector.
+
+    Returns
+    -------
+    tuple
+        (e_x, e_y, s [m], ṡ [m/s], heel [m], toe [m]).
+    """
+    ex = x + xdot * inv_omega - ankle_x
+    ey = y + ydot * inv_omega - ankle_y
+    norm = math.hypot(ex, ey)
+    if norm == 0.0:
+        ex, ey = heading_x, heading_y
+    else:
+        ex, ey = ex / norm, ey / norm
+        if ex * heading_x + ey * heading_y < 0.0:
+            ex, ey = -ex, -ey
+    fx = heading_x * ex + heading_y * ey  # the line in the foot's frame
+    fy = -heading_y * ex + heading_x * ey
+    fy = abs(fy) if swing == 0.0 else swing * fy
+    heel, toe = math.inf, -math.inf
+    for k in range(len(foot_x)):
+        ahead = foot_x[k] * fx + foot_y[k] * fy
+        heel = min(heel, ahead)
+        toe = max(toe, ahead)
+    along = (x - ankle_x) * ex + (y - ankle_y) * ey
+    return ex, ey, along, xdot * ex + ydot * ey, heel, toe
+
+
 def feasible_xy(
     x: float,
     y: float,
@@ -283,36 +333,47 @@ def feasible_xy(
     reach: float,
     leg: float,
 ) -> bool:
-    """:func:`feasible` for a state on the ground plane, on its step line.
+    """:func:`feasible` for a state on the ground plane, on its :func:`step_line`.
 
-    The line of :func:`pushrecovery.surfaces.plane.plan_step_xy`: from the stance's ankle to
-    ξ = r + ṙ/ω, turned to the heading's side; the state projected on it; the landing foot's
-    edges along it from the foot's vertices (in its frame), ``swing`` = −1 for the right foot
-    (the left shape mirrored), +1 for the left, 0 for the one on the side of the step
-    (double support). ``leg``: no step once the CoM is a leg length along the line from the
-    ankle. Positions [m], velocities [m/s], 1/ω [s], the heading a unit vector.
+    No step once the CoM is ``leg`` [m] or more along the line from the ankle.
     """
-    ex = x + xdot * inv_omega - ankle_x
-    ey = y + ydot * inv_omega - ankle_y
-    norm = math.hypot(ex, ey)
-    if norm == 0.0:
-        ex, ey = heading_x, heading_y
-    else:
-        ex, ey = ex / norm, ey / norm
-        if ex * heading_x + ey * heading_y < 0.0:
-            ex, ey = -ex, -ey
-    along = (x - ankle_x) * ex + (y - ankle_y) * ey
-    if abs(along) >= leg:
+    line = step_line(
+        x, y, xdot, ydot, inv_omega, ankle_x, ankle_y, heading_x, heading_y, swing, foot_x, foot_y
+    )
+    if abs(line[2]) >= leg:
         return False
-    fx = heading_x * ex + heading_y * ey
-    fy = -heading_y * ex + heading_x * ey
-    fy = abs(fy) if swing == 0.0 else swing * fy
-    heel, toe = math.inf, -math.inf
-    for k in range(foot_x.shape[0]):
-        ahead = foot_x[k] * fx + foot_y[k] * fy
-        heel = min(heel, ahead)
-        toe = max(toe, ahead)
-    return feasible(along, xdot * ex + ydot * ey, heel, toe, height, gravity, reach)
+    return feasible(line[2], line[3], line[4], line[5], height, gravity, reach)
+
+
+def decide_xy(
+    x: float,
+    y: float,
+    xdot: float,
+    ydot: float,
+    inv_omega: float,
+    ankle_x: float,
+    ankle_y: float,
+    heading_x: float,
+    heading_y: float,
+    swing: float,
+    foot_x: NDArray[float64],
+    foot_y: NDArray[float64],
+    height: float,
+    gravity: float,
+    reach: float,
+    leg: float,
+) -> tuple[float, bool]:
+    """(step margin [m], feasible) of :func:`decide` on the :func:`step_line` of a state.
+
+    (−inf, False) once the CoM is ``leg`` [m] or more along the line from the ankle.
+    """
+    line = step_line(
+        x, y, xdot, ydot, inv_omega, ankle_x, ankle_y, heading_x, heading_y, swing, foot_x, foot_y
+    )
+    if abs(line[2]) >= leg:
+        return -math.inf, False
+    decision = decide(line[2], line[3], line[4], line[5], height, gravity, reach)
+    return decision[7], decision[2]
 
 
 def feasible_xy_parallel(

@@ -81,10 +81,22 @@ _compile("_capture_at", inline="always")
 _compile("feasible")
 _feasible_serial = _compile("feasible_serial")
 _feasible_parallel = _compile("feasible_parallel", parallel=True)
+_compile("step_line", inline="always")
 _compile("feasible_xy")
 _feasible_xy_parallel = _compile("feasible_xy_parallel", parallel=True)
 mark_feasible = _compile("mark_feasible", parallel=True)
 mark_feasible_xy = _compile("mark_feasible_xy", parallel=True)
+
+
+#: Signature of :func:`scalar_decide_xy`: the planar state, the step frame and the body.
+DECIDE_XY_SIGNATURE = numba.types.Tuple((numba.float64, numba.boolean))(
+    *(numba.float64,) * 10, numba.float64[::1], numba.float64[::1], *(numba.float64,) * 4
+)
+
+
+def scalar_decide_xy() -> Callable[..., tuple[float, bool]]:
+    """``_step_scalar.decide_xy`` compiled with :data:`DECIDE_XY_SIGNATURE` (never again)."""
+    return _build("decide_xy", DECIDE_XY_SIGNATURE)
 
 
 def scalar_decide() -> Callable[..., _step_scalar.Decision]:

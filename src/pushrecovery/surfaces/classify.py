@@ -24,11 +24,11 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery._validate import finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import Stance, Support
+from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
-from pushrecovery.surfaces.plane import capture_margin_xy, cmp_polygon, plan_step_xy
+from pushrecovery.surfaces.plane import StepFrame, capture_margin_xy, cmp_polygon, plan_step_xy
 from pushrecovery.surfaces.step import StepDecision, plan_step, plan_steps
 
 __all__ = [
@@ -344,9 +344,13 @@ def _plane_codes(
     hip = capture_margin_xy(xs, ys, xds, yds, omega, hip_region)
     flat_codes[...] = np.where(cop > 0.0, _ANKLE, np.where(hip > 0.0, _HIP, _FALL))
     index = np.flatnonzero(flat_codes == _FALL)
-    if index.size:
-        feasible = _plane_steps(xs[index], ys[index], xds[index], yds[index], params, support)
-        flat_codes[index[feasible]] = _STEP
+    if index.size < _FEASIBLE_MIN_SIZE:  # a few states: the plan itself, in Python
+        for i in index:
+            plan = plan_step_xy(xs[i], ys[i], xds[i], yds[i], params, support)[1]
+            if plan is not None and plan.feasible:
+                flat_codes[i] = _STEP
+    else:
+        _mark_plane_steps(xs, ys, xds, yds, flat_codes, params, StepFrame.of(support))
     return codes
 
 
@@ -359,16 +363,12 @@ def _plane_codes_compiled(
     hip_region: ConvexPolygon,
 ) -> None:
     """Large arrays: the compiled region test, then the compiled step test, chunk by chunk."""
-    from pushrecovery.models._stepping_kernels import mark_feasible_xy
     from pushrecovery.surfaces._kernels import padded_edges, plane_codes
 
     inv = 1.0 / params.omega
     cop_edges = padded_edges(support.polygon.edge_table)
     hip_edges = padded_edges(hip_region.edge_table)
-    heading = (math.cos(support.yaw), math.sin(support.yaw))
-    swing = {Stance.LEFT: -1.0, Stance.RIGHT: 1.0, Stance.DOUBLE: 0.0}[support.stance]
-    body = (params.com_height, params.gravity, params.max_step_length, params.leg_length)
-    foot_x, foot_y = (np.ascontiguousarray(support.foot.vertices[:, k]) for k in (0, 1))
+    frame = StepFrame.of(support)
     for start in range(0, flat_codes.size, _CHUNK):
         part = slice(start, min(start + _CHUNK, flat_codes.size))
         xs, ys, xds, yds = (_chunk(a, shape, part) for a in inputs)
@@ -379,22 +379,39 @@ def _plane_codes_compiled(
                 finite_array(name, array)
             raise InvalidParameterError("states are too large: the capture point overflows")
         if beyond:
-            mark_feasible_xy(
-                xs,
-                ys,
-                xds,
-                yds,
-                inv,
-                *support.ankle,
-                *heading,
-                swing,
-                foot_x,
-                foot_y,
-                *body,
-                chunk,
-                _FALL,
-                _STEP,
-            )
+            _mark_plane_steps(xs, ys, xds, yds, chunk, params, frame)
+
+
+def _mark_plane_steps(
+    xs: NDArray[np.float64],
+    ys: NDArray[np.float64],
+    xds: NDArray[np.float64],
+    yds: NDArray[np.float64],
+    codes: NDArray[np.int8],
+    params: BodyParams,
+    frame: StepFrame,
+) -> None:
+    """Mark ``step`` where one step recovers the states coded ``fall`` (compiled, in place)."""
+    from pushrecovery.models._stepping_kernels import mark_feasible_xy
+
+    mark_feasible_xy(
+        *(np.ascontiguousarray(a) for a in (xs, ys, xds, yds)),
+        1.0 / params.omega,
+        frame.ankle_x,
+        frame.ankle_y,
+        frame.heading_x,
+        frame.heading_y,
+        frame.swing,
+        np.array(frame.foot_x),
+        np.array(frame.foot_y),
+        params.com_height,
+        params.gravity,
+        params.max_step_length,
+        params.leg_length,
+        codes,
+        _FALL,
+        _STEP,
+    )
 
 
 def _chunk(array: NDArray[np.float64], shape: tuple[int, ...], part: slice) -> NDArray[np.float64]:
@@ -404,58 +421,3 @@ def _chunk(array: NDArray[np.float64], shape: tuple[int, ...], part: slice) -> N
     if array.size == 1:
         return np.full(part.stop - part.start, float(array.reshape(-1)[0]))
     return np.ascontiguousarray(np.broadcast_to(array, shape).flat[part])
-
-
-def _plane_steps(
-    xs: NDArray[np.float64],
-    ys: NDArray[np.float64],
-    xds: NDArray[np.float64],
-    yds: NDArray[np.float64],
-    params: BodyParams,
-    support: Support,
-) -> NDArray[np.bool_]:
-    """Vectorised single-step feasibility on the step lines of :func:`plan_step_xy`."""
-    omega = params.omega
-    ax, ay = support.ankle
-    inv = 1.0 / omega
-    ex, ey = xs + xds * inv - ax, ys + yds * inv - ay
-    norm = np.hypot(ex, ey)
-    heading = (math.cos(support.yaw), math.sin(support.yaw))
-    safe = np.where(norm > 0.0, norm, 1.0)
-    ex = np.where(norm > 0.0, ex / safe, heading[0])
-    ey = np.where(norm > 0.0, ey / safe, heading[1])
-    flip = np.where(ex * heading[0] + ey * heading[1] < 0.0, -1.0, 1.0)
-    ex, ey = ex * flip, ey * flip
-    along = (xs - ax) * ex + (ys - ay) * ey
-    speed = xds * ex + yds * ey
-    heel, toe = _landing_edges(support, ex, ey)
-    if along.size >= _FEASIBLE_MIN_SIZE:
-        from pushrecovery.models._stepping_kernels import feasible
-
-        steps = feasible(
-            along,
-            speed,
-            heel,
-            toe,
-            params.com_height,
-            params.gravity,
-            params.max_step_length,
-        )
-    else:
-        steps = np.asarray(plan_steps(along, speed, params, heel=heel, toe=toe).feasible)
-    return steps & (np.abs(along) < params.leg_length)
-
-
-def _landing_edges(
-    support: Support, ex: NDArray[np.float64], ey: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Vectorised :meth:`Support.landing_foot`: (heel, toe) along unit vectors (ex, ey) [m]."""
-    c, s = math.cos(support.yaw), math.sin(support.yaw)
-    fx, fy = c * ex + s * ey, -s * ex + c * ey
-    if support.stance is Stance.LEFT:
-        fy = -fy  # the right foot swings: the left shape mirrored
-    elif support.stance is Stance.DOUBLE:
-        fy = np.abs(fy)
-    vertices = support.foot.vertices
-    ahead = vertices[None, :, 0] * fx[:, None] + vertices[None, :, 1] * fy[:, None]
-    return np.min(ahead, axis=1), np.max(ahead, axis=1)

@@ -2,10 +2,11 @@
 
 :class:`BalanceMonitor` is built once from the body and its support (and rebuilt with
 :meth:`BalanceMonitor.set_support` when a foot lands or lifts). Every query then runs on Python
-floats and tuples prepared at construction: no arrays, no thread pool, no compilation. The
-step decision (Sec. IV) calls the compiled scalar planner of
-:func:`pushrecovery.surfaces.step.compiled_plan_step`, loaded from numba's on-disk cache and
-called once in the constructor, so the first query of a process pays nothing either.
+floats and tuples prepared at construction (no arrays allocated, no thread pool, no
+compilation) and one call of the compiled step decision on the step line
+(``models._step_scalar.decide_xy``, the code behind :func:`~pushrecovery.surfaces.plane.
+plan_step_xy`), its signature fixed and loaded from numba's on-disk cache in the constructor,
+which calls every path once: the first query of a process pays nothing either.
 
 The verdicts, capture point and margins are those of
 :func:`pushrecovery.surfaces.classify.classify` on the ground plane (tested to 1e-12).
@@ -17,13 +18,14 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import Stance, Support
+from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import Strategy
-from pushrecovery.surfaces.plane import cmp_polygon
-from pushrecovery.surfaces.step import compiled_plan_step
+from pushrecovery.surfaces.plane import StepFrame, cmp_polygon
 
 __all__ = ["BalanceMonitor", "Verdict"]
 
@@ -114,41 +116,38 @@ class BalanceMonitor:
     'hip'
     """
 
-    __slots__ = (
-        "_ankle",
-        "_cmp",
-        "_cop",
-        "_feet",
-        "_heading",
-        "_inv_omega",
-        "_plan",
-        "_plan_args",
-        "_reach",
-        "_swing",
-        "params",
-        "support",
-    )
+    __slots__ = ("_cmp", "_cop", "_inv_omega", "_step", "_step_args", "params", "support")
 
     def __init__(self, params: BodyParams, support: Support | None = None) -> None:
+        from pushrecovery.models._stepping_kernels import scalar_decide_xy
+
         self.params = params
         self._inv_omega = 1.0 / params.omega
-        self._reach = params.leg_length
-        self._plan_args = (params.com_height, params.gravity, params.max_step_length)
-        self._plan: Callable[..., tuple[float, bool, bool, float, float, float, float, float]]
-        self._plan = compiled_plan_step()
+        self._step: Callable[..., tuple[float, bool]] = scalar_decide_xy()
         self.set_support(Support.from_params(params) if support is None else support)
         self.query(0.0, 0.0, 10.0, 0.0)  # loads every compiled path before the first tick
 
     def set_support(self, support: Support) -> None:
-        """Use another stance or foot placement (a few µs of set-up; not for every tick)."""
+        """Use another stance or foot placement (tens of µs of set-up; not for every tick)."""
         self.support = support
         self._cop = _edges(support.polygon)
         self._cmp = _edges(cmp_polygon(support, self.params))
-        self._ankle = support.ankle
-        self._heading = (math.cos(support.yaw), math.sin(support.yaw))
-        self._feet = tuple((float(x), float(y)) for x, y in support.foot.vertices)
-        # Which foot lands (Support.landing_foot): -1 mirrors the left shape into the right.
-        self._swing = {Stance.LEFT: -1.0, Stance.RIGHT: 1.0, Stance.DOUBLE: 0.0}[support.stance]
+        frame = StepFrame.of(support)
+        params = self.params
+        self._step_args = (
+            self._inv_omega,
+            frame.ankle_x,
+            frame.ankle_y,
+            frame.heading_x,
+            frame.heading_y,
+            frame.swing,
+            np.array(frame.foot_x),
+            np.array(frame.foot_y),
+            params.com_height,
+            params.gravity,
+            params.max_step_length,
+            params.leg_length,
+        )
 
     def query(self, x: float, y: float, xdot: float, ydot: float) -> Verdict:
         """Classify one CoM state on the ground plane.
@@ -177,42 +176,14 @@ class BalanceMonitor:
             )
         cop = _signed_distance(self._cop, px, py)
         cmp = _signed_distance(self._cmp, px, py)
-        step = self._step_margin_and_feasible(x, y, xdot, ydot, px, py)
+        # Sec. IV's step on the line of the excursion, as plan_step_xy (compiled, one call).
+        step_margin, step = self._step(x, y, xdot, ydot, *self._step_args)
         if cop > 0.0:
             strategy = Strategy.ANKLE
         elif cmp > 0.0:
             strategy = Strategy.HIP
-        elif step[1]:
+        elif step:
             strategy = Strategy.STEP
         else:
             strategy = Strategy.FALL
-        return Verdict(strategy, px, py, cop, cmp, step[0])
-
-    def _step_margin_and_feasible(
-        self, x: float, y: float, xdot: float, ydot: float, px: float, py: float
-    ) -> tuple[float, bool]:
-        """Sec. IV's step on the line of the excursion (as :func:`.plane.plan_step_xy`)."""
-        ex, ey = px - self._ankle[0], py - self._ankle[1]
-        norm = math.hypot(ex, ey)
-        hx, hy = self._heading
-        if norm == 0.0:
-            ex, ey = hx, hy
-        else:
-            ex, ey = ex / norm, ey / norm
-            if ex * hx + ey * hy < 0.0:
-                ex, ey = -ex, -ey
-        along = (x - self._ankle[0]) * ex + (y - self._ankle[1]) * ey
-        if abs(along) >= self._reach:
-            return -math.inf, False
-        fx, fy = hx * ex + hy * ey, -hy * ex + hx * ey  # the line in the foot's frame
-        fy = abs(fy) if self._swing == 0.0 else self._swing * fy
-        toe = -math.inf
-        heel = math.inf
-        for vx, vy in self._feet:
-            reach = vx * fx + vy * fy
-            if reach > toe:
-                toe = reach
-            if reach < heel:
-                heel = reach
-        plan = self._plan(along, xdot * ex + ydot * ey, heel, toe, *self._plan_args)
-        return plan[7], plan[2]
+        return Verdict(strategy, px, py, cop, cmp, step_margin)

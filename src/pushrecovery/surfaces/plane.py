@@ -32,13 +32,15 @@ inside (``docs/plane.md``).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery._validate import finite_array
 from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import Support
+from pushrecovery.ground.support import Stance, Support
+from pushrecovery.models._step_scalar import step_line
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import _fusable
@@ -46,6 +48,7 @@ from pushrecovery.surfaces.step import StepDecision, plan_step, step_feasible
 
 __all__ = [
     "DIRECTIONS",
+    "StepFrame",
     "capture_margin_xy",
     "capture_point_xy",
     "cmp_margin_xy",
@@ -210,6 +213,64 @@ def direction_thresholds(
     }
 
 
+@dataclass(frozen=True, slots=True)
+class StepFrame:
+    """What the step line of a support needs (:func:`_step_scalar.step_line`), as floats.
+
+    Attributes
+    ----------
+    ankle_x, ankle_y : float
+        The stance's ankle (the ankles' midpoint in double support) [m].
+    heading_x, heading_y : float
+        Unit vector of the stance's heading.
+    swing : float
+        −1: the right foot lands (left stance), +1: the left (right stance), 0: the foot on
+        the side of the step (double support).
+    foot_x, foot_y : tuple of float
+        The left foot's vertices in its own frame [m] (the right one is their mirror).
+    """
+
+    ankle_x: float
+    ankle_y: float
+    heading_x: float
+    heading_y: float
+    swing: float
+    foot_x: tuple[float, ...]
+    foot_y: tuple[float, ...]
+
+    @classmethod
+    def of(cls, support: Support) -> StepFrame:
+        """Return the frame of ``support``."""
+        swing = {Stance.LEFT: -1.0, Stance.RIGHT: 1.0, Stance.DOUBLE: 0.0}[support.stance]
+        return cls(
+            *support.ankle,
+            math.cos(support.yaw),
+            math.sin(support.yaw),
+            swing,
+            tuple(float(v) for v in support.foot.vertices[:, 0]),
+            tuple(float(v) for v in support.foot.vertices[:, 1]),
+        )
+
+    def line(
+        self, x: float, y: float, xdot: float, ydot: float, inv_omega: float
+    ) -> tuple[float, float, float, float, float, float]:
+        """(e_x, e_y, s, ṡ, heel, toe) of a state: :func:`_step_scalar.step_line`."""
+        return step_line(
+            x,
+            y,
+            xdot,
+            ydot,
+            inv_omega,
+            self.ankle_x,
+            self.ankle_y,
+            self.heading_x,
+            self.heading_y,
+            self.swing,
+            self.foot_x,  # type: ignore[arg-type]
+            self.foot_y,  # type: ignore[arg-type]
+        )
+
+
 def plan_step_xy(
     x: float, y: float, xdot: float, ydot: float, params: BodyParams, support: Support
 ) -> tuple[tuple[float, float], StepDecision | None]:
@@ -218,9 +279,11 @@ def plan_step_xy(
     The line's unit vector e points from the stance's ankle (the stance ankle, or the ankles'
     midpoint in double support) to ξ, turned to the stance's heading side (e · heading >= 0)
     so that the sagittal case keeps its signs. The state is projected on it, s = (r − ankle)
-    · e, ṡ = ṙ · e, as the sagittal model measures x from the ankle, and the landing foot's
-    edges along e are its support function (:meth:`~pushrecovery.ground.Support.landing_foot`);
-    the planner then steps forward or backward along e exactly as on the sagittal line
+    · e, ṡ = ṙ · e, as the sagittal model measures x from the ankle, and the landing foot
+    (the swing foot: the right one from left stance, the left from right stance, the one on
+    the side of the step from double support) lands with the stance's yaw, its edges along e
+    its support function (``models._step_scalar.step_line``, the one implementation of the
+    line). The planner then steps forward or backward along e exactly as on the sagittal line
     (:func:`~pushrecovery.surfaces.step.plan_step`). With y = ẏ = 0 and feet at yaw 0 this is
     the sagittal plan.
 
@@ -240,33 +303,12 @@ def plan_step_xy(
     (tuple of float, StepDecision or None)
         The line's unit vector e, and the plan (None when |s| >= leg_length: no step).
     """
-    line, projected = _step_line(x, y, xdot, ydot, params, support)
-    if projected is None:
-        return line, None
-    along, speed, heel, toe = projected
-    return line, plan_step(along, speed, params, heel=heel, toe=toe)
-
-
-def _step_line(
-    x: float, y: float, xdot: float, ydot: float, params: BodyParams, support: Support
-) -> tuple[tuple[float, float], tuple[float, float, float, float] | None]:
-    """Return the step line of :func:`plan_step_xy`, the state and the foot on it (or None)."""
-    inv = 1.0 / params.omega
-    ankle = support.ankle
-    ex, ey = x + xdot * inv - ankle[0], y + ydot * inv - ankle[1]
-    norm = math.hypot(ex, ey)
-    heading = (math.cos(support.yaw), math.sin(support.yaw))
-    if norm == 0.0:
-        ex, ey = heading
-    else:
-        ex, ey = ex / norm, ey / norm
-        if ex * heading[0] + ey * heading[1] < 0.0:
-            ex, ey = -ex, -ey
-    along = (x - ankle[0]) * ex + (y - ankle[1]) * ey
+    ex, ey, along, speed, heel, toe = StepFrame.of(support).line(
+        x, y, xdot, ydot, 1.0 / params.omega
+    )
     if abs(along) >= params.leg_length:
         return (ex, ey), None
-    heel, toe = support.landing_foot(ex, ey)
-    return (ex, ey), (along, xdot * ex + ydot * ey, heel, toe)
+    return (ex, ey), plan_step(along, speed, params, heel=heel, toe=toe)
 
 
 def step_threshold_xy(
@@ -280,12 +322,15 @@ def step_threshold_xy(
     Along ±x on yaw-0 feet it is :func:`~pushrecovery.surfaces.step.step_thresholds`.
     """
     ux, uy = math.cos(heading), math.sin(heading)
-    ax, ay = support.ankle
+    frame = StepFrame.of(support)
+    inv = 1.0 / params.omega
     low, high = 0.0, math.sqrt(params.gravity * params.leg_length)
     while high - low > tolerance:
         middle = 0.5 * (low + high)
-        projected = _step_line(ax, ay, middle * ux, middle * uy, params, support)[1]
-        if projected is not None and step_feasible(*projected, params):
+        _, _, along, speed, heel, toe = frame.line(
+            frame.ankle_x, frame.ankle_y, middle * ux, middle * uy, inv
+        )
+        if abs(along) < params.leg_length and step_feasible(along, speed, heel, toe, params):
             low = middle
         else:
             high = middle
