@@ -235,36 +235,6 @@ def feasible(
     return _capture_at(top_sin, top_cos, scaled, toe * inv_length) < 0.0
 
 
-def feasible_serial(
-    x: NDArray[float64],
-    xdot: NDArray[float64],
-    heel: NDArray[float64],
-    toe: NDArray[float64],
-    height: float,
-    gravity: float,
-    reach: float,
-    out: NDArray[bool_],
-) -> None:
-    """:func:`feasible` for every state of flat arrays (a foot per state), into ``out``."""
-    for i in range(x.shape[0]):
-        out[i] = feasible(x[i], xdot[i], heel[i], toe[i], height, gravity, reach)
-
-
-def feasible_parallel(
-    x: NDArray[float64],
-    xdot: NDArray[float64],
-    heel: NDArray[float64],
-    toe: NDArray[float64],
-    height: float,
-    gravity: float,
-    reach: float,
-    out: NDArray[bool_],
-) -> None:
-    """:func:`feasible_serial` over threads, once compiled (``prange``)."""
-    for i in prange(x.shape[0]):
-        out[i] = feasible(x[i], xdot[i], heel[i], toe[i], height, gravity, reach)
-
-
 def step_line(
     x: float,
     y: float,
@@ -374,47 +344,6 @@ def decide_xy(
         return -math.inf, False
     decision = decide(line[2], line[3], line[4], line[5], height, gravity, reach)
     return decision[7], decision[2]
-
-
-def feasible_xy_parallel(
-    x: NDArray[float64],
-    y: NDArray[float64],
-    xdot: NDArray[float64],
-    ydot: NDArray[float64],
-    inv_omega: float,
-    ankle_x: float,
-    ankle_y: float,
-    heading_x: float,
-    heading_y: float,
-    swing: float,
-    foot_x: NDArray[float64],
-    foot_y: NDArray[float64],
-    height: float,
-    gravity: float,
-    reach: float,
-    leg: float,
-    out: NDArray[bool_],
-) -> None:
-    """:func:`feasible_xy` for every state of flat arrays, over threads once compiled."""
-    for i in prange(x.shape[0]):
-        out[i] = feasible_xy(
-            x[i],
-            y[i],
-            xdot[i],
-            ydot[i],
-            inv_omega,
-            ankle_x,
-            ankle_y,
-            heading_x,
-            heading_y,
-            swing,
-            foot_x,
-            foot_y,
-            height,
-            gravity,
-            reach,
-            leg,
-        )
 
 
 def mark_feasible(

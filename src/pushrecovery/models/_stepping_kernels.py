@@ -29,12 +29,11 @@ from pushrecovery.models import _step_scalar
 __all__ = [
     "PARALLEL_MIN_SIZE",
     "decide",
-    "feasible",
-    "feasible_xy",
     "mark_feasible",
     "mark_feasible_xy",
     "plan",
     "scalar_decide",
+    "scalar_decide_xy",
     "solve",
 ]
 
@@ -79,11 +78,8 @@ _solve_serial = _compile("solve_serial")
 _solve_parallel = _compile("solve_parallel", parallel=True)
 _compile("_capture_at", inline="always")
 _compile("feasible")
-_feasible_serial = _compile("feasible_serial")
-_feasible_parallel = _compile("feasible_parallel", parallel=True)
 _compile("step_line", inline="always")
 _compile("feasible_xy")
-_feasible_xy_parallel = _compile("feasible_xy_parallel", parallel=True)
 mark_feasible = _compile("mark_feasible", parallel=True)
 mark_feasible_xy = _compile("mark_feasible_xy", parallel=True)
 
@@ -156,65 +152,4 @@ def solve(
     parallel = energy.size >= PARALLEL_MIN_SIZE if parallel is None else parallel
     kernel = _solve_parallel if parallel else _solve_serial
     kernel(energy, lean, target, float(length), float(gravity), out)
-    return out
-
-
-def feasible(
-    x: NDArray[np.float64],
-    xdot: NDArray[np.float64],
-    heel: NDArray[np.float64] | float,
-    toe: NDArray[np.float64] | float,
-    height: float,
-    gravity: float,
-    reach: float,
-    *,
-    parallel: bool | None = None,
-) -> NDArray[np.bool_]:
-    """Compiled ``_step_scalar.feasible`` over flat arrays (``heel``/``toe`` broadcast)."""
-    x, xdot = _flat(x), _flat(xdot)
-    heel, toe = (
-        _flat(np.broadcast_to(np.asarray(a, dtype=np.float64), x.shape)) for a in (heel, toe)
-    )
-    out = np.empty(x.size, dtype=np.bool_)
-    parallel = x.size >= PARALLEL_MIN_SIZE if parallel is None else parallel
-    kernel = _feasible_parallel if parallel else _feasible_serial
-    kernel(x, xdot, heel, toe, float(height), float(gravity), float(reach), out)
-    return out
-
-
-def feasible_xy(
-    x: NDArray[np.float64],
-    y: NDArray[np.float64],
-    xdot: NDArray[np.float64],
-    ydot: NDArray[np.float64],
-    inv_omega: float,
-    ankle: tuple[float, float],
-    heading: tuple[float, float],
-    swing: float,
-    foot: NDArray[np.float64],
-    body: tuple[float, float, float, float],
-) -> NDArray[np.bool_]:
-    """Compiled ``_step_scalar.feasible_xy`` over flat arrays (on the thread pool).
-
-    ``foot``: the landing shape's vertices (n, 2) [m]; ``body``: (com_height, gravity,
-    max_step_length, leg_length).
-    """
-    x, y, xdot, ydot = (_flat(a) for a in (x, y, xdot, ydot))
-    out = np.empty(x.size, dtype=np.bool_)
-    _feasible_xy_parallel(
-        x,
-        y,
-        xdot,
-        ydot,
-        float(inv_omega),
-        float(ankle[0]),
-        float(ankle[1]),
-        float(heading[0]),
-        float(heading[1]),
-        float(swing),
-        _flat(foot[:, 0]),
-        _flat(foot[:, 1]),
-        *(float(v) for v in body),
-        out,
-    )
     return out
