@@ -394,24 +394,8 @@ def _mark_plane_steps(
     """Mark ``step`` where one step recovers the states coded ``fall`` (compiled, in place)."""
     from pushrecovery.models._stepping_kernels import mark_feasible_xy
 
-    mark_feasible_xy(
-        *(np.ascontiguousarray(a) for a in (xs, ys, xds, yds)),
-        1.0 / params.omega,
-        frame.ankle_x,
-        frame.ankle_y,
-        frame.heading_x,
-        frame.heading_y,
-        frame.swing,
-        np.array(frame.foot_x),
-        np.array(frame.foot_y),
-        params.com_height,
-        params.gravity,
-        params.max_step_length,
-        params.leg_length,
-        codes,
-        _FALL,
-        _STEP,
-    )
+    states = (np.ascontiguousarray(a) for a in (xs, ys, xds, yds))
+    mark_feasible_xy(*states, *frame.kernel_args(params), codes, _FALL, _STEP)
 
 
 def _chunk(array: NDArray[np.float64], shape: tuple[int, ...], part: slice) -> NDArray[np.float64]:

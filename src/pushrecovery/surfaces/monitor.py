@@ -18,8 +18,6 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numpy as np
-
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
@@ -132,22 +130,7 @@ class BalanceMonitor:
         self.support = support
         self._cop = _edges(support.polygon)
         self._cmp = _edges(cmp_polygon(support, self.params))
-        frame = StepFrame.of(support)
-        params = self.params
-        self._step_args = (
-            self._inv_omega,
-            frame.ankle_x,
-            frame.ankle_y,
-            frame.heading_x,
-            frame.heading_y,
-            frame.swing,
-            np.array(frame.foot_x),
-            np.array(frame.foot_y),
-            params.com_height,
-            params.gravity,
-            params.max_step_length,
-            params.leg_length,
-        )
+        self._step_args = StepFrame.of(support).kernel_args(self.params)
 
     def query(self, x: float, y: float, xdot: float, ydot: float) -> Verdict:
         """Classify one CoM state on the ground plane.
