@@ -253,7 +253,7 @@ class StepFrame:
         )
 
     def kernel_args(self, params: BodyParams) -> tuple[Any, ...]:
-        """The arguments after the state of the compiled ``decide_xy`` / ``mark_feasible_xy``.
+        """Return the arguments after the state of the compiled ``decide_xy``, ``mark_*_xy``.
 
         (1/ω, ankle, heading, swing, foot vertices as arrays, L, g, max step, leg length).
         """
