@@ -15,6 +15,7 @@ the ankles and the sagittal model's x axis runs between the feet.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from enum import StrEnum
@@ -118,10 +119,13 @@ class Support:
     ) -> Support:
         """Support polygon of ``stance`` for feet at ``left``/``right`` (default poses: module).
 
+        The last supports built are kept (everything here is immutable), so asking again for
+        the same body, stance and feet costs a dictionary look-up, not a hull.
+
         Raises
         ------
         InvalidParameterError
-            Unknown stance.
+            Unknown stance, overlapping or too distant feet in double support.
         """
         try:
             stance = Stance(stance)
@@ -132,6 +136,14 @@ class Support:
         half = 0.5 * params.stance_width
         left = FootPose(0.0, half) if left is None else left
         right = FootPose(0.0, -half) if right is None else right
+        if cls is Support:
+            return _support(params, stance, left, right)
+        return cls._build(params, stance, left, right)
+
+    @classmethod
+    def _build(
+        cls, params: BodyParams, stance: Stance, left: FootPose, right: FootPose
+    ) -> Support:
         foot = foot_shape(params)
         placed = {
             Stance.LEFT: foot.transformed(left.x, left.y, left.yaw),
@@ -201,3 +213,9 @@ def _check_double_support(
             f"({left.x:g}, {left.y:g}), right at ({right.x:g}, {right.y:g}); stance_width "
             f"{params.stance_width:g} m, foot_width {params.foot_width:g} m)"
         )
+
+
+@functools.lru_cache(maxsize=64)
+def _support(params: BodyParams, stance: Stance, left: FootPose, right: FootPose) -> Support:
+    """:meth:`Support._build`, remembered (params and poses are frozen and hashable)."""
+    return Support._build(params, stance, left, right)

@@ -31,6 +31,7 @@ inside (``docs/plane.md``).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -39,7 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery._validate import finite_array
-from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.models._step_scalar import step_line
 from pushrecovery.params import BodyParams
@@ -100,9 +101,22 @@ def capture_point_xy(
 def cmp_polygon(support: Support, params: BodyParams) -> ConvexPolygon:
     """Capture-point region of CMP balancing: P ⊕ box(a_pitch, a_roll) [m] (module docstring).
 
-    The box is aligned with the stance's heading (the upper body's pitch and roll axes).
+    The box is aligned with the stance's heading (the upper body's pitch and roll axes). The
+    last regions built are kept, keyed by the polygon's vertices and the box.
     """
-    return support.polygon.grown(cmp_offset(params), cmp_offset_roll(params), support.yaw)
+    vertices = support.polygon.vertices
+    return _grown(
+        vertices.tobytes(), len(vertices), cmp_offset(params), cmp_offset_roll(params), support.yaw
+    )
+
+
+@functools.lru_cache(maxsize=64)
+def _grown(
+    vertices: bytes, count: int, half_x: float, half_y: float, yaw: float
+) -> ConvexPolygon:
+    """:meth:`ConvexPolygon.grown` of the polygon with these (float64, CCW) vertices."""
+    polygon = convex_hull(np.frombuffer(vertices, dtype=np.float64).reshape(count, 2))
+    return polygon.grown(half_x, half_y, yaw)
 
 
 def capture_margin_xy(
