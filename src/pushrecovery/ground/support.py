@@ -141,9 +141,7 @@ class Support:
         return cls._build(params, stance, left, right)
 
     @classmethod
-    def _build(
-        cls, params: BodyParams, stance: Stance, left: FootPose, right: FootPose
-    ) -> Support:
+    def _build(cls, params: BodyParams, stance: Stance, left: FootPose, right: FootPose) -> Support:
         foot = foot_shape(params)
         placed = {
             Stance.LEFT: foot.transformed(left.x, left.y, left.yaw),

@@ -111,9 +111,7 @@ def cmp_polygon(support: Support, params: BodyParams) -> ConvexPolygon:
 
 
 @functools.lru_cache(maxsize=64)
-def _grown(
-    vertices: bytes, count: int, half_x: float, half_y: float, yaw: float
-) -> ConvexPolygon:
+def _grown(vertices: bytes, count: int, half_x: float, half_y: float, yaw: float) -> ConvexPolygon:
     """:meth:`ConvexPolygon.grown` of the polygon with these (float64, CCW) vertices."""
     polygon = convex_hull(np.frombuffer(vertices, dtype=np.float64).reshape(count, 2))
     return polygon.grown(half_x, half_y, yaw)
