@@ -247,6 +247,17 @@ for n in (100, PARALLEL_MIN_SIZE):  # one thread, then the pool
     solve_step_angle(np.linspace(0.1, 3.0, n), 0.0, 1.0, 9.81)
 compiled_plan_step()(0.0, 1.2, -0.05, 0.15, 1.0, 9.81, 1.0)
 cop_margin(np.zeros(1 << 16), np.zeros(1 << 16), P)  # its fused kernel
+# The ground plane: the monitor (its fixed-signature step decision), the vectorised verdicts
+# (region codes, the in-place step tests) and the planar margins.
+from pushrecovery.surfaces.classify import classify_states
+from pushrecovery.surfaces.monitor import BalanceMonitor
+from pushrecovery.surfaces.plane import cop_margin_xy
+from pushrecovery.ground import Support
+BalanceMonitor(P).query(0.0, 0.0, 1.2, 0.3)
+big = np.linspace(-1.0, 1.0, 1 << 17)
+classify_states(0.1 * big, big, P)
+classify_states(0.1 * big, big, P, y=0.05 * big, ydot=big)
+cop_margin_xy(0.1 * big, 0.1 * big, big, big, Support.from_params(P), P)
 """
 KERNELS = {
     "_step_scalar.decide",
@@ -255,6 +266,12 @@ KERNELS = {
     "_step_scalar.solve_serial",
     "_step_scalar.solve_parallel",
     "cop._fused_margin_kernel.locals.kernel",
+    "_step_scalar.decide_xy",
+    "_step_scalar.mark_feasible",
+    "_step_scalar.mark_feasible_xy",
+    "_kernels.sagittal_codes",
+    "_kernels.plane_codes",
+    "_kernels.polygon_margin",
 }
 
 
