@@ -176,13 +176,23 @@ def decide(
     return direction, ready, feasible, theta, step_length, shortest, longest, margin
 
 
-def _capture_at(sin: float, cos: float, energy: float, target: float) -> float:
-    """ξ⁺/l − target at the angle with this sine and cosine, l = g = 1 (:func:`capture_residual`).
+def _capture_below(sin: float, cos: float, energy: float, target: float, strict: bool) -> bool:
+    """Whether ξ⁺/l < target (``strict``) or <= target at the angle with this sine and cosine.
 
-    cos 2θ = cos²θ − sin²θ: no trigonometric call.
+    In units l = g = 1 (:func:`capture_residual`): ξ⁺/l = −s + R (c² − s²)/√c with
+    R = √(energy + 2 (1 − c)). For θ in [0, π/4], c² − s² = cos 2θ >= 0, so the left side of
+    R (c² − s²)/√c < target + s is >= 0: the inequality fails when target + s is negative (or
+    zero, strictly) and otherwise holds exactly when its square does,
+    R² (c² − s²)² < (target + s)² c. No square root, no trigonometric call.
     """
-    rate = math.sqrt(max(0.0, energy + 2.0 * (1.0 - cos)))
-    return -sin + rate * (cos * cos - sin * sin) / math.sqrt(cos) - target
+    room = target + sin
+    if room < 0.0 or (strict and room == 0.0):
+        return False
+    spin = max(0.0, energy + 2.0 * (1.0 - cos))
+    squeeze = cos * cos - sin * sin
+    left = spin * squeeze * squeeze
+    right = room * room * cos
+    return left < right if strict else left <= right
 
 
 def feasible(
@@ -202,13 +212,13 @@ def feasible(
     compression, and both. Every angle involved lies in [0, π/2), where sines order angles, and
     each is known by its sine and cosine (the lean: x/l, L/l; the reach: its half-step over l;
     π/4; the compression limit: its cosine), so no trigonometric function is evaluated: two
-    evaluations of ξ⁺ replace three Newton solves. The answer can differ from :func:`decide`'s
-    only within rounding of the boundary (f(allowed) within ~1e-15 of toe/l). Arguments as in
-    :func:`decide`.
+    comparisons of ξ⁺ (:func:`_capture_below`, squared) replace three Newton solves. The
+    answer can differ from :func:`decide`'s only within rounding of the boundary (f(allowed)
+    within ~1e-15 of toe/l). Arguments as in :func:`decide`.
     """
     if x + xdot * math.sqrt(height / gravity) < 0.5 * (heel + toe):
         x, xdot, heel, toe = -x, -xdot, -toe, -heel  # the mirror image: a forward step
-    length = math.hypot(x, height)
+    length = math.sqrt(x * x + height * height)  # as hypot, |x| and L being far below 1e150
     inv_length = 1.0 / length  # one division; the rest multiply (divisions are slow)
     lean_cos = height * inv_length
     lean_rate = xdot * lean_cos * inv_length
@@ -230,9 +240,9 @@ def feasible(
     if not (low_sin < top_sin and 2.0 * length * top_sin >= MIN_STEP_LENGTH):
         return False
     scaled = energy * length / gravity  # θ̇² in units of g/l
-    if _capture_at(low_sin, low_cos, scaled, heel * inv_length) <= 0.0:
+    if _capture_below(low_sin, low_cos, scaled, heel * inv_length, False):
         return False
-    return _capture_at(top_sin, top_cos, scaled, toe * inv_length) < 0.0
+    return _capture_below(top_sin, top_cos, scaled, toe * inv_length, True)
 
 
 def step_line(
@@ -266,7 +276,9 @@ def step_line(
     """
     ex = x + xdot * inv_omega - ankle_x
     ey = y + ydot * inv_omega - ankle_y
-    norm = math.hypot(ex, ey)
+    norm = math.sqrt(ex * ex + ey * ey)  # hypot is several times slower
+    if not norm < math.inf:  # |ξ| beyond 1e154 m: only hypot does not overflow
+        norm = math.hypot(ex, ey)
     if norm == 0.0:
         ex, ey = heading_x, heading_y
     else:
