@@ -282,9 +282,9 @@ def step_line(
     if norm == 0.0:
         ex, ey = heading_x, heading_y
     else:
-        ex, ey = ex / norm, ey / norm
-        if ex * heading_x + ey * heading_y < 0.0:
-            ex, ey = -ex, -ey
+        # Turned to the heading's side, in the same multiplication that normalises it.
+        scale = (1.0 if ex * heading_x + ey * heading_y >= 0.0 else -1.0) / norm
+        ex, ey = ex * scale, ey * scale
     fx = heading_x * ex + heading_y * ey  # the line in the foot's frame
     fy = -heading_y * ex + heading_x * ey
     fy = abs(fy) if swing == 0.0 else swing * fy
