@@ -313,6 +313,9 @@ _ANKLE, _HIP, _STEP, _FALL = (STRATEGY_CODES.index(s) for s in Strategy)
 _FEASIBLE_MIN_SIZE = 64
 #: States per chunk of the vectorised classifier: temporaries stay in the cache.
 _CHUNK = 1 << 16
+#: States per chunk of the compiled planar classifier: few thread-pool launches, and at most
+#: 32 MiB of broadcast copies.
+_COMPILED_CHUNK = 1 << 20
 
 
 def _plane_codes(
@@ -369,8 +372,8 @@ def _plane_codes_compiled(
     cop_edges = padded_edges(support.polygon.edge_table)
     hip_edges = padded_edges(hip_region.edge_table)
     frame = StepFrame.of(support)
-    for start in range(0, flat_codes.size, _CHUNK):
-        part = slice(start, min(start + _CHUNK, flat_codes.size))
+    for start in range(0, flat_codes.size, _COMPILED_CHUNK):
+        part = slice(start, min(start + _COMPILED_CHUNK, flat_codes.size))
         xs, ys, xds, yds = (_chunk(a, shape, part) for a in inputs)
         chunk = flat_codes[part]
         beyond, bad = plane_codes(xs, ys, xds, yds, inv, cop_edges, hip_edges, chunk)
