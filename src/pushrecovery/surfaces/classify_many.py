@@ -1,0 +1,217 @@
+"""Vectorised verdicts: :func:`classify_states` for arrays of states, on a line or the plane.
+
+The rules of :func:`pushrecovery.surfaces.classify.classify`, decided for millions of states:
+the regions first, in one compiled pass (or numpy for small arrays), then the single-step test
+only for the states beyond the hip region, in place and without solving for the step angle
+(``models._step_scalar.feasible``, ``feasible_xy``), chunk by chunk, so that the extra memory is
+the codes themselves.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pushrecovery._validate import finite_array
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.support import Support
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
+from pushrecovery.surfaces.cop import cop_margin, cop_region
+from pushrecovery.surfaces.plane import StepFrame, capture_margin_xy, cmp_polygon, plan_step_xy
+from pushrecovery.surfaces.step import plan_steps
+from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
+
+__all__ = ["classify_states"]
+
+
+def classify_states(
+    x: ArrayLike,
+    xdot: ArrayLike,
+    params: BodyParams,
+    *,
+    y: ArrayLike | None = None,
+    ydot: ArrayLike | None = None,
+    support: Support | None = None,
+) -> NDArray[np.int8]:
+    """Vectorised :func:`classify`: integer codes into :data:`STRATEGY_CODES`.
+
+    The margins decide most states in one pass; Sec. IV's step is planned only for states
+    beyond the hip region, in chunks, so the extra memory stays a few bytes per state. With
+    ``y``, ``ydot`` or ``support`` the states are classified on the ground plane.
+
+    Parameters
+    ----------
+    x, xdot : array_like
+        CoM positions [m] and velocities [m/s], broadcast together.
+    params : BodyParams
+        Body parameters.
+    y, ydot : array_like, optional
+        Lateral positions [m] and velocities [m/s] (plane).
+    support : Support, optional
+        Stance and feet (plane; default double support).
+
+    Returns
+    -------
+    ndarray of int8
+        Codes of the broadcast shape.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a state is NaN or infinite.
+    """
+    if y is not None or ydot is not None or support is not None:
+        return _plane_codes(x, xdot, params, y, ydot, support)
+    x, xdot = np.broadcast_arrays(
+        np.asarray(x, dtype=np.float64), np.asarray(xdot, dtype=np.float64)
+    )
+    codes = np.empty(x.shape, dtype=np.int8)
+    if x.size == 0:
+        return codes
+    flat_x, flat_xdot = (np.ascontiguousarray(a).reshape(-1) for a in (x, xdot))
+    flat = codes.reshape(-1)  # a view: codes is new and contiguous
+    cop, hip = cop_region(params), cmp_region(params)
+    if flat.size >= _CHUNK:
+        from pushrecovery.surfaces._kernels import sagittal_codes
+
+        beyond, bad = sagittal_codes(
+            flat_x,
+            flat_xdot,
+            1.0 / params.omega,
+            cop.centre,
+            cop.half_width,
+            hip.centre,
+            hip.half_width,
+            flat,
+        )
+        if bad:
+            cop_margin(flat_x, flat_xdot, params)  # raises, naming the argument
+        if beyond:
+            _step_or_fall(flat_x, flat_xdot, flat, params)
+        return codes
+    cop_m, hip_m = cop_margin(flat_x, flat_xdot, params), cmp_margin(flat_x, flat_xdot, params)
+    flat[...] = np.where(cop_m > 0.0, _ANKLE, np.where(hip_m > 0.0, _HIP, _FALL))
+    index = np.flatnonzero(flat == _FALL)
+    if index.size:  # few states: the plan itself (pure Python up to 32 states)
+        flat[index[plan_steps(flat_x[index], flat_xdot[index], params).feasible]] = _STEP
+    return codes
+
+
+def _step_or_fall(
+    x: NDArray[np.float64], xdot: NDArray[np.float64], codes: NDArray[np.int8], params: BodyParams
+) -> None:
+    """Mark ``step`` where a single step recovers the states coded ``fall``.
+
+    Only feasibility is needed, so the compiled angle-free test replaces the full plan (three
+    Newton solves), in place, on the states still coded ``fall``.
+    """
+    from pushrecovery.models._stepping_kernels import mark_feasible
+
+    args = (params.heel, params.toe, params.com_height, params.gravity, params.max_step_length)
+    mark_feasible(x, xdot, *args, codes, _FALL, _STEP)
+
+
+_ANKLE, _HIP, _STEP, _FALL = (STRATEGY_CODES.index(s) for s in Strategy)
+#: From this many undecided states on, the compiled feasibility test (numba loaded).
+_FEASIBLE_MIN_SIZE = 64
+#: States per chunk of the vectorised classifier: temporaries stay in the cache.
+_CHUNK = 1 << 16
+#: States per chunk of the compiled planar classifier: few thread-pool launches, and at most
+#: 32 MiB of broadcast copies.
+_COMPILED_CHUNK = 1 << 20
+
+
+def _plane_codes(
+    x: ArrayLike,
+    xdot: ArrayLike,
+    params: BodyParams,
+    y: ArrayLike | None,
+    ydot: ArrayLike | None,
+    support: Support | None,
+) -> NDArray[np.int8]:
+    """:func:`classify_states` on the ground plane (the rules of :func:`_classify_plane`).
+
+    Chunk by chunk: both margins (the compiled pass for large chunks), then the step test on
+    the states beyond the hip region only, on their step lines.
+    """
+    support = Support.from_params(params) if support is None else support
+    inputs = [np.asarray(0.0 if a is None else a, dtype=np.float64) for a in (x, y, xdot, ydot)]
+    shape = np.broadcast_shapes(*(a.shape for a in inputs))
+    size = math.prod(shape)
+    codes = np.empty(shape, dtype=np.int8)
+    flat_codes = codes.reshape(-1)
+    hip_region = cmp_polygon(support, params)
+    omega = params.omega
+    if size >= _CHUNK:
+        _plane_codes_compiled(inputs, shape, flat_codes, params, support, hip_region)
+        return codes
+    xs, ys, xds, yds = (_chunk(a, shape, slice(0, size)) for a in inputs)
+    cop = capture_margin_xy(xs, ys, xds, yds, omega, support.polygon)
+    hip = capture_margin_xy(xs, ys, xds, yds, omega, hip_region)
+    flat_codes[...] = np.where(cop > 0.0, _ANKLE, np.where(hip > 0.0, _HIP, _FALL))
+    index = np.flatnonzero(flat_codes == _FALL)
+    if index.size < _FEASIBLE_MIN_SIZE:  # a few states: the plan itself, in Python
+        for i in index:
+            plan = plan_step_xy(xs[i], ys[i], xds[i], yds[i], params, support)[1]
+            if plan is not None and plan.feasible:
+                flat_codes[i] = _STEP
+    else:
+        _mark_plane_steps(xs, ys, xds, yds, flat_codes, params, StepFrame.of(support))
+    return codes
+
+
+def _plane_codes_compiled(
+    inputs: list[NDArray[np.float64]],
+    shape: tuple[int, ...],
+    flat_codes: NDArray[np.int8],
+    params: BodyParams,
+    support: Support,
+    hip_region: ConvexPolygon,
+) -> None:
+    """Large arrays: the compiled region test, then the compiled step test, chunk by chunk."""
+    from pushrecovery.surfaces._kernels import padded_edges, plane_codes
+
+    inv = 1.0 / params.omega
+    cop_edges = padded_edges(support.polygon.edge_table)
+    hip_edges = padded_edges(hip_region.edge_table)
+    frame = StepFrame.of(support)
+    for start in range(0, flat_codes.size, _COMPILED_CHUNK):
+        part = slice(start, min(start + _COMPILED_CHUNK, flat_codes.size))
+        xs, ys, xds, yds = (_chunk(a, shape, part) for a in inputs)
+        chunk = flat_codes[part]
+        beyond, bad = plane_codes(xs, ys, xds, yds, inv, cop_edges, hip_edges, chunk)
+        if bad:
+            for name, array in zip(("x", "y", "xdot", "ydot"), (xs, ys, xds, yds), strict=True):
+                finite_array(name, array)
+            raise InvalidParameterError("states are too large: the capture point overflows")
+        if beyond:
+            _mark_plane_steps(xs, ys, xds, yds, chunk, params, frame)
+
+
+def _mark_plane_steps(
+    xs: NDArray[np.float64],
+    ys: NDArray[np.float64],
+    xds: NDArray[np.float64],
+    yds: NDArray[np.float64],
+    codes: NDArray[np.int8],
+    params: BodyParams,
+    frame: StepFrame,
+) -> None:
+    """Mark ``step`` where one step recovers the states coded ``fall`` (compiled, in place)."""
+    from pushrecovery.models._stepping_kernels import mark_feasible_xy
+
+    states = (np.ascontiguousarray(a) for a in (xs, ys, xds, yds))
+    mark_feasible_xy(*states, *frame.kernel_args(params), codes, _FALL, _STEP)
+
+
+def _chunk(array: NDArray[np.float64], shape: tuple[int, ...], part: slice) -> NDArray[np.float64]:
+    """Elements ``part`` of ``array`` broadcast to ``shape`` and flattened (a copy of the part)."""
+    if array.shape == shape and array.flags.c_contiguous:
+        return array.reshape(-1)[part]
+    if array.size == 1:
+        return np.full(part.stop - part.start, float(array.reshape(-1)[0]))
+    return np.ascontiguousarray(np.broadcast_to(array, shape).flat[part])
