@@ -252,3 +252,25 @@ def test_margins_fall_with_push_size_along_any_direction(foot, roll, stance, hea
         for i in range(1, len(v) - 1):
             w = (v[i] - v[i - 1]) / (v[i + 1] - v[i - 1])
             assert m[i] >= (1 - w) * m[i - 1] + w * m[i + 1] - ROUND
+
+
+@pytest.mark.parametrize("corners", [3, 4, 5, 8, 9, 13])
+def test_the_compiled_margin_equals_the_exact_signed_distance(corners):
+    # Large arrays take the compiled kernel, whose edge loop is specialised for 4 and 8 edges
+    # (tables padded by repeating a row) and general above; each must give the numpy signed
+    # distance of ground.polygon, inside, beside edges and beside corners.
+    from pushrecovery.ground import convex_polygon
+    from pushrecovery.surfaces.plane import capture_margin_xy
+
+    angle = np.linspace(0.0, 2.0 * math.pi, corners, endpoint=False) + 0.3
+    ellipse = np.column_stack([0.15 * np.cos(angle) + 0.02, 0.08 * np.sin(angle)])  # convex
+    polygon = convex_polygon("polygon", ellipse)
+    rng = np.random.default_rng(corners)
+    n = 1 << 16  # above the size that takes the compiled pass
+    x, y = rng.normal(0.0, 0.08, n), rng.normal(0.0, 0.08, n)
+    xdot, ydot = rng.normal(0.0, 0.1, n), rng.normal(0.0, 0.1, n)
+    omega = 3.0
+    compiled = capture_margin_xy(x, y, xdot, ydot, omega, polygon)
+    exact = polygon.signed_distance(x + xdot / omega, y + ydot / omega)
+    assert 0.2 < np.mean(compiled > 0.0) < 0.8  # both sides sampled
+    np.testing.assert_allclose(compiled, exact, rtol=0.0, atol=ROUND)

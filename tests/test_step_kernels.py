@@ -270,8 +270,8 @@ KERNELS = {
     "_step_scalar.mark_feasible",
     "_step_scalar.mark_feasible_xy",
     "_kernels.sagittal_codes",
-    "_kernels.plane_codes",
-    "_kernels.polygon_margin",
+    "_kernels._codes_4",
+    "_kernels._margins_4",
 }
 
 

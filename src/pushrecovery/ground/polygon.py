@@ -72,11 +72,18 @@ class ConvexPolygon:
 
     @property
     def edge_table(self) -> FloatArray:
-        """One row per edge: n_x, n_y, b, start x, start y, edge x, edge y, 1/|edge|² [m]."""
+        """One row per edge: n_x, n_y, b, t_x, t_y, a, length [m].
+
+        (t_x, t_y) is the edge's unit direction (n turned +90°), a = t · v_i the tangential
+        coordinate of its start: a point p lies beside the segment when 0 <= t · p − a <=
+        length.
+        """
         start = self.vertices
         edge = np.roll(start, -1, axis=0) - start
-        inverse = 1.0 / np.einsum("ij,ij->i", edge, edge)
-        return np.column_stack([self.normals, self.offsets, start, edge, inverse])
+        length = np.hypot(edge[:, 0], edge[:, 1])
+        tangent = edge / length[:, None]
+        along = np.einsum("ij,ij->i", tangent, start)
+        return np.column_stack([self.normals, self.offsets, tangent, along, length])
 
     @property
     def area(self) -> float:

@@ -11,56 +11,81 @@ import math
 import numba
 import numpy as np
 
-#: States per block of the planar margin: the block's temporaries stay in the L1 cache.
-_BLOCK = 4096
+#: Edge tables come padded to one of these row counts when they have no more (repeating a row
+#: changes no maximum or minimum): the loop over edges then has a constant count, unrolls and
+#: runs on SIMD lanes across states, 3-5x faster than a loop of run-time length.
+EDGE_BLOCKS = (4, 8)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _point_margin(edges, count, px, py):  # type: ignore[no-untyped-def]
+    """Signed distance of p to the convex polygon of the first ``count`` rows of ``edges``.
+
+    Rows as :attr:`pushrecovery.ground.polygon.ConvexPolygon.edge_table`. Inside, the margin
+    is −max_i e_i with e_i = n_i · p − b_i. Outside it is −sqrt(min_i (e_i² + d_i²)), d_i =
+    max(−s_i, s_i − length_i, 0) with s_i = t_i · p − a_i the tangential coordinate: e_i² +
+    d_i² is the squared distance to edge i's segment, and the nearest point of the polygon
+    lies on one of them. No branches, so that the loop runs on SIMD lanes.
+    """
+    excess = -np.inf
+    gap2 = np.inf
+    for k in range(count):
+        e = edges[k, 0] * px + edges[k, 1] * py - edges[k, 2]
+        s = edges[k, 3] * px + edges[k, 4] * py - edges[k, 5]
+        d = max(max(-s, s - edges[k, 6]), 0.0)
+        c = e * e + d * d
+        excess = e if e > excess else excess
+        gap2 = c if c < gap2 else gap2
+    return -excess if excess <= 0.0 else -math.sqrt(gap2)
+
+
+def polygon_margin(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
+    """Signed distance of ξ = r + ṙ/ω to a convex polygon (see :func:`_point_margin`) [m].
+
+    ``edges`` from :func:`padded_edges`; flat float arrays. Returns the number of non-finite
+    margins.
+    """
+    count = edges.shape[0]
+    if count == EDGE_BLOCKS[0]:
+        return _margins_4(x, y, xdot, ydot, inv_omega, edges, out)
+    if count == EDGE_BLOCKS[1]:
+        return _margins_8(x, y, xdot, ydot, inv_omega, edges, out)
+    return _margins_any(x, y, xdot, ydot, inv_omega, edges, out)
 
 
 @numba.njit(parallel=True, cache=True, nogil=True)
-def polygon_margin(  # type: ignore[no-untyped-def]
-    x, y, xdot, ydot, inv_omega, edges, out
-):
-    """Signed distance of ξ = r + ṙ/ω to a convex polygon (see ground.polygon) [m].
-
-    ``edges`` has one row per edge: normal (2), offset, start vertex (2), edge vector (2) and
-    1/|edge|². Inside, the margin is −max_i e_i with e_i = n_i · ξ − b_i. Outside it is minus
-    the square root of min_i c_i, with c_i = e_i² where ξ projects onto edge i's segment
-    (0 <= t_i <= 1: the foot lies on the polygon) and |ξ − v_i|² elsewhere: every candidate
-    is the distance to a point of the polygon, and the nearest point (an edge's interior or a
-    vertex) is among them. Edge by edge over a block of states and without branches, so that
-    the inner loop runs on SIMD lanes. Returns the number of non-finite margins.
-    """
-    size = x.shape[0]
-    count = edges.shape[0]
-    blocks = (size + _BLOCK - 1) // _BLOCK
+def _margins_4(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
     bad = 0
-    for block in numba.prange(blocks):
-        start = block * _BLOCK
-        m = min(start + _BLOCK, size) - start
-        px = np.empty(m)
-        py = np.empty(m)
-        excess = np.empty(m)
-        gap2 = np.empty(m)
-        for i in range(m):
-            px[i] = x[start + i] + xdot[start + i] * inv_omega
-            py[i] = y[start + i] + ydot[start + i] * inv_omega
-            excess[i] = -np.inf
-            gap2[i] = np.inf
-        for k in range(count):
-            nx, ny, b = edges[k, 0], edges[k, 1], edges[k, 2]
-            vx, vy, ux, uy, inv = edges[k, 3], edges[k, 4], edges[k, 5], edges[k, 6], edges[k, 7]
-            for i in range(m):
-                e = nx * px[i] + ny * py[i] - b
-                excess[i] = e if e > excess[i] else excess[i]
-                dx = px[i] - vx
-                dy = py[i] - vy
-                t = (dx * ux + dy * uy) * inv
-                c = e * e if (t >= 0.0) & (t <= 1.0) else dx * dx + dy * dy
-                gap2[i] = c if c < gap2[i] else gap2[i]
-        for i in range(m):
-            margin = -excess[i] if excess[i] <= 0.0 else -math.sqrt(gap2[i])
-            out[start + i] = margin
-            if not math.isfinite(margin):
-                bad += 1
+    for i in numba.prange(x.shape[0]):
+        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+        margin = _point_margin(edges, EDGE_BLOCKS[0], px, py)
+        out[i] = margin
+        if not math.isfinite(margin):
+            bad += 1
+    return bad
+
+
+@numba.njit(parallel=True, cache=True, nogil=True)
+def _margins_8(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
+    bad = 0
+    for i in numba.prange(x.shape[0]):
+        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+        margin = _point_margin(edges, EDGE_BLOCKS[1], px, py)
+        out[i] = margin
+        if not math.isfinite(margin):
+            bad += 1
+    return bad
+
+
+@numba.njit(parallel=True, cache=True, nogil=True)
+def _margins_any(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
+    bad = 0
+    for i in numba.prange(x.shape[0]):
+        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+        margin = _point_margin(edges, edges.shape[0], px, py)
+        out[i] = margin
+        if not math.isfinite(margin):
+            bad += 1
     return bad
 
 
@@ -90,33 +115,62 @@ def sagittal_codes(  # type: ignore[no-untyped-def]
     return beyond, bad
 
 
-#: Edge tables of :func:`plane_codes` come padded to exactly this many rows when they have no
-#: more (repeating a row changes no maximum): the loop over edges then has a constant count,
-#: unrolls and runs without branches, 4-5x faster than a loop of run-time length.
-EDGE_BLOCK = 8
-
-
-@numba.njit(parallel=True, cache=True, nogil=True)
 def plane_codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
     """Strategy codes decided by the planar regions alone: 0 ankle, 1 hip, 3 beyond both.
 
-    Inside a convex polygon means max_i(n_i · ξ − b_i) < 0 (``edges`` rows: n_x, n_y, b), as
-    the signed distance > 0 of :mod:`pushrecovery.ground.polygon`; tables of
-    :data:`EDGE_BLOCK` rows take the unrolled loop. Returns (states beyond the hip region,
+    Inside a convex polygon means max_i(n_i · ξ − b_i) < 0 (``edges`` rows: n_x, n_y, b, ...),
+    as the signed distance > 0 of :mod:`pushrecovery.ground.polygon`; tables of
+    :func:`padded_edges` take an unrolled loop. Returns (states beyond the hip region,
     non-finite states).
     """
+    args = (x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out)
+    if cop_edges.shape[0] == cmp_edges.shape[0] == EDGE_BLOCKS[0]:
+        return _codes_4(*args)
+    if cop_edges.shape[0] <= EDGE_BLOCKS[1] and cmp_edges.shape[0] <= EDGE_BLOCKS[1]:
+        return _codes_8(*args[:5], padded_edges(cop_edges, 1), padded_edges(cmp_edges, 1), out)
+    return _codes_any(*args)
+
+
+# The three loops differ in their edge count only: a compile-time constant is what lets the
+# loops over edges unroll (a shared helper returning a tuple is 2-5x slower).
+@numba.njit(parallel=True, cache=True, nogil=True)
+def _codes_4(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
     beyond = 0
     bad = 0
-    fixed = cop_edges.shape[0] == EDGE_BLOCK and cmp_edges.shape[0] == EDGE_BLOCK
     for i in numba.prange(x.shape[0]):
-        px = x[i] + xdot[i] * inv_omega
-        py = y[i] + ydot[i] * inv_omega
-        if fixed:
-            cop = _max_excess_fixed(cop_edges, px, py)
-            hip = _max_excess_fixed(cmp_edges, px, py)
-        else:
-            cop = _max_excess(cop_edges, px, py)
-            hip = _max_excess(cmp_edges, px, py)
+        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+        cop = _max_excess(cop_edges, EDGE_BLOCKS[0], px, py)
+        hip = _max_excess(cmp_edges, EDGE_BLOCKS[0], px, py)
+        code = 0 if cop < 0.0 else (1 if hip < 0.0 else 3)
+        out[i] = code
+        beyond += code == 3
+        bad += not (abs(px) + abs(py) < np.inf)  # NaN or infinite
+    return beyond, bad
+
+
+@numba.njit(parallel=True, cache=True, nogil=True)
+def _codes_8(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
+    beyond = 0
+    bad = 0
+    for i in numba.prange(x.shape[0]):
+        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+        cop = _max_excess(cop_edges, EDGE_BLOCKS[1], px, py)
+        hip = _max_excess(cmp_edges, EDGE_BLOCKS[1], px, py)
+        code = 0 if cop < 0.0 else (1 if hip < 0.0 else 3)
+        out[i] = code
+        beyond += code == 3
+        bad += not (abs(px) + abs(py) < np.inf)  # NaN or infinite
+    return beyond, bad
+
+
+@numba.njit(parallel=True, cache=True, nogil=True)
+def _codes_any(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
+    beyond = 0
+    bad = 0
+    for i in numba.prange(x.shape[0]):
+        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+        cop = _max_excess(cop_edges, cop_edges.shape[0], px, py)
+        hip = _max_excess(cmp_edges, cmp_edges.shape[0], px, py)
         code = 0 if cop < 0.0 else (1 if hip < 0.0 else 3)
         out[i] = code
         beyond += code == 3
@@ -125,27 +179,22 @@ def plane_codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _max_excess_fixed(edges, px, py):  # type: ignore[no-untyped-def]
-    """max_i(n_i · p − b_i) over exactly EDGE_BLOCK rows (unrolled)."""
+def _max_excess(edges, count, px, py):  # type: ignore[no-untyped-def]
+    """max_i(n_i · p − b_i) over the first ``count`` rows of ``edges``."""
     excess = -np.inf
-    for k in range(EDGE_BLOCK):
+    for k in range(count):
         e = edges[k, 0] * px + edges[k, 1] * py - edges[k, 2]
         excess = e if e > excess else excess
     return excess
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
-def _max_excess(edges, px, py):  # type: ignore[no-untyped-def]
-    """max_i(n_i · p − b_i) over the rows of ``edges``."""
-    excess = -np.inf
-    for k in range(edges.shape[0]):
-        e = edges[k, 0] * px + edges[k, 1] * py - edges[k, 2]
-        excess = e if e > excess else excess
-    return excess
+def padded_edges(table, smallest=0):  # type: ignore[no-untyped-def]
+    """Return an edge table padded to the first of :data:`EDGE_BLOCKS` rows that holds it.
 
-
-def padded_edges(table):  # type: ignore[no-untyped-def]
-    """Return the (n_x, n_y, b) columns of an edge table, padded to EDGE_BLOCK rows if fewer."""
-    rows = np.ascontiguousarray(table[:, :3])
-    missing = max(0, EDGE_BLOCK - len(rows))
+    Repeats its last row; tables longer than every block come back as they are. Blocks before
+    index ``smallest`` are skipped.
+    """
+    rows = np.ascontiguousarray(table)
+    fits = [block for block in EDGE_BLOCKS[smallest:] if block >= len(rows)]
+    missing = fits[0] - len(rows) if fits else 0
     return np.ascontiguousarray(np.vstack([rows, np.repeat(rows[-1:], missing, axis=0)]))

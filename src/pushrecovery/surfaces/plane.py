@@ -160,13 +160,12 @@ def capture_margin_xy(
         and _fusable(arrays[0], arrays[2], out)
         and all(a.flags.c_contiguous for a in arrays)
     ):
-        from pushrecovery.surfaces._kernels import polygon_margin
+        from pushrecovery.surfaces._kernels import padded_edges, polygon_margin
 
         margin = np.empty(shape) if out is None else out
         flat = [a.reshape(-1) for a in arrays]
-        bad = polygon_margin(  # type: ignore[call-arg]
-            *flat, 1.0 / omega, polygon.edge_table, margin.reshape(-1)
-        )
+        edges = padded_edges(polygon.edge_table)
+        bad = polygon_margin(*flat, 1.0 / omega, edges, margin.reshape(-1))
     else:
         with np.errstate(over="ignore", invalid="ignore"):  # reported below, as one error
             px, py = capture_point_xy(arrays[0], arrays[1], arrays[2], arrays[3], omega)
