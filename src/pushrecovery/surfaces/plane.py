@@ -163,9 +163,9 @@ def capture_margin_xy(
         from pushrecovery.surfaces._kernels import padded_edges, polygon_margin
 
         margin = np.empty(shape) if out is None else out
-        flat = [a.reshape(-1) for a in arrays]
+        xs, ys, xds, yds = (a.reshape(-1) for a in arrays)
         edges = padded_edges(polygon.edge_table)
-        bad = polygon_margin(*flat, 1.0 / omega, edges, margin.reshape(-1))
+        bad = polygon_margin(xs, ys, xds, yds, 1.0 / omega, edges, margin.reshape(-1))
     else:
         with np.errstate(over="ignore", invalid="ignore"):  # reported below, as one error
             px, py = capture_point_xy(arrays[0], arrays[1], arrays[2], arrays[3], omega)
