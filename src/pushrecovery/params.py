@@ -20,6 +20,9 @@ __all__ = ["PRESETS", "BodyParams", "load_params"]
 
 #: Narrowest foot [m]: a narrower one is a line, whose distances are rounding noise.
 MIN_FOOT_WIDTH = 1e-3
+#: Longest step time [s] (e^{-ω Δt_s} is then far below any margin) and most steps.
+MAX_STEP_TIME = 5.0
+MAX_STEPS = 50
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,6 +67,19 @@ class BodyParams:
         limit [N m] and joint limit [rad]; ``None`` means equal to the pitch value. Like
         ``leg_length``, the value is fixed when the parameters are built: ``dataclasses.replace``
         of a pitch value keeps the roll value (``load_params`` re-derives it).
+    min_step_time : float
+        Δt_s, the shortest time from deciding to step to the swing foot's touchdown [s], in
+        [0, 5] (0: the paper's instantaneous step). Preset 0.3 s: the fast end of young adults'
+        compensatory steps, whose foot contact follows a perturbation by about 0.3-0.4 s
+        (``docs/steps.md``).
+    max_steps : int or None
+        Largest number of steps a ``step`` verdict may take, in [1, 50]; ``None``: the smallest
+        N beyond which the N-step capture region grows by less than 1 mm
+        (:func:`pushrecovery.surfaces.capture_region.default_max_steps`).
+    min_step_width : float or None
+        Narrowest lateral distance [m] between the stance ankle and the landing ankle, measured
+        outward on the swing foot's side (a kinematic limit that forbids crossing the stance
+        leg), in [0, max_step_length); ``None``: no limit (the reach is a disc).
 
     Raises
     ------
@@ -87,6 +103,9 @@ class BodyParams:
     flywheel_inertia_roll: float = field(default=None)  # type: ignore[assignment]
     torque_max_roll: float = field(default=None)  # type: ignore[assignment]
     flywheel_angle_max_roll: float = field(default=None)  # type: ignore[assignment]
+    min_step_time: float = 0.3
+    max_steps: int = field(default=None)  # type: ignore[assignment]
+    min_step_width: float | None = None
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -143,6 +162,39 @@ class BodyParams:
             )
         set_(self, "max_step_length", reach)
         self._check_ground_plane(leg)
+        self._check_steps()
+
+    def _check_steps(self) -> None:
+        """Validate the step timing and limits; derive ``max_steps`` when not given."""
+        set_ = object.__setattr__
+        step_time = finite_float("min_step_time", self.min_step_time, "s")
+        if not 0.0 <= step_time <= MAX_STEP_TIME:
+            raise InvalidParameterError(
+                f"min_step_time must be in [0, {MAX_STEP_TIME:g}] s, got {step_time:g}"
+            )
+        set_(self, "min_step_time", step_time)
+        if self.min_step_width is not None:
+            width = finite_float("min_step_width", self.min_step_width, "m")
+            if not 0.0 <= width < self.max_step_length:
+                raise InvalidParameterError(
+                    f"min_step_width must be in [0, max_step_length = {self.max_step_length:g})"
+                    f" m, got {width:g}"
+                )
+            set_(self, "min_step_width", width)
+        steps = self.max_steps
+        if steps is None:
+            from pushrecovery.surfaces.capture_region import default_max_steps
+
+            steps = default_max_steps(self)
+        elif isinstance(steps, bool) or not (
+            isinstance(steps, int) or (isinstance(steps, float) and steps.is_integer())
+        ):
+            raise InvalidParameterError(
+                f"max_steps must be a whole number in [1, {MAX_STEPS}], got {steps!r}"
+            )
+        if not 1 <= steps <= MAX_STEPS:
+            raise InvalidParameterError(f"max_steps must be in [1, {MAX_STEPS}], got {steps:g}")
+        set_(self, "max_steps", int(steps))
 
     def _check_ground_plane(self, leg: float) -> None:
         """Validate the foot width, stance width, foot polygon and the roll axis."""
@@ -239,6 +291,9 @@ PRESETS: Mapping[str, Mapping[str, Any]] = MappingProxyType(
                 "flywheel_inertia_roll": None,
                 "torque_max_roll": None,
                 "flywheel_angle_max_roll": None,
+                "min_step_time": 0.3,
+                "max_steps": None,
+                "min_step_width": None,
             }
         )
     }

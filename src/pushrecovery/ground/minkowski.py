@@ -1,0 +1,221 @@
+r"""Minkowski algebra of convex polygons: weighted sums, intersections, regular polygons.
+
+The capture regions of several steps (:mod:`pushrecovery.surfaces.capture_region`) are
+weighted Minkowski sums ⊕_k w_k P_k of convex polygons: their support function is the weighted
+sum of support functions, h(d) = Σ_k w_k h_{P_k}(d) for w_k >= 0 (a negative weight is the
+point reflection −P_k scaled by |w_k|). A sum is built exactly by merging the terms' edges in
+order of angle (de Berg et al., *Computational Geometry*, Sec. 13.3), O(total edges log).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import ConvexPolygon
+
+__all__ = ["Shape", "clip", "clip_halfplanes", "decompose", "minkowski_sum", "regular_polygon"]
+
+FloatArray = NDArray[np.float64]
+#: A term of a sum: a convex polygon, or counter-clockwise vertices of shape (n, 2) that may be
+#: degenerate (a point, n = 1; a segment, n = 2; the hip's box when one axis has no torque).
+Shape = ConvexPolygon | FloatArray
+
+
+def _vertices(shape: Shape) -> FloatArray:
+    return shape.vertices if isinstance(shape, ConvexPolygon) else np.asarray(shape, np.float64)
+
+
+#: Edges shorter than this fraction of the sum's size are dropped (rounding of collinear
+#: edges from different terms; the polygon type needs no repeated or collinear vertices).
+_RELATIVE_EDGE = 1e-12
+
+
+def minkowski_sum(
+    terms: Sequence[tuple[float, Shape]], offset: tuple[float, float] | FloatArray = (0.0, 0.0)
+) -> ConvexPolygon:
+    """Return offset ⊕ w_1 P_1 ⊕ ... ⊕ w_n P_n for convex polygons P_k and real weights w_k.
+
+    Terms of weight 0 vanish; a negative weight gives |w| (−P). At least one term must have
+    a non-zero weight.
+
+    Parameters
+    ----------
+    terms : sequence of (float, Shape)
+        Weights (dimensionless) and convex shapes [m].
+    offset : (float, float)
+        A translation added to the sum [m].
+
+    Returns
+    -------
+    ConvexPolygon
+        The sum, counter-clockwise, collinear vertices merged.
+    """
+    starts = []
+    edges = []
+    for weight, polygon in terms:
+        if not math.isfinite(weight):
+            raise InvalidParameterError(f"Minkowski weights must be finite, got {weight!r}")
+        if weight == 0.0:
+            continue
+        vertices = weight * _vertices(polygon)  # a point reflection keeps the orientation
+        step = np.roll(vertices, -1, axis=0) - vertices
+        lowest = int(np.lexsort((vertices[:, 0], vertices[:, 1]))[0])  # lowest, then leftmost
+        starts.append(vertices[lowest])
+        edges.append(np.roll(step, -lowest, axis=0))
+    if not edges:
+        raise InvalidParameterError("a Minkowski sum needs at least one term of non-zero weight")
+    every = np.concatenate(edges)
+    # From the lowest-leftmost vertex, a convex polygon's edge angles rise through [0, 2π).
+    angle = np.mod(np.arctan2(every[:, 1], every[:, 0]), 2.0 * math.pi)
+    every = every[np.argsort(angle, kind="stable")]
+    start = np.sum(starts, axis=0) + np.asarray(offset, dtype=np.float64)
+    vertices = start + np.concatenate([np.zeros((1, 2)), np.cumsum(every[:-1], axis=0)])
+    return _cleaned(vertices)
+
+
+def _cleaned(vertices: FloatArray) -> ConvexPolygon:
+    """Drop repeated and collinear vertices of a convex counter-clockwise vertex loop."""
+    scale = max(1.0, float(np.abs(vertices).max()))
+    keep = []
+    n = len(vertices)
+    for i in range(n):
+        prev, here, after = vertices[i - 1], vertices[i], vertices[(i + 1) % n]
+        a, b = here - prev, after - here
+        turn = a[0] * b[1] - a[1] * b[0]
+        if math.hypot(*b) > _RELATIVE_EDGE * scale and turn > _RELATIVE_EDGE * scale * scale:
+            keep.append(here)
+    if len(keep) < 3:
+        raise InvalidParameterError("the Minkowski sum has zero area")
+    return ConvexPolygon._from_ccw(np.array(keep))
+
+
+def clip(polygon: ConvexPolygon, window: ConvexPolygon) -> ConvexPolygon | None:
+    """Intersection of two convex polygons, or None when it has no area [m]."""
+    return clip_halfplanes(polygon, window.normals, window.offsets)
+
+
+def clip_halfplanes(
+    polygon: ConvexPolygon, normals: FloatArray, offsets: FloatArray
+) -> ConvexPolygon | None:
+    """``polygon`` ∩ {p : n_i · p <= b_i for all i}, or None when it has no area [m].
+
+    Sutherland-Hodgman: the polygon cut by one half-plane after the other.
+    """
+    points = polygon.vertices
+    scale = max(1.0, float(np.abs(points).max()))
+    for normal, offset in zip(normals, offsets, strict=True):
+        excess = points @ normal - offset
+        if np.all(excess <= 0.0):
+            continue
+        if np.all(excess >= 0.0):
+            return None
+        after = np.roll(points, -1, axis=0)
+        excess_after = np.roll(excess, -1)
+        kept: list[FloatArray] = []
+        for p, q, e, f in zip(points, after, excess, excess_after, strict=True):
+            if e <= 0.0:
+                kept.append(p)
+            if (e < 0.0 < f) or (f < 0.0 < e):
+                kept.append(p + (e / (e - f)) * (q - p))
+        points = np.array(kept)
+        if len(points) < 3:
+            return None
+    area = 0.5 * float(
+        np.dot(points[:, 0], np.roll(points[:, 1], -1))
+        - np.dot(np.roll(points[:, 0], -1), points[:, 1])
+    )
+    if area <= 1e-12 * scale * scale:
+        return None
+    try:
+        return _cleaned(points)
+    except InvalidParameterError:
+        return None
+
+
+def regular_polygon(
+    radius: float, sides: int, centre: tuple[float, float] = (0.0, 0.0), phase: float = 0.0
+) -> ConvexPolygon:
+    """Return the regular polygon of ``sides`` vertices on the circle of ``radius`` [m].
+
+    Vertices at angles phase + 2πk/sides [rad] about ``centre``; its edges come within
+    radius (1 − cos(π/sides)) of the circle.
+    """
+    if not (math.isfinite(radius) and radius > 0.0):
+        raise InvalidParameterError(f"radius must be > 0 m, got radius={radius!r}")
+    if sides < 3:
+        raise InvalidParameterError(f"sides must be >= 3, got sides={sides}")
+    angle = phase + 2.0 * math.pi * np.arange(sides) / sides
+    vertices = np.column_stack([np.cos(angle), np.sin(angle)]) * radius + np.asarray(centre)
+    return ConvexPolygon._from_ccw(vertices)
+
+
+def decompose(
+    point: FloatArray,
+    terms: Sequence[tuple[float, Shape]],
+    offset: FloatArray,
+    total: ConvexPolygon,
+) -> tuple[list[FloatArray], float]:
+    """Points p_k of the shapes with offset + Σ w_k p_k = ``point``, as central as possible.
+
+    ``total`` is :func:`minkowski_sum` of the same terms and offset, weights >= 0. With c_k
+    the shapes' vertex means and c = offset + Σ w_k c_k, the ray from c through the point
+    leaves ``total`` at b = c + λ u on an edge of outward normal n; b is offset + Σ w_k v_k with
+    v_k on the face of shape k that maximises n · p (a vertex, or along the edge for the
+    shapes that have one parallel to n). The point is the fraction s = |point − c| / λ of the
+    way, so p_k = (1 − s) c_k + s v_k lies in shape k (convexity) and keeps the same relative
+    depth in every shape: no term is pushed to its edge before the others.
+
+    Returns
+    -------
+    (list of ndarray, float)
+        The points p_k [m] (the centre c_k for zero weights) and s (> 1: the point is outside
+        ``total``, and the points are those of the boundary point b).
+    """
+    shapes = [_vertices(shape) for _, shape in terms]
+    weights = [float(weight) for weight, _ in terms]
+    centres = [v.mean(axis=0) for v in shapes]
+    centre = np.asarray(offset, np.float64) + sum(
+        (w * c for w, c in zip(weights, centres, strict=True)), np.zeros(2)
+    )
+    gap = np.asarray(point, np.float64) - centre
+    distance = math.hypot(*gap)
+    if distance == 0.0:
+        return centres, 0.0
+    u = gap / distance
+    rates = total.normals @ u
+    room = total.offsets - total.normals @ centre
+    ahead = rates > 0.0
+    ratios = np.where(ahead, room / np.where(ahead, rates, 1.0), np.inf)
+    edge = int(np.argmin(ratios))
+    reach = float(ratios[edge])
+    normal = total.normals[edge]
+    tangent = np.array([-normal[1], normal[0]])
+    boundary = centre + reach * u
+    scale = max(1.0, float(np.abs(total.vertices).max()))
+    faces = []
+    for w, vertices in zip(weights, shapes, strict=True):
+        if w == 0.0:
+            faces.append((vertices.mean(axis=0), 0.0))
+            continue
+        height = vertices @ normal
+        top = vertices[height >= height.max() - 1e-12 * scale / w]
+        along = top @ tangent
+        faces.append((top[int(np.argmin(along))], float(along.max() - along.min())))
+    start = np.asarray(offset, np.float64) + sum(
+        (w * f for w, (f, _) in zip(weights, faces, strict=True)), np.zeros(2)
+    )
+    left = float((boundary - start) @ tangent)
+    tops = []
+    for w, (face, length) in zip(weights, faces, strict=True):
+        move = min(max(left, 0.0), w * length)
+        left -= move
+        tops.append(face + (move / w if w else 0.0) * tangent)
+    share = distance / reach
+    s = min(share, 1.0)
+    points = [(1.0 - s) * c + s * t for c, t in zip(centres, tops, strict=True)]
+    return points, share
