@@ -91,14 +91,14 @@ def _margins_any(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-un
 
 @numba.njit(parallel=True, cache=True, nogil=True)
 def sagittal_codes(  # type: ignore[no-untyped-def]
-    x, xdot, inv_omega, cop_centre, cop_half, cmp_centre, cmp_half, out
+    x, xdot, inv_omega, cop_centre, cop_half, cmp_centre, cmp_half, step_centre, step_half, out
 ):
-    """Strategy codes decided by the margins alone: 0 ankle (Eq. 4), 1 hip (Eq. 15), 3 else.
+    """Strategy codes on the line: 0 ankle (Eq. 4), 1 hip (Eq. 15), 2 step (S1), 3 fall.
 
-    The margins are computed as :func:`pushrecovery.surfaces.cop.capture_margin` does, so
-    the verdicts agree bit for bit. Returns (states beyond the hip region, non-finite states).
+    Each region an interval (centre, half-width); the margins are computed as
+    :func:`pushrecovery.surfaces.cop.capture_margin` does, so the verdicts agree bit for bit.
+    Returns the number of non-finite states.
     """
-    beyond = 0
     bad = 0
     for i in numba.prange(x.shape[0]):
         xi = x[i] + xdot[i] * inv_omega
@@ -106,13 +106,13 @@ def sagittal_codes(  # type: ignore[no-untyped-def]
             out[i] = 0
         elif cmp_half - abs(xi - cmp_centre) > 0.0:
             out[i] = 1
+        elif step_half - abs(xi - step_centre) > 0.0:
+            out[i] = 2
         else:
             out[i] = 3
-            if math.isfinite(xi):
-                beyond += 1
-            else:
+            if not math.isfinite(xi):
                 bad += 1
-    return beyond, bad
+    return bad
 
 
 def plane_codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
@@ -198,3 +198,47 @@ def padded_edges(table, smallest=0):  # type: ignore[no-untyped-def]
     fits = [block for block in EDGE_BLOCKS[smallest:] if block >= len(rows)]
     missing = fits[0] - len(rows) if fits else 0
     return np.ascontiguousarray(np.vstack([rows, np.repeat(rows[-1:], missing, axis=0)]))
+
+
+@numba.njit(cache=True, nogil=True)
+def locate_steps(table, counts, steps, px, py):  # type: ignore[no-untyped-def]
+    """Return (steps of the first region holding p, 0 if none; largest signed distance [m]).
+
+    ``table`` stacks the regions' edge tables (rows padded), ``counts`` their edge counts,
+    ``steps`` the number of steps of each region (ascending).
+    """
+    found = 0
+    best = -np.inf
+    for r in range(table.shape[0]):
+        margin = _point_margin(table[r], counts[r], px, py)
+        best = margin if margin > best else best
+        if found == 0 and margin > 0.0:
+            found = steps[r]
+    return found, best
+
+
+@numba.njit(parallel=True, cache=True, nogil=True)
+def mark_regions(  # type: ignore[no-untyped-def]
+    x, y, xdot, ydot, inv_omega, table, counts, discs, codes, pending, mark
+):
+    """Set ``codes[i] = mark`` where ``codes[i] == pending`` and ξ_i lies in some region.
+
+    ``discs`` rows (c_x, c_y, r_in², r_out²): inside the inscribed disc is inside, outside the
+    circumscribed one outside, so that most states skip the edges.
+    """
+    for i in numba.prange(x.shape[0]):
+        if codes[i] != pending:
+            continue
+        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+        for r in range(table.shape[0]):
+            dx, dy = px - discs[r, 0], py - discs[r, 1]
+            gap = dx * dx + dy * dy
+            if gap < discs[r, 2]:
+                inside = True
+            elif gap >= discs[r, 3]:
+                inside = False
+            else:
+                inside = _max_excess(table[r], counts[r], px, py) < 0.0
+            if inside:
+                codes[i] = mark
+                break

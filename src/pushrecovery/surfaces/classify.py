@@ -1,14 +1,13 @@
 """The strategy a state needs: the complete strategy map of the paper, on a line or the plane.
 
 Vocabulary (stable, part of the JSON contract), escalating as the paper proposes (Sec. I-B):
-``ankle`` (CoP balancing, Eq. 4), ``hip`` (CMP balancing, corrected Eq. 15), ``step`` (a single
-step within reach recovers, Sec. IV, :mod:`pushrecovery.surfaces.step`) and ``fall``.
+``ankle`` (CoP balancing, Eq. 4), ``hip`` (CMP balancing, corrected Eq. 15), ``step`` (at most
+``max_steps`` steps capture the state: the N-step regions of
+:mod:`pushrecovery.surfaces.step_regions`, touchdowns every ``min_step_time``) and ``fall``.
 
 On the ground plane (:func:`classify` with ``y``, ``ydot`` or a ``support``) the ankle and hip
-regions are the support polygon and the CMP region of :mod:`pushrecovery.surfaces.plane`; the
-step is Sec. IV's single step applied on the line through the stance ankle and the capture
-point (the direction of its excursion), which issue 14's capture regions will replace
-(``docs/plane.md``).
+regions are the support polygon and the CMP region of :mod:`pushrecovery.surfaces.plane` and
+the step regions are polygons; on the line, intervals (``docs/steps.md``).
 """
 
 from __future__ import annotations
@@ -16,16 +15,23 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 from pushrecovery._validate import finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.capture_region import StepPlan
 from pushrecovery.surfaces.classify_many import classify_states
-from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
+from pushrecovery.surfaces.cmp import cmp_margin, cmp_offset, cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
-from pushrecovery.surfaces.plane import cmp_polygon, plan_step_xy
-from pushrecovery.surfaces.step import StepDecision, plan_step
+from pushrecovery.surfaces.plane import cmp_polygon
+from pushrecovery.surfaces.step_regions import (
+    StepRegions,
+    sagittal_plan,
+    sagittal_step_interval,
+    sagittal_steps,
+)
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
 __all__ = [
@@ -56,20 +62,23 @@ def strategy_region(strategy: str, params: BodyParams) -> CaptureInterval:
 
 @dataclass(frozen=True, slots=True)
 class Classification:
-    """Strategy needed by one state, with the capture point, the margins [m] and the step.
+    """Strategy needed by one state, with the capture point, the margins [m] and the steps.
 
     ``margins``: ``cop`` and ``cmp`` are signed distances of the capture point to the regions'
-    edges; ``step`` is the reach left beyond the shortest recovering step (max_step_length minus
-    it), −inf when no single step recovers. ``step`` holds the recommended step for the ``step``
-    strategy: ``step_length`` (foot to foot, signed like the step direction), ``com_to_foot``,
-    ``theta`` (stance-leg angle at impact) and the admissible ``step_length_range``.
+    edges; ``step`` is its largest signed distance to the N-step regions (N <= max_steps,
+    :mod:`pushrecovery.surfaces.step_regions`), positive exactly when steps capture the state
+    and null in JSON otherwise. ``steps`` is the number of steps needed (0: ankle or hip,
+    None: more than ``max_steps``) and ``plan`` the plan of a ``step`` verdict (footholds,
+    touchdown times, CoPs). ``step`` describes its first step: ``step_length`` (stance ankle
+    to landing ankle, signed like the step on the line), ``com_to_foot`` (landing ankle minus
+    CoM at touchdown), ``theta`` (the stance leg's lean at touchdown, atan of the CoM's
+    distance ahead of the stance ankle over L) and the ``step_length_range`` of first steps
+    along the same direction that still capture with the plan's number of steps.
 
     On the ground plane also ``capture_point_xy`` (ξ in the world frame [m]), the ``support``
     and the CMP region's vertices (``cmp_region``); margins are then signed Euclidean
-    distances in the plane, and ``step`` adds ``direction_xy`` (the unit vector of the step
-    line, along which ``step_length`` is signed) and ``foothold_xy`` [m]: the landing ankle,
-    ``step_length`` from the stance's reference ankle (in double support the ankles' midpoint,
-    where the sagittal model puts its stance leg).
+    distances in the plane, and ``step`` adds ``direction_xy`` (the unit vector from the
+    stance ankle to the first foothold) and ``foothold_xy`` [m].
     """
 
     capture_point: float
@@ -79,18 +88,26 @@ class Classification:
     capture_point_xy: tuple[float, float] | None = None
     support: Support | None = None
     cmp_region: list[list[float]] | None = None
+    steps: int | None = None
+    plan: StepPlan | None = None
 
     def to_dict(self) -> dict[str, object]:
-        """JSON form: ``{"capture_point", "strategy", "margins": {...}}`` (+ ``"step"``)."""
+        """JSON form: ``{"capture_point", "strategy", "margins", "steps"}`` (+ ``"step"``...)."""
         margins = {k: (v if math.isfinite(v) else None) for k, v in self.margins.items()}
+        step_margin = margins.get("step")
+        if step_margin is not None and not step_margin > 0.0:
+            margins["step"] = None
         data: dict[str, object] = {
             "capture_point": self.capture_point,
             "strategy": self.strategy.value,
             "margins": margins,
+            "steps": self.steps,
         }
         if self.step is not None:
             data["step"] = dict(self.step)
             data["step_length"] = self.step["step_length"]
+        if self.plan is not None:
+            data["plan"] = self.plan.to_dict()
         if self.capture_point_xy is not None:
             data["capture_point_xy"] = list(self.capture_point_xy)
         if self.support is not None:
@@ -116,7 +133,7 @@ def classify(
     ``support`` defaults to double support on the default feet
     (:meth:`~pushrecovery.ground.Support.from_params`). With y = ẏ = 0 and the default double
     support of a foot no longer than the stance is wide (the paper preset), both give the same
-    verdict, capture point and margins.
+    verdict, capture point and ankle and hip margins.
 
     Parameters
     ----------
@@ -139,8 +156,8 @@ def classify(
     Classification
         ``ankle`` when the capture point is strictly inside the foot or support polygon
         (Eq. 4), ``hip`` when it is inside the CMP region (corrected Eq. 15, in the plane:
-        the polygon grown by each axis's offset), ``step`` when a single step within reach
-        recovers (with the recommended step), else ``fall``.
+        the polygon grown by each axis's offset), ``step`` when at most ``max_steps`` steps
+        capture it (with the plan), else ``fall``.
     """
     x = finite_float("x", x, "m")
     xdot = finite_float("xdot", xdot, "m/s")
@@ -148,29 +165,90 @@ def classify(
         return _classify_plane(x, xdot, params, y, ydot, support)
     cop = float(cop_margin(x, xdot, params))
     cmp = float(cmp_margin(x, xdot, params))
-    plan = plan_step(x, xdot, params) if abs(x) < params.leg_length else None
     capture = float(capture_point(x, xdot, params.omega))
-    strategy, step = _escalate(cop, cmp, plan, params)
-    margins = {"cop": cop, "cmp": cmp, "step": plan.margin if plan is not None else -math.inf}
-    return Classification(capture, strategy, margins, step)
+    if not math.isfinite(capture):
+        raise InvalidParameterError("states are too large: the capture point overflows")
+    steps, step_margin = sagittal_steps(capture, params)
+    strategy = _strategy(cop, cmp, steps)
+    plan = sagittal_plan(capture, params, steps) if strategy is Strategy.STEP else None
+    step = None
+    if plan is not None:
+        step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)
+        step["step_length_range"] = _sagittal_range(capture, params, steps, step)
+    margins = {"cop": cop, "cmp": cmp, "step": step_margin}
+    return Classification(
+        capture, strategy, margins, step, steps=_steps(strategy, steps), plan=plan
+    )
 
 
-def _escalate(
-    cop: float, cmp: float, plan: StepDecision | None, params: BodyParams
-) -> tuple[Strategy, dict[str, object] | None]:
-    """Return the first strategy whose margin is positive, and the step for ``step``."""
+def _strategy(cop: float, cmp: float, steps: int) -> Strategy:
+    """Return the first strategy whose region holds the capture point."""
     if cop > 0.0:
-        return Strategy.ANKLE, None
+        return Strategy.ANKLE
     if cmp > 0.0:
-        return Strategy.HIP, None
-    if plan is None or not plan.feasible:
-        return Strategy.FALL, None
-    return Strategy.STEP, {
-        "step_length": plan.step_length,
-        "com_to_foot": plan.direction * params.leg_length * math.sin(plan.theta),
-        "theta": plan.theta,
-        "step_length_range": [plan.shortest, plan.longest],
+        return Strategy.HIP
+    return Strategy.STEP if steps > 0 else Strategy.FALL
+
+
+def _steps(strategy: Strategy, steps: int) -> int | None:
+    """Return the steps needed: 0 for ankle and hip, N for step, None for fall."""
+    if strategy is Strategy.FALL:
+        return None
+    return steps if strategy is Strategy.STEP else 0
+
+
+def _first_step(
+    plan: StepPlan,
+    position: tuple[float, float],
+    velocity: tuple[float, float],
+    ankle: tuple[float, float],
+    params: BodyParams,
+) -> dict[str, Any]:
+    """Return the ``step`` object of the plan's first step (class docstring).
+
+    The CoM at touchdown t_1 follows the LIPM with the first CoP p held (the hip's share
+    aside): r(t) = p + (r0 − p) cosh ωt + (ṙ0/ω) sinh ωt.
+    """
+    omega, t = params.omega, float(plan.touchdowns[0])
+    cop = plan.cops[0]
+    com = [
+        cop[i]
+        + (position[i] - cop[i]) * math.cosh(omega * t)
+        + velocity[i] / omega * math.sinh(omega * t)
+        for i in (0, 1)
+    ]
+    foot = plan.footholds[0]
+    gap = (float(foot[0] - ankle[0]), float(foot[1] - ankle[1]))
+    length = math.hypot(*gap)
+    lean = math.hypot(com[0] - ankle[0], com[1] - ankle[1])
+    return {
+        "step_length": math.copysign(length, gap[0]) if gap[1] == 0.0 else length,
+        "com_to_foot": math.hypot(float(foot[0]) - com[0], float(foot[1]) - com[1])
+        * (1.0 if (foot[0] - com[0]) * gap[0] + (foot[1] - com[1]) * gap[1] >= 0.0 else -1.0),
+        "theta": math.atan2(lean, params.com_height),
     }
+
+
+def _sagittal_range(
+    capture: float, params: BodyParams, steps: int, step: dict[str, Any]
+) -> list[float]:
+    """First step lengths that keep ``steps`` steps capturing, along the planned direction.
+
+    (S3) on the line: q_1 ∈ T ξ0 − T[−a, a] − (T − 1)[δ⁻, δ⁺] − V_{N−1}, V_{N−1} =
+    [δ⁻ − l s', δ⁺ + l s'] with s' = Σ_{k<N} β^k, T = e^{ωΔt_s}, within the reach ±l.
+    """
+    region = sagittal_step_interval(params, steps - 1) if steps > 1 else None
+    scale = math.exp(params.omega * params.min_step_time)
+    hip = cmp_offset(params)
+    heel_more = params.heel if region is None else region.lower + hip  # V without the hip
+    toe_more = params.toe if region is None else region.upper - hip
+    low = scale * capture - scale * hip - (scale - 1.0) * params.toe - toe_more
+    high = scale * capture + scale * hip - (scale - 1.0) * params.heel - heel_more
+    reach = params.max_step_length
+    low, high = max(low, -reach), min(high, reach)
+    sign = 1.0 if step["step_length"] >= 0.0 else -1.0
+    ends = sorted((sign * low, sign * high))
+    return [max(ends[0], 0.0), ends[1]]
 
 
 def _classify_plane(
@@ -192,15 +270,67 @@ def _classify_plane(
     cmp = float(hip_region.signed_distance(*xi))
     if not (math.isfinite(cop) and math.isfinite(cmp)):
         raise InvalidParameterError("states are too large: the capture point overflows")
-    line, plan = plan_step_xy(x, y, xdot, ydot, params, support)
-    strategy, step = _escalate(cop, cmp, plan, params)
-    if step is not None and plan is not None:
-        ankle = support.ankle
+    regions = StepRegions.of(params, support)
+    steps, step_margin = regions.locate(*xi)
+    strategy = _strategy(cop, cmp, steps)
+    plan = regions.plan(*xi, steps) if strategy is Strategy.STEP else None
+    step = None
+    if plan is not None:
+        option = next(o for o in regions.options if o.swing is plan.swings[0])
+        ankle = (float(option.ankle[0]), float(option.ankle[1]))
+        step = _first_step(plan, (x, y), (xdot, ydot), ankle, params)
+        foot = plan.footholds[0]
+        gap = (float(foot[0]) - ankle[0], float(foot[1]) - ankle[1])
+        length = math.hypot(*gap)
+        step["step_length"] = length
         # + 0.0 turns the −0.0 of a zero component into 0.0 in the JSON.
-        step["direction_xy"] = [line[0] + 0.0, line[1] + 0.0]
-        step["foothold_xy"] = [
-            ankle[0] + plan.step_length * line[0] + 0.0,
-            ankle[1] + plan.step_length * line[1] + 0.0,
-        ]
-    margins = {"cop": cop, "cmp": cmp, "step": plan.margin if plan is not None else -math.inf}
-    return Classification(xi[0], strategy, margins, step, xi, support, hip_region.to_list())
+        step["direction_xy"] = [gap[0] / length + 0.0, gap[1] / length + 0.0]
+        step["foothold_xy"] = [float(foot[0]) + 0.0, float(foot[1]) + 0.0]
+        step["step_length_range"] = _plane_range(
+            x, y, xdot, ydot, params, support, plan, ankle, gap
+        )
+    margins = {"cop": cop, "cmp": cmp, "step": step_margin}
+    return Classification(
+        xi[0],
+        strategy,
+        margins,
+        step,
+        xi,
+        support,
+        hip_region.to_list(),
+        steps=_steps(strategy, steps),
+        plan=plan,
+    )
+
+
+def _plane_range(
+    x: float,
+    y: float,
+    xdot: float,
+    ydot: float,
+    params: BodyParams,
+    support: Support,
+    plan: StepPlan,
+    ankle: tuple[float, float],
+    gap: tuple[float, float],
+) -> list[float]:
+    """First step lengths along the first step's direction within its N-step foothold region."""
+    from pushrecovery.surfaces.capture_region import capture_region
+
+    region = capture_region(
+        x, y, xdot, ydot, params, support, steps=plan.steps, swing=plan.swings[0]
+    ).polygon
+    length = math.hypot(*gap)
+    if region is None or length == 0.0:
+        return [length, length]
+    u = (gap[0] / length, gap[1] / length)
+    # The chord of the convex region along the ray ankle + s u: each half-plane bounds s.
+    low, high = 0.0, math.inf
+    for (nx, ny), b in zip(region.normals, region.offsets, strict=True):
+        rate = nx * u[0] + ny * u[1]
+        room = b - nx * ankle[0] - ny * ankle[1]
+        if rate > 0.0:
+            high = min(high, room / rate)
+        elif rate < 0.0:
+            low = max(low, room / rate)
+    return [low, high]

@@ -1,10 +1,11 @@
 """Vectorised verdicts: :func:`classify_states` for arrays of states, on a line or the plane.
 
 The rules of :func:`pushrecovery.surfaces.classify.classify`, decided for millions of states:
-the regions first, in one compiled pass (or numpy for small arrays), then the single-step test
-only for the states beyond the hip region, in place and without solving for the step angle
-(``models._step_scalar.feasible``, ``feasible_xy``), chunk by chunk, so that the extra memory is
-the codes themselves.
+on the line, the four intervals in one compiled pass; on the plane, the support polygon and the
+CMP region in one compiled pass, then the N-step regions
+(:class:`~pushrecovery.surfaces.step_regions.StepRegions`) only for the states beyond the hip
+region, in place (numpy for small arrays), chunk by chunk, so that the extra memory is the
+codes themselves.
 """
 
 from __future__ import annotations
@@ -21,8 +22,8 @@ from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import cop_margin, cop_region
-from pushrecovery.surfaces.plane import StepFrame, capture_margin_xy, cmp_polygon, plan_step_xy
-from pushrecovery.surfaces.step import plan_steps
+from pushrecovery.surfaces.plane import capture_margin_xy, cmp_polygon
+from pushrecovery.surfaces.step_regions import StepRegions, sagittal_step_interval
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
 __all__ = ["classify_states"]
@@ -39,8 +40,8 @@ def classify_states(
 ) -> NDArray[np.int8]:
     """Vectorised :func:`classify`: integer codes into :data:`STRATEGY_CODES`.
 
-    The margins decide most states in one pass; Sec. IV's step is planned only for states
-    beyond the hip region, in chunks, so the extra memory stays a few bytes per state. With
+    The regions decide every state without a plan (module docstring), in chunks, so the extra
+    memory stays a few bytes per state. With
     ``y``, ``ydot`` or ``support`` the states are classified on the ground plane.
 
     Parameters
@@ -75,10 +76,11 @@ def classify_states(
     flat_x, flat_xdot = (np.ascontiguousarray(a).reshape(-1) for a in (x, xdot))
     flat = codes.reshape(-1)  # a view: codes is new and contiguous
     cop, hip = cop_region(params), cmp_region(params)
+    step = sagittal_step_interval(params)
     if flat.size >= _CHUNK:
         from pushrecovery.surfaces._kernels import sagittal_codes
 
-        beyond, bad = sagittal_codes(
+        bad = sagittal_codes(
             flat_x,
             flat_xdot,
             1.0 / params.omega,
@@ -86,38 +88,23 @@ def classify_states(
             cop.half_width,
             hip.centre,
             hip.half_width,
+            step.centre,
+            step.half_width,
             flat,
         )
         if bad:
             cop_margin(flat_x, flat_xdot, params)  # raises, naming the argument
-        if beyond:
-            _step_or_fall(flat_x, flat_xdot, flat, params)
         return codes
     cop_m, hip_m = cop_margin(flat_x, flat_xdot, params), cmp_margin(flat_x, flat_xdot, params)
-    flat[...] = np.where(cop_m > 0.0, _ANKLE, np.where(hip_m > 0.0, _HIP, _FALL))
-    index = np.flatnonzero(flat == _FALL)
-    if index.size:  # few states: the plan itself (pure Python up to 32 states)
-        flat[index[plan_steps(flat_x[index], flat_xdot[index], params).feasible]] = _STEP
+    xi = flat_x + flat_xdot / params.omega
+    stepping = step.half_width - np.abs(xi - step.centre) > 0.0
+    flat[...] = np.where(
+        cop_m > 0.0, _ANKLE, np.where(hip_m > 0.0, _HIP, np.where(stepping, _STEP, _FALL))
+    )
     return codes
 
 
-def _step_or_fall(
-    x: NDArray[np.float64], xdot: NDArray[np.float64], codes: NDArray[np.int8], params: BodyParams
-) -> None:
-    """Mark ``step`` where a single step recovers the states coded ``fall``.
-
-    Only feasibility is needed, so the compiled angle-free test replaces the full plan (three
-    Newton solves), in place, on the states still coded ``fall``.
-    """
-    from pushrecovery.models._stepping_kernels import mark_feasible
-
-    args = (params.heel, params.toe, params.com_height, params.gravity, params.max_step_length)
-    mark_feasible(x, xdot, *args, codes, _FALL, _STEP)
-
-
 _ANKLE, _HIP, _STEP, _FALL = (STRATEGY_CODES.index(s) for s in Strategy)
-#: From this many undecided states on, the compiled feasibility test (numba loaded).
-_FEASIBLE_MIN_SIZE = 64
 #: States per chunk of the vectorised classifier: temporaries stay in the cache.
 _CHUNK = 1 << 16
 #: States per chunk of the compiled planar classifier: few thread-pool launches, and at most
@@ -153,14 +140,11 @@ def _plane_codes(
     cop = capture_margin_xy(xs, ys, xds, yds, omega, support.polygon)
     hip = capture_margin_xy(xs, ys, xds, yds, omega, hip_region)
     flat_codes[...] = np.where(cop > 0.0, _ANKLE, np.where(hip > 0.0, _HIP, _FALL))
-    index = np.flatnonzero(flat_codes == _FALL)
-    if index.size < _FEASIBLE_MIN_SIZE:  # a few states: the plan itself, in Python
-        for i in index:
-            plan = plan_step_xy(xs[i], ys[i], xds[i], yds[i], params, support)[1]
-            if plan is not None and plan.feasible:
-                flat_codes[i] = _STEP
-    else:
-        _mark_plane_steps(xs, ys, xds, yds, flat_codes, params, StepFrame.of(support))
+    beyond = flat_codes == _FALL
+    if beyond.any():
+        regions = StepRegions.of(params, support)
+        px, py = xs[beyond] + xds[beyond] / omega, ys[beyond] + yds[beyond] / omega
+        flat_codes[np.flatnonzero(beyond)[regions.margins(px, py) > 0.0]] = _STEP
     return codes
 
 
@@ -178,7 +162,7 @@ def _plane_codes_compiled(
     inv = 1.0 / params.omega
     cop_edges = padded_edges(support.polygon.edge_table)
     hip_edges = padded_edges(hip_region.edge_table)
-    frame = StepFrame.of(support)
+    regions = StepRegions.of(params, support)
     for start in range(0, flat_codes.size, _COMPILED_CHUNK):
         part = slice(start, min(start + _COMPILED_CHUNK, flat_codes.size))
         xs, ys, xds, yds = (_chunk(a, shape, part) for a in inputs)
@@ -189,7 +173,7 @@ def _plane_codes_compiled(
                 finite_array(name, array)
             raise InvalidParameterError("states are too large: the capture point overflows")
         if beyond:
-            _mark_plane_steps(xs, ys, xds, yds, chunk, params, frame)
+            _mark_plane_steps(xs, ys, xds, yds, chunk, params, regions)
 
 
 def _mark_plane_steps(
@@ -199,13 +183,14 @@ def _mark_plane_steps(
     yds: NDArray[np.float64],
     codes: NDArray[np.int8],
     params: BodyParams,
-    frame: StepFrame,
+    regions: StepRegions,
 ) -> None:
-    """Mark ``step`` where one step recovers the states coded ``fall`` (compiled, in place)."""
-    from pushrecovery.models._stepping_kernels import mark_feasible_xy
+    """Mark ``step`` where the N-step regions hold the states coded ``fall`` (compiled)."""
+    from pushrecovery.surfaces._kernels import mark_regions
 
-    states = (np.ascontiguousarray(a) for a in (xs, ys, xds, yds))
-    mark_feasible_xy(*states, *frame.kernel_args(params), codes, _FALL, _STEP)
+    x, y, xdot, ydot = (np.ascontiguousarray(a) for a in (xs, ys, xds, yds))
+    tables = (regions.table, regions.counts, regions.discs)
+    mark_regions(x, y, xdot, ydot, 1.0 / params.omega, *tables, codes, _FALL, _STEP)
 
 
 def _chunk(array: NDArray[np.float64], shape: tuple[int, ...], part: slice) -> NDArray[np.float64]:

@@ -3,10 +3,11 @@
 :class:`BalanceMonitor` is built once from the body and its support (and rebuilt with
 :meth:`BalanceMonitor.set_support` when a foot lands or lifts). Every query then runs on Python
 floats and tuples prepared at construction (no arrays allocated, no thread pool, no
-compilation) and one call of the compiled step decision on the step line
-(``models._step_scalar.decide_xy``, the code behind :func:`~pushrecovery.surfaces.plane.
-plan_step_xy`), its signature fixed and loaded from numba's on-disk cache in the constructor,
-which calls every path once: the first query of a process pays nothing either.
+compilation) and one call of the compiled N-step region test
+(``surfaces._kernels.locate_steps`` over the regions of
+:class:`~pushrecovery.surfaces.step_regions.StepRegions`), loaded from numba's on-disk cache
+in the constructor, which calls every path once: the first query of a process pays nothing
+either.
 
 The verdicts, capture point and margins are those of
 :func:`pushrecovery.surfaces.classify.classify` on the ground plane (tested to 1e-12).
@@ -18,12 +19,15 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import Strategy
-from pushrecovery.surfaces.plane import StepFrame, cmp_polygon
+from pushrecovery.surfaces.plane import cmp_polygon
+from pushrecovery.surfaces.step_regions import StepRegions
 
 __all__ = ["BalanceMonitor", "Verdict"]
 
@@ -43,7 +47,10 @@ class Verdict:
     cop_margin, cmp_margin : float
         Signed distances of ξ to the support polygon and to the CMP region [m], + inside.
     step_margin : float
-        Reach left beyond the shortest recovering single step [m]; −inf when none recovers.
+        Largest signed distance of ξ to the N-step regions, N <= max_steps [m]: positive
+        exactly when steps capture the state.
+    steps : int
+        Steps needed: 0 for ``ankle`` and ``hip``, N for ``step``, −1 for ``fall``.
     """
 
     strategy: Strategy
@@ -52,6 +59,7 @@ class Verdict:
     cop_margin: float
     cmp_margin: float
     step_margin: float
+    steps: int
 
 
 def _edges(polygon: ConvexPolygon) -> _Edges:
@@ -114,14 +122,14 @@ class BalanceMonitor:
     'hip'
     """
 
-    __slots__ = ("_cmp", "_cop", "_inv_omega", "_step", "_step_args", "params", "support")
+    __slots__ = ("_cmp", "_cop", "_inv_omega", "_locate", "_regions", "params", "support")
 
     def __init__(self, params: BodyParams, support: Support | None = None) -> None:
-        from pushrecovery.models._stepping_kernels import scalar_decide_xy
+        from pushrecovery.surfaces._kernels import locate_steps
 
         self.params = params
         self._inv_omega = 1.0 / params.omega
-        self._step: Callable[..., tuple[float, bool]] = scalar_decide_xy()
+        self._locate: Callable[..., tuple[int, float]] = locate_steps
         self.set_support(Support.from_params(params) if support is None else support)
         self.query(0.0, 0.0, 10.0, 0.0)  # loads every compiled path before the first tick
 
@@ -130,7 +138,8 @@ class BalanceMonitor:
         self.support = support
         self._cop = _edges(support.polygon)
         self._cmp = _edges(cmp_polygon(support, self.params))
-        self._step_args = StepFrame.of(support).kernel_args(self.params)
+        regions = StepRegions.of(self.params, support)
+        self._regions = (regions.table, regions.counts, np.array(regions.steps, dtype=np.int64))
 
     def query(self, x: float, y: float, xdot: float, ydot: float) -> Verdict:
         """Classify one CoM state on the ground plane.
@@ -159,14 +168,14 @@ class BalanceMonitor:
             )
         cop = _signed_distance(self._cop, px, py)
         cmp = _signed_distance(self._cmp, px, py)
-        # Sec. IV's step on the line of the excursion, as plan_step_xy (compiled, one call).
-        step_margin, step = self._step(x, y, xdot, ydot, *self._step_args)
+        # The N-step regions (compiled, one call), as StepRegions.locate.
+        steps, step_margin = self._locate(*self._regions, px, py)
         if cop > 0.0:
-            strategy = Strategy.ANKLE
+            strategy, steps = Strategy.ANKLE, 0
         elif cmp > 0.0:
-            strategy = Strategy.HIP
-        elif step:
+            strategy, steps = Strategy.HIP, 0
+        elif steps > 0:
             strategy = Strategy.STEP
         else:
-            strategy = Strategy.FALL
-        return Verdict(strategy, px, py, cop, cmp, step_margin)
+            strategy, steps = Strategy.FALL, -1
+        return Verdict(strategy, px, py, cop, cmp, step_margin, steps)
