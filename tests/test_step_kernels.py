@@ -266,9 +266,8 @@ KERNELS = {
     "_step_scalar.solve_serial",
     "_step_scalar.solve_parallel",
     "cop._fused_margin_kernel.locals.kernel",
-    "_step_scalar.decide_xy",
-    "_step_scalar.mark_feasible",
-    "_step_scalar.mark_feasible_xy",
+    "_kernels.locate_steps",
+    "_kernels.mark_regions",
     "_kernels.sagittal_codes",
     "_kernels._codes_4",
     "_kernels._margins_4",
@@ -311,7 +310,7 @@ def test_pure_loops_run_uncompiled():
 def test_feasibility_without_angles_equals_the_plan():
     # The angle-free test (two evaluations of ξ⁺, monotone in θ) against the full decision with
     # its three Newton solves, on states spanning every branch (backward, slow falls, beyond
-    # reach, stance leg pulling); compiled and pure Python. They may differ only where ξ⁺ at
+    # reach, stance leg pulling). They may differ only where ξ⁺ at
     # the limiting angle is within the solver's 1e-15 of the toe: none in this sample.
     from pushrecovery.models import _step_scalar
 
@@ -319,11 +318,7 @@ def test_feasibility_without_angles_equals_the_plan():
     for body in (P, load_params(overrides={"max_step_length": 0.4, "toe": 0.25})):
         x, xdot = rng.uniform(-0.8, 0.8, 200_000), rng.uniform(-4.5, 4.5, 200_000)
         args = (body.heel, body.toe, body.com_height, body.gravity, body.max_step_length)
-        codes = np.zeros(x.size, dtype=np.int8)
-        kernels.mark_feasible(x, xdot, *args, codes, 0, 1)
-        fast = codes == 1
         full = plan_steps(x, xdot, body).feasible
-        assert 0.05 < fast.mean() < 0.8  # both answers are common
-        np.testing.assert_array_equal(fast, full)
-        for i in range(0, 200_000, 97):
+        assert 0.05 < full.mean() < 0.8  # both answers are common
+        for i in range(0, 200_000, 37):
             assert _step_scalar.feasible(x[i], xdot[i], *args) == full[i]

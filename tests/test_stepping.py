@@ -20,7 +20,7 @@ from pushrecovery.models.stepping import (
 from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify, classify_states
-from pushrecovery.surfaces.step import plan_steps, step_thresholds
+from pushrecovery.surfaces.step import plan_steps
 
 P = load_params()
 L, G = P.leg_length, P.gravity
@@ -161,8 +161,22 @@ def test_solver_residual(v0, target):
         assert float(post_impact_capture_point(theta, v0, L, G)) == pytest.approx(target, abs=1e-12)
 
 
+def n_step_thresholds(params):
+    """Push speeds from rest over the ankle that max_steps steps absorb (docs/steps.md, S2).
+
+    ξ = v/ω must stay inside δ± ± (a + l Σ_{k=1}^{N} β^k), β = e^{−ω Δt_s}, a the corrected
+    Eq. (15) offset (errata E11) — written out here from the formulas, not the code.
+    """
+    omega = math.sqrt(params.gravity / params.com_height)
+    spin = math.sqrt(params.flywheel_inertia * params.flywheel_angle_max / params.torque_max)
+    hip = params.torque_max / (params.mass * params.gravity) * (1 - math.exp(-omega * spin)) ** 2
+    beta = math.exp(-omega * params.min_step_time)
+    grow = hip + params.max_step_length * sum(beta**k for k in range(1, params.max_steps + 1))
+    return omega * (params.heel - grow), omega * (params.toe + grow)
+
+
 def test_strategy_map_regions():
-    thresholds = step_thresholds(P)
+    thresholds = n_step_thresholds(P)
     cases = {
         0.3: "ankle",
         0.55: "hip",
@@ -187,7 +201,9 @@ def test_recommended_step_is_eq21_within_reach():
     clipped = plan_steps(0.0, 1.2, short_reach)
     assert bool(clipped.feasible) and float(clipped.step_length) == pytest.approx(0.6)
     none = load_params(overrides={"max_step_length": 0.3})
-    assert classify(0.0, 1.2, none).strategy == "fall"
+    assert not bool(plan_steps(0.0, 1.2, none).feasible)
+    shorter = load_params(overrides={"max_step_length": 0.1})  # N steps reach 0.27 m < ξ
+    assert classify(0.0, 1.2, shorter).strategy == "fall"
 
 
 def test_backward_step_is_the_mirror():

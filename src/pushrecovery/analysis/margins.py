@@ -9,8 +9,9 @@ region edges are arrays (one value per frame), in the lab frame:
   strategy alone recovers (Eq. 4);
 - CMP margin, the CoP margin plus the hip strategy's reach a (1 − e^{−ω T_max})², corrected
   Eq. (15) (errata E11);
-- step: :func:`pushrecovery.surfaces.step.plan_steps` for the state relative to the stance
-  ankle, with the single foot's own edges (the foot that lands after the step);
+- step: the N-step intervals of :func:`pushrecovery.surfaces.step_regions.line_steps` (at
+  most ``max_steps`` steps, touchdowns every ``min_step_time``) from the measured base and
+  the stance ankle, landing on the single foot's own edges;
 - time to leave: with the CoP (or the CMP) held where it is, ξ − p grows as e^{ωt}
   (ξ̇ = ω (ξ − p), the LIPM), so a capture point inside (lower, upper) reaches the edge on its
   side after
@@ -31,7 +32,7 @@ from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.cop import capture_point
-from pushrecovery.surfaces.step import plan_steps
+from pushrecovery.surfaces.step_regions import line_steps
 
 __all__ = ["DirectionMargins", "direction_margins", "time_to_leave"]
 
@@ -49,16 +50,19 @@ class DirectionMargins:
     capture_point : ndarray
         ξ = x + ẋ/ω, lab frame [m].
     cop, cmp, step : ndarray
-        Margins to the CoP region, the CMP region, and the reach left for a step [m]
-        (−inf when no single step recovers).
+        Margins to the CoP region, the CMP region and the region of ``max_steps`` steps [m]
+        (:func:`~pushrecovery.surfaces.step_regions.line_steps`; > 0 when steps capture).
     strategy : ndarray of int8
         Codes into :data:`~pushrecovery.surfaces.classify.STRATEGY_CODES`, −1 where invalid.
     time_to_leave_cop, time_to_leave_cmp : ndarray
         Time until ξ leaves the CoP (CMP) region with the CoP (CMP) held [s].
     step_length : ndarray
-        Recommended step, foot to foot, signed along the axis [m], where a step is needed.
+        First step of the plan, stance ankle to landing ankle, signed along the axis [m],
+        where a step is needed.
     step_shortest, step_longest : ndarray
-        Admissible recovering step lengths, unsigned [m], where a step is needed.
+        First step lengths that still capture with ``steps`` steps, unsigned [m].
+    steps : ndarray of int64
+        Steps needed (0 for ankle and hip, N for step, −1 for fall and invalid frames).
     """
 
     capture_point: FloatArray
@@ -71,6 +75,7 @@ class DirectionMargins:
     step_length: FloatArray
     step_shortest: FloatArray
     step_longest: FloatArray
+    steps: NDArray[np.int64]
 
 
 def time_to_leave(
@@ -148,11 +153,15 @@ def direction_margins(
     reach = cmp_offset(params)
     cmp_margin = cop_margin + reach
     valid = np.isfinite(cop_margin)
-    lean = com - ankle
-    # The stepping model holds for a CoM above the ankle's horizon only (|x| < leg).
-    plannable = valid & (np.abs(np.where(valid, lean, 0.0)) < params.leg_length)
-    plan = plan_steps(np.where(plannable, lean, 0.0), np.where(plannable, velocity, 0.0), params)
-    feasible = plannable & plan.feasible
+    known = valid & np.isfinite(ankle)
+    plan = line_steps(
+        np.where(known, capture, 0.0),
+        np.where(known, lower, 0.0),
+        np.where(known, upper, 0.0),
+        np.where(known, ankle, 0.0),
+        params,
+    )
+    feasible = known & (plan.steps > 0)
     strategy = np.full(len(com), _FALL, dtype=np.int8)
     strategy[feasible] = _STEP
     strategy[cmp_margin > 0.0] = _HIP
@@ -166,11 +175,14 @@ def direction_margins(
         capture_point=capture,
         cop=cop_margin,
         cmp=cmp_margin,
-        step=np.where(plannable, plan.margin, np.where(valid, -np.inf, np.nan)),
+        step=np.where(known, plan.margin, np.where(valid, -np.inf, np.nan)),
         strategy=strategy,
         time_to_leave_cop=time_to_leave(capture, cop_anchor, lower, upper, omega),
         time_to_leave_cmp=time_to_leave(capture, cmp_anchor, lower - reach, upper + reach, omega),
         step_length=np.where(stepping, plan.step_length, np.nan),
         step_shortest=np.where(stepping, plan.shortest, np.nan),
         step_longest=np.where(stepping, plan.longest, np.nan),
+        steps=np.where(stepping, plan.steps, np.where(strategy == _FALL, -1, 0)).astype(np.int64)
+        * (strategy >= 0)
+        - (strategy < 0),
     )

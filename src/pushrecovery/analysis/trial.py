@@ -308,6 +308,7 @@ def analyze(
                 f"{axis}_step_length": margins.step_length,
                 f"{axis}_step_length_min": margins.step_shortest,
                 f"{axis}_step_length_max": margins.step_longest,
+                f"{axis}_steps": margins.steps,
             }
         )
     codes = np.maximum(per_axis["ap"].strategy, per_axis["ml"].strategy)

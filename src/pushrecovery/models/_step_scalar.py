@@ -25,7 +25,7 @@ import math
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from numpy import bool_, float64, int8
+    from numpy import bool_, float64
     from numpy.typing import NDArray
 
 #: Largest step angle: at π/4 the impact absorbs all horizontal velocity (cos 2θ = 0) [rad].
@@ -295,133 +295,6 @@ def step_line(
         toe = max(toe, ahead)
     along = (x - ankle_x) * ex + (y - ankle_y) * ey
     return ex, ey, along, xdot * ex + ydot * ey, heel, toe
-
-
-def feasible_xy(
-    x: float,
-    y: float,
-    xdot: float,
-    ydot: float,
-    inv_omega: float,
-    ankle_x: float,
-    ankle_y: float,
-    heading_x: float,
-    heading_y: float,
-    swing: float,
-    foot_x: NDArray[float64],
-    foot_y: NDArray[float64],
-    height: float,
-    gravity: float,
-    reach: float,
-    leg: float,
-) -> bool:
-    """:func:`feasible` for a state on the ground plane, on its :func:`step_line`.
-
-    No step once the CoM is ``leg`` [m] or more along the line from the ankle.
-    """
-    line = step_line(
-        x, y, xdot, ydot, inv_omega, ankle_x, ankle_y, heading_x, heading_y, swing, foot_x, foot_y
-    )
-    if abs(line[2]) >= leg:
-        return False
-    return feasible(line[2], line[3], line[4], line[5], height, gravity, reach)
-
-
-def decide_xy(
-    x: float,
-    y: float,
-    xdot: float,
-    ydot: float,
-    inv_omega: float,
-    ankle_x: float,
-    ankle_y: float,
-    heading_x: float,
-    heading_y: float,
-    swing: float,
-    foot_x: NDArray[float64],
-    foot_y: NDArray[float64],
-    height: float,
-    gravity: float,
-    reach: float,
-    leg: float,
-) -> tuple[float, bool]:
-    """(step margin [m], feasible) of :func:`decide` on the :func:`step_line` of a state.
-
-    (−inf, False) once the CoM is ``leg`` [m] or more along the line from the ankle.
-    """
-    line = step_line(
-        x, y, xdot, ydot, inv_omega, ankle_x, ankle_y, heading_x, heading_y, swing, foot_x, foot_y
-    )
-    if abs(line[2]) >= leg:
-        return -math.inf, False
-    decision = decide(line[2], line[3], line[4], line[5], height, gravity, reach)
-    return decision[7], decision[2]
-
-
-def mark_feasible(
-    x: NDArray[float64],
-    xdot: NDArray[float64],
-    heel: float,
-    toe: float,
-    height: float,
-    gravity: float,
-    reach: float,
-    codes: NDArray[int8],
-    pending: int,
-    mark: int,
-) -> None:
-    """Set ``codes[i] = mark`` where ``codes[i] == pending`` and one step recovers state i.
-
-    :func:`feasible` in place over flat arrays with one foot, without gathering the states
-    (threads once compiled).
-    """
-    for i in prange(x.shape[0]):
-        if codes[i] == pending and feasible(x[i], xdot[i], heel, toe, height, gravity, reach):
-            codes[i] = mark
-
-
-def mark_feasible_xy(
-    x: NDArray[float64],
-    y: NDArray[float64],
-    xdot: NDArray[float64],
-    ydot: NDArray[float64],
-    inv_omega: float,
-    ankle_x: float,
-    ankle_y: float,
-    heading_x: float,
-    heading_y: float,
-    swing: float,
-    foot_x: NDArray[float64],
-    foot_y: NDArray[float64],
-    height: float,
-    gravity: float,
-    reach: float,
-    leg: float,
-    codes: NDArray[int8],
-    pending: int,
-    mark: int,
-) -> None:
-    """:func:`mark_feasible` on the ground plane (:func:`feasible_xy`)."""
-    for i in prange(x.shape[0]):
-        if codes[i] == pending and feasible_xy(
-            x[i],
-            y[i],
-            xdot[i],
-            ydot[i],
-            inv_omega,
-            ankle_x,
-            ankle_y,
-            heading_x,
-            heading_y,
-            swing,
-            foot_x,
-            foot_y,
-            height,
-            gravity,
-            reach,
-            leg,
-        ):
-            codes[i] = mark
 
 
 def _store(i: int, decision: Decision, values: NDArray[float64], flags: NDArray[bool_]) -> None:

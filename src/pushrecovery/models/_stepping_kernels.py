@@ -29,11 +29,8 @@ from pushrecovery.models import _step_scalar
 __all__ = [
     "PARALLEL_MIN_SIZE",
     "decide",
-    "mark_feasible",
-    "mark_feasible_xy",
     "plan",
     "scalar_decide",
-    "scalar_decide_xy",
     "solve",
 ]
 
@@ -76,23 +73,6 @@ _decide_serial = _compile("decide_serial")
 _decide_parallel = _compile("decide_parallel", parallel=True)
 _solve_serial = _compile("solve_serial")
 _solve_parallel = _compile("solve_parallel", parallel=True)
-_compile("_capture_below", inline="always")
-_compile("feasible", inline="always")
-_compile("step_line", inline="always")
-_compile("feasible_xy", inline="always")
-mark_feasible = _compile("mark_feasible", parallel=True)
-mark_feasible_xy = _compile("mark_feasible_xy", parallel=True)
-
-
-#: Signature of :func:`scalar_decide_xy`: the planar state, the step frame and the body.
-DECIDE_XY_SIGNATURE = numba.types.Tuple((numba.float64, numba.boolean))(
-    *(numba.float64,) * 10, numba.float64[::1], numba.float64[::1], *(numba.float64,) * 4
-)
-
-
-def scalar_decide_xy() -> Callable[..., tuple[float, bool]]:
-    """``_step_scalar.decide_xy`` compiled with :data:`DECIDE_XY_SIGNATURE` (never again)."""
-    return _build("decide_xy", DECIDE_XY_SIGNATURE)
 
 
 def scalar_decide() -> Callable[..., _step_scalar.Decision]:

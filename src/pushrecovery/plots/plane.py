@@ -100,15 +100,22 @@ def _recovery_limits(
     """Largest push along each heading that some strategy recovers, from rest [m/s].
 
     One vectorised bisection on :func:`~pushrecovery.surfaces.classify.classify_states` (not
-    ``fall``) over all headings, from [0, sqrt(g L)] as
-    :func:`~pushrecovery.surfaces.plane.step_threshold_xy`: beyond the hip region this is the
-    single-step limit, drawn by the same classifier as the samples.
+    ``fall``) over all headings, from 0 to ω times the farthest vertex of the regions: beyond
+    the hip region this is the limit of ``max_steps`` steps, drawn by the same classifier as
+    the samples.
     """
     from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify_states
+    from pushrecovery.surfaces.plane import cmp_polygon
+    from pushrecovery.surfaces.step_regions import StepRegions
 
     fall = STRATEGY_CODES.index(Strategy.FALL)
     low = np.zeros(angles.shape)
-    high = np.full(angles.shape, math.sqrt(params.gravity * params.leg_length))
+    corners = np.vstack(
+        [cmp_polygon(support, params).vertices]
+        + [p.vertices for p in StepRegions.of(params, support).polygons]
+    )
+    farthest = float(np.max(np.hypot(*(corners - np.array(support.ankle)).T)))
+    high = np.full(angles.shape, params.omega * farthest * (1.0 + 1e-9))
     ux, uy = np.cos(angles), np.sin(angles)
     x, y = np.full(angles.shape, support.ankle[0]), np.full(angles.shape, support.ankle[1])
     while float(np.max(high - low)) > tolerance:
@@ -128,7 +135,7 @@ def recovery_limits(params: BodyParams, support: Support) -> NDArray[np.float64]
     """Largest push some strategy recovers from rest above ``support.ankle`` [m/s].
 
     Along :data:`LIMIT_HEADINGS` evenly spaced headings, the first along +x (to 1e-4 m/s):
-    the single-step limit of Sec. IV along the capture point's excursion.
+    the limit of the ``step`` verdict (``max_steps`` steps).
     """
     return _recovery_limits(params, support, _limit_angles())
 

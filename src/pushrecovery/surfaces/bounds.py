@@ -18,8 +18,11 @@ def bounds_data(params: BodyParams, support: Support | None = None) -> dict[str,
     that of CMP balancing, corrected Eq. (15) [m], with its ``margin`` beyond the foot [m] and
     ``t_max`` the longest bang-bang half period, Eq. (12) [s] (None without hip torque);
     ``thresholds`` the largest recoverable CoM velocity from x = 0, [backward, forward], per
-    strategy [m/s] (ankle: ω δ±, hip: ω times the CMP bounds, step: the single-step limit of
-    Sec. IV); ``plane`` the ground-plane bounds of :func:`plane_bounds`.
+    strategy [m/s] (ankle: ω δ±, hip: ω times the CMP bounds, step: ω times the bounds of the
+    ``max_steps``-step interval of :mod:`pushrecovery.surfaces.step_regions`, the ``step``
+    verdict's limit), ``steps`` the same for each N = 1 ... max_steps and ``"inf"`` (Koolen's
+    d_∞), and ``step_sec4`` Sec. IV's instantaneous single step (the paper's model);
+    ``plane`` the ground-plane bounds of :func:`plane_bounds`.
 
     Parameters
     ----------
@@ -37,10 +40,17 @@ def bounds_data(params: BodyParams, support: Support | None = None) -> dict[str,
     from pushrecovery.surfaces.cmp import cmp_offset, cmp_region
     from pushrecovery.surfaces.cop import cop_region
     from pushrecovery.surfaces.step import step_thresholds
+    from pushrecovery.surfaces.step_regions import sagittal_step_interval
 
     cop, cmp = cop_region(params), cmp_region(params)
-    spin_up = max_spin_up_time(params)
     omega = params.omega
+    steps: dict[str, list[float]] = {}
+    for n in range(1, params.max_steps + 1):
+        interval = sagittal_step_interval(params, n)
+        steps[str(n)] = [omega * interval.lower, omega * interval.upper]
+    limit = sagittal_step_interval(params, 10**6)  # β^N underflows: the series' sum, d_∞
+    steps["inf"] = [omega * limit.lower, omega * limit.upper]
+    spin_up = max_spin_up_time(params)
     return {
         "params": params.to_dict(),
         "omega": omega,
@@ -55,7 +65,9 @@ def bounds_data(params: BodyParams, support: Support | None = None) -> dict[str,
         "thresholds": {
             "ankle": [omega * cop.lower, omega * cop.upper],
             "hip": [omega * cmp.lower, omega * cmp.upper],
-            "step": list(step_thresholds(params)),
+            "step": steps[str(params.max_steps)],
+            "steps": steps,
+            "step_sec4": list(step_thresholds(params)),
         },
         "plane": plane_bounds(params, Support.from_params(params) if support is None else support),
     }
@@ -66,9 +78,11 @@ def plane_bounds(params: BodyParams, support: Support) -> dict[str, Any]:
 
     ``thresholds`` holds, per strategy, the largest push speed [m/s] (unsigned) from a CoM at
     rest above ``support.ankle`` along ``forward`` (+x), ``backward``, ``left`` (+y) and
-    ``right``: ω times the distance to the region's edge for ankle and hip
-    (:func:`~pushrecovery.surfaces.plane.direction_thresholds`), the single-step limit for
-    step (:func:`~pushrecovery.surfaces.plane.step_threshold_xy`). ``cmp_offset`` gives the
+    ``right``: ω times the distance to the region's edge
+    (:func:`~pushrecovery.surfaces.plane.direction_thresholds`) for ankle, hip and step (the
+    farthest edge of the N-step regions, N <= max_steps, the ``step`` verdict's limit);
+    ``steps`` the same per N, and ``step_sec4`` Sec. IV's single step along the direction
+    (:func:`~pushrecovery.surfaces.plane.step_threshold_xy`). ``cmp_offset`` gives the
     hip region's growth along the pitch axis (the stance's heading) and the roll axis (its
     left) [m]; with yawed feet these are not the world's x and y.
     """
@@ -79,9 +93,22 @@ def plane_bounds(params: BodyParams, support: Support) -> dict[str, Any]:
         direction_thresholds,
         step_threshold_xy,
     )
+    from pushrecovery.surfaces.step_regions import StepRegions
 
     hip = cmp_polygon(support, params)
     omega = params.omega
+    regions = StepRegions.of(params, support)
+    steps: dict[str, dict[str, float]] = {}
+    for polygon, n in zip(regions.polygons, regions.steps, strict=True):
+        if float(polygon.signed_distance(*support.ankle)) <= 0.0:
+            continue  # this region does not hold the CoM at rest: no push it absorbs
+        found = direction_thresholds(polygon, support.ankle, omega)
+        # Every region up to N counts: a state needing fewer steps is a step verdict too.
+        previous = steps.get(str(n - 1), {})
+        steps[str(n)] = {
+            name: max(value, steps.get(str(n), {}).get(name, 0.0), previous.get(name, 0.0))
+            for name, value in found.items()
+        }
     return {
         "support": support.to_dict(),
         "reference": list(support.ankle),
@@ -90,7 +117,9 @@ def plane_bounds(params: BodyParams, support: Support) -> dict[str, Any]:
         "thresholds": {
             "ankle": direction_thresholds(support.polygon, support.ankle, omega),
             "hip": direction_thresholds(hip, support.ankle, omega),
-            "step": {
+            "step": steps.get(str(params.max_steps), dict.fromkeys(DIRECTIONS, 0.0)),
+            "steps": steps,
+            "step_sec4": {
                 name: step_threshold_xy(params, support, heading)
                 for name, heading in DIRECTIONS.items()
             },

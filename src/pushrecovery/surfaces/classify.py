@@ -17,21 +17,18 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from pushrecovery._validate import finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_region import StepPlan
 from pushrecovery.surfaces.classify_many import classify_states
-from pushrecovery.surfaces.cmp import cmp_margin, cmp_offset, cmp_region
+from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
-from pushrecovery.surfaces.step_regions import (
-    StepRegions,
-    sagittal_plan,
-    sagittal_step_interval,
-    sagittal_steps,
-)
+from pushrecovery.surfaces.step_regions import StepRegions, line_steps, sagittal_plan
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
 __all__ = [
@@ -77,8 +74,9 @@ class Classification:
 
     On the ground plane also ``capture_point_xy`` (ξ in the world frame [m]), the ``support``
     and the CMP region's vertices (``cmp_region``); margins are then signed Euclidean
-    distances in the plane, and ``step`` adds ``direction_xy`` (the unit vector from the
-    stance ankle to the first foothold) and ``foothold_xy`` [m].
+    distances in the plane, and ``step`` adds ``foothold_xy`` [m] and ``direction_xy``, the
+    unit vector from the stance ankle to the first foothold, turned to the heading's side
+    for a step mostly backward, whose ``step_length`` is then negative (as on the line).
     """
 
     capture_point: float
@@ -168,13 +166,14 @@ def classify(
     capture = float(capture_point(x, xdot, params.omega))
     if not math.isfinite(capture):
         raise InvalidParameterError("states are too large: the capture point overflows")
-    steps, step_margin = sagittal_steps(capture, params)
+    line = line_steps(np.array([capture]), params.heel, params.toe, 0.0, params)
+    steps, step_margin = int(line.steps[0]), float(line.margin[0])
     strategy = _strategy(cop, cmp, steps)
     plan = sagittal_plan(capture, params, steps) if strategy is Strategy.STEP else None
     step = None
     if plan is not None:
         step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)
-        step["step_length_range"] = _sagittal_range(capture, params, steps, step)
+        step["step_length_range"] = [float(line.shortest[0]), float(line.longest[0])]
     margins = {"cop": cop, "cmp": cmp, "step": step_margin}
     return Classification(
         capture, strategy, margins, step, steps=_steps(strategy, steps), plan=plan
@@ -229,28 +228,6 @@ def _first_step(
     }
 
 
-def _sagittal_range(
-    capture: float, params: BodyParams, steps: int, step: dict[str, Any]
-) -> list[float]:
-    """First step lengths that keep ``steps`` steps capturing, along the planned direction.
-
-    (S3) on the line: q_1 ∈ T ξ0 − T[−a, a] − (T − 1)[δ⁻, δ⁺] − V_{N−1}, V_{N−1} =
-    [δ⁻ − l s', δ⁺ + l s'] with s' = Σ_{k<N} β^k, T = e^{ωΔt_s}, within the reach ±l.
-    """
-    region = sagittal_step_interval(params, steps - 1) if steps > 1 else None
-    scale = math.exp(params.omega * params.min_step_time)
-    hip = cmp_offset(params)
-    heel_more = params.heel if region is None else region.lower + hip  # V without the hip
-    toe_more = params.toe if region is None else region.upper - hip
-    low = scale * capture - scale * hip - (scale - 1.0) * params.toe - toe_more
-    high = scale * capture + scale * hip - (scale - 1.0) * params.heel - heel_more
-    reach = params.max_step_length
-    low, high = max(low, -reach), min(high, reach)
-    sign = 1.0 if step["step_length"] >= 0.0 else -1.0
-    ends = sorted((sign * low, sign * high))
-    return [max(ends[0], 0.0), ends[1]]
-
-
 def _classify_plane(
     x: float,
     xdot: float,
@@ -281,7 +258,13 @@ def _classify_plane(
         step = _first_step(plan, (x, y), (xdot, ydot), ankle, params)
         foot = plan.footholds[0]
         gap = (float(foot[0]) - ankle[0], float(foot[1]) - ankle[1])
-        length = math.hypot(*gap)
+        # Signed like the sagittal step: a step mostly backward is negative along the
+        # direction turned to the heading's side; others keep their own direction.
+        heading = (math.cos(support.yaw), math.sin(support.yaw))
+        forward = gap[0] * heading[0] + gap[1] * heading[1]
+        sideways = -gap[0] * heading[1] + gap[1] * heading[0]
+        ahead = -1.0 if forward < 0.0 and abs(forward) >= abs(sideways) else 1.0
+        length = ahead * math.hypot(*gap)
         step["step_length"] = length
         # + 0.0 turns the −0.0 of a zero component into 0.0 in the JSON.
         step["direction_xy"] = [gap[0] / length + 0.0, gap[1] / length + 0.0]

@@ -34,7 +34,6 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -261,26 +260,6 @@ class StepFrame:
             swing,
             tuple(float(v) for v in support.foot.vertices[:, 0]),
             tuple(float(v) for v in support.foot.vertices[:, 1]),
-        )
-
-    def kernel_args(self, params: BodyParams) -> tuple[Any, ...]:
-        """Return the arguments after the state of the compiled ``decide_xy``, ``mark_*_xy``.
-
-        (1/ω, ankle, heading, swing, foot vertices as arrays, L, g, max step, leg length).
-        """
-        return (
-            1.0 / params.omega,
-            self.ankle_x,
-            self.ankle_y,
-            self.heading_x,
-            self.heading_y,
-            self.swing,
-            np.array(self.foot_x),
-            np.array(self.foot_y),
-            params.com_height,
-            params.gravity,
-            params.max_step_length,
-            params.leg_length,
         )
 
     def line(

@@ -7,12 +7,16 @@ needs the smallest N whose region holds its capture point ξ strictly; its step 
 largest signed distance of ξ to any of them (positive exactly when some plan of at most
 ``max_steps`` steps captures it: the margin agrees with the verdict everywhere).
 
-On the sagittal line (one foot [heel, toe], no width) the regions are intervals:
+On a line (the sagittal model, or one axis of a measured trial) the regions are intervals:
+with the support [s⁻, s⁺] before the first step, the stance ankle q_0, landing feet
+[δ⁻, δ⁺] about their ankles, (S2) along ±x gives
 
-.. math:: C_N = [\delta^- - a - l\,s_N,\ \delta^+ + a + l\,s_N], \qquad
-          s_N = \sum_{k=1}^{N} \beta^k,\ \beta = e^{-\omega\Delta t_s},
+.. math:: C_N = [a_1 (q_0 + \delta^-) + (1 - a_1) s^- - a - l\,s_N,\
+          a_1 (q_0 + \delta^+) + (1 - a_1) s^+ + a + l\,s_N], \qquad
+          s_N = \sum_{k=1}^{N} \beta^k,
 
-with a the corrected Eq. (15) offset and l = ``max_step_length``: (S2) along ±x.
+β = a_1 = e^{−ωΔt_s}, a the corrected Eq. (15) offset and l = ``max_step_length``; on the
+sagittal line s^± = δ^± and q_0 = 0: [δ⁻ − a − l s_N, δ⁺ + a + l s_N].
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
@@ -38,34 +42,117 @@ from pushrecovery.surfaces.capture_region import (
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.cop import CaptureInterval
 
-__all__ = ["StepRegions", "sagittal_plan", "sagittal_step_interval", "sagittal_steps"]
+__all__ = [
+    "LineSteps",
+    "StepRegions",
+    "line_step_bounds",
+    "line_steps",
+    "sagittal_plan",
+    "sagittal_step_interval",
+]
 
 FloatArray = NDArray[np.float64]
+
+
+def line_step_bounds(
+    lower: FloatArray | float,
+    upper: FloatArray | float,
+    ankle: FloatArray | float,
+    params: BodyParams,
+    steps: int,
+    *,
+    hip: bool = True,
+) -> tuple[FloatArray, FloatArray]:
+    """C_N on a line (module docstring) for supports [lower, upper] and stance ankles [m]."""
+    beta = math.exp(-params.omega * params.min_step_time)
+    grow = capturability_distance(
+        steps,
+        params.omega,
+        params.min_step_time,
+        params.max_step_length,
+        0.0,
+        cmp_offset(params) if hip else 0.0,
+    )
+    first = beta if steps > 0 else 0.0
+    low = first * (np.asarray(ankle) + params.heel) + (1.0 - first) * np.asarray(lower) - grow
+    high = first * (np.asarray(ankle) + params.toe) + (1.0 - first) * np.asarray(upper) + grow
+    return np.asarray(low, dtype=np.float64), np.asarray(high, dtype=np.float64)
+
+
+@dataclass(frozen=True, slots=True)
+class LineSteps:
+    """Step verdicts on a line, one per state (:func:`line_steps`).
+
+    Attributes
+    ----------
+    steps : ndarray of int64
+        Smallest N <= max_steps whose interval holds ξ strictly; 0 if none.
+    margin : ndarray
+        Signed distance of ξ to C_{max_steps} [m] (the intervals are nested).
+    step_length : ndarray
+        First step of the plan, landing ankle minus stance ankle [m] (NaN without steps).
+    shortest, longest : ndarray
+        The first steps along its direction that still capture with ``steps`` steps [m].
+    """
+
+    steps: NDArray[np.int64]
+    margin: FloatArray
+    step_length: FloatArray
+    shortest: FloatArray
+    longest: FloatArray
+
+
+def line_steps(
+    capture: ArrayLike,
+    lower: ArrayLike,
+    upper: ArrayLike,
+    ankle: ArrayLike,
+    params: BodyParams,
+) -> LineSteps:
+    """N-step verdicts and first steps on a line, vectorised (module docstring) [m].
+
+    The plan keeps every term of (S1) at the same fraction f of its half-width from its
+    centre (:func:`~pushrecovery.ground.minkowski.decompose` on intervals): f = (ξ − c)/h of
+    C_N, first step f l. The range of first steps is (S3) on the line: q_1 − q_0 in
+    T ξ − T[−a, a] − (T − 1)[s⁻, s⁺] − V_{N−1} − q_0, V_{N−1} = [δ⁻ − l s_{N−1}, δ⁺ +
+    l s_{N−1}], T = e^{ωΔt_s}, within ±l.
+    """
+    capture, lower, upper, ankle = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (capture, lower, upper, ankle))
+    )
+    steps = np.zeros(capture.shape, dtype=np.int64)
+    for n in range(params.max_steps, 0, -1):
+        low, high = line_step_bounds(lower, upper, ankle, params, n)
+        inside = (capture > low) & (capture < high)
+        steps[inside] = n
+        if n == params.max_steps:
+            margin = np.minimum(capture - low, high - capture)
+    length = np.full(capture.shape, np.nan)
+    shortest, longest = length.copy(), length.copy()
+    reach, hip = params.max_step_length, cmp_offset(params)
+    scale = math.exp(params.omega * params.min_step_time)
+    for n in np.unique(steps[steps > 0]):
+        rows = steps == n
+        low, high = line_step_bounds(lower[rows], upper[rows], ankle[rows], params, int(n))
+        share = np.clip((capture[rows] - 0.5 * (low + high)) / (0.5 * (high - low)), -1.0, 1.0)
+        length[rows] = share * reach
+        more = capturability_distance(int(n) - 1, params.omega, params.min_step_time, reach, 0.0)
+        xi = capture[rows]
+        first = scale * xi - scale * hip - (scale - 1.0) * upper[rows] - params.toe - more
+        last = scale * xi + scale * hip - (scale - 1.0) * lower[rows] - params.heel + more
+        first = np.maximum(first - ankle[rows], -reach)
+        last = np.minimum(last - ankle[rows], reach)
+        forward = length[rows] >= 0.0
+        shortest[rows] = np.where(forward, np.maximum(first, 0.0), np.maximum(-last, 0.0))
+        longest[rows] = np.where(forward, last, -first)
+    return LineSteps(steps, margin, length, shortest, longest)
 
 
 def sagittal_step_interval(params: BodyParams, steps: int | None = None) -> CaptureInterval:
     """C_N on the sagittal line (module docstring) [m]; N defaults to ``max_steps``."""
     count = params.max_steps if steps is None else steps
-    grow = capturability_distance(
-        count, params.omega, params.min_step_time, params.max_step_length, 0.0, cmp_offset(params)
-    )
-    return CaptureInterval(params.heel - grow, params.toe + grow)
-
-
-def sagittal_steps(xi: float, params: BodyParams) -> tuple[int, float]:
-    """(smallest N <= max_steps whose interval holds ξ strictly, 0 if none; margin [m]).
-
-    The margin is the signed distance of ξ to C_{max_steps} (the intervals are nested).
-    """
-    outer = sagittal_step_interval(params)
-    margin = outer.half_width - abs(xi - outer.centre)
-    if not margin > 0.0:
-        return 0, margin
-    for steps in range(1, params.max_steps + 1):
-        interval = sagittal_step_interval(params, steps)
-        if interval.half_width - abs(xi - interval.centre) > 0.0:
-            return steps, margin
-    return params.max_steps, margin  # pragma: no cover - the last interval is the outer one
+    low, high = line_step_bounds(params.heel, params.toe, 0.0, params, count)
+    return CaptureInterval(float(low), float(high))
 
 
 def sagittal_plan(xi: float, params: BodyParams, steps: int) -> StepPlan:
@@ -148,9 +235,23 @@ class StepRegions:
         return best
 
     def plan(self, px: float, py: float, steps: int) -> StepPlan:
-        """Return the plan of ``steps`` steps for ξ = (px, py), from the best foot to lift."""
+        """Return the plan of ``steps`` steps for ξ = (px, py).
+
+        From double support the foot on the capture point's side of the other ankle steps
+        when its regions capture ξ (a side step, not a crossover), else the other one.
+        """
         rows = [i for i, n in enumerate(self.steps) if n == steps]
-        row = max(rows, key=lambda i: float(self.polygons[i].signed_distance(px, py)))
+
+        def preference(i: int) -> tuple[bool, float]:
+            option = self.options[i]
+            lateral = -math.sin(option.yaw) * (px - option.ankle[0]) + math.cos(option.yaw) * (
+                py - option.ankle[1]
+            )
+            outward = lateral >= 0.0 if option.swing is Stance.LEFT else lateral <= 0.0
+            margin = float(self.polygons[i].signed_distance(px, py))
+            return margin > 0.0 and outward, margin
+
+        row = max(rows, key=preference)
         return plan_steps_xy(np.array([px, py]), self.params, self.options[row], steps)
 
 
