@@ -704,7 +704,9 @@ def step(
 def _register() -> None:
     from pushrecovery.cli.analyze import analyze
     from pushrecovery.cli.campaign import campaign, report
+    from pushrecovery.cli.steps import capture_region_command
 
+    cli.add_command(capture_region_command)
     cli.add_command(campaign)
     cli.add_command(report)
     cli.add_command(analyze)

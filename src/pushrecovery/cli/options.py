@@ -37,6 +37,17 @@ PARAM_FLAGS: tuple[tuple[str, str, str], ...] = (
         "flywheel_angle_max_roll",
         "Hip roll joint limit [rad] (default: pitch).",
     ),
+    (
+        "--min-step-time",
+        "min_step_time",
+        "Shortest time from deciding to step to touchdown Δt_s [s] (default 0.2).",
+    ),
+    ("--max-steps", "max_steps", "Most steps of a step verdict (default: where regions stop)."),
+    (
+        "--min-step-width",
+        "min_step_width",
+        "Narrowest lateral stance-to-landing ankle distance [m] (default: none, crossovers).",
+    ),
 )
 
 

@@ -466,7 +466,13 @@ def _after(
 
 
 def _chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
-    """Return the centre of the largest disc in a convex polygon (LP: max r, n_i·q + r <= b_i)."""
+    """Return the centre of the largest disc in a convex polygon [m].
+
+    An LP gives the radius r* (max r, n_i·q + r <= b_i); the centres of discs of radius
+    0.999 r* form a small polygon about every largest disc's centre, and its centroid is the
+    answer: unique, and mirrored with the polygon (the LP's own vertex is neither when the
+    largest disc can slide).
+    """
     from scipy.optimize import linprog
 
     normals, offsets = polygon.normals, polygon.offsets
@@ -480,7 +486,10 @@ def _chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
     )
     if result.status != 0:  # pragma: no cover - a polygon always has an interior point
         return np.asarray(polygon.centroid)
-    return np.asarray(result.x[:2], dtype=np.float64)
+    centres = clip_halfplanes(polygon, normals, offsets - 0.999 * float(result.x[2]))
+    if centres is None:  # pragma: no cover - too thin to clip: the LP's centre
+        return np.asarray(result.x[:2], dtype=np.float64)
+    return np.asarray(centres.centroid, dtype=np.float64)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
