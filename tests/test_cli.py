@@ -196,7 +196,11 @@ def test_figures(tmp_path):
         f"fig{n}.{ext}"
         for n in ("3a", "3b", "5a", "5b", "6a", "6b", "9", "10")
         for ext in ("png", "svg")
-    ] + ["plane.png", "plane.svg"]
+    ] + [
+        f"{stem}.{ext}"
+        for stem in ("plane", "steps-regions", "steps-map")
+        for ext in ("png", "svg")
+    ]
     assert names == sorted(expected)
     assert all((tmp_path / name).stat().st_size > 1000 for name in names)
 

@@ -169,7 +169,8 @@ def test_write_figures_writes_the_plane(
     for name in ("fig3a", "fig3b", "fig5", "fig6", "fig9", "fig10"):
         monkeypatch.setattr(figures, name, lambda *args: [])
     files = figures.write_figures(params, tmp_path)
-    assert sorted(p.name for p in files) == ["plane.png", "plane.svg"]
+    stems = ("plane", "steps-map", "steps-regions")
+    assert sorted(p.name for p in files) == [f"{s}.{e}" for s in stems for e in ("png", "svg")]
     assert all(p.stat().st_size > 1000 for p in files)
     assert (tmp_path / "plane.png").read_bytes().startswith(PNG)
     assert figures.write_figures(params, tmp_path / "none", ground_plane=False) == []
@@ -181,7 +182,7 @@ def test_report_has_the_ground_plane_section(params: BodyParams, tmp_path: Path)
     assert '<section id="plane">\n<h2>Ground plane</h2>' in html
     section = html[html.index('<section id="plane">') : html.index("</section>")]
     assert len(re.findall(r'<img src="data:image/png;base64,', section)) == 1
-    for phrase in ("support polygon", "CMP region", "Sec. IV", "m/s"):
+    for phrase in ("support polygon", "CMP region", "N-step", "m/s"):
         assert phrase in section
     table = re.search(r'<table id="plane-thresholds">(.*?)</table>', section, re.S)
     assert table is not None
@@ -195,3 +196,16 @@ def test_report_has_the_ground_plane_section(params: BodyParams, tmp_path: Path)
         assert value == pytest.approx(expected[direction], rel=5e-3)
     footer = html[html.index("<footer>") :]
     assert "Ground plane" in footer
+
+
+def test_report_has_the_steps_section(params: BodyParams, tmp_path: Path) -> None:
+    skip = [key for key in SECTIONS if key != "steps"]
+    html = write_report(params, tmp_path, skip=skip).read_text(encoding="utf-8")
+    section = html[html.index('<section id="steps">') : html.index("</section>")]
+    assert len(re.findall(r'<img src="data:image/png;base64,', section)) == 2
+    table = re.search(r'<table id="steps">(.*?)</table>', section, re.S)
+    assert table is not None
+    rows = re.findall(r"<tr>(.*?)</tr>", table.group(1))
+    assert len(rows) == 1 + params.max_steps + 1  # header, N = 1 ... max_steps, ∞
+    forward = [float(re.findall(r"<td[^>]*>([^<]*)</td>", r)[2]) for r in rows[1:]]
+    assert forward == sorted(forward)  # more steps, bigger pushes

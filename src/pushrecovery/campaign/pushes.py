@@ -13,7 +13,9 @@ it, and what the simulation did. Columns, SI units, positions relative to the st
 ``capture_point``      x0 + ẋ/ω [m]
 ``cop_margin``         signed distance of the capture point inside the CoP region, Eq. (4) [m]
 ``cmp_margin``         the same for the CMP region, corrected Eq. (15) [m]
-``step_margin``        reach left beyond the shortest recovering step [m]; −inf: none recovers
+``step_margin``        signed distance of the capture point to the N-step regions [m]; > 0:
+                       at most ``max_steps`` steps capture the state
+``predicted_steps``    steps the surfaces predict: 0 for ankle and hip, N for step, −1 fall
 ``predicted_recovers`` the predicted strategy is within the controller's (ankle < hip < step)
 ``outcome``            recovered, fell or undecided
 ``used``               strategy the run used: ankle (CoP only), hip (hip torque), step, or fall
@@ -52,6 +54,7 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("cop_margin", "float64"),
     ("cmp_margin", "float64"),
     ("step_margin", "float64"),
+    ("predicted_steps", "int64"),
     ("predicted_recovers", "bool"),
     ("outcome", "string"),
     ("used", "string"),
@@ -110,6 +113,7 @@ def run_push(
         cop_margin=found.margins["cop"],
         cmp_margin=found.margins["cmp"],
         step_margin=found.margins["step"],
+        predicted_steps=-1 if found.steps is None else found.steps,
         predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
         outcome=run.outcome.value,
         used=used.value,

@@ -105,4 +105,23 @@ def summarize(spec: CampaignSpec, table: Any) -> dict[str, Any]:
             "counts": counts.tolist(),
         },
         "boundary": boundary(spec, columns) if spec.samples is None else [],
+        "steps": _steps(columns, recovered),
+    }
+
+
+def _steps(columns: dict[str, Any], recovered: Any) -> dict[str, Any]:
+    """N-step predictions against the steps taken.
+
+    ``predicted``: pushes per predicted number of steps (key "-1": fall); ``taken``: per
+    number of steps the run took; ``exact``: the share of recovered pushes predicted to need
+    steps that took exactly the predicted number (None without such pushes).
+    """
+    if "predicted_steps" not in columns:  # a table written before the column existed
+        return {"predicted": {}, "taken": {}, "exact": None}
+    predicted, taken = columns["predicted_steps"], columns["steps"]
+    stepping = recovered & (predicted > 0)
+    return {
+        "predicted": {str(int(n)): int(np.sum(predicted == n)) for n in np.unique(predicted)},
+        "taken": {str(int(n)): int(np.sum(taken == n)) for n in np.unique(taken)},
+        "exact": float(np.mean(taken[stepping] == predicted[stepping])) if stepping.any() else None,
     }

@@ -104,12 +104,19 @@ def step_limit_curve(
 def _draw_boundaries(
     ax: Axes, params: BodyParams, xlim: tuple[float, float], vmax: float, *, legend: bool
 ) -> None:
-    """Capture-point lines of Eq. (4) and corrected Eq. (15), and the single-step limit."""
+    """Capture-point lines of Eq. (4), corrected Eq. (15) and N steps; Sec. IV's step limit."""
     omega = params.omega
     xs = np.linspace(*xlim, 50)
+    from pushrecovery.surfaces.step_regions import sagittal_step_interval
+
     for region, colour, label in (
         (cop_region(params), RECOVER_COLOUR, "CoP region edge, Eq. (4)"),
         (cmp_region(params), HIP_COLOUR, "CMP region edge, corrected Eq. (15)"),
+        (
+            sagittal_step_interval(params),
+            STEP_COLOUR,
+            f"edge of {params.max_steps} steps (docs/steps.md)",
+        ),
     ):
         for k, edge in enumerate((region.lower, region.upper)):
             ax.plot(
@@ -133,7 +140,7 @@ def _draw_boundaries(
                 color=STEP_COLOUR,
                 lw=1.2,
                 ls="-.",
-                label="single-step limit, Sec. IV" if legend and k == 0 else None,
+                label="Sec. IV's single step (recovery controller)" if legend and k == 0 else None,
             )
     for edge in (params.heel, params.toe):
         ax.axvline(edge, color="0.6", lw=0.8, ls=":")
@@ -286,9 +293,9 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     """Colour the (x, ẋ) plane by the strategy the paper's surfaces give each CoM state.
 
     :func:`~pushrecovery.surfaces.classify.classify_states`: ankle where the capture point lies
-    in the CoP region (Eq. 4), hip in the CMP region (corrected Eq. 15), step where one step
-    within reach recovers (Sec. IV), fall elsewhere; the boundaries drawn as in
-    :func:`plot_outcome_map`.
+    in the CoP region (Eq. 4), hip in the CMP region (corrected Eq. 15), step where at most
+    ``max_steps`` steps capture it (docs/steps.md), fall elsewhere; the boundaries drawn as
+    in :func:`plot_outcome_map`.
 
     Parameters
     ----------
@@ -297,7 +304,7 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     path : Path
         Output file; the format (PNG, SVG or PDF) from its extension.
     xdot_max : float, optional
-        Half-height of the plane [m/s]; default 1.25 times the largest single-step limit.
+        Half-height of the plane [m/s]; default 1.25 times the largest N-step limit.
 
     Returns
     -------
@@ -312,11 +319,12 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     from matplotlib.patches import Patch
 
     from pushrecovery.surfaces.classify import STRATEGY_CODES, classify_states
-    from pushrecovery.surfaces.step import step_thresholds
+    from pushrecovery.surfaces.step_regions import sagittal_step_interval
 
     path = _check_path(path)
     if xdot_max is None:
-        xdot_max = 1.25 * max(abs(v) for v in step_thresholds(params, tolerance=1e-4))
+        interval = sagittal_step_interval(params)
+        xdot_max = 1.25 * params.omega * max(abs(interval.lower), abs(interval.upper))
     span = params.toe - params.heel
     xlim = (params.heel - 0.25 * span, params.toe + 0.25 * span)
     xs = np.linspace(*xlim, 400)

@@ -117,7 +117,7 @@ def write_figures(
     """Write every reproduced figure into ``out``; return the files written.
 
     The paper's figures (:data:`PAPER_FIGURES`) and, with ``ground_plane``, ``plane``
-    (:func:`plane`).
+    (:func:`plane`) and the step figures (:func:`steps`).
     """
     formats = tuple(formats)
     return [
@@ -128,6 +128,22 @@ def write_figures(
         *fig9(params, formats, out),
         *fig10(params, formats, out),
         *(plane(params, formats, out) if ground_plane else []),
+        *(steps(params, formats, out) if ground_plane else []),
+    ]
+
+
+def steps(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
+    """Draw the capture regions of a few pushes and the N-step strategy map (``steps-*``).
+
+    :func:`~pushrecovery.plots.steps.capture_regions_figure` and
+    :func:`~pushrecovery.plots.steps.n_step_map_figure`.
+    """
+    from pushrecovery.plots.steps import capture_regions_figure, n_step_map_figure
+
+    formats = tuple(formats)
+    return [
+        *save_figure(capture_regions_figure(params), out / "steps-regions", formats),
+        *save_figure(n_step_map_figure(params), out / "steps-map", formats),
     ]
 
 

@@ -11,6 +11,8 @@ Sections, in the page's order (key: content):
 - ``map``: the strategy map of the (x, ẋ) plane;
 - ``plane``: the capture-point plane of the ground-plane model in double and single support,
   with the per-direction push thresholds;
+- ``steps``: one- and two-step capture regions for a few pushes, the N-step strategy map and
+  the N-step thresholds;
 - ``figures``: every reproduced figure of the paper;
 - ``analytic``: a campaign on the analytic ``stepping`` model with the ``recovery`` controller;
 - ``sweep``: the critical push of ``flywheel`` + ``mpc`` against the hip torque limit;
@@ -57,6 +59,7 @@ SECTIONS: Mapping[str, str] = {
     "bounds": "Parameters, bounds and thresholds",
     "map": "Strategy map",
     "plane": "Ground plane",
+    "steps": "Steps: capture regions and N-step capturability",
     "figures": "The paper's figures",
     "analytic": "Push campaign on the analytic models",
     "sweep": "Critical push against the hip torque limit",
@@ -76,6 +79,7 @@ _RUN_ORDER = (
     "bounds",
     "map",
     "plane",
+    "steps",
     "figures",
     "critical",
     "filmstrips",
@@ -442,8 +446,8 @@ def _map(ctx: _Context) -> str:
     return paragraph(
         "The strategy each CoM state (x, ẋ) needs according to the decision surfaces: ankle "
         "where the capture point x + ẋ/ω lies in the CoP region (Eq. 4), hip in the CMP region "
-        "(corrected Eq. 15), step where one step within reach recovers (Sec. IV, Eq. 21), "
-        "otherwise fall.",
+        "(corrected Eq. 15), step where at most max_steps steps capture it (the N-step capture "
+        "regions of the LIPM with a step time, docs/steps.md), otherwise fall.",
         "lead",
     ) + figure(picture, "Strategy map (<code>surfaces.classify.classify_states</code>).")
 
@@ -473,9 +477,8 @@ def _plane(ctx: _Context) -> str:
             "(Eq. 4 in the plane). Grown by the pitch and roll flywheels' offsets (corrected "
             f"Eq. 15: {num(offsets['pitch'], 3)} m along x and {num(offsets['roll'], 3)} m "
             "along y of the stance) it is the hip strategy's CMP region. Beyond it the body "
-            "must step: Sec. IV's single step, taken along the capture point's excursion (the "
-            "line from the support polygon's centre through ξ) until proper two-dimensional "
-            "capture regions replace it; beyond the dashed curve no single step recovers.",
+            "must step: the N-step capture regions of the next section; beyond the dashed "
+            "curve no plan of at most max_steps steps captures the push.",
             "lead",
         )
         + figure(
@@ -491,8 +494,8 @@ def _plane(ctx: _Context) -> str:
         + paragraph(
             "The largest push [m/s] each strategy recovers from a CoM at rest above the "
             "reference point, by direction (<code>pushrecovery bounds --json</code>, "
-            "<code>plane</code>): ω times the distance to the region's edge for ankle and hip, "
-            "the single-step limit of Sec. IV for step."
+            "<code>plane</code>): ω times the distance to the region's edge for ankle, hip "
+            "and step (the farthest N-step region)."
         )
         + table(
             ["support", "strategy", *(f"{d} [m/s]" for d in PLANE_DIRECTIONS)],
@@ -500,6 +503,51 @@ def _plane(ctx: _Context) -> str:
             text_columns=2,
             ident="plane-thresholds",
         )
+    )
+
+
+def _steps(ctx: _Context) -> str:
+    from pushrecovery.plots.common import save_figure
+    from pushrecovery.plots.steps import capture_regions_figure, n_step_map_figure
+    from pushrecovery.surfaces.bounds import bounds_data
+
+    params = ctx.params
+    (regions,) = save_figure(capture_regions_figure(params), ctx.out / "steps-regions", ["png"])
+    (steps_map,) = save_figure(n_step_map_figure(params), ctx.out / "steps-map", ["png"])
+    data = bounds_data(params)
+    rows = [
+        [n, num(-back, 3), num(forward, 3)]
+        for n, (back, forward) in data["thresholds"]["steps"].items()
+    ]
+    sec4 = data["thresholds"]["step_sec4"]
+    return (
+        paragraph(
+            "Beyond the hip region the body steps. With the CoP in the stance foot until the "
+            "touchdown, the landing foot alone afterwards, footholds within max_step_length "
+            f"({num(params.max_step_length, 3)} m) of the stance ankle and touchdowns at least "
+            f"min_step_time ({num(params.min_step_time, 3)} s) apart, the capture points that N "
+            "steps capture form a convex polygon, a Minkowski sum of the feet, the reach and the "
+            "hip's box, each scaled by e^{−ω t} of its touchdown (docs/steps.md, checked against "
+            "a linear program over CoP, foothold and flywheel torque sequences). A state needs "
+            f"the smallest N; at most max_steps = {params.max_steps} (where one more step grows "
+            "the region by less than 1 mm).",
+            "lead",
+        )
+        + figure(
+            regions,
+            "Footholds of the first landing foot that capture four pushes from rest in double "
+            "support with one step or two, and the recommended foothold (the region's "
+            "Chebyshev centre). <code>steps-regions.png</code>",
+        )
+        + figure(steps_map, "Steps each sagittal state needs. <code>steps-map.png</code>")
+        + "<h3>Largest push from rest with N steps</h3>\n"
+        + paragraph(
+            "From a CoM at rest over the ankle, sagittal model (<code>pushrecovery bounds "
+            "--json</code>, <code>thresholds.steps</code>; ∞: Koolen et al.'s d_∞). Sec. IV's "
+            f"instantaneous single step of the paper: {num(-sec4[0], 3)} m/s backward, "
+            f"{num(sec4[1], 3)} m/s forward (what the recovery controller takes)."
+        )
+        + table(["steps", "backward [m/s]", "forward [m/s]"], rows, text_columns=1, ident="steps")
     )
 
 
@@ -721,6 +769,7 @@ _BUILDERS: Mapping[str, Callable[[_Context], str]] = {
     "bounds": _bounds,
     "map": _map,
     "plane": _plane,
+    "steps": _steps,
     "figures": _figures,
     "analytic": _analytic,
     "sweep": _sweep,
