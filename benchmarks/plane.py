@@ -176,6 +176,14 @@ def classify_many() -> tuple[float, float]:
             f"{per_state:.1f} bytes/state (target <= 100)"
         )
         worst, worst_memory = max(worst, ratio), max(worst_memory, per_state)
+    hard = {"y": rng.normal(0.0, 0.1, N), "ydot": rng.normal(0.0, 2.5, N)}
+    hard_xdot = rng.normal(0.0, 2.5, N)
+    wall = best(lambda: classify_states(x, hard_xdot, params, **hard), number=1)
+    codes = classify_states(x, hard_xdot, params, **hard)
+    print(
+        f"  (information) planar, ẋ and ẏ ~ N(0, 2.5) m/s ({np.mean(codes == 3):.1%} fall, "
+        f"{np.mean(codes == 2):.1%} step): {wall * 1e3:.0f} ms, {wall / baseline:.1f}x numpy.add"
+    )
     calm_x, calm_xdot = rng.normal(0.05, 0.05, N), rng.normal(0.0, 0.15, N)
     calm = best(lambda: classify_states(calm_x, calm_xdot, params), number=1)
     beyond = float(np.mean(classify_states(calm_x, calm_xdot, params) >= 2))

@@ -25,6 +25,7 @@
    a multiple of real time, and per frame against reading the file alone.
 10. The ground plane (``benchmarks/plane.py``): the real-time monitor's single-state query,
    ``bounds`` start-up, 2-D margins and ``classify_states`` on 10**7 states.
+11. Steps (``benchmarks/steps.py``): one-step capture regions, N-step thresholds and plans.
 """
 
 from __future__ import annotations
@@ -327,8 +328,10 @@ def analysis() -> None:
 
 def main() -> int:
     import plane
+    import steps
 
     plane_failed = plane.main()
+    steps_failed = steps.main()
     ratio = surface()
     cli = startup()
     realtime()
@@ -339,7 +342,7 @@ def main() -> int:
     campaigns()
     analysis()
     failed = ratio > 2.0 or cli > 0.3 or step_rate < 2e6 or step_ratio < 1000 or physics < 150
-    failed = failed or bool(plane_failed)
+    failed = failed or bool(plane_failed) or bool(steps_failed)
     print("targets met" if not failed else "TARGET MISSED")
     return int(failed)
 

@@ -113,25 +113,26 @@ def clip_halfplanes(
 
     Sutherland-Hodgman: the polygon cut by one half-plane after the other.
     """
-    points = polygon.vertices
-    scale = max(1.0, float(np.abs(points).max()))
-    for normal, offset in zip(normals, offsets, strict=True):
-        excess = points @ normal - offset
-        if np.all(excess <= 0.0):
-            continue
-        if np.all(excess >= 0.0):
-            return None
-        after = np.roll(points, -1, axis=0)
-        excess_after = np.roll(excess, -1)
-        kept: list[FloatArray] = []
-        for p, q, e, f in zip(points, after, excess, excess_after, strict=True):
+    vertices = polygon.vertices
+    scale = max(1.0, float(np.abs(vertices).max()))
+    normals, offsets = np.asarray(normals), np.asarray(offsets)
+    cutting = np.any(vertices @ normals.T > offsets, axis=0)
+    # Python floats: a few cuts of a small polygon, where numpy's per-call cost would dominate.
+    loop = [(float(x), float(y)) for x, y in vertices]
+    for (nx, ny), b in zip(normals[cutting].tolist(), offsets[cutting].tolist(), strict=True):
+        kept: list[tuple[float, float]] = []
+        for k, (px, py) in enumerate(loop):
+            qx, qy = loop[k - len(loop) + 1]
+            e, f = nx * px + ny * py - b, nx * qx + ny * qy - b
             if e <= 0.0:
-                kept.append(p)
+                kept.append((px, py))
             if (e < 0.0 < f) or (f < 0.0 < e):
-                kept.append(p + (e / (e - f)) * (q - p))
-        points = np.array(kept)
-        if len(points) < 3:
+                share = e / (e - f)
+                kept.append((px + share * (qx - px), py + share * (qy - py)))
+        loop = kept
+        if len(loop) < 3:
             return None
+    points = np.array(loop)
     area = 0.5 * float(
         np.dot(points[:, 0], np.roll(points[:, 1], -1))
         - np.dot(np.roll(points[:, 0], -1), points[:, 1])

@@ -201,20 +201,24 @@ def padded_edges(table, smallest=0):  # type: ignore[no-untyped-def]
 
 
 @numba.njit(cache=True, nogil=True)
-def locate_steps(table, counts, steps, px, py):  # type: ignore[no-untyped-def]
+def locate_steps(table, counts, steps, outer, px, py):  # type: ignore[no-untyped-def]
     """Return (steps of the first region holding p, 0 if none; largest signed distance [m]).
 
     ``table`` stacks the regions' edge tables (rows padded), ``counts`` their edge counts,
-    ``steps`` the number of steps of each region (ascending).
+    ``steps`` the number of steps of each region (ascending); the distance is taken over the
+    regions flagged in ``outer``, whose union is that of all.
     """
-    found = 0
     best = -np.inf
     for r in range(table.shape[0]):
-        margin = _point_margin(table[r], counts[r], px, py)
-        best = margin if margin > best else best
-        if found == 0 and margin > 0.0:
-            found = steps[r]
-    return found, best
+        if outer[r]:
+            margin = _point_margin(table[r], counts[r], px, py)
+            best = margin if margin > best else best
+    if not best > 0.0:
+        return 0, best
+    for r in range(table.shape[0]):
+        if _max_excess(table[r], counts[r], px, py) < 0.0:
+            return steps[r], best
+    return 0, best  # pragma: no cover - inside the union is inside one of them
 
 
 @numba.njit(parallel=True, cache=True, nogil=True)
@@ -242,3 +246,61 @@ def mark_regions(  # type: ignore[no-untyped-def]
             if inside:
                 codes[i] = mark
                 break
+
+
+@numba.njit(cache=True, nogil=True)
+def chebyshev_centre(normals, offsets):  # type: ignore[no-untyped-def]
+    """(q_x, q_y, r, ok): the largest disc n_i · q + r <= b_i in a convex polygon [m].
+
+    The dual simplex of the LP max r: its dual, min b · y over y >= 0 with Σ y_i n_i = 0 and
+    Σ y_i = 1, has a basis of three edges whose normals hold the origin in their hull; (q, r)
+    are then the point equidistant from their lines, and an edge violated by it enters the
+    basis (the most violated; the ratio test picks the edge that leaves). ``normals`` in
+    counter-clockwise order (a ConvexPolygon's). ``ok`` is False when no start is found or the
+    iterations do not converge (the caller then solves the LP another way).
+    """
+    m = normals.shape[0]
+    # Start: edge 0, the last edge less than half a turn further round, and the next one.
+    base = math.atan2(normals[0, 1], normals[0, 0])
+    b = 0
+    for k in range(1, m):
+        turn = (math.atan2(normals[k, 1], normals[k, 0]) - base) % (2.0 * math.pi)
+        if turn < math.pi:
+            b = k
+    c = b + 1
+    if b == 0 or c >= m:
+        return 0.0, 0.0, 0.0, False
+    basis = np.array([0, b, c])
+    matrix = np.empty((3, 3))
+    for iteration in range(4 * m + 20):
+        for j in range(3):
+            matrix[j, 0] = normals[basis[j], 0]
+            matrix[j, 1] = normals[basis[j], 1]
+            matrix[j, 2] = 1.0
+        rhs = np.array([offsets[basis[0]], offsets[basis[1]], offsets[basis[2]]])
+        if abs(np.linalg.det(matrix)) < 1e-14:
+            return 0.0, 0.0, 0.0, False
+        point = np.linalg.solve(matrix, rhs)  # (q_x, q_y, r), equidistant from the three
+        worst, enter = -1e-13, -1
+        for k in range(m):
+            slack = offsets[k] - normals[k, 0] * point[0] - normals[k, 1] * point[1] - point[2]
+            if slack < worst:
+                worst, enter = slack, k
+        if enter < 0:
+            return point[0], point[1], point[2], True
+        # Ratio test: the dual weights y (Bᵀ y = (0, 0, 1)) and the entering direction u.
+        weights = np.linalg.solve(matrix.T, np.array([0.0, 0.0, 1.0]))
+        if iteration == 0 and weights.min() < -1e-12:
+            return 0.0, 0.0, 0.0, False  # the start is not dual feasible
+        column = np.array([normals[enter, 0], normals[enter, 1], 1.0])
+        direction = np.linalg.solve(matrix.T, column)
+        leave, best = -1, np.inf
+        for j in range(3):
+            if direction[j] > 1e-15:
+                ratio = weights[j] / direction[j]
+                if ratio < best:
+                    best, leave = ratio, j
+        if leave < 0:
+            return 0.0, 0.0, 0.0, False
+        basis[leave] = enter
+    return 0.0, 0.0, 0.0, False

@@ -150,6 +150,7 @@ def hip_box(params: BodyParams, yaw: float) -> FloatArray | None:
     return np.asarray(local @ np.array([[c, s], [-s, c]]), dtype=np.float64)
 
 
+@functools.lru_cache(maxsize=64)
 def landing_foot(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon:
     """Return the ``side`` foot (LEFT or RIGHT), its ankle at the origin, turned by yaw [m]."""
     foot = foot_shape(params)
@@ -468,28 +469,38 @@ def _after(
 def _chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
     """Return the centre of the largest disc in a convex polygon [m].
 
-    An LP gives the radius r* (max r, n_i·q + r <= b_i); the centres of discs of radius
-    0.999 r* form a small polygon about every largest disc's centre, and its centroid is the
-    answer: unique, and mirrored with the polygon (the LP's own vertex is neither when the
-    largest disc can slide).
+    The LP max r subject to n_i · q + r <= b_i, solved by a small compiled dual simplex
+    (``surfaces._kernels.chebyshev_centre``; scipy's HiGHS if it fails). When the largest disc
+    can slide (two parallel edges hold it) the centres form a segment and its midpoint is
+    returned: unique, and mirrored with the polygon.
     """
-    from scipy.optimize import linprog
+    from pushrecovery.surfaces._kernels import chebyshev_centre
 
     normals, offsets = polygon.normals, polygon.offsets
-    a_ub = np.column_stack([normals, np.ones(len(offsets))])
-    result = linprog(
-        [0.0, 0.0, -1.0],
-        A_ub=a_ub,
-        b_ub=offsets,
-        bounds=[(None, None), (None, None), (0.0, None)],
-        method="highs",
-    )
-    if result.status != 0:  # pragma: no cover - a polygon always has an interior point
-        return np.asarray(polygon.centroid)
-    centres = clip_halfplanes(polygon, normals, offsets - 0.999 * float(result.x[2]))
-    if centres is None:  # pragma: no cover - too thin to clip: the LP's centre
-        return np.asarray(result.x[:2], dtype=np.float64)
-    return np.asarray(centres.centroid, dtype=np.float64)
+    qx, qy, radius, ok = chebyshev_centre(normals, offsets)
+    if not ok:  # pragma: no cover - the compiled simplex found no start or did not converge
+        from scipy.optimize import linprog
+
+        a_ub = np.column_stack([normals, np.ones(len(offsets))])
+        bounds = [(None, None), (None, None), (0.0, None)]
+        qx, qy, radius = linprog([0.0, 0.0, -1.0], A_ub=a_ub, b_ub=offsets, bounds=bounds).x
+    centre = np.array([qx, qy])
+    slack = offsets - normals @ centre - radius
+    scale = max(1.0, float(np.abs(polygon.vertices).max()))
+    touching = normals[slack < 1e-9 * scale]
+    opposite = touching @ touching.T < -1.0 + 1e-9
+    if not opposite.any():
+        return centre
+    # Held by two parallel edges: slide along them as far as the other edges allow.
+    i = int(np.argwhere(opposite)[0, 0])
+    along = np.array([-touching[i, 1], touching[i, 0]])
+    rate = normals @ along
+    room = offsets - normals @ centre - radius
+    moving = np.abs(rate) > 1e-12
+    ends = room[moving] / rate[moving]
+    low = float(ends[rate[moving] < 0.0].max(initial=-np.inf))
+    high = float(ends[rate[moving] > 0.0].min(initial=np.inf))
+    return centre + 0.5 * (low + high) * along
 
 
 @dataclass(frozen=True, slots=True, eq=False)

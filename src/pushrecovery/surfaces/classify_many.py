@@ -189,7 +189,8 @@ def _mark_plane_steps(
     from pushrecovery.surfaces._kernels import mark_regions
 
     x, y, xdot, ydot = (np.ascontiguousarray(a) for a in (xs, ys, xds, yds))
-    tables = (regions.table, regions.counts, regions.discs)
+    outer = regions.outer  # their union is that of all the regions
+    tables = (regions.table[outer], regions.counts[outer], regions.discs[outer])
     mark_regions(x, y, xdot, ydot, 1.0 / params.omega, *tables, codes, _FALL, _STEP)
 
 

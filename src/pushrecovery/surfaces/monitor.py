@@ -139,7 +139,8 @@ class BalanceMonitor:
         self._cop = _edges(support.polygon)
         self._cmp = _edges(cmp_polygon(support, self.params))
         regions = StepRegions.of(self.params, support)
-        self._regions = (regions.table, regions.counts, np.array(regions.steps, dtype=np.int64))
+        steps = np.array(regions.steps, dtype=np.int64)
+        self._regions = (regions.table, regions.counts, steps, regions.outer)
 
     def query(self, x: float, y: float, xdot: float, ydot: float) -> Verdict:
         """Classify one CoM state on the ground plane.

@@ -201,6 +201,9 @@ class StepRegions:
         Edges of each polygon.
     discs : ndarray, shape (R, 4)
         (c_x, c_y, r_in², r_out²): discs inside and around each polygon about its centroid.
+    outer : ndarray of bool, shape (R,)
+        Polygons whose union is the union of all: the max_steps ones when every C_N lies in
+        C_{N+1} (checked vertex by vertex), else all.
     """
 
     params: BodyParams
@@ -210,6 +213,7 @@ class StepRegions:
     table: FloatArray
     counts: NDArray[np.int64]
     discs: FloatArray
+    outer: NDArray[np.bool_]
 
     @classmethod
     def of(cls, params: BodyParams, support: Support) -> StepRegions:
@@ -220,9 +224,9 @@ class StepRegions:
         """Return (steps needed, 0 beyond max_steps; step margin [m]) of one capture point."""
         best = -math.inf
         found = 0
-        for polygon, steps in zip(self.polygons, self.steps, strict=True):
+        for polygon, steps, outer in zip(self.polygons, self.steps, self.outer, strict=True):
             margin = float(polygon.signed_distance(px, py))
-            best = max(best, margin)
+            best = max(best, margin) if outer else best
             if found == 0 and margin > 0.0:
                 found = steps
         return found, best
@@ -230,8 +234,9 @@ class StepRegions:
     def margins(self, px: FloatArray, py: FloatArray) -> FloatArray:
         """Step margins of many capture points: the largest signed distance to a region [m]."""
         best = np.full(np.shape(px), -np.inf)
-        for polygon in self.polygons:
-            np.maximum(best, polygon.signed_distance(px, py), out=best)
+        for polygon, outer in zip(self.polygons, self.outer, strict=True):
+            if outer:
+                np.maximum(best, polygon.signed_distance(px, py), out=best)
         return best
 
     def plan(self, px: float, py: float, steps: int) -> StepPlan:
@@ -273,8 +278,16 @@ def _regions(params: BodyParams, support: Support) -> StepRegions:
         table[i, len(edges) :] = edges[-1]
         centre = np.array(polygon.centroid)
         inner = float(np.min(polygon.offsets - polygon.normals @ centre))
-        outer = float(np.max(np.hypot(*(polygon.vertices - centre).T)))
+        around = float(np.max(np.hypot(*(polygon.vertices - centre).T)))
         # Shrunk and grown by 1e-12 relative: rounding never moves a verdict across an edge.
-        discs[i] = (*centre, (inner * (1.0 - 1e-12)) ** 2, (outer * (1.0 + 1e-12)) ** 2)
+        discs[i] = (*centre, (inner * (1.0 - 1e-12)) ** 2, (around * (1.0 + 1e-12)) ** 2)
     counts = np.array([len(p.offsets) for p in polygons], dtype=np.int64)
-    return StepRegions(params, tuple(polygons), tuple(steps), tuple(options), table, counts, discs)
+    sides = len(polygons) // params.max_steps
+    nested = all(
+        float(polygons[i + sides].signed_distance(*polygons[i].vertices.T).min()) >= -1e-12
+        for i in range(len(polygons) - sides)
+    )
+    outer = np.array([not nested or n == params.max_steps for n in steps])
+    return StepRegions(
+        params, tuple(polygons), tuple(steps), tuple(options), table, counts, discs, outer
+    )

@@ -1,0 +1,74 @@
+"""Step benchmarks (issue 14): medians per call, each beside a baseline measured in the same run.
+
+1. ``capture_region`` (one step, left stance, touchdown after min_step_time, with the hip, the
+   recommended foothold included). Target: median <= 50 µs.
+2. ``capturability_distance`` (Koolen's d_N, 3 steps, disc foot, with the hip). Target: <= 5 µs.
+3. ``plan_steps_xy`` (a 3-step plan: footholds, touchdowns, CoPs). Target: <= 200 µs.
+
+Baseline: one ``numpy.dot`` of two 3-vectors, called in the same loop (a few hundred ns); the
+ratio to it is printed beside each median.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+
+import numpy as np
+
+from pushrecovery import load_params
+from pushrecovery.ground import Support
+from pushrecovery.surfaces.capture_region import (
+    capturability_distance,
+    capture_region,
+    plan_steps_xy,
+    step_options,
+)
+
+CALLS = 2000
+
+
+def median_us(func, calls=CALLS) -> float:
+    clock = time.perf_counter_ns
+    times = []
+    for _ in range(calls):
+        start = clock()
+        func()
+        times.append(clock() - start)
+    return statistics.median(times) / 1e3
+
+
+def main() -> int:
+    params = load_params()
+    support = Support.from_params(params, "left")
+    option = step_options(params, support)[0]
+    a, b = np.ones(3), np.arange(3.0)
+    xi = np.array([0.9, 0.2])
+    capture_region(0.0, 0.0, 1.5, 0.3, params, support)  # loads the compiled centre, caches
+    cases = {
+        "one-step capture region": (
+            lambda: capture_region(0.0, 0.0, 1.5, 0.3, params, support),
+            50.0,
+        ),
+        "3-step threshold d_N": (
+            lambda: capturability_distance(3, params.omega, 0.2, 1.0, 0.05, 0.056),
+            5.0,
+        ),
+        "3-step plan": (lambda: plan_steps_xy(xi, params, option, 3), 200.0),
+    }
+    failed = False
+    for name, (func, target) in cases.items():
+        baseline = median_us(lambda: np.dot(a, b))
+        median = median_us(func, 500 if target > 10 else CALLS)
+        failed |= median > target
+        print(
+            f"{name}: median {median:.1f} µs (target <= {target:g}); numpy.dot of 3-vectors "
+            f"{baseline:.2f} µs, ratio {median / baseline:.0f}"
+        )
+    print("step targets met" if not failed else "STEP TARGET MISSED")
+    return int(failed)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
