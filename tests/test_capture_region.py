@@ -25,6 +25,7 @@ from pushrecovery.surfaces.capture_region import (
     step_options,
     viable_region,
 )
+from pushrecovery.surfaces.classify import classify
 
 # The closed forms and the LP compute the same O(1 m) quantities through different sums
 # (a few dozen terms): agreement within 1e-9 m leaves room for rounding only.
@@ -304,3 +305,43 @@ def test_minkowski_sums_are_exact():
         )
         assert support_value(total, angle) == pytest.approx(expected, abs=1e-12)
     assert len(total.vertices) == 6  # 4 + 3 edges, one pair parallel
+
+
+def test_the_impact_at_a_symmetric_touchdown_is_sec4s():
+    # Legs at ±θ about the CoM (stance ankle a = 0, CoM at L tan θ, new foot at 2 L tan θ), the
+    # velocity perpendicular to the stance leg: Eqs. (18)-(20) give v⁺ = l θ̇ cos 2θ / cos θ.
+    from pushrecovery.ground.support import Stance
+    from pushrecovery.models.stepping import impact_velocities
+    from pushrecovery.surfaces.capture_region import StepPlan
+    from pushrecovery.surfaces.step_impact import plan_impacts
+
+    params = load_params(overrides={"min_step_time": 0.0})
+    height = params.com_height
+    for theta in (0.1, 0.3, 0.6):
+        leg = height / math.cos(theta)
+        rate = 1.7
+        before, _, after = impact_velocities(theta, rate, leg)
+        com = height * math.tan(theta)
+        plan = StepPlan(
+            1,
+            (Stance.LEFT,),
+            np.array([[2.0 * com, 0.0]]),
+            np.array([0.0]),  # touchdown now: the state is the touchdown state
+            np.zeros((2, 2)),
+            np.zeros(2),
+            0.0,
+        )
+        (impact,) = plan_impacts(plan, (com, 0.0), (float(before), 0.0), params)
+        assert impact.speed_ratio * float(before) == pytest.approx(float(after), rel=1e-12)
+        omega = params.omega
+        assert impact.capture_point_impact[0] == pytest.approx(com + float(after) / omega)
+
+
+def test_plans_keep_positive_margins_at_every_touchdown():
+    # The plan's CoPs (and the hip's share as a CMP offset until the first touchdown) carry the
+    # LIPM into each landing foot's remaining capture region: every touchdown margin >= 0.
+    for xdot in (1.2, 2.0, 2.8, 3.6):
+        found = classify(0.0, xdot, load_params())
+        plan = found.to_dict()["plan"]
+        assert all(i["margin"] >= -1e-9 for i in plan["impact"]), xdot
+        assert len(plan["impact"]) == found.steps

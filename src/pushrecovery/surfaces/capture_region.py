@@ -77,6 +77,7 @@ __all__ = [
     "default_max_steps",
     "hip_box",
     "landing_foot",
+    "landing_viable",
     "plan_steps_xy",
     "reach_polygon",
     "step_options",
@@ -294,7 +295,7 @@ def viable_region(
     return minkowski_sum(terms, offset)
 
 
-def _landing_viable(params: BodyParams, side: Stance, yaw: float, more: int) -> ConvexPolygon:
+def landing_viable(params: BodyParams, side: Stance, yaw: float, more: int) -> ConvexPolygon:
     """Return V_more: what the landed ``side`` foot and ``more`` steps capture [m].
 
     Capture points relative to the landing ankle, touchdowns every Δt_s, without the hip.
@@ -405,7 +406,7 @@ def capture_region(
         )
         swing = Stance.LEFT if lateral >= 0.0 else Stance.RIGHT
     option = step_options(params, support, swing)[0]
-    landing = _landing_viable(params, option.swing, option.yaw, steps - 1)
+    landing = landing_viable(params, option.swing, option.yaw, steps - 1)
     box = hip_box(params, option.yaw) if hip else None
     boxes: list[tuple[float, Shape]] = [] if box is None else [(1.0, box)]
     ankle_x, ankle_y = (float(v) for v in option.ankle)
@@ -523,6 +524,8 @@ class StepPlan:
         The hip's share of the capture point, ω∫e^{−ωs} c ds [m] (0 without hip).
     margin : float
         Signed distance of the capture point to the region C_N of the plan's timing [m].
+    ankle : ndarray, shape (2,)
+        The stance ankle the first step leaves [m].
     """
 
     steps: int
@@ -532,6 +535,7 @@ class StepPlan:
     cops: FloatArray
     hip: FloatArray
     margin: float
+    ankle: FloatArray = field(default_factory=lambda: np.zeros(2))
 
     def to_dict(self) -> dict[str, object]:
         """JSON form: footholds, touchdown times, landing feet and the CoPs [m, s]."""
@@ -543,6 +547,7 @@ class StepPlan:
             "cops": self.cops.tolist(),
             "hip": self.hip.tolist(),
             "margin": self.margin,
+            "ankle": self.ankle.tolist(),
         }
 
 
@@ -580,4 +585,5 @@ def plan_steps_xy(
         cops,
         np.asarray(points[0]) if hip and hip_box(params, option.yaw) is not None else np.zeros(2),
         float(total.signed_distance(xi[0], xi[1])),
+        np.array(option.ankle, dtype=np.float64),
     )

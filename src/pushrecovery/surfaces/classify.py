@@ -28,6 +28,7 @@ from pushrecovery.surfaces.classify_many import classify_states
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
+from pushrecovery.surfaces.step_impact import TouchdownImpact, plan_impacts
 from pushrecovery.surfaces.step_regions import StepRegions, line_steps, sagittal_plan
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
@@ -66,11 +67,13 @@ class Classification:
     :mod:`pushrecovery.surfaces.step_regions`), positive exactly when steps capture the state
     and null in JSON otherwise. ``steps`` is the number of steps needed (0: ankle or hip,
     None: more than ``max_steps``) and ``plan`` the plan of a ``step`` verdict (footholds,
-    touchdown times, CoPs). ``step`` describes its first step: ``step_length`` (stance ankle
-    to landing ankle, signed like the step on the line), ``com_to_foot`` (landing ankle minus
-    CoM at touchdown), ``theta`` (the stance leg's lean at touchdown, atan of the CoM's
-    distance ahead of the stance ankle over L) and the ``step_length_range`` of first steps
-    along the same direction that still capture with the plan's number of steps.
+    touchdown times, CoPs; ``impact``: each touchdown's capture point without and with Sec.
+    IV's impact, :mod:`pushrecovery.surfaces.step_impact`). ``step`` describes its first
+    step: ``step_length`` (stance ankle to landing ankle, signed like the step on the line),
+    ``com_to_foot`` (landing ankle minus CoM at touchdown), ``theta`` (the stance leg's lean
+    at touchdown, atan of the CoM's distance ahead of the stance ankle over L) and the
+    ``step_length_range`` of first steps along the same direction that still capture with
+    the plan's number of steps.
 
     On the ground plane also ``capture_point_xy`` (ξ in the world frame [m]), the ``support``
     and the CMP region's vertices (``cmp_region``); margins are then signed Euclidean
@@ -88,6 +91,7 @@ class Classification:
     cmp_region: list[list[float]] | None = None
     steps: int | None = None
     plan: StepPlan | None = None
+    impacts: tuple[TouchdownImpact, ...] = ()
 
     def to_dict(self) -> dict[str, object]:
         """JSON form: ``{"capture_point", "strategy", "margins", "steps"}`` (+ ``"step"``...)."""
@@ -105,7 +109,9 @@ class Classification:
             data["step"] = dict(self.step)
             data["step_length"] = self.step["step_length"]
         if self.plan is not None:
-            data["plan"] = self.plan.to_dict()
+            plan = self.plan.to_dict()
+            plan["impact"] = [impact.to_dict() for impact in self.impacts]
+            data["plan"] = plan
         if self.capture_point_xy is not None:
             data["capture_point_xy"] = list(self.capture_point_xy)
         if self.support is not None:
@@ -175,8 +181,9 @@ def classify(
         step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)
         step["step_length_range"] = [float(line.shortest[0]), float(line.longest[0])]
     margins = {"cop": cop, "cmp": cmp, "step": step_margin}
+    impacts = () if plan is None else tuple(plan_impacts(plan, (x, 0.0), (xdot, 0.0), params))
     return Classification(
-        capture, strategy, margins, step, steps=_steps(strategy, steps), plan=plan
+        capture, strategy, margins, step, steps=_steps(strategy, steps), plan=plan, impacts=impacts
     )
 
 
@@ -252,6 +259,7 @@ def _classify_plane(
     strategy = _strategy(cop, cmp, steps)
     plan = regions.plan(*xi, steps) if strategy is Strategy.STEP else None
     step = None
+    impacts: tuple[TouchdownImpact, ...] = ()
     if plan is not None:
         option = next(o for o in regions.options if o.swing is plan.swings[0])
         ankle = (float(option.ankle[0]), float(option.ankle[1]))
@@ -272,6 +280,7 @@ def _classify_plane(
         step["step_length_range"] = _plane_range(
             x, y, xdot, ydot, params, support, plan, ankle, gap
         )
+        impacts = tuple(plan_impacts(plan, (x, y), (xdot, ydot), params, option.yaw))
     margins = {"cop": cop, "cmp": cmp, "step": step_margin}
     return Classification(
         xi[0],
@@ -283,6 +292,7 @@ def _classify_plane(
         hip_region.to_list(),
         steps=_steps(strategy, steps),
         plan=plan,
+        impacts=impacts,
     )
 
 

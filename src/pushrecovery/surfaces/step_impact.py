@@ -1,0 +1,142 @@
+r"""Sec. IV's impact at each touchdown of a plan: what the LIPM analysis leaves out.
+
+The capture regions (:mod:`pushrecovery.surfaces.capture_region`) keep the CoM at height L and
+its velocity horizontal through every touchdown. Sec. IV's body has rigid legs: the CoM moves
+on the stance leg's sphere, so at touchdown its velocity is perpendicular to the stance leg
+(from the stance ankle a to the CoM) and has a vertical part, v_z = −v_h · (r − a)/L for a
+horizontal part v_h (Eq. 18, at height L). The impact (Eqs. 19–20) is an impulse along the new
+leg, from the landing ankle q to the CoM, that absorbs that vertical velocity, and so also
+changes the horizontal one:
+
+.. math:: \mathbf v_h^+ = \mathbf v_h - v_z \frac{\mathbf r - \mathbf q}{L}
+          = \mathbf v_h + \frac{\mathbf v_h\cdot(\mathbf r - \mathbf a)}{L^2}
+          (\mathbf r - \mathbf q).
+
+With the legs at ±θ on the sagittal line (r − a = L tan θ = −(r − q)) this is Sec. IV's
+v⁺ = L θ̇ cos 2θ / cos θ (with v_h = L θ̇ cos θ). The capture point after the impact is
+ξ⁺ = r + v_h⁺/ω (the height regulated back to L). Here each touchdown of a plan reports both
+capture points and their margins in what the rest of the plan needs (the landing foot and its
+remaining steps, C_{N−k} of (S1) about the landing ankle): the impact slows the body along
+the new leg, which helps when the capture point lies beyond the foot and hurts when the foot
+was placed beyond it. Neither analysis is conservative in general. The CoM state at touchdown
+follows the LIPM with the plan's CoPs held, the hip's share h of the capture point delivered
+as a constant CMP offset h / (1 − e^{−ωt₁}) until the first touchdown (the same ξ₀ budget).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.capture_region import StepPlan, landing_viable
+
+__all__ = ["TouchdownImpact", "plan_impacts"]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class TouchdownImpact:
+    """One touchdown of a plan, without and with Sec. IV's impact.
+
+    Attributes
+    ----------
+    time : float
+        Touchdown time [s].
+    com, velocity : (float, float)
+        CoM position [m] and velocity [m/s] at touchdown (LIPM, the plan's CoPs held).
+    capture_point, capture_point_impact : (float, float)
+        ξ without the impact and ξ⁺ after it [m].
+    margin, margin_impact : float
+        Their signed distances to what the rest of the plan captures [m], + inside.
+    speed_ratio : float
+        |v⁺_h| / |v_h|: the share of the horizontal speed the impact leaves.
+    """
+
+    time: float
+    com: tuple[float, float]
+    velocity: tuple[float, float]
+    capture_point: tuple[float, float]
+    capture_point_impact: tuple[float, float]
+    margin: float
+    margin_impact: float
+    speed_ratio: float
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON form [s, m, m/s]."""
+        return {
+            "time": self.time,
+            "com": list(self.com),
+            "velocity": list(self.velocity),
+            "capture_point": list(self.capture_point),
+            "capture_point_impact": list(self.capture_point_impact),
+            "margin": self.margin,
+            "margin_impact": self.margin_impact,
+            "speed_ratio": self.speed_ratio,
+        }
+
+
+def plan_impacts(
+    plan: StepPlan,
+    position: tuple[float, float],
+    velocity: tuple[float, float],
+    params: BodyParams,
+    yaw: float = 0.0,
+) -> list[TouchdownImpact]:
+    """Follow a plan's touchdowns from a CoM state, without and with the impact (module doc).
+
+    Parameters
+    ----------
+    plan : StepPlan
+        The plan (footholds, touchdowns, CoPs).
+    position, velocity : (float, float)
+        CoM position [m] and velocity [m/s] now.
+    params : BodyParams
+        The body (L, ω, feet, reach, Δt_s).
+    yaw : float
+        The stance's yaw, kept by the landing feet [rad].
+
+    Returns
+    -------
+    list of TouchdownImpact
+        One per touchdown. The LIPM state is carried on without the impact.
+    """
+    omega, height = params.omega, params.com_height
+    r = np.array(position, dtype=np.float64)
+    v = np.array(velocity, dtype=np.float64)
+    ankle = np.array(plan.ankle, dtype=np.float64)
+    start = 0.0
+    found = []
+    first = math.exp(-omega * float(plan.touchdowns[0]))
+    hip = plan.hip / (1.0 - first) if first < 1.0 else np.zeros(2)
+    for k in range(plan.steps):
+        t = float(plan.touchdowns[k])
+        p = plan.cops[k] + (hip if k == 0 else 0.0)
+        c, s = math.cosh(omega * (t - start)), math.sinh(omega * (t - start))
+        r, v = p + (r - p) * c + v / omega * s, (r - p) * omega * s + v * c
+        start = t
+        q = plan.footholds[k]
+        after = v + (v @ (r - ankle)) / height**2 * (r - q)
+        xi = r + v / omega
+        xi_impact = r + after / omega
+        remaining = landing_viable(params, plan.swings[k], yaw, plan.steps - 1 - k)
+        region = remaining.transformed(float(q[0]), float(q[1]), 0.0)
+        speed = float(np.hypot(*v))
+        found.append(
+            TouchdownImpact(
+                t,
+                (float(r[0]), float(r[1])),
+                (float(v[0]), float(v[1])),
+                (float(xi[0]), float(xi[1])),
+                (float(xi_impact[0]), float(xi_impact[1])),
+                float(region.signed_distance(*xi)),
+                float(region.signed_distance(*xi_impact)),
+                float(np.hypot(*after)) / speed if speed > 0.0 else 1.0,
+            )
+        )
+        ankle = np.array(q, dtype=np.float64)
+    return found
