@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.polygon import ConvexPolygon, following
 
 __all__ = ["Shape", "clip", "clip_halfplanes", "decompose", "minkowski_sum", "regular_polygon"]
 
@@ -63,10 +63,10 @@ def minkowski_sum(
         if weight == 0.0:
             continue
         vertices = weight * _vertices(polygon)  # a point reflection keeps the orientation
-        step = np.roll(vertices, -1, axis=0) - vertices
+        step = following(vertices) - vertices
         lowest = int(np.lexsort((vertices[:, 0], vertices[:, 1]))[0])  # lowest, then leftmost
         starts.append(vertices[lowest])
-        edges.append(np.roll(step, -lowest, axis=0))
+        edges.append(following(step, lowest))
     if not edges:
         raise InvalidParameterError("a Minkowski sum needs at least one term of non-zero weight")
     every = np.concatenate(edges)
@@ -86,8 +86,8 @@ def _cleaned(vertices: FloatArray) -> ConvexPolygon:
     """Drop repeated and collinear vertices of a convex counter-clockwise vertex loop."""
     scale = max(1.0, float(np.abs(vertices).max()))
     for _ in range(len(vertices)):  # each pass drops every flat vertex it sees; usually one
-        before = vertices - np.roll(vertices, 1, axis=0)
-        after = np.roll(vertices, -1, axis=0) - vertices
+        before = vertices - following(vertices, -1)
+        after = following(vertices) - vertices
         turn = before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0]
         long = np.hypot(after[:, 0], after[:, 1]) > _RELATIVE_EDGE * scale
         keep = long & (turn > _RELATIVE_EDGE * scale * scale)
@@ -134,8 +134,8 @@ def clip_halfplanes(
             return None
     points = np.array(loop)
     area = 0.5 * float(
-        np.dot(points[:, 0], np.roll(points[:, 1], -1))
-        - np.dot(np.roll(points[:, 0], -1), points[:, 1])
+        np.dot(points[:, 0], following(points[:, 1]))
+        - np.dot(following(points[:, 0]), points[:, 1])
     )
     if area <= 1e-12 * scale * scale:
         return None

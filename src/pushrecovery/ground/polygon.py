@@ -31,6 +31,13 @@ __all__ = ["ConvexPolygon", "convex_hull", "convex_polygon", "rectangle"]
 
 FloatArray = NDArray[np.float64]
 
+
+def following(array: NDArray[np.float64], shift: int = 1) -> NDArray[np.float64]:
+    """``np.roll(array, -shift, axis=0)``: element i + shift at i (cyclic), a few µs faster."""
+    shift %= len(array)
+    return np.concatenate((array[shift:], array[:shift]))
+
+
 # Rows of a chunk for the numpy signed distance: (edges x chunk) temporaries stay small.
 _CHUNK = 1 << 16
 #: Shortest edge of a user polygon [m] and smallest area [m²]: below, a foot is a point or a
@@ -62,7 +69,7 @@ class ConvexPolygon:
     @classmethod
     def _from_ccw(cls, vertices: FloatArray) -> ConvexPolygon:
         vertices = np.array(vertices, dtype=np.float64)
-        edges = np.roll(vertices, -1, axis=0) - vertices
+        edges = following(vertices) - vertices
         lengths = np.hypot(edges[:, 0], edges[:, 1])
         normals = np.column_stack([edges[:, 1], -edges[:, 0]]) / lengths[:, None]
         offsets = np.einsum("ij,ij->i", normals, vertices)
@@ -79,7 +86,7 @@ class ConvexPolygon:
         length.
         """
         start = self.vertices
-        edge = np.roll(start, -1, axis=0) - start
+        edge = following(start) - start
         length = np.hypot(edge[:, 0], edge[:, 1])
         tangent = edge / length[:, None]
         along = np.einsum("ij,ij->i", tangent, start)
@@ -89,13 +96,13 @@ class ConvexPolygon:
     def area(self) -> float:
         """Area [m²] (shoelace formula), > 0."""
         x, y = self.vertices[:, 0], self.vertices[:, 1]
-        return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+        return 0.5 * float(np.dot(x, following(y)) - np.dot(following(x), y))
 
     @property
     def centroid(self) -> tuple[float, float]:
         """Area centroid (x, y) [m]."""
         x, y = self.vertices[:, 0], self.vertices[:, 1]
-        xn, yn = np.roll(x, -1), np.roll(y, -1)
+        xn, yn = following(x), following(y)
         cross = x * yn - xn * y
         scale = 1.0 / (6.0 * self.area)
         return float(np.dot(x + xn, cross) * scale), float(np.dot(y + yn, cross) * scale)
@@ -152,7 +159,7 @@ class ConvexPolygon:
     def _outside_distance(self, px: FloatArray, py: FloatArray) -> FloatArray:
         """Distance to the nearest edge segment (points outside) [m]."""
         start = self.vertices
-        edge = np.roll(start, -1, axis=0) - start
+        edge = following(start) - start
         length2 = np.einsum("ij,ij->i", edge, edge)
         dx = px[None, :] - start[:, 0:1]
         dy = py[None, :] - start[:, 1:2]
@@ -335,11 +342,9 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
                 )
     turns = np.array([_cross(pts[i - 1], pts[i], pts[(i + 1) % n]) for i in range(n)])
     # A turn relative to its edges' lengths (the sine of the angle): tiny edges still turn.
-    lengths = np.hypot(*(np.roll(pts, -1, axis=0) - pts).T)
-    bends = 1e-12 * lengths * np.roll(lengths, 1)
-    area = 0.5 * float(
-        np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1])
-    )
+    lengths = np.hypot(*(following(pts) - pts).T)
+    bends = 1e-12 * lengths * following(lengths, -1)
+    area = 0.5 * float(np.sum(pts[:, 0] * following(pts[:, 1]) - following(pts[:, 0]) * pts[:, 1]))
     if abs(area) < max(MIN_AREA, eps):
         raise InvalidParameterError(
             f"{name} is degenerate: area {abs(area):.3g} m², at least {MIN_AREA:g} m² (1 mm²)"
