@@ -3,7 +3,7 @@
 1. ``capture_region`` (one step, left stance, touchdown after min_step_time, with the hip, the
    recommended foothold included). Target: median <= 50 µs.
 2. ``capturability_distance`` (Koolen's d_N, 3 steps, disc foot, with the hip). Target: <= 5 µs.
-3. ``plan_steps_xy`` (a 3-step plan: footholds, touchdowns, CoPs). Target: <= 200 µs.
+3. ``capture_plan`` (a 3-step plan: footholds, touchdowns, CoPs). Target: <= 200 µs.
 
 Baseline: one ``numpy.dot`` of two 3-vectors, called in the same loop (a few hundred ns); the
 ratio to it is printed beside each median.
@@ -19,12 +19,9 @@ import numpy as np
 
 from pushrecovery import load_params
 from pushrecovery.ground import Support
-from pushrecovery.surfaces.capture_region import (
-    capturability_distance,
-    capture_region,
-    plan_steps_xy,
-    step_options,
-)
+from pushrecovery.surfaces.capture_plan import capture_plan
+from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.n_step import capturability_distance, step_options
 
 CALLS = 2000
 
@@ -55,7 +52,7 @@ def main() -> int:
             lambda: capturability_distance(3, params.omega, 0.2, 1.0, 0.05, 0.056),
             5.0,
         ),
-        "3-step plan": (lambda: plan_steps_xy(xi, params, option, 3), 200.0),
+        "3-step plan": (lambda: capture_plan(xi, params, option, 3), 200.0),
     }
     failed = False
     for name, (func, target) in cases.items():

@@ -16,16 +16,16 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground import FootPose, Support
 from pushrecovery.ground.minkowski import minkowski_sum, regular_polygon
 from pushrecovery.surfaces.capture_lp_steps import step_lp
-from pushrecovery.surfaces.capture_region import (
+from pushrecovery.surfaces.capture_plan import capture_plan
+from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.classify import classify
+from pushrecovery.surfaces.n_step import (
     capturability_distance,
-    capture_region,
     default_max_steps,
     landing_foot,
-    plan_steps_xy,
     step_options,
     viable_region,
 )
-from pushrecovery.surfaces.classify import classify
 
 # The closed forms and the LP compute the same O(1 m) quantities through different sums
 # (a few dozen terms): agreement within 1e-9 m leaves room for rounding only.
@@ -156,7 +156,7 @@ def test_plans_capture_just_inside_and_nothing_captures_just_outside(steps):
         d = np.array([math.cos(angle), math.sin(angle)])
         reach = region.ray_distance(*option.ankle, angle)
         inside = option.ankle + 0.999 * reach * d
-        plan = plan_steps_xy(inside, params, option, steps, hip=False)
+        plan = capture_plan(inside, params, option, steps, hip=False)
         assert plan.margin > 0.0
         end = simulate(params, plan, inside)
         np.testing.assert_allclose(end, plan.cops[-1], atol=1e-6)  # at rest over the CoP
@@ -166,10 +166,10 @@ def test_plans_capture_just_inside_and_nothing_captures_just_outside(steps):
         assert np.all(np.hypot(gaps[:, 0], gaps[:, 1]) <= params.max_step_length + 1e-12)
         assert np.all(np.diff(plan.touchdowns) >= params.min_step_time - 1e-12)
         outside = option.ankle + 1.001 * reach * d
-        assert plan_steps_xy(outside, params, option, steps, hip=False).margin < 0.0
+        assert capture_plan(outside, params, option, steps, hip=False).margin < 0.0
         assert (
             np.linalg.norm(
-                simulate(params, plan_steps_xy(outside, params, option, steps, hip=False), outside)
+                simulate(params, capture_plan(outside, params, option, steps, hip=False), outside)
             )
             > 1.0
         )
@@ -312,7 +312,7 @@ def test_the_impact_at_a_symmetric_touchdown_is_sec4s():
     # velocity perpendicular to the stance leg: Eqs. (18)-(20) give v⁺ = l θ̇ cos 2θ / cos θ.
     from pushrecovery.ground.support import Stance
     from pushrecovery.models.stepping import impact_velocities
-    from pushrecovery.surfaces.capture_region import StepPlan
+    from pushrecovery.surfaces.capture_plan import CapturePlan
     from pushrecovery.surfaces.step_impact import plan_impacts
 
     params = load_params(overrides={"min_step_time": 0.0})
@@ -322,7 +322,7 @@ def test_the_impact_at_a_symmetric_touchdown_is_sec4s():
         rate = 1.7
         before, _, after = impact_velocities(theta, rate, leg)
         com = height * math.tan(theta)
-        plan = StepPlan(
+        plan = CapturePlan(
             1,
             (Stance.LEFT,),
             np.array([[2.0 * com, 0.0]]),

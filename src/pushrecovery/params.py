@@ -75,7 +75,7 @@ class BodyParams:
     max_steps : int or None
         Largest number of steps a ``step`` verdict may take, in [1, 50]; ``None``: the smallest
         N beyond which the N-step capture region grows by less than 1 mm
-        (:func:`pushrecovery.surfaces.capture_region.default_max_steps`).
+        (:func:`pushrecovery.surfaces.n_step.default_max_steps`).
     min_step_width : float or None
         Narrowest lateral distance [m] between the stance ankle and the landing ankle, measured
         outward on the swing foot's side (a kinematic limit that forbids crossing the stance
@@ -185,7 +185,7 @@ class BodyParams:
             set_(self, "min_step_width", width)
         steps = self.max_steps
         if steps is None:
-            from pushrecovery.surfaces.capture_region import default_max_steps
+            from pushrecovery.surfaces.n_step import default_max_steps
 
             steps = default_max_steps(self)
         elif isinstance(steps, bool) or not (

@@ -1,6 +1,6 @@
 r"""Minkowski algebra of convex polygons: weighted sums, intersections, regular polygons.
 
-The capture regions of several steps (:mod:`pushrecovery.surfaces.capture_region`) are
+The capture regions of several steps (:mod:`pushrecovery.surfaces.n_step`) are
 weighted Minkowski sums ⊕_k w_k P_k of convex polygons: their support function is the weighted
 sum of support functions, h(d) = Σ_k w_k h_{P_k}(d) for w_k >= 0 (a negative weight is the
 point reflection −P_k scaled by |w_k|). A sum is built exactly by merging the terms' edges in

@@ -1,6 +1,6 @@
 """Figures of steps: capture regions over the support polygon, and the N-step strategy map.
 
-Computing stays in :mod:`pushrecovery.surfaces.capture_region` and
+Computing stays in :mod:`pushrecovery.surfaces.capture_region`, ``n_step`` and
 :mod:`pushrecovery.surfaces.step_regions`; these functions draw on matplotlib ``Figure``
 objects (no pyplot state) and return them.
 """

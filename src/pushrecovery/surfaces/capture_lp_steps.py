@@ -1,7 +1,7 @@
 r"""N-step viability by linear programming: the ground truth of the capture regions.
 
 With the touchdown times fixed on a grid of ``dt``, the LIPM with steps and an upper body
-(:mod:`pushrecovery.surfaces.capture_region`) is linear in everything the body chooses: the
+(:mod:`pushrecovery.surfaces.n_step`) is linear in everything the body chooses: the
 CoP sequence p_i (piecewise constant, in the support of its phase: the stance polygon S, then
 q_k + F_k after the k-th touchdown), the footholds q_k (q_k − q_{k−1} in the reach polygon
 R_k), and the pitch and roll torques of the upper body (piecewise constant, |τ| ≤ τmax, the
@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.ground.support import Stance
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_region import StepOption, landing_foot, reach_polygon
+from pushrecovery.surfaces.n_step import StepOption, landing_foot, reach_polygon
 
 __all__ = ["StepLP", "step_lp"]
 

@@ -23,7 +23,7 @@ from pushrecovery._validate import finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_region import StepPlan
+from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.classify_many import classify_states
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
@@ -90,7 +90,7 @@ class Classification:
     support: Support | None = None
     cmp_region: list[list[float]] | None = None
     steps: int | None = None
-    plan: StepPlan | None = None
+    plan: CapturePlan | None = None
     impacts: tuple[TouchdownImpact, ...] = ()
 
     def to_dict(self) -> dict[str, object]:
@@ -204,7 +204,7 @@ def _steps(strategy: Strategy, steps: int) -> int | None:
 
 
 def _first_step(
-    plan: StepPlan,
+    plan: CapturePlan,
     position: tuple[float, float],
     velocity: tuple[float, float],
     ankle: tuple[float, float],
@@ -303,7 +303,7 @@ def _plane_range(
     ydot: float,
     params: BodyParams,
     support: Support,
-    plan: StepPlan,
+    plan: CapturePlan,
     ankle: tuple[float, float],
     gap: tuple[float, float],
 ) -> list[float]:

@@ -1,6 +1,6 @@
 r"""Sec. IV's impact at each touchdown of a plan: what the LIPM analysis leaves out.
 
-The capture regions (:mod:`pushrecovery.surfaces.capture_region`) keep the CoM at height L and
+The capture regions (:mod:`pushrecovery.surfaces.n_step`) keep the CoM at height L and
 its velocity horizontal through every touchdown. Sec. IV's body has rigid legs: the CoM moves
 on the stance leg's sphere, so at touchdown its velocity is perpendicular to the stance leg
 (from the stance ankle a to the CoM) and has a vertical part, v_z = −v_h · (r − a)/L for a
@@ -32,7 +32,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_region import StepPlan, landing_viable
+from pushrecovery.surfaces.capture_plan import CapturePlan
+from pushrecovery.surfaces.n_step import landing_viable
 
 __all__ = ["TouchdownImpact", "plan_impacts"]
 
@@ -81,7 +82,7 @@ class TouchdownImpact:
 
 
 def plan_impacts(
-    plan: StepPlan,
+    plan: CapturePlan,
     position: tuple[float, float],
     velocity: tuple[float, float],
     params: BodyParams,
@@ -91,7 +92,7 @@ def plan_impacts(
 
     Parameters
     ----------
-    plan : StepPlan
+    plan : CapturePlan
         The plan (footholds, touchdowns, CoPs).
     position, velocity : (float, float)
         CoM position [m] and velocity [m/s] now.

@@ -1,6 +1,6 @@
 r"""The ``step`` verdict: a state is captured by at most ``max_steps`` steps.
 
-A support's regions C_1 ... C_{max_steps} of :mod:`pushrecovery.surfaces.capture_region`
+A support's regions C_1 ... C_{max_steps} of :mod:`pushrecovery.surfaces.n_step`
 ((S1): touchdowns every ``min_step_time`` from ``min_step_time`` on, the hip's box included;
 from double support, one set per foot that may lift first) are built once and kept. A state
 needs the smallest N whose region holds its capture point ξ strictly; its step margin is the
@@ -31,16 +31,15 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_region import (
+from pushrecovery.surfaces.capture_plan import CapturePlan, capture_plan
+from pushrecovery.surfaces.cmp import cmp_offset
+from pushrecovery.surfaces.cop import CaptureInterval
+from pushrecovery.surfaces.n_step import (
     StepOption,
-    StepPlan,
     capturability_distance,
-    plan_steps_xy,
     step_options,
     viable_region,
 )
-from pushrecovery.surfaces.cmp import cmp_offset
-from pushrecovery.surfaces.cop import CaptureInterval
 
 __all__ = [
     "LineSteps",
@@ -155,8 +154,8 @@ def sagittal_step_interval(params: BodyParams, steps: int | None = None) -> Capt
     return CaptureInterval(float(low), float(high))
 
 
-def sagittal_plan(xi: float, params: BodyParams, steps: int) -> StepPlan:
-    """Return the plan of :func:`~.capture_region.plan_steps_xy` on the sagittal line.
+def sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
+    """Return the plan of :func:`~.capture_plan.capture_plan` on the sagittal line.
 
     Every term of (S1) at the same fraction f of its half-width from its centre, f = (ξ −
     c)/half-width of C_N: steps of f l, CoPs at the foot's middle plus f (δ⁺ − δ⁻)/2, the
@@ -170,7 +169,7 @@ def sagittal_plan(xi: float, params: BodyParams, steps: int) -> StepPlan:
     footholds[:, 0] = share * params.max_step_length * np.arange(1, steps + 1)
     cops[0, 0] = middle + share * half
     cops[1:, 0] = footholds[:, 0] + middle + share * half
-    return StepPlan(
+    return CapturePlan(
         steps,
         tuple(Stance.LEFT if k % 2 == 0 else Stance.RIGHT for k in range(steps)),
         footholds,
@@ -239,7 +238,7 @@ class StepRegions:
                 np.maximum(best, polygon.signed_distance(px, py), out=best)
         return best
 
-    def plan(self, px: float, py: float, steps: int) -> StepPlan:
+    def plan(self, px: float, py: float, steps: int) -> CapturePlan:
         """Return the plan of ``steps`` steps for ξ = (px, py).
 
         From double support the foot on the capture point's side of the other ankle steps
@@ -257,7 +256,7 @@ class StepRegions:
             return margin > 0.0 and outward, margin
 
         row = max(rows, key=preference)
-        return plan_steps_xy(np.array([px, py]), self.params, self.options[row], steps)
+        return capture_plan(np.array([px, py]), self.params, self.options[row], steps)
 
 
 @functools.lru_cache(maxsize=32)

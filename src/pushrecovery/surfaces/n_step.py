@@ -1,0 +1,295 @@
+r"""N-step capturability: the LIPM with feet, a reach and a step time, and the hip.
+
+The model is that of :mod:`pushrecovery.surfaces.plane` (ξ̇ = ω (ξ − p − c): the CoP p in the
+current support, the CMP offset c of the upper body) with steps: at touchdown times
+t_1 < t_2 < ... the landing foot F_k, its ankle at q_k, becomes the support and the previous
+stance foot lifts. A foothold lies in the reach polygon R_k about the stance ankle,
+q_k − q_{k−1} ∈ R_k, and touchdowns are at least Δt_s apart (``min_step_time``); the first
+comes no sooner than Δt_s after deciding to step (or after the remaining swing time).
+
+**Derivation** (``docs/steps.md``). ξ stays bounded if and only if
+ξ_0 = ω∫_0^∞ e^{−ωs} (p(s) + c(s)) ds. Split the CoP integral at the touchdowns, with
+a_k = e^{−ω t_k} and a_{N+1} = 0: over each phase it is a weighted mean of points of that
+phase's support, so it ranges over (1 − a_1) S ⊕ Σ_k (a_k − a_{k+1}) (q_k + F_k), each point
+reached with a CoP held still. With q_k = q_0 + r_1 + ... + r_k,
+Σ_k (a_k − a_{k+1}) q_k = a_1 q_0 + Σ_j a_j r_j. The hip's term ranges over the box H of
+:func:`~pushrecovery.surfaces.plane.cmp_polygon` whatever the touchdowns (the flywheel keeps
+turning through them). So the capture points captured by N steps at these times are
+
+.. math:: C_N = H \oplus (1 - a_1) S \oplus \{a_1 q_0\}
+          \oplus \bigoplus_{k=1}^N (a_k - a_{k+1}) F_k \oplus \bigoplus_{j=1}^N a_j R_j,
+          \qquad (S1)
+
+a convex polygon (a Minkowski sum, :mod:`pushrecovery.ground.minkowski`), with support function
+h(d) = h_H + (1 − a_1) h_S + a_1 d·q_0 + Σ (a_k − a_{k+1}) h_{F_k} + Σ a_j h_{R_j}  (S2).
+Along one direction with point feet (h_F = 0), a disc reach l, touchdowns Δt_s apart from Δt_s
+(a_k = β^k, β = e^{−ωΔt_s}) and no hip, (S2) is Koolen et al. (2012)'s
+d_N = l Σ_{k=1}^N β^k = (d_{N−1} + l) β; a disc foot of radius r adds r (their finite-foot
+d_N); the hip adds its offset. (S1) is exact under the independence conditions of
+:mod:`pushrecovery.surfaces.plane` and with the landing foot alone supporting after each
+touchdown (the double support of a touchdown, a hull, is not used: conservative).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery._validate import finite_float
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.minkowski import (
+    Shape,
+    clip_halfplanes,
+    minkowski_sum,
+    regular_polygon,
+)
+from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.support import Stance, Support, foot_shape
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+
+__all__ = [
+    "REACH_SIDES",
+    "StepOption",
+    "capturability_distance",
+    "check_touchdowns",
+    "default_max_steps",
+    "hip_box",
+    "landing_foot",
+    "landing_viable",
+    "reach_polygon",
+    "step_options",
+    "sum_terms",
+    "viable_region",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: Sides of the regular polygon inscribed in the reach disc: its edges come within
+#: max_step_length (1 − cos(π/64)) = 0.12 % of the circle (1.2 mm for a 1 m reach).
+REACH_SIDES = 64
+#: Growth of the region below which one more step does not count [m] (``max_steps``).
+GROWTH_TOLERANCE = 1e-3
+
+
+def default_max_steps(params: BodyParams) -> int:
+    """Smallest N whose next step grows every N-step region by less than 1 mm.
+
+    From (S2), one more step moves the support function by a_{N+1} (h_R + h_{F_{N+1}} −
+    h_{F_N}) <= β^{N+1} (l + 2 ρ_F), β = e^{−ωΔt_s}, l the reach and ρ_F the foot's farthest
+    vertex from its ankle: N is the smallest with that bound under 1 mm. With Δt_s = 0 (the
+    paper's instantaneous step) the regions never stop growing: N = 1, the paper's one step.
+    """
+    beta = math.exp(-params.omega * params.min_step_time)
+    foot = foot_shape(params)
+    size = params.max_step_length + 2.0 * float(np.hypot(*foot.vertices.T).max())
+    if beta >= 1.0:
+        return 1
+    for steps in range(1, 51):
+        if beta ** (steps + 1) * size < GROWTH_TOLERANCE:
+            return steps
+    return 50
+
+
+def capturability_distance(
+    steps: float,
+    omega: float,
+    step_time: float,
+    reach: float,
+    foot_radius: float = 0.0,
+    hip: float = 0.0,
+) -> float:
+    """d_N: the farthest capture point from the stance ankle that N steps capture [m].
+
+    (S2) along one direction for a point (``foot_radius`` 0) or disc foot, a reach ``reach``
+    [m] along that direction, touchdowns every ``step_time`` Δt_s [s] from Δt_s on and a hip
+    offset ``hip`` [m]: d_N = hip + r + l β (1 − β^N)/(1 − β), β = e^{−ωΔt_s} (Koolen et al.
+    2012, with the hip added); ``steps`` may be ``math.inf``. Δt_s = 0 gives hip + r + N l.
+    """
+    beta = math.exp(-omega * step_time)
+    if steps == 0:
+        return hip + foot_radius
+    if beta >= 1.0:
+        return hip + foot_radius + steps * reach
+    geometric = beta / (1.0 - beta) if math.isinf(steps) else beta * (1 - beta**steps) / (1 - beta)
+    return hip + foot_radius + reach * geometric
+
+
+def hip_box(params: BodyParams, yaw: float) -> FloatArray | None:
+    """Return the hip's box H: ±(pitch, roll) corrected Eq. 15 offsets, heading-aligned [m].
+
+    Counter-clockwise corners (a segment when one axis has no torque), or None when neither.
+    """
+    half_x, half_y = cmp_offset(params), cmp_offset_roll(params)
+    if half_x == 0.0 and half_y == 0.0:
+        return None
+    c, s = math.cos(yaw), math.sin(yaw)
+    local = np.array([[-half_x, -half_y], [half_x, -half_y], [half_x, half_y], [-half_x, half_y]])
+    if half_x == 0.0 or half_y == 0.0:
+        local = np.array([[-half_x, -half_y], [half_x, half_y]])
+    return np.asarray(local @ np.array([[c, s], [-s, c]]), dtype=np.float64)
+
+
+@functools.lru_cache(maxsize=64)
+def landing_foot(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon:
+    """Return the ``side`` foot (LEFT or RIGHT), its ankle at the origin, turned by yaw [m]."""
+    foot = foot_shape(params)
+    return (foot if side is Stance.LEFT else foot.mirrored()).transformed(0.0, 0.0, yaw)
+
+
+@functools.lru_cache(maxsize=32)
+def reach_polygon(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon:
+    """Footholds of the ``side`` foot relative to the stance ankle: R [m].
+
+    The regular polygon of :data:`REACH_SIDES` sides inscribed in the disc of radius
+    ``max_step_length`` (so no foothold beyond the reach is ever proposed), cut, when
+    ``min_step_width`` is set, to the half-plane at least that far out on the landing foot's
+    side of the stance ankle (a left foot lands on the left of a right stance foot), in the
+    frame turned by the stance's yaw.
+    """
+    disc = regular_polygon(params.max_step_length, REACH_SIDES, phase=yaw)
+    if params.min_step_width is None:
+        return disc
+    outward = 1.0 if side is Stance.LEFT else -1.0
+    normal = -outward * np.array([[-math.sin(yaw), math.cos(yaw)]])  # −(lateral, outward)
+    cut = clip_halfplanes(disc, normal, np.array([-params.min_step_width]))
+    if cut is None:  # pragma: no cover - min_step_width < max_step_length is validated
+        raise InvalidParameterError("min_step_width leaves no foothold within the reach")
+    return cut
+
+
+def _other(side: Stance) -> Stance:
+    return Stance.RIGHT if side is Stance.LEFT else Stance.LEFT
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class StepOption:
+    """One way to start stepping from a support: which foot lands first, on what it stands.
+
+    Attributes
+    ----------
+    swing : Stance
+        The foot that lands first (LEFT or RIGHT).
+    stance : ConvexPolygon
+        The support while it swings: the other foot [m].
+    ankle : ndarray, shape (2,)
+        The stance ankle q_0 [m].
+    yaw : float
+        The stance foot's yaw, kept by every landing foot [rad].
+    """
+
+    swing: Stance
+    stance: ConvexPolygon
+    ankle: FloatArray
+    yaw: float
+
+
+def step_options(
+    params: BodyParams, support: Support, swing: Stance | str | None = None
+) -> list[StepOption]:
+    """List the ways to step from ``support``: the free foot, or either one from double.
+
+    ``swing`` picks one foot from double support (it must be the free foot otherwise).
+    """
+    if swing is not None:
+        try:
+            swing = Stance(swing)
+        except ValueError:
+            raise InvalidParameterError(f"swing must be 'left' or 'right', got {swing!r}") from None
+        if swing is Stance.DOUBLE:
+            raise InvalidParameterError("swing must be 'left' or 'right', got 'double'")
+        if support.stance is not Stance.DOUBLE and swing is support.stance:
+            raise InvalidParameterError(
+                f"swing must be the free foot: the {support.stance.value} foot carries the body"
+            )
+    if support.stance is Stance.DOUBLE:
+        sides = [Stance.LEFT, Stance.RIGHT] if swing is None else [swing]
+    else:
+        sides = [_other(support.stance)]
+    options = []
+    for side in sides:
+        stance = _other(side)
+        pose = support.left if stance is Stance.LEFT else support.right
+        single = Support.from_params(params, stance, left=support.left, right=support.right)
+        options.append(StepOption(side, single.polygon, np.array([pose.x, pose.y]), pose.yaw))
+    return options
+
+
+def sum_terms(
+    params: BodyParams, option: StepOption, touchdowns: tuple[float, ...], hip: bool
+) -> tuple[list[tuple[float, Shape]], FloatArray, list[Stance]]:
+    """Return the weighted shapes and the offset of (S1), and the landing sides.
+
+    Terms in order: the hip's box, the stance, the landing feet, the reach polygons.
+    """
+    omega = params.omega
+    a = [math.exp(-omega * t) for t in touchdowns] + [0.0]
+    terms: list[tuple[float, Shape]] = []
+    box = hip_box(params, option.yaw) if hip else None
+    terms.append((1.0 if box is not None else 0.0, box if box is not None else np.zeros((1, 2))))
+    terms.append((1.0 - a[0], option.stance))
+    sides = []
+    side = option.swing
+    for k in range(len(touchdowns)):
+        sides.append(side)
+        terms.append((a[k] - a[k + 1], landing_foot(params, side, option.yaw)))
+        side = _other(side)
+    for k in range(len(touchdowns)):
+        terms.append((a[k], reach_polygon(params, sides[k], option.yaw)))
+    return terms, a[0] * option.ankle, sides
+
+
+def check_touchdowns(params: BodyParams, touchdowns: tuple[float, ...]) -> None:
+    """Refuse touchdown times that are not finite or come sooner than min_step_time apart."""
+    previous = 0.0
+    for k, t in enumerate(touchdowns):
+        finite_float("touchdown", t, "s")
+        gap = params.min_step_time if k else 0.0
+        if t < previous + gap - 1e-12:
+            raise InvalidParameterError(
+                f"touchdown {k + 1} at {t:g} s comes sooner than min_step_time "
+                f"{params.min_step_time:g} s after the previous one"
+            )
+        previous = t
+
+
+def viable_region(
+    params: BodyParams,
+    option: StepOption,
+    touchdowns: tuple[float, ...],
+    *,
+    hip: bool = True,
+) -> ConvexPolygon:
+    """C_N of (S1): the capture points that N steps at these touchdown times capture [m].
+
+    Parameters
+    ----------
+    params : BodyParams
+        Body parameters (ω, feet, reach, hip).
+    option : StepOption
+        Which foot lands first and the stance it leaves (:func:`step_options`).
+    touchdowns : tuple of float
+        t_1 < ... < t_N [s] from now, at least ``min_step_time`` apart; () gives S ⊕ H.
+    hip : bool
+        Include the upper body's box H.
+    """
+    check_touchdowns(params, touchdowns)
+    terms, offset, _ = sum_terms(params, option, tuple(touchdowns), hip)
+    return minkowski_sum(terms, offset)
+
+
+def landing_viable(params: BodyParams, side: Stance, yaw: float, more: int) -> ConvexPolygon:
+    """Return V_more: what the landed ``side`` foot and ``more`` steps capture [m].
+
+    Capture points relative to the landing ankle, touchdowns every Δt_s, without the hip.
+    """
+    foot = landing_foot(params, side, yaw)
+    if more == 0:
+        return foot
+    option = StepOption(_other(side), foot, np.zeros(2), yaw)
+    times = tuple(params.min_step_time * (k + 1) for k in range(more))
+    return viable_region(params, option, times, hip=False)
