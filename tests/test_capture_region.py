@@ -345,3 +345,22 @@ def test_plans_keep_positive_margins_at_every_touchdown():
         plan = found.to_dict()["plan"]
         assert all(i["margin"] >= -1e-9 for i in plan["impact"]), xdot
         assert len(plan["impact"]) == found.steps
+
+
+def test_ray_distances_from_the_support_function_equal_the_polygon():
+    # bounds measures the thresholds from (S2) without building C_N: the same distances.
+    from pushrecovery.surfaces.n_step import ray_distances
+
+    headings = np.linspace(0.0, 2.0 * math.pi, 16, endpoint=False)
+    for overrides in ({}, {"min_step_width": 0.05}, {"torque_max_roll": 0.0}, NO_HIP):
+        params = load_params(overrides=overrides)
+        support = Support.from_params(params, "double", left=FootPose(0.02, 0.11, 0.2))
+        for option in step_options(params, support):
+            for steps in (0, 1, 3):
+                times = touchdowns(params, steps)
+                region = viable_region(params, option, times)
+                fast = ray_distances(params, option, times, support.ankle, headings)
+                inside = float(region.signed_distance(*support.ankle)) > 0.0
+                for heading, value in zip(headings, fast, strict=True):
+                    exact = region.ray_distance(*support.ankle, heading) if inside else 0.0
+                    assert value == pytest.approx(exact, abs=1e-12)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 
@@ -87,28 +89,29 @@ def plane_bounds(params: BodyParams, support: Support) -> dict[str, Any]:
     left) [m]; with yawed feet these are not the world's x and y.
     """
     from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+    from pushrecovery.surfaces.n_step import ray_distances, step_options
     from pushrecovery.surfaces.plane import (
         DIRECTIONS,
         cmp_polygon,
         direction_thresholds,
         step_threshold_xy,
     )
-    from pushrecovery.surfaces.step_regions import StepRegions
 
     hip = cmp_polygon(support, params)
     omega = params.omega
-    regions = StepRegions.of(params, support)
+    # Every region up to N counts (a state needing fewer steps is a step verdict too), from
+    # either foot in double support: the farthest edge of all of them, from (S2) directly.
     steps: dict[str, dict[str, float]] = {}
-    for polygon, n in zip(regions.polygons, regions.steps, strict=True):
-        if float(polygon.signed_distance(*support.ankle)) <= 0.0:
-            continue  # this region does not hold the CoM at rest: no push it absorbs
-        found = direction_thresholds(polygon, support.ankle, omega)
-        # Every region up to N counts: a state needing fewer steps is a step verdict too.
-        previous = steps.get(str(n - 1), {})
-        steps[str(n)] = {
-            name: max(value, steps.get(str(n), {}).get(name, 0.0), previous.get(name, 0.0))
-            for name, value in found.items()
-        }
+    best = np.zeros(len(DIRECTIONS))
+    options = step_options(params, support)
+    headings = np.array(list(DIRECTIONS.values()))
+    for n in range(1, params.max_steps + 1):
+        times = tuple(params.min_step_time * (k + 1) for k in range(n))
+        for option in options:
+            best = np.maximum(
+                best, omega * ray_distances(params, option, times, support.ankle, headings)
+            )
+        steps[str(n)] = {name: float(v) for name, v in zip(DIRECTIONS, best, strict=True)}
     return {
         "support": support.to_dict(),
         "reference": list(support.ankle),

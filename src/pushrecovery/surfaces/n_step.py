@@ -47,7 +47,7 @@ from pushrecovery.ground.minkowski import (
     minkowski_sum,
     regular_polygon,
 )
-from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.polygon import ConvexPolygon, following
 from pushrecovery.ground.support import Stance, Support, foot_shape
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
@@ -61,6 +61,7 @@ __all__ = [
     "hip_box",
     "landing_foot",
     "landing_viable",
+    "ray_distances",
     "reach_polygon",
     "step_options",
     "sum_terms",
@@ -280,6 +281,58 @@ def viable_region(
     check_touchdowns(params, touchdowns)
     terms, offset, _ = sum_terms(params, option, tuple(touchdowns), hip)
     return minkowski_sum(terms, offset)
+
+
+def ray_distances(
+    params: BodyParams,
+    option: StepOption,
+    touchdowns: tuple[float, ...],
+    origin: tuple[float, float],
+    headings: FloatArray,
+    *,
+    hip: bool = True,
+) -> FloatArray:
+    """Distances from ``origin`` to the edge of C_N along each heading [m], from (S2) alone.
+
+    C_N = {p : n · p <= h(n)} over the edge normals n of its terms (a superset of its own
+    edge normals gives the same polygon), so the exit of the ray origin + s u is
+    min over n · u > 0 of (h(n) − n · origin) / (n · u), with h of (S2): no polygon is built
+    (``bounds`` needs only these distances). 0 when the origin is not inside C_N.
+    """
+    check_touchdowns(params, touchdowns)
+    terms, offset, _ = sum_terms(params, option, tuple(touchdowns), hip)
+    shapes: dict[int, tuple[FloatArray, list[float]]] = {}  # the reach repeats: one entry
+    for weight, shape in terms:
+        if weight != 0.0:
+            shapes.setdefault(id(shape), (_vertices_of(shape), []))[1].append(weight)
+    normals = np.vstack([_edge_normals(vertices) for vertices, _ in shapes.values()])
+    support = normals @ offset
+    for vertices, weights in shapes.values():
+        support = support + sum(weights) * (vertices @ normals.T).max(axis=0)
+    room = support - normals @ np.asarray(origin, dtype=np.float64)
+    headings = np.atleast_1d(np.asarray(headings, dtype=np.float64))
+    if np.any(room <= 0.0):
+        return np.zeros(headings.shape)
+    rate = normals @ np.vstack([np.cos(headings), np.sin(headings)])
+    ratio = np.where(rate > 1e-15, room[:, None] / np.where(rate > 1e-15, rate, 1.0), np.inf)
+    return np.asarray(ratio.min(axis=0), dtype=np.float64)
+
+
+def _vertices_of(shape: Shape) -> FloatArray:
+    return shape.vertices if isinstance(shape, ConvexPolygon) else np.asarray(shape)
+
+
+def _edge_normals(vertices: FloatArray) -> FloatArray:
+    """Return the outward unit normals of a counter-clockwise loop.
+
+    Both sides of a segment; none for a point.
+    """
+    if len(vertices) < 2:
+        return np.zeros((0, 2))
+    edges = following(vertices) - vertices
+    lengths = np.hypot(edges[:, 0], edges[:, 1])
+    keep = lengths > 0.0
+    return np.column_stack([edges[keep, 1], -edges[keep, 0]]) / lengths[keep, None]
 
 
 def landing_viable(params: BodyParams, side: Stance, yaw: float, more: int) -> ConvexPolygon:
