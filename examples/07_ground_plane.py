@@ -5,9 +5,8 @@ the left. Nobody reacts: the CoP stays at the middle of the foot and the upper b
 so the capture point runs away (the 2-D model of models.flywheel_plane, advanced exactly every
 millisecond). The monitor classifies every state as a 1 kHz balance loop would, and reports
 when the strategy the body needs escalates, from hip to a step to a fall: how long a controller
-has to decide. (At the fall the step margin is still positive: Sec. IV's margin counts the
-reach left beyond the shortest step that puts the capture point on the new foot, which can
-exist when no single step recovers: the inconsistency the next issue's capture regions fix.)
+has to decide. The step margin is the capture point's distance to the N-step capture regions
+(docs/steps.md): it turns negative exactly when the verdict turns to fall.
 """
 
 import time
@@ -21,7 +20,7 @@ from pushrecovery.surfaces.monitor import BalanceMonitor
 
 params = load_params()
 support = Support.from_params(params, "left", left=FootPose(0.0, 0.1, 0.2))
-monitor = BalanceMonitor(params, support)  # built once: loads the compiled step test
+monitor = BalanceMonitor(params, support)  # built once: the step regions, compiled tests
 
 cx, cy = support.polygon.centroid  # the CoP held at the middle of the foot
 state = np.array([cx, cy, 0.0, 0.0, 0.15, 0.25, 0.0, 0.0])  # just after the push [m, m/s]
