@@ -364,3 +364,14 @@ def test_ray_distances_from_the_support_function_equal_the_polygon():
                 for heading, value in zip(headings, fast, strict=True):
                     exact = region.ray_distance(*support.ankle, heading) if inside else 0.0
                     assert value == pytest.approx(exact, abs=1e-12)
+
+
+def test_minkowski_sums_with_a_point_term_keep_every_vertex():
+    # A point adds no edge; a vertex repeated by the sum must not take its twin with it.
+    square = regular_polygon(0.1, 4, centre=(0.3, 0.8), phase=0.4)
+    total = minkowski_sum([(1.9, np.array([[0.2, -0.1]])), (0.9, square)])
+    assert len(total.vertices) == 4
+    for angle in DIRECTIONS:
+        d = np.array([math.cos(angle), math.sin(angle)])
+        expected = 1.9 * (d @ [0.2, -0.1]) + 0.9 * support_value(square, angle)
+        assert support_value(total, angle) == pytest.approx(expected, abs=1e-12)

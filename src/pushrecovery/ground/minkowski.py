@@ -70,6 +70,7 @@ def minkowski_sum(
     if not edges:
         raise InvalidParameterError("a Minkowski sum needs at least one term of non-zero weight")
     every = np.concatenate(edges)
+    every = every[np.hypot(every[:, 0], every[:, 1]) > 0.0]  # points add no edge
     # From the lowest-leftmost vertex, a convex polygon's edge angles rise through [0, 2π).
     angle = np.mod(np.arctan2(every[:, 1], every[:, 0]), 2.0 * math.pi)
     order = np.argsort(angle, kind="stable")
@@ -83,19 +84,24 @@ def minkowski_sum(
 
 
 def _cleaned(vertices: FloatArray) -> ConvexPolygon:
-    """Drop repeated and collinear vertices of a convex counter-clockwise vertex loop."""
+    """Drop repeated and collinear vertices of a convex counter-clockwise vertex loop.
+
+    Repeats first (a vertex equal to the next one), then vertices where the loop does not
+    turn: a repeat's twin does not turn either, and must not be dropped with it.
+    """
     scale = max(1.0, float(np.abs(vertices).max()))
+    step = following(vertices) - vertices
+    vertices = vertices[np.hypot(step[:, 0], step[:, 1]) > _RELATIVE_EDGE * scale]
     for _ in range(len(vertices)):  # each pass drops every flat vertex it sees; usually one
+        if len(vertices) < 3:
+            break
         before = vertices - following(vertices, -1)
         after = following(vertices) - vertices
         turn = before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0]
-        long = np.hypot(after[:, 0], after[:, 1]) > _RELATIVE_EDGE * scale
-        keep = long & (turn > _RELATIVE_EDGE * scale * scale)
+        keep = turn > _RELATIVE_EDGE * scale * scale
         if keep.all():
             break
         vertices = vertices[keep]
-        if len(vertices) < 3:
-            break
     if len(vertices) < 3:
         raise InvalidParameterError("the Minkowski sum has zero area")
     return ConvexPolygon._from_ccw(np.ascontiguousarray(vertices))
@@ -117,22 +123,17 @@ def clip_halfplanes(
     scale = max(1.0, float(np.abs(vertices).max()))
     normals, offsets = np.asarray(normals), np.asarray(offsets)
     cutting = np.any(vertices @ normals.T > offsets, axis=0)
-    # Python floats: a few cuts of a small polygon, where numpy's per-call cost would dominate.
-    loop = [(float(x), float(y)) for x, y in vertices]
-    for (nx, ny), b in zip(normals[cutting].tolist(), offsets[cutting].tolist(), strict=True):
-        kept: list[tuple[float, float]] = []
-        for k, (px, py) in enumerate(loop):
-            qx, qy = loop[k - len(loop) + 1]
-            e, f = nx * px + ny * py - b, nx * qx + ny * qy - b
-            if e <= 0.0:
-                kept.append((px, py))
-            if (e < 0.0 < f) or (f < 0.0 < e):
-                share = e / (e - f)
-                kept.append((px + share * (qx - px), py + share * (qy - py)))
-        loop = kept
-        if len(loop) < 3:
-            return None
-    points = np.array(loop)
+    if not cutting.any():
+        return polygon
+    from pushrecovery.ground._clip import clip_loop  # compiled: hundreds of vertex visits
+
+    points = clip_loop(
+        np.ascontiguousarray(vertices),
+        np.ascontiguousarray(normals[cutting]),
+        np.ascontiguousarray(offsets[cutting]),
+    )
+    if len(points) < 3:
+        return None
     area = 0.5 * float(
         np.dot(points[:, 0], following(points[:, 1]))
         - np.dot(following(points[:, 0]), points[:, 1])

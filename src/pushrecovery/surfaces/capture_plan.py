@@ -6,15 +6,23 @@ The plan decomposes the capture point in the Minkowski sum (S1) of
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.ground.minkowski import decompose, minkowski_sum
+from pushrecovery.ground.minkowski import Shape, decompose, minkowski_sum
 from pushrecovery.ground.support import Stance
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.n_step import StepOption, check_touchdowns, hip_box, sum_terms
+from pushrecovery.surfaces.n_step import (
+    StepOption,
+    check_touchdowns,
+    hip_box,
+    landing_foot,
+    landing_viable,
+    sum_terms,
+)
 
 __all__ = ["CapturePlan", "capture_plan"]
 
@@ -76,18 +84,88 @@ def capture_plan(
     *,
     first_touchdown: float | None = None,
     hip: bool = True,
+    margin: float | None = None,
 ) -> CapturePlan:
     """Footholds, touchdowns and CoPs that capture the capture point ξ0 with ``steps`` steps.
 
-    The decomposition of ξ0 in the Minkowski sum (S1) that keeps every term equally deep
-    (:func:`~pushrecovery.ground.minkowski.decompose`): when ξ0 ∈ C_N the plan captures the
-    LIPM exactly (hold each CoP until the next touchdown, then the last one); outside, it is
-    the plan of the nearest boundary point along the ray from C_N's centre and ``margin`` < 0.
-    Touchdowns every ``min_step_time`` from ``first_touchdown`` (default: min_step_time).
+    Step by step, as a controller re-planning at each touchdown would: the first foothold is
+    the recommended one of the ``steps``-step foothold region (S3) at the first touchdown (the
+    farthest from the region's edges,
+    :func:`~pushrecovery.surfaces.capture_region.chebyshev_centre`); the CoP to hold until
+    then and the hip's share come from splitting T ξ0 − q_1 over T H ⊕ (T − 1) S ⊕ V_{N−1}
+    with every term equally deep (:func:`~pushrecovery.ground.minkowski.decompose`), which
+    also gives the capture point at the touchdown; the landing foot is then the stance of a
+    plan of N − 1 steps without the hip (its share is spent), every Δt_s. When ξ0 lies in C_N
+    the plan captures the LIPM exactly (each CoP held until the next touchdown, then the
+    last); when the region is empty, the plan of (S1)'s decomposition along the ray from C_N's
+    centre is returned, with ``margin`` < 0. Touchdowns every ``min_step_time`` from
+    ``first_touchdown`` (default: min_step_time). ``margin``, when known, skips computing the
+    signed distance of ξ0 to C_N (the recursion knows it is inside).
     """
+    from pushrecovery.surfaces.capture_region import chebyshev_centre, foothold_region
+
     first = params.min_step_time if first_touchdown is None else first_touchdown
     times = tuple(first + params.min_step_time * k for k in range(steps))
     check_touchdowns(params, times)
+    if margin is None:
+        terms, offset, _ = sum_terms(params, option, times, hip)
+        margin = float(minkowski_sum(terms, offset).signed_distance(xi[0], xi[1]))
+    region = foothold_region(np.asarray(xi), params, option, first, steps, hip=hip)
+    if region is None:
+        return _decomposed(xi, params, option, steps, times, hip, margin)
+    foothold = chebyshev_centre(region)
+    scale = math.exp(params.omega * first)
+    box = hip_box(params, option.yaw) if hip else None
+    landing = landing_viable(params, option.swing, option.yaw, steps - 1)
+    split: list[tuple[float, Shape]] = [
+        (scale, box if box is not None else np.zeros((1, 2))),
+        (scale - 1.0, option.stance),
+        (1.0, landing),
+    ]
+    target = scale * np.asarray(xi) - foothold
+    whole = minkowski_sum(split, np.zeros(2))
+    (share, cop, arrival), _ = decompose(target, split, np.zeros(2), whole)
+    hip_share = share if box is not None else np.zeros(2)
+    if steps == 1:
+        rest_footholds, rest_times, rest_cops = np.zeros((0, 2)), np.zeros(0), arrival[None, :]
+        rest_sides: tuple[Stance, ...] = ()
+        rest_cops = rest_cops + foothold
+    else:
+        following = StepOption(
+            Stance.RIGHT if option.swing is Stance.LEFT else Stance.LEFT,
+            landing_foot(params, option.swing, option.yaw).transformed(
+                float(foothold[0]), float(foothold[1]), 0.0
+            ),
+            np.asarray(foothold, dtype=np.float64),
+            option.yaw,
+        )
+        rest = capture_plan(
+            foothold + arrival, params, following, steps - 1, hip=False, margin=margin
+        )
+        rest_footholds, rest_times, rest_cops = rest.footholds, rest.touchdowns, rest.cops
+        rest_sides = rest.swings
+    return CapturePlan(
+        steps,
+        (option.swing, *rest_sides),
+        np.vstack([foothold[None, :], rest_footholds]),
+        np.concatenate([[first], first + rest_times]),
+        np.vstack([cop[None, :], rest_cops]),
+        np.asarray(hip_share, dtype=np.float64),
+        margin,
+        np.array(option.ankle, dtype=np.float64),
+    )
+
+
+def _decomposed(
+    xi: FloatArray,
+    params: BodyParams,
+    option: StepOption,
+    steps: int,
+    times: tuple[float, ...],
+    hip: bool,
+    margin: float,
+) -> CapturePlan:
+    """Return the plan of (S1)'s decomposition (every term equally deep), for ξ0 outside C_N."""
     terms, offset, sides = sum_terms(params, option, times, hip)
     total = minkowski_sum(terms, offset)
     points, _ = decompose(xi, terms, offset, total)
@@ -101,6 +179,6 @@ def capture_plan(
         np.array(times),
         cops,
         np.asarray(points[0]) if hip and hip_box(params, option.yaw) is not None else np.zeros(2),
-        float(total.signed_distance(xi[0], xi[1])),
+        margin,
         np.array(option.ankle, dtype=np.float64),
     )

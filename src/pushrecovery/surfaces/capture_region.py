@@ -31,9 +31,15 @@ from pushrecovery.ground.minkowski import Shape, clip, clip_halfplanes, minkowsk
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.n_step import hip_box, landing_viable, reach_polygon, step_options
+from pushrecovery.surfaces.n_step import (
+    StepOption,
+    hip_box,
+    landing_viable,
+    reach_polygon,
+    step_options,
+)
 
-__all__ = ["CaptureRegion", "capture_region"]
+__all__ = ["CaptureRegion", "capture_region", "chebyshev_centre", "foothold_region"]
 
 FloatArray = NDArray[np.float64]
 
@@ -136,22 +142,39 @@ def capture_region(
         )
         swing = Stance.LEFT if lateral >= 0.0 else Stance.RIGHT
     option = step_options(params, support, swing)[0]
+    polygon = foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
+    foothold = None if polygon is None else chebyshev_centre(polygon)
+    return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
+
+
+def foothold_region(
+    xi: FloatArray,
+    params: BodyParams,
+    option: StepOption,
+    touchdown: float,
+    steps: int,
+    *,
+    timing: Literal["exact", "after"] = "exact",
+    hip: bool = True,
+) -> ConvexPolygon | None:
+    """(S3) for the capture point ξ0: first footholds of ``option``'s landing foot [m].
+
+    The checked-arguments core of :func:`capture_region`; ``touchdown`` t [s] after now, then
+    ``steps`` − 1 steps every Δt_s. None when no foothold within reach captures.
+    """
     landing = landing_viable(params, option.swing, option.yaw, steps - 1)
     box = hip_box(params, option.yaw) if hip else None
     boxes: list[tuple[float, Shape]] = [] if box is None else [(1.0, box)]
     ankle_x, ankle_y = (float(v) for v in option.ankle)
     window = reach_polygon(params, option.swing, option.yaw).transformed(ankle_x, ankle_y, 0.0)
-    scale = math.exp(params.omega * t)
+    scale = math.exp(params.omega * touchdown)
     at = minkowski_sum(
         [(-scale * w, b) for w, b in boxes] + [(1.0 - scale, option.stance), (-1.0, landing)],
         scale * xi,
     )
     if timing == "exact":
-        polygon = clip(at, window)
-    else:
-        polygon = _after(at, xi, boxes, option.stance, window)
-    foothold = None if polygon is None else _chebyshev_centre(polygon)
-    return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
+        return clip(at, window)
+    return _after(at, xi, boxes, option.stance, window)
 
 
 def _capture_point(x: float, y: float, xdot: float, ydot: float, params: BodyParams) -> FloatArray:
@@ -197,7 +220,7 @@ def _after(
     return clip_halfplanes(window, normals, offsets)
 
 
-def _chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
+def chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
     """Return the centre of the largest disc in a convex polygon [m].
 
     The LP max r subject to n_i · q + r <= b_i, solved by a small compiled dual simplex
@@ -205,10 +228,10 @@ def _chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
     can slide (two parallel edges hold it) the centres form a segment and its midpoint is
     returned: unique, and mirrored with the polygon.
     """
-    from pushrecovery.surfaces._kernels import chebyshev_centre
+    from pushrecovery.surfaces._kernels import chebyshev_centre as solve
 
     normals, offsets = polygon.normals, polygon.offsets
-    qx, qy, radius, ok = chebyshev_centre(normals, offsets)
+    qx, qy, radius, ok = solve(normals, offsets)
     if not ok:  # pragma: no cover - the compiled simplex found no start or did not converge
         from scipy.optimize import linprog
 

@@ -335,6 +335,7 @@ def _edge_normals(vertices: FloatArray) -> FloatArray:
     return np.column_stack([edges[keep, 1], -edges[keep, 0]]) / lengths[keep, None]
 
 
+@functools.lru_cache(maxsize=256)
 def landing_viable(params: BodyParams, side: Stance, yaw: float, more: int) -> ConvexPolygon:
     """Return V_more: what the landed ``side`` foot and ``more`` steps capture [m].
 
