@@ -89,7 +89,8 @@ class LineSteps:
     margin : ndarray
         Signed distance of ξ to C_{max_steps} [m] (the intervals are nested).
     step_length : ndarray
-        First step of the plan, landing ankle minus stance ankle [m] (NaN without steps).
+        Recommended first step, the middle of its range, landing ankle minus stance ankle [m]
+        (NaN without steps).
     shortest, longest : ndarray
         The first steps along its direction that still capture with ``steps`` steps [m].
     """
@@ -110,11 +111,9 @@ def line_steps(
 ) -> LineSteps:
     """N-step verdicts and first steps on a line, vectorised (module docstring) [m].
 
-    The plan keeps every term of (S1) at the same fraction f of its half-width from its
-    centre (:func:`~pushrecovery.ground.minkowski.decompose` on intervals): f = (ξ − c)/h of
-    C_N, first step f l. The range of first steps is (S3) on the line: q_1 − q_0 in
-    T ξ − T[−a, a] − (T − 1)[s⁻, s⁺] − V_{N−1} − q_0, V_{N−1} = [δ⁻ − l s_{N−1}, δ⁺ +
-    l s_{N−1}], T = e^{ωΔt_s}, within ±l.
+    The range of first steps is (S3) on the line: q_1 − q_0 in T ξ − T[−a, a] − (T − 1)[s⁻, s⁺]
+    − V_{N−1} − q_0, V_{N−1} = [δ⁻ − l s_{N−1}, δ⁺ + l s_{N−1}], T = e^{ωΔt_s}, within ±l; the
+    recommended first step is its middle (the most robust, as :func:`sagittal_plan`).
     """
     capture, lower, upper, ankle = np.broadcast_arrays(
         *(np.asarray(a, dtype=np.float64) for a in (capture, lower, upper, ankle))
@@ -132,15 +131,13 @@ def line_steps(
     scale = math.exp(params.omega * params.min_step_time)
     for n in np.unique(steps[steps > 0]):
         rows = steps == n
-        low, high = line_step_bounds(lower[rows], upper[rows], ankle[rows], params, int(n))
-        share = np.clip((capture[rows] - 0.5 * (low + high)) / (0.5 * (high - low)), -1.0, 1.0)
-        length[rows] = share * reach
         more = capturability_distance(int(n) - 1, params.omega, params.min_step_time, reach, 0.0)
         xi = capture[rows]
         first = scale * xi - scale * hip - (scale - 1.0) * upper[rows] - params.toe - more
         last = scale * xi + scale * hip - (scale - 1.0) * lower[rows] - params.heel + more
         first = np.maximum(first - ankle[rows], -reach)
         last = np.minimum(last - ankle[rows], reach)
+        length[rows] = 0.5 * (first + last)  # the most robust first step: the middle
         forward = length[rows] >= 0.0
         shortest[rows] = np.where(forward, np.maximum(first, 0.0), np.maximum(-last, 0.0))
         longest[rows] = np.where(forward, last, -first)
@@ -157,26 +154,46 @@ def sagittal_step_interval(params: BodyParams, steps: int | None = None) -> Capt
 def sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
     """Return the plan of :func:`~.capture_plan.capture_plan` on the sagittal line.
 
-    Every term of (S1) at the same fraction f of its half-width from its centre, f = (ξ −
-    c)/half-width of C_N: steps of f l, CoPs at the foot's middle plus f (δ⁺ − δ⁻)/2, the
-    hip's share f a. Footholds (x, 0) from the ankle at 0, touchdowns every Δt_s.
+    Step by step: the first foothold is the middle of the interval of first footholds ((S3)
+    on the line: T ξ − T[−a, a] − (T − 1)(q_0 + [δ⁻, δ⁺]) − V_{N−1}, within q_0 ± l), the most
+    robust one; the CoP and the hip's share put every term of T ξ − q_1 at the same fraction of
+    its half-width from its centre, which gives the capture point at touchdown; then the same
+    from the new foot, N − 1 steps, without the hip. Footholds (x, 0), touchdowns every Δt_s.
     """
     interval = sagittal_step_interval(params, steps)
-    share = max(-1.0, min(1.0, (xi - interval.centre) / interval.half_width))
+    margin = interval.half_width - abs(xi - interval.centre)
+    scale = math.exp(params.omega * params.min_step_time)
     middle, half = 0.5 * (params.heel + params.toe), 0.5 * (params.toe - params.heel)
-    cops = np.zeros((steps + 1, 2))
-    footholds = np.zeros((steps, 2))
-    footholds[:, 0] = share * params.max_step_length * np.arange(1, steps + 1)
-    cops[0, 0] = middle + share * half
-    cops[1:, 0] = footholds[:, 0] + middle + share * half
+    reach = params.max_step_length
+    footholds, cops = np.zeros((steps, 2)), np.zeros((steps + 1, 2))
+    ankle, capture, hip, share_hip = 0.0, xi, cmp_offset(params), 0.0
+    for k in range(steps):
+        more = capturability_distance(steps - 1 - k, params.omega, params.min_step_time, reach, 0.0)
+        low = scale * capture - scale * hip - (scale - 1.0) * (ankle + params.toe)
+        low -= params.toe + more
+        high = scale * capture + scale * hip - (scale - 1.0) * (ankle + params.heel)
+        high -= params.heel - more
+        foothold = 0.5 * (max(low, ankle - reach) + min(high, ankle + reach))
+        # Split T ξ − q over T[−a, a] + (T − 1)(q_0 + [δ⁻, δ⁺]) + V_{N−1}, equally deep.
+        target = scale * capture - foothold
+        centre = (scale - 1.0) * (ankle + middle) + middle
+        width = scale * hip + (scale - 1.0) * half + half + more
+        share = max(-1.0, min(1.0, (target - centre) / width)) if width > 0.0 else 0.0
+        if k == 0:
+            share_hip = share * hip
+        cops[k, 0] = ankle + middle + share * half
+        footholds[k, 0] = foothold
+        capture = foothold + middle + share * (half + more)
+        ankle, hip = foothold, 0.0
+    cops[steps, 0] = capture  # the last CoP holds the capture point, in the last foot
     return CapturePlan(
         steps,
         tuple(Stance.LEFT if k % 2 == 0 else Stance.RIGHT for k in range(steps)),
         footholds,
         params.min_step_time * np.arange(1, steps + 1, dtype=np.float64),
         cops,
-        np.array([share * cmp_offset(params), 0.0]),
-        interval.half_width - abs(xi - interval.centre),
+        np.array([share_hip, 0.0]),
+        margin,
     )
 
 
