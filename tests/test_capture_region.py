@@ -375,3 +375,27 @@ def test_minkowski_sums_with_a_point_term_keep_every_vertex():
         d = np.array([math.cos(angle), math.sin(angle)])
         expected = 1.9 * (d @ [0.2, -0.1]) + 0.9 * support_value(square, angle)
         assert support_value(total, angle) == pytest.approx(expected, abs=1e-12)
+
+
+def test_the_compiled_chebyshev_centre_equals_highs():
+    # The dual simplex behind the recommended foothold against scipy's HiGHS on random hulls.
+    from pushrecovery.ground import convex_hull
+    from pushrecovery.surfaces._kernels import chebyshev_centre
+
+    rng = np.random.default_rng(7)
+    solved = 0
+    for _ in range(400):
+        points = rng.normal(size=(int(rng.integers(3, 60)), 2)) * rng.uniform(0.05, 2.0, 2)
+        try:
+            polygon = convex_hull(points)
+        except InvalidParameterError:
+            continue
+        qx, qy, radius, ok = chebyshev_centre(polygon.normals, polygon.offsets)
+        a_ub = np.column_stack([polygon.normals, np.ones(len(polygon.offsets))])
+        bounds = [(None, None), (None, None), (0.0, None)]
+        exact = linprog([0.0, 0.0, -1.0], A_ub=a_ub, b_ub=polygon.offsets, bounds=bounds)
+        assert ok and radius == pytest.approx(exact.x[2], abs=1e-10)
+        slack = polygon.offsets - polygon.normals @ [qx, qy]
+        assert slack.min() == pytest.approx(radius, abs=1e-10)  # a largest disc, inside
+        solved += 1
+    assert solved > 350
