@@ -307,10 +307,34 @@ def _disagreements(table: Any) -> str:
     )
     if several:
         text += (
-            f" ({several} of them predicted to fall, beyond the single-step limit, recovered "
-            "with two or more steps, which the single-step surface of Sec. IV does not count)"
+            f" ({several} of them predicted to fall recovered with two or more steps, beyond "
+            "max_steps or the N-step regions)"
         )
     return paragraph(text + ".")
+
+
+def _steps_line(summary: Mapping[str, Any]) -> str:
+    """Describe the N-step predictions against the steps taken (summary ``steps``)."""
+    steps = summary.get("steps") or {}
+    if not steps.get("predicted"):
+        return ""
+    predicted = ", ".join(
+        f"{n if n != '-1' else 'fall'}: {count}" for n, count in steps["predicted"].items()
+    )
+    taken = ", ".join(f"{n}: {count}" for n, count in steps["taken"].items())
+    exact = steps.get("exact")
+    share = (
+        ""
+        if exact is None
+        else (
+            f" Of the recovered pushes predicted to need steps, {num(100 * exact, 3)} % took "
+            "exactly the predicted number."
+        )
+    )
+    return paragraph(
+        f"Steps predicted per push (N-step regions, docs/steps.md): {esc(predicted)}; steps "
+        f"taken: {esc(taken)}.{share}"
+    )
 
 
 def _campaign_body(
@@ -342,6 +366,7 @@ def _campaign_body(
         )
         + _confusion_table(summary, f"confusion-{key}")
         + _disagreements(result.table)
+        + _steps_line(summary)
     )
     picture = plot_outcome_map(result.table, spec, result.directory / "outcome-map.png")
     parts.append(
@@ -350,8 +375,8 @@ def _campaign_body(
             picture,
             "Each push at (x0, ẋ), coloured by the strategy the run used (green ankle, orange "
             "hip, blue step; grey ×: fell; black ring: verdict ≠ outcome); dashed: the "
-            "capture-point edges of Eq. (4) and corrected Eq. (15); dash-dotted: the "
-            "single-step limit (Sec. IV).",
+            "capture-point edges of Eq. (4), corrected Eq. (15) and of max_steps steps; "
+            "dash-dotted: Sec. IV's single-step limit (the recovery controller's).",
         )
     )
     if boundary and summary["boundary"]:
