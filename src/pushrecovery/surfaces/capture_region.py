@@ -18,6 +18,7 @@ a step and may put its foot anywhere later).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Literal
@@ -165,8 +166,7 @@ def foothold_region(
     landing = landing_viable(params, option.swing, option.yaw, steps - 1)
     box = hip_box(params, option.yaw) if hip else None
     boxes: list[tuple[float, Shape]] = [] if box is None else [(1.0, box)]
-    ankle_x, ankle_y = (float(v) for v in option.ankle)
-    window = reach_polygon(params, option.swing, option.yaw).transformed(ankle_x, ankle_y, 0.0)
+    window = _window(params, option.swing, option.yaw, *(float(v) for v in option.ankle))
     scale = math.exp(params.omega * touchdown)
     at = minkowski_sum(
         [(-scale * w, b) for w, b in boxes] + [(1.0 - scale, option.stance), (-1.0, landing)],
@@ -175,6 +175,14 @@ def foothold_region(
     if timing == "exact":
         return clip(at, window)
     return _after(at, xi, boxes, option.stance, window)
+
+
+@functools.lru_cache(maxsize=64)
+def _window(
+    params: BodyParams, side: Stance, yaw: float, ankle_x: float, ankle_y: float
+) -> ConvexPolygon:
+    """Return the reach polygon about the stance ankle (kept: a loop asks again and again)."""
+    return reach_polygon(params, side, yaw).transformed(ankle_x, ankle_y, 0.0)
 
 
 def _capture_point(x: float, y: float, xdot: float, ydot: float, params: BodyParams) -> FloatArray:
