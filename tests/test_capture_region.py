@@ -380,7 +380,7 @@ def test_minkowski_sums_with_a_point_term_keep_every_vertex():
 def test_the_compiled_chebyshev_centre_equals_highs():
     # The dual simplex behind the recommended foothold against scipy's HiGHS on random hulls.
     from pushrecovery.ground import convex_hull
-    from pushrecovery.surfaces._kernels import chebyshev_centre
+    from pushrecovery.ground._kernels import chebyshev_centre
 
     rng = np.random.default_rng(7)
     solved = 0

@@ -258,6 +258,11 @@ big = np.linspace(-1.0, 1.0, 1 << 17)
 classify_states(0.1 * big, big, P)
 classify_states(0.1 * big, big, P, y=0.05 * big, ydot=big)
 cop_margin_xy(0.1 * big, 0.1 * big, big, big, Support.from_params(P), P)
+# Steps: the foothold region with its centre, and a plan.
+from pushrecovery.surfaces.classify import classify
+from pushrecovery.surfaces.capture_region import capture_region
+capture_region(0.0, 0.1, 1.5, -0.4, P, Support.from_params(P, "left"))
+classify(0.0, 2.6, P, y=0.0, ydot=0.0)
 """
 KERNELS = {
     "_step_scalar.decide",
@@ -271,6 +276,10 @@ KERNELS = {
     "_kernels.sagittal_codes",
     "_kernels._codes_4",
     "_kernels._margins_4",
+    "_kernels.foothold_kernel",
+    "_kernels.decompose_loop",
+    "_kernels.minkowski_loop",
+    "_kernels.loop_signed_distance",
 }
 
 

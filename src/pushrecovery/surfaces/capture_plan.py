@@ -12,7 +12,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.ground.minkowski import Shape, decompose, minkowski_sum
+from pushrecovery.ground.minkowski import (
+    Shape,
+    decompose,
+    minkowski_sum,
+    stacked_shapes,
+    sum_loop,
+)
 from pushrecovery.ground.support import Stance
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.n_step import (
@@ -102,18 +108,21 @@ def capture_plan(
     ``first_touchdown`` (default: min_step_time). ``margin``, when known, skips computing the
     signed distance of ξ0 to C_N (the recursion knows it is inside).
     """
-    from pushrecovery.surfaces.capture_region import chebyshev_centre, foothold_region
+    from pushrecovery.surfaces.capture_region import foothold_and_centre
 
     first = params.min_step_time if first_touchdown is None else first_touchdown
     times = tuple(first + params.min_step_time * k for k in range(steps))
     check_touchdowns(params, times)
     if margin is None:
+        from pushrecovery.ground._kernels import loop_signed_distance
+
         terms, offset, _ = sum_terms(params, option, times, hip)
-        margin = float(minkowski_sum(terms, offset).signed_distance(xi[0], xi[1]))
-    region = foothold_region(np.asarray(xi), params, option, first, steps, hip=hip)
-    if region is None:
+        margin = float(loop_signed_distance(sum_loop(terms, offset), xi[0], xi[1]))
+    _, foothold = foothold_and_centre(
+        np.asarray(xi), params, option, first, steps, hip, polygon=False
+    )
+    if foothold is None:
         return _decomposed(xi, params, option, steps, times, hip, margin)
-    foothold = chebyshev_centre(region)
     scale = math.exp(params.omega * first)
     box = hip_box(params, option.yaw) if hip else None
     landing = landing_viable(params, option.swing, option.yaw, steps - 1)
@@ -123,8 +132,7 @@ def capture_plan(
         (1.0, landing),
     ]
     target = scale * np.asarray(xi) - foothold
-    whole = minkowski_sum(split, np.zeros(2))
-    (share, cop, arrival), _ = decompose(target, split, np.zeros(2), whole)
+    share, cop, arrival = _split(target, split)
     hip_share = share if box is not None else np.zeros(2)
     if steps == 1:
         rest_footholds, rest_times, rest_cops = np.zeros((0, 2)), np.zeros(0), arrival[None, :]
@@ -154,6 +162,19 @@ def capture_plan(
         margin,
         np.array(option.ankle, dtype=np.float64),
     )
+
+
+def _split(
+    target: FloatArray, split: list[tuple[float, Shape]]
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Decompose ``target`` in the sum of ``split`` (compiled: a plan does it at every step)."""
+    from pushrecovery.ground._kernels import decompose_loop, minkowski_loop
+
+    stacked, counts, weights = stacked_shapes(split)
+    origin = np.zeros(2)
+    total = minkowski_loop(stacked, counts, weights, origin)
+    points, _ = decompose_loop(target, stacked, counts, weights, origin, total)
+    return points[0], points[1], points[2]
 
 
 def _decomposed(

@@ -28,7 +28,13 @@ from numpy.typing import NDArray
 
 from pushrecovery._validate import finite_float
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.minkowski import Shape, clip, clip_halfplanes, minkowski_sum
+from pushrecovery.ground.minkowski import (
+    Shape,
+    clip,
+    clip_halfplanes,
+    minkowski_sum,
+    stacked_shapes,
+)
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
@@ -40,7 +46,13 @@ from pushrecovery.surfaces.n_step import (
     step_options,
 )
 
-__all__ = ["CaptureRegion", "capture_region", "chebyshev_centre", "foothold_region"]
+__all__ = [
+    "CaptureRegion",
+    "capture_region",
+    "chebyshev_centre",
+    "foothold_and_centre",
+    "foothold_region",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -143,9 +155,49 @@ def capture_region(
         )
         swing = Stance.LEFT if lateral >= 0.0 else Stance.RIGHT
     option = step_options(params, support, swing)[0]
+    if timing == "exact":  # the compiled pipeline: a balance loop asks at every tick
+        polygon, foothold = foothold_and_centre(xi, params, option, t, steps, hip)
+        return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
     polygon = foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
     foothold = None if polygon is None else chebyshev_centre(polygon)
     return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
+
+
+def foothold_and_centre(
+    xi: FloatArray,
+    params: BodyParams,
+    option: StepOption,
+    t: float,
+    steps: int,
+    hip: bool,
+    *,
+    polygon: bool = True,
+) -> tuple[ConvexPolygon | None, FloatArray | None]:
+    """(S3) exactly at t and its recommended foothold, in one compiled call [m].
+
+    :func:`foothold_region` and :func:`chebyshev_centre` (the numpy path, taken when the
+    compiled simplex fails); (None, None) when no foothold captures. Without ``polygon`` the
+    region is not built (None) and only the foothold is returned.
+    """
+    from pushrecovery.ground._kernels import foothold_kernel
+
+    landing = landing_viable(params, option.swing, option.yaw, steps - 1)
+    box = hip_box(params, option.yaw) if hip else None
+    scale = math.exp(params.omega * t)
+    terms: list[tuple[float, Shape]] = [(1.0 - scale, option.stance), (-1.0, landing)]
+    if box is not None:
+        terms.append((-scale, box))
+    stacked, counts, weights = stacked_shapes(terms)
+    window = _window(params, option.swing, option.yaw, *(float(v) for v in option.ankle))
+    vertices, qx, qy, ok = foothold_kernel(
+        stacked, counts, weights, scale * xi, window.normals, window.offsets
+    )
+    if not ok:  # pragma: no cover - the compiled simplex found no start: the numpy path
+        region = foothold_region(xi, params, option, t, steps, hip=hip)
+        return region, None if region is None else chebyshev_centre(region)
+    if len(vertices) < 3:
+        return None, None
+    return (ConvexPolygon._from_ccw(vertices) if polygon else None), np.array([qx, qy])
 
 
 def foothold_region(
@@ -232,11 +284,11 @@ def chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
     """Return the centre of the largest disc in a convex polygon [m].
 
     The LP max r subject to n_i · q + r <= b_i, solved by a small compiled dual simplex
-    (``surfaces._kernels.chebyshev_centre``; scipy's HiGHS if it fails). When the largest disc
+    (``ground._kernels.chebyshev_centre``; scipy's HiGHS if it fails). When the largest disc
     can slide (two parallel edges hold it) the centres form a segment and its midpoint is
     returned: unique, and mirrored with the polygon.
     """
-    from pushrecovery.surfaces._kernels import chebyshev_centre as solve
+    from pushrecovery.ground._kernels import chebyshev_centre as solve
 
     normals, offsets = polygon.normals, polygon.offsets
     qx, qy, radius, ok = solve(normals, offsets)

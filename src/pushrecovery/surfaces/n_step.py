@@ -120,10 +120,12 @@ def capturability_distance(
     return hip + foot_radius + reach * geometric
 
 
+@functools.lru_cache(maxsize=64)
 def hip_box(params: BodyParams, yaw: float) -> FloatArray | None:
     """Return the hip's box H: ±(pitch, roll) corrected Eq. 15 offsets, heading-aligned [m].
 
-    Counter-clockwise corners (a segment when one axis has no torque), or None when neither.
+    Counter-clockwise corners (a segment when one axis has no torque), or None when neither;
+    read-only (the answers are kept).
     """
     half_x, half_y = cmp_offset(params), cmp_offset_roll(params)
     if half_x == 0.0 and half_y == 0.0:
@@ -132,7 +134,9 @@ def hip_box(params: BodyParams, yaw: float) -> FloatArray | None:
     local = np.array([[-half_x, -half_y], [half_x, -half_y], [half_x, half_y], [-half_x, half_y]])
     if half_x == 0.0 or half_y == 0.0:
         local = np.array([[-half_x, -half_y], [half_x, half_y]])
-    return np.asarray(local @ np.array([[c, s], [-s, c]]), dtype=np.float64)
+    box = np.asarray(local @ np.array([[c, s], [-s, c]]), dtype=np.float64)
+    box.flags.writeable = False  # kept and shared between callers
+    return box
 
 
 @functools.lru_cache(maxsize=64)
