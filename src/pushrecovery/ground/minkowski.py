@@ -112,12 +112,12 @@ def stacked_shapes(
 ) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
     """Return the terms as the compiled kernels take them: (shapes (K, M, 2), counts, weights)."""
     shapes = [_vertices(shape) for _, shape in terms]
-    stacked = np.zeros((len(shapes), max(len(v) for v in shapes), 2))
+    counts = np.array([len(v) for v in shapes], dtype=np.int64)
+    stacked = np.zeros((len(shapes), int(counts.max()), 2))
     for k, vertices in enumerate(shapes):
         stacked[k, : len(vertices)] = vertices
-    counts = np.array([len(v) for v in shapes], dtype=np.int64)
-    weights = np.array([float(w) for w, _ in terms])
-    if not np.all(np.isfinite(weights)):
+    weights = np.array([w for w, _ in terms], dtype=np.float64)
+    if not math.isfinite(float(weights.sum())):
         raise InvalidParameterError(f"Minkowski weights must be finite, got {weights.tolist()}")
     return stacked, counts, weights
 
