@@ -101,7 +101,12 @@ def random_states(n, seed):
 @pytest.mark.parametrize("name", list(SUPPORTS))
 def test_vectorised_and_monitor_equal_classify(name):
     support = SUPPORTS[name]
-    x, y, xdot, ydot = random_states(400, seed=hash(name) % 1000)
+    # A fixed seed per support (str hashes change between processes), and the support's own
+    # ankle at rest and just pushed, so that ankle, hip and beyond are all in the sample.
+    x, y, xdot, ydot = random_states(400, seed=11 + list(SUPPORTS).index(name))
+    ax, ay = support.ankle
+    x, y = np.append(x, [ax, ax, ax]), np.append(y, [ay, ay, ay])
+    xdot, ydot = np.append(xdot, [0.0, 0.5, 3.0]), np.append(ydot, [0.0, 0.1, 0.0])
     codes = classify_states(x, xdot, P, y=y, ydot=ydot, support=support)
     monitor = BalanceMonitor(P, support)
     seen = set()
