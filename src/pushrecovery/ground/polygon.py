@@ -173,6 +173,12 @@ class ConvexPolygon:
 
     def transformed(self, x: float, y: float, yaw: float) -> ConvexPolygon:
         """Rotate by ``yaw`` [rad] (counter-clockwise), then move by (x, y) [m]."""
+        if yaw == 0.0:  # a shift keeps the normals: only the offsets move
+            shift = np.array([x, y])
+            vertices = self.vertices + shift
+            offsets = self.offsets + self.normals @ shift
+            vertices.flags.writeable = offsets.flags.writeable = False
+            return ConvexPolygon(vertices, self.normals, offsets)
         c, s = math.cos(yaw), math.sin(yaw)
         rotation = np.array([[c, -s], [s, c]])
         return ConvexPolygon._from_ccw(self.vertices @ rotation.T + np.array([x, y]))
