@@ -399,3 +399,29 @@ def test_the_compiled_chebyshev_centre_equals_highs():
         assert slack.min() == pytest.approx(radius, abs=1e-10)  # a largest disc, inside
         solved += 1
     assert solved > 350
+
+
+def test_the_compiled_decomposition_and_sum_equal_numpys():
+    # The plan's compiled twins (ground._kernels) against ground.minkowski on random sums.
+    from pushrecovery.ground import convex_hull
+    from pushrecovery.ground._kernels import decompose_loop, minkowski_loop
+    from pushrecovery.ground.minkowski import decompose, stacked_shapes
+
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        terms = [
+            (float(rng.uniform(0.0, 2.0)), convex_hull(rng.normal(size=(8, 2)))) for _ in range(3)
+        ]
+        terms.append((float(rng.uniform(0.1, 2.0)), np.array([[0.3, -0.2]])))
+        offset = rng.normal(size=2)
+        total = minkowski_sum(terms, offset)
+        stacked, counts, weights = stacked_shapes(terms)
+        loop = minkowski_loop(stacked, counts, weights, offset)
+        np.testing.assert_allclose(loop, total.vertices, atol=1e-12)
+        point = total.centroid + rng.uniform(-1.0, 1.0, 2) * 0.5
+        expected, share = decompose(point, terms, offset, total)
+        found, found_share = decompose_loop(
+            np.asarray(point), stacked, counts, weights, offset, loop
+        )
+        assert found_share == pytest.approx(share, rel=1e-12)
+        np.testing.assert_allclose(found, np.array(expected), atol=1e-12)
