@@ -24,7 +24,6 @@ __all__ = [
     "clip_halfplanes",
     "decompose",
     "minkowski_sum",
-    "minkowski_sum_compiled",
     "regular_polygon",
     "stacked_shapes",
     "sum_loop",
@@ -91,20 +90,6 @@ def minkowski_sum(
     start = np.sum(starts, axis=0) + np.asarray(offset, dtype=np.float64)
     vertices = start + np.concatenate([np.zeros((1, 2)), np.cumsum(every[:-1], axis=0)])
     return _cleaned(vertices)
-
-
-def minkowski_sum_compiled(
-    terms: Sequence[tuple[float, Shape]], offset: tuple[float, float] | FloatArray = (0.0, 0.0)
-) -> ConvexPolygon:
-    """:func:`minkowski_sum` by the compiled twin (``ground._kernels.minkowski_loop``).
-
-    The same polygon (tested on random sums), a few times faster for the small sums of a
-    plan; it loads numba, which :func:`minkowski_sum` does not.
-    """
-    loop = sum_loop(terms, offset)
-    if len(loop) < 3:
-        raise InvalidParameterError("the Minkowski sum has zero area")
-    return ConvexPolygon._from_ccw(loop)
 
 
 def stacked_shapes(

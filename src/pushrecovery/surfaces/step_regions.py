@@ -273,7 +273,10 @@ class StepRegions:
             return margin > 0.0 and outward, margin
 
         row = max(rows, key=preference)
-        return capture_plan(np.array([px, py]), self.params, self.options[row], steps)
+        margin = float(self.polygons[row].signed_distance(px, py))  # its C_N: known here
+        return capture_plan(
+            np.array([px, py]), self.params, self.options[row], steps, margin=margin
+        )
 
 
 @functools.lru_cache(maxsize=32)
