@@ -425,3 +425,23 @@ def test_the_compiled_decomposition_and_sum_equal_numpys():
         )
         assert found_share == pytest.approx(share, rel=1e-12)
         np.testing.assert_allclose(found, np.array(expected), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (lambda p, o: capture_plan(np.array([0.5, 0.0]), p, o, 0), "steps must be"),
+        (lambda p, o: capture_plan(np.array([0.5, 0.0]), p, o, 2.0), "steps must be"),
+        (
+            lambda p, o: capture_plan(np.array([0.5, 0.0]), p, o, 1, first_touchdown=math.nan),
+            "first_touchdown",
+        ),
+        (lambda p, o: viable_region(p, o, (0.3, 0.35)), "sooner than min_step_time"),
+        (lambda p, o: viable_region(p, o, (math.inf,)), "touchdown"),
+    ],
+)
+def test_bad_plan_and_region_arguments_are_refused(call, match):
+    params = load_params()
+    option = step_options(params, Support.from_params(params, "left"))[0]
+    with pytest.raises(InvalidParameterError, match=match):
+        call(params, option)

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
     decompose,
@@ -110,7 +111,11 @@ def capture_plan(
     """
     from pushrecovery.surfaces.capture_region import foothold_and_centre
 
+    if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= 50:
+        raise InvalidParameterError(f"steps must be a whole number in [1, 50], got {steps!r}")
     first = params.min_step_time if first_touchdown is None else first_touchdown
+    if not 0.0 <= first <= 5.0:  # NaN fails too
+        raise InvalidParameterError(f"first_touchdown must be in [0, 5] s, got {first!r}")
     times = tuple(first + params.min_step_time * k for k in range(steps))
     check_touchdowns(params, times)
     if margin is None:
