@@ -137,6 +137,9 @@ def test_pd_gain_validation():
 )
 def test_controller_contract(name, x, v, t, theta, rate):
     controller = make_controller(name, PARAMS)
+    if controller.state_labels is not None:  # the ground plane
+        plane_contract(controller, x, v, t, theta, rate)
+        return
     hip = controller.strategy in ("hip", "step")
     state = {
         "ankle": np.array([x, v]),
@@ -151,6 +154,26 @@ def test_controller_contract(name, x, v, t, theta, rate):
     assert abs(command.flywheel_torque) <= PARAMS.torque_max
     if not hip:
         assert command.flywheel_torque == 0.0
+
+
+def plane_contract(controller, x, v, t, theta, rate):
+    """Ground plane: CoP on the feet, torques within limits, footholds within reach."""
+    from pushrecovery.ground.support import Support
+
+    state = np.array([x, -0.5 * x, theta, -theta, v, 0.5 * v, rate, -rate])
+    controller.reset(state)
+    command = controller.compute(t, state)
+    double = Support.from_params(PARAMS).polygon
+    values = (command.cop, command.cop_y, command.flywheel_torque, command.roll_torque)
+    assert all(math.isfinite(value) for value in values)
+    assert double.signed_distance(command.cop, command.cop_y) >= -1e-12
+    assert abs(command.flywheel_torque) <= PARAMS.torque_max
+    assert abs(command.roll_torque) <= PARAMS.torque_max_roll
+    if command.foothold is not None:
+        half = 0.5 * PARAMS.stance_width * (1.0 if command.swing == "right" else -1.0)
+        gap = math.hypot(command.foothold[0], command.foothold[1] - half)
+        assert gap <= PARAMS.max_step_length + 1e-12
+        assert command.touchdown >= t + PARAMS.min_step_time - 1e-12
 
 
 def test_saturated_controller_brakes_on_the_edge_then_holds():

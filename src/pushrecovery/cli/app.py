@@ -19,7 +19,7 @@ from pushrecovery.cli.options import (
 
 # Kept literal so that --help does not import the models; a test checks them against the
 # registries.
-MODEL_CHOICES = ("lipm", "pendulum", "flywheel", "stepping")
+MODEL_CHOICES = ("lipm", "pendulum", "flywheel", "stepping", "stepping-plane")
 MUJOCO_MODEL_CHOICES = ("foot", "torso", "biped")
 CONTROLLER_CHOICES = (
     "ankle-saturated",
@@ -28,6 +28,7 @@ CONTROLLER_CHOICES = (
     "bang-bang",
     "mpc",
     "recovery",
+    "recovery-plane",
 )
 
 
@@ -181,8 +182,9 @@ _model = click.option(
     type=click.Choice((*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES)),
     default="lipm",
     show_default=True,
-    help="Plant. Analytic: lipm, pendulum, flywheel, stepping; MuJoCo: foot (ankle), torso "
-    "(hip), biped (stepping).",
+    help="Plant. Analytic: lipm, pendulum, flywheel, stepping, stepping-plane (on the ground "
+    "plane, with recovery-plane; simulate only); MuJoCo: foot (ankle), torso (hip), biped "
+    "(stepping).",
 )
 _controller = click.option(
     "--controller",
@@ -221,6 +223,21 @@ def _with(*decorators: Any) -> Any:
 )
 @click.option("--xdot", type=float, default=None, help="CoM velocity just after the push [m/s].")
 @click.option(
+    "--y",
+    "y",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="stepping-plane only: CoM position, left, from the ankles' midpoint [m].",
+)
+@click.option(
+    "--ydot",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="stepping-plane only: CoM velocity, left, just after the push [m/s].",
+)
+@click.option(
     "--impulse",
     type=float,
     default=None,
@@ -258,6 +275,8 @@ def simulate(
     options: tuple[str, ...],
     x: float,
     xdot: float | None,
+    y: float,
+    ydot: float,
     impulse: float | None,
     duration: float,
     control_period: float | None,
@@ -269,7 +288,9 @@ def simulate(
     """Simulate a push on a model with a controller; report recovered or fell.
 
     With --backend mujoco, --impulse is a real force at the CoM over 10 ms (the body holding
-    still meanwhile) and the run starts as the push ends.
+    still meanwhile) and the run starts as the push ends. With --model stepping-plane
+    (controller recovery-plane) the body stands on both feet of the ground plane and --y,
+    --ydot add the sideways part (--impulse pushes along x).
     """
     from pushrecovery.control.base import make_controller
     from pushrecovery.sim.plants import make_plant
@@ -278,7 +299,15 @@ def simulate(
 
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)
-    predicted = classify_state(x, velocity, params)
+    plane = model == "stepping-plane"
+    if not plane and (y != 0.0 or ydot != 0.0):
+        from pushrecovery.errors import InvalidParameterError
+
+        raise InvalidParameterError("--y and --ydot need --model stepping-plane")
+    if plane:
+        predicted = classify_state(x, velocity, params, y=y, ydot=ydot)
+    else:
+        predicted = classify_state(x, velocity, params)
     if render and backend != "mujoco":
         from pushrecovery.errors import InvalidParameterError
 
@@ -298,6 +327,8 @@ def simulate(
         initial = physics.push(impulse)
     else:
         initial = plant.initial_state(x, velocity)
+        if plane:
+            initial[1], initial[5] = y, ydot  # the planar state's y and ẏ
     result = run(
         plant,
         make_controller(
@@ -308,7 +339,7 @@ def simulate(
         control_period=control_period,
     )
     data = result.to_dict()
-    data["initial_state"] = {"x": x, "xdot": velocity}
+    data["initial_state"] = {"x": x, "xdot": velocity} | ({"y": y, "ydot": ydot} if plane else {})
     data["predicted"] = predicted.to_dict()
     if backend == "mujoco":
         half = len(initial) // 2

@@ -5,6 +5,7 @@ from pushrecovery.control.bangbang import BangBang
 from pushrecovery.control.base import CONTROLLERS, Command, Controller, make_controller
 from pushrecovery.control.mpc import MPCController
 from pushrecovery.control.recovery import RecoveryController
+from pushrecovery.control.recovery_plane import PlaneRecoveryController
 
 __all__ = [
     "CONTROLLERS",
@@ -15,6 +16,7 @@ __all__ = [
     "Command",
     "Controller",
     "MPCController",
+    "PlaneRecoveryController",
     "RecoveryController",
     "make_controller",
 ]

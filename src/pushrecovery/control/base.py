@@ -7,7 +7,9 @@ Contract (what the simulators, the CLI and a robot's control loop may rely on):
    current state, and returns a :class:`Command` held constant until the next tick.
 3. ``state`` is a 1-D float array, positions then velocities; its first entry is the CoM
    position x relative to the ankle [m] and entry ``len(state) // 2`` the CoM velocity ẋ
-   [m/s] (``[x, xdot]`` for the ankle models; the flywheel model appends θ and θ̇).
+   [m/s] (``[x, xdot]`` for the ankle models; the flywheel model appends θ and θ̇). On the
+   ground plane (``stepping-plane``) it is ``[x, y, θp, θr, ẋ, ẏ, θ̇p, θ̇r]`` in the world
+   frame, and the command's ``cop_y``, ``roll_torque``, ``foothold`` and ``touchdown`` apply.
 4. The command is always finite and within the body's limits: ``cop`` on the foot
    [heel, toe] [m], ``flywheel_torque`` within ±torque_max [N m]. A controller that cannot
    meet its goal (the state is beyond what it can recover) still returns a saturated finite
@@ -47,12 +49,30 @@ class Command:
     step_length : float or None
         Take a step now: foot-to-foot length, signed (positive forward) [m]. Only the stepping
         model has legs to do it; ``None`` keeps the stance.
+    cop_y : float
+        On the ground plane: the CoP's y [m] (``cop`` is then its x), world frame.
+    roll_torque : float
+        On the ground plane: hip torque about the upper body's roll axis [N m], positive moves
+        the CMP to the body's left (``flywheel_torque`` is then the pitch torque).
+    foothold : tuple of float or None
+        On the ground plane: lift the free foot now and land its ankle at (x, y) [m], world
+        frame; ``None`` keeps the stance (and an ongoing swing).
+    touchdown : float or None
+        With ``foothold``: the touchdown time [s] on the controller's clock (time since
+        reset); the plant lands no sooner than ``min_step_time`` after the lift.
+    swing : str or None
+        With ``foothold`` from double support: the foot that steps, ``left`` or ``right``.
     """
 
     cop: float
     flywheel_torque: float = 0.0
     saturated: bool = False
     step_length: float | None = None
+    cop_y: float = 0.0
+    roll_torque: float = 0.0
+    foothold: tuple[float, float] | None = None
+    touchdown: float | None = None
+    swing: str | None = None
 
 
 class Controller(ABC):
@@ -66,6 +86,8 @@ class Controller(ABC):
     control_period: float | None = None
     #: True when the controller's internal model assumes exactly ``control_period``.
     fixed_period: ClassVar[bool] = False
+    #: The state the controller reads, by label (``None``: the sagittal states, by strategy).
+    state_labels: ClassVar[tuple[str, ...] | None] = None
 
     def __init__(self, params: BodyParams) -> None:
         self.params = params

@@ -167,6 +167,22 @@ class ConvexPolygon:
         gap = np.hypot(dx - along * edge[:, 0:1], dy - along * edge[:, 1:2])
         return np.asarray(gap.min(axis=0), dtype=np.float64)
 
+    def nearest_point(self, px: float, py: float) -> tuple[float, float]:
+        """Return the polygon's point nearest to (px, py): itself inside, else on an edge [m]."""
+        if float(np.max(self.normals @ np.array([px, py]) - self.offsets)) <= 0.0:
+            return px, py
+        start = self.vertices
+        edge = following(start) - start
+        along = np.clip(
+            ((px - start[:, 0]) * edge[:, 0] + (py - start[:, 1]) * edge[:, 1])
+            / np.einsum("ij,ij->i", edge, edge),
+            0.0,
+            1.0,
+        )
+        foot = start + along[:, None] * edge
+        nearest = int(np.argmin(np.hypot(foot[:, 0] - px, foot[:, 1] - py)))
+        return float(foot[nearest, 0]), float(foot[nearest, 1])
+
     def contains(self, px: ArrayLike, py: ArrayLike) -> NDArray[np.bool_]:
         """Return True strictly inside the polygon (signed distance > 0)."""
         return self.signed_distance(px, py) > 0.0

@@ -28,9 +28,27 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 
-__all__ = ["plane_continuous", "plane_discrete", "plane_propagate", "roll_axis"]
+__all__ = [
+    "PLANE_STATE_LABELS",
+    "plane_continuous",
+    "plane_discrete",
+    "plane_propagate",
+    "roll_axis",
+]
 
 FloatArray = NDArray[np.float64]
+
+#: The state X, in order (module docstring).
+PLANE_STATE_LABELS = (
+    "x",
+    "y",
+    "theta_pitch",
+    "theta_roll",
+    "xdot",
+    "ydot",
+    "theta_pitch_dot",
+    "theta_roll_dot",
+)
 
 
 def roll_axis(params: BodyParams) -> BodyParams:

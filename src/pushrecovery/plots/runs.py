@@ -1,15 +1,23 @@
-"""Plot of one simulated run: CoM and CoP over time, and the phase-plane path."""
+"""Plot of one simulated run: CoM and CoP over time, and the phase-plane path.
+
+A run on the ground plane (``stepping-plane``) is drawn from above instead
+(:func:`plane_run_figure`).
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Polygon
 
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import FALL_COLOUR, RECOVER_COLOUR, save_figure, shade_regions
 from pushrecovery.sim.result import SimulationResult
 
-__all__ = ["save_run"]
+__all__ = ["plane_run_figure", "save_run"]
 
 _FORMATS = {".png", ".svg", ".pdf"}
 
@@ -25,6 +33,9 @@ def save_run(result: SimulationResult, params: BodyParams, path: Path) -> Path:
         raise InvalidParameterError(
             f"plot must end in one of {sorted(_FORMATS)}, got {path.name!r}"
         )
+    if result.states.shape[1] == 8:
+        figure = plane_run_figure(result, params)
+        return save_figure(figure, path.with_suffix(""), [path.suffix.lstrip(".")])[0]
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")
     colour = RECOVER_COLOUR if result.recovered else FALL_COLOUR
     x, xdot = result.states[:, 0], result.states[:, result.states.shape[1] // 2]
@@ -43,3 +54,57 @@ def save_run(result: SimulationResult, params: BodyParams, path: Path) -> Path:
     right.plot(x, xdot, color=colour)
     right.plot(x[0], xdot[0], "o", color=colour)
     return save_figure(fig, path.with_suffix(""), [path.suffix.lstrip(".")])[0]
+
+
+def plane_run_figure(result: SimulationResult, params: BodyParams) -> Figure:
+    """Top view of a run on the ground plane: feet, CoM, capture point and CoP paths [m].
+
+    The feet are the two of the start (ankles at y = ±stance_width/2) and one at every
+    landed foothold (``result.footholds_xy``), numbered in order; x forward, y left.
+    """
+    from pushrecovery.ground.support import foot_shape
+
+    states = result.states
+    omega = params.omega
+    figure = Figure(figsize=(7.5, 6.0), layout="constrained")
+    ax = figure.add_subplot()
+    foot = foot_shape(params)
+    half = 0.5 * params.stance_width
+    starts = [(0.0, half, foot), (0.0, -half, foot.mirrored())]
+    landed = [(x, y, foot) for x, y in result.footholds_xy[1:]]
+    for i, (x, y, shape) in enumerate(starts + landed):
+        placed = shape.transformed(x, y, 0.0)
+        first = i >= len(starts)
+        ax.add_patch(
+            Polygon(
+                placed.vertices,
+                closed=True,
+                fc="0.85" if not first else "#bbdefb",
+                ec="0.3",
+                lw=0.8,
+                label=("feet at the start" if i == 0 else "landed feet" if i == 2 else None),
+            )
+        )
+        if first:
+            ax.annotate(str(i - 1), (x, y), ha="center", va="center", fontsize=8)
+    colour = RECOVER_COLOUR if result.recovered else FALL_COLOUR
+    xi = states[:, 0:2] + states[:, 4:6] / omega
+    ax.plot(states[:, 0], states[:, 1], color=colour, label="CoM")
+    ax.plot(xi[:, 0], xi[:, 1], color=colour, ls="--", lw=1, label="capture point")
+    # Points, not a line: the CoP jumps from foot to foot.
+    ax.plot(result.inputs[:, 0], result.inputs[:, 1], "m.", ms=3, label="CoP")
+    ax.plot(states[0, 0], states[0, 1], "o", color=colour)
+    points = np.vstack([states[:, 0:2], np.array(result.footholds_xy)])
+    low, high = points.min(axis=0) - 0.2, points.max(axis=0) + 0.2
+    ax.set_xlim(low[0], high[0])
+    ax.set_ylim(low[1], high[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x, forward [m]")
+    ax.set_ylabel("y, left [m]")
+    steps = len(result.footholds_xy) - 1
+    ax.set_title(
+        f"{result.model} + {result.controller}: {result.outcome.value} after {steps} "
+        f"step{'s' if steps != 1 else ''}"
+    )
+    ax.legend(loc="best", fontsize=8)
+    return figure

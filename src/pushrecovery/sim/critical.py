@@ -246,6 +246,10 @@ def critical_push(
     if force and backend != "mujoco":
         raise InvalidParameterError("force pushes need backend='mujoco'")
     plant = make_plant(model, params, backend)
+    if plant.state_labels is not None:
+        raise InvalidParameterError(
+            f"the critical push is sagittal; model {model!r} runs with simulate"
+        )
     ctrl = make_controller(controller, params, **(controller_options or {}))
     predicted = predicted_critical_velocity(params, ctrl.strategy, x0, direction)
 

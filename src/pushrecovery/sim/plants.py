@@ -9,6 +9,7 @@ moving outward can no longer be stopped by any admissible input (docs/convention
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any, ClassVar, Protocol
 
 import numpy as np
@@ -42,6 +43,14 @@ class Plant(Protocol):
     fall_limits: tuple[float, float]
     #: Times the flywheel hit its joint stop at speed (always 0 for models without one).
     stop_impacts: int
+    #: Applied inputs per tick that :meth:`step` returns (CoP then torque entries).
+    input_size: ClassVar[int]
+    #: Labels of the state entries; ``None`` on the sagittal models (told apart by length).
+    state_labels: ClassVar[tuple[str, ...] | None]
+
+    def at_rest(self, state: FloatArray, speed: float) -> bool:
+        """Whether the CoM moves at most ``speed`` [m/s] and stands over the support."""
+        ...
 
     def falling(self, state: FloatArray) -> bool:
         """Whether ``state`` is in the plant's absorbing fall set (docs/conventions.md)."""
@@ -54,11 +63,19 @@ class Plant(Protocol):
     def check_state(self, state: FloatArray) -> None:
         """Raise :class:`InvalidParameterError` if the model cannot start from ``state``."""
 
-    def step(
-        self, state: FloatArray, command: Command, dt: float
-    ) -> tuple[FloatArray, float, float]:
-        """Advance ``state`` by ``dt`` [s]; return it, the applied CoP [m] and torque [N m]."""
+    def step(self, state: FloatArray, command: Command, dt: float) -> tuple[FloatArray, Any, Any]:
+        """Advance ``state`` by ``dt`` [s]; return it, the applied CoP [m] and torque [N m].
+
+        CoP and torque are floats on the sagittal models, arrays of ``input_size // 2`` on
+        the plane.
+        """
         ...
+
+
+def over_foot_at_rest(state: FloatArray, params: BodyParams, speed: float) -> bool:
+    """Sagittal rest: |ẋ| <= ``speed`` [m/s] and the CoM strictly over the foot (heel, toe)."""
+    x, xdot = float(state[0]), float(state[len(state) // 2])
+    return abs(xdot) <= speed and params.heel < x < params.toe
 
 
 def check_com_state(x: float, xdot: float, params: BodyParams) -> None:
@@ -82,12 +99,18 @@ class _AnklePlant:
     """Shared parts of the ankle-only plants (state ``[x, xdot]``)."""
 
     name: ClassVar[str]
+    input_size: ClassVar[int] = 2
+    state_labels: ClassVar[tuple[str, ...] | None] = None
 
     def __init__(self, params: BodyParams) -> None:
         self.params = params
         # Beyond a foot edge, moving outward: lost for any CoP (docs/conventions.md).
         self.fall_limits = (params.heel, params.toe)
         self.stop_impacts = 0
+
+    def at_rest(self, state: FloatArray, speed: float) -> bool:
+        """:func:`over_foot_at_rest`."""
+        return over_foot_at_rest(state, self.params, speed)
 
     def falling(self, state: FloatArray) -> bool:
         """Beyond a foot edge and moving outward (absorbing for every CoP on the foot)."""
@@ -177,6 +200,8 @@ class FlywheelPlant:
     """
 
     name: ClassVar[str] = "flywheel"
+    input_size: ClassVar[int] = 2
+    state_labels: ClassVar[tuple[str, ...] | None] = None
 
     def __init__(self, params: BodyParams) -> None:
         self.params = params
@@ -226,6 +251,10 @@ class FlywheelPlant:
             self.stop_impacts += 1
         return new, cop, torque
 
+    def at_rest(self, state: FloatArray, speed: float) -> bool:
+        """:func:`over_foot_at_rest`."""
+        return over_foot_at_rest(state, self.params, speed)
+
     def falling(self, state: FloatArray) -> bool:
         """Beyond δ± ± τmax/(m g), moving outward, with H = m L ẋ + I θ̇ outward too.
 
@@ -240,8 +269,8 @@ class FlywheelPlant:
         )
 
 
-#: Model name -> plant class.
-MODELS: dict[str, type[Any]] = {}
+#: Model name -> plant class (or factory).
+MODELS: dict[str, Callable[[BodyParams], Plant]] = {}
 
 
 #: Models of the MuJoCo backend (:mod:`pushrecovery.sim.mujoco`).
@@ -293,6 +322,8 @@ class SteppingPlant:
 
     name: ClassVar[str] = "stepping"
     substep: ClassVar[float] = 1e-4
+    input_size: ClassVar[int] = 2
+    state_labels: ClassVar[tuple[str, ...] | None] = None
 
     def __init__(self, params: BodyParams) -> None:
         self.params = params
@@ -416,6 +447,10 @@ class SteppingPlant:
             new, _, _ = self.step(new, Command(0.0), remaining)
         return new
 
+    def at_rest(self, state: FloatArray, speed: float) -> bool:
+        """:func:`over_foot_at_rest` on the current stance foot."""
+        return over_foot_at_rest(state, self.params, speed)
+
     def falling(self, state: FloatArray) -> bool:
         """Tell whether the body is lost.
 
@@ -431,8 +466,15 @@ class SteppingPlant:
         return self._stance_plant(float(state[2])).falling(state[[0, 1, 3, 4]])
 
 
+def _plane_stepping(params: BodyParams) -> Plant:
+    from pushrecovery.sim.plane_stepping import PlaneSteppingPlant  # loads the N-step geometry
+
+    return PlaneSteppingPlant(params)
+
+
 MODELS.update(
     {
+        "stepping-plane": _plane_stepping,
         LipmPlant.name: LipmPlant,
         PendulumPlant.name: PendulumPlant,
         FlywheelPlant.name: FlywheelPlant,

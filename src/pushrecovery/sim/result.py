@@ -41,8 +41,9 @@ class SimulationResult:
         Sample times [s].
     states : ndarray, shape (n, d)
         States at those times (``[x, xdot]`` for the ankle models) [m, m/s].
-    inputs : ndarray, shape (n - 1, 2)
-        CoP [m] and hip (flywheel) torque [N m] applied over each control period.
+    inputs : ndarray, shape (n - 1, 2) or (n - 1, 4)
+        CoP [m] and hip (flywheel) torque [N m] applied over each control period; on the
+        ground plane CoP x, y, pitch and roll torques.
     outcome : Outcome
         ``recovered``, ``fell`` or ``undecided`` (neither within the duration).
     model, controller : str
@@ -51,6 +52,8 @@ class SimulationResult:
         Times the flywheel hit its joint stop at speed (a torque beyond τmax; errata E12).
     footholds : tuple of float
         World x of every stance foot, the first at 0 [m] (more than one after steps).
+    footholds_xy : tuple of (float, float)
+        On the ground plane: the start's stance reference and every landed ankle (x, y) [m].
     """
 
     time: NDArray[np.float64]
@@ -61,6 +64,7 @@ class SimulationResult:
     controller: str
     stop_impacts: int = 0
     footholds: tuple[float, ...] = (0.0,)
+    footholds_xy: tuple[tuple[float, float], ...] = ()
 
     @property
     def cops(self) -> NDArray[np.float64]:
@@ -69,8 +73,8 @@ class SimulationResult:
 
     @property
     def torques(self) -> NDArray[np.float64]:
-        """Hip (flywheel) torque applied over each control period [N m]."""
-        return self.inputs[:, 1]
+        """Hip (flywheel) torque applied over each control period [N m] (pitch on the plane)."""
+        return self.inputs[:, self.inputs.shape[1] // 2]
 
     @property
     def recovered(self) -> bool:
@@ -92,6 +96,8 @@ class SimulationResult:
             final_state.update(theta=float(final[1]), theta_dot=float(final[half + 1]))
         if len(final) == 6:
             final_state.update(z=float(final[2]))
+        if len(final) == 8:
+            final_state.update(y=float(final[1]), ydot=float(final[5]))
         return {
             "recovered": self.recovered,
             "outcome": self.outcome.value,
@@ -105,4 +111,4 @@ class SimulationResult:
             "peak_torque": float(np.abs(self.torques).max()),
             "stop_impacts": self.stop_impacts,
             "footholds": list(self.footholds),
-        }
+        } | ({"footholds_xy": [list(p) for p in self.footholds_xy]} if self.footholds_xy else {})

@@ -10,6 +10,7 @@ import numpy as np
 from pushrecovery._validate import finite_float, positive_float
 from pushrecovery.control.base import Controller
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.result import Outcome, SimulationResult
 
@@ -36,7 +37,8 @@ class RestCriterion:
     speed : float
         Largest |ẋ| that counts as at rest [m/s].
     duration : float
-        How long the CoM must stay at rest over the foot (heel < x < toe) [s].
+        How long the CoM must stay at rest over the support (the plant's ``at_rest``: on the
+        sagittal models heel < x < toe) [s].
     """
 
     speed: float = 1e-3
@@ -82,26 +84,24 @@ def simulate(
     """
     state, dt, steps = check_run(plant, controller, initial_state, duration, control_period)
     rest = rest or RestCriterion()
-    heel, toe = plant.params.heel, plant.params.toe
     plant.stop_impacts = 0
     rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))
-    vel = len(state) // 2
+    half = plant.input_size // 2
 
     states = np.empty((steps + 1, len(state)))
-    inputs = np.empty((steps, 2))
+    inputs = np.empty((steps, plant.input_size))
     states[0] = state
     controller.reset(state)
     outcome, at_rest, k = Outcome.UNDECIDED, 0, 0
     while k < steps:
         command = controller.compute(k * dt, state)
-        state, inputs[k, 0], inputs[k, 1] = plant.step(state, command, dt)
+        state, inputs[k, :half], inputs[k, half:] = plant.step(state, command, dt)
         k += 1
         states[k] = state
-        x, xdot = state[0], state[vel]
         if plant.falling(state):
             outcome = Outcome.FELL
             break
-        resting = abs(xdot) <= rest.speed and heel < x < toe and not command.saturated
+        resting = not command.saturated and plant.at_rest(state, rest.speed)
         at_rest = at_rest + 1 if resting else 0
         if at_rest >= rest_ticks:
             outcome = Outcome.RECOVERED
@@ -115,6 +115,7 @@ def simulate(
         controller=controller.name,
         stop_impacts=plant.stop_impacts,
         footholds=tuple(getattr(plant, "footholds", (0.0,))),
+        footholds_xy=(tuple(plant.footholds_xy) if isinstance(plant, PlaneSteppingPlant) else ()),
     )
 
 
@@ -149,13 +150,24 @@ def check_run(
     for i, value in enumerate(state):
         finite_float(f"initial_state[{i}]", value)
     plant.check_state(state)
+    labels = controller.state_labels
+    if labels is not None and labels != plant.state_labels:
+        raise InvalidParameterError(
+            f"controller {controller.name!r} needs the state {list(labels)}: "
+            f"model {plant.name!r} does not provide it"
+        )
+    if labels is None and len(state) == 8:
+        raise InvalidParameterError(
+            f"controller {controller.name!r} works on the sagittal models: "
+            f"use recovery-plane on {plant.name!r}"
+        )
     if controller.strategy == "hip" and len(state) != 4:
         raise InvalidParameterError(
             f"controller {controller.name!r} moves the upper body: use the flywheel model "
             "(or torso on mujoco), "
             f"not {plant.name!r}"
         )
-    if controller.strategy == "step" and len(state) != 6:
+    if controller.strategy == "step" and labels is None and len(state) != 6:
         raise InvalidParameterError(
             f"controller {controller.name!r} takes steps: use the stepping model "
             "(or biped on mujoco), "

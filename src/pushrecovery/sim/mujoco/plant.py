@@ -31,7 +31,7 @@ from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.models.pendulum import ankle_torque_for_cop
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, FOOT_MASS, MODEL_BUILDERS, TIMESTEP
-from pushrecovery.sim.plants import check_com_state
+from pushrecovery.sim.plants import check_com_state, over_foot_at_rest
 
 __all__ = [
     "DEFAULT_COP_MARGIN",
@@ -88,6 +88,8 @@ class MujocoPlant:
     #: default) for plants with joint servos; longer for open-loop torque maps of a slowly
     #: changing state.
     torque_hold: ClassVar[float] = TIMESTEP
+    input_size: ClassVar[int] = 2
+    state_labels: ClassVar[tuple[str, ...] | None] = None
 
     def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:
         import mujoco
@@ -243,6 +245,10 @@ class MujocoPlant:
             raise InvalidParameterError(
                 f"state must have shape ({size},) for {self.name}, got {state.shape}"
             )
+
+    def at_rest(self, state: FloatArray, speed: float) -> bool:
+        """:func:`~pushrecovery.sim.plants.over_foot_at_rest` on the stance foot."""
+        return over_foot_at_rest(state, self.params, speed)
 
     # --- dynamics ------------------------------------------------------------------------
     def measured_cop_world(self) -> float:

@@ -1,0 +1,240 @@
+r"""Push recovery on the ground plane: ankle, hip, then the N-step plan, re-planned at touchdowns.
+
+The controller of the planar stepping model (``stepping-plane``; state
+``[x, y, θp, θr, ẋ, ẏ, θ̇p, θ̇r]``, world frame). It works on the capture point
+ξ = r + ṙ/ω, whose LIPM dynamics are ξ̇ = ω (ξ − p − c), with p the CoP and c = (τp e_p +
+τr e_r)/(m g) the CMP offset of the hip torques. The body is captured when
+
+.. math:: \xi(t) = \omega\int_t^\infty e^{-\omega(s - t)}\,\big(p(s) + c(s)\big)\,ds ,
+
+so a hip manoeuvre already under way contributes its remaining share
+h(t) = ω∫_t^∞ e^{−ω(s−t)} c(s) ds and the feet have to capture ξ_e = ξ − h. Each tick:
+
+1. **Touchdown** (the time the step was commanded for): the landed foot is the support; the
+   plan is dropped and made again below from the new state (re-planning at each touchdown).
+2. **Ankle**: ξ_e strictly inside the support polygon: the CoP at ξ_e (ξ_e then stays put and
+   the CoM converges to it).
+3. **Hip**: ξ inside the CMP region (:func:`~pushrecovery.surfaces.plane.cmp_polygon`) and the
+   hip still unused: ξ is split into a CoP in the support and a share of the hip's box
+   (:func:`~pushrecovery.ground.minkowski.decompose`, every term equally deep); the share is
+   produced by the bang-bang profile of corrected Eq. (15) (+τ over T_max, −τ over T_max, per
+   axis) scaled to it. Its remaining share h(t) is known in closed form (:func:`hip_share`).
+4. **Step**: the smallest N whose region C_N holds ξ_e (:class:`~pushrecovery.surfaces.
+   step_regions.StepRegions`, with the hip only while unused; beyond ``max_steps`` the plan
+   of ``max_steps`` steps, a best effort flagged ``saturated``): lift the plan's first foot,
+   land it at its first foothold at its first touchdown, hold the plan's first CoP meanwhile
+   and start the plan's hip share. After the touchdown step 1 runs again.
+
+The controller keeps its own copy of the feet, moved by the steps it commands (the plant lands
+a foot at the commanded time and foothold; plans are within reach and ``min_step_time``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.control.base import Command, Controller, register
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.minkowski import Shape, decompose, minkowski_sum
+from pushrecovery.ground.support import FootPose, Stance, Support
+from pushrecovery.models.flywheel import max_spin_up_time
+from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, roll_axis
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.capture_plan import CapturePlan
+from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+from pushrecovery.surfaces.n_step import hip_box
+from pushrecovery.surfaces.plane import cmp_polygon
+from pushrecovery.surfaces.step_regions import StepRegions
+
+__all__ = ["PlaneRecoveryController", "hip_share"]
+
+FloatArray = NDArray[np.float64]
+
+
+def hip_share(elapsed: float, spin_up: float, omega: float) -> float:
+    """Remaining capture-point share of a unit bang-bang hip profile, in units of τ/(m g).
+
+    For c(s) = +1 on [0, T), −1 on [T, 2T), 0 after, the share ω∫_u^∞ e^{−ω(s−u)} c(s) ds at
+    ``elapsed`` u [s]: 1 − 2 e^{−ω(T−u)} + e^{−ω(2T−u)} for u < T (which is (1 − e^{−ωT})²,
+    corrected Eq. 15, at u = 0), −(1 − e^{−ω(2T−u)}) for T ≤ u < 2T, and 0 from 2T on.
+    """
+    if elapsed < spin_up:
+        return (
+            1.0
+            - 2.0 * math.exp(-omega * (spin_up - elapsed))
+            + math.exp(-omega * (2.0 * spin_up - elapsed))
+        )
+    if elapsed < 2.0 * spin_up:
+        return -(1.0 - math.exp(-omega * (2.0 * spin_up - elapsed)))
+    return 0.0
+
+
+def _profile_mean(start: float, end: float, spin_up: float) -> float:
+    """Mean of the unit bang-bang profile (+1, −1, 0; :func:`hip_share`) over [start, end]."""
+
+    def integral(u: float) -> float:  # ∫_0^u c(s) ds
+        if u <= spin_up:
+            return max(u, 0.0)
+        return max(2.0 * spin_up - u, 0.0)
+
+    return (integral(end) - integral(start)) / (end - start)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class _HipManoeuvre:
+    """A scaled bang-bang profile per axis started at ``start`` [s]."""
+
+    start: float
+    fractions: tuple[float, float]  # of τmax, pitch and roll, in [−1, 1]
+    yaw: float  # of the body's axes [rad]
+
+
+@register
+class PlaneRecoveryController(Controller):
+    """Ankle → hip → N-step plan on the ground plane (module docstring)."""
+
+    name = "recovery-plane"
+    strategy = "step"
+    state_labels = PLANE_STATE_LABELS
+
+    def __init__(self, params: BodyParams) -> None:
+        super().__init__(params)
+        self.control_period = 1e-3
+        self._without_hip = dataclasses.replace(params, torque_max=0.0, torque_max_roll=0.0)
+        self._spin_up = (max_spin_up_time(params), max_spin_up_time(roll_axis(params)))
+        self._offsets = (cmp_offset(params), cmp_offset_roll(params))
+        self._torques = (params.torque_max, params.torque_max_roll)
+        self.reset(np.zeros(len(PLANE_STATE_LABELS)))
+
+    def reset(self, state: NDArray[np.float64]) -> None:
+        """Start on both feet (the default poses), hip unused, no step under way."""
+        if np.shape(state) != (len(PLANE_STATE_LABELS),):
+            raise InvalidParameterError(
+                f"the {self.name} controller needs the state {list(PLANE_STATE_LABELS)}, "
+                f"got shape {np.shape(state)}"
+            )
+        self.support = Support.from_params(self.params, Stance.DOUBLE)
+        self.mode = "ankle"
+        self.plan: CapturePlan | None = None
+        self._hip: _HipManoeuvre | None = None
+        self._swing: tuple[Stance, tuple[float, float], float] | None = None
+
+    def compute(self, t: float, state: NDArray[np.float64]) -> Command:
+        """Return the command of the current phase (module docstring)."""
+        swing = self._swing
+        if swing is not None and t >= swing[2] - 1e-9:
+            self._land(*swing)
+        omega = self.params.omega
+        xi = np.array([state[0] + state[4] / omega, state[1] + state[5] / omega])
+        pitch, roll = self._hip_torques(t)
+        if self._swing is not None and self.plan is not None:
+            cop = self.plan.cops[0]
+            saturated = self.plan.margin <= 0.0
+            return Command(float(cop[0]), pitch, saturated, cop_y=float(cop[1]), roll_torque=roll)
+        effective = xi - self._hip_remaining(t)
+        polygon = self.support.polygon
+        if float(polygon.signed_distance(effective[0], effective[1])) > 0.0:
+            self.mode = "ankle" if self._hip is None else self.mode
+            return Command(float(effective[0]), pitch, cop_y=float(effective[1]), roll_torque=roll)
+        if self._hip is None and bool(cmp_polygon(self.support, self.params).contains(*xi)):
+            return self._start_hip(t, xi)
+        return self._start_step(t, effective)
+
+    def _start_hip(self, t: float, xi: FloatArray) -> Command:
+        """Split ξ over the support and the hip's box; start the scaled profile."""
+        box = hip_box(self.params, self.support.yaw)
+        if box is None:  # pragma: no cover - the CMP region is the support without a box
+            raise InvalidParameterError("no hip torque: the CMP region is the support")
+        terms: list[tuple[float, Shape]] = [(1.0, box), (1.0, self.support.polygon)]
+        origin = np.zeros(2)
+        points, _ = decompose(xi, terms, origin, minkowski_sum(terms, origin))
+        self._begin_hip(t, points[0])
+        self.mode = "hip"
+        pitch, roll = self._hip_torques(t)
+        cop = points[1]
+        return Command(float(cop[0]), pitch, cop_y=float(cop[1]), roll_torque=roll)
+
+    def _start_step(self, t: float, effective: FloatArray) -> Command:
+        """Lift the first foot of the smallest plan that captures ξ_e."""
+        body = self.params if self._hip is None else self._without_hip
+        regions = StepRegions.of(body, self.support)
+        steps, _ = regions.locate(float(effective[0]), float(effective[1]))
+        plan = regions.plan(
+            float(effective[0]), float(effective[1]), steps if steps else body.max_steps
+        )
+        if self._hip is None and float(np.abs(plan.hip).max()) > 0.0:
+            self._begin_hip(t, plan.hip)
+        foothold = (float(plan.footholds[0, 0]), float(plan.footholds[0, 1]))
+        touchdown = t + float(plan.touchdowns[0])
+        side = plan.swings[0]
+        self.plan, self.mode = plan, "step"
+        self._swing = (side, foothold, touchdown)
+        stance = Stance.RIGHT if side is Stance.LEFT else Stance.LEFT
+        self.support = Support.from_params(
+            self.params, stance, left=self.support.left, right=self.support.right
+        )
+        pitch, roll = self._hip_torques(t)
+        cop = plan.cops[0]
+        return Command(
+            float(cop[0]),
+            pitch,
+            plan.margin <= 0.0,
+            cop_y=float(cop[1]),
+            roll_torque=roll,
+            foothold=foothold,
+            touchdown=touchdown,
+            swing=side.value,
+        )
+
+    def _land(self, side: Stance, foothold: tuple[float, float], _: float) -> None:
+        support = self.support
+        yaw = (support.left if support.stance is Stance.LEFT else support.right).yaw
+        pose = FootPose(foothold[0], foothold[1], yaw)
+        left, right = (pose, support.right) if side is Stance.LEFT else (support.left, pose)
+        self.support = Support.from_params(self.params, side, left=left, right=right)
+        self._swing, self.plan = None, None
+
+    def _begin_hip(self, t: float, share: FloatArray) -> None:
+        """Start the profile whose capture-point share is ``share`` (world frame) [m]."""
+        yaw = self.support.yaw
+        along = (
+            math.cos(yaw) * float(share[0]) + math.sin(yaw) * float(share[1]),
+            -math.sin(yaw) * float(share[0]) + math.cos(yaw) * float(share[1]),
+        )
+        fractions = tuple(
+            max(-1.0, min(1.0, value / offset)) if offset > 0.0 else 0.0
+            for value, offset in zip(along, self._offsets, strict=True)
+        )
+        self._hip = _HipManoeuvre(t, (fractions[0], fractions[1]), yaw)
+
+    def _hip_remaining(self, t: float) -> FloatArray:
+        """Return the hip manoeuvre's remaining capture-point share h(t), world frame [m]."""
+        if self._hip is None:
+            return np.zeros(2)
+        omega, weight = self.params.omega, self.params.weight
+        along = [
+            fraction * torque / weight * hip_share(t - self._hip.start, spin_up, omega)
+            for fraction, torque, spin_up in zip(
+                self._hip.fractions, self._torques, self._spin_up, strict=True
+            )
+        ]
+        c, s = math.cos(self._hip.yaw), math.sin(self._hip.yaw)
+        return np.array([c * along[0] - s * along[1], s * along[0] + c * along[1]])
+
+    def _hip_torques(self, t: float) -> tuple[float, float]:
+        """Pitch and roll torques [N m]: the profile's mean over this tick (exact under ZOH)."""
+        if self._hip is None:
+            return 0.0, 0.0
+        start = t - self._hip.start
+        end = start + (self.control_period or 1e-3)
+        pitch, roll = (
+            fraction * torque * _profile_mean(start, end, spin_up)
+            for fraction, torque, spin_up in zip(
+                self._hip.fractions, self._torques, self._spin_up, strict=True
+            )
+        )
+        return pitch, roll

@@ -1,0 +1,189 @@
+"""Multi-step recovery on the ground plane: the recovery-plane controller on stepping-plane.
+
+Ground truth is the closed loop itself: the plant (exact zero-order-hold LIPM with flywheels,
+feet landing where and when commanded) knows nothing of the capture regions; the controller
+follows the N-step plans and re-plans at every touchdown. The verdicts of ``classify`` must
+then name the number of steps the closed loop takes, just inside and just outside every
+boundary, in every direction.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from pushrecovery import load_params
+from pushrecovery.control.base import Command, make_controller
+from pushrecovery.control.recovery_plane import PlaneRecoveryController, hip_share
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.models.flywheel_plane import plane_discrete
+from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
+from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.classify import classify
+
+# 8 directions, none on an axis of symmetry.
+DIRECTIONS = np.radians(np.arange(8) * 45.0 + 7.0)
+NO_HIP = {"torque_max": 0.0, "torque_max_roll": 0.0}
+
+
+def needed_steps(params, speed, angle):
+    """Steps of the verdict for the CoM over the ankles' midpoint pushed to ``speed``."""
+    verdict = classify(
+        0.0, speed * math.cos(angle), params, y=0.0, ydot=speed * math.sin(angle)
+    ).to_dict()
+    if verdict["strategy"] == "fall":
+        return math.inf
+    return verdict["steps"] or 0
+
+
+def boundary(params, steps, angle):
+    """Bisect the push speed [m/s] where the verdict needs more than ``steps`` steps."""
+    low, high = 0.0, 8.0
+    for _ in range(36):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if needed_steps(params, middle, angle) <= steps else (low, middle)
+    return low, high
+
+
+def run(params, speed, angle, duration=8.0):
+    plant = PlaneSteppingPlant(params)
+    start = plant.initial_state(0.0, speed * math.cos(angle), 0.0, speed * math.sin(angle))
+    result = simulate(plant, PlaneRecoveryController(params), start, duration=duration)
+    return result, len(result.footholds_xy) - 1
+
+
+@pytest.mark.parametrize("hip", [True, False], ids=["hip", "no-hip"])
+@pytest.mark.parametrize("steps", [0, 1, 2])
+def test_the_closed_loop_takes_the_predicted_number_of_steps(steps, hip):
+    params = load_params(overrides={"max_steps": 3} | ({} if hip else NO_HIP))
+    for angle in DIRECTIONS if hip else DIRECTIONS[::2]:
+        low, high = boundary(params, steps, angle)
+        inside, taken = run(params, 0.995 * low, angle)
+        assert inside.recovered and taken <= steps, (math.degrees(angle), taken)
+        outside, taken = run(params, 1.005 * high, angle)
+        assert not outside.recovered or taken > steps, (math.degrees(angle), taken)
+
+
+def test_beyond_the_last_region_the_body_falls_and_just_inside_it_recovers():
+    params = load_params()  # max_steps: where one more step adds < 1 mm
+    for angle in DIRECTIONS[::2]:
+        low, high = boundary(params, params.max_steps, angle)
+        inside, taken = run(params, 0.995 * low, angle, duration=10.0)
+        assert inside.recovered and taken <= params.max_steps
+        outside, _ = run(params, 1.005 * high, angle, duration=10.0)
+        assert outside.outcome.value == "fell"
+
+
+def test_plans_are_followed_and_kept_within_reach_and_step_time():
+    params = load_params()
+    result, taken = run(params, 2.8, DIRECTIONS[1])
+    assert result.recovered and taken >= 2
+    feet = np.array(result.footholds_xy[1:])
+    # Every foothold within reach of the foot before it (the first from a stance ankle).
+    half = 0.5 * params.stance_width
+    first_gap = min(math.hypot(feet[0, 0], feet[0, 1] - side) for side in (half, -half))
+    assert first_gap <= params.max_step_length + 1e-12
+    gaps = np.hypot(*np.diff(feet, axis=0).T)
+    assert np.all(gaps <= params.max_step_length + 1e-12)
+    # The CoP always on the support of its tick: on the foot under it at the end.
+    final = result.final_state
+    assert math.hypot(final[0] - feet[-1, 0], final[1] - feet[-1, 1]) < params.toe
+
+
+def test_the_hip_share_is_the_integral_of_the_bang_bang_profile():
+    omega, spin_up = 3.13, 0.3
+
+    def profile(s):
+        return 1.0 if s < spin_up else (-1.0 if s < 2.0 * spin_up else 0.0)
+
+    for elapsed in (0.0, 0.1, 0.299, 0.3, 0.45, 0.6, 0.9):
+        expected = omega * sum(
+            quad(lambda s: math.exp(-omega * (s - elapsed)) * profile(s), a, b, epsabs=1e-13)[0]
+            for a, b in ((elapsed, max(elapsed, spin_up)), (max(elapsed, spin_up), 2 * spin_up))
+            if b > a
+        )
+        assert hip_share(elapsed, spin_up, omega) == pytest.approx(expected, abs=1e-12)
+    assert hip_share(0.0, spin_up, omega) == pytest.approx((1.0 - math.exp(-omega * spin_up)) ** 2)
+
+
+def test_the_plant_is_the_exact_zero_order_hold_and_splits_a_tick_at_touchdown():
+    params = load_params()
+    plant = PlaneSteppingPlant(params)
+    state = plant.initial_state(0.01, 0.3, -0.02, 0.1)
+    plant.check_state(state)
+    command = Command(0.02, 10.0, cop_y=0.01, roll_torque=-5.0)
+    a, b = plane_discrete(params, 1e-3)
+    after, cop, torques = plant.step(state, command, 1e-3)
+    np.testing.assert_allclose(after, a @ state + b @ np.array([0.02, 0.01, 10.0, -5.0]), atol=1e-15)
+    np.testing.assert_allclose(cop, [0.02, 0.01])
+    # A touchdown inside a tick: the same as two ticks split at the touchdown.
+    step = Command(0.0, foothold=(0.3, 0.15), touchdown=0.2005, swing="left")
+    whole, split = PlaneSteppingPlant(params), PlaneSteppingPlant(params)
+    for plant_ in (whole, split):
+        plant_.check_state(state)
+    one, two = state, state
+    for _ in range(200):
+        one, _, _ = whole.step(one, step, 1e-3)
+        two, _, _ = split.step(two, step, 1e-3)
+    one, _, _ = whole.step(one, step, 1e-3)
+    two, _, _ = split.step(two, step, 5e-4)
+    two, _, _ = split.step(two, step, 5e-4)
+    np.testing.assert_allclose(one, two, atol=1e-14)
+    assert whole.footholds_xy[-1] == (0.3, 0.15)
+    assert whole.support.stance.value == "left"
+
+
+def test_the_plant_enforces_step_time_reach_and_the_foot():
+    params = load_params()
+    plant = PlaneSteppingPlant(params)
+    state = plant.initial_state(0.0, 0.0)
+    plant.check_state(state)
+    # A foothold beyond reach lands at the reach; a touchdown sooner than min_step_time later.
+    far = Command(5.0, cop_y=5.0, foothold=(5.0, 0.1), touchdown=0.01, swing="left")
+    state, cop, _ = plant.step(state, far, 1e-3)
+    # The CoP is moved onto the right foot (the stance while the left swings).
+    assert plant.support.polygon.signed_distance(*cop) >= -1e-12
+    ticks = 1
+    while plant.swinging:
+        state, _, _ = plant.step(state, Command(0.0), 1e-3)
+        ticks += 1
+    assert ticks * 1e-3 == pytest.approx(params.min_step_time, abs=1e-3)
+    x, y = plant.footholds_xy[-1]
+    assert math.hypot(x, y + 0.5 * params.stance_width) == pytest.approx(
+        params.max_step_length, rel=2e-3
+    )  # on the inscribed 64-gon of the reach disc
+
+
+@pytest.mark.parametrize(
+    ("command", "match"),
+    [
+        (Command(0.0, step_length=0.3), "foothold, not step_length"),
+        (Command(0.0, foothold=(0.3, 0.1)), "needs swing 'left' or 'right'"),
+        (Command(0.0, foothold=(0.3, 0.1), swing="double"), "needs swing"),
+    ],
+)
+def test_bad_plane_commands_are_refused(command, match):
+    plant = PlaneSteppingPlant(load_params())
+    state = plant.initial_state(0.0, 0.0)
+    plant.check_state(state)
+    with pytest.raises(InvalidParameterError, match=match):
+        plant.step(state, command, 1e-3)
+
+
+def test_models_and_controllers_must_fit():
+    params = load_params()
+    plane = make_plant("stepping-plane", params)
+    start = plane.initial_state(0.0, 0.5)
+    with pytest.raises(InvalidParameterError, match="use recovery-plane"):
+        simulate(plane, make_controller("recovery", params), start, duration=1.0)
+    sagittal = make_plant("stepping", params)
+    with pytest.raises(InvalidParameterError, match="needs the state"):
+        simulate(sagittal, PlaneRecoveryController(params), sagittal.initial_state(0, 1), duration=1)
+    with pytest.raises(InvalidParameterError, match="shape"):
+        plane.check_state(np.zeros(6))
+    with pytest.raises(InvalidParameterError, match="theta_roll"):
+        plane.check_state(np.array([0, 0, 0, 2.0, 0, 0, 0, 0.0]))
+    with pytest.raises(InvalidParameterError, match="xdot"):
+        plane.check_state(plane.initial_state(0.0, 1e3))
