@@ -5,16 +5,21 @@ right foot after min_step_time (0.2 s for the paper preset) the example prints t
 that capture the push with one step and with two (the first of two), the recommended foothold
 of each (the one farthest from the region's edges), the plan classify recommends (footholds,
 touchdown times and CoPs) and, at each touchdown, the capture point without and with Sec. IV's
-impact. It ends with the largest push from standing that N steps absorb, and draws the regions
-into out/examples/steps.png.
+impact. It ends with the largest push from standing that N steps absorb, draws the regions
+into out/examples/steps.png, and simulates a push on the planar stepping model with the
+recovery-plane controller (out/examples/steps_run.png, seen from above).
 """
 
 from pathlib import Path
 
 from pushrecovery import load_params
+from pushrecovery.control.recovery_plane import PlaneRecoveryController
 from pushrecovery.ground import Support
 from pushrecovery.plots.common import save_figure
+from pushrecovery.plots.runs import plane_run_figure
 from pushrecovery.plots.steps import capture_regions_figure
+from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
+from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.bounds import bounds_data
 from pushrecovery.surfaces.capture_region import capture_region
 from pushrecovery.surfaces.classify import classify
@@ -63,4 +68,17 @@ print(
 paths = save_figure(
     capture_regions_figure(params, support, [state]), Path("out/examples/steps"), ("png",)
 )
+print(f"figure: {paths[0]}")
+
+# The same push on the planar stepping model (double support at the start), recovered by the
+# recovery-plane controller: it follows the N-step plan and re-plans at every touchdown.
+plant = PlaneSteppingPlant(params)
+start = plant.initial_state(0.0, 2.6, 0.0, 1.0)  # CoM over the ankles' midpoint, pushed
+run = simulate(plant, PlaneRecoveryController(params), start, duration=8.0)
+predicted = classify(0.0, 2.6, params, y=0.0, ydot=1.0)
+print(
+    f"simulated: {run.outcome.value} after {len(run.footholds_xy) - 1} step(s); "
+    f"predicted {predicted.strategy.value} with {predicted.steps} step(s)"
+)
+paths = save_figure(plane_run_figure(run, params), Path("out/examples/steps_run"), ("png",))
 print(f"figure: {paths[0]}")
