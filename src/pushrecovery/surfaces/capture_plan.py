@@ -6,7 +6,7 @@ The plan decomposes the capture point in the Minkowski sum (S1) of
 
 from __future__ import annotations
 
-import math
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,14 +20,15 @@ from pushrecovery.ground.minkowski import (
     stacked_shapes,
     sum_loop,
 )
+from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance
 from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.capture_region import ORIGIN, step_terms
 from pushrecovery.surfaces.n_step import (
     StepOption,
     check_touchdowns,
     hip_box,
     landing_foot,
-    landing_viable,
     sum_terms,
 )
 
@@ -109,8 +110,6 @@ def capture_plan(
     ``first_touchdown`` (default: min_step_time). ``margin``, when known, skips computing the
     signed distance of ξ0 to C_N (the recursion knows it is inside).
     """
-    from pushrecovery.surfaces.capture_region import foothold_and_centre
-
     if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= 50:
         raise InvalidParameterError(f"steps must be a whole number in [1, 50], got {steps!r}")
     first = params.min_step_time if first_touchdown is None else first_touchdown
@@ -118,55 +117,126 @@ def capture_plan(
         raise InvalidParameterError(f"first_touchdown must be in [0, 5] s, got {first!r}")
     times = tuple(first + params.min_step_time * k for k in range(steps))
     check_touchdowns(params, times)
-    if margin is None:
-        from pushrecovery.ground._kernels import loop_signed_distance
+    from pushrecovery.ground._kernels import decompose_loop, foothold_kernel, loop_signed_distance
 
-        terms, offset, _ = sum_terms(params, option, times, hip)
-        margin = float(loop_signed_distance(sum_loop(terms, offset), xi[0], xi[1]))
-    _, foothold = foothold_and_centre(
-        np.asarray(xi), params, option, first, steps, hip, polygon=False
-    )
-    if foothold is None:
-        return _decomposed(xi, params, option, steps, times, hip, margin)
-    scale = math.exp(params.omega * first)
-    box = hip_box(params, option.yaw) if hip else None
-    landing = landing_viable(params, option.swing, option.yaw, steps - 1)
-    split: list[tuple[float, Shape]] = [
-        (scale, box if box is not None else np.zeros((1, 2))),
-        (scale - 1.0, option.stance),
-        (1.0, landing),
-    ]
-    target = scale * np.asarray(xi) - foothold
-    share, cop, arrival = _split(target, split)
-    hip_share = share if box is not None else np.zeros(2)
-    if steps == 1:
-        rest_footholds, rest_times, rest_cops = np.zeros((0, 2)), np.zeros(0), arrival[None, :]
-        rest_sides: tuple[Stance, ...] = ()
-        rest_cops = rest_cops + foothold
-    else:
-        following = StepOption(
-            Stance.RIGHT if option.swing is Stance.LEFT else Stance.LEFT,
-            landing_foot(params, option.swing, option.yaw).transformed(
-                float(foothold[0]), float(foothold[1]), 0.0
-            ),
-            np.asarray(foothold, dtype=np.float64),
-            option.yaw,
+    # Everything relative to the stance ankle a: the shapes then repeat from call to call and
+    # from step to step, so their stacked forms and sums are kept (_PlanTerms).
+    ankle = np.array(option.ankle, dtype=np.float64)
+    stance_key = (option.stance.vertices - ankle).tobytes()
+    relative = np.asarray(xi, dtype=np.float64) - ankle
+    if margin is None:
+        loop = _viable_loop(params, option.swing, option.yaw, times, hip, stance_key)
+        margin = float(loop_signed_distance(loop, relative[0], relative[1]))
+    swing, use_hip, touchdown = option.swing, hip, first
+    footholds: list[FloatArray] = []
+    cops: list[FloatArray] = []
+    sides: list[Stance] = []
+    hip_share = np.zeros(2)
+    for level in range(steps):
+        more = steps - level
+        terms = step_terms(params, swing, option.yaw, more, touchdown, use_hip, stance_key)
+        vertices, qx, qy, ok = foothold_kernel(
+            terms.foot_shapes,
+            terms.foot_counts,
+            terms.foot_weights,
+            terms.scale * relative,
+            terms.window_normals,
+            terms.window_offsets,
         )
-        rest = capture_plan(
-            foothold + arrival, params, following, steps - 1, hip=False, margin=margin
+        foothold: FloatArray | None = np.array([qx, qy]) if len(vertices) >= 3 else None
+        if not ok:  # pragma: no cover - the compiled simplex found no start: the numpy path
+            foothold = _numpy_foothold(
+                relative, params, swing, option.yaw, stance_key, more, touchdown, use_hip
+            )
+        if foothold is None:  # no foothold: (S1)'s decomposition for the rest
+            rest = _decomposed(
+                relative + ankle,
+                params,
+                _world_option(swing, option.yaw, stance_key, ankle),
+                more,
+                tuple(touchdown + params.min_step_time * k for k in range(more)),
+                use_hip,
+                margin,
+            )
+            if level == 0:
+                return rest
+            footholds.extend(rest.footholds)
+            cops.extend(rest.cops[:-1])
+            sides.extend(rest.swings)
+            relative, ankle = rest.cops[-1], np.zeros(2)
+            break
+        target = terms.scale * relative - foothold
+        points, _ = decompose_loop(
+            target,
+            terms.split_shapes,
+            terms.split_counts,
+            terms.split_weights,
+            ORIGIN,
+            terms.split_total,
         )
-        rest_footholds, rest_times, rest_cops = rest.footholds, rest.touchdowns, rest.cops
-        rest_sides = rest.swings
+        if level == 0 and terms.has_box:
+            hip_share = points[0].copy()
+        cops.append(points[1] + ankle)
+        footholds.append(foothold + ankle)
+        sides.append(swing)
+        # The landed foot is the next stance; its capture point arrives relative to its ankle.
+        ankle, relative = ankle + foothold, points[2].copy()
+        stance_key = landing_foot(params, swing, option.yaw).vertices.tobytes()
+        swing = Stance.RIGHT if swing is Stance.LEFT else Stance.LEFT
+        touchdown, use_hip = params.min_step_time, False
+    cops.append(relative + ankle)  # the last CoP holds the capture point, in the last foot
     return CapturePlan(
         steps,
-        (option.swing, *rest_sides),
-        np.vstack([foothold[None, :], rest_footholds]),
-        np.concatenate([[first], first + rest_times]),
-        np.vstack([cop[None, :], rest_cops]),
-        np.asarray(hip_share, dtype=np.float64),
+        tuple(sides),
+        np.array(footholds),
+        np.array(times),
+        np.array(cops),
+        hip_share,
         margin,
         np.array(option.ankle, dtype=np.float64),
     )
+
+
+@functools.lru_cache(maxsize=256)
+def _viable_loop(
+    params: BodyParams,
+    swing: Stance,
+    yaw: float,
+    touchdowns: tuple[float, ...],
+    hip: bool,
+    stance_key: bytes,
+) -> FloatArray:
+    """C_N's vertex loop relative to the stance ankle (read-only, kept)."""
+    stance = np.frombuffer(stance_key, dtype=np.float64).reshape(-1, 2)
+    option = StepOption(swing, ConvexPolygon._from_ccw(stance), ORIGIN, yaw)
+    terms, offset, _ = sum_terms(params, option, touchdowns, hip)
+    loop = sum_loop(terms, offset)
+    loop.flags.writeable = False
+    return loop
+
+
+def _world_option(swing: Stance, yaw: float, stance_key: bytes, ankle: FloatArray) -> StepOption:
+    """Return the step option of a relative stance placed at ``ankle``."""
+    stance = np.frombuffer(stance_key, dtype=np.float64).reshape(-1, 2) + ankle
+    return StepOption(swing, ConvexPolygon._from_ccw(stance), ankle, yaw)
+
+
+def _numpy_foothold(  # pragma: no cover - only when the compiled simplex fails
+    relative: FloatArray,
+    params: BodyParams,
+    swing: Stance,
+    yaw: float,
+    stance_key: bytes,
+    steps: int,
+    touchdown: float,
+    hip: bool,
+) -> FloatArray | None:
+    """Return the recommended foothold relative to the ankle, from the numpy region."""
+    from pushrecovery.surfaces.capture_region import foothold_and_centre
+
+    option = _world_option(swing, yaw, stance_key, np.zeros(2))
+    _, foothold = foothold_and_centre(relative, params, option, touchdown, steps, hip)
+    return foothold
 
 
 def _split(

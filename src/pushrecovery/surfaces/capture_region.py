@@ -163,6 +163,79 @@ def capture_region(
     return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
 
 
+ORIGIN = np.zeros(2)
+ORIGIN.flags.writeable = False
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class StepTerms:
+    """One step of a plan relative to its stance ankle, stacked for the compiled kernels.
+
+    The foothold region (S3) is scale·ξ_rel ⊕ (1 − scale) S ⊕ (−V_{N−1}) ⊕ (−scale H) cut by the
+    reach R; the split of scale·ξ_rel − q over scale H ⊕ (scale − 1) S ⊕ V_{N−1} gives the hip's
+    share, the CoP and the capture point at touchdown relative to the landed ankle.
+    """
+
+    scale: float
+    has_box: bool
+    foot_shapes: FloatArray
+    foot_counts: NDArray[np.int64]
+    foot_weights: FloatArray
+    window_normals: FloatArray
+    window_offsets: FloatArray
+    split_shapes: FloatArray
+    split_counts: NDArray[np.int64]
+    split_weights: FloatArray
+    split_total: FloatArray
+
+
+@functools.lru_cache(maxsize=256)
+def step_terms(
+    params: BodyParams,
+    swing: Stance,
+    yaw: float,
+    steps: int,
+    touchdown: float,
+    hip: bool,
+    stance_key: bytes,
+) -> StepTerms:
+    """Return the terms of one step, the stance given by its vertices relative to its ankle.
+
+    Kept (the plans and the regions ask for the same few again and again): ``stance_key`` is
+    the float64 bytes of the stance's vertices minus its ankle.
+    """
+    from pushrecovery.ground._kernels import minkowski_loop
+
+    stance = np.frombuffer(stance_key, dtype=np.float64).reshape(-1, 2)
+    landing = landing_viable(params, swing, yaw, steps - 1)
+    box = hip_box(params, yaw) if hip else None
+    scale = math.exp(params.omega * touchdown)
+    foot: list[tuple[float, Shape]] = [(1.0 - scale, stance), (-1.0, landing)]
+    if box is not None:
+        foot.append((-scale, box))
+    split: list[tuple[float, Shape]] = [
+        (scale, box if box is not None else np.zeros((1, 2))),
+        (scale - 1.0, stance),
+        (1.0, landing),
+    ]
+    foot_shapes, foot_counts, foot_weights = stacked_shapes(foot)
+    split_shapes, split_counts, split_weights = stacked_shapes(split)
+    window = reach_polygon(params, swing, yaw)
+    return StepTerms(
+        scale,
+        box is not None,
+        foot_shapes,
+        foot_counts,
+        foot_weights,
+        window.normals,
+        window.offsets,
+        split_shapes,
+        split_counts,
+        split_weights,
+        minkowski_loop(split_shapes, split_counts, split_weights, ORIGIN),
+    )
+
+
 def foothold_and_centre(
     xi: FloatArray,
     params: BodyParams,
@@ -181,23 +254,24 @@ def foothold_and_centre(
     """
     from pushrecovery.ground._kernels import foothold_kernel
 
-    landing = landing_viable(params, option.swing, option.yaw, steps - 1)
-    box = hip_box(params, option.yaw) if hip else None
-    scale = math.exp(params.omega * t)
-    terms: list[tuple[float, Shape]] = [(1.0 - scale, option.stance), (-1.0, landing)]
-    if box is not None:
-        terms.append((-scale, box))
-    stacked, counts, weights = stacked_shapes(terms)
-    window = _window(params, option.swing, option.yaw, *(float(v) for v in option.ankle))
+    ankle = np.asarray(option.ankle, dtype=np.float64)
+    key = (option.stance.vertices - ankle).tobytes()
+    terms = step_terms(params, option.swing, option.yaw, steps, t, hip, key)
     vertices, qx, qy, ok = foothold_kernel(
-        stacked, counts, weights, scale * xi, window.normals, window.offsets
+        terms.foot_shapes,
+        terms.foot_counts,
+        terms.foot_weights,
+        terms.scale * (xi - ankle),
+        terms.window_normals,
+        terms.window_offsets,
     )
     if not ok:  # pragma: no cover - the compiled simplex found no start: the numpy path
         region = foothold_region(xi, params, option, t, steps, hip=hip)
         return region, None if region is None else chebyshev_centre(region)
     if len(vertices) < 3:
         return None, None
-    return (ConvexPolygon._from_ccw(vertices) if polygon else None), np.array([qx, qy])
+    region = ConvexPolygon._from_ccw(vertices + ankle) if polygon else None
+    return region, np.array([qx + ankle[0], qy + ankle[1]])
 
 
 def foothold_region(
