@@ -108,6 +108,19 @@ class PlaneRecoveryController(Controller):
         self._spin_up = (max_spin_up_time(params), max_spin_up_time(roll_axis(params)))
         self._offsets = (cmp_offset(params), cmp_offset_roll(params))
         self._torques = (params.torque_max, params.torque_max_roll)
+        self._steps: dict[int, tuple[StepRegions, NDArray[np.int64]]] = {}
+        self.reset(np.zeros(len(PLANE_STATE_LABELS)))
+        # Build the regions and the plans' terms of every support it can meet, and load the
+        # compiled geometry, now rather than in the loop (0.1-0.5 s here; ms each in a tick).
+        for body in (params, self._without_hip):
+            for stance in Stance:
+                self.support = Support.from_params(params, stance)
+                regions, _ = self._regions(body)
+                cmp_polygon(self._canonical()[0], params)
+                self._locate(regions, 0.0, 0.5)
+                for steps in range(1, body.max_steps + 1):
+                    for side in (0.5, -0.5):  # either foot first
+                        regions.plan(0.0, side, steps)
         self.reset(np.zeros(len(PLANE_STATE_LABELS)))
 
     def reset(self, state: NDArray[np.float64]) -> None:
@@ -140,8 +153,10 @@ class PlaneRecoveryController(Controller):
         if float(polygon.signed_distance(effective[0], effective[1])) > 0.0:
             self.mode = "ankle" if self._hip is None else self.mode
             return Command(float(effective[0]), pitch, cop_y=float(effective[1]), roll_torque=roll)
-        if self._hip is None and bool(cmp_polygon(self.support, self.params).contains(*xi)):
-            return self._start_hip(t, xi)
+        if self._hip is None:
+            canonical, ankle = self._canonical()
+            if bool(cmp_polygon(canonical, self.params).contains(*(xi - ankle))):
+                return self._start_hip(t, xi)
         return self._start_step(t, effective)
 
     def _start_hip(self, t: float, xi: FloatArray) -> Command:
@@ -158,13 +173,47 @@ class PlaneRecoveryController(Controller):
         cop = points[1]
         return Command(float(cop[0]), pitch, cop_y=float(cop[1]), roll_torque=roll)
 
+    def _canonical(self) -> tuple[Support, FloatArray]:
+        """Return the support moved to the origin (on one foot) and the shift [m].
+
+        Its regions and CMP region are built once per side: a touchdown then costs a shift,
+        not a new set of Minkowski sums.
+        """
+        support = self.support
+        if support.stance is Stance.DOUBLE:
+            return support, np.zeros(2)
+        pose = support.left if support.stance is Stance.LEFT else support.right
+        origin = FootPose(0.0, 0.0, pose.yaw)
+        canonical = Support.from_params(self.params, support.stance, left=origin, right=origin)
+        return canonical, np.array([pose.x, pose.y])
+
+    def _regions(self, body: BodyParams) -> tuple[StepRegions, FloatArray]:
+        """Return the current support's step regions and the point they are relative to [m]."""
+        canonical, ankle = self._canonical()
+        return StepRegions.of(body, canonical), ankle
+
+    def _locate(self, regions: StepRegions, px: float, py: float) -> tuple[int, float]:
+        """:meth:`StepRegions.locate`, compiled (as the monitor's; tens of µs saved a call)."""
+        from pushrecovery.surfaces._kernels import locate_steps
+
+        entry = self._steps.get(id(regions))
+        if entry is None or entry[0] is not regions:
+            entry = self._steps[id(regions)] = (regions, np.array(regions.steps, dtype=np.int64))
+        found, margin = locate_steps(regions.table, regions.counts, entry[1], regions.outer, px, py)
+        return int(found), float(margin)
+
     def _start_step(self, t: float, effective: FloatArray) -> Command:
         """Lift the first foot of the smallest plan that captures ξ_e."""
         body = self.params if self._hip is None else self._without_hip
-        regions = StepRegions.of(body, self.support)
-        steps, _ = regions.locate(float(effective[0]), float(effective[1]))
-        plan = regions.plan(
-            float(effective[0]), float(effective[1]), steps if steps else body.max_steps
+        regions, ankle = self._regions(body)
+        px, py = float(effective[0] - ankle[0]), float(effective[1] - ankle[1])
+        steps, _ = self._locate(regions, px, py)
+        relative = regions.plan(px, py, steps if steps else body.max_steps)
+        plan = dataclasses.replace(
+            relative,
+            footholds=relative.footholds + ankle,
+            cops=relative.cops + ankle,
+            ankle=relative.ankle + ankle,
         )
         if self._hip is None and float(np.abs(plan.hip).max()) > 0.0:
             self._begin_hip(t, plan.hip)

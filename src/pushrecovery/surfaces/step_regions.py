@@ -261,7 +261,10 @@ class StepRegions:
         From double support the foot on the capture point's side of the other ankle steps
         when its regions capture ξ (a side step, not a crossover), else the other one.
         """
+        from pushrecovery.ground._kernels import loop_signed_distance  # compiled, as the plan
+
         rows = [i for i, n in enumerate(self.steps) if n == steps]
+        margins = {i: float(loop_signed_distance(self.polygons[i].vertices, px, py)) for i in rows}
 
         def preference(i: int) -> tuple[bool, float]:
             option = self.options[i]
@@ -269,11 +272,10 @@ class StepRegions:
                 py - option.ankle[1]
             )
             outward = lateral >= 0.0 if option.swing is Stance.LEFT else lateral <= 0.0
-            margin = float(self.polygons[i].signed_distance(px, py))
-            return margin > 0.0 and outward, margin
+            return margins[i] > 0.0 and outward, margins[i]
 
         row = max(rows, key=preference)
-        margin = float(self.polygons[row].signed_distance(px, py))  # its C_N: known here
+        margin = margins[row]  # its C_N: known here
         return capture_plan(
             np.array([px, py]), self.params, self.options[row], steps, margin=margin
         )
