@@ -1,12 +1,19 @@
 """The project's exception tree.
 
 Every error raised on bad user input derives from :class:`PushRecoveryError`; errors about
-values also derive from :class:`ValueError`, so ``except ValueError`` keeps working.
+values also derive from :class:`ValueError`, so ``except ValueError`` keeps working. Anything
+else (a plain ``ValueError``, ``TypeError``, ``RuntimeError``...) escaping the library is a bug
+in it, and the CLI shows it as one, with its traceback.
 """
 
 from __future__ import annotations
 
-__all__ = ["InputFileError", "InvalidParameterError", "PushRecoveryError"]
+__all__ = [
+    "InputFileError",
+    "InvalidParameterError",
+    "PushRecoveryError",
+    "SimulationDiverged",
+]
 
 
 class PushRecoveryError(Exception):
@@ -22,3 +29,7 @@ class InvalidParameterError(PushRecoveryError, ValueError):
 
 class InputFileError(PushRecoveryError, ValueError):
     """A file given by the user is missing, unreadable or malformed."""
+
+
+class SimulationDiverged(PushRecoveryError, RuntimeError):
+    """The physics engine became unstable: the push or the state is beyond what it simulates."""

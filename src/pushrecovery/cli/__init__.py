@@ -1,4 +1,9 @@
-"""Command-line interface. ``main`` turns every user error into one stderr line and exit 2."""
+"""Command-line interface. ``main`` turns every user error into one stderr line and exit 2.
+
+User errors are the project's own (:class:`~pushrecovery.errors.PushRecoveryError`), click's
+usage errors, files the system cannot open (``OSError``) and memory the machine does not have.
+Any other exception is a bug of the library and keeps its traceback.
+"""
 
 from __future__ import annotations
 
@@ -26,9 +31,10 @@ def main(argv: list[str] | None = None) -> None:
         _fail(exc.format_message())
     except PushRecoveryError as exc:
         _fail(str(exc))
-    except (OSError, ValueError, ArithmeticError, MemoryError) as exc:
-        # Last resort: a user-facing tool reports, it does not dump a traceback.
+    except OSError as exc:  # a file or a device the system refuses
         _fail(f"{type(exc).__name__}: {exc}")
+    except MemoryError:
+        _fail("not enough memory for this request: ask for fewer states, pushes or frames")
     except click.Abort:
         sys.exit(130)
     sys.exit(code if isinstance(code, int) else 0)

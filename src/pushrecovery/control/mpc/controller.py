@@ -86,13 +86,11 @@ class MPCController(Controller):
     def plan(self, state: NDArray[np.float64]) -> Plan:
         """Solve the QP from ``state``; the fallback plan if it is infeasible."""
         qp = self.qp
-        try:
-            if self.workspace is not None:
-                solution = self.workspace.solve(state)
-            else:
-                solution = self._solve_qpsolvers(state)
-        except Exception:
-            solution = None
+        # Only the solvers' own failures mean "infeasible"; any other exception is a bug.
+        if self.workspace is not None:
+            solution = self.workspace.solve(state)
+        else:
+            solution = self._solve_qpsolvers(state)
         if solution is None or not np.isfinite(solution).all():
             inputs = np.tile(self._fallback(state), (self.settings.horizon, 1))
             return Plan(inputs, qp.predict(state, inputs), feasible=False)
@@ -101,18 +99,22 @@ class MPCController(Controller):
 
     def _solve_qpsolvers(self, state: NDArray[np.float64]) -> NDArray[np.float64] | None:
         from qpsolvers import solve_qp
+        from qpsolvers.exceptions import ProblemError, SolverError
 
         qp = self.qp
         q, h = qp.vectors(state)
-        solution: NDArray[np.float64] | None = solve_qp(
-            qp.scaled_hessian,
-            q,
-            qp.scaled_inequality,
-            h,
-            lb=qp.scaled_lower,
-            ub=qp.scaled_upper,
-            solver=self.settings.solver,
-        )
+        try:
+            solution: NDArray[np.float64] | None = solve_qp(
+                qp.scaled_hessian,
+                q,
+                qp.scaled_inequality,
+                h,
+                lb=qp.scaled_lower,
+                ub=qp.scaled_upper,
+                solver=self.settings.solver,
+            )
+        except (ProblemError, SolverError):
+            return None
         return solution
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:

@@ -293,7 +293,8 @@ class MujocoBipedPlant(MujocoPlant):
         joints = ["x", "z", "pitch"] + [f"{n}_{j}" for n in LEGS for j in ("hip", "knee", "ankle")]
         for i, joint in enumerate(joints):
             if model.joint(joint).qposadr[0] != i or model.joint(joint).dofadr[0] != i:
-                raise AssertionError(f"unexpected joint layout at {joint}")
+                # The generated model and this plant disagree: a bug here, not bad input.
+                raise RuntimeError(f"the biped model's joint {joint!r} is not at index {i}")
         reach = params.torque_max / params.weight
         # As SteppingPlant: beyond δ± ± τmax/(m g) no CMP stops an outgoing CoM.
         self.fall_limits = (params.heel - reach, params.toe + reach)

@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command
-from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.models.pendulum import ankle_torque_for_cop
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, FOOT_MASS, MODEL_BUILDERS, TIMESTEP
@@ -132,7 +132,11 @@ class MujocoPlant:
         self._hold_steps = max(1, round(self.torque_hold / self._substep))
         self._steps_done = 0
         self._measuring = False
-        self._unstable = int(mujoco.mjtWarning.mjWARN_BADQACC)
+        # MuJoCo resets the data after any of these (as dm_control's check_divergence reads).
+        warning = mujoco.mjtWarning
+        self._unstable = [
+            int(w) for w in (warning.mjWARN_BADQACC, warning.mjWARN_BADQVEL, warning.mjWARN_BADQPOS)
+        ]
 
     @classmethod
     def xml(cls, params: BodyParams) -> str:
@@ -307,8 +311,8 @@ class MujocoPlant:
             torque = actuate(cop, command)
             mj_step(model, d, nstep=min(hold, steps))
             steps -= hold
-        if d.warning[self._unstable].number:
-            raise PushRecoveryError(
+        if any(d.warning[w].number for w in self._unstable):
+            raise SimulationDiverged(
                 "MuJoCo's simulation became unstable (accelerations blew up); "
                 "the push or the state is beyond what the model can simulate"
             )

@@ -1,0 +1,89 @@
+"""Bugs stay bugs: only user errors become the CLI's one-line message (issue 15, item 8).
+
+Each test plants a fault inside the library (a programming error, not bad input) and checks
+that it surfaces as the exception it is, instead of being reported as "infeasible", as a
+user's mistake, or through an ``AssertionError``.
+"""
+
+import numpy as np
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.cli import main
+from pushrecovery.control.mpc import MPCController
+from pushrecovery.errors import PushRecoveryError, SimulationDiverged
+
+
+def test_a_bug_in_a_command_keeps_its_traceback(monkeypatch, capsys):
+    import pushrecovery.surfaces.bounds as bounds
+
+    def broken(*args, **kwargs):
+        raise ValueError("a bug: not the user's input")
+
+    monkeypatch.setattr(bounds, "bounds_data", broken)
+    with pytest.raises(ValueError, match="a bug"):
+        main(["bounds"])
+    assert "pushrecovery: error" not in capsys.readouterr().err
+
+
+def test_user_errors_are_still_one_line(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["classify", "--x", "0", "--xdot", "0", "--mass", "-1"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pushrecovery: error: ") and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("solver", ["daqp", "quadprog"])
+def test_a_bug_in_the_mpc_is_not_reported_as_infeasible(monkeypatch, solver):
+    controller = MPCController(load_params(), solver=solver)
+    state = np.array([0.0, 0.0, 0.5, 0.0])
+    controller.reset(state)
+    assert controller.plan(state).feasible
+
+    def broken(*args, **kwargs):
+        raise TypeError("a bug in the QP's vectors")
+
+    monkeypatch.setattr(controller.qp, "vectors", broken)
+    monkeypatch.setattr(controller.qp, "vectors_into", broken)
+    with pytest.raises(TypeError, match="a bug"):
+        controller.plan(state)
+
+
+def test_divergence_has_its_own_error():
+    assert issubclass(SimulationDiverged, PushRecoveryError)
+    assert issubclass(SimulationDiverged, RuntimeError)
+    assert not issubclass(SimulationDiverged, ValueError)  # not the user's value
+
+
+def test_mujoco_divergence_raises_simulation_diverged():
+    pytest.importorskip("mujoco")
+    from pushrecovery.control.base import Command
+    from pushrecovery.sim.plants import make_plant
+
+    plant = make_plant("torso", load_params(), "mujoco")
+    state = plant.initial_state(0.0, 0.0)
+    plant.check_state(state)
+    plant.data.qvel[:] = 1e12  # no body moves like this: MuJoCo's accelerations blow up
+    with pytest.raises(SimulationDiverged, match="unstable"):
+        for _ in range(50):
+            plant.step(state, Command(0.0), 1e-3)
+
+
+def test_a_biped_layout_mismatch_is_a_bug_not_an_assertion(monkeypatch):
+    pytest.importorskip("mujoco")
+    from pushrecovery.sim.mujoco import biped
+
+    original = biped.biped_model
+
+    def swapped(params):
+        # The same model with the two legs declared in the other order: joints move.
+        xml = original(params)
+        return xml.replace('name="left_', 'name="tmp_').replace(
+            'name="right_', 'name="left_'
+        ).replace('name="tmp_', 'name="right_')
+
+    monkeypatch.setattr(biped, "biped_model", swapped)
+    with pytest.raises(RuntimeError, match="not at index") as error:
+        biped.MujocoBipedPlant(load_params())
+    assert not isinstance(error.value, AssertionError | PushRecoveryError)
