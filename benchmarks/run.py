@@ -41,7 +41,7 @@ import numpy as np
 
 from pushrecovery import load_params
 from pushrecovery.control import make_controller
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.cop import cop_margin
 

@@ -5,8 +5,8 @@ import numpy as np
 from pushrecovery import load_params
 from pushrecovery.control import make_controller
 from pushrecovery.sim.critical import critical_push
-from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.push import Push
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 
 params = load_params()

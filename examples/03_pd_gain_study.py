@@ -12,7 +12,7 @@ from pushrecovery import load_params
 from pushrecovery.control import make_controller
 from pushrecovery.models.pendulum import ankle_torque_for_cop, lean_from_com
 from pushrecovery.sim.critical import NotRecoverableError, critical_push
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from pushrecovery import load_params
 from pushrecovery.control import make_controller
 from pushrecovery.sim.mujoco.render import render_run
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.sim.validation import LABELS, confusion_matrix, critical_table
 

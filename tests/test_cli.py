@@ -88,7 +88,7 @@ def test_bounds_thresholds_and_classify_step():
 def test_choices_match_the_registries():
     from pushrecovery.cli.app import CONTROLLER_CHOICES, MODEL_CHOICES
     from pushrecovery.control import CONTROLLERS
-    from pushrecovery.sim.plants import MODELS
+    from pushrecovery.sim.registry import MODELS
 
     assert set(MODEL_CHOICES) == set(MODELS)
     assert set(CONTROLLER_CHOICES) == set(CONTROLLERS)

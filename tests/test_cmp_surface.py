@@ -12,7 +12,7 @@ from scipy.integrate import quad
 from pushrecovery import load_params
 from pushrecovery.control import make_controller
 from pushrecovery.models.flywheel import max_spin_up_time
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.capture_lp import largest_capture_point
 from pushrecovery.surfaces.classify import classify

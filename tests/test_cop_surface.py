@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import make_controller
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces import cop as cop_module
 from pushrecovery.surfaces.classify import STRATEGY_CODES, classify, classify_states

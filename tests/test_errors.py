@@ -59,7 +59,7 @@ def test_divergence_has_its_own_error():
 def test_mujoco_divergence_raises_simulation_diverged():
     pytest.importorskip("mujoco")
     from pushrecovery.control.base import Command
-    from pushrecovery.sim.plants import make_plant
+    from pushrecovery.sim.registry import make_plant
 
     plant = make_plant("torso", load_params(), "mujoco")
     state = plant.initial_state(0.0, 0.0)
@@ -79,9 +79,11 @@ def test_a_biped_layout_mismatch_is_a_bug_not_an_assertion(monkeypatch):
     def swapped(params):
         # The same model with the two legs declared in the other order: joints move.
         xml = original(params)
-        return xml.replace('name="left_', 'name="tmp_').replace(
-            'name="right_', 'name="left_'
-        ).replace('name="tmp_', 'name="right_')
+        return (
+            xml.replace('name="left_', 'name="tmp_')
+            .replace('name="right_', 'name="left_')
+            .replace('name="tmp_', 'name="right_')
+        )
 
     monkeypatch.setattr(biped, "biped_model", swapped)
     with pytest.raises(RuntimeError, match="not at index") as error:

@@ -20,7 +20,7 @@ from pushrecovery.models.flywheel import (
     flywheel_propagate,
     max_spin_up_time,
 )
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.cmp import cmp_region
 

@@ -10,7 +10,7 @@ from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control.mpc import CondensedQP, MPCController, MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.sim.critical import critical_push
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 
 P = load_params()

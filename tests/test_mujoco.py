@@ -7,7 +7,7 @@ import pytest
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import Command, make_controller
 from pushrecovery.sim.critical import critical_push
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.sim.validation import mujoco_corrected_prediction
 

@@ -10,7 +10,7 @@ import pytest
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import make_controller
 from pushrecovery.sim.mujoco.biped import LEG_MASS, MujocoBipedPlant, biped_model
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import RestCriterion, simulate
 from pushrecovery.surfaces.step import step_critical_velocity, step_thresholds
 

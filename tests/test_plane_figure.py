@@ -15,6 +15,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Polygon
 
 from pushrecovery import BodyParams, InvalidParameterError
+from pushrecovery.experiments.paper_figures import PaperRuns
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.plots import figures
 from pushrecovery.plots.campaign import STRATEGY_COLOURS
@@ -168,12 +169,13 @@ def test_write_figures_writes_the_plane(
 ) -> None:
     for name in ("fig3a", "fig3b", "fig5", "fig6", "fig9", "fig10"):
         monkeypatch.setattr(figures, name, lambda *args: [])
-    files = figures.write_figures(params, tmp_path)
+    runs = PaperRuns([], [], [], [], [])  # the paper's figures are stubbed out above
+    files = figures.write_figures(params, runs, tmp_path)
     stems = ("plane", "steps-map", "steps-regions")
     assert sorted(p.name for p in files) == [f"{s}.{e}" for s in stems for e in ("png", "svg")]
     assert all(p.stat().st_size > 1000 for p in files)
     assert (tmp_path / "plane.png").read_bytes().startswith(PNG)
-    assert figures.write_figures(params, tmp_path / "none", ground_plane=False) == []
+    assert figures.write_figures(params, runs, tmp_path / "none", ground_plane=False) == []
 
 
 def test_report_has_the_ground_plane_section(params: BodyParams, tmp_path: Path) -> None:

@@ -19,7 +19,7 @@ from pushrecovery.control.recovery_plane import PlaneRecoveryController, hip_sha
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel_plane import plane_discrete
 from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify
 
@@ -43,7 +43,9 @@ def boundary(params, steps, angle):
     low, high = 0.0, 8.0
     for _ in range(36):
         middle = 0.5 * (low + high)
-        low, high = (middle, high) if needed_steps(params, middle, angle) <= steps else (low, middle)
+        low, high = (
+            (middle, high) if needed_steps(params, middle, angle) <= steps else (low, middle)
+        )
     return low, high
 
 
@@ -99,11 +101,12 @@ def test_the_hip_share_is_the_integral_of_the_bang_bang_profile():
         return 1.0 if s < spin_up else (-1.0 if s < 2.0 * spin_up else 0.0)
 
     for elapsed in (0.0, 0.1, 0.299, 0.3, 0.45, 0.6, 0.9):
-        expected = omega * sum(
-            quad(lambda s: math.exp(-omega * (s - elapsed)) * profile(s), a, b, epsabs=1e-13)[0]
-            for a, b in ((elapsed, max(elapsed, spin_up)), (max(elapsed, spin_up), 2 * spin_up))
-            if b > a
-        )
+
+        def integrand(s, u=elapsed):
+            return math.exp(-omega * (s - u)) * profile(s)
+
+        pieces = ((elapsed, max(elapsed, spin_up)), (max(elapsed, spin_up), 2 * spin_up))
+        expected = omega * sum(quad(integrand, a, b, epsabs=1e-13)[0] for a, b in pieces if b > a)
         assert hip_share(elapsed, spin_up, omega) == pytest.approx(expected, abs=1e-12)
     assert hip_share(0.0, spin_up, omega) == pytest.approx((1.0 - math.exp(-omega * spin_up)) ** 2)
 
@@ -115,8 +118,10 @@ def test_the_plant_is_the_exact_zero_order_hold_and_splits_a_tick_at_touchdown()
     plant.check_state(state)
     command = Command(0.02, 10.0, cop_y=0.01, roll_torque=-5.0)
     a, b = plane_discrete(params, 1e-3)
-    after, cop, torques = plant.step(state, command, 1e-3)
-    np.testing.assert_allclose(after, a @ state + b @ np.array([0.02, 0.01, 10.0, -5.0]), atol=1e-15)
+    after, cop, _ = plant.step(state, command, 1e-3)
+    np.testing.assert_allclose(
+        after, a @ state + b @ np.array([0.02, 0.01, 10.0, -5.0]), atol=1e-15
+    )
     np.testing.assert_allclose(cop, [0.02, 0.01])
     # A touchdown inside a tick: the same as two ticks split at the touchdown.
     step = Command(0.0, foothold=(0.3, 0.15), touchdown=0.2005, swing="left")
@@ -180,7 +185,9 @@ def test_models_and_controllers_must_fit():
         simulate(plane, make_controller("recovery", params), start, duration=1.0)
     sagittal = make_plant("stepping", params)
     with pytest.raises(InvalidParameterError, match="needs the state"):
-        simulate(sagittal, PlaneRecoveryController(params), sagittal.initial_state(0, 1), duration=1)
+        simulate(
+            sagittal, PlaneRecoveryController(params), sagittal.initial_state(0, 1), duration=1
+        )
     with pytest.raises(InvalidParameterError, match="shape"):
         plane.check_state(np.zeros(6))
     with pytest.raises(InvalidParameterError, match="theta_roll"):

@@ -11,7 +11,7 @@ import pytest
 
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import make_controller
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify
 from pushrecovery.surfaces.step import plan_step, step_thresholds

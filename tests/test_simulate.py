@@ -11,8 +11,8 @@ from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import CONTROLLERS, AnklePD, Command, Controller, make_controller
 from pushrecovery.models.lipm import lipm_state
 from pushrecovery.sim.critical import NotRecoverableError, critical_push
-from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.push import Push
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 
 PARAMS = load_params()

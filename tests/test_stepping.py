@@ -17,7 +17,7 @@ from pushrecovery.models.stepping import (
     solve_step_angle,
     step_solution,
 )
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify, classify_states
 from pushrecovery.surfaces.step import plan_steps

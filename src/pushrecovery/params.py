@@ -16,7 +16,7 @@ from typing import Any
 from pushrecovery._validate import finite_float, positive_float
 from pushrecovery.errors import InputFileError, InvalidParameterError
 
-__all__ = ["PRESETS", "BodyParams", "load_params"]
+__all__ = ["GROWTH_TOLERANCE", "PRESETS", "BodyParams", "default_max_steps", "load_params"]
 
 #: Narrowest foot [m]: a narrower one is a line, whose distances are rounding noise.
 MIN_FOOT_WIDTH = 1e-3
@@ -185,8 +185,6 @@ class BodyParams:
             set_(self, "min_step_width", width)
         steps = self.max_steps
         if steps is None:
-            from pushrecovery.surfaces.n_step import default_max_steps
-
             steps = default_max_steps(self)
         elif isinstance(steps, bool) or not (
             isinstance(steps, int) or (isinstance(steps, float) and steps.is_integer())
@@ -245,6 +243,14 @@ class BodyParams:
             if value < 0.0:
                 raise InvalidParameterError(f"{name} must be >= 0 N m, got {name}={value:g}")
             set_(self, name, float(value))
+
+    @property
+    def foot_radius(self) -> float:
+        """Distance from the ankle to the foot's farthest vertex [m] (rectangle or polygon)."""
+        if self.foot_polygon is not None:
+            return max(math.hypot(x, y) for x, y in self.foot_polygon)
+        half = 0.5 * self.foot_width
+        return max(math.hypot(self.heel, half), math.hypot(self.toe, half))
 
     @property
     def omega(self) -> float:
@@ -422,3 +428,27 @@ def _read_toml(path: Path) -> dict[str, Any]:
             raise InputFileError(f"[body] in {path} must be a table")
         data.update(body)
     return data
+
+
+#: One more step must grow every N-step region by less than this for N to be the default
+#: ``max_steps`` [m].
+GROWTH_TOLERANCE = 1e-3
+
+
+def default_max_steps(params: BodyParams) -> int:
+    """Smallest N whose next step grows every N-step region by less than 1 mm.
+
+    From (S2) of docs/steps.md, one more step moves the support function by a_{N+1} (h_R +
+    h_{F_{N+1}} − h_{F_N}) <= β^{N+1} (l + 2 ρ_F), β = e^{−ωΔt_s}, l the reach and ρ_F the
+    foot's farthest vertex from its ankle: N is the smallest with that bound under
+    :data:`GROWTH_TOLERANCE`. With Δt_s = 0 (the paper's instantaneous step) the regions never
+    stop growing: N = 1, the paper's one step.
+    """
+    beta = math.exp(-params.omega * params.min_step_time)
+    size = params.max_step_length + 2.0 * params.foot_radius
+    if beta >= 1.0:
+        return 1
+    for steps in range(1, 51):
+        if beta ** (steps + 1) * size < GROWTH_TOLERANCE:
+            return steps
+    return 50

@@ -37,7 +37,7 @@ from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.control.base import make_controller
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import pushed_state
-from pushrecovery.sim.plants import make_plant
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify
 

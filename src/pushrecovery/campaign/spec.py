@@ -205,7 +205,7 @@ class CampaignSpec:
     def _check_setup(self) -> None:
         """Check that the model, controller and duration work together (:func:`check_run`)."""
         from pushrecovery.control.base import make_controller
-        from pushrecovery.sim.plants import make_plant
+        from pushrecovery.sim.registry import make_plant
         from pushrecovery.sim.simulate import check_run
 
         first = self.push(0)

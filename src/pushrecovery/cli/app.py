@@ -293,7 +293,7 @@ def simulate(
     --ydot add the sideways part (--impulse pushes along x).
     """
     from pushrecovery.control.base import make_controller
-    from pushrecovery.sim.plants import make_plant
+    from pushrecovery.sim.registry import make_plant
     from pushrecovery.sim.simulate import simulate as run
     from pushrecovery.surfaces.classify import classify as classify_state
 
@@ -646,10 +646,11 @@ def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) ->
     polygon (ankle), the CMP region (hip) and pushes coloured by the strategy they need, in
     double, left and right support.
     """
+    from pushrecovery.experiments.paper_figures import paper_runs
     from pushrecovery.plots.figures import write_figures
 
     params = params_from(kwargs)
-    files = write_figures(params, Path(out), formats)
+    files = write_figures(params, paper_runs(params), Path(out), formats)
     emit({"files": [str(f) for f in files]}, as_json)
 
 

@@ -29,12 +29,10 @@ _TITLES = {"ap": "anterior-posterior (forward +)", "ml": "medio-lateral (left +)
 
 
 def _figure(rows: int, cols: int, width: float, height: float):  # type: ignore[no-untyped-def]
-    import matplotlib
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt.subplots(rows, cols, figsize=(width, height), layout="constrained", squeeze=False)
+    figure = Figure(figsize=(width, height), layout="constrained")
+    return figure, figure.subplots(rows, cols, squeeze=False)
 
 
 def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:

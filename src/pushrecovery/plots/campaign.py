@@ -213,19 +213,17 @@ def plot_outcome_map(table: Any, spec: CampaignSpec, path: Path) -> Path:
     Path
         The file written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     path = _check_path(path)
     columns = _columns(table)
     panels = _panels(spec, columns)
-    fig, axes = plt.subplots(
+    from matplotlib.figure import Figure
+
+    fig = Figure(
+        figsize=(6.4 if len(panels) == 1 else 4.4 * len(panels), 4.8), layout="constrained"
+    )
+    axes = fig.subplots(
         1,
         len(panels),
-        figsize=(6.4 if len(panels) == 1 else 4.4 * len(panels), 4.8),
-        layout="constrained",
         sharey=True,
         squeeze=False,
     )
@@ -311,10 +309,6 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     Path
         The file written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -332,7 +326,10 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     codes = classify_states(xs[np.newaxis, :], vs[:, np.newaxis], params)
     names = [str(code) for code in STRATEGY_CODES]
     cmap = ListedColormap([STRATEGY_COLOURS[name] for name in names])
-    fig, ax = plt.subplots(figsize=(7.2, 5.0), layout="constrained")
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(7.2, 5.0), layout="constrained")
+    ax = fig.add_subplot()
     ax.imshow(
         codes,
         origin="lower",
@@ -385,9 +382,6 @@ def plot_critical_vs_parameter(summary: Mapping[str, Any], path: Path) -> Path:
     """
     import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     path = _check_path(path)
     sweeps = [name for name, _ in summary["spec"]["sweeps"]]
     if len(sweeps) != 1:
@@ -401,14 +395,11 @@ def plot_critical_vs_parameter(summary: Mapping[str, Any], path: Path) -> Path:
         raise InvalidParameterError("the summary has no boundary rows (a random campaign?)")
     directions = [d for d in ("forward", "backward") if any(r["direction"] == d for r in rows)]
     x0s = sorted({float(r["x0"]) for r in rows})
-    fig, axes = plt.subplots(
-        1,
-        len(directions),
-        figsize=(5.2 * len(directions), 4.2),
-        layout="constrained",
-        squeeze=False,
-    )
-    cmap = plt.get_cmap("viridis")
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(5.2 * len(directions), 4.2), layout="constrained")
+    axes = fig.subplots(1, len(directions), squeeze=False)
+    cmap = matplotlib.colormaps["viridis"]
     strategy = rows[0].get("strategy", "")
     for ax, direction in zip(axes[0], directions, strict=True):
         for k, x0 in enumerate(x0s):

@@ -32,14 +32,11 @@ FALL_COLOUR = "#c62828"
 
 
 def new_figure(width: float = 6.4, height: float = 4.8) -> tuple[Figure, Axes]:
-    """Create a figure with one axes, drawn off-screen (Agg)."""
-    import matplotlib
+    """Create a figure with one axes, outside pyplot (no global backend, nothing to close)."""
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(width, height), layout="constrained")
-    return fig, ax
+    fig = Figure(figsize=(width, height), layout="constrained")
+    return fig, fig.add_subplot()
 
 
 def shade_regions(
@@ -96,9 +93,7 @@ def shade_regions(
 
 
 def save_figure(fig: Figure, stem: Path, formats: Iterable[str]) -> list[Path]:
-    """Save ``fig`` as ``stem.<fmt>`` for each format; close it; return the paths."""
-    import matplotlib.pyplot as plt
-
+    """Save ``fig`` as ``stem.<fmt>`` for each format; return the paths."""
     paths = []
     try:
         stem.parent.mkdir(parents=True, exist_ok=True)
@@ -108,6 +103,4 @@ def save_figure(fig: Figure, stem: Path, formats: Iterable[str]) -> list[Path]:
             paths.append(path)
     except OSError as exc:
         raise InputFileError(f"cannot write {stem.parent}: {exc.strerror or exc}") from None
-    finally:
-        plt.close(fig)
     return paths

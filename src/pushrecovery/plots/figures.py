@@ -1,7 +1,8 @@
-"""Reproductions of the paper's figures: Fig. 3 (Sec. II), 5 and 6 (Sec. III), 9 and 10 (Sec. IV).
+"""Drawings of the paper's figures: Fig. 3 (Sec. II), 5 and 6 (Sec. III), 9 and 10 (Sec. IV).
 
-Each figure has a function that computes its runs and one that draws them. Besides the paper's,
-``plane``: the capture-point plane of the ground-plane model (:mod:`pushrecovery.plots.plane`).
+The runs they show are simulated by :mod:`pushrecovery.experiments.paper_figures`, which also
+writes them all; these functions only draw. Besides the paper's, ``plane``: the capture-point
+plane of the ground-plane model (:mod:`pushrecovery.plots.plane`), and ``steps``.
 """
 
 from __future__ import annotations
@@ -11,8 +12,9 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
 
-from pushrecovery.control.base import make_controller
+from pushrecovery.experiments.paper_figures import PaperRuns
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import (
@@ -23,11 +25,8 @@ from pushrecovery.plots.common import (
     save_figure,
     shade_regions,
 )
-from pushrecovery.sim.plants import make_plant
 from pushrecovery.sim.result import SimulationResult
-from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.cmp import cmp_region
-from pushrecovery.surfaces.cop import critical_velocity
 
 __all__ = [
     "PAPER_FIGURES",
@@ -38,6 +37,7 @@ __all__ = [
     "fig9",
     "fig10",
     "plane",
+    "steps",
     "write_figures",
 ]
 
@@ -52,53 +52,34 @@ def _limits(params: BodyParams) -> tuple[tuple[float, float], tuple[float, float
     return xlim, (-vmax, vmax)
 
 
-def _draw_runs(
-    ax: object,
-    params: BodyParams,
-    model: str,
-    controller: str,
-    starts: Iterable[tuple[float, float]],
-) -> None:
-    plant, ctrl = make_plant(model, params), make_controller(controller, params)
-    for x0, v0 in starts:
-        run = simulate(plant, ctrl, np.array([x0, v0]), duration=4.0)
+def _draw_runs(ax: Axes, runs: Iterable[SimulationResult]) -> None:
+    """Phase paths (x, ẋ) of ankle-model runs, green recovered, red fell."""
+    for run in runs:
         colour = RECOVER_COLOUR if run.recovered else FALL_COLOUR
-        ax.plot(run.states[:, 0], run.states[:, 1], color=colour, lw=1.2)  # type: ignore[attr-defined]
-        ax.plot(x0, v0, "o", color=colour, ms=3)  # type: ignore[attr-defined]
+        ax.plot(run.states[:, 0], run.states[:, 1], color=colour, lw=1.2)
+        ax.plot(run.states[0, 0], run.states[0, 1], "o", color=colour, ms=3)
 
 
-def fig3a(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
+def fig3a(
+    params: BodyParams, runs: Iterable[SimulationResult], formats: Iterable[str], out: Path
+) -> list[Path]:
     """Fig. 3(a): open-loop saturated ankle torque on the LIPM from upright, pushed."""
     fig, ax = new_figure()
     xlim, ylim = _limits(params)
     shade_regions(ax, params, xlim, ylim)
-    # Pushes from upright spanning both boundaries: ẋ0 from 1.4x the backward to 1.4x the
-    # forward critical velocity of Eq. (4).
-    v_back, v_fwd = params.omega * params.heel, params.omega * params.toe
-    _draw_runs(
-        ax,
-        params,
-        "lipm",
-        "ankle-saturated",
-        [(0.0, v) for v in np.linspace(1.4 * v_back, 1.4 * v_fwd, 13)],
-    )
+    _draw_runs(ax, runs)
     ax.set_title("Fig. 3(a): saturated ankle torque, LIPM (green recovers, red falls)")
     return save_figure(fig, out / "fig3a", formats)
 
 
-def fig3b(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
+def fig3b(
+    params: BodyParams, runs: Iterable[SimulationResult], formats: Iterable[str], out: Path
+) -> list[Path]:
     """Fig. 3(b): saturated PD ankle control of the nonlinear pendulum from many states."""
     fig, ax = new_figure()
     xlim, ylim = _limits(params)
     shade_regions(ax, params, xlim, ylim)
-    # From three positions: pushes 15 % inside and outside Eq. (4) in both directions.
-    starts = [
-        (float(x0), float(fraction * critical_velocity(x0, direction, params)))
-        for x0 in np.linspace(params.heel, params.toe, 5)[1:-1]
-        for direction in (1.0, -1.0)
-        for fraction in (0.5, 0.85, 1.15)
-    ]
-    _draw_runs(ax, params, "pendulum", "ankle-pd", starts)
+    _draw_runs(ax, runs)
     ax.set_title(
         "Fig. 3(b): saturated PD ankle control, nonlinear pendulum\n"
         "(pushes 15 % inside / outside Eq. (4); falls drawn until certain)",
@@ -109,22 +90,24 @@ def fig3b(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
 
 def write_figures(
     params: BodyParams,
+    runs: PaperRuns,
     out: Path,
     formats: Iterable[str] = ("png", "svg"),
     *,
     ground_plane: bool = True,
 ) -> list[Path]:
-    """Write every reproduced figure into ``out``; return the files written.
+    """Draw every reproduced figure into ``out`` from ``runs``; return the files written.
 
-    The paper's figures (:data:`PAPER_FIGURES`) and, with ``ground_plane``, ``plane``
-    (:func:`plane`) and the step figures (:func:`steps`).
+    The paper's figures (:data:`PAPER_FIGURES`), the runs from
+    :func:`~pushrecovery.experiments.paper_figures.paper_runs`, and, with ``ground_plane``,
+    ``plane`` and the step figures.
     """
     formats = tuple(formats)
     return [
-        *fig3a(params, formats, out),
-        *fig3b(params, formats, out),
-        *fig5(params, formats, out),
-        *fig6(params, formats, out),
+        *fig3a(params, runs.fig3a, formats, out),
+        *fig3b(params, runs.fig3b, formats, out),
+        *fig5(params, runs.fig5, runs.fig5_worst, formats, out),
+        *fig6(params, runs.fig6, formats, out),
         *fig9(params, formats, out),
         *fig10(params, formats, out),
         *(plane(params, formats, out) if ground_plane else []),
@@ -159,18 +142,6 @@ def plane(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     return save_figure(capture_plane_panels(params), out / "plane", formats)
 
 
-def _hip_runs(
-    params: BodyParams, controller: str, fractions: Iterable[float], **options: float
-) -> list[SimulationResult]:
-    """Pushes from upright at fractions of the hip strategy's forward critical velocity."""
-    plant = make_plant("flywheel", params)
-    ctrl = make_controller(controller, params, **options)
-    limit = float(critical_velocity(0.0, 1.0, params, region=cmp_region(params)))
-    return [
-        simulate(plant, ctrl, plant.initial_state(0.0, f * limit), duration=4.0) for f in fractions
-    ]
-
-
 def _phase(
     params: BodyParams,
     runs: list[SimulationResult],
@@ -200,9 +171,10 @@ def _time_panels(
     formats: tuple[str, ...],
     mark: float | None = None,
 ) -> list[Path]:
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
-    fig, axes = plt.subplots(4, 1, figsize=(6.4, 7.5), sharex=True, layout="constrained")
+    fig = Figure(figsize=(6.4, 7.5), layout="constrained")
+    axes = fig.subplots(4, 1, sharex=True)
     labels = (
         "flywheel angle θ [rad]",
         "flywheel rate θ̇ [rad/s]",
@@ -232,10 +204,18 @@ def _time_panels(
     return save_figure(fig, stem, formats)
 
 
-def fig5(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
-    """Fig. 5: bang-bang flywheel control. (a) phase plot; (b) flywheel and torque vs time."""
+def fig5(
+    params: BodyParams,
+    runs: list[SimulationResult],
+    worst: list[SimulationResult],
+    formats: Iterable[str],
+    out: Path,
+) -> list[Path]:
+    """Fig. 5: bang-bang flywheel control: (a) ``runs`` in the phase plane, (b) ``worst`` in time.
+
+    ``worst`` switches at T = T_max.
+    """
     formats = tuple(formats)
-    runs = _hip_runs(params, "bang-bang", (0.3, 0.6, 0.85, 0.99, 1.05))
     files = _phase(
         params,
         runs,
@@ -244,7 +224,6 @@ def fig5(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
         formats,
     )
     spin_up = max_spin_up_time(params)
-    worst = _hip_runs(params, "bang-bang", (0.99,), switch_time=spin_up)
     files += _time_panels(
         params,
         worst,
@@ -256,10 +235,14 @@ def fig5(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     return files
 
 
-def fig6(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
-    """Fig. 6: receding-horizon control (Eqs. 16-17). (a) phase plot; (b) time plots."""
+def fig6(
+    params: BodyParams, runs: list[SimulationResult], formats: Iterable[str], out: Path
+) -> list[Path]:
+    """Fig. 6: receding-horizon control (Eqs. 16-17). (a) phase plot; (b) time plots.
+
+    ``runs``: pushes at 0.3, 0.6, 0.85, 0.99 and 1.05 of the hip's critical push.
+    """
     formats = tuple(formats)
-    runs = _hip_runs(params, "mpc", (0.3, 0.6, 0.85, 0.99, 1.05))
     files = _phase(
         params,
         runs,

@@ -24,11 +24,6 @@ _FORMATS = {".png", ".svg", ".pdf"}
 
 def save_run(result: SimulationResult, params: BodyParams, path: Path) -> Path:
     """Write a two-panel plot of ``result`` to ``path`` (format from the extension)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     if path.suffix.lower() not in _FORMATS:
         raise InvalidParameterError(
             f"plot must end in one of {sorted(_FORMATS)}, got {path.name!r}"
@@ -36,7 +31,8 @@ def save_run(result: SimulationResult, params: BodyParams, path: Path) -> Path:
     if result.states.shape[1] == 8:
         figure = plane_run_figure(result, params)
         return save_figure(figure, path.with_suffix(""), [path.suffix.lstrip(".")])[0]
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")
+    fig = Figure(figsize=(11, 4.2), layout="constrained")
+    left, right = fig.subplots(1, 2)
     colour = RECOVER_COLOUR if result.recovered else FALL_COLOUR
     x, xdot = result.states[:, 0], result.states[:, result.states.shape[1] // 2]
     left.plot(result.time, x, color=colour, label="CoM x")

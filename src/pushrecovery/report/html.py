@@ -515,6 +515,7 @@ def _steps(ctx: _Context) -> str:
 
 
 def _figures(ctx: _Context) -> str:
+    from pushrecovery.experiments.paper_figures import paper_runs
     from pushrecovery.plots.figures import write_figures
 
     parts = [
@@ -527,7 +528,9 @@ def _figures(ctx: _Context) -> str:
     ]
     with tempfile.TemporaryDirectory(prefix="pushrecovery-figures-") as tmp:
         # The ground plane has its own section.
-        for path in write_figures(ctx.params, Path(tmp), ("png",), ground_plane=False):
+        for path in write_figures(
+            ctx.params, paper_runs(ctx.params), Path(tmp), ("png",), ground_plane=False
+        ):
             caption = FIGURE_CAPTIONS.get(path.stem, "")
             parts.append(figure(path, f"{esc(caption)} <code>{esc(path.name)}</code>"))
     return "".join(parts)
@@ -678,7 +681,7 @@ def _filmstrips(ctx: _Context) -> str:
         select_times,
         write_filmstrip,
     )
-    from pushrecovery.sim.plants import MUJOCO_MODELS, make_plant
+    from pushrecovery.sim.registry import MUJOCO_MODELS, make_plant
     from pushrecovery.sim.simulate import simulate
 
     lead = paragraph(

@@ -18,8 +18,9 @@ from pushrecovery._validate import finite_float, positive_float
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.plants import Plant, make_plant
+from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.push import direction_sign
+from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import strategy_region

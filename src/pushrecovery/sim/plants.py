@@ -9,7 +9,6 @@ moving outward can no longer be stopped by any admissible input (docs/convention
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any, ClassVar, Protocol
 
 import numpy as np
@@ -23,13 +22,11 @@ from pushrecovery.params import BodyParams
 from pushrecovery.sim.result import is_falling
 
 __all__ = [
-    "MODELS",
     "FlywheelPlant",
     "LipmPlant",
     "PendulumPlant",
     "Plant",
     "SteppingPlant",
-    "make_plant",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -269,38 +266,6 @@ class FlywheelPlant:
         )
 
 
-#: Model name -> plant class (or factory).
-MODELS: dict[str, Callable[[BodyParams], Plant]] = {}
-
-
-#: Models of the MuJoCo backend (:mod:`pushrecovery.sim.mujoco`).
-MUJOCO_MODELS = ("foot", "torso", "biped")
-
-
-def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plant:
-    """Build the plant ``name`` of ``backend`` (``analytic`` or ``mujoco``); unknown names raise."""
-    if backend == "mujoco":
-        if name not in MUJOCO_MODELS:
-            raise InvalidParameterError(
-                f"model must be one of {list(MUJOCO_MODELS)} for the mujoco backend, got {name!r}"
-            )
-        from pushrecovery.sim.mujoco import PLANTS
-
-        mujoco_plant: Plant = PLANTS[name](params)
-        return mujoco_plant
-    if backend != "analytic":
-        raise InvalidParameterError(f"backend must be 'analytic' or 'mujoco', got {backend!r}")
-    try:
-        plant: Plant = MODELS[name](params)
-    except KeyError:
-        hint = " (a MuJoCo model: use backend 'mujoco')" if name in MUJOCO_MODELS else ""
-        raise InvalidParameterError(
-            f"model must be one of {sorted(MODELS)} for the analytic backend, "
-            f"got model={name!r}{hint}"
-        ) from None
-    return plant
-
-
 class SteppingPlant:
     """LIPM + flywheel in stance, Hofmann's pendulum in swing, and the impact of Sec. IV.
 
@@ -464,20 +429,3 @@ class SteppingPlant:
             pulls = length * rate * rate > self.params.gravity * math.cos(lean)
             return self._swing[2] * rate <= 0.0 or abs(lean) >= 0.5 * math.pi - 1e-9 or pulls
         return self._stance_plant(float(state[2])).falling(state[[0, 1, 3, 4]])
-
-
-def _plane_stepping(params: BodyParams) -> Plant:
-    from pushrecovery.sim.plane_stepping import PlaneSteppingPlant  # loads the N-step geometry
-
-    return PlaneSteppingPlant(params)
-
-
-MODELS.update(
-    {
-        "stepping-plane": _plane_stepping,
-        LipmPlant.name: LipmPlant,
-        PendulumPlant.name: PendulumPlant,
-        FlywheelPlant.name: FlywheelPlant,
-        SteppingPlant.name: SteppingPlant,
-    }
-)

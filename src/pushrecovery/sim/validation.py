@@ -32,7 +32,7 @@ from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import critical_push, pushed_state
-from pushrecovery.sim.plants import MUJOCO_MODELS, make_plant
+from pushrecovery.sim.registry import MUJOCO_MODELS, make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify, strategy_region
 

@@ -49,7 +49,7 @@ from pushrecovery.ground.minkowski import (
 )
 from pushrecovery.ground.polygon import ConvexPolygon, following
 from pushrecovery.ground.support import Stance, Support, foot_shape
-from pushrecovery.params import BodyParams
+from pushrecovery.params import BodyParams, default_max_steps
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 
 __all__ = [
@@ -73,27 +73,6 @@ FloatArray = NDArray[np.float64]
 #: Sides of the regular polygon inscribed in the reach disc: its edges come within
 #: max_step_length (1 − cos(π/64)) = 0.12 % of the circle (1.2 mm for a 1 m reach).
 REACH_SIDES = 64
-#: Growth of the region below which one more step does not count [m] (``max_steps``).
-GROWTH_TOLERANCE = 1e-3
-
-
-def default_max_steps(params: BodyParams) -> int:
-    """Smallest N whose next step grows every N-step region by less than 1 mm.
-
-    From (S2), one more step moves the support function by a_{N+1} (h_R + h_{F_{N+1}} −
-    h_{F_N}) <= β^{N+1} (l + 2 ρ_F), β = e^{−ωΔt_s}, l the reach and ρ_F the foot's farthest
-    vertex from its ankle: N is the smallest with that bound under 1 mm. With Δt_s = 0 (the
-    paper's instantaneous step) the regions never stop growing: N = 1, the paper's one step.
-    """
-    beta = math.exp(-params.omega * params.min_step_time)
-    foot = foot_shape(params)
-    size = params.max_step_length + 2.0 * float(np.hypot(*foot.vertices.T).max())
-    if beta >= 1.0:
-        return 1
-    for steps in range(1, 51):
-        if beta ** (steps + 1) * size < GROWTH_TOLERANCE:
-            return steps
-    return 50
 
 
 def capturability_distance(

@@ -9,7 +9,8 @@ from pushrecovery.sim.mujoco.plant import MujocoFootPlant, MujocoTorsoPlant
 
 __all__ = ["PLANTS"]
 
-#: MuJoCo model name -> plant class (the names of ``plants.MUJOCO_MODELS``).
+#: MuJoCo model name -> plant class (the registry, :mod:`pushrecovery.sim.registry`, names
+#: them by import string).
 PLANTS: dict[str, type[Any]] = {
     "foot": MujocoFootPlant,
     "torso": MujocoTorsoPlant,

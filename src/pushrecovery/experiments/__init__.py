@@ -1,0 +1,1 @@
+"""Experiments: runs of the simulator that figures, the report and validation need."""

@@ -1,0 +1,59 @@
+"""Which plants exist, by backend and name: import strings, loaded on demand.
+
+As Gymnasium's registry: the names cost nothing to list (``pushrecovery --help`` imports no
+model), and a plant's module, with MuJoCo for that backend, is imported only when one is
+built. The simulation core (:mod:`pushrecovery.sim.plants`, :mod:`pushrecovery.sim.simulate`)
+never imports a backend; backends plug in here.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+from pushrecovery.sim.plants import Plant
+
+__all__ = ["MODELS", "MUJOCO_MODELS", "PLANTS", "available_models", "make_plant"]
+
+#: Backend -> model name -> "module:Class" of its plant.
+PLANTS: dict[str, dict[str, str]] = {
+    "analytic": {
+        "lipm": "pushrecovery.sim.plants:LipmPlant",
+        "pendulum": "pushrecovery.sim.plants:PendulumPlant",
+        "flywheel": "pushrecovery.sim.plants:FlywheelPlant",
+        "stepping": "pushrecovery.sim.plants:SteppingPlant",
+        "stepping-plane": "pushrecovery.sim.plane_stepping:PlaneSteppingPlant",
+    },
+    "mujoco": {
+        "foot": "pushrecovery.sim.mujoco.plant:MujocoFootPlant",
+        "torso": "pushrecovery.sim.mujoco.plant:MujocoTorsoPlant",
+        "biped": "pushrecovery.sim.mujoco.biped:MujocoBipedPlant",
+    },
+}
+#: Models of the analytic backend.
+MODELS = tuple(PLANTS["analytic"])
+#: Models of the MuJoCo backend (:mod:`pushrecovery.sim.mujoco`).
+MUJOCO_MODELS = tuple(PLANTS["mujoco"])
+
+
+def available_models(backend: str) -> tuple[str, ...]:
+    """Return the model names of ``backend`` (``analytic`` or ``mujoco``)."""
+    if backend not in PLANTS:
+        raise InvalidParameterError(f"backend must be one of {list(PLANTS)}, got {backend!r}")
+    return tuple(PLANTS[backend])
+
+
+def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plant:
+    """Build the plant ``name`` of ``backend``; unknown names raise, naming the choices."""
+    models = available_models(backend)
+    if name not in models:
+        other = next((b for b, names in PLANTS.items() if b != backend and name in names), None)
+        hint = f" ({name!r} is a {other} model: use backend {other!r})" if other else ""
+        raise InvalidParameterError(
+            f"model must be one of {list(models)} for the {backend} backend, "
+            f"got model={name!r}{hint}"
+        )
+    module, _, attribute = PLANTS[backend][name].partition(":")
+    plant: Plant = getattr(importlib.import_module(module), attribute)(params)
+    return plant
