@@ -179,11 +179,11 @@ def mujoco_realtime() -> float:
     never = RestCriterion(duration=1e3)  # run the whole 3 s
 
     def loop():
-        plant.initial_state(0.0, 0.0)
+        plant.reset(0.0, 0.0)
         simulate(plant, ctrl, plant.push(40.0), duration=3.0, rest=never)
 
     def bare():
-        plant.initial_state(0.0, 0.0)
+        plant.reset(0.0, 0.0)
         plant._mj.mj_step(plant.model, plant.data, nstep=3000)
 
     def ticks():
@@ -191,10 +191,10 @@ def mujoco_realtime() -> float:
         for k, state in enumerate(states):
             ctrl.compute(0.02 * k, state)
 
-    plant.initial_state(0.0, 0.0)
+    plant.reset(0.0, 0.0)
     states = simulate(plant, ctrl, plant.push(40.0), duration=3.0, rest=never).states[:-1]
     # The settling before each run (0.3 s of physics) is in both timings.
-    settle = best(lambda: plant.initial_state(0.0, 0.0), number=1)
+    settle = best(lambda: plant.reset(0.0, 0.0), number=1)
     wall = best(loop) - settle
     physics = best(bare) - settle
     # The fastest any loop could be: MuJoCo alone plus the MPC's own ticks, nothing between.
@@ -227,7 +227,7 @@ def batch() -> None:
 
         def mujoco_batch(plant=plant, ctrl=ctrl):
             for v in speeds:
-                plant.initial_state(0.0, 0.0)
+                plant.reset(0.0, 0.0)
                 simulate(plant, ctrl, plant.push(params.mass * v), duration=6.0)
 
         def analytic_batch(reference=reference, ctrl=ctrl, starts=starts):

@@ -50,14 +50,15 @@ def controller_ticks_us(params) -> np.ndarray:
     times = []
     for xdot, ydot in ((1.2, 0.4), (2.6, -0.9), (-2.2, 0.5), (0.8, 2.9), (3.4, 1.0)):
         plant = PlaneSteppingPlant(params)
-        state = plant.initial_state(0.0, xdot, 0.0, ydot)
-        plant.check_state(state)
+        state = plant.reset(0.0, xdot, 0.0, ydot)
         controller.reset(state)
         for k in range(3000):
             start = clock()
             command = controller.compute(k * 1e-3, state)
             times.append(clock() - start)
-            state, _, _ = plant.step(state, command, 1e-3)
+            step = plant.step(command, 1e-3)
+            state = step.state
+            controller.observe(step.info)
     return np.array(times) / 1e3
 
 

@@ -74,7 +74,7 @@ def main() -> None:
         model, controller, impulse, caption = FILMSTRIPS[strategy]
         plant = make_plant(model, params, "mujoco")
         plant.record()
-        plant.initial_state(0.0, 0.0)
+        plant.reset(0.0, 0.0)
         result = simulate(
             plant, make_controller(controller, params), plant.push(impulse), duration=4.0
         )

@@ -73,7 +73,7 @@ print(f"figure: {paths[0]}")
 # The same push on the planar stepping model (double support at the start), recovered by the
 # recovery-plane controller: it follows the N-step plan and re-plans at every touchdown.
 plant = PlaneSteppingPlant(params)
-start = plant.initial_state(0.0, 2.6, 0.0, 1.0)  # CoM over the ankles' midpoint, pushed
+start = plant.reset(0.0, 2.6, 0.0, 1.0)  # CoM over the ankles' midpoint, pushed
 run = simulate(plant, PlaneRecoveryController(params), start, duration=8.0)
 predicted = classify(0.0, 2.6, params, y=0.0, ydot=1.0)
 print(

@@ -61,7 +61,7 @@ def test_bang_bang_just_inside_recovers_just_outside_falls(x0, forward):
         run = simulate(
             plant,
             controller,
-            plant.initial_state(x0, P.omega * (xi - x0)),
+            plant.reset(x0, P.omega * (xi - x0)),
             control_period=T_MAX / 400,
         )  # the switch falls on a tick
         outcomes.append(run.outcome.value)
@@ -107,7 +107,7 @@ def test_classification_matches_bang_bang_outcome(x, xi):
         return  # the 1 ms control tick quantises T; the exact boundary is tested above
     v = P.omega * (xi - x)
     plant = make_plant("flywheel", P)
-    run = simulate(plant, make_controller("bang-bang", P), plant.initial_state(x, v))
+    run = simulate(plant, make_controller("bang-bang", P), plant.reset(x, v))
     assert run.recovered == (classify(x, v, P).strategy in ("ankle", "hip"))
 
 

@@ -62,12 +62,11 @@ def test_mujoco_divergence_raises_simulation_diverged():
     from pushrecovery.sim.registry import make_plant
 
     plant = make_plant("torso", load_params(), "mujoco")
-    state = plant.initial_state(0.0, 0.0)
-    plant.check_state(state)
+    plant.reset(0.0, 0.0)
     plant.data.qvel[:] = 1e12  # no body moves like this: MuJoCo's accelerations blow up
     with pytest.raises(SimulationDiverged, match="unstable"):
         for _ in range(50):
-            plant.step(state, Command(0.0), 1e-3)
+            plant.step(Command(0.0), 1e-3)
 
 
 def test_a_biped_layout_mismatch_is_a_bug_not_an_assertion(monkeypatch):

@@ -116,7 +116,7 @@ def test_plant_runs_bang_bang_exactly():
     controller = make_controller("bang-bang", P, switch_time=T_MAX)
     plant = make_plant("flywheel", P)
     run = simulate(
-        plant, controller, plant.initial_state(0.0, 0.6), duration=2 * T_MAX, control_period=period
+        plant, controller, plant.reset(0.0, 0.6), duration=2 * T_MAX, control_period=period
     )
     x, xdot, theta, rate = bang_bang_end_state(0.0, 0.6, P, switch_time=T_MAX, cop=P.toe)
     np.testing.assert_allclose(run.states[800], [x, theta, xdot, rate], atol=1e-12)
@@ -125,13 +125,15 @@ def test_plant_runs_bang_bang_exactly():
 
 def test_joint_stop_conserves_generalised_momentum():
     plant = make_plant("flywheel", P)
-    state = plant.initial_state(0.0, 0.0)
+    state = plant.reset(0.0, 0.0)
     state[1] = 0.99
     state[3] = 2.0
-    new, _, _ = plant.step(state, Command(0.0, 0.0), 0.01)
+    plant.begin(state)
+    new = plant.step(Command(0.0, 0.0), 0.01).state
     assert new[1] == P.flywheel_angle_max and new[3] == 0.0
+    assert plant.step(Command(0.0), 0.01).info.stop_impacts == 1  # counted in the run's info
     # m L ẋ + I θ̇ only changes through gravity over the step, not through the stop.
-    free, _, _ = make_plant("flywheel", P).step(state, Command(0.0, 0.0), 0.01)
+    free, _, _ = make_plant("flywheel", P).advance(state, Command(0.0, 0.0), 0.01)
     momentum = lambda s: P.mass * P.com_height * s[2] + P.flywheel_inertia * s[3]  # noqa: E731
     assert momentum(new) == pytest.approx(momentum(free), rel=1e-12)
 
@@ -170,7 +172,7 @@ def test_driving_into_the_stop_is_reported_and_beats_the_bound():
 
     plant = make_plant("flywheel", P)
     xi = cmp_region(P).upper + 5e-4
-    run = simulate(plant, IntoTheStop(P), plant.initial_state(0.0, P.omega * xi))
+    run = simulate(plant, IntoTheStop(P), plant.reset(0.0, P.omega * xi))
     assert run.recovered and run.stop_impacts == 1
     assert run.to_dict()["stop_impacts"] == 1
 

@@ -98,7 +98,7 @@ def test_daqp_workspace_matches_qpsolvers():
     # pushed runs that saturate the inputs (one recovers, one falls), then infeasible states,
     # through it and through qpsolvers' cold solve_qp (the route of the other solvers).
     plant = make_plant("flywheel", P)
-    runs = [simulate(plant, MPCController(P), plant.initial_state(0.0, v)) for v in (0.64, -0.5)]
+    runs = [simulate(plant, MPCController(P), plant.reset(0.0, v)) for v in (0.64, -0.5)]
     infeasible = [np.array([0.0, 0.9, 0.0, 5.0]), np.array([0.05, -0.95, 0.1, -3.0])]
     start = runs[0].states[:2]
     states = [*runs[0].states, *runs[1].states, *infeasible, *start]
@@ -166,8 +166,8 @@ def test_feasibility_matches_the_stopping_distance(theta, rate, x, v):
 
 def test_mpc_recovers_inside_and_falls_outside_the_bound():
     plant = make_plant("flywheel", P)
-    inside = simulate(plant, CONTROLLER, plant.initial_state(0.0, 0.6))
-    outside = simulate(plant, CONTROLLER, plant.initial_state(0.0, 0.7))
+    inside = simulate(plant, CONTROLLER, plant.reset(0.0, 0.6))
+    outside = simulate(plant, CONTROLLER, plant.reset(0.0, 0.7))
     assert inside.recovered and np.abs(inside.final_state).max() < 1e-2
     assert outside.outcome.value == "fell"
     assert np.abs(inside.states[:, 1]).max() <= P.flywheel_angle_max + 1e-9
@@ -199,11 +199,11 @@ def test_settings_validation():
 def test_no_hip_torque_is_not_saturation():
     no_hip = load_params(overrides={"torque_max": 0.0})
     plant = make_plant("flywheel", no_hip)
-    run = simulate(plant, MPCController(no_hip), plant.initial_state(0.0, 0.3))
+    run = simulate(plant, MPCController(no_hip), plant.reset(0.0, 0.3))
     assert run.recovered
 
 
 def test_mpc_period_is_fixed():
     plant = make_plant("flywheel", P)
     with pytest.raises(InvalidParameterError, match="control_period must match"):
-        simulate(plant, CONTROLLER, plant.initial_state(0.0, 0.3), control_period=0.01)
+        simulate(plant, CONTROLLER, plant.reset(0.0, 0.3), control_period=0.01)

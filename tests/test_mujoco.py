@@ -16,7 +16,7 @@ P = load_params()
 
 def run(controller, v=0.0, impulse=None, duration=6.0, model="foot"):
     plant = make_plant(model, P, "mujoco")
-    state = plant.initial_state(0.0, v if impulse is None else 0.0)
+    state = plant.reset(0.0, v if impulse is None else 0.0)
     if impulse is not None:
         state = plant.push(impulse)
     return plant, simulate(plant, make_controller(controller, P), state, duration=duration)
@@ -75,7 +75,7 @@ def test_push_as_a_real_force():
 
 def test_push_ends_with_the_momentum_of_the_impulse():
     plant = make_plant("torso", P, "mujoco")
-    plant.initial_state(0.0, 0.0)
+    plant.reset(0.0, 0.0)
     state = plant.push(36.0)
     # The contact pushes back only through the ankle torque holding the CoP under the CoM:
     # over 10 ms the CoM gains J / m = 0.5 m/s to within the gravity moment's share (< 1 %).
@@ -130,9 +130,9 @@ def test_commanded_cop_is_where_mujoco_puts_it(model, x0, v0, cop, hip_torque):
     # contact has followed the torque step at t = 0 (contact time constant 2 ms; the foot
     # rocks for ~35 ms, the CoP up to 9 mm off for a 70 N m step: checked from 40 ms on).
     plant = make_plant(model, P, "mujoco")
-    state = plant.initial_state(x0, v0)
+    plant.reset(x0, v0)
     for tick in range(80):  # 80 ms
-        state, applied, _ = plant.step(state, Command(cop, hip_torque), 1e-3)
+        applied = plant.step(Command(cop, hip_torque), 1e-3).applied[0]
         if tick >= 40:
             assert plant.measured_cop() == pytest.approx(applied, abs=3e-4), tick
 
@@ -147,10 +147,10 @@ def test_held_torques_keep_the_cop(model, x0, v0, cop, hip_torque):
     # the CoP is still within the 0.3 mm of a refresh at every step (a 20 ms hold is 0.5 mm
     # off on the torso).
     plant = make_plant(model, P, "mujoco")
-    state = plant.initial_state(x0, v0)
+    plant.reset(x0, v0)
     plant.measure()
     for tick in range(15):
-        state, applied, _ = plant.step(state, Command(cop, hip_torque), 0.02)
+        applied = plant.step(Command(cop, hip_torque), 0.02).applied[0]
         if tick >= 1:  # after the contact has followed the torque step at t = 0
             assert plant.measured_cops[-1] == pytest.approx(applied, abs=3e-4), tick
 
@@ -245,9 +245,9 @@ def test_cli_mujoco_bad_input_is_one_line(capsys, args, words):
 
 def test_push_a_named_body():
     plant = make_plant("torso", P, "mujoco")
-    plant.initial_state(0.0, 0.0)
+    plant.reset(0.0, 0.0)
     at_com = plant.push(20.0)
-    plant.initial_state(0.0, 0.0)
+    plant.reset(0.0, 0.0)
     named = plant.push(20.0, body="torso")  # the CoM body by name: the same push
     np.testing.assert_array_equal(at_com, named)
     with pytest.raises(InvalidParameterError, match="body must be one of"):

@@ -42,7 +42,7 @@ def recovery(params=P, first_step=None):
 
 def run(v=0.0, impulse=None, duration=5.0, rest=None, first_step=None):
     plant = MujocoBipedPlant(P)
-    state = plant.initial_state(0.0, v if impulse is None else 0.0)
+    state = plant.reset(0.0, v if impulse is None else 0.0)
     if impulse is not None:
         plant.schedule_push(impulse)
     controller = recovery(first_step=first_step)
@@ -52,7 +52,7 @@ def run(v=0.0, impulse=None, duration=5.0, rest=None, first_step=None):
 
 def analytic(v, duration=5.0):
     plant = make_plant("stepping", P)
-    state = plant.initial_state(0.0, v)
+    state = plant.reset(0.0, v)
     return simulate(plant, make_controller("recovery", P), state, duration=duration)
 
 
@@ -149,7 +149,7 @@ def test_forward_pushes_from_ahead_of_the_ankle_recover(v):
     # bisection found 1.89 m/s against the single-step limit 2.60 m/s).
     assert v < step_critical_velocity(0.05, 1.0, P)  # one step recovers it (2.60 m/s)
     plant = MujocoBipedPlant(P)
-    plant.initial_state(0.05, 0.0)
+    plant.reset(0.05, 0.0)
     state = plant.push(P.mass * v)
     controller = recovery()
     result = simulate(plant, controller, state, duration=3.0)

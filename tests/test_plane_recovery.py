@@ -51,7 +51,7 @@ def boundary(params, steps, angle):
 
 def run(params, speed, angle, duration=8.0):
     plant = PlaneSteppingPlant(params)
-    start = plant.initial_state(0.0, speed * math.cos(angle), 0.0, speed * math.sin(angle))
+    start = plant.reset(0.0, speed * math.cos(angle), 0.0, speed * math.sin(angle))
     result = simulate(plant, PlaneRecoveryController(params), start, duration=duration)
     return result, len(result.footholds_xy) - 1
 
@@ -114,28 +114,30 @@ def test_the_hip_share_is_the_integral_of_the_bang_bang_profile():
 def test_the_plant_is_the_exact_zero_order_hold_and_splits_a_tick_at_touchdown():
     params = load_params()
     plant = PlaneSteppingPlant(params)
-    state = plant.initial_state(0.01, 0.3, -0.02, 0.1)
-    plant.check_state(state)
+    state = plant.reset(0.01, 0.3, -0.02, 0.1)
     command = Command(0.02, 10.0, cop_y=0.01, roll_torque=-5.0)
     a, b = plane_discrete(params, 1e-3)
-    after, cop, _ = plant.step(state, command, 1e-3)
+    step = plant.step(command, 1e-3)
     np.testing.assert_allclose(
-        after, a @ state + b @ np.array([0.02, 0.01, 10.0, -5.0]), atol=1e-15
+        step.state, a @ state + b @ np.array([0.02, 0.01, 10.0, -5.0]), atol=1e-15
     )
-    np.testing.assert_allclose(cop, [0.02, 0.01])
+    np.testing.assert_allclose(step.applied, [0.02, 0.01, 10.0, -5.0])
+    assert step.info.stance and plant.input_labels[:2] == ("cop_x", "cop_y")
     # A touchdown inside a tick: the same as two ticks split at the touchdown.
-    step = Command(0.0, foothold=(0.3, 0.15), touchdown=0.2005, swing="left")
+    lift = Command(0.0, foothold=(0.3, 0.15), touchdown=0.2005, swing="left")
     whole, split = PlaneSteppingPlant(params), PlaneSteppingPlant(params)
+    hold = Command(0.0)
     for plant_ in (whole, split):
-        plant_.check_state(state)
-    one, two = state, state
-    for _ in range(200):
-        one, _, _ = whole.step(one, step, 1e-3)
-        two, _, _ = split.step(two, step, 1e-3)
-    one, _, _ = whole.step(one, step, 1e-3)
-    two, _, _ = split.step(two, step, 5e-4)
-    two, _, _ = split.step(two, step, 5e-4)
-    np.testing.assert_allclose(one, two, atol=1e-14)
+        plant_.begin(state)
+        assert not plant_.step(lift, 1e-3).info.stance  # swinging
+    for _ in range(199):
+        whole.step(hold, 1e-3)
+        split.step(hold, 1e-3)
+    one = whole.step(hold, 1e-3).state
+    split.step(hold, 5e-4)
+    two = split.step(hold, 5e-4)
+    np.testing.assert_allclose(one, two.state, atol=1e-14)
+    assert two.info.stance and len(two.info.footholds) == 2
     assert whole.footholds_xy[-1] == (0.3, 0.15)
     assert whole.support.stance.value == "left"
 
@@ -143,16 +145,15 @@ def test_the_plant_is_the_exact_zero_order_hold_and_splits_a_tick_at_touchdown()
 def test_the_plant_enforces_step_time_reach_and_the_foot():
     params = load_params()
     plant = PlaneSteppingPlant(params)
-    state = plant.initial_state(0.0, 0.0)
-    plant.check_state(state)
+    plant.reset(0.0, 0.0)
     # A foothold beyond reach lands at the reach; a touchdown sooner than min_step_time later.
     far = Command(5.0, cop_y=5.0, foothold=(5.0, 0.1), touchdown=0.01, swing="left")
-    state, cop, _ = plant.step(state, far, 1e-3)
+    cop = plant.step(far, 1e-3).applied[:2]
     # The CoP is moved onto the right foot (the stance while the left swings).
     assert plant.support.polygon.signed_distance(*cop) >= -1e-12
     ticks = 1
     while plant.swinging:
-        state, _, _ = plant.step(state, Command(0.0), 1e-3)
+        plant.step(Command(0.0), 1e-3)
         ticks += 1
     assert ticks * 1e-3 == pytest.approx(params.min_step_time, abs=1e-3)
     x, y = plant.footholds_xy[-1]
@@ -171,26 +172,23 @@ def test_the_plant_enforces_step_time_reach_and_the_foot():
 )
 def test_bad_plane_commands_are_refused(command, match):
     plant = PlaneSteppingPlant(load_params())
-    state = plant.initial_state(0.0, 0.0)
-    plant.check_state(state)
+    plant.reset(0.0, 0.0)
     with pytest.raises(InvalidParameterError, match=match):
-        plant.step(state, command, 1e-3)
+        plant.step(command, 1e-3)
 
 
 def test_models_and_controllers_must_fit():
     params = load_params()
     plane = make_plant("stepping-plane", params)
-    start = plane.initial_state(0.0, 0.5)
-    with pytest.raises(InvalidParameterError, match="use recovery-plane"):
+    start = plane.reset(0.0, 0.5)
+    with pytest.raises(InvalidParameterError, match=r"needs the state .* lacks"):
         simulate(plane, make_controller("recovery", params), start, duration=1.0)
     sagittal = make_plant("stepping", params)
     with pytest.raises(InvalidParameterError, match="needs the state"):
-        simulate(
-            sagittal, PlaneRecoveryController(params), sagittal.initial_state(0, 1), duration=1
-        )
+        simulate(sagittal, PlaneRecoveryController(params), sagittal.reset(0, 1), duration=1)
     with pytest.raises(InvalidParameterError, match="shape"):
         plane.check_state(np.zeros(6))
     with pytest.raises(InvalidParameterError, match="theta_roll"):
         plane.check_state(np.array([0, 0, 0, 2.0, 0, 0, 0, 0.0]))
     with pytest.raises(InvalidParameterError, match="xdot"):
-        plane.check_state(plane.initial_state(0.0, 1e3))
+        plane.check_state(plane.reset(0.0, 1e3))

@@ -22,7 +22,7 @@ BACK, FORWARD = step_thresholds(P)
 
 def push(v, x=0.0, params=P):
     plant = make_plant("stepping", params)
-    run = simulate(plant, make_controller("recovery", params), plant.initial_state(x, v))
+    run = simulate(plant, make_controller("recovery", params), plant.reset(x, v))
     return run
 
 
@@ -92,12 +92,13 @@ def test_with_a_short_reach_the_hip_finishes_what_the_step_began():
 def test_recovery_needs_the_stepping_model():
     plant = make_plant("flywheel", P)
     with pytest.raises(InvalidParameterError, match="use the stepping model"):
-        simulate(plant, make_controller("recovery", P), plant.initial_state(0.0, 1.0))
+        simulate(plant, make_controller("recovery", P), plant.reset(0.0, 1.0))
     lipm = make_plant("lipm", P)
     with pytest.raises(InvalidParameterError, match="no legs"):
         from pushrecovery.control import Command
 
-        lipm.step(np.array([0.0, 0.0]), Command(0.0, step_length=0.3), 1e-3)
+        lipm.reset(0.0, 0.0)
+        lipm.step(Command(0.0, step_length=0.3), 1e-3)
 
 
 def test_critical_push_beyond_the_single_step_prediction():

@@ -211,7 +211,7 @@ class CampaignSpec:
         first = self.push(0)
         plant = make_plant(self.model, first.params, self.backend)
         controller = make_controller(self.controller, first.params)
-        check_run(plant, controller, plant.initial_state(first.x0, 0.0), self.duration)
+        check_run(plant, controller, plant.reset(first.x0, 0.0), self.duration)
 
     # --- the pushes -----------------------------------------------------------------------
     @property

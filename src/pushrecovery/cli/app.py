@@ -293,6 +293,8 @@ def simulate(
     --ydot add the sideways part (--impulse pushes along x).
     """
     from pushrecovery.control.base import make_controller
+    from pushrecovery.sim.backend import Measuring, Recording
+    from pushrecovery.sim.push import Push
     from pushrecovery.sim.registry import make_plant
     from pushrecovery.sim.simulate import simulate as run
     from pushrecovery.surfaces.classify import classify as classify_state
@@ -317,16 +319,17 @@ def simulate(
 
         require_offscreen_gl()  # fail before the run, not after it
     plant = make_plant(model, params, backend)
-    physics: Any = plant  # the MuJoCo plant's extras (push, record, measured CoP)
-    if backend == "mujoco":
-        # Frames (an extra forward pass per tick) only for the pictures.
-        physics.record() if render else physics.measure()
+    # Frames (an extra forward pass per tick) only for the pictures.
+    if render and isinstance(plant, Recording):
+        plant.record()
+    elif isinstance(plant, Measuring):
+        plant.measure()
     if backend == "mujoco" and impulse is not None:
         # A real force at the CoM, over 10 ms, instead of a velocity jump.
-        plant.initial_state(x, 0.0)
-        initial = physics.push(impulse)
+        plant.reset(x, 0.0)
+        initial = plant.apply_push(Push.from_impulse(impulse, params.mass))
     else:
-        initial = plant.initial_state(x, velocity)
+        initial = plant.reset(x, velocity)
         if plane:
             initial[1], initial[5] = y, ydot  # the planar state's y and ẏ
     result = run(
@@ -341,14 +344,14 @@ def simulate(
     data = result.to_dict()
     data["initial_state"] = {"x": x, "xdot": velocity} | ({"y": y, "ydot": ydot} if plane else {})
     data["predicted"] = predicted.to_dict()
-    if backend == "mujoco":
+    if isinstance(plant, Measuring):  # MuJoCo: the state the push left, the CoP it measured
         half = len(initial) // 2
         data["after_push"] = {"x": float(initial[0]), "xdot": float(initial[half])}
-        data["measured_cop"] = _measured_cop(physics.measured_cops)
-    if render:
+        data["measured_cop"] = _measured_cop(plant.measured_cops)
+    if render and isinstance(plant, Recording) and plant.frames is not None:
         from pushrecovery.sim.mujoco.render import render_run
 
-        files = render_run(physics.model, physics.frames, Path(render))
+        files = render_run(plant.model, plant.frames, Path(render))
         data["render"] = [str(f) for f in files]
     if plot:
         from pushrecovery.plots.runs import save_run

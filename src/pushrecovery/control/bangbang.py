@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 from pushrecovery._validate import positive_float
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.models.flywheel import bang_bang_switch_time, max_spin_up_time
+from pushrecovery.models.flywheel import FLYWHEEL_STATE, bang_bang_switch_time, max_spin_up_time
 from pushrecovery.params import BodyParams
 
 __all__ = ["BangBang"]
@@ -41,6 +41,7 @@ class BangBang(Controller):
 
     name = "bang-bang"
     strategy = "hip"
+    state_labels = FLYWHEEL_STATE
 
     def __init__(self, params: BodyParams, switch_time: float | None = None) -> None:
         super().__init__(params)

@@ -14,6 +14,12 @@ Contract (what the simulators, the CLI and a robot's control loop may rely on):
    [heel, toe] [m], ``flywheel_torque`` within ±torque_max [N m]. A controller that cannot
    meet its goal (the state is beyond what it can recover) still returns a saturated finite
    command and sets ``saturated=True``; it never raises inside the loop.
+5. ``observe(info)`` is called after every step of the plant with what the plant reports
+   beside the state (:class:`StepInfo`: stance, footholds, stop impacts, measured CoP), before
+   the next ``compute``. The default ignores it; a controller that steps learns its landings
+   from it (a robot's loop passes its own contact detection).
+6. ``state_labels`` names the state entries a controller reads; the simulator checks that the
+   plant's state has them, by label.
 """
 
 from __future__ import annotations
@@ -28,9 +34,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.models.lipm import ANKLE_STATE
 from pushrecovery.params import BodyParams
 
-__all__ = ["CONTROLLERS", "Command", "Controller", "make_controller", "register"]
+__all__ = ["CONTROLLERS", "Command", "Controller", "StepInfo", "make_controller", "register"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,6 +82,29 @@ class Command:
     swing: str | None = None
 
 
+@dataclass(frozen=True, slots=True)
+class StepInfo:
+    """What a plant reports after a step, beside the state (contract item 5).
+
+    Attributes
+    ----------
+    stance : bool
+        True while the feet on the ground carry the body (no foot swinging toward a landing).
+    footholds : tuple of float
+        World x of every stance ankle of the run so far, the first at the start [m].
+    stop_impacts : int
+        Times the flywheel hit its joint stop at speed during the run.
+    measured_cop : float or None
+        CoP measured from the contact forces, relative to the stance ankle [m] (NaN while
+        airborne); None when the plant does not measure it.
+    """
+
+    stance: bool = True
+    footholds: tuple[float, ...] = (0.0,)
+    stop_impacts: int = 0
+    measured_cop: float | None = None
+
+
 class Controller(ABC):
     """Base class of all controllers; see the module docstring for the contract."""
 
@@ -86,8 +116,9 @@ class Controller(ABC):
     control_period: float | None = None
     #: True when the controller's internal model assumes exactly ``control_period``.
     fixed_period: ClassVar[bool] = False
-    #: The state the controller reads, by label (``None``: the sagittal states, by strategy).
-    state_labels: ClassVar[tuple[str, ...] | None] = None
+    #: The state entries the controller reads (contract item 6); the plant's must include
+    #: them. By default the CoM position and velocity, which every plant has.
+    state_labels: ClassVar[tuple[str, ...]] = ANKLE_STATE
 
     def __init__(self, params: BodyParams) -> None:
         self.params = params
@@ -99,6 +130,9 @@ class Controller(ABC):
     @abstractmethod
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """Return the command for time ``t`` [s] and ``state``."""
+
+    def observe(self, info: StepInfo) -> None:  # noqa: B027 - optional hook, no-op default
+        """Take the plant's report of its last step (contract item 5); ignored by default."""
 
     @classmethod
     def option_names(cls) -> tuple[str, ...]:

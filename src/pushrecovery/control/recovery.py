@@ -8,9 +8,10 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.base import Command, Controller, register
+from pushrecovery.control.base import Command, Controller, StepInfo, register
 from pushrecovery.control.mpc import MPCController
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.models.stepping import STEPPING_STATE
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.step import plan_steps
@@ -44,6 +45,7 @@ class RecoveryController(Controller):
 
     name = "recovery"
     strategy = "step"
+    state_labels = STEPPING_STATE
 
     def __init__(self, params: BodyParams) -> None:
         super().__init__(params)
@@ -53,6 +55,7 @@ class RecoveryController(Controller):
         self._swing_start: float | None = None
         self._held: Command | None = None
         self._held_until = -1.0
+        self._stance = True
 
     def reset(self, state: NDArray[np.float64]) -> None:
         """Start in ankle mode on the current foot."""
@@ -62,6 +65,11 @@ class RecoveryController(Controller):
                 f"[x, theta, z, xdot, theta_dot, zdot], got shape {np.shape(state)}"
             )
         self.mode, self._swing_start, self._held = "ankle", None, None
+        self._stance = True
+
+    def observe(self, info: StepInfo) -> None:
+        """Learn from the plant whether the feet carry the body (a landing ends a swing)."""
+        self._stance = info.stance
 
     def _body(self, height: float) -> tuple[BodyParams, MPCController]:
         entry = self._bodies.get(height)
@@ -80,11 +88,11 @@ class RecoveryController(Controller):
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """Command for the current mode (escalating first if the state calls for it)."""
-        x, theta, z, xdot, theta_rate, zdot = (float(v) for v in state)
+        x, theta, z, xdot, theta_rate, _ = (float(v) for v in state)
         p = self.params
         if self._swing_start is not None:  # swinging: wait for the landing
-            # The plant keeps ż = 0 only in stance: the first such tick after the step landed.
-            if zdot != 0.0 or t <= self._swing_start:
+            # The plant reports the landing (observe): the first tick in stance after the step.
+            if not self._stance or t <= self._swing_start:
                 brake = -p.flywheel_inertia * theta_rate / STEP_BRAKE_TIME
                 return Command(0.0, max(-p.torque_max, min(p.torque_max, brake)))
             self._swing_start, self.mode, self._held = None, "ankle", None

@@ -56,7 +56,7 @@ def ankle_runs(
 ) -> list[SimulationResult]:
     """Simulate ``controller`` on an ankle ``model`` from each (x0, ẋ0) for 4 s."""
     plant, ctrl = make_plant(model, params), make_controller(controller, params)
-    return [simulate(plant, ctrl, plant.initial_state(x0, v0), duration=4.0) for x0, v0 in starts]
+    return [simulate(plant, ctrl, plant.reset(x0, v0), duration=4.0) for x0, v0 in starts]
 
 
 def hip_runs(
@@ -66,9 +66,7 @@ def hip_runs(
     plant = make_plant("flywheel", params)
     ctrl = make_controller(controller, params, **options)
     limit = float(critical_velocity(0.0, 1.0, params, region=cmp_region(params)))
-    return [
-        simulate(plant, ctrl, plant.initial_state(0.0, f * limit), duration=4.0) for f in fractions
-    ]
+    return [simulate(plant, ctrl, plant.reset(0.0, f * limit), duration=4.0) for f in fractions]
 
 
 @dataclass(frozen=True, slots=True)

@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.params import BodyParams
 
 __all__ = [
+    "FLYWHEEL_STATE",
     "bang_bang_end_state",
     "bang_bang_switch_time",
     "bang_bang_torque",
@@ -32,6 +33,9 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
+
+#: The state X of Eq. (16): CoM position, flywheel angle and their rates [m, rad, m/s, rad/s].
+FLYWHEEL_STATE = ("x", "theta", "xdot", "theta_dot")
 
 
 def max_spin_up_time(params: BodyParams) -> float:

@@ -14,9 +14,18 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["lipm_acceleration", "lipm_propagate", "lipm_state", "lipm_transition"]
+__all__ = [
+    "ANKLE_STATE",
+    "lipm_acceleration",
+    "lipm_propagate",
+    "lipm_state",
+    "lipm_transition",
+]
 
 FloatArray = NDArray[np.float64]
+
+#: The state of the ankle models (LIPM, pendulum): CoM position and velocity [m, m/s].
+ANKLE_STATE = ("x", "xdot")
 
 
 def lipm_acceleration(x: ArrayLike, cop: ArrayLike, omega: float) -> FloatArray:

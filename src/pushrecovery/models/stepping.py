@@ -44,6 +44,7 @@ from pushrecovery.models._step_scalar import MAX_STEP_ANGLE as MAX_STEP_ANGLE
 from pushrecovery.models._step_scalar import step_angle
 
 __all__ = [
+    "STEPPING_STATE",
     "StepSolution",
     "fall_rate",
     "impact_velocities",
@@ -54,6 +55,10 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
+
+#: The stepping model's state: CoM relative to the stance ankle, flywheel angle, CoM height
+#: and their rates [m, rad, m, m/s, rad/s, m/s].
+STEPPING_STATE = ("x", "theta", "z", "xdot", "theta_dot", "zdot")
 #: Up to this many angles, :func:`solve_step_angle` runs the pure-Python solver (a few µs an
 #: angle) instead of loading numba (0.4 s, once per process) and its compiled loops.
 _PYTHON_MAX_SIZE = 32

@@ -674,6 +674,7 @@ def _critical(ctx: _Context) -> str:
 
 def _filmstrips(ctx: _Context) -> str:
     from pushrecovery.control.base import make_controller
+    from pushrecovery.sim.backend import Recording
     from pushrecovery.sim.mujoco.render import (
         fit_view,
         render_frames,
@@ -681,6 +682,7 @@ def _filmstrips(ctx: _Context) -> str:
         select_times,
         write_filmstrip,
     )
+    from pushrecovery.sim.push import Push
     from pushrecovery.sim.registry import MUJOCO_MODELS, make_plant
     from pushrecovery.sim.simulate import simulate
 
@@ -703,13 +705,14 @@ def _filmstrips(ctx: _Context) -> str:
         if model not in MUJOCO_MODELS:
             parts.append(paragraph(f"No MuJoCo model {esc(model)} for {esc(strategy)}.", "note"))
             continue
-        plant: Any = make_plant(model, ctx.params, "mujoco")
+        plant = make_plant(model, ctx.params, "mujoco")
+        if not isinstance(plant, Recording):  # pragma: no cover - every MuJoCo plant records
+            raise TypeError(f"the MuJoCo model {model!r} records no frames")
         plant.record()
-        plant.initial_state(0.0, 0.0)
-        run = simulate(
-            plant, make_controller(controller, ctx.params), plant.push(impulse), duration=4.0
-        )
-        frames = plant.frames
+        plant.reset(0.0, 0.0)
+        pushed = plant.apply_push(Push.from_impulse(impulse, ctx.params.mass))
+        run = simulate(plant, make_controller(controller, ctx.params), pushed, duration=4.0)
+        frames = plant.frames or []
         strip = select_times(frames, 7)
         images = render_frames(
             plant.model, strip, width=180, height=240, view=fit_view(plant.model, frames, 0.75)

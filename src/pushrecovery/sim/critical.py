@@ -19,7 +19,7 @@ from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.plants import Plant
-from pushrecovery.sim.push import direction_sign
+from pushrecovery.sim.push import Push, direction_sign
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
@@ -162,12 +162,9 @@ def pushed_state(plant: Plant, x0: float, velocity: float, *, force: bool) -> ND
     (MuJoCo plants' :meth:`push`).
     """
     if not force:
-        return plant.initial_state(x0, velocity)
-    plant.initial_state(x0, 0.0)
-    pushed: NDArray[np.float64] = plant.push(  # type: ignore[attr-defined]
-        plant.params.mass * velocity
-    )
-    return pushed
+        return plant.reset(x0, velocity)
+    plant.reset(x0, 0.0)
+    return plant.apply_push(Push(velocity))
 
 
 def predicted_critical_velocity(
@@ -247,7 +244,7 @@ def critical_push(
     if force and backend != "mujoco":
         raise InvalidParameterError("force pushes need backend='mujoco'")
     plant = make_plant(model, params, backend)
-    if plant.state_labels is not None:
+    if "y" in plant.state_labels:  # a push along x of a planar model is not its critical push
         raise InvalidParameterError(
             f"the critical push is sagittal; model {model!r} runs with simulate"
         )

@@ -30,11 +30,12 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.base import Command
+from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, plane_discrete
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import PlantBase, check_com_state
 from pushrecovery.surfaces.n_step import reach_polygon
 
 __all__ = ["PlaneSteppingPlant"]
@@ -42,7 +43,7 @@ __all__ = ["PlaneSteppingPlant"]
 FloatArray = NDArray[np.float64]
 
 
-class PlaneSteppingPlant:
+class PlaneSteppingPlant(PlantBase):
     """The planar LIPM + flywheels with stepping feet (module docstring).
 
     Attributes
@@ -56,22 +57,22 @@ class PlaneSteppingPlant:
     """
 
     name: ClassVar[str] = "stepping-plane"
-    state_labels: ClassVar[tuple[str, ...] | None] = PLANE_STATE_LABELS
+    state_labels: ClassVar[tuple[str, ...]] = PLANE_STATE_LABELS
     #: Applied inputs per tick: CoP x, y [m], pitch and roll torques [N m].
-    input_size: ClassVar[int] = 4
+    input_labels: ClassVar[tuple[str, ...]] = ("cop_x", "cop_y", "pitch_torque", "roll_torque")
 
     def __init__(self, params: BodyParams) -> None:
-        self.params = params
+        super().__init__(params)
         self.fall_limits = (params.heel, params.toe)  # along x from the start: reporting only
-        self.stop_impacts = 0
         self._limits = (
             (params.torque_max, params.flywheel_inertia, params.flywheel_angle_max),
             (params.torque_max_roll, params.flywheel_inertia_roll, params.flywheel_angle_max_roll),
         )
         self._matrices: dict[tuple[float, float], tuple[FloatArray, FloatArray]] = {}
-        self._start()
+        self._restart_records()
 
-    def _start(self) -> None:
+    def _restart_records(self) -> None:
+        self.stop_impacts = 0
         self.support = Support.from_params(self.params, Stance.DOUBLE)
         self.time = 0.0
         self._swing: tuple[Stance, tuple[float, float], float] | None = None
@@ -79,14 +80,19 @@ class PlaneSteppingPlant:
         self.footholds: list[float] = [ankle[0]]
         self.footholds_xy: list[tuple[float, float]] = [ankle]
 
-    def initial_state(self, x: float, xdot: float, y: float = 0.0, ydot: float = 0.0) -> FloatArray:
-        """CoM at (x, y) [m] moving at (ẋ, ẏ) [m/s], upper body upright and still."""
-        return np.array([x, y, 0.0, 0.0, xdot, ydot, 0.0, 0.0])
+    def _start(self, x: float, xdot: float) -> FloatArray:
+        return np.array([x, 0.0, 0.0, 0.0, xdot, 0.0, 0.0, 0.0])
+
+    def reset(self, x: float, xdot: float, y: float = 0.0, ydot: float = 0.0) -> FloatArray:
+        """Start on both feet, the CoM at (x, y) [m] moving at (ẋ, ẏ) [m/s] (contract item 2)."""
+        return self.begin(np.array([x, y, 0.0, 0.0, xdot, ydot, 0.0, 0.0]))
+
+    def info(self) -> StepInfo:
+        """Stance unless a foot swings toward its landing (contract item 5)."""
+        return StepInfo(self._swing is None, tuple(self.footholds), self.stop_impacts, None)
 
     def check_state(self, state: FloatArray) -> None:
-        """Require a planar state within the model; also start again on both feet."""
-        from pushrecovery.sim.plants import check_com_state
-
+        """Require a planar state within the model."""
         if state.shape != (8,):
             raise InvalidParameterError(
                 f"state must be {list(PLANE_STATE_LABELS)}, got shape {state.shape}"
@@ -99,12 +105,10 @@ class PlaneSteppingPlant:
                     f"{PLANE_STATE_LABELS[index]} must satisfy |angle| <= {limit:g} rad, "
                     f"got {float(state[index]):g}"
                 )
-        self._start()
 
-    def step(
-        self, state: FloatArray, command: Command, dt: float
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Advance by dt [s]; return the state, the mean applied CoP (x, y) and the torques."""
+    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, FloatArray]:
+        """Advance by dt [s]; return the state and the mean CoP (x, y) and the torques held."""
+        state = self.state
         if command.step_length is not None:
             raise InvalidParameterError(
                 "the stepping-plane model steps to a foothold: set foothold, not step_length"
@@ -125,15 +129,15 @@ class PlaneSteppingPlant:
         swing = self._swing
         if swing is not None and self.time + dt >= swing[2] - 1e-12:
             before = max(0.0, swing[2] - self.time)
-            state = self._advance(state, wanted, torques, before, cop_sum)
+            state = self._hold(state, wanted, torques, before, cop_sum)
             self._land(swing[0], *swing[1])
             left = dt - before
         if left > 0.0:
-            state = self._advance(state, wanted, torques, left, cop_sum)
+            state = self._hold(state, wanted, torques, left, cop_sum)
         self.time += dt
-        return state, cop_sum / dt, torques
+        return state, np.concatenate([cop_sum / dt, torques])
 
-    def _advance(
+    def _hold(
         self,
         state: FloatArray,
         wanted: tuple[float, float],

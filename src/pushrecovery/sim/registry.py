@@ -22,7 +22,7 @@ PLANTS: dict[str, dict[str, str]] = {
         "lipm": "pushrecovery.sim.plants:LipmPlant",
         "pendulum": "pushrecovery.sim.plants:PendulumPlant",
         "flywheel": "pushrecovery.sim.plants:FlywheelPlant",
-        "stepping": "pushrecovery.sim.plants:SteppingPlant",
+        "stepping": "pushrecovery.sim.stepping_plant:SteppingPlant",
         "stepping-plane": "pushrecovery.sim.plane_stepping:PlaneSteppingPlant",
     },
     "mujoco": {

@@ -31,6 +31,16 @@ def is_falling(x: float, xdot: float, lower: float, upper: float) -> bool:
     return (x > upper and xdot >= 0.0) or (x < lower and xdot <= 0.0)
 
 
+#: Labels of results made without them, by state size (the sagittal models').
+_LEGACY_LABELS = {
+    2: ("x", "xdot"),
+    4: ("x", "theta", "xdot", "theta_dot"),
+    6: ("x", "theta", "z", "xdot", "theta_dot", "zdot"),
+}
+#: ``final_state`` keys in the order the JSON contract first had them.
+_FIRST_KEYS = ("x", "xdot", "theta", "theta_dot", "z", "y", "ydot")
+
+
 @dataclass(frozen=True, slots=True)
 class SimulationResult:
     """A simulated run.
@@ -54,6 +64,8 @@ class SimulationResult:
         World x of every stance foot, the first at 0 [m] (more than one after steps).
     footholds_xy : tuple of (float, float)
         On the ground plane: the start's stance reference and every landed ankle (x, y) [m].
+    state_labels : tuple of str
+        The entries of the states (the plant's ``state_labels``).
     """
 
     time: NDArray[np.float64]
@@ -65,6 +77,7 @@ class SimulationResult:
     stop_impacts: int = 0
     footholds: tuple[float, ...] = (0.0,)
     footholds_xy: tuple[tuple[float, float], ...] = ()
+    state_labels: tuple[str, ...] = ()
 
     @property
     def cops(self) -> NDArray[np.float64]:
@@ -89,15 +102,12 @@ class SimulationResult:
     def to_dict(self) -> dict[str, object]:
         """JSON summary (the ``simulate`` contract); trajectories are not included."""
         final = self.final_state
-        x, xdot = final[0], final[len(final) // 2]
-        final_state = {"x": float(x), "xdot": float(xdot)}
-        if len(final) in (4, 6):
-            half = len(final) // 2
-            final_state.update(theta=float(final[1]), theta_dot=float(final[half + 1]))
-        if len(final) == 6:
-            final_state.update(z=float(final[2]))
-        if len(final) == 8:
-            final_state.update(y=float(final[1]), ydot=float(final[5]))
+        labels = self.state_labels or _LEGACY_LABELS.get(len(final), ())
+        values = dict(zip(labels, (float(v) for v in final), strict=True))
+        # The keys of the first releases first, in their order; the rest by label.
+        order = [key for key in _FIRST_KEYS if key in values]
+        order += [key for key in labels if key not in order]
+        final_state = {key: values[key] for key in order}
         return {
             "recovered": self.recovered,
             "outcome": self.outcome.value,

@@ -8,8 +8,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from pushrecovery._validate import finite_float, positive_float
-from pushrecovery.control.base import Controller
+from pushrecovery.control.base import Controller, StepInfo
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS
 from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.result import Outcome, SimulationResult
@@ -22,6 +23,11 @@ DEFAULT_CONTROL_PERIOD = 1e-3
 MAX_STEPS = 10_000_000
 #: Largest ω · control_period: beyond it the hold between ticks dominates the dynamics.
 MAX_OMEGA_DT = 0.1
+#: Which model a controller of each strategy needs, for the error message.
+_MODEL_HINTS = {
+    "hip": ": it moves the upper body: use the flywheel model (or torso on mujoco)",
+    "step": ": it takes steps: use the stepping model (or biped on mujoco)",
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,18 +90,21 @@ def simulate(
     """
     state, dt, steps = check_run(plant, controller, initial_state, duration, control_period)
     rest = rest or RestCriterion()
-    plant.stop_impacts = 0
+    state = plant.begin(state)
     rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))
-    half = plant.input_size // 2
 
     states = np.empty((steps + 1, len(state)))
-    inputs = np.empty((steps, plant.input_size))
+    inputs = np.empty((steps, len(plant.input_labels)))
     states[0] = state
     controller.reset(state)
     outcome, at_rest, k = Outcome.UNDECIDED, 0, 0
+    info = StepInfo()
     while k < steps:
         command = controller.compute(k * dt, state)
-        state, inputs[k, :half], inputs[k, half:] = plant.step(state, command, dt)
+        step = plant.step(command, dt)
+        state, info = step.state, step.info
+        controller.observe(info)
+        inputs[k] = step.applied
         k += 1
         states[k] = state
         if plant.falling(state):
@@ -113,9 +122,10 @@ def simulate(
         outcome=outcome,
         model=plant.name,
         controller=controller.name,
-        stop_impacts=plant.stop_impacts,
-        footholds=tuple(getattr(plant, "footholds", (0.0,))),
+        stop_impacts=info.stop_impacts,
+        footholds=info.footholds,
         footholds_xy=(tuple(plant.footholds_xy) if isinstance(plant, PlaneSteppingPlant) else ()),
+        state_labels=plant.state_labels,
     )
 
 
@@ -150,28 +160,16 @@ def check_run(
     for i, value in enumerate(state):
         finite_float(f"initial_state[{i}]", value)
     plant.check_state(state)
-    labels = controller.state_labels
-    if labels is not None and labels != plant.state_labels:
-        raise InvalidParameterError(
-            f"controller {controller.name!r} needs the state {list(labels)}: "
-            f"model {plant.name!r} does not provide it"
+    missing = [label for label in controller.state_labels if label not in plant.state_labels]
+    if missing:
+        hint = (
+            _MODEL_HINTS.get(controller.strategy, "")
+            if controller.state_labels != (PLANE_STATE_LABELS)
+            else ": use the stepping-plane model"
         )
-    if labels is None and len(state) == 8:
         raise InvalidParameterError(
-            f"controller {controller.name!r} works on the sagittal models: "
-            f"use recovery-plane on {plant.name!r}"
-        )
-    if controller.strategy == "hip" and len(state) != 4:
-        raise InvalidParameterError(
-            f"controller {controller.name!r} moves the upper body: use the flywheel model "
-            "(or torso on mujoco), "
-            f"not {plant.name!r}"
-        )
-    if controller.strategy == "step" and labels is None and len(state) != 6:
-        raise InvalidParameterError(
-            f"controller {controller.name!r} takes steps: use the stepping model "
-            "(or biped on mujoco), "
-            f"not {plant.name!r}"
+            f"controller {controller.name!r} needs the state {list(controller.state_labels)}, "
+            f"which model {plant.name!r} {list(plant.state_labels)} lacks{hint}"
         )
     steps = math.ceil(duration / dt - 1e-9)
     if steps > MAX_STEPS:

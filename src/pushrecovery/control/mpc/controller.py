@@ -14,6 +14,7 @@ from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.qp import CondensedQP
 from pushrecovery.control.mpc.workspace import DaqpWorkspace
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.models.flywheel import FLYWHEEL_STATE
 from pushrecovery.params import BodyParams
 
 __all__ = ["MPCController"]
@@ -45,6 +46,7 @@ class MPCController(Controller):
 
     name = "mpc"
     strategy = "hip"
+    state_labels = FLYWHEEL_STATE
     fixed_period = True
     #: The paper's prediction step [s].
     default_dt = MPCSettings().dt

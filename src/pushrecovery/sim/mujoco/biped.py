@@ -25,10 +25,11 @@ State
 ``[x, theta, z, xdot, theta_dot, zdot]`` as the analytic stepping model: the whole-body CoM
 relative to the current stance ankle (joint kinematics; the stance ankle is at rest, so its
 velocities are the CoM's), the torso's absolute pitch and rate, and in stance the CoM height
-the stance holds (measured at its start) with ż exactly 0.0, which is how the recovery
-controller tells a landing. During a swing, and during the ``IMPACT_TIME`` after a landing in
-which the stance leg absorbs the impact (the analytic impact is instantaneous), z and ż are
-measured. ``footholds`` lists the world x of every stance ankle.
+the stance holds (measured at its start) with ż = 0. During a swing, and during the
+``IMPACT_TIME`` after a landing in which the stance leg absorbs the impact (the analytic impact
+is instantaneous), z and ż are measured. Each step's ``StepInfo`` says which: ``stance`` is
+True only in the held stance (how the recovery controller learns a landing), and
+``footholds`` lists the world x of every stance ankle.
 
 Control: commands → joint torques, every 1 ms physics step
 ---------------------------------------------------------
@@ -95,10 +96,12 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.base import Command
+from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.pendulum import ankle_torque_for_cop
+from pushrecovery.models.stepping import STEPPING_STATE
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import check_com_state
 from pushrecovery.sim.mujoco.models import (
     ANKLE_HEIGHT,
     FOOT_HALF_THICKNESS,
@@ -108,7 +111,6 @@ from pushrecovery.sim.mujoco.models import (
     header,
 )
 from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, FOOT_TIP_LIMIT, MujocoPlant
-from pushrecovery.sim.plants import check_com_state
 
 __all__ = ["LEG_MASS", "MujocoBipedPlant", "biped_model"]
 
@@ -274,11 +276,12 @@ class MujocoBipedPlant(MujocoPlant):
 
     Same state, commands, ``footholds`` and ``fall_limits`` as
     :class:`~pushrecovery.sim.plants.SteppingPlant`; the module docstring describes the model
-    and how commands become joint torques. A push can be a velocity (:meth:`initial_state`) or
+    and how commands become joint torques. A push can be a velocity (:meth:`reset`) or
     a force (:meth:`schedule_push`, on the torso at the hip).
     """
 
     name: ClassVar[str] = "mujoco-biped"
+    state_labels: ClassVar[tuple[str, ...]] = STEPPING_STATE
     model_name: ClassVar[str] = "biped"
     pushed_body: ClassVar[str] = "torso"
 
@@ -407,9 +410,7 @@ class MujocoBipedPlant(MujocoPlant):
             self._check_landing(q, v)
         x, z, xdot, zdot = self._com(q, v, self._stance[0])
         if self._swing is None and self._ticks >= self._impact_end:
-            z, zdot = self._height, 0.0
-        elif zdot == 0.0:
-            zdot = -5e-324  # ż = 0.0 means stance to the controller: never report it in a swing
+            z, zdot = self._height, 0.0  # the height the stance holds (info().stance)
         return np.array([x, q[_PITCH], z, xdot, v[_PITCH], zdot])
 
     def ankle_x(self) -> float:
@@ -455,7 +456,7 @@ class MujocoBipedPlant(MujocoPlant):
         q[:] = conf
         qd[:] = [rate * u for u in unit]
 
-    def initial_state(self, x: float, xdot: float) -> FloatArray:
+    def reset(self, x: float, xdot: float) -> FloatArray:
         """Stand on both feet, legs straight, the CoM at x moving at ẋ, torso upright.
 
         As the other MuJoCo plants, the body first settles upright for ``SETTLE_TIME``;
@@ -463,9 +464,17 @@ class MujocoBipedPlant(MujocoPlant):
         """
         self._reset_phase()
         self._height = self._standing_height()
-        state = super().initial_state(x, xdot)
+        return super().reset(x, xdot)
+
+    def _restart_records(self) -> None:
+        super()._restart_records()
         self.footholds = [self.ankle_x()]
-        return state
+
+    def info(self) -> StepInfo:
+        """Stance once a landing's impact is over and no foot swings (contract item 5)."""
+        measured = self.measured_cops[-1] if self._measuring and self.measured_cops else None
+        stance = self._swing is None and self._ticks >= self._impact_end
+        return StepInfo(stance, tuple(self.footholds), self.stop_impacts, measured)
 
     def _standing_height(self) -> float:
         """CoM height above the ankles standing straight and upright [m]."""
@@ -473,7 +482,7 @@ class MujocoBipedPlant(MujocoPlant):
         return self._length + self._com_offset(q, q)[1]
 
     def check_state(self, state: FloatArray) -> None:
-        """Require ``[x, theta, z, xdot, theta_dot, zdot]`` in stance; restart ``footholds``."""
+        """Require ``[x, theta, z, xdot, theta_dot, zdot]`` in stance."""
         if state.shape != (6,):
             raise InvalidParameterError(
                 f"state must be [x, theta, z, xdot, theta_dot, zdot], got shape {state.shape}"
@@ -481,7 +490,6 @@ class MujocoBipedPlant(MujocoPlant):
         if not (float(state[2]) > 0.0 and float(state[5]) == 0.0):
             raise InvalidParameterError("the biped starts in stance: z > 0, zdot = 0")
         check_com_state(float(state[0]), float(state[3]), self.params)
-        self.footholds = [self.ankle_x()]
 
     def foot_tipped(self) -> bool:
         """Tell whether a stance foot's pitch is beyond ``FOOT_TIP_LIMIT``."""

@@ -434,7 +434,7 @@ def record_push(
     name = controller or DEFAULT_CONTROLLERS[model]
     plant: MujocoPlant = PLANTS[model](params)
     ctrl = make_controller(name, params)
-    state = plant.initial_state(x0, 0.0)
+    state = plant.reset(x0, 0.0)
     # The controller's own period (else 1 ms), checked against the model as simulate() does.
     state, period, _ = check_run(plant, ctrl, state, duration)
     rest = RestCriterion()
@@ -442,6 +442,7 @@ def record_push(
 
     # The initial stance foot: the first ankle (both feet side by side for the biped).
     first_ankle = float(plant.ankle_x())
+    footholds = plant.info().footholds
     lab = _Lab(plant, model, _plate_areas(first_ankle + 0.5 * (params.heel + params.toe)))
     n_plates = len(lab.plates)
     markers = {label: np.zeros((n_frames, 3)) for label in MARKER_LABELS}
@@ -502,12 +503,13 @@ def record_push(
             # Whole physics steps per tick, rounded per tick as the plants do.
             next_tick = origin + round(tick * period / h)
         try:
-            state, _, torque = plant.step(state, command, h)
+            step = plant.step(command, h)
         except PushRecoveryError:
             if outcome is not Outcome.FELL:
                 raise
             end = s  # a fallen model blew up: the recording ends here
             break
+        state, torque, footholds = step.state, float(step.applied[1]), step.info.footholds
         peak = max(peak, abs(torque))
         if s % decimation == 0:
             a = s // decimation
@@ -528,7 +530,6 @@ def record_push(
         _plate_channels(area, forces[:n_kept, j].copy(), moments[:n_kept, j])
         for j, area in enumerate(lab.plates)
     )
-    footholds = [float(f) for f in getattr(plant, "footholds", [first_ankle])]
     steps = len(footholds) - 1
     used = "step" if steps else "hip" if peak > HIP_TORQUE_THRESHOLD else "ankle"
     truth: dict[str, object] = {
@@ -553,7 +554,7 @@ def record_push(
         "plant_cop": plant_cop[:n_kept],
         "steps": steps,
         "step_lengths": [b - a for a, b in itertools.pairwise(footholds)],
-        "footholds": footholds,
+        "footholds": list(footholds),
         "stance_width": 2.0 * STANCE_HALF_WIDTH,
         "off_plate_samples": lab.off_plate,
         "params": dataclasses.asdict(params),

@@ -26,12 +26,15 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.base import Command
+from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
+from pushrecovery.models.flywheel import FLYWHEEL_STATE
+from pushrecovery.models.lipm import ANKLE_STATE
 from pushrecovery.models.pendulum import ankle_torque_for_cop
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import RecordedFrame, Step, check_com_state, over_foot_at_rest
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, FOOT_MASS, MODEL_BUILDERS, TIMESTEP
-from pushrecovery.sim.plants import check_com_state, over_foot_at_rest
+from pushrecovery.sim.push import Push
 
 __all__ = [
     "DEFAULT_COP_MARGIN",
@@ -59,7 +62,6 @@ TORQUE_HOLD = 0.01
 FloatArray = NDArray[np.float64]
 
 #: One recorded instant: time [s], qpos, CoM (x, z) [m], capture point x [m], CoP x [m] (world).
-RecordedFrame = tuple[float, FloatArray, tuple[float, float], float, float]
 
 
 class MujocoPlant:
@@ -88,8 +90,8 @@ class MujocoPlant:
     #: default) for plants with joint servos; longer for open-loop torque maps of a slowly
     #: changing state.
     torque_hold: ClassVar[float] = TIMESTEP
-    input_size: ClassVar[int] = 2
-    state_labels: ClassVar[tuple[str, ...] | None] = None
+    state_labels: ClassVar[tuple[str, ...]]
+    input_labels: ClassVar[tuple[str, ...]] = ("cop", "hip_torque")
 
     def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:
         import mujoco
@@ -106,6 +108,7 @@ class MujocoPlant:
         self.data = mujoco.MjData(self.model)
         self.fall_limits = (params.heel, params.toe)
         self.stop_impacts = 0
+        self._first_ankle = 0.0
         self.time = 0.0
         #: Frames recorded by :meth:`step` after :meth:`record` (for rendering), else None.
         self.frames: list[RecordedFrame] | None = None
@@ -152,7 +155,7 @@ class MujocoPlant:
         ``body`` names another MuJoCo body to push (at that body's own centre of mass, e.g.
         ``"foot"``); the CoP map then does not know the push, so the CoP wanders during it.
 
-        Applied from the next :meth:`step` on (call after :meth:`initial_state`), over the
+        Applied from the next :meth:`step` on (call after :meth:`reset`), over the
         whole physics steps nearest to ``duration`` (at least one), with the force that makes
         their total exactly ``impulse``. The velocity jump it stands for, J/m, must satisfy
         the models' validity (|J/m| < 10 sqrt(g L)).
@@ -187,7 +190,7 @@ class MujocoPlant:
         self.schedule_push(impulse, duration, body)
         state = self.read_state()
         while self._push_steps > 0:
-            state, _, _ = self.step(state, Command(float(state[0])), self._substep)
+            state, _, _ = self._hold(Command(float(state[0])), self._substep)
         self._start_clock()
         return state
 
@@ -223,11 +226,12 @@ class MujocoPlant:
         """World x of the stance ankle [m]."""
         raise NotImplementedError
 
-    def initial_state(self, x: float, xdot: float) -> FloatArray:
+    def reset(self, x: float, xdot: float) -> FloatArray:
         """Lean so the CoM is x ahead of the ankle, moving at ẋ; feet flat, upper body upright.
 
         The body first stands upright (an exact balance, no torque) for ``SETTLE_TIME`` so
-        that the contacts are at equilibrium when the lean and the push are applied.
+        that the contacts are at equilibrium when the lean and the push are applied (contract
+        item 2).
         """
         check_com_state(x, xdot, self.params)
         mj, d = self._mj, self.data
@@ -240,15 +244,40 @@ class MujocoPlant:
         self.pose(x, xdot)
         mj.mj_forward(self.model, d)
         self._start_clock()
+        self._restart_records()
         return self.read_state()
 
     def check_state(self, state: FloatArray) -> None:
-        """Require the state shape of the model (set it with :meth:`initial_state`)."""
-        size = len(self.read_state())
+        """Require the state shape of the model (set it with :meth:`reset`)."""
+        size = len(self.state_labels)
         if state.shape != (size,):
             raise InvalidParameterError(
-                f"state must have shape ({size},) for {self.name}, got {state.shape}"
+                f"state must be {list(self.state_labels)} for {self.name}, got shape {state.shape}"
             )
+
+    def begin(self, state: FloatArray) -> FloatArray:
+        """Start a run from the body as it is now (after :meth:`reset` or a push; item 3).
+
+        MuJoCo's state is its joints: ``state`` must have the model's shape; the run's
+        records (stop impacts, footholds) start here.
+        """
+        state = np.array(state, dtype=np.float64)
+        self.check_state(state)
+        self._restart_records()
+        return state
+
+    def _restart_records(self) -> None:
+        self.stop_impacts = 0
+        self._first_ankle = self.ankle_x()
+
+    def apply_push(self, push: Push) -> FloatArray:
+        """Push at the CoM with the impulse m Δẋ over ``PUSH_DURATION`` (contract item 4)."""
+        return self.push(push.impulse(self.params.mass))
+
+    def info(self) -> StepInfo:
+        """Return the report of the run so far (contract item 5): stance, footholds, CoP."""
+        measured = self.measured_cops[-1] if self._measuring and self.measured_cops else None
+        return StepInfo(True, (self._first_ankle,), self.stop_impacts, measured)
 
     def at_rest(self, state: FloatArray, speed: float) -> bool:
         """:func:`~pushrecovery.sim.plants.over_foot_at_rest` on the stance foot."""
@@ -272,14 +301,15 @@ class MujocoPlant:
         """CoP of the floor's normal forces on the soles, relative to the stance ankle [m]."""
         return self.measured_cop_world() - self.ankle_x()
 
-    def step(
-        self, state: FloatArray, command: Command, dt: float
-    ) -> tuple[FloatArray, float, float]:
-        """Hold ``command`` over dt (torques refreshed every ``torque_hold``); return the state.
+    def step(self, command: Command, dt: float) -> Step:
+        """Hold ``command`` over dt, torques refreshed every ``torque_hold`` (contract item 5).
 
-        Returns the estimated state, the commanded CoP after clipping [m] and the hip torque
-        [N m].
+        The applied inputs are the commanded CoP after clipping [m] and the hip torque [N m].
         """
+        state, cop, torque = self._hold(command, dt)
+        return Step(state, np.array([cop, torque]), self.info())
+
+    def _hold(self, command: Command, dt: float) -> tuple[FloatArray, float, float]:
         p, margin = self.params, self.cop_margin
         cop = min(p.toe - margin, max(p.heel + margin, command.cop))
         mj_step, model, d, h = self._mj.mj_step, self.model, self.data, self._substep
@@ -355,13 +385,14 @@ class MujocoPlant:
 class MujocoFootPlant(MujocoPlant):
     """Rigid body on a tipping foot, in MuJoCo (model ``foot``): the pendulum of Fig. 3(b).
 
-    A push can be a velocity jump (:meth:`initial_state`) or a real force:
+    A push can be a velocity jump (:meth:`reset`) or a real force:
     :meth:`schedule_push` applies an impulse [N s] at the CoM over a short duration at the
     start of the run. The rest criterion of the simulator (CoM at rest over the foot,
     unsaturated command) decides recovery, as for the analytic models.
     """
 
     name: ClassVar[str] = "mujoco-foot"
+    state_labels: ClassVar[tuple[str, ...]] = ANKLE_STATE
     model_name: ClassVar[str] = "foot"
     pushed_body: ClassVar[str] = "body"
     #: The CoP → torque map depends on the lean and its rate only, which change little in
@@ -441,6 +472,7 @@ class MujocoTorsoPlant(MujocoFootPlant):
     """
 
     name: ClassVar[str] = "mujoco-torso"
+    state_labels: ClassVar[tuple[str, ...]] = FLYWHEEL_STATE
     model_name: ClassVar[str] = "torso"
     pushed_body: ClassVar[str] = "torso"
 

@@ -1,0 +1,231 @@
+"""The backend contract: what the simulator, the experiments and a test bench rely on of a plant.
+
+Contract (every plant, analytic or MuJoCo, implements it; :func:`~pushrecovery.sim.simulate.
+simulate` is written against it alone):
+
+1. A plant is built from :class:`~pushrecovery.params.BodyParams` and has a registry ``name``,
+   its ``params``, ``state_labels`` (the entries of its state, positions then velocities, the
+   CoM position ``x`` first and its velocity ``xdot`` at ``len // 2``) and ``input_labels``
+   (the applied inputs of a step: CoP entries, then torques).
+2. ``reset(x, xdot)`` starts a run with the CoM at x [m] moving at ẋ [m/s] and everything else
+   at rest (standing; MuJoCo after settling) and returns the state.
+3. ``check_state(state)`` raises :class:`~pushrecovery.errors.InvalidParameterError`, naming
+   the entry and its range, for a state the model cannot start from; ``begin(state)`` checks
+   it and starts a run from it (as returned by ``reset``/``apply_push``, or any valid state),
+   returning it. A run's records (footholds, stop impacts, measurements) start here.
+4. ``apply_push(push)`` pushes now (:class:`~pushrecovery.sim.push.Push`): a jump of the CoM
+   velocity on the analytic models, a force on the pushed body over the push's duration on
+   MuJoCo (the body holding still meanwhile), and returns the state after it.
+5. ``step(command, dt)`` holds ``command`` for ``dt`` [s] and returns a :class:`Step`: the new
+   state, the inputs the plant applied (commands are clipped to the feet and the torque
+   limits: physics, not politeness) and a :class:`~pushrecovery.control.base.StepInfo`
+   (stance, footholds, stop impacts, measured CoP). It raises
+   :class:`~pushrecovery.errors.SimulationDiverged` if the physics blows up.
+6. ``falling(state)`` tells whether the state is in the plant's absorbing fall set
+   (docs/conventions.md); ``at_rest(state, speed)`` whether the CoM moves at most ``speed``
+   [m/s] over the support.
+7. Optional capabilities are their own protocols: :class:`Recording` (frames for rendering)
+   and :class:`Measuring` (the CoP measured from contact forces). Check them with
+   ``isinstance``; nothing else is looked up by name.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.control.base import Command, StepInfo
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+from pushrecovery.sim.push import Push
+
+__all__ = [
+    "Backend",
+    "Measuring",
+    "PlantBase",
+    "RecordedFrame",
+    "Recording",
+    "Step",
+    "check_com_state",
+    "over_foot_at_rest",
+]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class Step:
+    """One step of a plant (contract item 5).
+
+    Attributes
+    ----------
+    state : ndarray
+        The state after the step (``state_labels``).
+    applied : ndarray
+        The inputs held over the step (``input_labels``): CoP [m], then torques [N m].
+    info : StepInfo
+        Stance, footholds, stop impacts and measured CoP.
+    """
+
+    state: FloatArray
+    applied: FloatArray
+    info: StepInfo
+
+
+class Backend(Protocol):
+    """A plant behind the numbered contract of the module docstring."""
+
+    name: ClassVar[str]
+    state_labels: ClassVar[tuple[str, ...]]
+    input_labels: ClassVar[tuple[str, ...]]
+    params: BodyParams
+
+    def reset(self, x: float, xdot: float) -> FloatArray:
+        """Start a run standing with the CoM at x [m] moving at ẋ [m/s] (item 2)."""
+        ...
+
+    def check_state(self, state: FloatArray) -> None:
+        """Raise if the model cannot start from ``state`` (item 3)."""
+        ...
+
+    def begin(self, state: FloatArray) -> FloatArray:
+        """Start a run from ``state``, checked (item 3)."""
+        ...
+
+    def apply_push(self, push: Push) -> FloatArray:
+        """Push now; return the state after the push (item 4)."""
+        ...
+
+    def step(self, command: Command, dt: float) -> Step:
+        """Hold ``command`` for ``dt`` [s] (item 5)."""
+        ...
+
+    def falling(self, state: FloatArray) -> bool:
+        """Whether ``state`` is in the absorbing fall set (item 6)."""
+        ...
+
+    def at_rest(self, state: FloatArray, speed: float) -> bool:
+        """Whether the CoM moves at most ``speed`` [m/s] over the support (item 6)."""
+        ...
+
+
+#: One recorded instant: time [s], joint positions, CoM (x, z) [m], capture point x [m] and
+#: measured CoP x [m], world frame.
+RecordedFrame = tuple[float, FloatArray, tuple[float, float], float, float]
+
+
+@runtime_checkable
+class Recording(Protocol):
+    """A plant that records frames for rendering (MuJoCo): its ``model`` and ``frames``."""
+
+    model: object
+    frames: list[RecordedFrame] | None
+
+    def record(self) -> None:
+        """Record a frame at every step from now on (``frames``)."""
+        ...
+
+
+@runtime_checkable
+class Measuring(Protocol):
+    """A plant that measures the CoP from its contact forces (MuJoCo)."""
+
+    measured_cops: list[float]
+
+    def measure(self) -> None:
+        """Record the measured CoP at every step from now on (``measured_cops``)."""
+        ...
+
+
+def check_com_state(x: float, xdot: float, params: BodyParams) -> None:
+    """Reject CoM states outside every model's validity.
+
+    |x| < L (the CoM above the ankle's horizon) and |ẋ| < 10 sqrt(g L): ten times the speed at
+    which an upright pendulum's foot unloads (docs/conventions.md).
+    """
+    if abs(x) >= params.com_height:
+        raise InvalidParameterError(
+            f"x must satisfy |x| < com_height = {params.com_height:g} m, got x={x:g}"
+        )
+    speed = 10.0 * math.sqrt(params.gravity * params.com_height)
+    if abs(xdot) >= speed:
+        raise InvalidParameterError(
+            f"xdot must satisfy |xdot| < 10 sqrt(g L) = {speed:g} m/s, got xdot={xdot:g}"
+        )
+
+
+def over_foot_at_rest(state: FloatArray, params: BodyParams, speed: float) -> bool:
+    """Sagittal rest: |ẋ| <= ``speed`` [m/s] and the CoM strictly over the foot (heel, toe)."""
+    x, xdot = float(state[0]), float(state[len(state) // 2])
+    return abs(xdot) <= speed and params.heel < x < params.toe
+
+
+class PlantBase:
+    """The analytic plants' side of the contract: the run's state and records, the template.
+
+    Subclasses implement :meth:`_start` (the state of ``reset``), :meth:`check_state` and
+    :meth:`_advance` (one held step of the model, returning the new state and the applied
+    inputs); ``step`` keeps the state and builds the :class:`Step`.
+    """
+
+    name: ClassVar[str]
+    state_labels: ClassVar[tuple[str, ...]]
+    input_labels: ClassVar[tuple[str, ...]] = ("cop", "hip_torque")
+
+    def __init__(self, params: BodyParams) -> None:
+        self.params = params
+        self.stop_impacts = 0
+        self.footholds: list[float] = [0.0]
+        self.state: FloatArray = np.zeros(len(self.state_labels))
+
+    def _start(self, x: float, xdot: float) -> FloatArray:
+        raise NotImplementedError  # pragma: no cover - every plant defines it
+
+    def check_state(self, state: FloatArray) -> None:
+        """Raise :class:`InvalidParameterError` if the model cannot start from ``state``."""
+        raise NotImplementedError  # pragma: no cover - every plant defines it
+
+    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, FloatArray]:
+        raise NotImplementedError  # pragma: no cover - every plant defines it
+
+    def _restart_records(self) -> None:
+        """Clear the run's records (footholds, stop impacts, phase)."""
+        self.stop_impacts = 0
+        self.footholds = [0.0]
+
+    def info(self) -> StepInfo:
+        """Return the plant's report of the run so far (contract item 5)."""
+        return StepInfo(True, tuple(self.footholds), self.stop_impacts, None)
+
+    def reset(self, x: float, xdot: float) -> FloatArray:
+        """Start standing with the CoM at x [m] moving at ẋ [m/s] (contract item 2)."""
+        return self.begin(self._start(float(x), float(xdot)))
+
+    def begin(self, state: FloatArray) -> FloatArray:
+        """Start a run from ``state``, checked (contract item 3)."""
+        state = np.array(state, dtype=np.float64)
+        self.check_state(state)
+        self._restart_records()
+        self.state = state
+        return state.copy()
+
+    def apply_push(self, push: Push) -> FloatArray:
+        """Add the push's velocity jump to the CoM velocity now (contract item 4)."""
+        state = self.state.copy()
+        state[len(state) // 2] += push.delta_velocity
+        check_com_state(float(state[0]), float(state[len(state) // 2]), self.params)
+        self.state = state
+        return state.copy()
+
+    def step(self, command: Command, dt: float) -> Step:
+        """Hold ``command`` for ``dt`` [s] (contract item 5).
+
+        The returned state is the plant's own (not copied: a step makes a new array).
+        """
+        state, applied = self._advance(command, dt)
+        self.state = state
+        return Step(state, applied, self.info())
