@@ -6,13 +6,8 @@ import numpy as np
 import pytest
 
 from pushrecovery import InvalidParameterError, load_params
-from pushrecovery.sim.mujoco.mocap import (
-    MARKER_LABELS,
-    PLATE_LENGTH,
-    PLATE_WIDTH,
-    MocapRecording,
-    record_push,
-)
+from pushrecovery.experiments.mocap import record_push
+from pushrecovery.sim.mujoco.lab import MARKER_LABELS, PLATE_LENGTH, PLATE_WIDTH, MocapRecording
 from pushrecovery.surfaces.step import plan_step
 
 P = load_params()

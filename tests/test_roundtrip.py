@@ -12,8 +12,8 @@ import pytest
 from pushrecovery.analysis.c3d import write_c3d
 from pushrecovery.analysis.readers import read_c3d_recording
 from pushrecovery.analysis.trial import AnalysisSettings, analyze, body_for
+from pushrecovery.experiments.mocap import record_push
 from pushrecovery.params import load_params
-from pushrecovery.sim.mujoco.mocap import record_push
 
 PARAMS = load_params()
 SETTINGS = AnalysisSettings()

@@ -90,16 +90,9 @@ def run_push(
     # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
     reach = STRATEGY_CODES.index(Strategy(controller.strategy))
     steps = len(run.footholds) - 1
-    hip = float(abs(run.torques).max()) if run.torques.size else 0.0
+    hip = run.peak_hip_torque
     cops = run.cops
-    if not run.recovered:
-        used = Strategy.FALL
-    elif steps:
-        used = Strategy.STEP
-    elif hip > 0.0:
-        used = Strategy.HIP
-    else:
-        used = Strategy.ANKLE
+    used = run.strategy_used() if run.recovered else Strategy.FALL
     row: dict[str, Any] = {
         f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
     }

@@ -221,6 +221,10 @@ class PlantBase:
         self.state = state
         return state.copy()
 
+    def jump_velocity(self, delta: float) -> FloatArray:
+        """Add ``delta`` [m/s] to the CoM velocity now: the analytic push."""
+        return self.apply_push(Push(delta))
+
     def step(self, command: Command, dt: float) -> Step:
         """Hold ``command`` for ``dt`` [s] (contract item 5).
 

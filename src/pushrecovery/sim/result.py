@@ -8,7 +8,14 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Outcome", "SimulationResult", "is_falling"]
+from pushrecovery.surfaces.classify import Strategy
+
+__all__ = ["HIP_TORQUE_THRESHOLD", "Outcome", "SimulationResult", "is_falling"]
+
+#: Largest |hip torque| [N m] that still counts as not using the hip: a solver's rounding or
+#: a servo holding the upper body still (the MPC leaves 2e-5 N m on a push of 0), not CMP
+#: balancing (whose torques are tens of N m).
+HIP_TORQUE_THRESHOLD = 1.0
 
 
 class Outcome(StrEnum):
@@ -66,6 +73,8 @@ class SimulationResult:
         On the ground plane: the start's stance reference and every landed ankle (x, y) [m].
     state_labels : tuple of str
         The entries of the states (the plant's ``state_labels``).
+    decided_time : float or None
+        When the outcome was decided [s] (None: undecided).
     """
 
     time: NDArray[np.float64]
@@ -78,6 +87,7 @@ class SimulationResult:
     footholds: tuple[float, ...] = (0.0,)
     footholds_xy: tuple[tuple[float, float], ...] = ()
     state_labels: tuple[str, ...] = ()
+    decided_time: float | None = None
 
     @property
     def cops(self) -> NDArray[np.float64]:
@@ -88,6 +98,23 @@ class SimulationResult:
     def torques(self) -> NDArray[np.float64]:
         """Hip (flywheel) torque applied over each control period [N m] (pitch on the plane)."""
         return self.inputs[:, self.inputs.shape[1] // 2]
+
+    @property
+    def peak_hip_torque(self) -> float:
+        """Largest |hip torque| held during the run [N m] (pitch on the plane)."""
+        return float(np.abs(self.torques).max()) if self.torques.size else 0.0
+
+    def strategy_used(self) -> Strategy:
+        """Return the strategy the run used, whatever its outcome (the one definition).
+
+        ``step`` if a foot landed, else ``hip`` if the hip torque exceeded
+        :data:`HIP_TORQUE_THRESHOLD`, else ``ankle``.
+        """
+        if len(self.footholds) > 1:
+            return Strategy.STEP
+        if self.peak_hip_torque > HIP_TORQUE_THRESHOLD:
+            return Strategy.HIP
+        return Strategy.ANKLE
 
     @property
     def recovered(self) -> bool:

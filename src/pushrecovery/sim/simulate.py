@@ -3,14 +3,21 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from pushrecovery._validate import finite_float, positive_float
-from pushrecovery.control.base import Controller, StepInfo
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.control.base import Command, Controller, StepInfo
+from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS
+from pushrecovery.sim.events import (
+    ForcePushing,
+    Observer,
+    ScheduledPush,
+    VelocityJumping,
+)
 from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.result import Outcome, SimulationResult
@@ -59,21 +66,27 @@ def simulate(
     duration: float = 10.0,
     control_period: float | None = None,
     rest: RestCriterion | None = None,
+    push: ScheduledPush | None = None,
+    plant_step: float | None = None,
+    observers: Sequence[Observer] = (),
+    keep_running: tuple[float, float] = (0.0, 0.0),
 ) -> SimulationResult:
     """Simulate ``controller`` on ``plant`` from ``initial_state`` (sampled-data, ZOH).
 
-    Every ``control_period`` the controller computes a command that the plant holds until the
-    next tick. The run ends as ``fell`` as soon as the CoM is beyond the plant's fall limit and
-    moving away from the foot (:func:`~pushrecovery.sim.result.is_falling`, an absorbing set),
-    as ``recovered`` once the CoM has stayed at rest over the foot with an unsaturated command
-    for ``rest.duration``, and as ``undecided`` if neither happens within ``duration``.
+    The only closed loop of the project. Every ``control_period`` the controller computes a
+    command that the plant holds until the next tick, in steps of ``plant_step``; after every
+    step the controller observes the plant's report and every observer sees the step. At the
+    end of each tick the criteria decide: ``fell`` as soon as the state is in the plant's
+    absorbing fall set (beyond the fall limit, moving away), ``recovered`` once the CoM has
+    stayed at rest over the support with an unsaturated command for ``rest.duration``;
+    ``undecided`` if neither happens within ``duration``.
 
     Parameters
     ----------
     plant : Plant
-        The model (see :mod:`pushrecovery.sim.plants`).
+        The model, behind the backend contract (:mod:`pushrecovery.sim.backend`).
     controller : Controller
-        Any controller; ``reset`` is called here.
+        Any controller whose state labels the plant has; ``reset`` is called here.
     initial_state : ndarray
         Start state, e.g. ``[x, xdot]`` just after the push [m, m/s].
     duration : float
@@ -83,40 +96,90 @@ def simulate(
         ``control_period`` (the MPC's dt), else 1 ms.
     rest : RestCriterion, optional
         Recovery criterion; default ``RestCriterion()``.
+    push : ScheduledPush, optional
+        A push during the run (e.g. after quiet standing): the criteria only count from
+        its end, when the controller restarts (unless ``push.react``).
+    plant_step : float, optional
+        The plant's step [s] (default: the control period), a whole fraction of it: a
+        recorder that samples faster than the controller ticks.
+    observers : sequence of Observer
+        Called after every plant step.
+    keep_running : (float, float)
+        Keep simulating this long [s] after the run is decided as recovered, and as fell
+        (``math.inf``: to the end of ``duration``); the outcome stays the first decision.
 
     Returns
     -------
     SimulationResult
+        States at every plant step; ``decided_time`` when the outcome was decided.
     """
-    state, dt, steps = check_run(plant, controller, initial_state, duration, control_period)
+    state, dt, ticks = check_run(plant, controller, initial_state, duration, control_period)
+    h = dt if plant_step is None else positive_float("plant_step", plant_step, "s")
+    if h > dt:
+        raise InvalidParameterError(f"plant_step must be <= the control period {dt:g} s, got {h:g}")
     rest = rest or RestCriterion()
-    state = plant.begin(state)
     rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))
+    # Whole plant steps per tick, rounded tick by tick (a period that is not a multiple of
+    # the plant's step keeps the plant's clock on the controller's).
+    total = ticks if h == dt else math.ceil(duration / h - 1e-9)
+    start = -1 if push is None else round(push.time / h)
+    if push is not None and start >= total:
+        raise InvalidParameterError(
+            f"push time must be before the end of the run, {duration:g} s, got {push.time:g}"
+        )
+    hold_until = -1  # the plant step at which the push is over
+    settled = push is None  # rest counts once the push is over
 
-    states = np.empty((steps + 1, len(state)))
-    inputs = np.empty((steps, len(plant.input_labels)))
+    state = plant.begin(state)
+    states = np.empty((total + 1, len(state)))
+    inputs = np.empty((total, len(plant.input_labels)))
     states[0] = state
     controller.reset(state)
-    outcome, at_rest, k = Outcome.UNDECIDED, 0, 0
+    outcome, decided, at_rest = Outcome.UNDECIDED, -1, 0
     info = StepInfo()
-    while k < steps:
-        command = controller.compute(k * dt, state)
-        step = plant.step(command, dt)
+    command = Command(float(state[0]))
+    tick, next_tick, origin, end, k = 0, 0, 0, total, 0
+    while k < end:
+        if push is not None and k == start:
+            state, hold_until = _start_push(plant, push, state, k, h)
+            states[k] = state  # a jump changes the state at this instant
+        if push is not None and k == hold_until and not settled:
+            settled = True
+            if not push.react:  # the controller restarts on the pushed state
+                controller.reset(state)
+                tick, next_tick, origin = 0, k, k
+        if not settled and k >= start >= 0 and push is not None and not push.react:
+            command = Command(float(state[0]))  # holding still while the force acts
+        elif k == next_tick:
+            command = controller.compute(tick * dt, state)
+            tick += 1
+            next_tick = origin + round(tick * dt / h)
+        try:
+            step = plant.step(command, h)
+        except SimulationDiverged:
+            if outcome is not Outcome.FELL:
+                raise
+            break  # a fallen model blew up: the run ends here
         state, info = step.state, step.info
         controller.observe(info)
         inputs[k] = step.applied
+        for observer in observers:
+            observer.on_step(k, step, command)
         k += 1
         states[k] = state
+        if k != next_tick or outcome is not Outcome.UNDECIDED:
+            continue  # the criteria are judged at the end of a control tick
         if plant.falling(state):
-            outcome = Outcome.FELL
-            break
-        resting = not command.saturated and plant.at_rest(state, rest.speed)
+            outcome, decided = Outcome.FELL, k
+            end = min(end, k + _steps_after(keep_running[1], h))
+            continue
+        resting = settled and not command.saturated and plant.at_rest(state, rest.speed)
         at_rest = at_rest + 1 if resting else 0
         if at_rest >= rest_ticks:
-            outcome = Outcome.RECOVERED
-            break
+            outcome, decided = Outcome.RECOVERED, k
+            end = min(end, k + _steps_after(keep_running[0], h))
     return SimulationResult(
-        time=np.arange(k + 1, dtype=np.float64) * dt,
+        time=np.arange(k + 1, dtype=np.float64) * h,
         states=states[: k + 1],
         inputs=inputs[:k],
         outcome=outcome,
@@ -126,7 +189,29 @@ def simulate(
         footholds=info.footholds,
         footholds_xy=(tuple(plant.footholds_xy) if isinstance(plant, PlaneSteppingPlant) else ()),
         state_labels=plant.state_labels,
+        decided_time=None if decided < 0 else decided * h,
     )
+
+
+def _steps_after(seconds: float, h: float) -> int:
+    """Plant steps in ``seconds`` [s] after a decision (0: stop at once; inf: no limit)."""
+    return MAX_STEPS * 1000 if math.isinf(seconds) else round(seconds / h)
+
+
+def _start_push(
+    plant: Plant, push: ScheduledPush, state: np.ndarray, k: int, h: float
+) -> tuple[np.ndarray, int]:
+    """Start ``push`` at plant step k; return the state and the step at which it is over.
+
+    A force acts over the plant's following steps (the plant tells how many); a jump is over
+    at once.
+    """
+    if push.kind == "force" and isinstance(plant, ForcePushing):
+        lasts = plant.schedule_push(push.push.impulse(plant.params.mass))
+        return state, k + max(1, math.ceil(lasts / h - 1e-9))
+    if isinstance(plant, VelocityJumping):
+        return plant.jump_velocity(push.push.delta_velocity), k
+    return plant.apply_push(push.push), k
 
 
 def check_run(

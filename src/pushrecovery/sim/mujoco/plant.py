@@ -149,7 +149,7 @@ class MujocoPlant:
     # --- pushes and recording ------------------------------------------------------------
     def schedule_push(
         self, impulse: float, duration: float = PUSH_DURATION, body: str | None = None
-    ) -> None:
+    ) -> float:
         """Push the body at its CoM with ``impulse`` [N s] (+x forward) over ``duration`` [s].
 
         ``body`` names another MuJoCo body to push (at that body's own centre of mass, e.g.
@@ -158,7 +158,7 @@ class MujocoPlant:
         Applied from the next :meth:`step` on (call after :meth:`reset`), over the
         whole physics steps nearest to ``duration`` (at least one), with the force that makes
         their total exactly ``impulse``. The velocity jump it stands for, J/m, must satisfy
-        the models' validity (|J/m| < 10 sqrt(g L)).
+        the models' validity (|J/m| < 10 sqrt(g L)). Returns how long the force acts [s].
         """
         if not (math.isfinite(impulse) and math.isfinite(duration)):
             raise InvalidParameterError(
@@ -177,6 +177,7 @@ class MujocoPlant:
             raise InvalidParameterError(f"body must be one of {names}, got {body!r}") from None
         self._push_steps = round(duration / self._substep)
         self._push_force = impulse / (self._push_steps * self._substep)
+        return self._push_steps * self._substep
 
     def push(
         self, impulse: float, duration: float = PUSH_DURATION, body: str | None = None
@@ -269,6 +270,16 @@ class MujocoPlant:
     def _restart_records(self) -> None:
         self.stop_impacts = 0
         self._first_ankle = self.ankle_x()
+
+    def jump_velocity(self, delta: float) -> FloatArray:
+        """Add ``delta`` [m/s] to the CoM velocity now, the body's pose kept (a velocity push)."""
+        state = self.read_state()
+        if delta == 0.0:
+            return state
+        check_com_state(float(state[0]), float(state[len(state) // 2]) + delta, self.params)
+        self.pose(float(state[0]), float(state[len(state) // 2]) + delta)
+        self._mj.mj_forward(self.model, self.data)
+        return self.read_state()
 
     def apply_push(self, push: Push) -> FloatArray:
         """Push at the CoM with the impulse m Δẋ over ``PUSH_DURATION`` (contract item 4)."""
