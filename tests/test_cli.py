@@ -85,13 +85,39 @@ def test_bounds_thresholds_and_classify_step():
     assert thresholds["step_sec4"][1] < thresholds["step"][1] < thresholds["steps"]["inf"][1]
 
 
-def test_choices_match_the_registries():
-    from pushrecovery.cli.app import CONTROLLER_CHOICES, MODEL_CHOICES
-    from pushrecovery.control import CONTROLLERS
-    from pushrecovery.sim.registry import MODELS
+def test_the_string_registries_name_real_classes():
+    import importlib
 
-    assert set(MODEL_CHOICES) == set(MODELS)
-    assert set(CONTROLLER_CHOICES) == set(CONTROLLERS)
+    from pushrecovery.cli.app import COMMANDS
+    from pushrecovery.control import CONTROLLERS
+    from pushrecovery.control.registry import CONTROLLER_PATHS
+    from pushrecovery.sim.registry import PLANTS
+
+    def load(path):
+        module, _, attribute = path.partition(":")
+        return getattr(importlib.import_module(module), attribute)
+
+    for name, path in CONTROLLER_PATHS.items():
+        assert load(path).name == name and CONTROLLERS[name] is load(path)
+    for backend, models in PLANTS.items():
+        for name, path in models.items():
+            assert hasattr(load(path), "state_labels"), (backend, name)
+    for name, (path, short) in COMMANDS.items():
+        command = load(path)
+        assert command.name == name and command.get_short_help_str(200) == short
+
+
+def test_help_loads_no_command_and_no_numpy():
+    script = (
+        "import sys\n"
+        "from pushrecovery.cli import main\n"
+        "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+        "print(sorted(m for m in sys.modules if m == 'numpy' or m.startswith('pushrecovery.cli.')))"
+    )
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "Commands:" in run.stdout and "capture-region" in run.stdout
+    assert run.stdout.strip().splitlines()[-1] == "['pushrecovery.cli.app']"
 
 
 def test_hip_commands():

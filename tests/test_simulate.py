@@ -8,7 +8,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from pushrecovery import InvalidParameterError, load_params
-from pushrecovery.control import CONTROLLERS, AnklePD, Command, Controller, make_controller
+from pushrecovery.control import AnklePD, Command, Controller, make_controller
+from pushrecovery.control.registry import CONTROLLER_NAMES
 from pushrecovery.models.lipm import lipm_state
 from pushrecovery.sim.critical import NotRecoverableError, critical_push
 from pushrecovery.sim.push import Push
@@ -127,7 +128,7 @@ def test_pd_gain_validation():
         AnklePD(PARAMS, stiffness=math.nan)
 
 
-@pytest.mark.parametrize("name", sorted(CONTROLLERS))
+@pytest.mark.parametrize("name", sorted(CONTROLLER_NAMES))
 @given(
     x=st.floats(-0.9, 0.9),
     v=st.floats(-5, 5),

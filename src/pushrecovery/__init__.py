@@ -1,16 +1,20 @@
 """pushrecovery: decision surfaces and controllers for humanoid push recovery.
 
 Implements and verifies the models of Stephens, "Humanoid Push Recovery" [Stephens07]:
-CoP (ankle) balancing, CMP (hip) balancing and stepping. Importing the package is cheap; the
-plotting and CLI layers import their heavy dependencies lazily.
+CoP (ankle) balancing, CMP (hip) balancing and stepping. Importing the package is cheap (the
+parameters and numpy load on first use, PEP 562); the plotting and CLI layers import their
+heavy dependencies lazily.
 
 References
 ----------
 .. [Stephens07] B. Stephens, "Humanoid Push Recovery", IEEE-RAS Humanoids, 2007.
 """
 
+from __future__ import annotations
+
+from typing import Any
+
 from pushrecovery.errors import InputFileError, InvalidParameterError, PushRecoveryError
-from pushrecovery.params import PRESETS, BodyParams, load_params
 
 __version__ = "0.1.0"
 
@@ -23,3 +27,11 @@ __all__ = [
     "__version__",
     "load_params",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in ("PRESETS", "BodyParams", "load_params"):
+        from pushrecovery import params
+
+        return getattr(params, name)
+    raise AttributeError(f"module 'pushrecovery' has no attribute {name!r}")

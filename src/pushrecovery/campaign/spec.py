@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery.control.base import CONTROLLERS
+from pushrecovery.control.base import controller_class
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
@@ -148,10 +148,7 @@ class CampaignSpec:
                 f"model must be one of {list(BACKENDS[self.backend])} on the {self.backend} "
                 f"backend, got {self.model!r}"
             )
-        if self.controller not in CONTROLLERS:
-            raise InvalidParameterError(
-                f"controller must be one of {sorted(CONTROLLERS)}, got {self.controller!r}"
-            )
+        controller_class(self.controller)  # raises, naming the controllers
         if (self.xdot is None) == (self.impulse is None):
             raise InvalidParameterError("give exactly one of xdot and impulse (the pushes)")
         # Every number of the body can be swept; a polygon cannot.

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from pushrecovery.campaign.spec import CampaignSpec
-from pushrecovery.control.base import CONTROLLERS
+from pushrecovery.control.base import controller_class
 from pushrecovery.sim.critical import predicted_critical_velocity
 from pushrecovery.sim.validation import LABELS as VALIDATION_LABELS
 
@@ -37,7 +37,7 @@ def _clean(value: float) -> float | None:
 
 def boundary(spec: CampaignSpec, columns: dict[str, np.ndarray]) -> list[dict[str, Any]]:
     """Empirical critical pushes against the analytic ones (module docstring)."""
-    strategy = CONTROLLERS[spec.controller].strategy
+    strategy = controller_class(spec.controller).strategy
     names = [f"param_{name}" for name in spec.sweeps]
     groups: dict[tuple[float, ...], list[int]] = defaultdict(list)
     for i in range(len(columns["x0"])):

@@ -1,38 +1,89 @@
-"""The ``pushrecovery`` commands. Heavy modules are imported inside each command."""
+"""The ``pushrecovery`` command group: commands are imported only when they run.
+
+As click's "lazily loaded subcommands": the group names each command by import string with
+its one-line help, so ``pushrecovery --help`` imports no command module, no numpy and no model.
+"""
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import Any
+import importlib
 
 import click
 
 from pushrecovery import __version__
-from pushrecovery.cli.options import (
-    body_options,
-    echo_confusion,
-    emit,
-    params_from,
-    support_from,
-    support_options,
-)
 
-# Kept literal so that --help does not import the models; a test checks them against the
-# registries.
-MODEL_CHOICES = ("lipm", "pendulum", "flywheel", "stepping", "stepping-plane")
-MUJOCO_MODEL_CHOICES = ("foot", "torso", "biped")
-CONTROLLER_CHOICES = (
-    "ankle-saturated",
-    "ankle-pd",
-    "ankle-capture-point",
-    "bang-bang",
-    "mpc",
-    "recovery",
-    "recovery-plane",
-)
+__all__ = ["COMMANDS", "cli"]
+
+#: Command name -> ("module:attribute", one-line help).
+COMMANDS: dict[str, tuple[str, str]] = {
+    "analyze": (
+        "pushrecovery.cli.analyze:analyze",
+        "Per-frame margins and strategies of a measured trial (CSV, C3D).",
+    ),
+    "bounds": ("pushrecovery.cli.surfaces:bounds", "Capture-point bounds of each strategy."),
+    "campaign": (
+        "pushrecovery.cli.campaign:campaign",
+        "Sweep pushes over starts, push sizes and parameters, at scale.",
+    ),
+    "capture-region": (
+        "pushrecovery.cli.steps:capture_region_command",
+        "Footholds that capture a state with N steps.",
+    ),
+    "classify": (
+        "pushrecovery.cli.surfaces:classify",
+        "Strategy a CoM state needs: ankle, hip, step or fall.",
+    ),
+    "critical-push": (
+        "pushrecovery.cli.simulation:critical_push",
+        "Largest recoverable push, vs Eq. 4.",
+    ),
+    "figures": (
+        "pushrecovery.cli.figures:figures",
+        "Reproduce the paper's figures and the ground-plane figure.",
+    ),
+    "report": (
+        "pushrecovery.cli.campaign:report",
+        "The HTML report of a parameter set (the main job).",
+    ),
+    "simulate": (
+        "pushrecovery.cli.simulation:simulate",
+        "Simulate a push; report recovered or fell.",
+    ),
+    "step": ("pushrecovery.cli.surfaces:step", "Optimal step after a push (Sec. IV, Eq. 21)."),
+    "validate": (
+        "pushrecovery.cli.simulation:validate",
+        "Critical pushes and a confusion matrix in simulation vs the surfaces.",
+    ),
+}
+
+
+class LazyGroup(click.Group):
+    """A group whose commands are imported on first use (:data:`COMMANDS`)."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        """Return every command name, sorted."""
+        return sorted({*super().list_commands(ctx), *COMMANDS})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        """Import and return the command ``cmd_name`` (None if there is none)."""
+        if cmd_name not in COMMANDS:
+            return super().get_command(ctx, cmd_name)
+        module, _, attribute = COMMANDS[cmd_name][0].partition(":")
+        command = getattr(importlib.import_module(module), attribute)
+        if not isinstance(command, click.Command):  # pragma: no cover - the table is ours
+            raise TypeError(f"{COMMANDS[cmd_name][0]} is not a click command")
+        return command
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """List the commands with their one-line help, importing none of them."""
+        rows = [(name, COMMANDS[name][1]) for name in self.list_commands(ctx) if name in COMMANDS]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
 
 
 @click.group(
+    cls=LazyGroup,
     no_args_is_help=True,
     context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100},
 )
@@ -44,707 +95,3 @@ def cli() -> None:
     to the ankles' midpoint (ground plane). Every command takes the body-parameter flags and
     --json.
     """
-
-
-@cli.command(short_help="Capture-point bounds of each strategy.")
-@support_options
-@body_options
-def bounds(as_json: bool, **kwargs: Any) -> None:
-    """Capture-point bounds of each balance strategy (Eq. 4, corrected Eq. 15).
-
-    On the sagittal line (cop, cmp, thresholds [m/s] from x = 0) and on the ground plane
-    (plane: the support polygon, the CMP region and the thresholds along forward, backward,
-    left and right for the chosen --stance).
-    """
-    from pushrecovery.surfaces.bounds import bounds_data
-
-    params = params_from(kwargs)
-    emit(bounds_data(params, support_from(kwargs, params)), as_json)
-
-
-@cli.command(short_help="Strategy a CoM state needs: ankle, hip, step or fall.")
-@click.option(
-    "--x", "x", type=float, required=True, help="CoM position, forward, from the ankle(s) [m]."
-)
-@click.option("--xdot", type=float, required=True, help="CoM velocity, forward [m/s].")
-@click.option(
-    "--y",
-    "y",
-    type=float,
-    default=None,
-    help="CoM position, left [m] (default 0); puts the state on the ground plane.",
-)
-@click.option(
-    "--ydot",
-    type=float,
-    default=None,
-    help="CoM velocity, left [m/s] (default 0); puts the state on the ground plane.",
-)
-@support_options
-@body_options
-def classify(
-    x: float, xdot: float, y: float | None, ydot: float | None, as_json: bool, **kwargs: Any
-) -> None:
-    """Which strategy the CoM state needs: ankle, hip, step or fall.
-
-    Without --y, --ydot, --stance, --left-foot or --right-foot: the paper's sagittal model, x
-    relative to the ankle of a foot [heel, toe]. With any of them: the ground plane, x forward
-    and y left in the frame of the feet (by default the ankles' midpoint is the origin, in
-    every stance), where the support polygon and the CMP region are 2-D and the margins are
-    signed distances of the capture point to them [m], positive inside.
-    """
-    from pushrecovery.surfaces.classify import classify as classify_state
-
-    params = params_from(kwargs)
-    planar = (
-        y is not None
-        or ydot is not None
-        or any(kwargs[name] is not None for name in ("stance", "left_foot", "right_foot"))
-    )
-    if not planar:
-        for name in ("stance", "left_foot", "right_foot"):
-            kwargs.pop(name)
-        result = classify_state(x, xdot, params).to_dict()
-        emit({**result, "state": {"x": x, "xdot": xdot}}, as_json)
-        return
-    y, ydot = (0.0 if y is None else y), (0.0 if ydot is None else ydot)
-    support = support_from(kwargs, params)
-    result = classify_state(x, xdot, params, y=y, ydot=ydot, support=support).to_dict()
-    emit({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)
-
-
-def _push_velocity(xdot: float | None, impulse: float | None, mass: float) -> float:
-    from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.sim.push import Push
-
-    if xdot is not None and impulse is not None:
-        raise InvalidParameterError("give either --xdot [m/s] or --impulse [N s], not both")
-    if impulse is not None:
-        return Push.from_impulse(impulse, mass).delta_velocity
-    return 0.0 if xdot is None else xdot
-
-
-def _measured_cop(cops: list[float]) -> dict[str, float | None]:
-    """Range of the CoP MuJoCo measured from the contact forces, relative to the ankle [m]."""
-    import math
-
-    finite = [cop for cop in cops if not math.isnan(cop)]
-    if not finite:
-        return {"min": None, "max": None}
-    return {"min": min(finite), "max": max(finite)}
-
-
-def _value_range(option: str, triple: tuple[float, float, float], limit: int) -> Any:
-    """START, START+STEP, ... up to STOP (inclusive) as an array; at most ``limit`` values."""
-    from pushrecovery.campaign.spec import value_range
-
-    return value_range(option, triple, limit)
-
-
-def _controller_options(
-    kp: float | None, kd: float | None, pairs: tuple[str, ...] = ()
-) -> dict[str, Any]:
-    from pushrecovery.errors import InvalidParameterError
-
-    options: dict[str, Any] = {"stiffness": kp, "damping": kd}
-    for pair in pairs:
-        name, sep, text = pair.partition("=")
-        if not sep or not name:
-            raise InvalidParameterError(f"--option must be NAME=VALUE, got {pair!r}")
-        try:
-            value: Any = int(text) if text.lstrip("+-").isdigit() else float(text)
-        except ValueError:
-            raise InvalidParameterError(f"--option {name} must be a number, got {text!r}") from None
-        options[name.replace("-", "_")] = value
-    return {k: v for k, v in options.items() if v is not None}
-
-
-def _options_for(controller: str, options: dict[str, Any]) -> dict[str, Any]:
-    """Drop the ankle-pd gain flags for other controllers (they default to None anyway)."""
-    if controller != "ankle-pd":
-        for gain in ("stiffness", "damping"):
-            if gain in options:
-                from pushrecovery.errors import InvalidParameterError
-
-                raise InvalidParameterError(f"--kp/--kd apply to ankle-pd, not {controller!r}")
-    return options
-
-
-_backend = click.option(
-    "--backend",
-    type=click.Choice(("analytic", "mujoco")),
-    default="analytic",
-    show_default=True,
-    help="Physics: the analytic models, or MuJoCo (models foot, torso, biped).",
-)
-_model = click.option(
-    "--model",
-    type=click.Choice((*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES)),
-    default="lipm",
-    show_default=True,
-    help="Plant. Analytic: lipm, pendulum, flywheel, stepping, stepping-plane (on the ground "
-    "plane, with recovery-plane; simulate only); MuJoCo: foot (ankle), torso (hip), biped "
-    "(stepping).",
-)
-_controller = click.option(
-    "--controller",
-    type=click.Choice(CONTROLLER_CHOICES),
-    default="ankle-pd",
-    show_default=True,
-    help="Controller.",
-)
-_gains = (
-    click.option("--kp", type=float, default=None, help="ankle-pd stiffness [N m/rad]."),
-    click.option("--kd", type=float, default=None, help="ankle-pd damping [N m s/rad]."),
-    click.option(
-        "--option",
-        "options",
-        multiple=True,
-        metavar="NAME=VALUE",
-        help="Controller option, repeatable: e.g. horizon=30, gamma=1, dt=0.01 (mpc); "
-        "switch_time=0.2 (bang-bang).",
-    ),
-)
-
-
-def _with(*decorators: Any) -> Any:
-    def apply(func: Any) -> Any:
-        for decorator in reversed(decorators):
-            func = decorator(func)
-        return func
-
-    return apply
-
-
-@cli.command(short_help="Simulate a push; report recovered or fell.")
-@_with(_backend, _model, _controller, *_gains)
-@click.option(
-    "--x", "x", type=float, default=0.0, show_default=True, help="CoM position before the push [m]."
-)
-@click.option("--xdot", type=float, default=None, help="CoM velocity just after the push [m/s].")
-@click.option(
-    "--y",
-    "y",
-    type=float,
-    default=0.0,
-    show_default=True,
-    help="stepping-plane only: CoM position, left, from the ankles' midpoint [m].",
-)
-@click.option(
-    "--ydot",
-    type=float,
-    default=0.0,
-    show_default=True,
-    help="stepping-plane only: CoM velocity, left, just after the push [m/s].",
-)
-@click.option(
-    "--impulse",
-    type=float,
-    default=None,
-    help="Push as an impulse on the CoM [N s] (instead of --xdot).",
-)
-@click.option(
-    "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
-)
-@click.option(
-    "--control-period",
-    type=float,
-    default=None,
-    help="Controller period [s] (default: the controller's own, else 0.001).",
-)
-@click.option(
-    "--plot",
-    type=click.Path(dir_okay=False),
-    default=None,
-    help="Write a plot of the run (PNG, SVG or PDF by extension).",
-)
-@click.option(
-    "--render",
-    type=click.Path(dir_okay=False),
-    default=None,
-    help="MuJoCo only: write a filmstrip PNG of the run to this file and an animated GIF "
-    "beside it (CoM, capture point and CoP drawn).",
-)
-@body_options
-def simulate(
-    backend: str,
-    model: str,
-    controller: str,
-    kp: float | None,
-    kd: float | None,
-    options: tuple[str, ...],
-    x: float,
-    xdot: float | None,
-    y: float,
-    ydot: float,
-    impulse: float | None,
-    duration: float,
-    control_period: float | None,
-    plot: str | None,
-    render: str | None,
-    as_json: bool,
-    **kwargs: Any,
-) -> None:
-    """Simulate a push on a model with a controller; report recovered or fell.
-
-    With --backend mujoco, --impulse is a real force at the CoM over 10 ms (the body holding
-    still meanwhile) and the run starts as the push ends. With --model stepping-plane
-    (controller recovery-plane) the body stands on both feet of the ground plane and --y,
-    --ydot add the sideways part (--impulse pushes along x).
-    """
-    from pushrecovery.control.base import make_controller
-    from pushrecovery.sim.backend import Measuring, Recording
-    from pushrecovery.sim.push import Push
-    from pushrecovery.sim.registry import make_plant
-    from pushrecovery.sim.simulate import simulate as run
-    from pushrecovery.surfaces.classify import classify as classify_state
-
-    params = params_from(kwargs)
-    velocity = _push_velocity(xdot, impulse, params.mass)
-    plane = model == "stepping-plane"
-    if not plane and (y != 0.0 or ydot != 0.0):
-        from pushrecovery.errors import InvalidParameterError
-
-        raise InvalidParameterError("--y and --ydot need --model stepping-plane")
-    if plane:
-        predicted = classify_state(x, velocity, params, y=y, ydot=ydot)
-    else:
-        predicted = classify_state(x, velocity, params)
-    if render and backend != "mujoco":
-        from pushrecovery.errors import InvalidParameterError
-
-        raise InvalidParameterError("--render needs --backend mujoco")
-    if render:
-        from pushrecovery.sim.mujoco.render import require_offscreen_gl
-
-        require_offscreen_gl()  # fail before the run, not after it
-    plant = make_plant(model, params, backend)
-    # Frames (an extra forward pass per tick) only for the pictures.
-    if render and isinstance(plant, Recording):
-        plant.record()
-    elif isinstance(plant, Measuring):
-        plant.measure()
-    if backend == "mujoco" and impulse is not None:
-        # A real force at the CoM, over 10 ms, instead of a velocity jump.
-        plant.reset(x, 0.0)
-        initial = plant.apply_push(Push.from_impulse(impulse, params.mass))
-    else:
-        initial = plant.reset(x, velocity)
-        if plane:
-            initial[1], initial[5] = y, ydot  # the planar state's y and ẏ
-    result = run(
-        plant,
-        make_controller(
-            controller, params, **_options_for(controller, _controller_options(kp, kd, options))
-        ),
-        initial,
-        duration=duration,
-        control_period=control_period,
-    )
-    data = result.to_dict()
-    data["initial_state"] = {"x": x, "xdot": velocity} | ({"y": y, "ydot": ydot} if plane else {})
-    data["predicted"] = predicted.to_dict()
-    if isinstance(plant, Measuring):  # MuJoCo: the state the push left, the CoP it measured
-        half = len(initial) // 2
-        data["after_push"] = {"x": float(initial[0]), "xdot": float(initial[half])}
-        data["measured_cop"] = _measured_cop(plant.measured_cops)
-    if render and isinstance(plant, Recording) and plant.frames is not None:
-        from pushrecovery.sim.mujoco.render import render_run
-
-        files = render_run(plant.model, plant.frames, Path(render))
-        data["render"] = [str(f) for f in files]
-    if plot:
-        from pushrecovery.plots.runs import save_run
-
-        data["plot"] = str(save_run(result, params, Path(plot)))
-    emit(data, as_json)
-
-
-@cli.command("critical-push", short_help="Largest recoverable push, vs Eq. 4.")
-@_with(_backend, _model, _controller, *_gains)
-@click.option(
-    "--x",
-    "x",
-    type=float,
-    default=0.0,
-    show_default=True,
-    help="CoM position before the push, on the foot [m].",
-)
-@click.option(
-    "--direction", type=click.Choice(("forward", "backward")), default="forward", show_default=True
-)
-@click.option(
-    "--tolerance",
-    type=float,
-    default=1e-4,
-    show_default=True,
-    help="Width of the final velocity bracket [m/s].",
-)
-@click.option(
-    "--duration",
-    type=float,
-    default=10.0,
-    show_default=True,
-    help="Longest simulated time per push [s].",
-)
-@click.option(
-    "--control-period",
-    type=float,
-    default=None,
-    help="Controller period [s] (default: the controller's own, else 0.001).",
-)
-@body_options
-def critical_push(
-    backend: str,
-    model: str,
-    controller: str,
-    kp: float | None,
-    kd: float | None,
-    options: tuple[str, ...],
-    x: float,
-    direction: str,
-    tolerance: float,
-    duration: float,
-    control_period: float | None,
-    as_json: bool,
-    **kwargs: Any,
-) -> None:
-    """Largest recoverable push from x by bisection, against the strategy's surface."""
-    from pushrecovery.sim.critical import critical_push as search
-
-    params = params_from(kwargs)
-    found = search(
-        params,
-        model,
-        controller,
-        x,
-        direction,
-        tolerance=tolerance,
-        duration=duration,
-        control_period=control_period,
-        controller_options=_options_for(controller, _controller_options(kp, kd, options)),
-        backend=backend,
-    )
-    emit(
-        {
-            "velocity": found.velocity,
-            "impulse": params.mass * found.velocity,
-            "predicted_velocity": found.predicted_velocity,
-            "predicted_impulse": params.mass * found.predicted_velocity,
-            "relative_error": found.relative_error(),
-            "bracket": list(found.bracket),
-            "simulations": found.iterations,
-            "model": model,
-            "controller": controller,
-            "x": x,
-            "direction": direction,
-            "backend": backend,
-            "predicted": _critical_prediction(params, controller, x, direction, backend),
-        },
-        as_json,
-    )
-
-
-def _critical_prediction(
-    params: Any, controller: str, x: float, direction: str, backend: str
-) -> dict[str, Any]:
-    """Return the surface's critical push (and the corrected one on MuJoCo)."""
-    from pushrecovery.control.base import make_controller
-    from pushrecovery.sim.critical import predicted_critical_velocity
-
-    strategy = make_controller(controller, params).strategy
-    surface = {"ankle": "Eq. 4", "hip": "corrected Eq. 15", "step": "single-step limit"}[strategy]
-    velocity = predicted_critical_velocity(params, strategy, x, direction)
-    data: dict[str, Any] = {
-        "strategy": strategy,
-        "surface": surface,
-        "velocity": velocity,
-        "impulse": params.mass * velocity,
-    }
-    if backend == "mujoco" and strategy != "step":
-        from pushrecovery.sim.validation import mujoco_corrected_prediction
-
-        sign = 1.0 if direction == "forward" else -1.0
-        corrected = mujoco_corrected_prediction(strategy, x, sign, params)
-        data["corrected_velocity"] = corrected
-        data["corrected_impulse"] = params.mass * corrected
-    return data
-
-
-@cli.command(short_help="Critical pushes and a confusion matrix in simulation vs the surfaces.")
-@click.option(
-    "--backend",
-    type=click.Choice(("analytic", "mujoco")),
-    default="mujoco",
-    show_default=True,
-    help="Physics (MuJoCo pushes with real forces).",
-)
-@click.option(
-    "--strategy",
-    "strategies",
-    type=click.Choice(("ankle", "hip", "step")),
-    multiple=True,
-    help="Strategies to validate (repeatable; default all the backend has models for).",
-)
-@click.option(
-    "--x0",
-    "x0s",
-    type=float,
-    multiple=True,
-    help="CoM positions before the push [m] (repeatable; default 0 and 0.05).",
-)
-@click.option(
-    "--tolerance",
-    type=float,
-    default=2e-3,
-    show_default=True,
-    help="Width of each critical-push bracket [m/s].",
-)
-@click.option(
-    "--duration", type=float, default=6.0, show_default=True, help="Longest run per push [s]."
-)
-@click.option(
-    "--grid",
-    nargs=3,
-    type=float,
-    default=(-1.0, 2.0, 0.25),
-    show_default=True,
-    metavar="START STOP STEP",
-    help="Push velocities of the confusion matrix [m/s], from each --x0.",
-)
-@click.option(
-    "--confusion/--no-confusion",
-    default=True,
-    show_default=True,
-    help="Also simulate the grid of pushes for the confusion matrix.",
-)
-@body_options
-def validate(
-    backend: str,
-    strategies: tuple[str, ...],
-    x0s: tuple[float, ...],
-    tolerance: float,
-    duration: float,
-    grid: tuple[float, float, float],
-    confusion: bool,
-    as_json: bool,
-    **kwargs: Any,
-) -> None:
-    """Critical push of each strategy in simulation against its surface, and a confusion matrix.
-
-    For each strategy (ankle: foot + ankle-pd; hip: torso + mpc; step: biped + recovery on
-    MuJoCo, or the analytic models) the critical push by bisection, both directions, from each
-    --x0, next to the surface's prediction (and, on MuJoCo, the prediction corrected for the CoP
-    margin and the push's duration). The confusion matrix compares the strategy the surfaces
-    predict for each push of the grid with the least strategy that recovers it in simulation.
-    """
-    import sys
-
-    import numpy as np
-
-    from pushrecovery._validate import finite_array
-    from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.sim.validation import (
-        available_strategies,
-        confusion_matrix,
-        critical_table,
-    )
-
-    params = params_from(kwargs)
-    strategies = strategies or available_strategies(backend)
-    missing = set(strategies) - set(available_strategies(backend))
-    if missing:
-        raise InvalidParameterError(
-            f"--strategy {sorted(missing)[0]} has no {backend} model yet; "
-            f"available: {list(available_strategies(backend))}"
-        )
-    x0s = tuple(finite_array("--x0", x0s)) if x0s else (0.0, 0.05)
-    for x0 in x0s:
-        if not params.heel < x0 < params.toe:
-            raise InvalidParameterError(
-                f"--x0 must lie on the foot, {params.heel:g} < x0 < {params.toe:g} m, got {x0:g}"
-            )
-    velocities = _value_range("--grid", grid, limit=10_000)
-    rows_total = len(strategies) * len(x0s) * 2
-    total = rows_total + (len(x0s) * len(velocities) if confusion else 0)
-    # On a terminal only: a piped stderr keeps its one-line errors.
-    with click.progressbar(
-        length=total, label="validating", file=sys.stderr, hidden=not sys.stderr.isatty()
-    ) as bar:
-        rows = critical_table(
-            params,
-            backend=backend,
-            strategies=strategies,
-            x0s=x0s,
-            tolerance=tolerance,
-            duration=duration,
-            progress=bar.update,
-        )
-        matrix = (
-            confusion_matrix(
-                params,
-                x0s,
-                velocities.tolist(),
-                backend=backend,
-                strategies=strategies,
-                duration=duration,
-                progress=bar.update,
-            )
-            if confusion
-            else None
-        )
-    data: dict[str, Any] = {
-        "backend": backend,
-        "params": params.to_dict(),
-        "critical": [row.to_dict(params.mass) for row in rows],
-    }
-    if matrix is not None:
-        data["confusion"] = matrix.to_dict()
-    if as_json:
-        emit(data, True)
-        return
-    click.echo(
-        f"{'strategy':<9}{'dir':<9}{'x0':>7}{'predicted':>11}{'corrected':>11}"
-        f"{'measured':>10}{'error':>9}{'corr.err':>10}"
-    )
-    for row in rows:
-        corrected = "" if np.isnan(row.corrected) else f"{row.corrected:.4f}"
-        error = "" if np.isnan(row.corrected) else f"{100 * row.corrected_error:+.1f}%"
-        click.echo(
-            f"{row.strategy:<9}{row.direction:<9}{row.x0:>7.3f}{row.predicted:>11.4f}"
-            f"{corrected:>11}{row.measured:>10.4f}{100 * row.relative_error:>+8.1f}%{error:>10}"
-        )
-    if matrix is not None:
-        from pushrecovery.sim.validation import LABELS
-
-        echo_confusion(
-            f"\nconfusion (rows predicted, columns needed), accuracy {matrix.accuracy:.3f}",
-            LABELS,
-            matrix.counts.tolist(),
-        )
-
-
-@cli.command(short_help="Reproduce the paper's figures and the ground-plane figure.")
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False),
-    default="out/figures",
-    show_default=True,
-    help="Directory for the figures.",
-)
-@click.option(
-    "--format",
-    "formats",
-    multiple=True,
-    default=("png", "svg"),
-    show_default=True,
-    type=click.Choice(("png", "svg", "pdf")),
-    help="File formats (repeatable).",
-)
-@body_options
-def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) -> None:
-    """Reproduce the paper's figures (Fig. 3, 5, 6, 9, 10) into a directory.
-
-    Also plane.png/svg: the capture-point plane (x forward, y left [m]) with the support
-    polygon (ankle), the CMP region (hip) and pushes coloured by the strategy they need, in
-    double, left and right support.
-    """
-    from pushrecovery.experiments.paper_figures import paper_runs
-    from pushrecovery.plots.figures import write_figures
-
-    params = params_from(kwargs)
-    files = write_figures(params, paper_runs(params), Path(out), formats)
-    emit({"files": [str(f) for f in files]}, as_json)
-
-
-@cli.command(short_help="Optimal step after a push (Sec. IV, Eq. 21).")
-@click.option(
-    "--v0",
-    "speeds",
-    type=float,
-    multiple=True,
-    help="CoM velocity with the CoM above the stance ankle [m/s], > 0 (repeatable).",
-)
-@click.option(
-    "--v0-range",
-    nargs=3,
-    type=float,
-    default=None,
-    metavar="START STOP STEP",
-    help="Velocities START, START+STEP, ... up to STOP (inclusive) [m/s].",
-)
-@body_options
-def step(
-    speeds: tuple[float, ...],
-    v0_range: tuple[float, float, float] | None,
-    as_json: bool,
-    **kwargs: Any,
-) -> None:
-    """Optimal step (Eq. 21) and the range of recovering steps for initial CoM velocities."""
-    import numpy as np
-
-    from pushrecovery._validate import finite_array
-    from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.models.stepping import step_solution
-
-    params = params_from(kwargs)
-    values = list(speeds)
-    if v0_range is not None:
-        values.extend(_value_range("--v0-range", v0_range, limit=100_000))
-    if not values:
-        raise InvalidParameterError("give --v0 V (repeatable) or --v0-range START STOP STEP")
-    v0 = finite_array("v0", values)
-    if np.any(v0 < 1e-6):
-        raise InvalidParameterError(
-            "v0 must be >= 1e-6 m/s (a forward push; backward steps are the mirror image)"
-        )
-    sol = step_solution(v0, params.leg_length, params.gravity, params.heel, params.toe)
-    reach = params.max_step_length
-    rows = [
-        {
-            "v0": float(sol.v0[i]),
-            "theta": float(sol.theta[i]),
-            "theta_rate": float(sol.theta_rate[i]),
-            "time_to_impact": float(sol.time_to_impact[i]),
-            "step_length": float(sol.step_length[i]),
-            "com_to_foot": float(sol.com_to_foot[i]),
-            "velocity_before": {
-                "x": float(sol.velocity_before_x[i]),
-                "z": float(sol.velocity_before_z[i]),
-            },
-            "velocity_after": float(sol.velocity_after[i]),
-            "height_after": float(sol.height_after[i]),
-            "theta_range": [float(sol.theta_low[i]), float(sol.theta_high[i])],
-            "step_length_range": [
-                float(sol.step_length_of(sol.theta_low[i])),
-                float(sol.step_length_of(sol.theta_high[i])),
-            ],
-            "centred_theta": float(sol.centred_theta[i]),
-            "centred_step_length": float(sol.step_length_of(sol.centred_theta[i])),
-            "stance_leg_in_compression": bool(sol.stance_leg_in_compression[i]),
-            "within_reach": bool(sol.step_length[i] <= reach),
-        }
-        for i in range(len(v0))
-    ]
-    if as_json:
-        import json
-
-        click.echo(json.dumps(rows[0] if len(rows) == 1 else rows, indent=2, allow_nan=False))
-        return
-    for row in rows:
-        emit(row, False)
-        click.echo("")
-
-
-def _register() -> None:
-    from pushrecovery.cli.analyze import analyze
-    from pushrecovery.cli.campaign import campaign, report
-    from pushrecovery.cli.steps import capture_region_command
-
-    cli.add_command(capture_region_command)
-    cli.add_command(campaign)
-    cli.add_command(report)
-    cli.add_command(analyze)
-
-
-_register()

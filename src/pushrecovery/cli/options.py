@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable, Sequence
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import click
 
-from pushrecovery.params import BodyParams, load_params
+if TYPE_CHECKING:
+    from pushrecovery.params import BodyParams
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -98,6 +99,8 @@ def support_from(kwargs: dict[str, Any], params: BodyParams) -> Any:
 def params_from(kwargs: dict[str, Any]) -> BodyParams:
     """Pop the parameter options out of a command's kwargs and build the parameter set."""
     overrides = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
+    from pushrecovery.params import load_params
+
     return load_params(kwargs.pop("preset"), kwargs.pop("params_file"), overrides)
 
 
@@ -136,3 +139,10 @@ def _fmt(value: Any) -> str:
     if isinstance(value, list | tuple):
         return "[" + ", ".join(_fmt(v) for v in value) + "]"
     return str(value)
+
+
+def value_range_option(option: str, triple: tuple[float, float, float], limit: int) -> Any:
+    """START, START+STEP, ... up to STOP (inclusive) as an array; at most ``limit`` values."""
+    from pushrecovery.campaign.spec import value_range
+
+    return value_range(option, triple, limit)

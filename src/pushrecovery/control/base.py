@@ -24,6 +24,7 @@ Contract (what the simulators, the CLI and a robot's control loop may rely on):
 
 from __future__ import annotations
 
+import importlib
 import inspect
 from abc import ABC, abstractmethod
 from collections.abc import Callable
@@ -37,7 +38,15 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.lipm import ANKLE_STATE
 from pushrecovery.params import BodyParams
 
-__all__ = ["CONTROLLERS", "Command", "Controller", "StepInfo", "make_controller", "register"]
+__all__ = [
+    "CONTROLLERS",
+    "Command",
+    "Controller",
+    "StepInfo",
+    "controller_class",
+    "make_controller",
+    "register",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -162,20 +171,37 @@ def register(cls: type[Controller]) -> type[Controller]:
     return cls
 
 
-def make_controller(name: str, params: BodyParams, **options: Any) -> Controller:
-    """Build the registered controller ``name`` for ``params``.
+def controller_class(name: str) -> type[Controller]:
+    """Return the controller class registered as ``name`` (built-in ones imported on demand).
 
     Raises
     ------
     InvalidParameterError
         If ``name`` is not registered.
     """
+    from pushrecovery.control.registry import CONTROLLER_PATHS
+
+    if name not in CONTROLLERS and name in CONTROLLER_PATHS:
+        module, _, _ = CONTROLLER_PATHS[name].partition(":")
+        importlib.import_module(module)  # its @register fills CONTROLLERS
     try:
-        cls = CONTROLLERS[name]
+        return CONTROLLERS[name]
     except KeyError:
+        names = sorted({*CONTROLLERS, *CONTROLLER_PATHS})
         raise InvalidParameterError(
-            f"controller must be one of {sorted(CONTROLLERS)}, got controller={name!r}"
+            f"controller must be one of {names}, got controller={name!r}"
         ) from None
+
+
+def make_controller(name: str, params: BodyParams, **options: Any) -> Controller:
+    """Build the registered controller ``name`` for ``params``.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``name`` is not registered, or an option is not one of its constructor's.
+    """
+    cls = controller_class(name)
     unknown = sorted(set(options) - set(cls.option_names()))
     if unknown:
         raise InvalidParameterError(

@@ -9,10 +9,13 @@ never imports a backend; backends plug in here.
 from __future__ import annotations
 
 import importlib
+from typing import TYPE_CHECKING
 
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.params import BodyParams
-from pushrecovery.sim.plants import Plant
+
+if TYPE_CHECKING:  # listing the models must not load numpy (pushrecovery --help)
+    from pushrecovery.params import BodyParams
+    from pushrecovery.sim.plants import Plant
 
 __all__ = ["MODELS", "MUJOCO_MODELS", "PLANTS", "available_models", "make_plant"]
 

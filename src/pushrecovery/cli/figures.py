@@ -1,0 +1,45 @@
+"""The ``figures`` command: the paper's figures reproduced into a folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+
+from pushrecovery.cli.options import body_options, emit, params_from
+
+__all__ = ["figures"]
+
+
+@click.command(short_help="Reproduce the paper's figures and the ground-plane figure.")
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False),
+    default="out/figures",
+    show_default=True,
+    help="Directory for the figures.",
+)
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    default=("png", "svg"),
+    show_default=True,
+    type=click.Choice(("png", "svg", "pdf")),
+    help="File formats (repeatable).",
+)
+@body_options
+def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) -> None:
+    """Reproduce the paper's figures (Fig. 3, 5, 6, 9, 10) into a directory.
+
+    Also plane.png/svg: the capture-point plane (x forward, y left [m]) with the support
+    polygon (ankle), the CMP region (hip) and pushes coloured by the strategy they need, in
+    double, left and right support.
+    """
+    from pushrecovery.experiments.paper_figures import paper_runs
+    from pushrecovery.plots.figures import write_figures
+
+    params = params_from(kwargs)
+    files = write_figures(params, paper_runs(params), Path(out), formats)
+    emit({"files": [str(f) for f in files]}, as_json)

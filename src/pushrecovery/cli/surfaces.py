@@ -1,0 +1,164 @@
+"""Commands about decision surfaces: ``bounds``, ``classify`` and ``step``."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import click
+
+from pushrecovery.cli.options import (
+    body_options,
+    emit,
+    params_from,
+    support_from,
+    support_options,
+    value_range_option,
+)
+
+__all__ = ["bounds", "classify", "step"]
+
+
+@click.command(short_help="Capture-point bounds of each strategy.")
+@support_options
+@body_options
+def bounds(as_json: bool, **kwargs: Any) -> None:
+    """Capture-point bounds of each balance strategy (Eq. 4, corrected Eq. 15).
+
+    On the sagittal line (cop, cmp, thresholds [m/s] from x = 0) and on the ground plane
+    (plane: the support polygon, the CMP region and the thresholds along forward, backward,
+    left and right for the chosen --stance).
+    """
+    from pushrecovery.surfaces.bounds import bounds_data
+
+    params = params_from(kwargs)
+    emit(bounds_data(params, support_from(kwargs, params)), as_json)
+
+
+@click.command(short_help="Strategy a CoM state needs: ankle, hip, step or fall.")
+@click.option(
+    "--x", "x", type=float, required=True, help="CoM position, forward, from the ankle(s) [m]."
+)
+@click.option("--xdot", type=float, required=True, help="CoM velocity, forward [m/s].")
+@click.option(
+    "--y",
+    "y",
+    type=float,
+    default=None,
+    help="CoM position, left [m] (default 0); puts the state on the ground plane.",
+)
+@click.option(
+    "--ydot",
+    type=float,
+    default=None,
+    help="CoM velocity, left [m/s] (default 0); puts the state on the ground plane.",
+)
+@support_options
+@body_options
+def classify(
+    x: float, xdot: float, y: float | None, ydot: float | None, as_json: bool, **kwargs: Any
+) -> None:
+    """Which strategy the CoM state needs: ankle, hip, step or fall.
+
+    Without --y, --ydot, --stance, --left-foot or --right-foot: the paper's sagittal model, x
+    relative to the ankle of a foot [heel, toe]. With any of them: the ground plane, x forward
+    and y left in the frame of the feet (by default the ankles' midpoint is the origin, in
+    every stance), where the support polygon and the CMP region are 2-D and the margins are
+    signed distances of the capture point to them [m], positive inside.
+    """
+    from pushrecovery.surfaces.classify import classify as classify_state
+
+    params = params_from(kwargs)
+    planar = (
+        y is not None
+        or ydot is not None
+        or any(kwargs[name] is not None for name in ("stance", "left_foot", "right_foot"))
+    )
+    if not planar:
+        for name in ("stance", "left_foot", "right_foot"):
+            kwargs.pop(name)
+        result = classify_state(x, xdot, params).to_dict()
+        emit({**result, "state": {"x": x, "xdot": xdot}}, as_json)
+        return
+    y, ydot = (0.0 if y is None else y), (0.0 if ydot is None else ydot)
+    support = support_from(kwargs, params)
+    result = classify_state(x, xdot, params, y=y, ydot=ydot, support=support).to_dict()
+    emit({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)
+
+
+@click.command(short_help="Optimal step after a push (Sec. IV, Eq. 21).")
+@click.option(
+    "--v0",
+    "speeds",
+    type=float,
+    multiple=True,
+    help="CoM velocity with the CoM above the stance ankle [m/s], > 0 (repeatable).",
+)
+@click.option(
+    "--v0-range",
+    nargs=3,
+    type=float,
+    default=None,
+    metavar="START STOP STEP",
+    help="Velocities START, START+STEP, ... up to STOP (inclusive) [m/s].",
+)
+@body_options
+def step(
+    speeds: tuple[float, ...],
+    v0_range: tuple[float, float, float] | None,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Optimal step (Eq. 21) and the range of recovering steps for initial CoM velocities."""
+    import numpy as np
+
+    from pushrecovery._validate import finite_array
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.models.stepping import step_solution
+
+    params = params_from(kwargs)
+    values = list(speeds)
+    if v0_range is not None:
+        values.extend(value_range_option("--v0-range", v0_range, limit=100_000))
+    if not values:
+        raise InvalidParameterError("give --v0 V (repeatable) or --v0-range START STOP STEP")
+    v0 = finite_array("v0", values)
+    if np.any(v0 < 1e-6):
+        raise InvalidParameterError(
+            "v0 must be >= 1e-6 m/s (a forward push; backward steps are the mirror image)"
+        )
+    sol = step_solution(v0, params.leg_length, params.gravity, params.heel, params.toe)
+    reach = params.max_step_length
+    rows = [
+        {
+            "v0": float(sol.v0[i]),
+            "theta": float(sol.theta[i]),
+            "theta_rate": float(sol.theta_rate[i]),
+            "time_to_impact": float(sol.time_to_impact[i]),
+            "step_length": float(sol.step_length[i]),
+            "com_to_foot": float(sol.com_to_foot[i]),
+            "velocity_before": {
+                "x": float(sol.velocity_before_x[i]),
+                "z": float(sol.velocity_before_z[i]),
+            },
+            "velocity_after": float(sol.velocity_after[i]),
+            "height_after": float(sol.height_after[i]),
+            "theta_range": [float(sol.theta_low[i]), float(sol.theta_high[i])],
+            "step_length_range": [
+                float(sol.step_length_of(sol.theta_low[i])),
+                float(sol.step_length_of(sol.theta_high[i])),
+            ],
+            "centred_theta": float(sol.centred_theta[i]),
+            "centred_step_length": float(sol.step_length_of(sol.centred_theta[i])),
+            "stance_leg_in_compression": bool(sol.stance_leg_in_compression[i]),
+            "within_reach": bool(sol.step_length[i] <= reach),
+        }
+        for i in range(len(v0))
+    ]
+    if as_json:
+        import json
+
+        click.echo(json.dumps(rows[0] if len(rows) == 1 else rows, indent=2, allow_nan=False))
+        return
+    for row in rows:
+        emit(row, False)
+        click.echo("")
