@@ -51,7 +51,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     ),
     "step": ("pushrecovery.cli.surfaces:step", "Optimal step after a push (Sec. IV, Eq. 21)."),
     "validate": (
-        "pushrecovery.cli.simulation:validate",
+        "pushrecovery.cli.validate:validate",
         "Critical pushes and a confusion matrix in simulation vs the surfaces.",
     ),
 }
