@@ -156,3 +156,27 @@ def test_forward_pushes_from_ahead_of_the_ankle_recover(v):
     assert result.recovered and len(controller.steps) == 1
     landed = result.footholds[1] - result.footholds[0]
     assert landed == pytest.approx(controller.steps[0], abs=LANDING_TOLERANCE)
+
+
+def test_biped_kinematics_match_subtree_com():
+    # The plant's own CoM kinematics (the state it reports) against MuJoCo's subtree_com and
+    # subtree_linvel of the same model, over random configurations: a change of a segment's
+    # mass or length in the model that the plant does not follow fails here.
+    plant = MujocoBipedPlant(P)
+    model, data = plant.model, plant.data
+    rng = np.random.default_rng(42)
+    worst_x = worst_v = 0.0
+    for _ in range(200):
+        data.qpos[:] = rng.uniform(-0.6, 0.6, model.nq)
+        data.qpos[4::3] = rng.uniform(0.0, 1.0, 2)  # knees bend one way
+        data.qvel[:] = rng.uniform(-2.0, 2.0, model.nv)
+        mujoco.mj_forward(model, data)
+        mujoco.mj_subtreeVel(model, data)
+        q, v = data.qpos.tolist(), data.qvel.tolist()
+        for i, leg in enumerate(("left", "right")):
+            x, z, xdot, zdot = plant._com(q, v, i)
+            ankle = data.xanchor[model.joint(f"{leg}_ankle").id]
+            com, velocity = data.subtree_com[0], data.subtree_linvel[0]
+            worst_x = max(worst_x, abs(x - (com[0] - ankle[0])), abs(z - (com[2] - ankle[2])))
+        worst_v = max(worst_v, abs(xdot - velocity[0]), abs(zdot - velocity[2]))
+    assert worst_x < 1e-12 and worst_v < 1e-12

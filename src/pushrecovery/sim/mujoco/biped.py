@@ -90,11 +90,13 @@ back from the step: that foot can never land.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.interpolate import BPoly
 
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
@@ -257,18 +259,19 @@ def biped_model(params: BodyParams) -> str:
 def _path(start: float, rate: float, goal: float, t: float, duration: float) -> tuple[float, float]:
     """Quintic from ``start`` at ``rate`` to rest at ``goal`` in ``duration``: value, rate at t.
 
-    Zero acceleration at both ends; with ``rate`` = 0 the minimum-jerk path.
+    Zero acceleration at both ends (with ``rate`` = 0 the minimum-jerk path): scipy's
+    Bernstein polynomial with those end derivatives, built once per plan.
     """
     if t >= duration:
         return goal, 0.0
-    span, move = goal - start, rate * duration
-    c3 = 10.0 * span - 6.0 * move
-    c4 = -15.0 * span + 8.0 * move
-    c5 = 6.0 * span - 3.0 * move
-    tau = t / duration
-    shape = tau * (move + tau * tau * (c3 + tau * (c4 + tau * c5)))
-    slope = move + tau * tau * (3.0 * c3 + tau * (4.0 * c4 + tau * 5.0 * c5))
-    return start + shape, slope / duration
+    path, slope = _quintic(start, rate, goal, duration)
+    return float(path(t)), float(slope(t))
+
+
+@functools.lru_cache(maxsize=16)
+def _quintic(start: float, rate: float, goal: float, duration: float) -> tuple[BPoly, BPoly]:
+    path = BPoly.from_derivatives([0.0, duration], [[start, rate, 0.0], [goal, 0.0, 0.0]])
+    return path, path.derivative()
 
 
 class MujocoBipedPlant(MujocoPlant):
