@@ -262,6 +262,24 @@ class BodyParams:
         """Body weight m g [N]; the vertical ground reaction force of the LIPM."""
         return self.mass * self.gravity
 
+    @property
+    def hip_fall_limits(self) -> tuple[float, float]:
+        """Return δ⁻ − τmax/(m g), δ⁺ + τmax/(m g) [m]: the fall limits with the hip.
+
+        Beyond them, moving outward, no CMP the hip can produce stops the CoM
+        (docs/conventions.md).
+        """
+        reach = self.torque_max / self.weight
+        return self.heel - reach, self.toe + reach
+
+    def clip_cop(self, cop: float) -> float:
+        """Return ``cop`` [m] moved onto the foot [heel, toe]."""
+        return min(self.toe, max(self.heel, cop))
+
+    def clip_hip_torque(self, torque: float) -> float:
+        """Return ``torque`` [N m] clipped to ±torque_max."""
+        return min(self.torque_max, max(-self.torque_max, torque))
+
     def to_dict(self) -> dict[str, float]:
         """Return the parameters as a plain dict (the ``params`` object of the JSON contract).
 

@@ -94,7 +94,7 @@ class RecoveryController(Controller):
             # The plant reports the landing (observe): the first tick in stance after the step.
             if not self._stance or t <= self._swing_start:
                 brake = -p.flywheel_inertia * theta_rate / STEP_BRAKE_TIME
-                return Command(0.0, max(-p.torque_max, min(p.torque_max, brake)))
+                return Command(0.0, p.clip_hip_torque(brake))
             self._swing_start, self.mode, self._held = None, "ankle", None
         body, mpc = self._body(z)
         omega = math.sqrt(p.gravity / z)

@@ -67,7 +67,7 @@ class _AnklePlant(PlantBase):
                 f"the {self.name} model has no upper body: flywheel_torque must be 0, "
                 f"got {command.flywheel_torque:g} N m"
             )
-        return min(self.params.toe, max(self.params.heel, command.cop))
+        return self.params.clip_cop(command.cop)
 
 
 class LipmPlant(_AnklePlant):
@@ -134,9 +134,8 @@ class FlywheelPlant(PlantBase):
 
     def __init__(self, params: BodyParams) -> None:
         super().__init__(params)
-        reach = params.torque_max / params.weight
         # Beyond δ± ± τmax/(m g), moving outward, no CMP on offer can stop the CoM.
-        self.fall_limits = (params.heel - reach, params.toe + reach)
+        self.fall_limits = params.hip_fall_limits
         self._momentum = np.array([params.mass * params.com_height, params.flywheel_inertia])
         self._dt = -1.0
         self._a = self._b = np.empty(0)
@@ -170,8 +169,7 @@ class FlywheelPlant(PlantBase):
         impact adds to ``stop_impacts``.
         """
         p = self.params
-        cop = min(p.toe, max(p.heel, command.cop))
-        torque = min(p.torque_max, max(-p.torque_max, command.flywheel_torque))
+        cop, torque = p.clip_cop(command.cop), p.clip_hip_torque(command.flywheel_torque)
         if command.step_length is not None:
             raise InvalidParameterError("the flywheel model has no legs to step with")
         if dt != self._dt:

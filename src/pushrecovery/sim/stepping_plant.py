@@ -46,8 +46,7 @@ class SteppingPlant(PlantBase):
 
     def __init__(self, params: BodyParams) -> None:
         super().__init__(params)
-        reach = params.torque_max / params.weight
-        self.fall_limits = (params.heel - reach, params.toe + reach)
+        self.fall_limits = params.hip_fall_limits
         self._swing: tuple[float, float, float] | None = None  # (length, landing lean, sign)
         self._stance: dict[float, FlywheelPlant] = {}
 
@@ -103,7 +102,7 @@ class SteppingPlant(PlantBase):
             inner, cop, torque = plant.advance(state[[0, 1, 3, 4]], command, dt)
             self.stop_impacts += plant.stop_impacts - before
             return np.array([inner[0], inner[1], state[2], inner[2], inner[3], 0.0]), cop, torque
-        torque = min(self.params.torque_max, max(-self.params.torque_max, command.flywheel_torque))
+        torque = self.params.clip_hip_torque(command.flywheel_torque)
         return self._swing_step(state, dt, torque), 0.0, torque
 
     def _start_swing(self, state: FloatArray, step_length: float) -> FloatArray:

@@ -126,8 +126,7 @@ class MPCController(Controller):
         cop, torque = plan.first_input
         p = self.params
         # Clip what the solver's tolerance may leave a hair outside the limits.
-        cop = min(p.toe, max(p.heel, float(cop)))
-        torque = min(p.torque_max, max(-p.torque_max, float(torque)))
+        cop, torque = p.clip_cop(float(cop)), p.clip_hip_torque(float(torque))
         at_limit = cop in (p.heel, p.toe) or (
             p.torque_max > 0.0 and abs(torque) >= p.torque_max * (1 - 1e-9)
         )
@@ -136,7 +135,7 @@ class MPCController(Controller):
     def _fallback(self, state: NDArray[np.float64]) -> NDArray[np.float64]:
         p = self.params
         capture = state[0] + state[2] / p.omega
-        cop = min(p.toe, max(p.heel, capture))
+        cop = p.clip_cop(capture)
         rate = state[3]
         torque = -math.copysign(p.torque_max, rate) if rate != 0.0 else 0.0
         return np.array([cop, torque])

@@ -301,9 +301,8 @@ class MujocoBipedPlant(MujocoPlant):
             if model.joint(joint).qposadr[0] != i or model.joint(joint).dofadr[0] != i:
                 # The generated model and this plant disagree: a bug here, not bad input.
                 raise RuntimeError(f"the biped model's joint {joint!r} is not at index {i}")
-        reach = params.torque_max / params.weight
         # As SteppingPlant: beyond δ± ± τmax/(m g) no CMP stops an outgoing CoM.
-        self.fall_limits = (params.heel - reach, params.toe + reach)
+        self.fall_limits = params.hip_fall_limits
         self.footholds: list[float] = [0.0]
         self._length = params.com_height
         self._segment = 0.5 * params.com_height
@@ -575,8 +574,7 @@ class MujocoBipedPlant(MujocoPlant):
         """
         q, v = self._qpos.tolist(), self._qvel.tolist()
         p = self.params
-        limit = p.torque_max
-        fly = min(limit, max(-limit, command.flywheel_torque))
+        fly = p.clip_hip_torque(command.flywheel_torque)
         if self._swing is None and command.step_length is not None:
             self._start_swing(q, v, command.step_length)
         elif self._swing is not None:

@@ -489,9 +489,8 @@ class MujocoTorsoPlant(MujocoFootPlant):
 
     def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:
         super().__init__(params, cop_margin)
-        reach = params.torque_max / params.weight
         # As the flywheel model: beyond δ± ± τmax/(m g) no CMP stops an outgoing CoM.
-        self.fall_limits = (params.heel - reach, params.toe + reach)
+        self.fall_limits = params.hip_fall_limits
         self._hip = int(self.model.joint("hip").qposadr[0])
         self._hip_v = int(self.model.joint("hip").dofadr[0])
         self._at_stop = False
@@ -520,8 +519,7 @@ class MujocoTorsoPlant(MujocoFootPlant):
         """Hip torque (clipped to τmax) and the ankle torque for the CoP under it."""
         if command.step_length is not None:
             raise InvalidParameterError("the mujoco torso model has no legs to step with")
-        limit = self.params.torque_max
-        torque = min(limit, max(-limit, command.flywheel_torque))
+        torque = self.params.clip_hip_torque(command.flywheel_torque)
         self._ctrl[0] = -self.ankle_torque(cop, torque)
         self._ctrl[1] = torque
         at_stop = abs(self._qpos[self._hip]) >= self.params.flywheel_angle_max - 1e-3
