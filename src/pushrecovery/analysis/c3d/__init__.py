@@ -1,0 +1,32 @@
+"""Read and write C3D motion-capture files: markers and force plates, SI units, lab frame.
+
+:func:`read_c3d` returns the markers [m] and, per force plate, the ground reaction force on the
+subject [N], the centre of pressure (CoP) [m] and the free moment [N m], all in the lab frame;
+:func:`write_c3d` writes the same quantities as a file that third-party readers understand.
+The conventions (lab frame, plate types 1-4, units, what is ours and what is ezc3d's) are in
+docs/c3d.md. Modules: :mod:`.reader`, :mod:`.writer`, :mod:`.forceplate` (the plate
+mathematics, pure numpy), :mod:`.parameters`, :mod:`.header`, :mod:`.content` (the results).
+"""
+
+from pushrecovery.analysis.c3d.content import C3DContent, ForcePlate
+from pushrecovery.analysis.c3d.forceplate import (
+    plate_cop_in_plate_frame,
+    plate_frame,
+    wrench_type2,
+    wrench_type3,
+    wrench_type4,
+)
+from pushrecovery.analysis.c3d.reader import read_c3d
+from pushrecovery.analysis.c3d.writer import write_c3d
+
+__all__ = [
+    "C3DContent",
+    "ForcePlate",
+    "plate_cop_in_plate_frame",
+    "plate_frame",
+    "read_c3d",
+    "wrench_type2",
+    "wrench_type3",
+    "wrench_type4",
+    "write_c3d",
+]

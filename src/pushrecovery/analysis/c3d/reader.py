@@ -1,0 +1,215 @@
+"""Read a C3D file: markers and force plates (docs/c3d.md for the conventions)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.analysis.c3d.content import C3DContent, ForcePlate
+from pushrecovery.analysis.c3d.forceplate import (
+    _load_sign,
+    _threshold,
+    plate_cop_in_plate_frame,
+    plate_frame,
+    wrench_type2,
+    wrench_type3,
+)
+from pushrecovery.analysis.c3d.header import _check_header
+from pushrecovery.analysis.c3d.parameters import (
+    _CHANNEL_KINDS,
+    _LENGTH_UNITS,
+    _cal_matrix,
+    _first_text,
+    _lab_up,
+    _labels,
+    _mass,
+    _param,
+    _rate,
+    _required,
+    _unit_scale,
+)
+from pushrecovery.errors import InputFileError
+
+FloatArray = NDArray[np.float64]
+
+
+def read_c3d(path: str | Path, *, threshold: float = 20.0) -> C3DContent:
+    """Read the markers, force plates and subject mass of a C3D file (lab frame, SI).
+
+    Parameters
+    ----------
+    path : str or Path
+        The C3D file.
+    threshold : float
+        Smallest load on a plate [N] for which its CoP is defined, >= 0.
+
+    Returns
+    -------
+    C3DContent
+        Markers at the point rate, plates at the analog rate (conventions: module docstring).
+
+    Raises
+    ------
+    InputFileError
+        One line naming the file and the problem: missing, a directory, not C3D, truncated,
+        no frames, an unsupported plate type, missing channels, unknown units.
+    InvalidParameterError
+        If ``threshold`` is negative or not finite.
+    """
+    limit = _threshold(threshold)
+    file = Path(path)
+    if not file.exists():
+        raise InputFileError(f"{file}: no such file")
+    if file.is_dir():
+        raise InputFileError(f"{file}: is a directory, not a C3D file")
+    try:
+        _check_header(file)
+    except OSError as exc:
+        raise InputFileError(f"{file}: cannot read ({_one_line(exc)})") from exc
+    import ezc3d  # heavy import, only when reading
+
+    try:
+        c3d = ezc3d.c3d(str(file))
+    except Exception as exc:  # ezc3d raises OSError, RuntimeError, IndexError, ... on bad input
+        raise InputFileError(f"{file}: not a readable C3D file ({_one_line(exc)})") from exc
+    try:
+        return _content(file, c3d, limit)
+    except InputFileError:
+        raise
+    except (KeyError, IndexError, ValueError, TypeError, RuntimeError) as exc:
+        raise InputFileError(f"{file}: malformed C3D parameters ({_one_line(exc)})") from exc
+
+
+def _content(file: Path, c3d: Any, threshold: float) -> C3DContent:
+    params = c3d["parameters"]
+    points = np.asarray(c3d["data"]["points"], dtype=np.float64)
+    analogs = np.asarray(c3d["data"]["analogs"], dtype=np.float64)
+    n_markers, n_frames = points.shape[1], points.shape[2]
+    n_channels = analogs.shape[1] if analogs.ndim == 3 else 0
+    n_analog = analogs.shape[2] if n_channels else 0
+    if n_frames == 0 and n_analog == 0:
+        raise InputFileError(f"{file}: the file has no frames")
+
+    unit_text = _first_text(_param(params, "POINT", "UNITS"))
+    length = _LENGTH_UNITS.get(unit_text.strip().lower()) if unit_text.strip() else 1e-3
+    if length is None:
+        raise InputFileError(f"{file}: unknown POINT:UNITS {unit_text!r} (expected mm, cm or m)")
+
+    markers: dict[str, FloatArray] = {}
+    point_rate: float | None = None
+    first_time = 0.0
+    if n_markers:
+        point_rate = _rate(file, params, "POINT")
+        first_time = float(c3d["header"]["points"]["first_frame"]) / point_rate
+        trajectories = np.moveaxis(points[:3], 0, -1)  # (markers, frames, xyz)
+        for label, xyz in zip(_labels(params, n_markers), trajectories, strict=True):
+            values = xyz * length
+            values[(values == 0.0).all(axis=1)] = np.nan  # exact zeros: a gap, not the origin
+            values.setflags(write=False)
+            markers[label] = values
+
+    analog_rate = _rate(file, params, "ANALOG") if n_channels else None
+    plates = _plates(
+        file, params, analogs[0] if n_channels else np.zeros((0, 0)), length, threshold
+    )
+    return C3DContent(
+        point_rate=point_rate,
+        markers=markers,
+        analog_rate=analog_rate,
+        plates=plates,
+        mass=_mass(file, params),
+        point_units=unit_text,
+        first_time=first_time,
+        n_points=n_frames if n_markers else 0,
+        n_analog=n_analog,
+        up=_lab_up(params),
+    )
+
+
+def _plates(
+    file: Path, params: Any, analogs: FloatArray, length: float, threshold: float
+) -> tuple[ForcePlate, ...]:
+    """Every plate of FORCE_PLATFORM in the lab frame (``analogs``: channels × samples)."""
+    used = _param(params, "FORCE_PLATFORM", "USED")
+    n_plates = int(np.asarray(used).ravel()[0]) if used is not None and np.size(used) else 0
+    if n_plates <= 0:
+        return ()
+    types = np.asarray(_required(file, params, "FORCE_PLATFORM", "TYPE")).ravel().astype(int)
+    corners = np.asarray(_required(file, params, "FORCE_PLATFORM", "CORNERS"), dtype=np.float64)
+    origins = np.asarray(_required(file, params, "FORCE_PLATFORM", "ORIGIN"), dtype=np.float64)
+    channel = np.asarray(_required(file, params, "FORCE_PLATFORM", "CHANNEL")).astype(int)
+    if channel.ndim == 1:
+        channel = channel[:, None]
+    if types.size < n_plates or corners.size < 12 * n_plates or origins.size < 3 * n_plates:
+        raise InputFileError(
+            f"{file}: FORCE_PLATFORM describes fewer plates than FORCE_PLATFORM:USED = {n_plates}"
+        )
+    corners = corners.reshape(3, 4, -1, order="F") if corners.ndim != 3 else corners
+    origins = origins.reshape(3, -1, order="F") if origins.ndim != 2 else origins
+    unit_values = _param(params, "ANALOG", "UNITS")
+    units = [] if unit_values is None else [str(u) for u in np.atleast_1d(unit_values)]
+    point_unit = _first_text(_param(params, "POINT", "UNITS")).strip() or "mm"
+    up = _lab_up(params)
+    plates = []
+    for index in range(n_plates):
+        kind = int(types[index])
+        if kind not in _CHANNEL_KINDS:
+            raise InputFileError(
+                f"{file}: force plate {index + 1} has unsupported FORCE_PLATFORM:TYPE {kind} "
+                "(supported: 1, 2, 3, 4)"
+            )
+        kinds = _CHANNEL_KINDS[kind]
+        numbers: list[int] = (
+            [int(n) for n in channel[: len(kinds), index]] if channel.shape[1] > index else []
+        )
+        if len(numbers) < len(kinds) or min(numbers) < 1 or max(numbers) > analogs.shape[0]:
+            raise InputFileError(
+                f"{file}: force plate {index + 1} (type {kind}) needs {len(kinds)} analog "
+                f"channels; FORCE_PLATFORM:CHANNEL lists {numbers} of "
+                f"{analogs.shape[0]} recorded"
+            )
+        raw = analogs[np.asarray(numbers) - 1].T  # (n, channels)
+        scales = np.array(
+            [
+                _unit_scale(file, units, number - 1, what, point_unit, length, kind == 4)
+                for number, what in zip(numbers, kinds, strict=True)
+            ]
+        )
+        origin = origins[:, index] * length
+        if kind == 1:
+            data = raw * scales
+            force = data[:, :3]
+            cop = np.column_stack([data[:, 3], data[:, 4], np.zeros(len(data))])
+            free = data[:, 5]
+            sign = _load_sign(force)
+            force, free = sign * force, sign * free
+            unloaded = force[:, 2] < threshold
+            cop[unloaded] = np.nan
+            free = np.where(unloaded, np.nan, free)
+        else:
+            if kind == 2:
+                force, moment = wrench_type2(raw * scales, origin)
+            elif kind == 3:
+                force, moment = wrench_type3(raw * scales, origin)
+            else:  # calibrate first: the units are those of the calibrated outputs
+                calibrated = raw @ _cal_matrix(file, params, index).T * scales
+                force, moment = wrench_type2(calibrated, origin)
+            sign = _load_sign(force)
+            force, moment = sign * force, sign * moment
+            cop, free = plate_cop_in_plate_frame(force, moment, threshold=threshold)
+        rotation, centre = plate_frame(corners[:, :, index].T * length, up)
+        grf = -(force @ rotation.T)
+        cop_lab = centre + cop @ rotation.T
+        lab_corners = corners[:, :, index].T * length
+        for array in (grf, cop_lab, free, lab_corners):
+            array.setflags(write=False)
+        plates.append(ForcePlate(grf, cop_lab, free, lab_corners))
+    return tuple(plates)
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text[:200]
