@@ -85,11 +85,13 @@ _RUN_ORDER = (
     "critical",
     "filmstrips",
 )
-#: Filmstrips: strategy -> (model, controller, impulse [N s], caption), as docs/validation.md.
-FILMSTRIPS: Mapping[str, tuple[str, str, float, str]] = {
-    "ankle": ("foot", "ankle-pd", 25.0, "ankle strategy: foot + ankle PD, 25 N s"),
-    "hip": ("torso", "mpc", 40.0, "hip strategy: torso + MPC, 40 N s"),
-    "step": ("biped", "recovery", 80.0, "stepping: biped + recovery controller, 80 N s"),
+#: Filmstrips: strategy -> (model, controller, caption), as docs/validation.md; the push is the
+#: body's own (:func:`~pushrecovery.experiments.pushes.strategy_pushes`: 25, 40 and 80 N s for
+#: the paper's body).
+FILMSTRIPS: Mapping[str, tuple[str, str, str]] = {
+    "ankle": ("foot", "ankle-pd", "ankle strategy: foot + ankle PD"),
+    "hip": ("torso", "mpc", "hip strategy: torso + MPC"),
+    "step": ("biped", "recovery", "stepping: biped + recovery controller"),
 }
 #: Captions of the paper's figures, by file stem.
 FIGURE_CAPTIONS: Mapping[str, str] = {
@@ -674,6 +676,7 @@ def _critical(ctx: _Context) -> str:
 
 def _filmstrips(ctx: _Context) -> str:
     from pushrecovery.control.base import make_controller
+    from pushrecovery.experiments.pushes import strategy_pushes
     from pushrecovery.sim.backend import Recording
     from pushrecovery.sim.mujoco.render import (
         fit_view,
@@ -701,7 +704,10 @@ def _filmstrips(ctx: _Context) -> str:
         )
     parts = [lead]
     folder = ctx.out / "filmstrips"
-    for strategy, (model, controller, impulse, caption) in FILMSTRIPS.items():
+    pushes = strategy_pushes(ctx.params)
+    for strategy, (model, controller, name) in FILMSTRIPS.items():
+        impulse = pushes.impulse(strategy, ctx.params.mass)
+        caption = f"{name}, {impulse:g} N s"
         if model not in MUJOCO_MODELS:
             parts.append(paragraph(f"No MuJoCo model {esc(model)} for {esc(strategy)}.", "note"))
             continue

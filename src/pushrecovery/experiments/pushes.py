@@ -1,0 +1,60 @@
+"""Pushes chosen relative to a body's own thresholds, so that a figure tells its story for any body.
+
+A push fixed in N s means a different thing for a 45 kg robot and a 72 kg person: the 40 N s
+"hip strategy" push of the paper's body is beyond a light robot's hip region. These pushes are
+placed between the body's own thresholds from upright (x = 0, forward): Eq. (4) for the ankle,
+corrected Eq. (15) for the hip, Sec. IV's single step (:func:`~pushrecovery.surfaces.step.
+step_critical_velocity`) for stepping.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cmp import cmp_region
+from pushrecovery.surfaces.cop import critical_velocity
+from pushrecovery.surfaces.step import step_critical_velocity
+
+__all__ = ["ANKLE_FRACTION", "STEP_FRACTION", "StrategyPushes", "strategy_pushes"]
+
+#: The ankle push, as a fraction of the ankle's critical push (well inside Eq. 4).
+ANKLE_FRACTION = 0.74
+#: The step push: this fraction of the way from the hip's critical push to one step's.
+STEP_FRACTION = 0.24
+
+
+@dataclass(frozen=True, slots=True)
+class StrategyPushes:
+    """One push per strategy from upright, forward, as CoM velocity jumps [m/s].
+
+    Attributes
+    ----------
+    ankle : float
+        ``ANKLE_FRACTION`` of the ankle's critical push.
+    hip : float
+        Midway between the ankle's and the hip's critical pushes.
+    step : float
+        ``STEP_FRACTION`` of the way from the hip's critical push to one step's.
+    """
+
+    ankle: float
+    hip: float
+    step: float
+
+    def impulse(self, strategy: str, mass: float) -> float:
+        """Return the push of ``strategy`` as an impulse m Δẋ [N s], rounded to 1 N s."""
+        velocity = {"ankle": self.ankle, "hip": self.hip, "step": self.step}[strategy]
+        return float(round(mass * velocity))
+
+
+def strategy_pushes(params: BodyParams) -> StrategyPushes:
+    """Return the pushes between ``params``' own thresholds (module docstring)."""
+    ankle = float(critical_velocity(0.0, 1.0, params))
+    hip = float(critical_velocity(0.0, 1.0, params, region=cmp_region(params)))
+    step = step_critical_velocity(0.0, 1.0, params)
+    return StrategyPushes(
+        ankle=ANKLE_FRACTION * ankle,
+        hip=0.5 * (ankle + hip),
+        step=hip + STEP_FRACTION * (step - hip),
+    )

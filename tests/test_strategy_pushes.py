@@ -1,0 +1,47 @@
+"""Pushes relative to a body's own thresholds (the report's filmstrips, issue 15 item 5)."""
+
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.control import make_controller
+from pushrecovery.experiments.pushes import strategy_pushes
+from pushrecovery.sim.push import Push
+from pushrecovery.sim.registry import make_plant
+from pushrecovery.sim.simulate import simulate
+from pushrecovery.surfaces.cmp import cmp_region
+from pushrecovery.surfaces.cop import critical_velocity
+from pushrecovery.surfaces.step import step_critical_velocity
+
+ROBOT = {"mass": 45.0, "com_height": 0.7, "torque_max": 40.0, "flywheel_inertia": 3.0}
+BODIES = [{}, ROBOT, {"mass": 95.0, "toe": 0.2}, {"torque_max": 20.0}]
+
+
+@pytest.mark.parametrize("overrides", BODIES)
+def test_each_push_lies_between_the_bodys_own_thresholds(overrides):
+    params = load_params(overrides=overrides)
+    pushes = strategy_pushes(params)
+    ankle = float(critical_velocity(0.0, 1.0, params))
+    hip = float(critical_velocity(0.0, 1.0, params, region=cmp_region(params)))
+    step = step_critical_velocity(0.0, 1.0, params)
+    assert 0.0 < pushes.ankle < ankle < pushes.hip < hip < pushes.step < step
+
+
+def test_the_paper_body_keeps_its_pushes():
+    params = load_params()
+    pushes = strategy_pushes(params)
+    assert [pushes.impulse(s, params.mass) for s in ("ankle", "hip", "step")] == [25, 40, 80]
+
+
+def test_a_light_robots_hip_push_is_recovered_with_the_hip():
+    # The 40 N s of the paper's body is beyond this robot's hip region (it would fall); its
+    # own hip push is recovered by the MPC on the MuJoCo torso, using the hip.
+    pytest.importorskip("mujoco")
+    params = load_params(overrides=ROBOT)
+    limit = float(critical_velocity(0.0, 1.0, params, region=cmp_region(params)))
+    assert 40.0 / params.mass > limit
+    plant = make_plant("torso", params, "mujoco")
+    plant.reset(0.0, 0.0)
+    impulse = strategy_pushes(params).impulse("hip", params.mass)
+    pushed = plant.apply_push(Push.from_impulse(impulse, params.mass))
+    run = simulate(plant, make_controller("mpc", params), pushed, duration=4.0)
+    assert run.recovered and run.strategy_used().value == "hip"
