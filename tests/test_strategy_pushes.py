@@ -45,3 +45,31 @@ def test_a_light_robots_hip_push_is_recovered_with_the_hip():
     pushed = plant.apply_push(Push.from_impulse(impulse, params.mass))
     run = simulate(plant, make_controller("mpc", params), pushed, duration=4.0)
     assert run.recovered and run.strategy_used().value == "hip"
+
+
+def test_the_reports_grids_follow_the_bodys_thresholds():
+    from pushrecovery.experiments.pushes import push_scale
+    from pushrecovery.report.html import SIZES, _body_grids
+
+    paper = load_params()
+    assert _body_grids(SIZES["small"], paper) == SIZES["small"]
+    robot = load_params(overrides=ROBOT)
+    grids = _body_grids(SIZES["small"], robot)
+    step, hip = push_scale(robot, "step", paper), push_scale(robot, "hip", paper)
+    assert grids.analytic.xdot[1] == pytest.approx(SIZES["small"].analytic.xdot[1] * step)
+    assert grids.mujoco.xdot[1] == pytest.approx(SIZES["small"].mujoco.xdot[1] * hip)
+    # The hip grid reaches as far past the robot's hip threshold as the paper's does past its.
+    limit = float(critical_velocity(0.0, 1.0, robot, region=cmp_region(robot)))
+    paper_limit = float(critical_velocity(0.0, 1.0, paper, region=cmp_region(paper)))
+    assert grids.mujoco.xdot[1] / limit == pytest.approx(
+        SIZES["small"].mujoco.xdot[1] / paper_limit
+    )
+
+
+def test_percentages_are_no_finer_than_their_resolution():
+    from pushrecovery.report.markup import percent_within
+
+    assert percent_within(0.2743, 0.04) == "+27 % ± 4 %"
+    assert percent_within(-0.0587, 0.005) == "−5.9 % ± 0.5 %"
+    assert percent_within(0.01234, 0.0004) == "+1.23 % ± 0.04 %"
+    assert percent_within(0.1, None) == "+10.0 %"

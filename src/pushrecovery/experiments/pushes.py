@@ -16,7 +16,14 @@ from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import critical_velocity
 from pushrecovery.surfaces.step import step_critical_velocity
 
-__all__ = ["ANKLE_FRACTION", "STEP_FRACTION", "StrategyPushes", "strategy_pushes"]
+__all__ = [
+    "ANKLE_FRACTION",
+    "STEP_FRACTION",
+    "StrategyPushes",
+    "push_scale",
+    "scaled_range",
+    "strategy_pushes",
+]
 
 #: The ankle push, as a fraction of the ankle's critical push (well inside Eq. 4).
 ANKLE_FRACTION = 0.74
@@ -57,4 +64,31 @@ def strategy_pushes(params: BodyParams) -> StrategyPushes:
         ankle=ANKLE_FRACTION * ankle,
         hip=0.5 * (ankle + hip),
         step=hip + STEP_FRACTION * (step - hip),
+    )
+
+
+def _threshold(params: BodyParams, strategy: str) -> float:
+    if strategy == "hip":
+        return float(critical_velocity(0.0, 1.0, params, region=cmp_region(params)))
+    if strategy == "step":
+        return step_critical_velocity(0.0, 1.0, params)
+    return float(critical_velocity(0.0, 1.0, params))
+
+
+def push_scale(params: BodyParams, strategy: str, reference: BodyParams) -> float:
+    """Return how much larger ``params``' critical push of ``strategy`` is than ``reference``'s.
+
+    The forward critical push from upright: Eq. (4) (``ankle``), corrected Eq. (15) (``hip``)
+    or Sec. IV's single step (``step``). A grid of pushes drawn for ``reference`` and scaled
+    by it covers the same part of ``params``' strategy map.
+    """
+    return _threshold(params, strategy) / _threshold(reference, strategy)
+
+
+def scaled_range(triple: tuple[float, float, float], scale: float) -> tuple[float, float, float]:
+    """Return (start, stop, step) [m/s] multiplied by ``scale`` (6 significant digits)."""
+    return (
+        float(f"{triple[0] * scale:.6g}"),
+        float(f"{triple[1] * scale:.6g}"),
+        float(f"{triple[2] * scale:.6g}"),
     )

@@ -40,7 +40,16 @@ import numpy as np
 
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
-from pushrecovery.report.markup import esc, figure, num, page, paragraph, percent, table
+from pushrecovery.report.markup import (
+    esc,
+    figure,
+    num,
+    page,
+    paragraph,
+    percent,
+    percent_within,
+    table,
+)
 from pushrecovery.report.steps import step_counts
 from pushrecovery.surfaces.bounds import bounds_data
 
@@ -201,6 +210,30 @@ class _Context:
 
 
 # --- helpers ---------------------------------------------------------------------------------
+def _body_grids(grids: ReportGrids, params: BodyParams) -> ReportGrids:
+    """Return the built-in grids (drawn for the paper's body) scaled to ``params``' thresholds.
+
+    Each campaign's pushes are multiplied by the ratio of the body's critical push to the
+    paper body's for the strategy the campaign is about (one step for the stepping campaigns,
+    the hip for the MPC's): the same part of the strategy map for any body.
+    """
+    from pushrecovery.experiments.pushes import push_scale, scaled_range
+    from pushrecovery.params import load_params
+
+    reference = load_params("paper")
+    if params == reference:
+        return grids
+    step = push_scale(params, "step", reference)
+    hip = push_scale(params, "hip", reference)
+    return replace(
+        grids,
+        analytic=replace(grids.analytic, xdot=scaled_range(grids.analytic.xdot, step)),
+        biped=replace(grids.biped, xdot=scaled_range(grids.biped.xdot, step)),
+        mujoco=replace(grids.mujoco, xdot=scaled_range(grids.mujoco.xdot, hip)),
+        sweep=replace(grids.sweep, xdot=scaled_range(grids.sweep.xdot, hip)),
+    )
+
+
 def _fit_x0(grid: PushGrid, params: BodyParams) -> Range:
     """``grid.x0`` restricted to the values strictly on the foot; the foot's middle if none."""
     from pushrecovery.campaign import value_range
@@ -273,7 +306,7 @@ def _boundary_table(summary: Mapping[str, Any]) -> str:
                 num(r["analytic"]),
                 num(r["empirical"]),
                 f"[{num(low)}, {num(high)}]",
-                percent(r["relative_error"]),
+                percent_within(r["relative_error"], _resolution(r)),
                 "yes" if r["monotone"] else "no",
             ]
         )
@@ -289,6 +322,31 @@ def _boundary_table(summary: Mapping[str, Any]) -> str:
         "monotone",
     ]
     return table(header, rows, text_columns=0)
+
+
+def _verdict_table(pushes: Any, ident: str) -> str:
+    """Return the accuracy's own table: the surfaces' verdict against the outcome, by push.
+
+    Accuracy = (recovered where the verdict says the controller recovers + not recovered where
+    it says it does not) / pushes: the diagonal of this table over its total.
+    """
+    verdict = np.asarray(pushes.column("predicted_recovers").to_numpy(zero_copy_only=False))
+    outcome = np.asarray(pushes.column("outcome").to_numpy(zero_copy_only=False))
+    recovered = outcome == "recovered"
+    cells = [
+        [int(np.sum(verdict & recovered)), int(np.sum(verdict & ~recovered))],
+        [int(np.sum(~verdict & recovered)), int(np.sum(~verdict & ~recovered))],
+    ]
+    rows = [
+        ["recovers (the controller's strategy or a lesser one)", *map(str, cells[0])],
+        ["does not", *map(str, cells[1])],
+    ]
+    return paragraph(
+        "Where the accuracy comes from: the surfaces' verdict (rows) against the outcome "
+        f"(columns); accuracy = ({cells[0][0]} + {cells[1][1]}) / {sum(map(sum, cells))}."
+    ) + table(
+        ["verdict \\ outcome", "recovered", "fell or undecided"], rows, text_columns=1, ident=ident
+    )
 
 
 def _disagreements(table: Any) -> str:
@@ -337,6 +395,7 @@ def _campaign_body(
             "(the controller's strategy or a lesser one recovers) matches the outcome."
         )
     )
+    parts.append(_verdict_table(result.table, f"verdicts-{key}"))
     parts.append(
         "<h3>Confusion matrix</h3>\n"
         + paragraph(
@@ -359,16 +418,46 @@ def _campaign_body(
         )
     )
     if boundary and summary["boundary"]:
+        irregular = [r for r in summary["boundary"] if not r["monotone"]]
+        note = (
+            f" {len(irregular)} row(s) are not monotone: a push beyond the first fall recovered."
+            if irregular
+            else " Every row is monotone: no push beyond the first fall recovered."
+        )
         parts.append(
             "<h3>Critical pushes of the grid</h3>\n"
             + paragraph(
                 "The empirical critical push is the middle of the bracket [largest push that "
                 "recovered with every smaller one, next push of the grid]; analytic: the "
-                "controller's surface. Not monotone: a push beyond the first fall recovered."
+                "controller's surface; the error is given to the grid's resolution (± half the "
+                "bracket)." + note
             )
             + _boundary_table(summary)
         )
+    parts.append(_data_links(key))
     return "".join(parts)
+
+
+def _resolution(row: Mapping[str, Any]) -> float | None:
+    """Half the bracket relative to the analytic critical push: what the grid can resolve."""
+    low, high = row["bracket"]
+    if low is None or high is None or not row["analytic"]:
+        return None
+    return 0.5 * abs(high - low) / abs(row["analytic"])
+
+
+def _data_links(key: str) -> str:
+    """Links to the files behind a campaign's tables (next to the report)."""
+    folder = f"campaign-{key}"
+    return paragraph(
+        "Data: "
+        + ", ".join(
+            f'<a href="{esc(folder)}/{esc(name)}">{esc(name)}</a>'
+            for name in ("pushes.parquet", "summary.json", "spec.json")
+        )
+        + " (one row per push; the counts, confusion matrix and critical pushes; the grid).",
+        "note",
+    )
 
 
 # --- sections --------------------------------------------------------------------------------
@@ -831,7 +920,7 @@ def write_report(
         raise InvalidParameterError(f"workers must be >= 1, got {workers}")
     params = load_params() if params is None else params
     size = "full" if full else size
-    grids = SIZES[size]
+    grids = _body_grids(SIZES[size], params)
     grids = replace(
         grids,
         analytic=analytic_grid or grids.analytic,
@@ -891,6 +980,7 @@ def _body(params: BodyParams, bodies: Mapping[str, str], ctx: _Context, size: st
             f"<code>{esc(size)}</code>.",
             "lead",
         ),
+        _verdict(params, ctx),
         "<nav><ul>\n"
         + "".join(f'<li><a href="#{key}">{esc(SECTIONS[key])}</a></li>\n' for key in shown)
         + "</ul></nav>\n",
@@ -901,6 +991,26 @@ def _body(params: BodyParams, bodies: Mapping[str, str], ctx: _Context, size: st
             f'<section id="{key}">\n<h2>{esc(SECTIONS[key])}</h2>\n{bodies[key]}{notes}</section>\n'
         )
     return "".join(parts)
+
+
+def _verdict(params: BodyParams, ctx: _Context) -> str:
+    """One paragraph at the top: the body's thresholds and how well the surfaces predicted."""
+    data = bounds_data(params)["thresholds"]
+    text = (
+        "<strong>Verdict.</strong> From upright this body recovers pushes up to "
+        f"{num(data['ankle'][1], 3)} m/s forward with the ankles (Eq. 4), "
+        f"{num(data['hip'][1], 3)} m/s with the hip (corrected Eq. 15) and "
+        f"{num(data['step'][1], 3)} m/s with steps (the N-step verdict)."
+    )
+    scores = [
+        f"{esc(SECTIONS[key])}: {num(summary['accuracy'], 3)} of {summary['pushes']} pushes"
+        for key, summary in ctx.summaries.items()
+    ]
+    if scores:
+        text += (
+            " The surfaces' verdicts matched the simulated outcomes in " + "; ".join(scores) + "."
+        )
+    return paragraph(text, "verdict")
 
 
 def _footer(

@@ -32,6 +32,7 @@ h2 { font-size: 1.3em; margin-top: 2.2em; border-bottom: 1px solid #ccc; padding
 h3 { font-size: 1.05em; margin-top: 1.4em; }
 p.lead { color: #444; }
 p.note { background: #fff4e5; border-left: 4px solid #ef6c00; padding: 0.5em 0.8em; }
+p.verdict { background: #e8f5e9; border-left: 4px solid #2e7d32; padding: 0.6em 0.9em; }
 table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.92em; }
 th, td { border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: right; }
 th { background: #f0f0f0; }
@@ -65,6 +66,18 @@ def percent(value: float | None, digits: int = 1) -> str:
     if value is None or math.isnan(value):
         return "—"
     return f"{100.0 * value:+.{digits}f} %".replace("-", "−")
+
+
+def percent_within(value: float | None, resolution: float | None) -> str:
+    """Format a fraction as a percentage no finer than ``resolution`` (a fraction), with it.
+
+    ``+27 % ± 4 %`` for a value known to ±0.04; one more digit per factor of ten finer, up
+    to two decimals; :func:`percent` when the resolution is unknown.
+    """
+    if value is None or math.isnan(value) or resolution is None or not resolution > 0.0:
+        return percent(value)
+    digits = min(2, max(0, math.ceil(-math.log10(100.0 * resolution))))
+    return f"{100.0 * value:+.{digits}f} % ± {100.0 * resolution:.{digits}f} %".replace("-", "−")
 
 
 def paragraph(text: str, cls: str | None = None) -> str:
