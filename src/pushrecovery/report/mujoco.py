@@ -1,0 +1,132 @@
+"""The MuJoCo sections: the critical-push table and the filmstrips."""
+
+from __future__ import annotations
+
+from pushrecovery.errors import PushRecoveryError
+from pushrecovery.report.config import FILMSTRIPS
+from pushrecovery.report.context import _Context
+from pushrecovery.report.markup import (
+    esc,
+    figure,
+    num,
+    paragraph,
+    percent,
+    table,
+)
+
+
+def _critical(ctx: _Context) -> str:
+    from pushrecovery.sim.validation import available_strategies, critical_table
+
+    grids = ctx.grids
+    rows = []
+    for strategy in available_strategies("mujoco"):
+        tolerance = grids.step_tolerance if strategy == "step" else grids.critical_tolerance
+        for row in critical_table(
+            ctx.params,
+            backend="mujoco",
+            strategies=(strategy,),
+            x0s=tuple(x for x in grids.critical_x0s if ctx.params.heel < x < ctx.params.toe),
+            tolerance=tolerance,
+        ):
+            rows.append(
+                [
+                    row.strategy,
+                    f"{row.model} + {row.controller}",
+                    row.direction,
+                    num(row.x0),
+                    num(row.predicted),
+                    num(row.corrected),
+                    num(row.measured),
+                    f"[{num(row.bracket[0])}, {num(row.bracket[1])}]",
+                    percent(row.relative_error),
+                    percent(row.corrected_error),
+                    str(row.simulations),
+                ]
+            )
+    header = [
+        "strategy",
+        "model + controller",
+        "direction",
+        "x0 [m]",
+        "predicted [m/s]",
+        "corrected [m/s]",
+        "MuJoCo [m/s]",
+        "bracket [m/s]",
+        "vs predicted",
+        "vs corrected",
+        "simulations",
+    ]
+    return paragraph(
+        "The largest push each strategy recovers in MuJoCo (bisection on a real force, shown "
+        "as J/m), against the paper's surface (Eq. 4, corrected Eq. 15, the single-step limit "
+        "of Sec. IV) and, for ankle and hip, the prediction corrected for the foot's usable "
+        "length and the push's duration (docs/validation.md).",
+        "lead",
+    ) + table(header, rows, text_columns=3)
+
+
+def _filmstrips(ctx: _Context) -> str:
+    from pushrecovery.control.base import make_controller
+    from pushrecovery.experiments.pushes import strategy_pushes
+    from pushrecovery.sim.backend import Recording
+    from pushrecovery.sim.mujoco.render import (
+        fit_view,
+        render_frames,
+        require_offscreen_gl,
+        select_times,
+        write_filmstrip,
+    )
+    from pushrecovery.sim.push import Push
+    from pushrecovery.sim.registry import MUJOCO_MODELS, make_plant
+    from pushrecovery.sim.simulate import simulate
+
+    lead = paragraph(
+        "One MuJoCo run per strategy from upright, pushed by a real force: the ankle strategy "
+        "inside Eq. (4), the hip strategy beyond it but inside corrected Eq. (15), and a step "
+        "beyond both (Sec. IV). Red: CoM; blue: capture point; green: CoP.",
+        "lead",
+    )
+    try:
+        require_offscreen_gl()
+    except PushRecoveryError as exc:
+        return lead + paragraph(
+            f"Rendering is not available on this machine, so there are no filmstrips: {esc(exc)}",
+            "note",
+        )
+    parts = [lead]
+    folder = ctx.out / "filmstrips"
+    pushes = strategy_pushes(ctx.params)
+    for strategy, (model, controller, name) in FILMSTRIPS.items():
+        impulse = pushes.impulse(strategy, ctx.params.mass)
+        caption = f"{name}, {impulse:g} N s"
+        if model not in MUJOCO_MODELS:
+            parts.append(paragraph(f"No MuJoCo model {esc(model)} for {esc(strategy)}.", "note"))
+            continue
+        plant = make_plant(model, ctx.params, "mujoco")
+        if not isinstance(plant, Recording):  # pragma: no cover - every MuJoCo plant records
+            raise TypeError(f"the MuJoCo model {model!r} records no frames")
+        plant.record()
+        plant.reset(0.0, 0.0)
+        pushed = plant.apply_push(Push.from_impulse(impulse, ctx.params.mass))
+        run = simulate(plant, make_controller(controller, ctx.params), pushed, duration=4.0)
+        frames = plant.frames or []
+        strip = select_times(frames, 7)
+        images = render_frames(
+            plant.model, strip, width=180, height=240, view=fit_view(plant.model, frames, 0.75)
+        )
+        path = write_filmstrip(
+            images,
+            [f.time for f in strip],
+            folder / f"{strategy}.png",
+            title=f"{caption}: {run.outcome.value}",
+        )
+        parts.append(
+            f"<h3>{esc(strategy)}</h3>\n"
+            + figure(
+                path,
+                f"{esc(caption)} (ẋ = J/m = {num(impulse / ctx.params.mass, 3)} m/s): "
+                f"{esc(run.outcome.value)}.",
+            )
+        )
+    return "".join(parts)
