@@ -240,7 +240,8 @@ def _verdict(params: BodyParams, ctx: _Context) -> str:
         f"{num(data['step'][1], 3)} m/s with steps (the N-step verdict)."
     )
     scores = [
-        f"{esc(SECTIONS[key])}: {num(summary['accuracy'], 3)} of {summary['pushes']} pushes"
+        f"{esc(SECTIONS[key])}: accuracy {num(summary['accuracy'], 3)} over "
+        f"{summary['pushes']} pushes"
         for key, summary in ctx.summaries.items()
     ]
     if scores:
