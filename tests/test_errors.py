@@ -76,13 +76,23 @@ def test_a_biped_layout_mismatch_is_a_bug_not_an_assertion(monkeypatch):
     original = biped.biped_model
 
     def swapped(params):
-        # The same model with the two legs declared in the other order: joints move.
-        xml = original(params)
-        return (
-            xml.replace('name="left_', 'name="tmp_')
-            .replace('name="right_', 'name="left_')
-            .replace('name="tmp_', 'name="right_')
-        )
+        # The same model with the two legs' names swapped: the joints are not where expected.
+        spec = original(params)
+
+        def swap(name):
+            for a, b in (("left_", "right_"), ("right_", "left_")):
+                if name.startswith(a):
+                    return b + name[len(a) :]
+            return name
+
+        elements = (*spec.joints, *spec.bodies, *spec.geoms, *spec.actuators)
+        for element in elements:  # through temporary names: names must stay unique
+            element.name = "tmp_" + swap(element.name)
+        for element in elements:
+            element.name = element.name[len("tmp_") :]
+        for actuator in spec.actuators:
+            actuator.target = swap(actuator.target)
+        return spec
 
     monkeypatch.setattr(biped, "biped_model", swapped)
     with pytest.raises(RuntimeError, match="not at index") as error:

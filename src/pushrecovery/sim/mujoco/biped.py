@@ -92,7 +92,7 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -108,9 +108,9 @@ from pushrecovery.sim.mujoco.models import (
     ANKLE_HEIGHT,
     FOOT_HALF_THICKNESS,
     FOOT_MASS,
-    MASS_RADIUS,
-    TORSO_LENGTH,
-    header,
+    add_motor,
+    add_upper_body,
+    model_spec,
 )
 from pushrecovery.sim.mujoco.plant import DEFAULT_COP_MARGIN, FOOT_TIP_LIMIT, MujocoPlant
 
@@ -183,8 +183,8 @@ TRAIL_TIME = 0.3
 _X, _Z, _PITCH = 0, 1, 2
 
 
-def biped_model(params: BodyParams) -> str:
-    """MJCF text of the planar ``biped`` for ``params`` (module docstring).
+def biped_model(params: BodyParams) -> Any:
+    """Return the ``MjSpec`` of the planar ``biped`` for ``params`` (module docstring).
 
     Raises
     ------
@@ -192,6 +192,8 @@ def biped_model(params: BodyParams) -> str:
         If ``leg_length != com_height`` (the straight legs carry the hip at the CoM height L)
         or the mass does not exceed the legs'.
     """
+    import mujoco
+
     if params.leg_length != params.com_height:
         raise InvalidParameterError(
             "the biped's straight legs carry the hip at the CoM height: leg_length must equal "
@@ -202,58 +204,56 @@ def biped_model(params: BodyParams) -> str:
         raise InvalidParameterError(
             f"mass must exceed the legs' {2.0 * LEG_MASS:g} kg, got {params.mass:g} kg"
         )
+    hinge, capsule = mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtGeom.mjGEOM_CAPSULE
+    y_axis, leg_colour = [0.0, 1.0, 0.0], [0.4, 0.5, 0.8, 1.0]
     length = params.com_height
     segment = 0.5 * length
-    inertia, limit = params.flywheel_inertia, params.flywheel_angle_max
-    half_length = 0.5 * (params.toe - params.heel)
-    centre = 0.5 * (params.toe + params.heel)
+    limit = params.flywheel_angle_max
+    spec = model_spec("biped", params)
+    torso = add_upper_body(spec.worldbody, params, torso_mass, [0.0, 0.0, length + ANKLE_HEIGHT])
+    torso.add_joint(name="x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0])
+    torso.add_joint(name="z", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0.0, 0.0, 1.0])
+    torso.add_joint(
+        name="pitch",
+        type=hinge,
+        axis=y_axis,
+        limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+        range=[-limit, limit],
+    )
+    # The joints come before the body's geoms in the compiled model whatever the order here.
     # The shank's capsule ends 1.5 cm above the ankle, so that only the sole reaches the floor.
     shank_end = segment - SHANK_RADIUS - 0.015
-    legs = "".join(
-        f"""
-      <body name="{name}_thigh" pos="0 {y} 0">
-        <joint name="{name}_hip" type="hinge" axis="0 1 0"/>
-        <geom name="{name}_thigh" type="capsule" fromto="0 0 0 0 0 {-segment}"
-              size="{THIGH_RADIUS}" mass="{THIGH_MASS}" contype="2" conaffinity="1"
-              rgba="0.4 0.5 0.8 1"/>
-        <body name="{name}_shank" pos="0 0 {-segment}">
-          <joint name="{name}_knee" type="hinge" axis="0 1 0" range="0 {KNEE_MAX}"
-                 solreflimit="0.005 1" armature="{KNEE_ARMATURE}"/>
-          <geom name="{name}_shank" type="capsule" fromto="0 0 0 0 0 {-shank_end}"
-                size="{SHANK_RADIUS}" mass="{SHANK_MASS}" contype="2" conaffinity="1"
-                rgba="0.4 0.5 0.8 1"/>
-          <body name="{name}_foot" pos="0 0 {-segment}">
-            <joint name="{name}_ankle" type="hinge" axis="0 1 0" armature="{ANKLE_ARMATURE}"/>
-            <geom name="{name}_sole" type="box" pos="{centre} 0 {-FOOT_HALF_THICKNESS}"
-                  size="{half_length} 0.05 {FOOT_HALF_THICKNESS}" mass="{FOOT_MASS}"
-                  contype="2" conaffinity="1" rgba="0.3 0.3 0.3 1"/>
-          </body>
-        </body>
-      </body>"""
-        for name, y in zip(LEGS, (HIP_SPREAD, -HIP_SPREAD), strict=True)
-    )
-    motors = "".join(
-        f'\n    <motor name="{name}_{joint}" joint="{name}_{joint}" gear="1"/>'
-        for name in LEGS
-        for joint in ("hip", "knee", "ankle")
-    )
     # contype 2 / conaffinity 1: every body geom touches the floor (1/1), none touches another.
-    return f"""{header("biped", params)}
-    <body name="torso" pos="0 0 {length + ANKLE_HEIGHT}">
-      <joint name="x" type="slide" axis="1 0 0"/>
-      <joint name="z" type="slide" axis="0 0 1"/>
-      <joint name="pitch" type="hinge" axis="0 1 0" limited="true" range="{-limit} {limit}"/>
-      <inertial pos="0 0 0" mass="{torso_mass}" diaginertia="{inertia} {inertia} {inertia}"/>
-      <geom name="pelvis" type="sphere" size="{MASS_RADIUS}" contype="2" conaffinity="1"
-            rgba="0.9 0.6 0.2 1"/>
-      <geom name="trunk" type="capsule" fromto="0 0 0 0 0 {TORSO_LENGTH}" size="0.05"
-            contype="2" conaffinity="1" rgba="0.9 0.6 0.2 1"/>{legs}
-    </body>
-  </worldbody>
-  <actuator>{motors}
-  </actuator>
-</mujoco>
-"""
+    for name, y in zip(LEGS, (HIP_SPREAD, -HIP_SPREAD), strict=True):
+        thigh = torso.add_body(name=f"{name}_thigh", pos=[0.0, y, 0.0])
+        thigh.add_joint(name=f"{name}_hip", type=hinge, axis=y_axis)
+        thigh.add_geom(
+            name=f"{name}_thigh", type=capsule, fromto=[0.0, 0.0, 0.0, 0.0, 0.0, -segment],
+            size=[THIGH_RADIUS, 0.0, 0.0], mass=THIGH_MASS, contype=2, conaffinity=1,
+            rgba=leg_colour,
+        )  # fmt: skip
+        shank = thigh.add_body(name=f"{name}_shank", pos=[0.0, 0.0, -segment])
+        shank.add_joint(
+            name=f"{name}_knee", type=hinge, axis=y_axis, range=[0.0, KNEE_MAX],
+            solref_limit=[0.005, 1.0], armature=KNEE_ARMATURE,
+        )  # fmt: skip
+        shank.add_geom(
+            name=f"{name}_shank", type=capsule, fromto=[0.0, 0.0, 0.0, 0.0, 0.0, -shank_end],
+            size=[SHANK_RADIUS, 0.0, 0.0], mass=SHANK_MASS, contype=2, conaffinity=1,
+            rgba=leg_colour,
+        )  # fmt: skip
+        foot = shank.add_body(name=f"{name}_foot", pos=[0.0, 0.0, -segment])
+        foot.add_joint(name=f"{name}_ankle", type=hinge, axis=y_axis, armature=ANKLE_ARMATURE)
+        foot.add_geom(
+            name=f"{name}_sole", type=mujoco.mjtGeom.mjGEOM_BOX,
+            pos=[0.5 * (params.toe + params.heel), 0.0, -FOOT_HALF_THICKNESS],
+            size=[0.5 * (params.toe - params.heel), 0.05, FOOT_HALF_THICKNESS],
+            mass=FOOT_MASS, contype=2, conaffinity=1, rgba=[0.3, 0.3, 0.3, 1.0],
+        )  # fmt: skip
+    for name in LEGS:
+        for joint in ("hip", "knee", "ankle"):
+            add_motor(spec, f"{name}_{joint}")
+    return spec
 
 
 def _path(start: float, rate: float, goal: float, t: float, duration: float) -> tuple[float, float]:
@@ -289,8 +289,8 @@ class MujocoBipedPlant(MujocoPlant):
     pushed_body: ClassVar[str] = "torso"
 
     @classmethod
-    def xml(cls, params: BodyParams) -> str:
-        """MJCF text of the model for ``params`` (:func:`biped_model`)."""
+    def build(cls, params: BodyParams) -> Any:
+        """Return the model's ``MjSpec`` for ``params`` (:func:`biped_model`)."""
         return biped_model(params)
 
     def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:

@@ -13,10 +13,15 @@ upper body of mass m whose centre of mass is *at the hip* with inertia I about i
 flywheel of Sec. III (Fig. 6), m and L as for ``foot``, I the upper body's inertia about the
 hip. Turning the upper body does not move the CoM, as in the paper.
 
-The geometry is shared (:func:`foot_xml`) so that the two models differ only by the upper body.
+Each model is built as a ``mujoco.MjSpec`` (named elements, no MJCF text); the parts are shared
+(:func:`model_spec`, :func:`add_foot`, :func:`add_upper_body`, :func:`add_motor`) so that the
+models differ only by what they add. MuJoCo's types appear as ``Any``: its bindings ship no
+type information.
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 from pushrecovery.params import BodyParams
 
@@ -25,8 +30,11 @@ __all__ = [
     "FOOT_MASS",
     "MODEL_BUILDERS",
     "TIMESTEP",
+    "add_foot",
+    "add_motor",
+    "add_upper_body",
     "foot_model",
-    "foot_xml",
+    "model_spec",
     "torso_model",
 ]
 
@@ -48,98 +56,162 @@ TIMESTEP = 1e-3
 CONTACT_TIME = 2e-3
 
 
-def header(name: str, params: BodyParams) -> str:
-    """``<mujoco>`` opening, options, contact defaults and the floor of every model."""
-    return f"""
-<mujoco model="pushrecovery-{name}">
-  <compiler angle="radian"/>
-  <option timestep="{TIMESTEP}" gravity="0 0 {-params.gravity}" integrator="implicitfast"
-          cone="pyramidal"/>
-  <visual><global offwidth="640" offheight="480"/></visual>
-  <default>
-    <geom contype="1" conaffinity="1" friction="1.0 0.005 0.0001"
-          solref="{CONTACT_TIME} 1" solimp="0.95 0.99 0.001"/>
-  </default>
-  <worldbody>
-    <light pos="0 -2 3" dir="0 1 -1" directional="true"/>
-    <geom name="floor" type="plane" size="5 1 0.1" rgba="0.85 0.85 0.85 1"/>
-"""
+def model_spec(name: str, params: BodyParams) -> Any:
+    """Return a new ``mujoco.MjSpec``: options, contact defaults, the light and the floor.
 
-
-def foot_xml(params: BodyParams, name: str = "foot", x: float = 0.0, inner: str = "") -> str:
-    """Return a free (x, z, pitch) foot box, sole geom ``<name>_sole``, holding ``inner``.
-
-    ``inner`` is placed on top of the foot, at the ankle (``ANKLE_HEIGHT`` above the floor).
+    The shared part of every model (the ``<mujoco>`` header of an MJCF file).
     """
-    half_length = 0.5 * (params.toe - params.heel)
-    centre = 0.5 * (params.toe + params.heel)
-    sole = "sole" if name == "foot" else f"{name}_sole"
-    return f"""
-    <body name="{name}" pos="{x} 0 {FOOT_HALF_THICKNESS}">
-      <joint name="{name}_x" type="slide" axis="1 0 0"/>
-      <joint name="{name}_z" type="slide" axis="0 0 1"/>
-      <joint name="{name}_pitch" type="hinge" axis="0 1 0"/>
-      <geom name="{sole}" type="box" pos="{centre} 0 0"
-            size="{half_length} 0.05 {FOOT_HALF_THICKNESS}" mass="{FOOT_MASS}"
-            rgba="0.3 0.3 0.3 1"/>
-      {inner}
-    </body>
-"""
+    import mujoco
 
-
-def _rod(length: float) -> str:
-    return (
-        f'<geom name="rod" type="capsule" fromto="0 0 0 0 0 {length}" size="0.01" '
-        f'mass="{ROD_MASS}" contype="2" conaffinity="2" rgba="0.4 0.5 0.8 1"/>'
+    spec = mujoco.MjSpec()
+    spec.modelname = f"pushrecovery-{name}"
+    spec.compiler.degree = False  # angles in radians
+    spec.option.timestep = TIMESTEP
+    spec.option.gravity = [0.0, 0.0, -params.gravity]
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.cone = mujoco.mjtCone.mjCONE_PYRAMIDAL
+    spec.visual.global_.offwidth = 640
+    spec.visual.global_.offheight = 480
+    geom = spec.default.geom
+    geom.contype, geom.conaffinity = 1, 1
+    geom.friction = [1.0, 0.005, 0.0001]
+    geom.solref = [CONTACT_TIME, 1.0]
+    geom.solimp[:3] = [0.95, 0.99, 0.001]
+    spec.worldbody.add_light(
+        pos=[0.0, -2.0, 3.0], dir=[0.0, 1.0, -1.0], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
     )
+    spec.worldbody.add_geom(
+        name="floor",
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        size=[5.0, 1.0, 0.1],
+        rgba=[0.85, 0.85, 0.85, 1.0],
+    )
+    return spec
 
 
-def foot_model(params: BodyParams) -> str:
-    """MJCF text of the ``foot`` model (single inverted pendulum on a foot) for ``params``."""
-    length = params.com_height
-    body = f"""
-      <body name="body" pos="0 0 {FOOT_HALF_THICKNESS}">
-        <joint name="ankle" type="hinge" axis="0 1 0"/>
-        {_rod(length)}
-        <geom name="mass" type="sphere" pos="0 0 {length}" size="{MASS_RADIUS}"
-              mass="{params.mass}" contype="2" conaffinity="1" rgba="0.9 0.6 0.2 1"/>
-      </body>"""
-    return f"""{header("foot", params)}{foot_xml(params, inner=body)}
-  </worldbody>
-  <actuator>
-    <motor name="ankle" joint="ankle" gear="1"/>
-  </actuator>
-</mujoco>
-"""
+def add_foot(parent: Any, params: BodyParams, name: str = "foot", x: float = 0.0) -> Any:
+    """Add a free (x, z, pitch) foot box to ``parent``, sole geom ``<name>_sole``; return it.
+
+    Its ankle (where the leg attaches) is ``ANKLE_HEIGHT`` above the floor, at the box's top:
+    children go at ``pos = (0, 0, FOOT_HALF_THICKNESS)``.
+    """
+    import mujoco
+
+    foot = parent.add_body(name=name, pos=[x, 0.0, FOOT_HALF_THICKNESS])
+    for axis, kind, joint in (
+        ([1.0, 0.0, 0.0], mujoco.mjtJoint.mjJNT_SLIDE, "x"),
+        ([0.0, 0.0, 1.0], mujoco.mjtJoint.mjJNT_SLIDE, "z"),
+        ([0.0, 1.0, 0.0], mujoco.mjtJoint.mjJNT_HINGE, "pitch"),
+    ):
+        foot.add_joint(name=f"{name}_{joint}", type=kind, axis=axis)
+    foot.add_geom(
+        name="sole" if name == "foot" else f"{name}_sole",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        pos=[0.5 * (params.toe + params.heel), 0.0, 0.0],
+        size=[0.5 * (params.toe - params.heel), 0.05, FOOT_HALF_THICKNESS],
+        mass=FOOT_MASS,
+        rgba=[0.3, 0.3, 0.3, 1.0],
+    )
+    return foot
 
 
-def torso_model(params: BodyParams) -> str:
-    """MJCF text of the ``torso`` model (pendulum + upper body on a hip) for ``params``."""
-    length, limit, inertia = params.com_height, params.flywheel_angle_max, params.flywheel_inertia
-    body = f"""
-      <body name="body" pos="0 0 {FOOT_HALF_THICKNESS}">
-        <joint name="ankle" type="hinge" axis="0 1 0"/>
-        {_rod(length)}
-        <body name="torso" pos="0 0 {length}">
-          <joint name="hip" type="hinge" axis="0 1 0" limited="true"
-                 range="{-limit} {limit}"/>
-          <inertial pos="0 0 0" mass="{params.mass}"
-                    diaginertia="{inertia} {inertia} {inertia}"/>
-          <geom name="pelvis" type="sphere" size="{MASS_RADIUS}" contype="2" conaffinity="1"
-                rgba="0.9 0.6 0.2 1"/>
-          <geom name="trunk" type="capsule" fromto="0 0 0 0 0 {TORSO_LENGTH}" size="0.05"
-                contype="2" conaffinity="1" rgba="0.9 0.6 0.2 1"/>
-        </body>
-      </body>"""
-    return f"""{header("torso", params)}{foot_xml(params, inner=body)}
-  </worldbody>
-  <actuator>
-    <motor name="ankle" joint="ankle" gear="1"/>
-    <motor name="hip" joint="hip" gear="1"/>
-  </actuator>
-</mujoco>
-"""
+def _leg_body(foot: Any, length: float) -> Any:
+    """Add the rod standing for massless legs on an ankle hinge on top of ``foot``."""
+    import mujoco
+
+    body = foot.add_body(name="body", pos=[0.0, 0.0, FOOT_HALF_THICKNESS])
+    body.add_joint(name="ankle", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 1.0, 0.0])
+    body.add_geom(
+        name="rod",
+        type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+        fromto=[0.0, 0.0, 0.0, 0.0, 0.0, length],
+        size=[0.01, 0.0, 0.0],
+        mass=ROD_MASS,
+        contype=2,
+        conaffinity=2,
+        rgba=[0.4, 0.5, 0.8, 1.0],
+    )
+    return body
 
 
-#: Model name -> MJCF builder.
+def add_motor(spec: Any, joint: str) -> None:
+    """Add a torque motor (gear 1) on ``joint``, named as it."""
+    import mujoco
+
+    motor = spec.add_actuator(name=joint, target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    motor.set_to_motor()
+
+
+def add_upper_body(parent: Any, params: BodyParams, mass: float, pos: list[float]) -> Any:
+    """Add the upper body ``torso`` at ``pos``: ``mass`` [kg] at its origin, inertia I.
+
+    Drawn as a pelvis sphere and a trunk; its joint (the hip of ``torso``, the floating base of
+    ``biped``) is the caller's.
+    """
+    import mujoco
+
+    torso = parent.add_body(name="torso", pos=pos)
+    torso.explicitinertial = True
+    torso.mass, torso.ipos = mass, [0.0, 0.0, 0.0]
+    torso.inertia = [params.flywheel_inertia] * 3
+    torso.add_geom(
+        name="pelvis",
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[MASS_RADIUS, 0.0, 0.0],
+        contype=2,
+        conaffinity=1,
+        rgba=[0.9, 0.6, 0.2, 1.0],
+    )
+    torso.add_geom(
+        name="trunk",
+        type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+        fromto=[0.0, 0.0, 0.0, 0.0, 0.0, TORSO_LENGTH],
+        size=[0.05, 0.0, 0.0],
+        contype=2,
+        conaffinity=1,
+        rgba=[0.9, 0.6, 0.2, 1.0],
+    )
+    return torso
+
+
+def foot_model(params: BodyParams) -> Any:
+    """Return the ``MjSpec`` of the ``foot`` model (single inverted pendulum on a foot)."""
+    import mujoco
+
+    spec = model_spec("foot", params)
+    body = _leg_body(add_foot(spec.worldbody, params), params.com_height)
+    body.add_geom(
+        name="mass",
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        pos=[0.0, 0.0, params.com_height],
+        size=[MASS_RADIUS, 0.0, 0.0],
+        mass=params.mass,
+        contype=2,
+        conaffinity=1,
+        rgba=[0.9, 0.6, 0.2, 1.0],
+    )
+    add_motor(spec, "ankle")
+    return spec
+
+
+def torso_model(params: BodyParams) -> Any:
+    """Return the ``MjSpec`` of the ``torso`` model (pendulum + upper body on a hip)."""
+    import mujoco
+
+    spec = model_spec("torso", params)
+    body = _leg_body(add_foot(spec.worldbody, params), params.com_height)
+    torso = add_upper_body(body, params, params.mass, [0.0, 0.0, params.com_height])
+    limit = params.flywheel_angle_max
+    torso.add_joint(
+        name="hip",
+        type=mujoco.mjtJoint.mjJNT_HINGE,
+        axis=[0.0, 1.0, 0.0],
+        limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+        range=[-limit, limit],
+    )
+    add_motor(spec, "ankle")
+    add_motor(spec, "hip")
+    return spec
+
+
 MODEL_BUILDERS = {"foot": foot_model, "torso": torso_model}

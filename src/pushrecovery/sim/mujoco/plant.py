@@ -104,7 +104,7 @@ class MujocoPlant:
         self._mj: Any = mujoco
         self.params = params
         self.cop_margin = cop_margin
-        self.model = mujoco.MjModel.from_xml_string(self.xml(params))
+        self.model = self.build(params).compile()
         self.data = mujoco.MjData(self.model)
         self.fall_limits = (params.heel, params.toe)
         self.stop_impacts = 0
@@ -142,9 +142,15 @@ class MujocoPlant:
         ]
 
     @classmethod
-    def xml(cls, params: BodyParams) -> str:
-        """MJCF text of the model for ``params`` (:data:`~.models.MODEL_BUILDERS`)."""
+    def build(cls, params: BodyParams) -> Any:
+        """Return the model's ``mujoco.MjSpec`` for ``params`` (:data:`~.models.MODEL_BUILDERS`)."""
         return MODEL_BUILDERS[cls.model_name](params)
+
+    @classmethod
+    def xml(cls, params: BodyParams) -> str:
+        """Return the model as MJCF text (from :meth:`build`), e.g. to inspect or save it."""
+        text: str = cls.build(params).to_xml()
+        return text
 
     # --- pushes and recording ------------------------------------------------------------
     def schedule_push(
