@@ -1,0 +1,143 @@
+"""Recorded frames of a run: converting, selecting and subsampling them in time."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError
+
+if TYPE_CHECKING:
+    pass
+
+
+__all__ = [
+    "Frame",
+    "FrameLike",
+    "select_times",
+    "subsample",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """One recorded instant of a run.
+
+    Attributes
+    ----------
+    time : float
+        Simulation time [s].
+    qpos : NDArray[np.float64]
+        Copy of ``data.qpos`` (shape ``(model.nq,)``).
+    com : tuple[float, float]
+        CoM position (x, z) in world coordinates [m].
+    capture_point : float
+        Capture point x on the floor [m] (drawn at z = 0; not drawn if not finite).
+    cop : float
+        CoP x on the floor [m]; NaN when the foot is off the floor (then not drawn).
+    """
+
+    time: float
+    qpos: NDArray[np.float64]
+    com: tuple[float, float]
+    capture_point: float
+    cop: float
+
+
+#: A :class:`Frame` or a tuple of its fields in order (time, qpos, com, capture_point, cop),
+#: as the plants record them (``MujocoPlant.frames``).
+FrameLike = Frame | tuple[float, NDArray[np.float64], tuple[float, float], float, float]
+
+
+def _as_frames(frames: Sequence[FrameLike]) -> list[Frame]:
+    if len(frames) == 0:
+        raise InvalidParameterError("frames must not be empty")
+    out = []
+    for f in frames:
+        if isinstance(f, Frame):
+            out.append(f)
+        else:
+            if len(f) != 5:
+                raise InvalidParameterError(
+                    "a frame must be a Frame or a tuple (time, qpos, com, capture_point, cop)"
+                )
+            t, qpos, com, capture_point, cop = f
+            out.append(
+                Frame(
+                    float(t),
+                    np.asarray(qpos, dtype=float),
+                    (float(com[0]), float(com[1])),
+                    float(capture_point),
+                    float(cop),
+                )
+            )
+    return out
+
+
+# --- frames and camera ---------------------------------------------------------------------
+def _times(frames: Sequence[Frame]) -> NDArray[np.float64]:
+    times = np.array([f.time for f in frames], dtype=float)
+    if not np.all(np.isfinite(times)) or np.any(np.diff(times) < 0.0):
+        raise InvalidParameterError("frame times must be finite and non-decreasing")
+    return times
+
+
+def _nearest(times: NDArray[np.float64], targets: NDArray[np.float64]) -> list[int]:
+    """Return the indices of the times nearest to the targets, without repeats, in order."""
+    if len(times) == 1:
+        return [0]
+    right = np.clip(np.searchsorted(times, targets), 1, len(times) - 1)
+    left = right - 1
+    idx = np.where(np.abs(times[left] - targets) <= np.abs(times[right] - targets), left, right)
+    return [int(i) for i in np.unique(idx)]
+
+
+def subsample(frames: Sequence[FrameLike], fps: float) -> list[Frame]:
+    """Frames nearest to a regular grid of ``fps`` frames per second (first and last kept).
+
+    Parameters
+    ----------
+    frames : Sequence[FrameLike]
+        Recorded frames, times non-decreasing (e.g. recorded at 1 kHz).
+    fps : float
+        Target frame rate [1/s], > 0.
+
+    Returns
+    -------
+    list[Frame]
+        At most about ``duration * fps + 1`` frames.
+    """
+    if not (math.isfinite(fps) and fps > 0.0):
+        raise InvalidParameterError(f"fps must be > 0 1/s, got {fps:g}")
+    frames = _as_frames(frames)
+    times = _times(frames)
+    count = math.floor((times[-1] - times[0]) * fps + 1e-9) + 1
+    targets = np.append(times[0] + np.arange(count) / fps, times[-1])
+    return [frames[i] for i in _nearest(times, targets)]
+
+
+def select_times(frames: Sequence[FrameLike], count: int) -> list[Frame]:
+    """``count`` frames evenly spaced in time, from the first to the last.
+
+    Parameters
+    ----------
+    frames : Sequence[FrameLike]
+        Recorded frames, times non-decreasing.
+    count : int
+        Number of frames wanted, >= 1 (fewer are returned if there are fewer distinct ones).
+
+    Returns
+    -------
+    list[Frame]
+        The frames nearest to ``count`` evenly spaced times.
+    """
+    if count < 1:
+        raise InvalidParameterError(f"count must be >= 1, got {count}")
+    frames = _as_frames(frames)
+    times = _times(frames)
+    return [frames[i] for i in _nearest(times, np.linspace(times[0], times[-1], count))]

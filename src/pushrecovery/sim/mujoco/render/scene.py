@@ -1,0 +1,388 @@
+"""Rendering frames off-screen with MuJoCo: the GL context, the view, the overlay markers."""
+
+from __future__ import annotations
+
+import importlib
+import math
+import os
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+
+if TYPE_CHECKING:
+    import mujoco
+from pushrecovery.sim.mujoco.render.frames import Frame, FrameLike, _as_frames, _times, select_times
+
+__all__ = [
+    "AZIMUTH",
+    "BACKDROP_DISTANCE",
+    "BACKDROP_RGBA",
+    "CAPTURE_POINT_RGBA",
+    "COM_RGBA",
+    "COP_RGBA",
+    "ELEVATION",
+    "LEGEND",
+    "MARKER_OFFSET",
+    "MARKER_SCALE",
+    "View",
+    "fit_view",
+    "render_frames",
+    "require_offscreen_gl",
+]
+
+
+#: RGBA colours of the overlay markers (also used by the legends).
+COM_RGBA = (1.0, 0.0, 0.0, 1.0)
+
+
+CAPTURE_POINT_RGBA = (0.1, 0.3, 1.0, 1.0)
+
+
+COP_RGBA = (0.0, 0.8, 0.0, 1.0)
+
+
+#: Legend entries: label and RGBA colour.
+LEGEND = (("CoM", COM_RGBA), ("capture point", CAPTURE_POINT_RGBA), ("CoP", COP_RGBA))
+
+
+#: Markers are moved this far towards the camera [m] (along the line of sight, so they are
+#: drawn at the same pixel) so that the body does not hide them.
+MARKER_OFFSET = 0.25
+
+
+#: Marker radius as a fraction of the visible height.
+MARKER_SCALE = 0.018
+
+
+#: Default side camera angles [deg]: x from left to right, seen slightly from above.
+AZIMUTH = 90.0
+
+
+ELEVATION = -10.0
+
+
+#: Backdrop: a light wall behind the plane y = 0, at this y [m], and its colour.
+BACKDROP_DISTANCE = 3.0
+
+
+BACKDROP_RGBA = (0.8, 0.86, 0.94, 1.0)
+
+
+_EXTENT_SAMPLES = 12
+
+
+@dataclass(frozen=True)
+class View:
+    """A free camera looking at the sagittal plane y = 0 (see :func:`fit_view`).
+
+    Attributes
+    ----------
+    lookat : tuple[float, float, float]
+        Point looked at, world coordinates [m].
+    distance : float
+        Camera distance from ``lookat`` [m].
+    azimuth : float
+        Camera azimuth [deg]; 90 puts x from left to right.
+    elevation : float
+        Camera elevation [deg]; negative looks down.
+    """
+
+    lookat: tuple[float, float, float]
+    distance: float
+    azimuth: float = AZIMUTH
+    elevation: float = ELEVATION
+
+
+# --- OpenGL --------------------------------------------------------------------------------
+def _gl_name() -> str:
+    return os.environ.get("MUJOCO_GL", "")
+
+
+def _gl_error(exc: BaseException) -> PushRecoveryError:
+    detail = (str(exc).strip().splitlines() or [""])[0] or type(exc).__name__
+    if len(detail) > 120:
+        detail = detail[:117] + "..."
+    return PushRecoveryError(
+        f"cannot render offscreen with MUJOCO_GL={_gl_name()!r} ({type(exc).__name__}: "
+        f"{detail}); set MUJOCO_GL=egl (headless) or glfw (with a display)"
+    )
+
+
+def _mujoco_for_rendering() -> ModuleType:
+    """Import ``mujoco`` with its OpenGL backend following ``MUJOCO_GL`` (egl by default)."""
+    if sys.platform.startswith("linux"):
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        import mujoco
+
+        # The module the Renderer takes its GLContext class from (it looks the class up
+        # there when a Renderer is created).
+        renderer_module = sys.modules.get(getattr(mujoco.Renderer, "__module__", ""))
+        gl_context = getattr(renderer_module, "gl_context", None)
+        chosen = getattr(gl_context, "_MUJOCO_GL", None)
+        if gl_context is not None and chosen is not None:
+            if chosen != _gl_name().lower().strip():
+                # mujoco was imported before MUJOCO_GL was set: select the backend again.
+                importlib.reload(gl_context)
+    except Exception as exc:  # an invalid MUJOCO_GL raises RuntimeError, a broken one others
+        raise _gl_error(exc) from exc
+    return mujoco
+
+
+def _open_renderer(model: mujoco.MjModel, width: int, height: int) -> mujoco.Renderer:
+    mj = _mujoco_for_rendering()
+    buffer = (model.vis.global_.offwidth, model.vis.global_.offheight)
+    if not (0 < width <= buffer[0] and 0 < height <= buffer[1]):
+        raise InvalidParameterError(
+            f"image size must be within the model's offscreen buffer {buffer[0]}x{buffer[1]} "
+            f"px, got {width}x{height}"
+        )
+    try:
+        return mj.Renderer(model, height=height, width=width)
+    except Exception as exc:  # FatalError, ImportError, AttributeError, ... by backend
+        raise _gl_error(exc) from exc
+
+
+def require_offscreen_gl() -> None:
+    """Check that offscreen rendering works (call it before a long run to fail early).
+
+    Raises
+    ------
+    PushRecoveryError
+        If no OpenGL context can be created; the message names ``MUJOCO_GL``.
+    """
+    mj = _mujoco_for_rendering()
+    model = mj.MjModel.from_xml_string("<mujoco/>")
+    _open_renderer(model, 8, 8).close()
+
+
+def _check_qpos(model: mujoco.MjModel, frame: Frame) -> None:
+    if np.shape(frame.qpos) != (model.nq,):
+        raise InvalidParameterError(
+            f"frame qpos must have shape ({model.nq},), got {np.shape(frame.qpos)}"
+        )
+
+
+def _body_extent(model: mujoco.MjModel, frames: Sequence[Frame]) -> NDArray[np.float64]:
+    """World x and z of the corners of the bounding boxes of the moving geoms, ``(n, 2)`` [m].
+
+    Geoms of the world body (floor, static scenery) are left out; up to ``_EXTENT_SAMPLES``
+    frames evenly spaced in time are replayed.
+    """
+    mj = _mujoco_for_rendering()
+    moving = np.flatnonzero(np.asarray(model.geom_bodyid) != 0)
+    if moving.size == 0:
+        return np.empty((0, 2))
+    aabb = np.asarray(model.geom_aabb, dtype=float)[moving]
+    data = mj.MjData(model)
+    points = []
+    for f in select_times(frames, _EXTENT_SAMPLES):
+        data.qpos[:] = f.qpos
+        mj.mj_kinematics(model, data)
+        rot = np.asarray(data.geom_xmat, dtype=float)[moving].reshape(-1, 3, 3)
+        centre = np.asarray(data.geom_xpos, dtype=float)[moving] + np.einsum(
+            "gij,gj->gi", rot, aabb[:, :3]
+        )
+        half = np.einsum("gij,gj->gi", np.abs(rot), aabb[:, 3:])
+        for sign in (-1.0, 1.0):
+            points.append((centre + sign * half)[:, [0, 2]])
+    return np.concatenate(points)
+
+
+def fit_view(model: mujoco.MjModel, frames: Sequence[FrameLike], aspect: float) -> View:
+    """Side view framing the floor, the moving bodies and the CoM and CoP over all ``frames``.
+
+    The visible box spans the bounding boxes of the moving geoms (replayed at a few frames),
+    the CoM and CoP paths and the floor (z = 0), with a 15 % margin; the capture point may
+    leave the image.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model the frames were recorded with (its free camera field of view
+        ``vis.global_.fovy`` is used).
+    frames : Sequence[FrameLike]
+        Recorded frames.
+    aspect : float
+        Image width / height, > 0.
+
+    Returns
+    -------
+    View
+        Camera looking at the centre of the box from the side (azimuth 90 deg, elevation
+        -10 deg), far enough for the box to fit.
+    """
+    if not (math.isfinite(aspect) and aspect > 0.0):
+        raise InvalidParameterError(f"aspect must be > 0, got {aspect:g}")
+    frames = _as_frames(frames)
+    _times(frames)
+    for f in frames:
+        _check_qpos(model, f)
+    com = np.array([f.com for f in frames], dtype=float).reshape(-1, 2)
+    cop = np.array([(f.cop, 0.0) for f in frames], dtype=float)
+    points = np.concatenate([com, cop, _body_extent(model, frames), [[com[0, 0], 0.0]]])
+    points = points[np.all(np.isfinite(points), axis=1)]
+    (x_lo, z_lo), (x_hi, z_hi) = points.min(axis=0), points.max(axis=0)
+    z_lo = min(float(z_lo), 0.0)
+    height = max(float(z_hi) - z_lo, 0.2)
+    margin = 0.15 * height
+    width = float(x_hi - x_lo) + 2.0 * margin
+    height += 2.0 * margin
+    half_tan = math.tan(math.radians(float(model.vis.global_.fovy)) / 2.0)
+    distance = max(height / (2.0 * half_tan), width / (2.0 * half_tan * aspect))
+    lookat = (0.5 * float(x_lo + x_hi), 0.0, 0.5 * float(z_lo + z_hi))
+    return View(lookat=lookat, distance=distance)
+
+
+def _add_geom(
+    mj: Any,
+    scene: Any,
+    kind: Any,
+    size: tuple[float, float, float],
+    pos: NDArray[np.float64],
+    rgba: tuple[float, float, float, float],
+    emission: float,
+) -> None:
+    """Append a decoration geom to ``scene`` (silently skipped when the scene is full)."""
+    if scene.ngeom >= scene.maxgeom:
+        return
+    geom = scene.geoms[scene.ngeom]
+    mj.mjv_initGeom(
+        geom,
+        kind,
+        np.array(size, dtype=float),
+        np.asarray(pos, dtype=float),
+        np.eye(3).ravel(),
+        np.array(rgba, dtype=np.float32),
+    )
+    geom.category = mj.mjtCatBit.mjCAT_DECOR
+    geom.emission = emission
+    geom.specular = 0.0
+    geom.castshadow = 0
+    scene.ngeom += 1
+
+
+def _backdrop_emission(model: mujoco.MjModel) -> float:
+    """Emission that brings the backdrop to about its own colour whatever the lights.
+
+    Estimates the light on a wall facing the camera (-y): the headlight (ambient and diffuse)
+    plus each light's ambient and diffuse (as if directional) terms.
+    """
+    head = model.vis.headlight
+    light = float(np.mean(head.ambient) + np.mean(head.diffuse)) if head.active else 0.0
+    for k in range(model.nlight):
+        direction = np.asarray(model.light_dir[k], dtype=float)
+        facing = max(0.0, float(direction[1]) / max(float(np.linalg.norm(direction)), 1e-9))
+        light += float(np.mean(model.light_ambient[k]) + np.mean(model.light_diffuse[k]) * facing)
+    return max(0.0, 1.0 - light)
+
+
+def _decorate(
+    mj: Any, scene: Any, frame: Frame | None, view: View, radius: float, backdrop: float
+) -> None:
+    """Add the backdrop and the CoM, capture point and CoP markers of ``frame`` to ``scene``.
+
+    Each marker is moved ``MARKER_OFFSET`` towards the camera along its line of sight, so it
+    is drawn at its true pixel but in front of the body. The CoP marker is smaller and nearer
+    the camera than the capture point's, so both show when they coincide. ``backdrop`` is the
+    backdrop's emission.
+    """
+    eye = 0.5 * (np.array(scene.camera[0].pos) + np.array(scene.camera[1].pos))
+    x, _, z = view.lookat
+    far = 4.0 * view.distance
+    _add_geom(
+        mj, scene, mj.mjtGeom.mjGEOM_BOX, (far, 0.01, far),
+        np.array([x, BACKDROP_DISTANCE, z]), BACKDROP_RGBA, backdrop,
+    )  # fmt: skip
+    if frame is None:
+        return
+    markers = (
+        ((frame.com[0], frame.com[1]), COM_RGBA, 1.0, 0.0),
+        ((frame.capture_point, 0.0), CAPTURE_POINT_RGBA, 1.0, 0.0),
+        ((frame.cop, 0.0), COP_RGBA, 0.6, 1.5),
+    )
+    for (px, pz), rgba, scale, nearer in markers:
+        point = np.array([px, 0.0, pz], dtype=float)
+        if not np.all(np.isfinite(point)):
+            continue
+        ray = (eye - point) / np.linalg.norm(eye - point)
+        pos = point + (MARKER_OFFSET + nearer * radius) * ray
+        _add_geom(mj, scene, mj.mjtGeom.mjGEOM_SPHERE, (scale * radius, 0, 0), pos, rgba, 0.5)
+
+
+def render_frames(
+    model: mujoco.MjModel,
+    frames: Sequence[FrameLike],
+    *,
+    width: int = 320,
+    height: int = 240,
+    view: View | None = None,
+    markers: bool = True,
+    shadows: bool = False,
+) -> list[NDArray[np.uint8]]:
+    """Render each frame (``qpos`` replayed with ``mj_forward``) from the side.
+
+    A light backdrop is drawn behind the plane y = 0 (at y = ``BACKDROP_DISTANCE``).
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The model the frames were recorded with.
+    frames : Sequence[FrameLike]
+        Frames to render (all of them: subsample first with :func:`subsample`).
+    width, height : int
+        Image size [px], within the model's offscreen buffer (640x480 by default).
+    view : View or None
+        Camera; default :func:`fit_view` of ``frames``.
+    markers : bool
+        Draw the CoM (red), capture point (blue) and CoP (green) markers.
+    shadows : bool
+        Render shadows (off by default: about 8 times slower with software OpenGL).
+
+    Returns
+    -------
+    list[NDArray[np.uint8]]
+        One ``(height, width, 3)`` RGB image per frame.
+
+    Raises
+    ------
+    PushRecoveryError
+        If offscreen OpenGL is unavailable (message names ``MUJOCO_GL``).
+    """
+    frames = _as_frames(frames)
+    _times(frames)
+    for f in frames:
+        _check_qpos(model, f)
+    view = view if view is not None else fit_view(model, frames, width / height)
+    mj = _mujoco_for_rendering()
+    renderer = _open_renderer(model, width, height)
+    data = mj.MjData(model)
+    camera = mj.MjvCamera()
+    camera.type = mj.mjtCamera.mjCAMERA_FREE
+    camera.lookat[:] = view.lookat
+    camera.distance = view.distance
+    camera.azimuth = view.azimuth
+    camera.elevation = view.elevation
+    half_tan = math.tan(math.radians(float(model.vis.global_.fovy)) / 2.0)
+    radius = MARKER_SCALE * 2.0 * view.distance * half_tan
+    backdrop = _backdrop_emission(model)
+    images: list[NDArray[np.uint8]] = []
+    try:
+        for f in frames:
+            data.qpos[:] = f.qpos
+            mj.mj_forward(model, data)
+            renderer.update_scene(data, camera=camera)
+            scene = renderer.scene
+            scene.flags[mj.mjtRndFlag.mjRND_SHADOW] = shadows
+            _decorate(mj, scene, f if markers else None, view, radius, backdrop)
+            images.append(renderer.render().copy())
+    finally:
+        renderer.close()
+    return images
