@@ -1,0 +1,199 @@
+"""The analysis of one measured trial: signals, the CoM, margins and strategies per frame."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.analysis.margins import DirectionMargins, direction_margins
+from pushrecovery.analysis.recording import (
+    AXES,
+    LOADED,
+    Recording,
+)
+from pushrecovery.analysis.signals import (
+    Gap,
+    repair_gaps,
+    resample,
+    smooth_and_differentiate,
+)
+from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
+from pushrecovery.analysis.trial.summary import _exclusions, _interpolated, _names, _summary
+from pushrecovery.analysis.trial.support import _repair_loaded, _support
+from pushrecovery.analysis.zero_point import ZERO_FORCE, com_from_force
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+
+__all__ = [
+    "FloatArray",
+    "analyze",
+]
+
+
+FloatArray = NDArray[np.float64]
+
+
+def analyze(
+    recording: Recording,
+    params: BodyParams,
+    settings: AnalysisSettings | None = None,
+    *,
+    sources: dict[str, str] | None = None,
+) -> TrialAnalysis:
+    """Analyse a trial (module docstring).
+
+    Parameters
+    ----------
+    recording : Recording
+        The measured trial (:mod:`pushrecovery.analysis.readers`).
+    params : BodyParams
+        The body: mass, CoM height (ω), hip limits, leg and reach; its heel and toe are the
+        foot's edges when the file does not locate them (see :func:`body_for`).
+    settings : AnalysisSettings, optional
+        Filtering, gaps and support options.
+    sources : dict, optional
+        Where mass and CoM height came from, for the summary.
+
+    Returns
+    -------
+    TrialAnalysis
+
+    Raises
+    ------
+    InvalidParameterError
+        When the trial has no usable CoM (neither positions nor a ground reaction force that
+        crosses zero), or the base of support is inconsistent.
+    """
+    settings = settings or AnalysisSettings()
+    gaps: list[Gap] = []
+    notes = list(recording.notes)
+    force_time = recording.force_time
+    force = cop = None
+    if recording.force is not None and force_time is not None:
+        force, found = repair_gaps(force_time, recording.force, settings.max_gap, "force")
+        gaps += found
+        force, _ = smooth_and_differentiate(force_time, force, settings.force_cutoff)
+    if recording.cop is not None and force_time is not None:
+        cop, found = _repair_loaded(force_time, recording.cop, force, settings.max_gap)
+        gaps += found
+        cop, _ = smooth_and_differentiate(force_time, cop, settings.force_cutoff)
+
+    if recording.com is not None:
+        time = recording.time
+        com, found = repair_gaps(time, recording.com[:, :2], settings.max_gap, "com")
+        gaps += found
+        com, velocity = smooth_and_differentiate(time, com, settings.cutoff)
+        if recording.com_velocity is not None:
+            measured, found = repair_gaps(
+                time, recording.com_velocity, settings.max_gap, "com_velocity"
+            )
+            gaps += found
+            velocity, _ = smooth_and_differentiate(time, measured, settings.cutoff)
+        com_source = "file"
+    else:
+        if force is None or cop is None or force_time is None:
+            raise InvalidParameterError(
+                "the trial has no CoM: give CoM markers or columns, or force plates (ground "
+                "reaction force and CoP) to integrate it from"
+            )
+        time = force_time
+        com = np.empty((len(time), 2))
+        velocity = np.empty((len(time), 2))
+        for i in range(2):
+            com[:, i], _ = com_from_force(
+                time, force[:, i], cop[:, i], params.mass, tolerance=ZERO_FORCE * params.weight
+            )
+        # Each interval's velocity has its own constant: it jumps at the zero points. The
+        # integrated position is continuous; low-pass it like a measured CoM and differentiate.
+        com, velocity = smooth_and_differentiate(time, com, settings.cutoff)
+        com_source = "zero-point-to-zero-point integration of the ground reaction force"
+        notes.append(
+            "CoM integrated from the force plates: an external push is no ground reaction "
+            "force, so its impulse is missing between the zero points around it"
+        )
+
+    if force is not None and force_time is not None:
+        force = resample(force_time, force, time)
+    if cop is not None and force_time is not None:
+        cop = resample(force_time, cop, time)
+    support, support_source, found = _support(recording, time, com, cop, params, settings)
+    gaps += found
+
+    columns: dict[str, NDArray[Any]] = {"time": time}
+    per_axis: dict[str, DirectionMargins] = {}
+    bodies: dict[str, BodyParams] = {}
+    for i, axis in enumerate(AXES):
+        heel, toe = support.foot[axis]
+        body = replace(params, heel=heel, toe=toe)
+        bodies[axis] = body
+        capture = com[:, i] + velocity[:, i] / params.omega
+        ankle = support.stance_ankle(axis, capture)
+        cmp = None
+        if force is not None:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                loaded = force[:, 2] > LOADED
+                cmp = np.where(
+                    loaded, com[:, i] - params.com_height * force[:, i] / force[:, 2], np.nan
+                )
+        axis_cop = None if cop is None else cop[:, i]
+        margins = direction_margins(
+            com[:, i],
+            velocity[:, i],
+            support.lower[axis],
+            support.upper[axis],
+            ankle,
+            body,
+            cop=axis_cop,
+            cmp=cmp,
+        )
+        per_axis[axis] = margins
+        nan = np.full(len(time), np.nan)
+        columns.update(
+            {
+                f"{axis}_com": com[:, i],
+                f"{axis}_com_velocity": velocity[:, i],
+                f"{axis}_cop": nan if axis_cop is None else axis_cop,
+                f"{axis}_cmp": nan if cmp is None else cmp,
+                f"{axis}_capture_point": margins.capture_point,
+                f"{axis}_base_min": support.lower[axis],
+                f"{axis}_base_max": support.upper[axis],
+                f"{axis}_ankle": ankle,
+                f"{axis}_margin_cop": margins.cop,
+                f"{axis}_margin_cmp": margins.cmp,
+                f"{axis}_margin_step": margins.step,
+                f"{axis}_strategy": _names(margins.strategy),
+                f"{axis}_time_to_leave_cop": margins.time_to_leave_cop,
+                f"{axis}_time_to_leave_cmp": margins.time_to_leave_cmp,
+                f"{axis}_step_length": margins.step_length,
+                f"{axis}_step_length_min": margins.step_shortest,
+                f"{axis}_step_length_max": margins.step_longest,
+                f"{axis}_steps": margins.steps,
+            }
+        )
+    codes = np.maximum(per_axis["ap"].strategy, per_axis["ml"].strategy)
+    invalid = (per_axis["ap"].strategy < 0) | (per_axis["ml"].strategy < 0)
+    codes[invalid] = -1
+    columns["strategy"] = _names(codes)
+    columns["valid"] = ~invalid
+    columns["interpolated"] = _interpolated(time, gaps)
+
+    summary = _summary(
+        recording,
+        time,
+        columns,
+        codes,
+        per_axis,
+        params,
+        bodies,
+        settings,
+        gaps,
+        sources=sources or {},
+        com_source=com_source,
+        support_source=support_source,
+        notes=notes,
+        reasons=_exclusions(com, velocity, support, invalid),
+    )
+    return TrialAnalysis(columns, summary)

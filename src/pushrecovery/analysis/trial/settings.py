@@ -1,0 +1,150 @@
+"""Settings and results of a trial's analysis, and the body it assumes."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.analysis.recording import (
+    LOADED,
+    Recording,
+)
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+
+__all__ = [
+    "COP_AHEAD_OF_ANKLE",
+    "AnalysisSettings",
+    "TrialAnalysis",
+    "body_for",
+]
+
+FloatArray = NDArray[np.float64]
+
+
+#: Assumed distance of the mean CoP ahead of the ankle in quiet standing when nothing in the
+#: file locates the feet [m] (the gravity line falls a few cm in front of the ankle joint).
+COP_AHEAD_OF_ANKLE = 0.05
+
+
+@dataclass(frozen=True, slots=True)
+class AnalysisSettings:
+    """How a trial is processed; all SI.
+
+    Parameters
+    ----------
+    cutoff : float
+        Low-pass cutoff of the CoM and marker trajectories [Hz]; 0 for none. 6 Hz is the usual
+        choice for whole-body kinematics (Winter).
+    force_cutoff : float
+        Low-pass cutoff of the force-plate signals [Hz]; 0 for none.
+    max_gap : float
+        Longest gap that is interpolated [s], >= 0; longer gaps are excluded.
+    contact_height : float
+        A foot supports while its lower marker is within this of its lowest [m], > 0.
+    foot_width : float or None
+        Foot width, for the medio-lateral base around the foot markers [m], > 0; None: the
+        body's ``foot_width`` (:class:`~pushrecovery.params.BodyParams`).
+    stance_width : float or None
+        Ankle-to-ankle distance of the fixed feet assumed without foot data [m], >= 0; None:
+        the body's ``stance_width``.
+    ankle_ap, ankle_ml : float or None
+        Lab position of the fixed feet (midpoint of the ankles) [m]; default from the mean
+        CoP (ap: ``COP_AHEAD_OF_ANKLE`` behind it) or, without a CoP, the mean CoM.
+    """
+
+    cutoff: float = 6.0
+    force_cutoff: float = 10.0
+    max_gap: float = 0.1
+    contact_height: float = 0.02
+    foot_width: float | None = None
+    stance_width: float | None = None
+    ankle_ap: float | None = None
+    ankle_ml: float | None = None
+
+    def widths(self, params: BodyParams) -> tuple[float, float]:
+        """Foot width and stance width [m]: these settings', else the body's."""
+        return (
+            params.foot_width if self.foot_width is None else self.foot_width,
+            params.stance_width if self.stance_width is None else self.stance_width,
+        )
+
+    def __post_init__(self) -> None:
+        for name in ("cutoff", "force_cutoff", "max_gap", "stance_width"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if not (math.isfinite(value) and value >= 0.0):
+                raise InvalidParameterError(f"{name} must be a finite number >= 0, got {value}")
+        for name in ("contact_height", "foot_width"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if not (math.isfinite(value) and value > 0.0):
+                raise InvalidParameterError(f"{name} must be a finite number > 0, got {value}")
+        for name in ("ankle_ap", "ankle_ml"):
+            value = getattr(self, name)
+            if value is not None and not math.isfinite(value):
+                raise InvalidParameterError(f"{name} must be finite, got {value}")
+
+
+@dataclass(frozen=True, slots=True)
+class TrialAnalysis:
+    """Result of :func:`analyze`: the per-frame table and the summary (``summary.json``)."""
+
+    columns: dict[str, NDArray[Any]]
+    summary: dict[str, Any]
+
+    @property
+    def time(self) -> FloatArray:
+        """Frame times [s]."""
+        return self.columns["time"]
+
+
+def body_for(
+    recording: Recording,
+    *,
+    mass: float | None,
+    com_height: float | None,
+    gravity: float,
+) -> tuple[dict[str, float], dict[str, str]]:
+    """Subject mass and CoM height: a flag, else the file, else the force plates.
+
+    Parameters
+    ----------
+    recording : Recording
+        The trial.
+    mass, com_height : float or None
+        Values given as flags [kg, m].
+    gravity : float
+        g [m/s^2], to weigh the subject on the force plates.
+
+    Returns
+    -------
+    (values, sources)
+        ``mass`` and ``com_height`` found (to override the preset with, see
+        :func:`pushrecovery.params.load_params`; a quantity the file does not give is left
+        out), and where each came from: ``flag``, ``file``, ``force plates`` (mean vertical
+        force / g while loaded) or ``preset``.
+    """
+    values: dict[str, float] = {}
+    sources = {"mass": "preset", "com_height": "preset"}
+    if mass is not None:
+        values["mass"], sources["mass"] = mass, "flag"
+    elif recording.mass is not None:
+        values["mass"], sources["mass"] = recording.mass, "file"
+    elif recording.force is not None:
+        vertical = recording.force[:, 2]
+        loaded = vertical[vertical > LOADED]
+        if len(loaded):
+            values["mass"] = float(np.mean(loaded)) / gravity
+            sources["mass"] = "force plates (mean vertical force / g)"
+    if com_height is not None:
+        values["com_height"], sources["com_height"] = com_height, "flag"
+    elif recording.com_height is not None:
+        values["com_height"], sources["com_height"] = recording.com_height, "file"
+    return values, sources

@@ -1,0 +1,118 @@
+"""The base of support of a measured trial, per frame: from the feet, stated, or assumed."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.analysis.recording import (
+    AXES,
+    LOADED,
+    Foot,
+    Recording,
+    Support,
+    fixed_feet,
+    support_from_feet,
+)
+from pushrecovery.analysis.signals import (
+    Gap,
+    repair_gaps,
+    resample,
+)
+from pushrecovery.analysis.trial.settings import COP_AHEAD_OF_ANKLE, AnalysisSettings
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import BodyParams
+
+FloatArray = NDArray[np.float64]
+
+
+def _repair_loaded(
+    time: FloatArray, cop: FloatArray, force: FloatArray | None, max_gap: float
+) -> tuple[FloatArray, list[Gap]]:
+    """Repair CoP gaps; while the plates are unloaded the CoP is undefined, not a gap."""
+    repaired, gaps = repair_gaps(time, cop, max_gap, "cop")
+    if force is not None:
+        unloaded = ~(force[:, 2] > LOADED)
+        repaired[unloaded] = np.nan
+    return repaired, gaps
+
+
+def _support(
+    recording: Recording,
+    time: FloatArray,
+    com: FloatArray,
+    cop: FloatArray | None,
+    params: BodyParams,
+    settings: AnalysisSettings,
+) -> tuple[Support, str, list[Gap]]:
+    """Build the base of support from the feet, CSV columns, or two assumed fixed feet."""
+    gaps: list[Gap] = []
+    if recording.feet:
+        measured: list[Foot] = []
+        for foot in recording.feet:
+            parts = []
+            for part in ("heel", "toe", "ankle"):
+                values = resample(recording.time, getattr(foot, part), time)
+                values, found = repair_gaps(time, values, settings.max_gap, f"{foot.name} {part}")
+                gaps += found
+                parts.append(values)
+            measured.append(Foot(foot.name, *parts))
+        support = support_from_feet(
+            tuple(measured),
+            contact_height=settings.contact_height,
+            foot_width=settings.widths(params)[0],
+        )
+        return support, "foot markers", gaps
+    if recording.base:
+        return _explicit_support(recording, time, params, settings), "base columns", gaps
+    centre = cop if cop is not None and np.isfinite(cop).any() else com
+    if not np.isfinite(centre).any():
+        raise InvalidParameterError(
+            "nothing locates the feet: the trial has no CoP and no CoM values; give "
+            "--ankle-ap and --ankle-ml"
+        )
+    ankle_ap = settings.ankle_ap
+    ankle_ml = settings.ankle_ml
+    assumed = []
+    if ankle_ap is None:
+        ankle_ap = float(np.nanmean(centre[:, 0])) - COP_AHEAD_OF_ANKLE
+        what = "CoP" if centre is cop else "CoM"
+        assumed.append(f"ankles {COP_AHEAD_OF_ANKLE:g} m behind the mean {what}")
+    if ankle_ml is None:
+        ankle_ml = float(np.nanmean(centre[:, 1]))
+        assumed.append("centred on it medio-laterally")
+    foot_width, stance_width = settings.widths(params)
+    feet = fixed_feet(len(time), ankle_ap, ankle_ml, params.heel, params.toe, stance_width)
+    support = support_from_feet(feet, contact_height=settings.contact_height, foot_width=foot_width)
+    source = "fixed feet (heel/toe flags, --stance-width)"
+    if assumed:
+        source += ": " + ", ".join(assumed)
+    return support, source, gaps
+
+
+def _explicit_support(
+    recording: Recording, time: FloatArray, params: BodyParams, settings: AnalysisSettings
+) -> Support:
+    """Support from CSV columns: base edges, optionally the stance ankle, per axis."""
+    lower, upper, ankles = {}, {}, {}
+    for axis in AXES:
+        if axis not in recording.base:
+            raise InvalidParameterError(
+                f"give the base of support along both axes: base_{axis}_min and base_{axis}_max "
+                "columns are missing"
+            )
+        edges = recording.base[axis]
+        lower[axis], upper[axis] = edges[:, 0], edges[:, 1]
+        if axis in recording.ankle:
+            ankle = recording.ankle[axis]
+        elif axis == "ap":
+            ankle = lower[axis] - params.heel  # the ankle |heel| in front of the rear edge
+        else:
+            ankle = 0.5 * (lower[axis] + upper[axis])
+        ankles[axis] = ankle[:, None]
+    foot = {
+        "ap": (params.heel, params.toe),
+        "ml": (-settings.widths(params)[0] / 2, settings.widths(params)[0] / 2),
+    }
+    supporting = np.isfinite(lower["ap"])[:, None]
+    return Support(lower, upper, ankles, foot, supporting)
