@@ -72,6 +72,7 @@ def test_mujoco_divergence_raises_simulation_diverged():
 def test_a_biped_layout_mismatch_is_a_bug_not_an_assertion(monkeypatch):
     pytest.importorskip("mujoco")
     from pushrecovery.sim.mujoco import biped
+    from pushrecovery.sim.mujoco.biped import plant as biped_plant
 
     original = biped.biped_model
 
@@ -94,7 +95,7 @@ def test_a_biped_layout_mismatch_is_a_bug_not_an_assertion(monkeypatch):
             actuator.target = swap(actuator.target)
         return spec
 
-    monkeypatch.setattr(biped, "biped_model", swapped)
+    monkeypatch.setattr(biped_plant, "biped_model", swapped)
     with pytest.raises(RuntimeError, match="not at index") as error:
         biped.MujocoBipedPlant(load_params())
     assert not isinstance(error.value, AssertionError | PushRecoveryError)
