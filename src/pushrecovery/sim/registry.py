@@ -29,8 +29,8 @@ PLANTS: dict[str, dict[str, str]] = {
         "stepping-plane": "pushrecovery.sim.plane_stepping:PlaneSteppingPlant",
     },
     "mujoco": {
-        "foot": "pushrecovery.sim.mujoco.plant:MujocoFootPlant",
-        "torso": "pushrecovery.sim.mujoco.plant:MujocoTorsoPlant",
+        "foot": "pushrecovery.sim.mujoco.pendulums:MujocoFootPlant",
+        "torso": "pushrecovery.sim.mujoco.pendulums:MujocoTorsoPlant",
         "biped": "pushrecovery.sim.mujoco.biped:MujocoBipedPlant",
     },
 }

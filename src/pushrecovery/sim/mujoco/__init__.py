@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from pushrecovery.sim.mujoco.biped import MujocoBipedPlant
-from pushrecovery.sim.mujoco.plant import MujocoFootPlant, MujocoTorsoPlant
+from pushrecovery.sim.mujoco.pendulums import MujocoFootPlant, MujocoTorsoPlant
 
 __all__ = ["PLANTS"]
 
