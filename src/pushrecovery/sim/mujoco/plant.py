@@ -5,10 +5,12 @@ plants turn them into joint torques (refreshed at every control tick and at leas
 ``torque_hold``: 1 ms, the physics step, or 10 ms for ``foot`` and ``torso``) and estimate the
 state from MuJoCo's joints:
 
-- ``foot`` (:class:`~pushrecovery.sim.mujoco.pendulums.MujocoFootPlant`): state ``[x, xdot]``, the CoM (the mass at the top of the
-  rod) relative to the ankle, x = L sinφ with φ the body's absolute pitch (foot pitch + ankle).
-- ``torso`` (:class:`~pushrecovery.sim.mujoco.pendulums.MujocoTorsoPlant`): state ``[x, theta, xdot, theta_dot]`` as the flywheel
-  model, with θ the upper body's absolute pitch (the flywheel angle of Eq. 7).
+- ``foot`` (:class:`~pushrecovery.sim.mujoco.pendulums.MujocoFootPlant`): state
+  ``[x, xdot]``, the CoM (the mass at the top of the rod) relative to the ankle, x = L sinφ
+  with φ the body's absolute pitch (foot pitch + ankle).
+- ``torso`` (:class:`~pushrecovery.sim.mujoco.pendulums.MujocoTorsoPlant`): state
+  ``[x, theta, xdot, theta_dot]`` as the flywheel model, with θ the upper body's absolute
+  pitch (the flywheel angle of Eq. 7).
 
 A CoP command δ becomes the ankle torque that puts the CoP there on a pendulum whose hip carries
 the commanded hip torque τ_h, τ(δ) = δ (A + τ_h sinφ/L) / (1 − δ sinφ/L) with
