@@ -73,7 +73,7 @@ class MujocoFootPlant(MujocoPlant):
     def pose(self, x: float, xdot: float) -> None:
         """Lean the body above the ankle; the foot stays as it settled."""
         length = self.params.com_height
-        lean = math.asin(x / length)  # |x| < L: checked by initial_state
+        lean = math.asin(x / length)  # |x| < L: checked by reset
         self._qpos[self._ankle] = lean - self._qpos[self._pitch]
         self._qvel[self._ankle_v] = xdot / (length * math.cos(lean))
 

@@ -96,7 +96,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         """Standing on both feet, nothing in the air."""
         self._stance: tuple[int, ...] = (0, 1)
         self._lipm = False  # stance kind: straight-leg pendulum (standing) or held height
-        self._height = 0.0  # reported CoM height in stance [m] (set by initial_state)
+        self._height = 0.0  # reported CoM height in stance [m] (set by reset)
         self._hip_height = 0.0  # hip height the servo holds after a landing [m]
         # Swing: leg, direction ±1, touchdown angle [rad], touchdown length [m].
         self._swing: tuple[int, float, float, float] | None = None
