@@ -77,9 +77,7 @@ def startup() -> float:
         return lambda: subprocess.run(cmd, check=True, capture_output=True, env=env)
 
     bare = min(timeit.repeat(run([sys.executable, "-c", "pass"]), number=1, repeat=REPEAT))
-    click = min(
-        timeit.repeat(run([sys.executable, "-c", "import click"]), number=1, repeat=REPEAT)
-    )
+    click = min(timeit.repeat(run([sys.executable, "-c", "import click"]), number=1, repeat=REPEAT))
     cli = min(timeit.repeat(run([str(exe), "--help"]), number=1, repeat=REPEAT))
     print(
         f"pushrecovery --help: {cli * 1e3:.0f} ms; python -c 'import click' {click * 1e3:.0f} ms, "
