@@ -89,6 +89,8 @@ def test_keep_running_after_a_fall_and_the_decision_time():
         ({"push": ScheduledPush(5.0, Push(0.1))}, "push time must be before the end"),
         ({"plant_step": 0.01}, "plant_step must be <= the control period"),
         ({"plant_step": -1.0}, "plant_step must be"),
+        ({"keep_running": (-1.0, 0.0)}, "keep_running must be"),
+        ({"keep_running": (0.0, math.nan)}, "keep_running must be"),
     ],
 )
 def test_bad_loop_arguments_are_refused(kwargs, match):

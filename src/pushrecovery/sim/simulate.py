@@ -117,6 +117,10 @@ def simulate(
     h = dt if plant_step is None else positive_float("plant_step", plant_step, "s")
     if h > dt:
         raise InvalidParameterError(f"plant_step must be <= the control period {dt:g} s, got {h:g}")
+    if not all(seconds >= 0.0 for seconds in keep_running):  # NaN fails too
+        raise InvalidParameterError(
+            f"keep_running must be two durations >= 0 s (inf allowed), got {keep_running!r}"
+        )
     rest = rest or RestCriterion()
     rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))
     # Whole plant steps per tick, rounded tick by tick (a period that is not a multiple of
