@@ -192,3 +192,45 @@ def test_models_and_controllers_must_fit():
         plane.check_state(np.array([0, 0, 0, 2.0, 0, 0, 0, 0.0]))
     with pytest.raises(InvalidParameterError, match="xdot"):
         plane.check_state(plane.reset(0.0, 1e3))
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (
+            ["--model", "stepping", "--controller", "recovery", "--ydot", "1"],
+            "need --model stepping-plane",
+        ),
+        (
+            ["--model", "stepping-plane", "--controller", "recovery-plane", "--y", "5"],
+            "y must satisfy",
+        ),
+        (
+            ["--model", "stepping-plane", "--controller", "recovery-plane", "--ydot", "1e9"],
+            "ydot must",
+        ),
+        (["--model", "stepping-plane", "--controller", "recovery"], "needs the state"),
+    ],
+)
+def test_bad_plane_simulations_are_one_line_errors(args, match, capsys):
+    from pushrecovery.cli import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(["simulate", *args])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and err.count("\n") == 1 and match in err
+
+
+def test_simulate_on_the_plane_reports_its_footholds(capsys):
+    import json
+
+    from pushrecovery.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["simulate", "--model", "stepping-plane", "--controller", "recovery-plane",
+              "--xdot", "2.2", "--ydot", "1.2", "--json"])  # fmt: skip
+    data = json.loads(capsys.readouterr().out)
+    assert data["recovered"] and data["predicted"]["steps"] == len(data["footholds_xy"]) - 1
+    np.testing.assert_allclose(
+        data["footholds_xy"][1], data["predicted"]["plan"]["footholds"][0], atol=1e-9
+    )

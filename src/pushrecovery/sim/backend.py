@@ -141,20 +141,26 @@ class Measuring(Protocol):
         ...
 
 
-def check_com_state(x: float, xdot: float, params: BodyParams) -> None:
+def check_com_state(
+    x: float, xdot: float, params: BodyParams, names: tuple[str, str] = ("x", "xdot")
+) -> None:
     """Reject CoM states outside every model's validity.
 
     |x| < L (the CoM above the ankle's horizon) and |ẋ| < 10 sqrt(g L): ten times the speed at
-    which an upright pendulum's foot unloads (docs/conventions.md).
+    which an upright pendulum's foot unloads (docs/conventions.md). ``names`` are the
+    coordinate's in the messages (``("y", "ydot")`` sideways).
     """
+    position, velocity = names
     if abs(x) >= params.com_height:
         raise InvalidParameterError(
-            f"x must satisfy |x| < com_height = {params.com_height:g} m, got x={x:g}"
+            f"{position} must satisfy |{position}| < com_height = {params.com_height:g} m, "
+            f"got {position}={x:g}"
         )
     speed = 10.0 * math.sqrt(params.gravity * params.com_height)
     if abs(xdot) >= speed:
         raise InvalidParameterError(
-            f"xdot must satisfy |xdot| < 10 sqrt(g L) = {speed:g} m/s, got xdot={xdot:g}"
+            f"{velocity} must satisfy |{velocity}| < 10 sqrt(g L) = {speed:g} m/s, "
+            f"got {velocity}={xdot:g}"
         )
 
 

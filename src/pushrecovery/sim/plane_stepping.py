@@ -98,7 +98,7 @@ class PlaneSteppingPlant(PlantBase):
                 f"state must be {list(PLANE_STATE_LABELS)}, got shape {state.shape}"
             )
         check_com_state(float(state[0]), float(state[4]), self.params)
-        check_com_state(float(state[1]), float(state[5]), self.params)
+        check_com_state(float(state[1]), float(state[5]), self.params, ("y", "ydot"))
         for index, (_, _, limit) in zip((2, 3), self._limits, strict=True):
             if abs(float(state[index])) > limit:
                 raise InvalidParameterError(
