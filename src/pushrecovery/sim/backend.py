@@ -32,8 +32,7 @@ simulate` is written against it alone):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import ClassVar, Protocol, runtime_checkable
+from typing import ClassVar, NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -57,22 +56,21 @@ __all__ = [
 FloatArray = NDArray[np.float64]
 
 
-@dataclass(frozen=True, slots=True)
-class Step:
-    """One step of a plant (contract item 5).
+class Step(NamedTuple):
+    """One step of a plant (contract item 5); a named tuple (made at every tick: cheap).
 
     Attributes
     ----------
     state : ndarray
         The state after the step (``state_labels``).
-    applied : ndarray
+    applied : tuple of float
         The inputs held over the step (``input_labels``): CoP [m], then torques [N m].
     info : StepInfo
         Stance, footholds, stop impacts and measured CoP.
     """
 
     state: FloatArray
-    applied: FloatArray
+    applied: tuple[float, ...]
     info: StepInfo
 
 
@@ -187,6 +185,8 @@ class PlantBase:
         self.stop_impacts = 0
         self.footholds: list[float] = [0.0]
         self.state: FloatArray = np.zeros(len(self.state_labels))
+        self._info_key: tuple[bool, int, int] | None = None
+        self._info = StepInfo()
 
     def _start(self, x: float, xdot: float) -> FloatArray:
         raise NotImplementedError  # pragma: no cover - every plant defines it
@@ -195,7 +195,7 @@ class PlantBase:
         """Raise :class:`InvalidParameterError` if the model cannot start from ``state``."""
         raise NotImplementedError  # pragma: no cover - every plant defines it
 
-    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, FloatArray]:
+    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, tuple[float, ...]]:
         raise NotImplementedError  # pragma: no cover - every plant defines it
 
     def _restart_records(self) -> None:
@@ -203,9 +203,20 @@ class PlantBase:
         self.stop_impacts = 0
         self.footholds = [0.0]
 
+    def _in_stance(self) -> bool:
+        """Whether the feet on the ground carry the body (no foot swinging); always, here."""
+        return True
+
     def info(self) -> StepInfo:
-        """Return the plant's report of the run so far (contract item 5)."""
-        return StepInfo(True, tuple(self.footholds), self.stop_impacts, None)
+        """Return the plant's report of the run so far (contract item 5).
+
+        Kept between steps that change none of it (a new one costs a microsecond a tick).
+        """
+        key = (self._in_stance(), len(self.footholds), self.stop_impacts)
+        if key != self._info_key:
+            self._info_key = key
+            self._info = StepInfo(key[0], tuple(self.footholds), self.stop_impacts, None)
+        return self._info
 
     def reset(self, x: float, xdot: float) -> FloatArray:
         """Start standing with the CoM at x [m] moving at ẋ [m/s] (contract item 2)."""

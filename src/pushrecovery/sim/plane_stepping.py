@@ -30,7 +30,7 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.base import Command, StepInfo
+from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, plane_discrete
@@ -87,9 +87,9 @@ class PlaneSteppingPlant(PlantBase):
         """Start on both feet, the CoM at (x, y) [m] moving at (ẋ, ẏ) [m/s] (contract item 2)."""
         return self.begin(np.array([x, y, 0.0, 0.0, xdot, ydot, 0.0, 0.0]))
 
-    def info(self) -> StepInfo:
-        """Stance unless a foot swings toward its landing (contract item 5)."""
-        return StepInfo(self._swing is None, tuple(self.footholds), self.stop_impacts, None)
+    def _in_stance(self) -> bool:
+        """Stance unless a foot swings toward its landing."""
+        return self._swing is None
 
     def check_state(self, state: FloatArray) -> None:
         """Require a planar state within the model."""
@@ -106,7 +106,7 @@ class PlaneSteppingPlant(PlantBase):
                     f"got {float(state[index]):g}"
                 )
 
-    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, FloatArray]:
+    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, tuple[float, ...]]:
         """Advance by dt [s]; return the state and the mean CoP (x, y) and the torques held."""
         state = self.state
         if command.step_length is not None:
@@ -135,7 +135,7 @@ class PlaneSteppingPlant(PlantBase):
         if left > 0.0:
             state = self._hold(state, wanted, torques, left, cop_sum)
         self.time += dt
-        return state, np.concatenate([cop_sum / dt, torques])
+        return state, (*(cop_sum / dt).tolist(), *torques.tolist())
 
     def _hold(
         self,

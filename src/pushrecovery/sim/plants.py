@@ -80,7 +80,7 @@ class LipmPlant(_AnklePlant):
         self._dt = -1.0
         self._cosh = self._sinh = 1.0
 
-    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, FloatArray]:
+    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, tuple[float, ...]]:
         """Advance exactly by dt with the CoP held (Eq. 24)."""
         state = self.state
         cop = self.applied_cop(command)
@@ -91,7 +91,7 @@ class LipmPlant(_AnklePlant):
         offset, xdot = float(state[0]) - cop, float(state[1])
         # Eq. (24) at t = dt, and its derivative.
         state = np.array([cop + offset * c + xdot / omega * s, omega * offset * s + xdot * c])
-        return state, np.array([cop, 0.0])
+        return state, (cop, 0.0)
 
 
 class PendulumPlant(_AnklePlant):
@@ -102,7 +102,7 @@ class PendulumPlant(_AnklePlant):
     #: Largest RK4 substep [s]; ω h ≈ 0.003 keeps the local error far below 1e-12.
     max_substep: ClassVar[float] = 1e-3
 
-    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, FloatArray]:
+    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, tuple[float, ...]]:
         """Advance by dt with RK4 (substeps <= ``max_substep``)."""
         cop = self.applied_cop(command)
         p, state = self.params, self.state
@@ -114,7 +114,7 @@ class PendulumPlant(_AnklePlant):
         if abs(theta) >= 0.5 * math.pi:
             # Lying on the floor: x = ±L, at rest. (x, ẋ) cannot describe θ past horizontal.
             theta, rate = math.copysign(0.5 * math.pi, theta), 0.0
-        return np.array(com_from_lean(theta, rate, p.com_height)), np.array([cop, 0.0])
+        return np.array(com_from_lean(theta, rate, p.com_height)), (cop, 0.0)
 
 
 class FlywheelPlant(PlantBase):
@@ -156,9 +156,9 @@ class FlywheelPlant(PlantBase):
                 f"{self.params.flywheel_angle_max:g} rad, got {float(state[1]):g}"
             )
 
-    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, FloatArray]:
+    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, tuple[float, ...]]:
         state, cop, torque = self.advance(self.state, command, dt)
-        return state, np.array([cop, torque])
+        return state, (cop, torque)
 
     def advance(
         self, state: FloatArray, command: Command, dt: float

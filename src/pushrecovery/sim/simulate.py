@@ -143,21 +143,26 @@ def simulate(
     info = StepInfo()
     command = Command(float(state[0]))
     tick, next_tick, origin, end, k = 0, 0, 0, total, 0
+    # The hot loop (a campaign runs it millions of times): skip what a run does not use.
+    observing = type(controller).observe is not Controller.observe
+    per_tick = round(dt / h) if abs(dt / h - round(dt / h)) < 1e-9 else 0  # 0: round per tick
+    pushing = push is not None
     while k < end:
-        if push is not None and k == start:
-            state, hold_until = _start_push(plant, push, state, k, h)
-            states[k] = state  # a jump changes the state at this instant
-        if push is not None and k == hold_until and not settled:
-            settled = True
-            if not push.react:  # the controller restarts on the pushed state
-                controller.reset(state)
-                tick, next_tick, origin = 0, k, k
+        if pushing and push is not None:
+            if k == start:
+                state, hold_until = _start_push(plant, push, state, k, h)
+                states[k] = state  # a jump changes the state at this instant
+            if k == hold_until and not settled:
+                settled = True
+                if not push.react:  # the controller restarts on the pushed state
+                    controller.reset(state)
+                    tick, next_tick, origin = 0, k, k
         if not settled and k >= start >= 0 and push is not None and not push.react:
             command = Command(float(state[0]))  # holding still while the force acts
         elif k == next_tick:
             command = controller.compute(tick * dt, state)
             tick += 1
-            next_tick = origin + round(tick * dt / h)
+            next_tick = k + per_tick if per_tick else origin + round(tick * dt / h)
         try:
             step = plant.step(command, h)
         except SimulationDiverged:
@@ -165,10 +170,12 @@ def simulate(
                 raise
             break  # a fallen model blew up: the run ends here
         state, info = step.state, step.info
-        controller.observe(info)
+        if observing:
+            controller.observe(info)
         inputs[k] = step.applied
-        for observer in observers:
-            observer.on_step(k, step, command)
+        if observers:
+            for observer in observers:
+                observer.on_step(k, step, command)
         k += 1
         states[k] = state
         if k != next_tick or outcome is not Outcome.UNDECIDED:

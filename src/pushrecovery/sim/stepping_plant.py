@@ -8,7 +8,7 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.base import Command, StepInfo
+from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.pendulum import pendulum_step
 from pushrecovery.models.stepping import STEPPING_STATE
@@ -58,9 +58,9 @@ class SteppingPlant(PlantBase):
         super()._restart_records()
         self._swing = None
 
-    def info(self) -> StepInfo:
-        """Stance unless a foot swings toward its landing (contract item 5)."""
-        return StepInfo(self._swing is None, tuple(self.footholds), self.stop_impacts, None)
+    def _in_stance(self) -> bool:
+        """Stance unless a foot swings toward its landing."""
+        return self._swing is None
 
     def check_state(self, state: FloatArray) -> None:
         """Require ``[x, theta, z, xdot, theta_dot, zdot]`` standing (ż = 0, 0 < z)."""
@@ -86,10 +86,10 @@ class SteppingPlant(PlantBase):
             plant = self._stance[height] = FlywheelPlant(body)
         return plant
 
-    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, FloatArray]:
+    def _advance(self, command: Command, dt: float) -> tuple[FloatArray, tuple[float, ...]]:
         """Advance by dt in the current phase; a step command starts a swing."""
         state, cop, torque = self._phase_step(self.state, command, dt)
-        return state, np.array([cop, torque])
+        return state, (cop, torque)
 
     def _phase_step(
         self, state: FloatArray, command: Command, dt: float

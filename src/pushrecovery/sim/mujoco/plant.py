@@ -321,7 +321,7 @@ class MujocoPlant:
         The applied inputs are the commanded CoP after clipping [m] and the hip torque [N m].
         """
         state, cop, torque = self._hold(command, dt)
-        return Step(state, np.array([cop, torque]), self.info())
+        return Step(state, (cop, torque), self.info())
 
     def _hold(self, command: Command, dt: float) -> tuple[FloatArray, float, float]:
         p, margin = self.params, self.cop_margin
