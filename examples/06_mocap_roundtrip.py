@@ -10,7 +10,7 @@ from pushrecovery.analysis.c3d import write_c3d
 from pushrecovery.analysis.readers import read_c3d_recording
 from pushrecovery.analysis.trial import analyze, body_for
 from pushrecovery.experiments.mocap import record_push
-from pushrecovery.params import load_params
+from pushrecovery.presets import load_params
 
 params = load_params()
 recording = record_push("biped", params, impulse=1.3 * params.mass, duration=2.5)

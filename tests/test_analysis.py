@@ -20,7 +20,7 @@ from pushrecovery.analysis.signals import lowpass, repair_gaps, smooth_and_diffe
 from pushrecovery.analysis.trial import AnalysisSettings, analyze, body_for
 from pushrecovery.analysis.zero_point import com_from_force
 from pushrecovery.errors import InputFileError, InvalidParameterError
-from pushrecovery.params import load_params
+from pushrecovery.presets import load_params
 from pushrecovery.surfaces.classify import STRATEGY_CODES, classify, classify_states
 
 PARAMS = load_params()

@@ -3,7 +3,7 @@ import math
 import pytest
 
 from pushrecovery import BodyParams, InputFileError, InvalidParameterError, load_params
-from pushrecovery.params import PRESETS
+from pushrecovery.presets import PRESETS
 
 
 def test_paper_preset_values():

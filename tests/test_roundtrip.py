@@ -13,7 +13,7 @@ from pushrecovery.analysis.c3d import write_c3d
 from pushrecovery.analysis.readers import read_c3d_recording
 from pushrecovery.analysis.trial import AnalysisSettings, analyze, body_for
 from pushrecovery.experiments.mocap import record_push
-from pushrecovery.params import load_params
+from pushrecovery.presets import load_params
 
 PARAMS = load_params()
 SETTINGS = AnalysisSettings()

@@ -30,8 +30,12 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    if name in ("PRESETS", "BodyParams", "load_params"):
-        from pushrecovery import params
+    if name == "BodyParams":
+        from pushrecovery.params import BodyParams
 
-        return getattr(params, name)
+        return BodyParams
+    if name in ("PRESETS", "load_params"):
+        from pushrecovery import presets
+
+        return getattr(presets, name)
     raise AttributeError(f"module 'pushrecovery' has no attribute {name!r}")

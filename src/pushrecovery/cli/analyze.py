@@ -126,7 +126,7 @@ def analyze(file: Path, out: Path, as_json: bool, **kwargs: Any) -> None:
     from pushrecovery.analysis.readers import read_recording
     from pushrecovery.analysis.trial import AnalysisSettings, body_for
     from pushrecovery.analysis.trial import analyze as analyze_trial
-    from pushrecovery.params import load_params
+    from pushrecovery.presets import load_params
 
     options: dict[str, Any] = {}
     suffix = file.suffix.lower()

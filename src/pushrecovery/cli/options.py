@@ -99,7 +99,7 @@ def support_from(kwargs: dict[str, Any], params: BodyParams) -> Any:
 def params_from(kwargs: dict[str, Any]) -> BodyParams:
     """Pop the parameter options out of a command's kwargs and build the parameter set."""
     overrides = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
-    from pushrecovery.params import load_params
+    from pushrecovery.presets import load_params
 
     return load_params(kwargs.pop("preset"), kwargs.pop("params_file"), overrides)
 

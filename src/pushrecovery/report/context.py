@@ -35,7 +35,7 @@ def _body_grids(grids: ReportGrids, params: BodyParams) -> ReportGrids:
     the hip for the MPC's): the same part of the strategy map for any body.
     """
     from pushrecovery.experiments.pushes import push_scale, scaled_range
-    from pushrecovery.params import load_params
+    from pushrecovery.presets import load_params
 
     reference = load_params("paper")
     if params == reference:

@@ -127,7 +127,7 @@ def body_for(
     -------
     (values, sources)
         ``mass`` and ``com_height`` found (to override the preset with, see
-        :func:`pushrecovery.params.load_params`; a quantity the file does not give is left
+        :func:`pushrecovery.presets.load_params`; a quantity the file does not give is left
         out), and where each came from: ``flag``, ``file``, ``force plates`` (mean vertical
         force / g while loaded) or ``preset``.
     """
