@@ -208,7 +208,7 @@ class BodyParams:
             )
         set_(self, "stance_width", stance)
         if self.foot_polygon is not None:
-            from pushrecovery.ground.polygon import convex_polygon
+            from pushrecovery.ground.user_polygon import convex_polygon
 
             polygon = convex_polygon("foot_polygon", self.foot_polygon, contains_origin=True)
             set_(self, "foot_polygon", tuple((float(x), float(y)) for x, y in polygon.vertices))

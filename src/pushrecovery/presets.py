@@ -104,7 +104,7 @@ def load_params(
     if {"com_height", "leg_length"} & given and "max_step_length" not in given:
         values["max_step_length"] = PRESETS[preset].get("max_step_length")
     if values.get("foot_polygon") is not None:
-        from pushrecovery.ground.polygon import convex_polygon
+        from pushrecovery.ground.user_polygon import convex_polygon
 
         # Validated before its extents become heel, toe and foot_width, so that errors name it.
         polygon = convex_polygon(

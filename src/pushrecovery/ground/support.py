@@ -24,7 +24,8 @@ import numpy as np
 
 from pushrecovery._validate import finite_float
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.polygon import ConvexPolygon, convex_hull, convex_polygon, rectangle
+from pushrecovery.ground.polygon import ConvexPolygon, convex_hull, rectangle
+from pushrecovery.ground.user_polygon import convex_polygon
 from pushrecovery.params import BodyParams
 
 __all__ = ["FootPose", "Stance", "Support", "foot_shape"]
