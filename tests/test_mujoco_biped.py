@@ -130,7 +130,7 @@ def test_a_second_step_swaps_the_legs():
     assert result.recovered and len(controller.steps) == 2 and len(result.footholds) == 3
     steps = np.diff(result.footholds)
     assert steps == pytest.approx(controller.steps, abs=LANDING_TOLERANCE)
-    assert plant._stance == (0,)  # right leg first, then left
+    assert plant.gait.stance == (0,)  # right leg first, then left
 
 
 def test_bad_states():

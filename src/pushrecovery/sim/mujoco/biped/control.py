@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass, field
+from enum import Enum
 from typing import Any
 
 import numpy as np
@@ -17,7 +19,7 @@ from pushrecovery.sim.mujoco.models import (
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["BipedServos"]
+__all__ = ["BipedServos", "GaitState", "Phase"]
 
 # --- control -----------------------------------------------------------------------------------
 #: Stance knee held straight or locked during a swing [N m/rad, N m s/rad]; the damping makes
@@ -83,6 +85,73 @@ def _quintic(start: float, rate: float, goal: float, duration: float) -> tuple[B
     return path, path.derivative()
 
 
+class Phase(Enum):
+    """Where the gait is (docs/biped.md): the control and the state differ by phase."""
+
+    STANDING = "standing"  # both feet down, legs straight: the pendulum of the start
+    SWING = "swing"  # a foot on its way to the touchdown, the stance leg locked
+    IMPACT = "impact"  # landed; the height servo absorbs the impact (IMPACT_TIME)
+    STANCE = "stance"  # one foot, the LIPM at the held height
+
+
+@dataclass(slots=True)
+class GaitState:
+    """What the biped's phase machine remembers between physics steps.
+
+    Attributes
+    ----------
+    stance : tuple of int
+        Legs on the floor (both at the start, then one).
+    lipm : bool
+        Stance kind: straight-leg pendulum (standing) or the held height (after a landing).
+    height, hip_height : float
+        Reported CoM height in stance, and the hip height the servo holds [m].
+    swing : (leg, direction ±1, touchdown angle [rad], touchdown length [m]) or None
+        The step under way.
+    armed : bool
+        The swing sole has risen ``ARM_HEIGHT``: a contact now is a landing.
+    anchor, lock : float
+        World x of the stance ankle at the swing's start [m]; the stance knee angle locked
+        during the swing [rad].
+    at_stop : bool
+        The torso is at its joint stop.
+    ticks, impact_end : int
+        Physics steps since the reset; the step at which the last landing's impact is over.
+    plans : list
+        Per leg in the air: its angle's path (from, at rate, to, start tick, duration [s]).
+    hip_acc : (float, float)
+        The hip's acceleration (a_x / g, 1 + a_z / g).
+    bends : list
+        Knee bend references of the legs in the air and their rates [rad, rad/s].
+    """
+
+    stance: tuple[int, ...] = (0, 1)
+    lipm: bool = False
+    height: float = 0.0
+    hip_height: float = 0.0
+    swing: tuple[int, float, float, float] | None = None
+    armed: bool = False
+    anchor: float = 0.0
+    lock: float = 0.0
+    at_stop: bool = False
+    ticks: int = 0
+    plans: list[tuple[float, float, float, int, float]] = field(
+        default_factory=lambda: [(0.0, 0.0, 0.0, 0, 1.0), (0.0, 0.0, 0.0, 0, 1.0)]
+    )
+    hip_acc: tuple[float, float] = (0.0, 1.0)
+    bends: list[tuple[float, float]] = field(default_factory=lambda: [(0.0, 0.0), (0.0, 0.0)])
+    impact_end: int = 0
+
+    @property
+    def phase(self) -> Phase:
+        """Return the phase the remembered state is in."""
+        if self.swing is not None:
+            return Phase.SWING
+        if len(self.stance) == 2:
+            return Phase.STANDING
+        return Phase.IMPACT if self.ticks < self.impact_end else Phase.STANCE
+
+
 class BipedServos:
     """The biped's torque laws: the stance foot, the knee lock, a leg in the air (docs/biped.md)."""
 
@@ -100,8 +169,7 @@ class BipedServos:
     _thigh_w: tuple[float, float]
     _shank_w: tuple[float, float]
     _foot_w: tuple[float, float, float]
-    _bends: list[tuple[float, float]]
-    _hip_acc: tuple[float, float]
+    gait: GaitState
 
     def _sole_load(self, i: int) -> float:
         """Return the floor's normal force on leg i's sole in the last physics step [N]."""
@@ -170,13 +238,13 @@ class BipedServos:
         # filter: a jump (or a jump of its rate) would kick the thigh and, through the torso,
         # the stance leg.
         h, omega = self._substep, BEND_RATE
-        bend, bend_rate = self._bends[i]
+        bend, bend_rate = self.gait.bends[i]
         goal = 2.0 * math.acos(wanted / length)
         bend_rate += h * omega * (omega * (goal - bend) - 2.0 * bend_rate)
         bend += h * bend_rate
-        self._bends[i] = (bend, bend_rate)
+        self.gait.bends[i] = (bend, bend_rate)
         # Σ m (a_x r_z − (g + a_z) r_x) over the masses below each joint, r from the joint.
-        ax, up = self._hip_acc
+        ax, up = self.gait.hip_acc
         s1, c1, s2, c2 = math.sin(a1), math.cos(a1), math.sin(a2), math.cos(a2)
         sb, cb = math.sin(beta), math.cos(beta)
         (wt, ct), (ws, cs), (wf, fx, fz) = self._thigh_w, self._shank_w, self._foot_w

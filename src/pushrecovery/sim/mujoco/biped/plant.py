@@ -30,6 +30,8 @@ from pushrecovery.sim.mujoco.biped.control import (
     TOUCHDOWN_BEND,
     TRAIL_TIME,
     BipedServos,
+    GaitState,
+    Phase,
     _path,
 )
 from pushrecovery.sim.mujoco.biped.kinematics import BipedKinematics
@@ -94,40 +96,24 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
 
     def _reset_phase(self) -> None:
         """Standing on both feet, nothing in the air."""
-        self._stance: tuple[int, ...] = (0, 1)
-        self._lipm = False  # stance kind: straight-leg pendulum (standing) or held height
-        self._height = 0.0  # reported CoM height in stance [m] (set by reset)
-        self._hip_height = 0.0  # hip height the servo holds after a landing [m]
-        # Swing: leg, direction ±1, touchdown angle [rad], touchdown length [m].
-        self._swing: tuple[int, float, float, float] | None = None
-        self._armed = False
-        self._anchor = 0.0  # world x of the stance ankle when the swing started [m]
-        self._lock = 0.0  # stance knee angle locked during the swing [rad]
-        self._at_stop = False
-        self._ticks = 0  # physics steps since the reset
-        # Per leg in the air: path of its angle (from, at rate, to, start tick, duration [s]).
-        self._plans = [(0.0, 0.0, 0.0, 0, 1.0), (0.0, 0.0, 0.0, 0, 1.0)]
-        self._hip_acc = (0.0, 1.0)  # hip acceleration (a_x / g, 1 + a_z / g)
-        # Knee bend references of the legs in the air and their rates [rad, rad/s].
-        self._bends = [(0.0, 0.0), (0.0, 0.0)]
-        self._impact_end = 0  # tick at which the impact of the last landing is over
+        self.gait = GaitState()
         self.footholds = [0.0]
 
     # --- state ---------------------------------------------------------------------------
     def read_state(self) -> FloatArray:
         """``[x, theta, z, xdot, theta_dot, zdot]`` (module docstring) [m, rad, m/s, rad/s]."""
         q, v = self._qpos.tolist(), self._qvel.tolist()
-        if self._swing is not None:
+        if self.gait.swing is not None:
             self._check_landing(q, v)
-        x, z, xdot, zdot = self._com(q, v, self._stance[0])
-        if self._swing is None and self._ticks >= self._impact_end:
-            z, zdot = self._height, 0.0  # the height the stance holds (info().stance)
+        x, z, xdot, zdot = self._com(q, v, self.gait.stance[0])
+        if self.gait.phase in (Phase.STANDING, Phase.STANCE):
+            z, zdot = self.gait.height, 0.0  # the height the stance holds (info().stance)
         return np.array([x, q[_PITCH], z, xdot, v[_PITCH], zdot])
 
     def ankle_x(self) -> float:
         """World x of the stance ankle (of the first foot when standing on both) [m]."""
         q = self._qpos.tolist()
-        alpha, length, _ = self._leg(q, self._stance[0])
+        alpha, length, _ = self._leg(q, self.gait.stance[0])
         return float(q[_X] - length * math.sin(alpha))
 
     def pose(self, x: float, xdot: float) -> None:
@@ -174,7 +160,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         ``z`` is then the standing CoM height, held for the first stance.
         """
         self._reset_phase()
-        self._height = self._standing_height()
+        self.gait.height = self._standing_height()
         return super().reset(x, xdot)
 
     def _restart_records(self) -> None:
@@ -184,7 +170,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
     def info(self) -> StepInfo:
         """Stance once a landing's impact is over and no foot swings (contract item 5)."""
         measured = self.measured_cops[-1] if self._measuring and self.measured_cops else None
-        stance = self._swing is None and self._ticks >= self._impact_end
+        stance = self.gait.phase in (Phase.STANDING, Phase.STANCE)
         return StepInfo(stance, tuple(self.footholds), self.stop_impacts, measured)
 
     def _standing_height(self) -> float:
@@ -207,22 +193,24 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         q = self._qpos.tolist()
         return any(
             abs(q[_PITCH] + q[3 + 3 * i] + q[4 + 3 * i] + q[5 + 3 * i]) > FOOT_TIP_LIMIT
-            for i in self._stance
+            for i in self.gait.stance
         )
 
     def falling(self, state: FloatArray) -> bool:
         """Tell a fall: the base class's, or a swing whose CoM turns back (it cannot land)."""
-        if self._swing is not None:
+        if self.gait.swing is not None:
             x, z, xdot, zdot = (float(state[i]) for i in (0, 2, 3, 5))
-            if self._swing[1] * (xdot * z - zdot * x) <= 0.0:
+            if self.gait.swing[1] * (xdot * z - zdot * x) <= 0.0:
                 return True
         return super().falling(state)
 
     # --- phases --------------------------------------------------------------------------
     def _start_swing(self, q: list[float], v: list[float], step: float) -> None:
         """Lock the stance leg and plan the swing of the other one for a step of ``step`` [m]."""
-        stance, swing = (0, 1) if len(self._stance) == 2 else (self._stance[0], 1 - self._stance[0])
-        self._stance = (stance,)
+        stance, swing = (
+            (0, 1) if len(self.gait.stance) == 2 else (self.gait.stance[0], 1 - self.gait.stance[0])
+        )
+        self.gait.stance = (stance,)
         lean, length, kappa = self._leg(q, stance)
         sign = 1.0 if step > 0.0 else -1.0
         reach = min(length, self._length * math.cos(0.5 * TOUCHDOWN_BEND))
@@ -231,10 +219,10 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         along = (length * length - reach * reach + d * d) / (2.0 * d)
         target = -sign * math.asin(max(-1.0, min(1.0, (d - along) / reach)))
         landing = math.asin(max(-1.0, min(1.0, along / length)))  # lean at touchdown, unsigned
-        self._swing = (swing, sign, target, reach)
-        self._lock = kappa
-        self._armed = self._sole_height(q, swing) > ARM_HEIGHT
-        self._anchor = q[_X] - length * math.sin(lean)
+        self.gait.swing = (swing, sign, target, reach)
+        self.gait.lock = kappa
+        self.gait.armed = self._sole_height(q, swing) > ARM_HEIGHT
+        self.gait.anchor = q[_X] - length * math.sin(lean)
         # The pendulum's time to the landing lean, from its energy (trapezoid on the rate).
         x, z = length * math.sin(lean), length * math.cos(lean)
         rate = sign * (v[_X] * z - v[_Z] * x) / (length * length)
@@ -245,16 +233,16 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         longest, shortest = SWING_TIME
         duration = min(longest, max(shortest, SWING_SHARE * time))
         now = (self._leg(q, swing)[0], self._leg_rate(v, swing))
-        self._plans[swing] = (*now, target, self._ticks, duration)
-        self._bends[swing] = (q[4 + 3 * swing], v[4 + 3 * swing])
+        self.gait.plans[swing] = (*now, target, self.gait.ticks, duration)
+        self.gait.bends[swing] = (q[4 + 3 * swing], v[4 + 3 * swing])
 
     def _check_landing(self, q: list[float], v: list[float]) -> None:
         """Land when the swing sole reaches the floor after it has lifted."""
-        assert self._swing is not None
-        leg = self._swing[0]
+        assert self.gait.swing is not None
+        leg = self.gait.swing[0]
         height = self._sole_height(q, leg)
-        if not self._armed:
-            self._armed = height > ARM_HEIGHT
+        if not self.gait.armed:
+            self.gait.armed = height > ARM_HEIGHT
             return
         if height > 0.0:
             return
@@ -262,18 +250,18 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
             # Not yet pressed on the floor (or grazing it on the way up): the stance torques
             # would act on a leg in the air, tip the foot heel or toe first and bounce it.
             return
-        old = self._stance[0]
+        old = self.gait.stance[0]
         rate = self._leg_rate(v, old)
-        self._plans[old] = (self._leg(q, old)[0], rate, 0.0, self._ticks, TRAIL_TIME)
-        self._bends[old] = (q[4 + 3 * old], 0.0)
-        self._stance = (leg,)
-        self._swing = None
-        self._lipm = True
+        self.gait.plans[old] = (self._leg(q, old)[0], rate, 0.0, self.gait.ticks, TRAIL_TIME)
+        self.gait.bends[old] = (q[4 + 3 * old], 0.0)
+        self.gait.stance = (leg,)
+        self.gait.swing = None
+        self.gait.lipm = True
         alpha, length, _ = self._leg(q, leg)
         self.footholds.append(float(q[_X] - length * math.sin(alpha)))
-        self._hip_height = length * math.cos(alpha)
-        self._height = self._hip_height + self._com_offset(q, [0.0] * len(q))[1]
-        self._impact_end = self._ticks + round(IMPACT_TIME / self._substep)
+        self.gait.hip_height = length * math.cos(alpha)
+        self.gait.height = self.gait.hip_height + self._com_offset(q, [0.0] * len(q))[1]
+        self.gait.impact_end = self.gait.ticks + round(IMPACT_TIME / self._substep)
 
     # --- control -------------------------------------------------------------------------
     def actuate(self, cop: float, command: Command) -> float:
@@ -284,42 +272,42 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         q, v = self._qpos.tolist(), self._qvel.tolist()
         p = self.params
         fly = p.clip_hip_torque(command.flywheel_torque)
-        if self._swing is None and command.step_length is not None:
+        if self.gait.swing is None and command.step_length is not None:
             self._start_swing(q, v, command.step_length)
-        elif self._swing is not None:
+        elif self.gait.swing is not None:
             self._check_landing(q, v)
-        self._ticks += 1
+        self.gait.ticks += 1
         ctrl = [0.0] * 6
-        stance = self._stance
+        stance = self.gait.stance
         alpha, length, kappa = self._leg(q, stance[0])
         sin, cos = math.sin(alpha), math.cos(alpha)
         x, z = length * sin, length * cos  # hip relative to the stance ankle
         rate = (v[_X] * z - v[_Z] * x) / (length * length)
         g = p.gravity
-        if self._swing is not None:
+        if self.gait.swing is not None:
             # The hip on the passive, locked stance leg moves as a pendulum.
             spin = length * rate * rate / g
-            self._hip_acc = (sin * cos - spin * sin, cos * cos - spin * cos)
+            self.gait.hip_acc = (sin * cos - spin * sin, cos * cos - spin * cos)
         else:
-            self._hip_acc = ((x - cop) / z, 1.0)  # the LIPM's
+            self.gait.hip_acc = ((x - cop) / z, 1.0)  # the LIPM's
         others = 0.0  # hip torques of the legs in the air (they react on the torso)
         for i in (0, 1):
             if i in stance:
                 continue
-            start, start_rate, goal, tick, duration = self._plans[i]
-            if not self._armed and self._swing is not None and self._swing[0] == i:
+            start, start_rate, goal, tick, duration = self.gait.plans[i]
+            if not self.gait.armed and self.gait.swing is not None and self.gait.swing[0] == i:
                 # A foot still on the floor lifts first (a loaded leg cannot swing), moving
                 # with the body meanwhile, and the swing starts from there: the lift eats
                 # into the swing's time.
                 start, start_rate = self._leg(q, i)[0], self._leg_rate(v, i)
                 duration = max(SWING_TIME[1], duration - self._substep)
-                tick = self._ticks
-                self._plans[i] = (start, start_rate, goal, tick, duration)
+                tick = self.gait.ticks
+                self.gait.plans[i] = (start, start_rate, goal, tick, duration)
             ref, ref_rate = _path(
-                start, start_rate, goal, (self._ticks - tick) * self._substep, duration
+                start, start_rate, goal, (self.gait.ticks - tick) * self._substep, duration
             )
-            if self._swing is not None and self._swing[0] == i:
-                _, sign, target, reach = self._swing
+            if self.gait.swing is not None and self.gait.swing[0] == i:
+                _, sign, target, reach = self.gait.swing
                 left = sign * (q[_PITCH] + q[3 + 3 * i] + 0.5 * q[4 + 3 * i] - target)
                 clearance = CLEARANCE * min(1.0, max(0.0, left / CLEARANCE_ANGLE))
                 self._free_leg(q, v, i, ref, ref_rate, reach, clearance, ctrl)
@@ -327,7 +315,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
                 self._free_leg(q, v, i, ref, ref_rate, self._length - HANG, CLEARANCE, ctrl)
             others += ctrl[3 * i]
         n = len(stance)
-        if self._swing is not None:
+        if self.gait.swing is not None:
             # The swing hip's reaction goes to the torso, which the controller brakes: the
             # passive stance pendulum feels only the command, as with the paper's massless
             # swing leg. (Through the stance hip it would disturb the pendulum and, near the
@@ -336,7 +324,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         # The torso feels the flywheel command; in stance the stance hips also take the
         # reaction of the leg in the air, which the CoP map accounts for.
         hip = (-fly - others) / n
-        if self._swing is not None:
+        if self.gait.swing is not None:
             # Passive ankle; the knee locked against the pendulum's load along the leg.
             load = p.mass * (g * cos - length * rate * rate)
             for i in stance:
@@ -348,12 +336,12 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
                     # would swing the light leg and kick the foot back. The hip holds the
                     # leg over the foothold instead, where the foot lands again.
                     hp, hd = HIP_GAINS
-                    over = math.asin(max(-0.99, min(0.99, (q[_X] - self._anchor) / length)))
+                    over = math.asin(max(-0.99, min(0.99, (q[_X] - self.gait.anchor) / length)))
                     over_rate = v[_X] / (length * math.cos(over))
                     error_rate = self._leg_rate(v, i) - over_rate
                     ctrl[3 * i] = -hp * (alpha - over) - hd * error_rate
-                ctrl[3 * i + 1] = self._knee_lock(q, v, i, self._lock, load)
-        elif not self._lipm:
+                ctrl[3 * i + 1] = self._knee_lock(q, v, i, self.gait.lock, load)
+        elif not self.gait.lipm:
             cx, cz, cvx, cvz = self._com(q, v, stance[0])
             reach = math.hypot(cx, cz)
             torque = ankle_torque_for_cop(
@@ -374,7 +362,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         else:
             i, h, seg = stance[0], ANKLE_HEIGHT, self._segment
             kp, kd = HEIGHT_GAINS
-            fz = max(0.0, p.mass * (g + kp * (self._hip_height - z) - kd * v[_Z]))
+            fz = max(0.0, p.mass * (g + kp * (self.gait.hip_height - z) - kd * v[_Z]))
             # Moments about the hip of the (massless) leg: the hip torque on it is `hip`.
             fx = ((x - cop) * fz + hip) / (z + h)
             a2 = alpha + 0.5 * kappa  # the shank's angle
@@ -387,7 +375,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
             ctrl[3 * i + 2] = cop * p.weight + h * fx - self._foot(q, i)
         self._ctrl[:] = ctrl
         at_stop = abs(q[_PITCH]) >= p.flywheel_angle_max - 1e-3
-        if at_stop and not self._at_stop:
+        if at_stop and not self.gait.at_stop:
             self.stop_impacts += 1
-        self._at_stop = at_stop
+        self.gait.at_stop = at_stop
         return fly
