@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +26,9 @@ from pushrecovery.plots.plane import (
     plane_samples,
     recovery_limits,
 )
-from pushrecovery.report import SECTIONS, write_report
+from pushrecovery.report import SECTIONS
+from pushrecovery.report.build import build_report
+from pushrecovery.report.data import PlaneSection, StepsSection
 from pushrecovery.surfaces.bounds import plane_bounds
 from pushrecovery.surfaces.classify import STRATEGY_CODES, classify
 from pushrecovery.surfaces.plane import DIRECTIONS, cmp_polygon
@@ -180,34 +181,31 @@ def test_write_figures_writes_the_plane(
 
 def test_report_has_the_ground_plane_section(params: BodyParams, tmp_path: Path) -> None:
     skip = [key for key in SECTIONS if key != "plane"]
-    html = write_report(params, tmp_path, skip=skip).read_text(encoding="utf-8")
-    assert '<section id="plane">\n<h2>Ground plane</h2>' in html
-    section = html[html.index('<section id="plane">') : html.index("</section>")]
-    assert len(re.findall(r'<img src="data:image/png;base64,', section)) == 1
-    for phrase in ("support polygon", "CMP region", "N-step", "m/s"):
-        assert phrase in section
-    table = re.search(r'<table id="plane-thresholds">(.*?)</table>', section, re.S)
-    assert table is not None
-    rows = re.findall(r"<tr>(.*?)</tr>", table.group(1))
-    assert len(rows) == 1 + 3 * 3  # header; ankle, hip, step for each stance
-    cells = re.findall(r"<td[^>]*>([^<]*)</td>", rows[1 + 3 + 2])  # left support, step
+    report = build_report(params, tmp_path, skip=skip)
+    assert [key for key, _, _ in report.sections] == ["plane"]
+    section = report.section("plane")
+    assert isinstance(section, PlaneSection)
+    assert section.picture.path.read_bytes().startswith(PNG)
+    table = section.thresholds
+    assert table.ident == "plane-thresholds"
+    assert len(table.rows) == 3 * 3  # ankle, hip, step for each stance
+    cells = table.rows[3 + 2]  # left support, step
     expected = plane_bounds(params, Support.from_params(params, "left"))["thresholds"]["step"]
-    assert cells[:2] == ["left", "step"]
+    assert cells[:2] == ("left", "step")
     numbers = [float(c.replace("−", "-")) for c in cells[2:]]
     for value, direction in zip(numbers, ("forward", "backward", "left", "right"), strict=True):
         assert value == pytest.approx(expected[direction], rel=5e-3)
-    footer = html[html.index("<footer>") :]
-    assert "Ground plane" in footer
+    assert report.footer is not None
+    assert [title for title, _ in report.footer.timings] == ["Ground plane"]
 
 
 def test_report_has_the_steps_section(params: BodyParams, tmp_path: Path) -> None:
     skip = [key for key in SECTIONS if key != "steps"]
-    html = write_report(params, tmp_path, skip=skip).read_text(encoding="utf-8")
-    section = html[html.index('<section id="steps">') : html.index("</section>")]
-    assert len(re.findall(r'<img src="data:image/png;base64,', section)) == 2
-    table = re.search(r'<table id="steps">(.*?)</table>', section, re.S)
-    assert table is not None
-    rows = re.findall(r"<tr>(.*?)</tr>", table.group(1))
-    assert len(rows) == 1 + params.max_steps + 1  # header, N = 1 ... max_steps, ∞
-    forward = [float(re.findall(r"<td[^>]*>([^<]*)</td>", r)[2]) for r in rows[1:]]
+    section = build_report(params, tmp_path, skip=skip).section("steps")
+    assert isinstance(section, StepsSection)
+    for picture in (section.regions, section.steps_map):
+        assert picture.path.read_bytes().startswith(PNG)
+    rows = section.thresholds.rows
+    assert len(rows) == params.max_steps + 1  # N = 1 ... max_steps, ∞
+    forward = [float(r[2]) for r in rows]
     assert forward == sorted(forward)  # more steps, bigger pushes

@@ -4,12 +4,15 @@ from __future__ import annotations
 
 import json
 import re
+from dataclasses import replace
+from html import unescape
 from pathlib import Path
 
+import pyarrow.parquet as pq
 import pytest
 from click.testing import CliRunner
 
-from pushrecovery import BodyParams, InvalidParameterError, PushRecoveryError
+from pushrecovery import BodyParams, InvalidParameterError, PushRecoveryError, load_params
 from pushrecovery.campaign import CampaignResult, CampaignSpec, run_campaign
 from pushrecovery.cli.app import cli
 from pushrecovery.plots.campaign import (
@@ -18,6 +21,16 @@ from pushrecovery.plots.campaign import (
     step_limit_curve,
 )
 from pushrecovery.report import SECTIONS, PushGrid, write_report
+from pushrecovery.report.build import build_report
+from pushrecovery.report.data import (
+    CampaignSection,
+    FailedSection,
+    FiguresSection,
+    FilmstripsSection,
+    Report,
+    SweepSection,
+)
+from pushrecovery.report.render import render_report
 from pushrecovery.sim.critical import predicted_critical_velocity
 from pushrecovery.surfaces.bounds import bounds_data
 
@@ -105,51 +118,95 @@ def test_bounds_are_the_numbers_of_the_bounds_command(params: BodyParams) -> Non
     assert json.loads(result.output) == json.loads(json.dumps(bounds_data(params)))
 
 
-def _confusion(html: str, ident: str) -> list[list[int]]:
-    """Counts of the confusion table ``ident`` (without the totals)."""
-    block = re.search(rf'<table class="confusion" id="{ident}">(.*?)</table>', html, re.S)
-    assert block is not None
-    rows = re.findall(r"<tr><th[^>]*>(\w+)</th>(.*?)</tr>", block.group(1))
-    return [
-        [int(c) for c in re.findall(r"<td[^>]*>(\d+)</td>", cells)[:-1]]
-        for label, cells in rows
-        if label != "total"
-    ]
-
-
 TINY = {
     "analytic_grid": PushGrid((0.0, 0.05, 0.05), (-1.0, 1.0, 0.5)),
     "sweep_grid": PushGrid((0.0, 0.0, 1.0), (-0.4, 0.8, 0.4), {"torque_max": (0.0, 100.0, 100.0)}),
 }
+SHOWN = ("bounds", "map", "plane", "steps", "figures", "analytic", "sweep")
 
 
-def test_report_is_one_self_contained_page(params: BodyParams, tmp_path: Path) -> None:
+@pytest.fixture(scope="module")
+def report(tmp_path_factory: pytest.TempPathFactory) -> tuple[Report, Path, list[str]]:
+    """The report without MuJoCo on tiny grids, as data, with its progress lines."""
+    out = tmp_path_factory.mktemp("report")
     lines: list[str] = []
-    path = write_report(params, tmp_path, mujoco=False, workers=1, progress=lines.append, **TINY)
-    assert path == tmp_path / "index.html"
-    assert [p.name for p in tmp_path.glob("*.html")] == ["index.html"]
-    html = path.read_text(encoding="utf-8")
+    data = build_report(load_params(), out, mujoco=False, workers=1, progress=lines.append, **TINY)
+    return data, out, lines
+
+
+def test_report_sections_are_the_campaigns_numbers(
+    report: tuple[Report, Path, list[str]],
+) -> None:
+    data, out, lines = report
+    assert [key for key, _, _ in data.sections] == list(SHOWN)
+    assert [title for _, title, _ in data.sections] == [SECTIONS[key] for key in SHOWN]
+    summary = json.loads((out / "campaign-analytic" / "summary.json").read_text())
+    section = data.section("analytic")
+    assert isinstance(section, CampaignSection)
+    # The confusion matrix is the summary's; its totals are the push count.
+    assert [list(row) for row in section.confusion.counts] == summary["confusion"]["counts"]
+    assert section.confusion.total == summary["pushes"] == section.pushes
+    # The accuracy is explained by its own table, counted from the pushes, not the summary.
+    pushes = pq.read_table(out / "campaign-analytic" / "pushes.parquet").to_pylist()
+    right = sum(p["predicted_recovers"] == (p["outcome"] == "recovered") for p in pushes)
+    assert section.verdicts.right == right
+    assert section.verdicts.total == len(pushes)
+    assert section.accuracy == pytest.approx(right / len(pushes), abs=1e-12)
+    assert section.disagreements.wrong == len(pushes) - right
+    assert section.recovered + section.fell + section.undecided == len(pushes)
+    for name in section.data_files:
+        assert (out / name).is_file()
+    assert section.outcome_map.path.read_bytes().startswith(PNG)
+    # The sweep and its critical pushes; the verdict paragraph's scores.
+    sweep = data.section("sweep")
+    assert isinstance(sweep, SweepSection) and sweep.parameter == "torque_max"
+    assert [(title, pushes) for title, _, pushes in data.verdict.scores] == [
+        (SECTIONS["sweep"], sweep.pushes),
+        (SECTIONS["analytic"], section.pushes),
+    ]
+    thresholds = bounds_data(load_params())["thresholds"]
+    assert data.verdict.hip == thresholds["hip"][1]
+    # Every figure is a PNG on disk; every section's wall time in the footer, as it ran.
+    figures = data.section("figures")
+    assert isinstance(figures, FiguresSection) and len(figures.pictures) >= 8
+    assert all(p.path.read_bytes().startswith(PNG) for p in figures.pictures)
+    assert data.footer is not None
+    assert {title for title, _ in data.footer.timings} == {SECTIONS[key] for key in SHOWN}
+    assert any(line.startswith(SECTIONS["analytic"] + ":") for line in lines)
+
+
+def test_the_report_renders_one_self_contained_page(
+    report: tuple[Report, Path, list[str]],
+) -> None:
+    data, _, _ = report
+    html = render_report(data)
     # Nothing outside the page: no remote or relative resources, no script, no stylesheet link.
     for forbidden in ('src="http', 'href="http', "<script", "<link", "url("):
         assert forbidden not in html
     images = re.findall(r'<img src="([^"]*)"', html)
     assert len(images) >= 8 + 4  # the paper's figures, the map, the plane, two campaign plots
     assert all(src.startswith("data:image/png;base64,") for src in images)
-    for key in ("bounds", "map", "plane", "figures", "analytic", "sweep"):
-        assert f"<h2>{SECTIONS[key].replace(chr(39), '&#x27;')}</h2>" in html
-    for key in ("mujoco", "biped", "critical", "filmstrips"):
-        assert f'id="{key}"' not in html
+    titles = re.findall(r'<section id="(\w+)">\n<h2>([^<]*)</h2>', html)
+    assert [(key, unescape(title)) for key, title in titles] == [(k, SECTIONS[k]) for k in SHOWN]
     for number in ("Eq. (4)", "Eq. (15)", "Eq. (12)", "Sec. IV"):
         assert number in html
-    # The confusion matrix is the one of the campaign's summary.
-    summary = json.loads((tmp_path / "campaign-analytic" / "summary.json").read_text())
-    assert _confusion(html, "confusion-analytic") == summary["confusion"]["counts"]
-    assert f"Accuracy {summary['accuracy']:.3g}" in html
-    # Every section's wall time in the footer, and reported as it ran.
-    footer = html[html.index("<footer>") :]
-    for key in ("bounds", "map", "plane", "figures", "analytic", "sweep"):
-        assert SECTIONS[key].replace("'", "&#x27;") in footer
-    assert any(line.startswith(SECTIONS["analytic"] + ":") for line in lines)
+    assert html.count('<table class="confusion"') == 1
+    assert html.index("<footer>") > html.index('<section id="sweep">')
+
+
+def test_the_page_escapes_its_data(report: tuple[Report, Path, list[str]]) -> None:
+    data, _, _ = report
+    hostile = "<script>alert('x')</script> & <b>"
+    failed = replace(
+        data,
+        sections=(("bounds", hostile, FailedSection("ValueError", hostile)),),
+        notes={"bounds": (hostile,)},
+    )
+    html = render_report(failed)
+    assert "<script" not in html and "<b>" not in html
+    # The title, the nav entry, the error and the note, each escaped (any quote form).
+    assert html.count("&lt;script&gt;alert(") == 4
+    assert html.count("&lt;/script&gt; &amp; &lt;b&gt;") == 4
 
 
 def test_report_reuses_and_replaces_its_campaigns(params: BodyParams, tmp_path: Path) -> None:
@@ -160,12 +217,12 @@ def test_report_reuses_and_replaces_its_campaigns(params: BodyParams, tmp_path: 
     write_report(params, tmp_path, mujoco=False, skip=skip, workers=1, **TINY)
     assert batch.stat().st_mtime_ns == stamp  # reused, not simulated again
     other = PushGrid((0.0, 0.0, 1.0), (0.0, 0.5, 0.5))
-    html = write_report(
-        params, tmp_path, mujoco=False, skip=skip, workers=1, analytic_grid=other
-    ).read_text()
+    report = build_report(params, tmp_path, mujoco=False, skip=skip, workers=1, analytic_grid=other)
     summary = json.loads((tmp_path / "campaign-analytic" / "summary.json").read_text())
-    assert summary["pushes"] == 2
-    assert _confusion(html, "confusion-analytic") == summary["confusion"]["counts"]
+    section = report.section("analytic")
+    assert isinstance(section, CampaignSection)
+    assert summary["pushes"] == 2 == section.confusion.total
+    assert [list(row) for row in section.confusion.counts] == summary["confusion"]["counts"]
 
 
 def test_report_without_rendering_says_so(
@@ -182,6 +239,8 @@ def test_report_without_rendering_says_so(
     assert "Rendering is not available" in html
     assert "no OpenGL here" in html
     assert "<img" not in html
+    section = build_report(params, tmp_path, skip=skip).section("filmstrips")
+    assert section == FilmstripsSection((), unavailable="no OpenGL here (MUJOCO_GL=egl)")
 
 
 def test_report_rejects_unknown_sections_and_sizes(params: BodyParams, tmp_path: Path) -> None:

@@ -49,7 +49,8 @@ def test_a_light_robots_hip_push_is_recovered_with_the_hip():
 
 def test_the_reports_grids_follow_the_bodys_thresholds():
     from pushrecovery.experiments.pushes import push_scale
-    from pushrecovery.report.html import SIZES, _body_grids
+    from pushrecovery.report.config import SIZES
+    from pushrecovery.report.context import _body_grids
 
     paper = load_params()
     assert _body_grids(SIZES["small"], paper) == SIZES["small"]

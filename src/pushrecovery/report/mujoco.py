@@ -5,17 +5,11 @@ from __future__ import annotations
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.report.config import FILMSTRIPS
 from pushrecovery.report.context import _Context
-from pushrecovery.report.markup import (
-    esc,
-    figure,
-    num,
-    paragraph,
-    percent,
-    table,
-)
+from pushrecovery.report.data import CriticalSection, Filmstrip, FilmstripsSection, Picture, Table
+from pushrecovery.report.markup import num, percent
 
 
-def _critical(ctx: _Context) -> str:
+def _critical(ctx: _Context) -> CriticalSection:
     from pushrecovery.sim.validation import available_strategies, critical_table
 
     grids = ctx.grids
@@ -30,7 +24,7 @@ def _critical(ctx: _Context) -> str:
             tolerance=tolerance,
         ):
             rows.append(
-                [
+                (
                     row.strategy,
                     f"{row.model} + {row.controller}",
                     row.direction,
@@ -42,9 +36,9 @@ def _critical(ctx: _Context) -> str:
                     percent(row.relative_error),
                     percent(row.corrected_error),
                     str(row.simulations),
-                ]
+                )
             )
-    header = [
+    header = (
         "strategy",
         "model + controller",
         "direction",
@@ -56,17 +50,11 @@ def _critical(ctx: _Context) -> str:
         "vs predicted",
         "vs corrected",
         "simulations",
-    ]
-    return paragraph(
-        "The largest push each strategy recovers in MuJoCo (bisection on a real force, shown "
-        "as J/m), against the paper's surface (Eq. 4, corrected Eq. 15, the single-step limit "
-        "of Sec. IV) and, for ankle and hip, the prediction corrected for the foot's usable "
-        "length and the push's duration (docs/validation.md).",
-        "lead",
-    ) + table(header, rows, text_columns=3)
+    )
+    return CriticalSection(Table(header, tuple(rows), text_columns=3))
 
 
-def _filmstrips(ctx: _Context) -> str:
+def _filmstrips(ctx: _Context) -> FilmstripsSection:
     from pushrecovery.control.base import make_controller
     from pushrecovery.experiments.pushes import strategy_pushes
     from pushrecovery.sim.backend import Recording
@@ -81,27 +69,19 @@ def _filmstrips(ctx: _Context) -> str:
     from pushrecovery.sim.registry import MUJOCO_MODELS, make_plant
     from pushrecovery.sim.simulate import simulate
 
-    lead = paragraph(
-        "One MuJoCo run per strategy from upright, pushed by a real force: the ankle strategy "
-        "inside Eq. (4), the hip strategy beyond it but inside corrected Eq. (15), and a step "
-        "beyond both (Sec. IV). Red: CoM; blue: capture point; green: CoP.",
-        "lead",
-    )
     try:
         require_offscreen_gl()
     except PushRecoveryError as exc:
-        return lead + paragraph(
-            f"Rendering is not available on this machine, so there are no filmstrips: {esc(exc)}",
-            "note",
-        )
-    parts = [lead]
+        return FilmstripsSection((), unavailable=str(exc))
+    strips = []
     folder = ctx.out / "filmstrips"
     pushes = strategy_pushes(ctx.params)
     for strategy, (model, controller, name) in FILMSTRIPS.items():
         impulse = pushes.impulse(strategy, ctx.params.mass)
         caption = f"{name}, {impulse:g} N s"
+        velocity = impulse / ctx.params.mass
         if model not in MUJOCO_MODELS:
-            parts.append(paragraph(f"No MuJoCo model {esc(model)} for {esc(strategy)}.", "note"))
+            strips.append(Filmstrip(strategy, model, caption, impulse, velocity, None, None))
             continue
         plant = make_plant(model, ctx.params, "mujoco")
         if not isinstance(plant, Recording):  # pragma: no cover - every MuJoCo plant records
@@ -121,12 +101,17 @@ def _filmstrips(ctx: _Context) -> str:
             folder / f"{strategy}.png",
             title=f"{caption}: {run.outcome.value}",
         )
-        parts.append(
-            f"<h3>{esc(strategy)}</h3>\n"
-            + figure(
-                path,
-                f"{esc(caption)} (ẋ = J/m = {num(impulse / ctx.params.mass, 3)} m/s): "
-                f"{esc(run.outcome.value)}.",
+        strips.append(
+            Filmstrip(
+                strategy,
+                model,
+                caption,
+                impulse,
+                velocity,
+                run.outcome.value,
+                Picture(
+                    path, f"{caption} (ẋ = J/m = {num(velocity, 3)} m/s): {run.outcome.value}."
+                ),
             )
         )
-    return "".join(parts)
+    return FilmstripsSection(tuple(strips))
