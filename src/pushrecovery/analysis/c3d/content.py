@@ -30,12 +30,16 @@ class ForcePlate:
         ``cop`` is.
     corners : ndarray, shape (4, 3)
         Plate corners in the file's order (C3D quadrants +x+y, −x+y, −x−y, +x−y) [m].
+    computed_by : {"ezc3d", "own"}
+        Who computed the plate: ezc3d's force-platform module or this package's formulas
+        (:func:`pushrecovery.analysis.c3d.plate_path`; the same numbers to rounding either way).
     """
 
     force: FloatArray
     cop: FloatArray
     free_moment: FloatArray
     corners: FloatArray
+    computed_by: str = "own"
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -92,6 +96,3 @@ class C3DContent:
         if self.analog_rate is None:
             return np.zeros(0)
         return self.first_time + np.arange(self.n_analog) / self.analog_rate
-
-
-# --- Pure plate geometry and wrenches ----------------------------------------------------------

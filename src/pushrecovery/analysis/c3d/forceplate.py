@@ -160,13 +160,19 @@ def wrench_type4(
 
 
 def plate_cop_in_plate_frame(
-    force: ArrayLike, moment: ArrayLike, *, threshold: float = 20.0
+    force: ArrayLike,
+    moment: ArrayLike,
+    *,
+    threshold: float = 20.0,
+    cop_poly: ArrayLike | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """CoP and free moment in the plate frame from the wrench about the top-surface centre.
 
     The force acts at c = (cx, cy, 0) on the top surface with a free moment Tz about the
     plate's z axis only, so M = c × F + (0, 0, Tz): cx = −My/Fz, cy = Mx/Fz and
-    Tz = Mz − cx Fy + cy Fx.
+    Tz = Mz − cx Fy + cy Fx. With ``cop_poly`` the CoP is first corrected by Kistler's
+    polynomial (:func:`kistler_cop_correction`) and Tz taken about the corrected CoP, as ezc3d
+    does.
 
     Parameters
     ----------
@@ -176,6 +182,8 @@ def plate_cop_in_plate_frame(
         Moment of that force about the top-surface centre [N m] (:func:`wrench_type2` ...).
     threshold : float
         Smallest Fz [N] with a defined CoP, >= 0.
+    cop_poly : array_like, shape (12,), optional
+        ``FORCE_PLATFORM:FPCOPPOLY`` of this plate (Kistler's coefficients, for the CoP in mm).
 
     Returns
     -------
@@ -194,8 +202,66 @@ def plate_cop_in_plate_frame(
     fz = np.where(loaded, f[:, 2], np.nan)  # NaN, not inf, where the plate is unloaded
     cx = -m[:, 1] / fz
     cy = m[:, 0] / fz
+    if cop_poly is not None:  # Kistler's coefficients are for millimetres
+        corrected = kistler_cop_correction(np.column_stack([cx, cy]) * 1000.0, cop_poly)
+        cx, cy = corrected[:, 0] / 1000.0, corrected[:, 1] / 1000.0
     cop = np.column_stack([cx, cy, np.where(loaded, 0.0, np.nan)])
     return cop, m[:, 2] - cx * f[:, 1] + cy * f[:, 0]
+
+
+def kistler_cop_correction(cop_mm: ArrayLike, coefficients: ArrayLike) -> FloatArray:
+    """Kistler's CoP correction polynomial (``FORCE_PLATFORM:FPCOPPOLY``) applied to a CoP.
+
+    With (ax, ay) the measured CoP [mm] relative to the plate centre in Kistler's plate frame
+    (the plate frame here: sensor 1 at (+a, +b), z down) and the coefficients P1x ... P6x,
+    P1y ... P6y in that order::
+
+        Δx = (P1x ay⁴ + P2x ay² + P3x) ax³ + (P4x ay⁴ + P5x ay² + P6x) ax
+        Δy = (P1y ax⁴ + P2y ax² + P3y) ay³ + (P4y ax⁴ + P5y ax² + P6y) ay
+        corrected = (ax − Δx, ay − Δy)
+
+    Source: Kistler's manual of the 9281E/9287C plates, section 8.4.3 "COP Correction
+    Algorithm for Force Plates" (it lists the coefficients per plate model); ezc3d applies the
+    same to type-3 plates (pyomeca/ezc3d#253, PR #297). docs/c3d.md has the details.
+
+    Parameters
+    ----------
+    cop_mm : array_like, shape (n, 2) or (n, 3)
+        Measured CoP (ax, ay[, az]) [mm], plate frame; a third column is returned unchanged.
+        NaN rows stay NaN.
+    coefficients : array_like, shape (12,)
+        P1x, ..., P6x, P1y, ..., P6y (units making Δx, Δy millimetres).
+
+    Returns
+    -------
+    ndarray, same shape as ``cop_mm``
+        The corrected CoP [mm].
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``coefficients`` are not 12 finite numbers or ``cop_mm`` is not (n, 2) or (n, 3).
+    """
+    values = np.asarray(coefficients, dtype=np.float64).reshape(-1)
+    if values.shape != (12,) or not np.isfinite(values).all():
+        raise InvalidParameterError(
+            "FORCE_PLATFORM:FPCOPPOLY must hold 12 finite coefficients per plate "
+            f"(P1x..P6x, P1y..P6y), got {values.size}"
+        )
+    cop = np.array(cop_mm, dtype=np.float64)
+    if cop.ndim != 2 or cop.shape[1] not in (2, 3):
+        raise InvalidParameterError(f"cop_mm must be (n, 2) or (n, 3), got shape {cop.shape}")
+    ax, ay = cop[:, 0].copy(), cop[:, 1].copy()
+    px, py = values[:6], values[6:]
+    dx = (px[0] * ay**4 + px[1] * ay**2 + px[2]) * ax**3 + (
+        px[3] * ay**4 + px[4] * ay**2 + px[5]
+    ) * ax
+    dy = (py[0] * ax**4 + py[1] * ax**2 + py[2]) * ay**3 + (
+        py[3] * ax**4 + py[4] * ax**2 + py[5]
+    ) * ay
+    cop[:, 0] = ax - dx
+    cop[:, 1] = ay - dy
+    return cop
 
 
 # --- Reading --------------------------------------------------------------------------------

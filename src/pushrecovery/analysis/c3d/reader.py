@@ -8,29 +8,19 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.analysis.c3d.content import C3DContent, ForcePlate
-from pushrecovery.analysis.c3d.forceplate import (
-    _load_sign,
-    _threshold,
-    plate_cop_in_plate_frame,
-    plate_frame,
-    wrench_type2,
-    wrench_type3,
-)
+from pushrecovery.analysis.c3d.content import C3DContent
+from pushrecovery.analysis.c3d.forceplate import _threshold
 from pushrecovery.analysis.c3d.header import _check_header
 from pushrecovery.analysis.c3d.parameters import (
-    _CHANNEL_KINDS,
     _LENGTH_UNITS,
-    _cal_matrix,
     _first_text,
     _lab_up,
     _labels,
     _mass,
     _param,
     _rate,
-    _required,
-    _unit_scale,
 )
+from pushrecovery.analysis.c3d.plates import read_plates
 from pushrecovery.errors import InputFileError
 
 FloatArray = NDArray[np.float64]
@@ -112,7 +102,7 @@ def _content(file: Path, c3d: Any, threshold: float) -> C3DContent:
             markers[label] = values
 
     analog_rate = _rate(file, params, "ANALOG") if n_channels else None
-    plates = _plates(
+    plates = read_plates(
         file, params, analogs[0] if n_channels else np.zeros((0, 0)), length, threshold
     )
     return C3DContent(
@@ -127,87 +117,6 @@ def _content(file: Path, c3d: Any, threshold: float) -> C3DContent:
         n_analog=n_analog,
         up=_lab_up(params),
     )
-
-
-def _plates(
-    file: Path, params: Any, analogs: FloatArray, length: float, threshold: float
-) -> tuple[ForcePlate, ...]:
-    """Every plate of FORCE_PLATFORM in the lab frame (``analogs``: channels × samples)."""
-    used = _param(params, "FORCE_PLATFORM", "USED")
-    n_plates = int(np.asarray(used).ravel()[0]) if used is not None and np.size(used) else 0
-    if n_plates <= 0:
-        return ()
-    types = np.asarray(_required(file, params, "FORCE_PLATFORM", "TYPE")).ravel().astype(int)
-    corners = np.asarray(_required(file, params, "FORCE_PLATFORM", "CORNERS"), dtype=np.float64)
-    origins = np.asarray(_required(file, params, "FORCE_PLATFORM", "ORIGIN"), dtype=np.float64)
-    channel = np.asarray(_required(file, params, "FORCE_PLATFORM", "CHANNEL")).astype(int)
-    if channel.ndim == 1:
-        channel = channel[:, None]
-    if types.size < n_plates or corners.size < 12 * n_plates or origins.size < 3 * n_plates:
-        raise InputFileError(
-            f"{file}: FORCE_PLATFORM describes fewer plates than FORCE_PLATFORM:USED = {n_plates}"
-        )
-    corners = corners.reshape(3, 4, -1, order="F") if corners.ndim != 3 else corners
-    origins = origins.reshape(3, -1, order="F") if origins.ndim != 2 else origins
-    unit_values = _param(params, "ANALOG", "UNITS")
-    units = [] if unit_values is None else [str(u) for u in np.atleast_1d(unit_values)]
-    point_unit = _first_text(_param(params, "POINT", "UNITS")).strip() or "mm"
-    up = _lab_up(params)
-    plates = []
-    for index in range(n_plates):
-        kind = int(types[index])
-        if kind not in _CHANNEL_KINDS:
-            raise InputFileError(
-                f"{file}: force plate {index + 1} has unsupported FORCE_PLATFORM:TYPE {kind} "
-                "(supported: 1, 2, 3, 4)"
-            )
-        kinds = _CHANNEL_KINDS[kind]
-        numbers: list[int] = (
-            [int(n) for n in channel[: len(kinds), index]] if channel.shape[1] > index else []
-        )
-        if len(numbers) < len(kinds) or min(numbers) < 1 or max(numbers) > analogs.shape[0]:
-            raise InputFileError(
-                f"{file}: force plate {index + 1} (type {kind}) needs {len(kinds)} analog "
-                f"channels; FORCE_PLATFORM:CHANNEL lists {numbers} of "
-                f"{analogs.shape[0]} recorded"
-            )
-        raw = analogs[np.asarray(numbers) - 1].T  # (n, channels)
-        scales = np.array(
-            [
-                _unit_scale(file, units, number - 1, what, point_unit, length, kind == 4)
-                for number, what in zip(numbers, kinds, strict=True)
-            ]
-        )
-        origin = origins[:, index] * length
-        if kind == 1:
-            data = raw * scales
-            force = data[:, :3]
-            cop = np.column_stack([data[:, 3], data[:, 4], np.zeros(len(data))])
-            free = data[:, 5]
-            sign = _load_sign(force)
-            force, free = sign * force, sign * free
-            unloaded = force[:, 2] < threshold
-            cop[unloaded] = np.nan
-            free = np.where(unloaded, np.nan, free)
-        else:
-            if kind == 2:
-                force, moment = wrench_type2(raw * scales, origin)
-            elif kind == 3:
-                force, moment = wrench_type3(raw * scales, origin)
-            else:  # calibrate first: the units are those of the calibrated outputs
-                calibrated = raw @ _cal_matrix(file, params, index).T * scales
-                force, moment = wrench_type2(calibrated, origin)
-            sign = _load_sign(force)
-            force, moment = sign * force, sign * moment
-            cop, free = plate_cop_in_plate_frame(force, moment, threshold=threshold)
-        rotation, centre = plate_frame(corners[:, :, index].T * length, up)
-        grf = -(force @ rotation.T)
-        cop_lab = centre + cop @ rotation.T
-        lab_corners = corners[:, :, index].T * length
-        for array in (grf, cop_lab, free, lab_corners):
-            array.setflags(write=False)
-        plates.append(ForcePlate(grf, cop_lab, free, lab_corners))
-    return tuple(plates)
 
 
 def _one_line(exc: BaseException) -> str:
