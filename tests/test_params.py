@@ -22,11 +22,19 @@ def test_params_are_frozen(params):
 @pytest.mark.parametrize(
     ("field", "value", "words"),
     [
-        ("mass", 0.0, "mass must be > 0"),
-        ("mass", -72.0, "mass must be > 0"),
-        ("com_height", 0.0, "com_height must be > 0"),
-        ("com_height", -1.0, "com_height must be > 0"),
-        ("gravity", 0.0, "gravity must be > 0"),
+        ("mass", 0.0, r"mass must be in \[0.01, 10000\] \[kg\], got mass=0"),
+        ("mass", -72.0, r"mass must be in \[0.01, 10000\]"),
+        ("com_height", 0.0, r"com_height must be in \[0.01, 10\]"),
+        ("com_height", -1.0, r"com_height must be in \[0.01, 10\]"),
+        ("gravity", 0.0, r"gravity must be in \[0.1, 100\]"),
+        # Physically meaningless magnitudes are refused before any arithmetic (issue 16).
+        ("gravity", 1e15, r"gravity must be in \[0.1, 100\] \[m/s\^2\], got gravity=1e\+15"),
+        ("mass", 1e-300, r"mass must be in \[0.01, 10000\]"),
+        ("leg_length", 1e300, r"leg_length must be in \[0.01, 10\]"),
+        ("torque_max", 1e300, r"torque_max must be in \[0, 100000\]"),
+        ("flywheel_inertia", 1e30, r"flywheel_inertia must be in \[1e-06, 10000\]"),
+        ("flywheel_angle_max", 4.0, r"flywheel_angle_max must be in \[0.001, 3.14159\]"),
+        ("torque_max_roll", -1.0, r"torque_max_roll must be in \[0, 100000\]"),
         ("mass", math.nan, "mass must be a finite number"),
         ("toe", math.inf, "toe must be a finite number"),
         ("heel", 0.2, "heel must be < toe"),  # inverted foot
@@ -34,10 +42,10 @@ def test_params_are_frozen(params):
         ("heel", 0.01, "heel must be < 0"),
         ("toe", -0.01, "toe must be > 0"),
         ("toe", 2.0, "closer to the ankle than com_height"),
-        ("flywheel_inertia", -1.0, "flywheel_inertia must be > 0"),
-        ("torque_max", -1.0, "torque_max must be >= 0"),
-        ("flywheel_angle_max", 0.0, "flywheel_angle_max must be > 0"),
-        ("leg_length", -1.0, "leg_length must be > 0"),
+        ("flywheel_inertia", -1.0, "flywheel_inertia must be in"),
+        ("torque_max", -1.0, r"torque_max must be in \[0,"),
+        ("flywheel_angle_max", 0.0, "flywheel_angle_max must be in"),
+        ("leg_length", -1.0, "leg_length must be in"),
     ],
 )
 def test_bad_values_name_the_parameter(field, value, words):

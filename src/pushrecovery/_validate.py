@@ -30,6 +30,16 @@ def positive_float(name: str, value: object, unit: str = "") -> float:
     return number
 
 
+def bounded_float(name: str, value: object, low: float, high: float, unit: str = "") -> float:
+    """Return ``value`` as a finite float in [``low``, ``high``] or raise naming the range."""
+    number = finite_float(name, value, unit, allowed=f"in [{low:g}, {high:g}]")
+    if not low <= number <= high:
+        raise InvalidParameterError(
+            f"{name} must be in [{low:g}, {high:g}]{_unit(unit)}, got {name}={number:g}"
+        )
+    return number
+
+
 def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
     """Return ``value`` as a float64 array with only finite entries, or raise naming ``name``."""
     try:
