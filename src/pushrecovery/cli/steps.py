@@ -8,6 +8,7 @@ from typing import Any
 import click
 
 from pushrecovery.cli.options import body_options, emit, params_from, support_from, support_options
+from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["capture_region_command"]
 
@@ -107,7 +108,10 @@ def capture_region_command(
         "area": region.area,
         "vertices": None if region.polygon is None else region.polygon.to_list(),
         "foothold": None if region.foothold is None else [float(v) for v in region.foothold],
-        "capture_point_xy": [x + xdot / params.omega, y + ydot / params.omega],
+        "capture_point_xy": [
+            capture_point(x, xdot, params.omega),
+            capture_point(y, ydot, params.omega),
+        ],
         "support": support.to_dict(),
         "state": {"x": x, "y": y, "xdot": xdot, "ydot": ydot},
     }

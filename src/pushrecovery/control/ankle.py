@@ -15,6 +15,7 @@ from pushrecovery._validate import finite_float
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["AnkleCapturePoint", "AnklePD", "AnkleSaturated", "default_pd_gains"]
 
@@ -37,7 +38,7 @@ class AnkleSaturated(Controller):
     def __init__(self, params: BodyParams) -> None:
         super().__init__(params)
         self._direction = 0.0
-        self._inv_omega = 1.0 / params.omega
+        self._omega = params.omega
 
     def reset(self, state: NDArray[np.float64]) -> None:
         """Record the push direction from the initial CoM velocity."""
@@ -51,7 +52,7 @@ class AnkleSaturated(Controller):
             edge = self.params.toe if self._direction > 0.0 else self.params.heel
             return Command(edge, saturated=True)
         self._direction = 0.0
-        cop, clipped = self.clip_cop(x + xdot * self._inv_omega)
+        cop, clipped = self.clip_cop(capture_point(x, xdot, self._omega))
         return Command(cop, saturated=clipped)
 
 
@@ -139,7 +140,7 @@ class AnkleCapturePoint(Controller):
         omega = params.omega if omega is None else finite_float("omega", omega, "1/s")
         if omega <= 0.0:
             raise InvalidParameterError(f"omega must be > 0 1/s, got {omega:g}")
-        self._inv_omega = 1.0 / omega
+        self._omega = omega
 
     def reset(self, state: NDArray[np.float64]) -> None:
         """Do nothing: the controller has no internal state."""
@@ -147,5 +148,5 @@ class AnkleCapturePoint(Controller):
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """CoP at ξ = x + ẋ/ω, clipped to the foot [m]."""
         x, xdot = float(state[0]), float(state[len(state) // 2])
-        cop, clipped = self.clip_cop(x + xdot * self._inv_omega)
+        cop, clipped = self.clip_cop(capture_point(x, xdot, self._omega))
         return Command(cop, saturated=clipped)

@@ -12,6 +12,7 @@ from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import FLYWHEEL_STATE, bang_bang_switch_time, max_spin_up_time
 from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["BangBang"]
 
@@ -60,13 +61,13 @@ class BangBang(Controller):
         self._tick = spin_up / math.ceil(spin_up / 1e-3)
         self.control_period = self._tick
         self.switch_time = 0.0
-        self._inv_omega = 1.0 / params.omega
+        self._omega = params.omega
         self._direction = 0.0
 
     def reset(self, state: NDArray[np.float64]) -> None:
         """Choose the direction and length of the spin-up from the initial capture point."""
         p = self.params
-        capture = float(state[0]) + float(state[len(state) // 2]) * self._inv_omega
+        capture = capture_point(float(state[0]), float(state[len(state) // 2]), self._omega)
         if capture >= p.toe:
             self._direction, edge = 1.0, p.toe
         elif capture <= p.heel:
@@ -91,5 +92,5 @@ class BangBang(Controller):
             sign = direction if t < switch else -direction
             return Command(edge, sign * self.params.torque_max, saturated=True)
         x, xdot = float(state[0]), float(state[len(state) // 2])
-        cop, clipped = self.clip_cop(x + xdot * self._inv_omega)
+        cop, clipped = self.clip_cop(capture_point(x, xdot, self._omega))
         return Command(cop, saturated=clipped)

@@ -14,6 +14,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.stepping import STEPPING_STATE
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
+from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.step import plan_steps
 
 __all__ = ["RecoveryController"]
@@ -98,7 +99,7 @@ class RecoveryController(Controller):
             self._swing_start, self.mode, self._held = None, "ankle", None
         body, mpc = self._body(z)
         omega = math.sqrt(p.gravity / z)
-        capture = x + xdot / omega
+        capture = capture_point(x, xdot, omega)
         upright = abs(theta) < _UPRIGHT and abs(theta_rate) < _UPRIGHT
         if self.mode == "ankle" and not (p.heel < capture < p.toe and upright):
             region = cmp_region(body)

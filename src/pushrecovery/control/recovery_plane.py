@@ -46,6 +46,7 @@ from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, roll_axis
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.n_step import hip_box
 from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.step_regions import StepRegions
@@ -142,7 +143,7 @@ class PlaneRecoveryController(Controller):
         if swing is not None and t >= swing[2] - 1e-9:
             self._land(*swing)
         omega = self.params.omega
-        xi = np.array([state[0] + state[4] / omega, state[1] + state[5] / omega])
+        xi = capture_point(state[0:2], state[4:6], omega)
         pitch, roll = self._hip_torques(t)
         if self._swing is not None and self.plan is not None:
             cop = self.plan.cops[0]

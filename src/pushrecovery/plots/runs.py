@@ -16,6 +16,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import FALL_COLOUR, RECOVER_COLOUR, save_figure, shade_regions
 from pushrecovery.sim.result import SimulationResult
+from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["plane_run_figure", "save_run"]
 
@@ -84,7 +85,7 @@ def plane_run_figure(result: SimulationResult, params: BodyParams) -> Figure:
         if first:
             ax.annotate(str(i - 1), (x, y), ha="center", va="center", fontsize=8)
     colour = RECOVER_COLOUR if result.recovered else FALL_COLOUR
-    xi = states[:, 0:2] + states[:, 4:6] / omega
+    xi = capture_point(states[:, 0:2], states[:, 4:6], omega)
     ax.plot(states[:, 0], states[:, 1], color=colour, label="CoM")
     ax.plot(xi[:, 0], xi[:, 1], color=colour, ls="--", lw=1, label="capture point")
     # Points, not a line: the CoP jumps from foot to foot.

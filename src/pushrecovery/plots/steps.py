@@ -20,6 +20,7 @@ from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR
+from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["STEP_COLOURS", "capture_regions_figure", "n_step_map_figure"]
 
@@ -60,7 +61,7 @@ def draw_capture_regions(
     from pushrecovery.surfaces.plane import cmp_polygon
 
     x, y, xdot, ydot = state
-    xi = (x + xdot / params.omega, y + ydot / params.omega)
+    xi = (capture_point(x, xdot, params.omega), capture_point(y, ydot, params.omega))
     _fill(ax, support.polygon, RECOVER_COLOUR, "support polygon (ankle)")
     _outline(ax, cmp_polygon(support, params), HIP_COLOUR, "CMP region (hip)")
     corners = [support.polygon.vertices, np.array([xi])]
@@ -163,7 +164,7 @@ def n_step_map_figure(
     vs = np.linspace(*top, resolution)
     x, v = np.meshgrid(xs, vs)
     codes = classify_states(x, v, params)
-    steps = line_steps(x + v / omega, params.heel, params.toe, 0.0, params).steps
+    steps = line_steps(capture_point(x, v, omega), params.heel, params.toe, 0.0, params).steps
     # 0 ankle, 1 hip, 2..5 steps 1..4+, 6 fall.
     shade = np.where(codes == STRATEGY_CODES.index(Strategy.STEP), 1 + np.minimum(steps, 4), 0)
     shade = np.where(codes == STRATEGY_CODES.index(Strategy.HIP), 1, shade)

@@ -25,6 +25,7 @@ from pushrecovery._validate import positive_float
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["CaptureLP", "largest_capture_point"]
 
@@ -99,7 +100,7 @@ def largest_capture_point(
         rows[np.arange(steps), 2 + 2 * np.arange(steps)] += h * h / (2 * params.flywheel_inertia)
         inside.append(rows)
     theta_rows = np.vstack([s[1:, 1, :], *inside])
-    capture_end = s[steps, 0, :] + s[steps, 2, :] / omega
+    capture_end = capture_point(s[steps, 0, :], s[steps, 2, :], omega)
     a_ub = np.vstack([theta_rows, -theta_rows, capture_end, -capture_end])
     b_ub = np.concatenate(
         [np.full(2 * len(theta_rows), params.flywheel_angle_max), [params.toe, -params.heel]]

@@ -247,8 +247,7 @@ def _classify_plane(
     y = 0.0 if y is None else finite_float("y", y, "m")
     ydot = 0.0 if ydot is None else finite_float("ydot", ydot, "m/s")
     support = Support.from_params(params) if support is None else support
-    inv = 1.0 / params.omega  # ξ as the monitor and the compiled margins compute it
-    xi = (x + xdot * inv, y + ydot * inv)
+    xi = (capture_point(x, xdot, params.omega), capture_point(y, ydot, params.omega))
     hip_region = cmp_polygon(support, params)
     cop = float(support.polygon.signed_distance(*xi))
     cmp = float(hip_region.signed_distance(*xi))

@@ -17,6 +17,7 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -57,24 +58,39 @@ class CaptureInterval:
         return 0.5 * (self.upper - self.lower)
 
 
-def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> NDArray[np.float64]:
+@overload
+def capture_point(x: float, xdot: float, omega: float) -> float: ...
+
+
+@overload
+def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> NDArray[np.float64]: ...
+
+
+def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> float | NDArray[np.float64]:
     """Capture point ξ = x + ẋ/ω, the middle term of Eq. (4) [m].
+
+    The one definition in the project (controllers, plots, the CLI and the surfaces call it);
+    two Python floats give a float without touching numpy (a controller's tick), anything
+    else an array.
 
     Parameters
     ----------
-    x : array_like
-        CoM position relative to the ankle [m], x forward.
-    xdot : array_like
+    x : float or array_like
+        CoM position relative to the ankle [m], x forward (or one axis of the plane).
+    xdot : float or array_like
         CoM velocity [m/s].
     omega : float
         LIPM natural frequency sqrt(g / L) [1/s], > 0.
 
     Returns
     -------
-    ndarray
+    float or ndarray
         ξ [m], where the CoP would have to be for the CoM to come to rest over it.
     """
-    return np.asarray(x, dtype=np.float64) + np.asarray(xdot, dtype=np.float64) / omega
+    inv = 1.0 / omega  # multiplied, as the compiled kernels do: the same ξ to the bit
+    if type(x) is float and type(xdot) is float:
+        return x + xdot * inv
+    return np.asarray(x, dtype=np.float64) + np.asarray(xdot, dtype=np.float64) * inv
 
 
 def cop_region(params: BodyParams) -> CaptureInterval:

@@ -26,6 +26,7 @@ from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import Strategy
+from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.step_regions import StepRegions
 
@@ -122,13 +123,13 @@ class BalanceMonitor:
     'hip'
     """
 
-    __slots__ = ("_cmp", "_cop", "_inv_omega", "_locate", "_regions", "params", "support")
+    __slots__ = ("_cmp", "_cop", "_locate", "_omega", "_regions", "params", "support")
 
     def __init__(self, params: BodyParams, support: Support | None = None) -> None:
         from pushrecovery.surfaces._kernels import locate_steps
 
         self.params = params
-        self._inv_omega = 1.0 / params.omega
+        self._omega = params.omega
         self._locate: Callable[..., tuple[int, float]] = locate_steps
         self.set_support(Support.from_params(params) if support is None else support)
         self.query(0.0, 0.0, 10.0, 0.0)  # loads every compiled path before the first tick
@@ -161,8 +162,8 @@ class BalanceMonitor:
         InvalidParameterError
             If a value is NaN or infinite.
         """
-        px = x + xdot * self._inv_omega
-        py = y + ydot * self._inv_omega
+        px = capture_point(x, xdot, self._omega)
+        py = capture_point(y, ydot, self._omega)
         if not (math.isfinite(px) and math.isfinite(py) and math.isfinite(x + y)):
             raise InvalidParameterError(
                 f"x, y, xdot, ydot must be finite, got {x!r}, {y!r}, {xdot!r}, {ydot!r}"

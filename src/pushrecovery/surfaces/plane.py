@@ -44,7 +44,7 @@ from pushrecovery.ground.support import Stance, Support
 from pushrecovery.models._step_scalar import step_line
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
-from pushrecovery.surfaces.cop import _fusable
+from pushrecovery.surfaces.cop import _fusable, capture_point
 from pushrecovery.surfaces.step import StepDecision, plan_step, step_feasible
 
 __all__ = [
@@ -90,10 +90,9 @@ def capture_point_xy(
     (ndarray, ndarray)
         ξ_x and ξ_y [m].
     """
-    inv = 1.0 / omega
     return (
-        np.asarray(x, dtype=np.float64) + np.asarray(xdot, dtype=np.float64) * inv,
-        np.asarray(y, dtype=np.float64) + np.asarray(ydot, dtype=np.float64) * inv,
+        np.asarray(capture_point(x, xdot, omega), dtype=np.float64),
+        np.asarray(capture_point(y, ydot, omega), dtype=np.float64),
     )
 
 

@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
+from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.n_step import landing_viable
 
 __all__ = ["TouchdownImpact", "plan_impacts"]
@@ -122,8 +123,8 @@ def plan_impacts(
         start = t
         q = plan.footholds[k]
         after = v + (v @ (r - ankle)) / height**2 * (r - q)
-        xi = r + v / omega
-        xi_impact = r + after / omega
+        xi = capture_point(r, v, omega)
+        xi_impact = capture_point(r, after, omega)
         remaining = landing_viable(params, plan.swings[k], yaw, plan.steps - 1 - k)
         region = remaining.transformed(float(q[0]), float(q[1]), 0.0)
         speed = float(np.hypot(*v))
