@@ -264,7 +264,12 @@ def test_table_output_is_readable():
         (["step", "--v0-range", "0.1", "1e9", "1e-9"], "at most 100000"),
         (["bounds", "--max-step-length", "3"], "max_step_length must be < 2 leg_length"),
         (["simulate", "--model", "flywheel", "--controller", "recovery"], "stepping model"),
-        (["simulate", "--duration", "1e12"], "must be <= 1e+07 steps"),
+        (["simulate", "--duration", "1e12"], "duration must be in (0, 60] s, got duration=1e+12"),
+        (["simulate", "--duration", "60", "--control-period", "1e-6"], "must be <= 1e+07 steps"),
+        (
+            ["simulate", "--model", "flywheel", "--controller", "mpc", "--option", "horizon=3000"],
+            "horizon must be an integer in [1, 200], got 3000",
+        ),
         (["simulate", "--x", "1.79e308"], "x must satisfy |x| < com_height"),
         (["simulate", "--xdot", "3000"], "xdot must satisfy"),
         (

@@ -180,7 +180,7 @@ def test_mpc_critical_push_close_to_the_bound():
 
 
 def test_settings_validation():
-    with pytest.raises(InvalidParameterError, match="horizon must be an integer >= 1"):
+    with pytest.raises(InvalidParameterError, match="horizon must be an integer in \\[1, 200\\]"):
         MPCSettings(horizon=0)
     with pytest.raises(InvalidParameterError, match="gamma must be in"):
         MPCSettings(gamma=1.5)

@@ -18,6 +18,8 @@ from pushrecovery.params import FIELD_NAMES, BodyParams
 __all__ = ["PRESETS", "load_params"]
 
 
+#: Largest parameter file [bytes]: a body is a few hundred bytes of TOML.
+MAX_TOML_BYTES = 64 * 1024
 #: Built-in presets. ``paper``: the flywheel values of Fig. 5(b) (I, τmax, θmax); the body and
 #: foot are our documented choice (a 72 kg adult, CoM 1 m above the ankle, 20 cm foot with the
 #: ankle 5 cm in front of the heel, 10 cm wide, ankles 20 cm apart; the roll axis of the upper
@@ -150,11 +152,23 @@ def _polygon_value(value: Any) -> tuple[tuple[float, float], ...]:
 
 
 def _read_toml(path: Path) -> dict[str, Any]:
+    import stat
     import tomllib  # here, not at the top: 10-20 ms of every start-up without a file
 
     try:
+        # A FIFO or a device would block or never end: only regular files, and small ones.
+        mode = path.stat().st_mode
+        if stat.S_ISDIR(mode):
+            raise InputFileError(f"parameter file {path} is a directory")
+        if not stat.S_ISREG(mode):
+            raise InputFileError(f"parameter file {path} is not a regular file")
         with path.open("rb") as handle:
-            data = tomllib.load(handle)
+            text = handle.read(MAX_TOML_BYTES + 1)
+        if len(text) > MAX_TOML_BYTES:
+            raise InputFileError(
+                f"parameter file {path} is larger than {MAX_TOML_BYTES // 1024} KiB"
+            )
+        data = tomllib.loads(text.decode("utf-8"))
     except FileNotFoundError:
         raise InputFileError(f"parameter file not found: {path}") from None
     except OSError as exc:
@@ -163,8 +177,8 @@ def _read_toml(path: Path) -> dict[str, Any]:
         raise InputFileError(f"malformed TOML in {path}: {exc}") from None
     except UnicodeDecodeError:
         raise InputFileError(f"parameter file {path} is not UTF-8 text (TOML)") from None
-    except IsADirectoryError:
-        raise InputFileError(f"parameter file {path} is a directory") from None
+    except RecursionError:
+        raise InputFileError(f"malformed TOML in {path}: nested too deeply") from None
     body = data.pop("body", None)
     if body is not None:
         if not isinstance(body, dict):

@@ -185,12 +185,19 @@ def _connect(scheduler: str) -> Any:
     from distributed import Client
     from distributed.comm import parse_address
 
+    malformed = CampaignError(
+        f"--scheduler must be an address such as tcp://HOST:PORT, got {scheduler!r}"
+    )
     try:
-        parse_address(scheduler, strict=True)
+        scheme, location = parse_address(scheduler, strict=True)
     except ValueError:
-        raise CampaignError(
-            f"--scheduler must be an address such as tcp://HOST:PORT, got {scheduler!r}"
-        ) from None
+        raise malformed from None
+    # Dask accepts "tcp://" and then waits for the connect timeout: check host and port here.
+    host, _, port = location.rpartition(":")
+    if scheme in ("tcp", "tls", "ws", "wss") and not (
+        host.strip("[]") and port.isdigit() and 0 < int(port) < 65536
+    ):
+        raise malformed
     try:
         return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:

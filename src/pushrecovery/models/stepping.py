@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models._step_scalar import MAX_STEP_ANGLE as MAX_STEP_ANGLE
 from pushrecovery.models._step_scalar import step_angle
 
@@ -218,8 +219,26 @@ def step_solution(
     Returns
     -------
     StepSolution
+
+    Raises
+    ------
+    InvalidParameterError
+        On a non-finite value, a length or gravity out of :data:`~pushrecovery.params.LIMITS`,
+        or |v0| >= 10 sqrt(g L) (ten times the speed at which the stance foot leaves the
+        floor: no step of this model, and float64 overflow beyond).
     """
-    v0 = np.asarray(v0, dtype=np.float64)
+    from pushrecovery._validate import bounded_float, finite_array
+    from pushrecovery.params import LIMITS
+
+    length = bounded_float("length", length, *LIMITS["leg_length"])
+    gravity = bounded_float("gravity", gravity, *LIMITS["gravity"])
+    v0 = finite_array("v0", v0)
+    limit = 10.0 * math.sqrt(gravity * length)
+    if v0.size and float(np.max(np.abs(v0))) >= limit:
+        raise InvalidParameterError(
+            f"v0 must satisfy |v0| < 10 sqrt(g L) = {limit:g} m/s, "
+            f"got {float(np.max(np.abs(v0))):g}"
+        )
     targets = np.stack(np.broadcast_arrays(0.0, toe, heel, 0.5 * (heel + toe)))
     angles = solve_step_angle(
         v0[None, ...], targets.reshape((4,) + (1,) * v0.ndim), length, gravity

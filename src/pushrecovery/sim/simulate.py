@@ -28,6 +28,10 @@ __all__ = ["DEFAULT_CONTROL_PERIOD", "RestCriterion", "check_run", "simulate"]
 DEFAULT_CONTROL_PERIOD = 1e-3
 #: Longest run, in control ticks (memory for the trajectory: 8e7 floats at most).
 MAX_STEPS = 10_000_000
+#: Longest simulated time of one run [s]: a push is recovered or lost within seconds, and a
+#: bisection of runs that never come to rest (a PD without damping) stays within minutes of
+#: wall time (docs/reliability.md).
+MAX_DURATION = 60.0
 #: Largest ω · control_period: beyond it the hold between ticks dominates the dynamics.
 MAX_OMEGA_DT = 0.1
 #: Which model a controller of each strategy needs, for the error message.
@@ -240,6 +244,10 @@ def check_run(
     duration or the dynamics.
     """
     duration = positive_float("duration", duration, "s")
+    if duration > MAX_DURATION:
+        raise InvalidParameterError(
+            f"duration must be in (0, {MAX_DURATION:g}] s, got duration={duration:g}"
+        )
     if control_period is None:
         control_period = controller.control_period or DEFAULT_CONTROL_PERIOD
     elif controller.fixed_period and control_period != controller.control_period:

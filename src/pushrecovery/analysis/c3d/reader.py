@@ -21,6 +21,7 @@ from pushrecovery.analysis.c3d.parameters import (
     _rate,
 )
 from pushrecovery.analysis.c3d.plates import read_plates
+from pushrecovery.analysis.c3d.structure import check_parameter_section, read_parameter_section
 from pushrecovery.errors import InputFileError
 
 FloatArray = NDArray[np.float64]
@@ -57,6 +58,8 @@ def read_c3d(path: str | Path, *, threshold: float = 20.0) -> C3DContent:
         raise InputFileError(f"{file}: is a directory, not a C3D file")
     try:
         _check_header(file)
+        # ezc3d is C++: a record it misreads can end the process, so the section is walked here.
+        check_parameter_section(file, read_parameter_section(file))
     except OSError as exc:
         raise InputFileError(f"{file}: cannot read ({_one_line(exc)})") from exc
     import ezc3d  # heavy import, only when reading

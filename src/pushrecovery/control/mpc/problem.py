@@ -18,6 +18,10 @@ from pushrecovery.errors import InvalidParameterError
 __all__ = ["MPCSettings"]
 
 
+#: Longest horizon [samples]: 4 s at the default 0.02 s; the condensed QP grows as N² (a
+#: horizon of 3000 would take minutes to build and gigabytes to hold).
+MAX_HORIZON = 200
+
 @dataclass(frozen=True, slots=True)
 class MPCSettings:
     """Settings of the receding-horizon controller; defaults are the paper's (Sec. III-B).
@@ -48,8 +52,14 @@ class MPCSettings:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive_float("dt", self.dt, "s"))
-        if isinstance(self.horizon, bool) or not isinstance(self.horizon, int) or self.horizon < 1:
-            raise InvalidParameterError(f"horizon must be an integer >= 1, got {self.horizon!r}")
+        if (
+            isinstance(self.horizon, bool)
+            or not isinstance(self.horizon, int)
+            or not 1 <= self.horizon <= MAX_HORIZON
+        ):
+            raise InvalidParameterError(
+                f"horizon must be an integer in [1, {MAX_HORIZON}], got {self.horizon!r}"
+            )
         for name, values, size in (
             ("state_weights", self.state_weights, 4),
             ("input_weights", self.input_weights, 2),
