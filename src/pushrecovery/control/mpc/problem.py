@@ -22,6 +22,7 @@ __all__ = ["MPCSettings"]
 #: horizon of 3000 would take minutes to build and gigabytes to hold).
 MAX_HORIZON = 200
 
+
 @dataclass(frozen=True, slots=True)
 class MPCSettings:
     """Settings of the receding-horizon controller; defaults are the paper's (Sec. III-B).
