@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 OUT := out
 
-.PHONY: demo test bench lint venv clean
+.PHONY: demo test bench lint fuzz venv clean
 
 venv: $(STAMP)
 
@@ -28,6 +28,12 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run.py
+
+# Hostile input (docs/reliability.md): the API properties with 50x the examples, then 10,000
+# command lines and mutated C3D/CSV/TOML files in crash-isolated workers; one summary line.
+fuzz: $(STAMP)
+	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q -n 2 tests/test_api_hostile.py tests/test_hostile.py
+	$(BIN)/python tests/fuzz/campaign.py --cases 10000 --seed 0
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks examples

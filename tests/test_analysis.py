@@ -485,3 +485,12 @@ def test_body_axes_follow_the_files_up_axis():
     assert np.linalg.det(rotation) == pytest.approx(1.0)
     with pytest.raises(InvalidParameterError, match="horizontal"):
         body_rotation("y", y_up)
+
+
+def test_a_header_that_is_not_utf8_is_one_clear_line(tmp_path):
+    # Found by make fuzz: pyarrow decoded the names lazily and raised UnicodeDecodeError.
+    path = tmp_path / "latin1.csv"
+    path.write_bytes(b"time,com_\xe3p,com_ml\n" + b"".join(b"0.%02d,0,0\n" % i for i in range(12)))
+    with pytest.raises(InputFileError, match="the header is not UTF-8 text") as info:
+        read_csv_recording(path)
+    assert "\n" not in str(info.value)

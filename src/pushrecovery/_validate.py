@@ -40,12 +40,19 @@ def bounded_float(name: str, value: object, low: float, high: float, unit: str =
     return number
 
 
+def float_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
+    """Return ``value`` as a float64 array (values not checked), or raise naming ``name``."""
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidParameterError(
+            f"{name} must be a number or an array of numbers, got {str(value)[:40]!r}"
+        ) from None
+
+
 def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
     """Return ``value`` as a float64 array with only finite entries, or raise naming ``name``."""
-    try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{name} must be numeric, got {value!r}") from None
+    array = float_array(name, value)
     if not np.isfinite(array).all():
         bad = int(np.size(array) - np.count_nonzero(np.isfinite(array)))
         raise InvalidParameterError(f"{name} must be finite, got {bad} non-finite value(s)")

@@ -11,6 +11,7 @@ from __future__ import annotations
 __all__ = [
     "InputFileError",
     "InvalidParameterError",
+    "ParameterTypeError",
     "PushRecoveryError",
     "SimulationDiverged",
 ]
@@ -24,6 +25,13 @@ class InvalidParameterError(PushRecoveryError, ValueError):
     """A parameter or argument is outside its allowed range.
 
     The message names the parameter, the value received and the allowed range.
+    """
+
+
+class ParameterTypeError(PushRecoveryError, TypeError):
+    """An argument has the wrong type (a number where a mapping belongs, ...).
+
+    The message names the parameter, the type expected and the type received.
     """
 
 

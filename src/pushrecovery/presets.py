@@ -12,7 +12,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from pushrecovery.errors import InputFileError, InvalidParameterError
+from pushrecovery.errors import InputFileError, InvalidParameterError, ParameterTypeError
 from pushrecovery.params import FIELD_NAMES, BodyParams
 
 __all__ = ["PRESETS", "load_params"]
@@ -92,6 +92,11 @@ def load_params(
         )
     values.update(PRESETS[preset])
     values.update(from_file)
+    if overrides is not None and not isinstance(overrides, Mapping):
+        raise ParameterTypeError(
+            "overrides must be a mapping of parameter names to values, got "
+            f"{type(overrides).__name__}"
+        )
     values.update({k: v for k, v in (overrides or {}).items() if v is not None})
     unknown = sorted(set(values) - set(FIELD_NAMES))
     if unknown:

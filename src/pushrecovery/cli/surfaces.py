@@ -109,8 +109,6 @@ def step(
     **kwargs: Any,
 ) -> None:
     """Optimal step (Eq. 21) and the range of recovering steps for initial CoM velocities."""
-    import numpy as np
-
     from pushrecovery._validate import finite_array
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.models.stepping import step_solution
@@ -122,10 +120,6 @@ def step(
     if not values:
         raise InvalidParameterError("give --v0 V (repeatable) or --v0-range START STOP STEP")
     v0 = finite_array("v0", values)
-    if np.any(v0 < 1e-6):
-        raise InvalidParameterError(
-            "v0 must be >= 1e-6 m/s (a forward push; backward steps are the mirror image)"
-        )
     sol = step_solution(v0, params.leg_length, params.gravity, params.heel, params.toe)
     reach = params.max_step_length
     rows = [

@@ -32,8 +32,9 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.lipm import ANKLE_STATE
 from pushrecovery.params import BodyParams
@@ -139,6 +140,27 @@ class Controller(ABC):
     @abstractmethod
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """Return the command for time ``t`` [s] and ``state``."""
+
+    def command(self, t: float, state: ArrayLike) -> Command:
+        """Return :meth:`compute`'s command after checking ``t`` and ``state`` (a user's loop).
+
+        :meth:`compute` is the unchecked kernel :func:`~pushrecovery.sim.simulate.simulate`
+        calls at every tick, once it has checked the run; call this one from your own loop.
+
+        Raises
+        ------
+        InvalidParameterError
+            If ``t`` is not finite, or ``state`` is not a 1-D array of finite numbers with at
+            least one entry per :attr:`state_labels`.
+        """
+        time = finite_float("t", t, "s")
+        values = finite_array("state", state)
+        if values.ndim != 1 or values.size < len(self.state_labels):
+            raise InvalidParameterError(
+                f"state must be a 1-D array of at least {len(self.state_labels)} values "
+                f"{list(self.state_labels)}, got shape {values.shape}"
+            )
+        return self.compute(time, values)
 
     def observe(self, info: StepInfo) -> None:  # noqa: B027 - optional hook, no-op default
         """Take the plant's report of its last step (contract item 5); ignored by default."""

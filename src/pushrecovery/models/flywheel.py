@@ -19,6 +19,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import positive_float
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
 __all__ = [
@@ -31,6 +33,9 @@ __all__ = [
     "flywheel_propagate",
     "max_spin_up_time",
 ]
+
+#: Largest ω dt of one discrete step: cosh(50) = 2.6e21, far from float64 overflow (ω dt ≈ 710).
+MAX_OMEGA_DT = 50.0
 
 FloatArray = NDArray[np.float64]
 
@@ -78,14 +83,24 @@ def flywheel_discrete(params: BodyParams, dt: float) -> tuple[FloatArray, FloatA
     params : BodyParams
         Body parameters.
     dt : float
-        Step [s].
+        Step [s], in (0, 50/ω] (beyond, cosh ω dt leaves any useful precision).
 
     Returns
     -------
     A : ndarray, shape (4, 4)
     B : ndarray, shape (4, 2)
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``dt`` is not in (0, 50/ω].
     """
     omega, weight, inertia = params.omega, params.weight, params.flywheel_inertia
+    dt = positive_float("dt", dt, "s")
+    if omega * dt > MAX_OMEGA_DT:
+        raise InvalidParameterError(
+            f"dt must be in (0, {MAX_OMEGA_DT:g}/omega = {MAX_OMEGA_DT / omega:g}] s, got dt={dt:g}"
+        )
     ch, sh = math.cosh(omega * dt), math.sinh(omega * dt)
     a = np.array(
         [

@@ -28,6 +28,9 @@ from __future__ import annotations
 
 import math
 
+from pushrecovery._validate import bounded_float, finite_float
+from pushrecovery.params import LIMITS
+
 __all__ = [
     "ankle_torque_for_cop",
     "com_from_lean",
@@ -109,7 +112,26 @@ def ankle_torque_for_cop(
 def pendulum_acceleration(
     theta: float, theta_rate: float, cop: float, mass: float, length: float, gravity: float
 ) -> float:
-    """Lean acceleration θ̈ = g sinθ / L − τ / (m L²) with τ from the CoP [rad/s²]."""
+    """Lean acceleration θ̈ = g sinθ / L − τ / (m L²) with τ from the CoP [rad/s²].
+
+    Raises
+    ------
+    InvalidParameterError
+        If a value is not finite, or ``mass``, ``length`` or ``gravity`` is outside
+        :data:`~pushrecovery.params.LIMITS` (``length`` as ``com_height``).
+    """
+    for name, value in (("theta", theta), ("theta_rate", theta_rate), ("cop", cop)):
+        finite_float(name, value)
+    mass = bounded_float("mass", mass, *LIMITS["mass"])
+    length = bounded_float("length", length, *LIMITS["com_height"])
+    gravity = bounded_float("gravity", gravity, *LIMITS["gravity"])
+    return _pendulum_acceleration(theta, theta_rate, cop, mass, length, gravity)
+
+
+def _pendulum_acceleration(
+    theta: float, theta_rate: float, cop: float, mass: float, length: float, gravity: float
+) -> float:
+    """:func:`pendulum_acceleration` unchecked: the kernel of :func:`pendulum_step`'s RK4."""
     torque = ankle_torque_for_cop(theta, theta_rate, cop, mass, length, gravity)
     return gravity * math.sin(theta) / length - torque / (mass * length * length)
 
@@ -158,13 +180,13 @@ def pendulum_step(
     h = dt / substeps
     args = (cop, mass, length, gravity)
     for _ in range(substeps):
-        k1a = pendulum_acceleration(theta, theta_rate, *args)
+        k1a = _pendulum_acceleration(theta, theta_rate, *args)
         k2q = theta_rate + 0.5 * h * k1a
-        k2a = pendulum_acceleration(theta + 0.5 * h * theta_rate, k2q, *args)
+        k2a = _pendulum_acceleration(theta + 0.5 * h * theta_rate, k2q, *args)
         k3q = theta_rate + 0.5 * h * k2a
-        k3a = pendulum_acceleration(theta + 0.5 * h * k2q, k3q, *args)
+        k3a = _pendulum_acceleration(theta + 0.5 * h * k2q, k3q, *args)
         k4q = theta_rate + h * k3a
-        k4a = pendulum_acceleration(theta + h * k3q, k4q, *args)
+        k4a = _pendulum_acceleration(theta + h * k3q, k4q, *args)
         theta += h / 6.0 * (theta_rate + 2.0 * k2q + 2.0 * k3q + k4q)
         theta_rate += h / 6.0 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a)
     return theta, theta_rate

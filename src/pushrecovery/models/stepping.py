@@ -55,6 +55,9 @@ __all__ = [
     "time_to_angle",
 ]
 
+#: Slowest push a step is solved for [m/s]: at rest over the ankle nothing falls.
+MIN_V0 = 1e-6
+
 FloatArray = NDArray[np.float64]
 
 #: The stepping model's state: CoM relative to the stance ankle, flywheel angle, CoM height
@@ -224,8 +227,8 @@ def step_solution(
     ------
     InvalidParameterError
         On a non-finite value, a length or gravity out of :data:`~pushrecovery.params.LIMITS`,
-        or |v0| >= 10 sqrt(g L) (ten times the speed at which the stance foot leaves the
-        floor: no step of this model, and float64 overflow beyond).
+        v0 < 1e-6 m/s, or |v0| >= 10 sqrt(g L) (ten times the speed at which the stance
+        foot leaves the floor: no step of this model, and float64 overflow beyond).
     """
     from pushrecovery._validate import bounded_float, finite_array
     from pushrecovery.params import LIMITS
@@ -234,6 +237,11 @@ def step_solution(
     gravity = bounded_float("gravity", gravity, *LIMITS["gravity"])
     v0 = finite_array("v0", v0)
     limit = 10.0 * math.sqrt(gravity * length)
+    if v0.size and float(np.min(v0)) < MIN_V0:
+        raise InvalidParameterError(
+            "v0 must be >= 1e-6 m/s (a forward push; backward steps are the mirror "
+            f"image), got {float(np.min(v0)):g}"
+        )
     if v0.size and float(np.max(np.abs(v0))) >= limit:
         raise InvalidParameterError(
             f"v0 must satisfy |v0| < 10 sqrt(g L) = {limit:g} m/s, "

@@ -22,9 +22,9 @@ from typing import overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array
+from pushrecovery._validate import finite_array, float_array, positive_float
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.params import BodyParams
+from pushrecovery.params import LIMITS, BodyParams
 
 __all__ = [
     "CaptureInterval",
@@ -34,6 +34,10 @@ __all__ = [
     "cop_region",
     "critical_velocity",
 ]
+
+#: sqrt(g/L) over the bodies :data:`~pushrecovery.params.LIMITS` admits [1/s]: 0.1 to 100.
+OMEGA_MIN = math.sqrt(LIMITS["gravity"][0] / LIMITS["com_height"][1])
+OMEGA_MAX = math.sqrt(LIMITS["gravity"][1] / LIMITS["com_height"][0])
 
 # From this size on, one fused, multithreaded numba pass beats five numpy passes; below it the
 # numpy path avoids compiling the kernel at all.
@@ -86,7 +90,23 @@ def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> float | NDArra
     -------
     float or ndarray
         ξ [m], where the CoP would have to be for the CoM to come to rest over it.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``omega`` is outside [0.1, 100] 1/s, the sqrt(g/L) of every body
+        :data:`~pushrecovery.params.LIMITS` admits (the states are not checked here: a NaN state
+        gives a NaN ξ; the margins and verdicts built on it refuse them).
     """
+    try:
+        valid = OMEGA_MIN <= omega <= OMEGA_MAX  # one comparison: this runs at every tick
+    except TypeError:
+        valid = False
+    if not valid:
+        raise InvalidParameterError(
+            f"omega must be in [{OMEGA_MIN:g}, {OMEGA_MAX:g}] 1/s (sqrt(g/L) of any body), "
+            f"got {omega!r}"
+        )
     inv = 1.0 / omega  # multiplied, as the compiled kernels do: the same ξ to the bit
     if type(x) is float and type(xdot) is float:
         return x + xdot * inv
@@ -148,11 +168,11 @@ def capture_margin(
     Raises
     ------
     InvalidParameterError
-        If a state is NaN or infinite.
+        If a state is NaN or infinite, or ``omega`` is not a finite number > 0.
     """
-    x = np.asarray(x, dtype=np.float64)
-    xdot = np.asarray(xdot, dtype=np.float64)
-    inv_omega = 1.0 / omega
+    x = float_array("x", x)
+    xdot = float_array("xdot", xdot)
+    inv_omega = 1.0 / positive_float("omega", omega, "1/s")
     centre, half = region.centre, region.half_width
     if _fusable(x, xdot, out):
         margin = np.empty_like(x) if out is None else out
@@ -232,9 +252,16 @@ def critical_velocity(
     -------
     ndarray
         Critical velocity [m/s] (the supremum: the boundary itself is not recoverable).
+
+    Raises
+    ------
+    InvalidParameterError
+        If a position is not finite or a direction is not +1 or −1.
     """
     region = cop_region(params) if region is None else region
-    x = np.asarray(x, dtype=np.float64)
-    direction = np.asarray(direction, dtype=np.float64)
+    x = finite_array("x", x)
+    direction = finite_array("direction", direction)
+    if not np.all(np.abs(direction) == 1.0):
+        raise InvalidParameterError("direction must be +1 (forward) or -1 (backward)")
     edge = np.where(direction > 0.0, region.upper, region.lower)
     return params.omega * (edge - x)

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import finite_array
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models._step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
 from pushrecovery.models._step_scalar import decide, feasible
@@ -159,12 +160,14 @@ def plan_steps(
     Raises
     ------
     InvalidParameterError
-        If a heel is not behind its toe. States and edges are not checked for NaN or infinity:
-        no step is feasible there.
+        If a heel is not behind its toe, or a state or an edge is NaN or infinite.
     """
     back, front = _edges(params, heel, toe)
     xs, xds, backs, fronts = np.broadcast_arrays(
-        *(np.asarray(a, dtype=np.float64) for a in (x, xdot, back, front))
+        *(
+            finite_array(name, a)
+            for name, a in (("x", x), ("xdot", xdot), ("heel", back), ("toe", front))
+        )
     )
     shape = xs.shape
     height, gravity, reach = params.com_height, params.gravity, params.max_step_length

@@ -190,10 +190,13 @@ def _read_table(path: Path) -> dict[str, FloatArray]:
                 null_values=["", "nan", "NaN", "NAN", "NA", "null"], strings_can_be_null=True
             ),
         )
+        # pyarrow checks the values' UTF-8 but not the header's: decode the names here.
+        names = [name.strip().lower() for name in table.column_names]
     except pa.ArrowInvalid as exc:
         message = " ".join(str(exc).split())
         raise InputFileError(f"{path}: malformed CSV: {message}") from None
-    names = [name.strip().lower() for name in table.column_names]
+    except UnicodeDecodeError:
+        raise InputFileError(f"{path}: malformed CSV: the header is not UTF-8 text") from None
     if len(set(names)) != len(names):
         raise InputFileError(f"{path}: repeated column names: {', '.join(table.column_names)}")
     if "time" not in names:

@@ -1,0 +1,213 @@
+"""``make fuzz``: thousands of hostile command lines and mutated files, each counted.
+
+Cases (``cases.py``) run in worker processes (``worker.py``), many per process; a worker that
+dies takes only its current case with it (a *crash*, then a new worker goes on), one that does
+not answer within ``--timeout`` is killed (a *hang*). Each answer is checked as a user would
+see it: exit status 0 or 2; on 2, exactly one stderr line ``pushrecovery: error: ...``; no
+traceback, no Python warning, and no NaN or infinity in the output. One summary line, the
+failures in ``OUT/failures.jsonl`` (with their input files kept), exit status 1 on any.
+
+Usage: ``python tests/fuzz/campaign.py [--cases 10000] [--seed 0] [--timeout 60]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import json
+import queue
+import random
+import re
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+import cases as fuzz_cases
+
+ROOT = Path(__file__).resolve().parents[2]
+#: A NaN or an infinity printed as a value: not the key "inf" (N = ∞ steps) of ``bounds``,
+#: which is followed by a colon (JSON) or a value (the table).
+NUMBER = re.compile(r"(?<![\w.\"])-?(nan|NaN|inf|Inf|Infinity)(?![\w\"])(?!\s+\[)")
+KINDS = ("crash", "hang", "traceback", "nan", "multiline", "warning", "exit")
+
+
+class Worker:
+    """A worker process and the thread that reads its answers."""
+
+    def __init__(self, log: Path) -> None:
+        self.log = log.open("a")
+        self.proc = subprocess.Popen(
+            [sys.executable, str(Path(__file__).parent / "worker.py")],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.log,
+            text=True,
+            cwd=ROOT,
+        )
+        self.lines: queue.Queue[str | None] = queue.Queue()
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self) -> None:
+        assert self.proc.stdout is not None
+        for line in self.proc.stdout:
+            self.lines.put(line)
+        self.lines.put(None)
+
+    def ask(self, case: dict, timeout: float) -> tuple[str, dict | int | None]:
+        """Return ("answer", result), ("crash", returncode) or ("hang", None)."""
+        assert self.proc.stdin is not None
+        try:
+            self.proc.stdin.write(json.dumps(case) + "\n")
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            return "crash", self.proc.wait()
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                line = self.lines.get(timeout=max(0.0, deadline - time.monotonic()))
+            except queue.Empty:
+                self.proc.kill()
+                return "hang", None
+            if line is None:
+                return "crash", self.proc.wait()
+            message = json.loads(line)
+            if "started" not in message:
+                return "answer", message
+
+    def close(self) -> None:
+        if self.proc.poll() is None:
+            assert self.proc.stdin is not None
+            self.proc.stdin.close()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+
+
+def problems(result: dict) -> list[str]:
+    """What a user would call broken in one answer."""
+    found = []
+    code, err, out = result["code"], result["stderr"], result["stdout"]
+    if result["escaped"] or "Traceback" in err:
+        found.append("traceback")
+    if code not in (0, 2, 130):
+        found.append("exit")
+    if code == 2 and not (err.count("\n") == 1 and err.startswith("pushrecovery: error: ")):
+        found.append("multiline")
+    if result["warnings"] or "Warning" in err:
+        found.append("warning")
+    if code == 0 and NUMBER.search(out):
+        found.append("nan")
+    return found
+
+
+def generate(rng: random.Random, folder: Path, index: int, sources: list[Path]) -> fuzz_cases.Case:
+    draw = rng.random()
+    if draw < 0.5:
+        return fuzz_cases.command_case(rng, folder)
+    if draw < 0.7:
+        return fuzz_cases.c3d_case(rng, folder, index, sources)
+    if draw < 0.85:
+        return fuzz_cases.csv_case(rng, folder, index)
+    return fuzz_cases.toml_case(rng, folder, index)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cases", type=int, default=10_000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--timeout", type=float, default=60.0, help="hang limit per case [s]")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=ROOT / "out" / "fuzz")
+    options = parser.parse_args()
+
+    import biomdp
+
+    sources = sorted((Path(biomdp.__file__).parent / "tests" / "datasets").glob("*.c3d"))
+    options.out = options.out.resolve()
+    shutil.rmtree(options.out, ignore_errors=True)
+    work, kept = options.out / "work", options.out / "inputs"
+    work.mkdir(parents=True)
+    kept.mkdir()
+    rng = random.Random(options.seed)
+    todo: queue.Queue[tuple[int, fuzz_cases.Case, Path]] = queue.Queue()
+    for index in range(options.cases):
+        folder = work / f"{index % 64}"
+        folder.mkdir(exist_ok=True)
+        todo.put((index, generate(rng, folder, index, sources), folder))
+    counts: collections.Counter[str] = collections.Counter()
+    kinds: collections.Counter[str] = collections.Counter()
+    slowest = [0.0, ""]
+    failures = (options.out / "failures.jsonl").open("w")
+    lock = threading.Lock()
+    start = time.monotonic()
+
+    def serve() -> None:
+        log = options.out / f"worker-{threading.get_ident()}.log"
+        worker = Worker(log)
+        while True:
+            try:
+                index, case, folder = todo.get_nowait()
+            except queue.Empty:
+                break
+            began = time.monotonic()
+            status, answer = worker.ask(
+                {"id": index, "args": case.args, "cwd": str(folder)}, options.timeout
+            )
+            spent = time.monotonic() - began
+            found = (
+                problems(answer) if status == "answer" and isinstance(answer, dict) else [status]
+            )
+            if status != "answer":
+                worker.close()
+                worker = Worker(log)
+            with lock:
+                kinds[case.kind] += 1
+                if spent > slowest[0]:
+                    slowest[:] = [spent, " ".join(case.args)[:120]]
+                for kind in found:
+                    counts[kind] += 1
+                if found:
+                    for arg in case.args:
+                        if arg.startswith(str(folder)) and Path(arg).is_file():
+                            shutil.copy(arg, kept / f"{index}-{Path(arg).name}")
+                    record = {"id": index, "problems": found, "args": case.args}
+                    if isinstance(answer, dict):
+                        record.update(answer)
+                    else:
+                        record["returncode"] = answer
+                    failures.write(json.dumps(record) + "\n")
+                    failures.flush()
+            for arg in case.args:  # the case's files and outputs
+                path = Path(arg)
+                if arg.startswith(f"{folder}/") and path.exists():
+                    shutil.rmtree(path) if path.is_dir() else path.unlink()
+        worker.close()
+
+    threads = [threading.Thread(target=serve) for _ in range(options.workers)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    failures.close()
+    shutil.rmtree(work, ignore_errors=True)
+    total = sum(kinds.values())
+    classes = ", ".join(f"{k} {v}" for k, v in sorted(kinds.items()))
+    bad = sum(counts.values())
+    print(
+        f"fuzz: {total} cases in {time.monotonic() - start:.0f} s "
+        f"(seed {options.seed}; {classes}): "
+        + ", ".join(f"{counts[k]} {k}" for k in KINDS)
+        + f"; slowest {slowest[0]:.1f} s ({slowest[1]})"
+        + (f"; details in {options.out / 'failures.jsonl'}" if bad else "")
+    )
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,234 @@
+"""Fuzzing cases: random command lines of every command and mutated C3D, CSV and TOML files.
+
+Every draw comes from one ``random.Random(seed)``: a campaign is reproducible from its seed.
+The options and their types are read from the commands themselves (click's parameters), so a
+new option is fuzzed without touching this file.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import random
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import click
+
+from pushrecovery.cli.app import COMMANDS
+
+FLOATS = [
+    "0", "-0.0", "0.1", "-0.3", "1", "2.5", "-2.5", "9.81", "72", "0.05", "1e-3", "1e-9",
+    "1e-300", "5e-324", "1e15", "1e300", "-1e300", "1.7976931348623157e308", "nan", "-nan",
+    "inf", "-inf", "abc", "", "1e", "0x10", "1_0", "3000", "-1",
+]  # fmt: skip
+INTS = ["0", "1", "-1", "2", "5", "100", "3000", "1000000000", "99999999999999999999", "abc", ""]
+STRINGS: dict[str, list[str]] = {
+    "--option": [
+        "horizon=30",
+        "horizon=3000",
+        "horizon=0",
+        "dt=1e-9",
+        "dt=0.01",
+        "gamma=nan",
+        "gamma=1",
+        "switch_time=-1",
+        "switch_time=0.2",
+        "x",
+        "=",
+        "horizon=1e400",
+        "solver=nope",
+    ],
+    "--param": [
+        "torque_max=50:150:50",
+        "mass=10:5",
+        "mass=1:2:0",
+        "x=1:2:3",
+        "torque_max=0:1e9:1e-9",
+        "gravity=nan:1:1",
+        "mass",
+        "mass=1:2:1:4",
+    ],
+    "--left-foot": [
+        "[[0,0],[0.2,0],[0,0.1]]",
+        "[[-0.05,-0.05],[0.15,-0.05],[0.15,0.05],[-0.05,0.05]]",
+        "[[0,0]]",
+        "junk",
+        "[[nan,0],[1,1],[0,1]]",
+        "[[0,0],[1e300,0],[0,1e300]]",
+        "[]",
+    ],
+    "--scheduler": ["tcp://", "tcp://127.0.0.1:99999", "xyz", "tcp://:1"],
+    "--preset": ["paper", "nope", ""],
+    "--model": ["stepping", "pendulum", "flywheel", "torso", "biped", "foot", "nope", ""],
+    "--controller": ["recovery", "ankle-pd", "mpc", "bang-bang", "nope"],
+    "--com-marker": ["CoM", "", "nope"],
+    "--foot": ["left:LHEE,LTOE", "junk", ""],
+}
+STRINGS["--right-foot"] = STRINGS["--left-foot"]
+#: Commands that may run for minutes on valid input: fuzzed with one invalid body value, so
+#: that what is checked is that they refuse it before any work.
+HEAVY = {"report", "figures", "validate", "campaign"}
+INVALID_BODY = [
+    ["--mass", "nan"], ["--gravity", "1e15"], ["--com-height", "-1"], ["--toe", "inf"],
+    ["--leg-length", "1e300"], ["--max-steps", "0.5"], ["--heel", "0.3"],
+]  # fmt: skip
+SKIP = {"--help", "--version"}
+
+
+@dataclass(frozen=True)
+class Case:
+    """One command line, and what it exercises (the input class of the summary)."""
+
+    kind: str
+    args: list[str]
+
+
+def _commands() -> dict[str, click.Command]:
+    found = {}
+    for name, (path, _) in COMMANDS.items():
+        module, _, attribute = path.partition(":")
+        found[name] = getattr(importlib.import_module(module), attribute)
+    return found
+
+
+def _value(rng: random.Random, param: click.Parameter, name: str, folder: Path) -> list[str]:
+    kind = param.type
+    count = param.nargs if param.nargs > 1 else 1
+    if name in STRINGS:
+        return [rng.choice(STRINGS[name])]
+    if isinstance(kind, click.Choice):
+        return [rng.choice([*map(str, kind.choices), "nope"])]
+    if isinstance(kind, click.types.IntParamType):
+        return [rng.choice(INTS) for _ in range(count)]
+    if isinstance(kind, click.types.FloatParamType):
+        return [rng.choice(FLOATS) for _ in range(count)]
+    if isinstance(kind, click.Path):
+        inside = [str(folder / name) for name in ("out", "plot.png", "x.txt")]
+        choices = [*inside, "/proc/version/x.png", "/dev/null", "/dev/zero", str(folder), "no.toml"]
+        return [rng.choice(choices)]
+    return [rng.choice(["", "x", "0", "nan"])]
+
+
+def command_case(rng: random.Random, folder: Path) -> Case:
+    """A random command line of a random command."""
+    commands = _commands()
+    name = rng.choice(sorted(commands))
+    command = commands[name]
+    args = [name]
+    params = [p for p in command.params if isinstance(p, click.Option) and p.opts[0] not in SKIP]
+    for param in rng.sample(params, k=min(len(params), rng.choice([0, 1, 2, 3, 4, 6]))):
+        option = max(param.opts, key=len)
+        if param.is_flag:
+            args.append(option)
+            continue
+        args += [option, *_value(rng, param, option, folder)]
+    if name == "analyze" or name == "campaign":
+        args += ["--out", str(folder / "out")]
+    if name == "analyze":
+        args.insert(1, rng.choice(["missing.c3d", str(folder), "/dev/null"]))
+    if name in HEAVY or "mujoco" in args:
+        args += rng.choice(INVALID_BODY)
+    return Case(f"cli:{name}", args)
+
+
+# --- files ------------------------------------------------------------------------------------
+def mutate_bytes(rng: random.Random, data: bytes, head: int = 8192) -> bytes:
+    """Flip, insert, delete or truncate a few bytes (most in the first ``head`` bytes)."""
+    out = bytearray(data)
+    for _ in range(rng.choice([1, 1, 2, 3, 5, 8])):
+        if not out:
+            break
+        limit = min(len(out), head) if rng.random() < 0.8 else len(out)
+        at = rng.randrange(limit)
+        action = rng.random()
+        if action < 0.6:
+            out[at] = rng.randrange(256)
+        elif action < 0.75:
+            out[at] = rng.choice([0, 0xFF, 0x7F, 0x80])
+        elif action < 0.85:
+            out.insert(at, rng.randrange(256))
+        elif action < 0.95:
+            del out[at]
+        else:
+            del out[at:]
+    return bytes(out)
+
+
+def mutate_text(rng: random.Random, text: str) -> str:
+    """Replace numbers, drop or repeat lines, rename a header, or flip bytes of a text file."""
+    lines = text.splitlines()
+    for _ in range(rng.choice([1, 2, 3])):
+        if not lines:
+            break
+        i = rng.randrange(len(lines))
+        action = rng.random()
+        if action < 0.35:
+            cells = lines[i].split(",")
+            j = rng.randrange(len(cells))
+            cells[j] = rng.choice(["nan", "inf", "-1e309", "1e300", "", "x", "0", "-0", "1e-320"])
+            lines[i] = ",".join(cells)
+        elif action < 0.5:
+            del lines[i]
+        elif action < 0.6:
+            lines.insert(i, lines[i])
+        elif action < 0.7:
+            lines[i] = lines[i].replace(",", ";", 1)
+        elif action < 0.8:
+            lines = lines[: max(1, i)]
+        else:
+            raw = mutate_bytes(rng, "\n".join(lines).encode(), head=1 << 20)
+            return raw.decode("latin-1")
+    return "\n".join(lines) + "\n"
+
+
+def toml_case(rng: random.Random, folder: Path, index: int) -> Case:
+    """``bounds --params FILE`` with a mutated parameter file."""
+    values = {"mass": "72.0", "com_height": "1.0", "gravity": "9.81", "heel": "-0.05",
+              "toe": "0.15", "torque_max": "100.0", "min_step_time": "0.2"}  # fmt: skip
+    choices = ["nan", "inf", "-1", "0", "1e15", "1e300", '"heavy"', "[1, 2]", "{a = 1}", "true",
+               "1979-05-27", "1e-300", "-0.0"]  # fmt: skip
+    lines = [f"{k} = {v}" for k, v in values.items()]
+    for _ in range(rng.choice([1, 2])):
+        i = rng.randrange(len(lines))
+        lines[i] = lines[i].split("=")[0] + "= " + rng.choice(choices)
+    text = "[body]\n" + "\n".join(lines) + "\n"
+    if rng.random() < 0.4:
+        text = mutate_bytes(rng, text.encode(), head=1 << 20).decode("latin-1")
+    if rng.random() < 0.1:
+        text = "a = " + "{b = " * rng.choice([10, 200, 2000]) + "1" + "}" * 2000 + "\n"
+    path = folder / f"case{index}.toml"
+    path.write_text(text, encoding="latin-1")
+    command = rng.choice(
+        [["bounds"], ["classify", "--x", "0", "--xdot", "0.5"], ["step", "--v0", "1"]]
+    )
+    return Case("file:toml", [*command, "--params", str(path), "--json"])
+
+
+def csv_text(rng: random.Random) -> str:
+    """A valid trial: the CoM of a pendulum swaying, with its CoP, at 100 Hz."""
+    rows = ["time,com_ap,com_ml,cop_ap,cop_ml"]
+    amplitude = rng.choice([0.01, 0.03])
+    for i in range(rng.choice([30, 200])):
+        t = i / 100.0
+        rows.append(
+            f"{t:.2f},{amplitude * math.sin(3 * t):.6f},0,{amplitude * math.sin(3 * t) * 1.1:.6f},0"
+        )
+    return "\n".join(rows) + "\n"
+
+
+def csv_case(rng: random.Random, folder: Path, index: int) -> Case:
+    """``analyze FILE`` with a mutated CSV trial."""
+    path = folder / f"case{index}.csv"
+    path.write_text(mutate_text(rng, csv_text(rng)), encoding="latin-1")
+    return Case("file:csv", ["analyze", str(path), "--out", str(folder / f"out{index}"), "--json"])
+
+
+def c3d_case(rng: random.Random, folder: Path, index: int, sources: list[Path]) -> Case:
+    """``analyze FILE`` with a mutated C3D file (biomdp's and one written by the project)."""
+    source = rng.choice(sources)
+    path = folder / f"case{index}.c3d"
+    path.write_bytes(mutate_bytes(rng, source.read_bytes()))
+    extra: list[Any] = rng.choice([[], ["--json"], ["--units", "mm"]])
+    return Case("file:c3d", ["analyze", str(path), "--out", str(folder / f"out{index}"), *extra])

@@ -1,0 +1,65 @@
+"""One fuzzing worker: runs cases from stdin in this process, one JSON line out per case.
+
+Protocol (``campaign.py``): a line ``{"id": ..., "args": [...]}`` in; ``{"id": ...,
+"code": int, "stdout": str, "stderr": str, "warnings": [str], "escaped": str | null}`` out,
+after the line ``{"started": id}`` that tells the parent which case a crash belongs to.
+``escaped`` is an exception that left ``pushrecovery.cli.main`` (a traceback for the user).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import sys
+import traceback
+import warnings
+
+
+def run(args: list[str]) -> dict[str, object]:
+    """Run ``pushrecovery ARGS`` in this process and return what a user would see."""
+    from pushrecovery.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    code, escaped = 0, None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                main(args)
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+            except BaseException as exc:  # a traceback the user would see
+                code = 1
+                escaped = "".join(traceback.format_exception_only(type(exc), exc)).strip()
+                escaped += " | " + traceback.format_tb(exc.__traceback__)[-1].strip()[:300]
+    return {
+        "code": code,
+        "stdout": out.getvalue()[-4000:],
+        "stderr": err.getvalue()[-4000:],
+        "warnings": [f"{w.category.__name__}: {w.message}"[:300] for w in caught],
+        "escaped": escaped,
+    }
+
+
+def serve() -> None:
+    """Answer cases from stdin until it closes."""
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    # Every case's relative paths land in the case folder the parent names.
+    home = os.getcwd()
+    for line in sys.stdin:
+        case = json.loads(line)
+        sys.__stdout__.write(json.dumps({"started": case["id"]}) + "\n")
+        sys.__stdout__.flush()
+        folder = case.get("cwd", home)
+        os.makedirs(folder, exist_ok=True)
+        os.chdir(folder)
+        result = run(case["args"])
+        os.chdir(home)
+        sys.__stdout__.write(json.dumps({"id": case["id"], **result}) + "\n")
+        sys.__stdout__.flush()
+
+
+if __name__ == "__main__":
+    serve()
