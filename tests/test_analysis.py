@@ -5,6 +5,7 @@ library's simulators), written out as measured data.
 """
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -494,3 +495,13 @@ def test_a_header_that_is_not_utf8_is_one_clear_line(tmp_path):
     with pytest.raises(InputFileError, match="the header is not UTF-8 text") as info:
         read_csv_recording(path)
     assert "\n" not in str(info.value)
+
+
+def test_time_to_leave_a_subnormal_away_from_the_anchor_is_infinite_without_a_warning():
+    # Found by make fuzz: a CSV cell of 1e-320 overflowed edge / ahead with a RuntimeWarning.
+    from pushrecovery.analysis.margins import time_to_leave
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        time = time_to_leave(np.array([1e-320]), np.array([0.0]), -0.05, 0.15, 3.13)
+    assert time[0] == np.inf

@@ -132,3 +132,19 @@ def test_a_parameter_file_over_64_kib_is_refused(
     big = tmp_path / "big.toml"
     big.write_text("# padding\n" * 7000 + "mass = 70.0\n")
     _one_line_error(*_cli_error(["bounds", "--params", str(big)], capsys), "larger than 64 KiB")
+
+
+def test_a_c3d_file_that_crashes_ezc3d_costs_one_line_not_the_process(tmp_path: Path) -> None:
+    """A mutation found by make fuzz (seed 3, case 830) that passes the structural checks.
+
+    ezc3d ends its process with SIGSEGV on it; the helper process takes the crash.
+    """
+    from pushrecovery import InputFileError
+    from pushrecovery.analysis.c3d import read_c3d
+
+    path = DATA / "fuzz-segfault-kistler.c3d"
+    with pytest.raises(InputFileError, match="the C3D reader crashed on this file"):
+        read_c3d(path)
+    # The next read gets a new helper.
+    good = Path(__import__("biomdp").__file__).parent / "tests" / "datasets" / "kistler_COP.c3d"
+    assert len(read_c3d(good).plates) == 1

@@ -104,7 +104,8 @@ def time_to_leave(
     anchor = np.clip(anchor, lower, upper)
     ahead = capture - anchor
     edge = np.where(ahead > 0.0, upper, lower) - anchor
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # A ξ a subnormal away from the anchor overflows the ratio: +inf, as for ξ on it.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         ratio = edge / ahead
         time = np.where(ratio > 1.0, np.log(ratio) / omega, 0.0)
     time = np.where(ahead == 0.0, np.inf, time)

@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 from pushrecovery.analysis.c3d.content import C3DContent
 from pushrecovery.analysis.c3d.forceplate import _threshold
 from pushrecovery.analysis.c3d.header import _check_header
+from pushrecovery.analysis.c3d.isolated import run_isolated
 from pushrecovery.analysis.c3d.parameters import (
     _LENGTH_UNITS,
     _first_text,
@@ -62,6 +63,18 @@ def read_c3d(path: str | Path, *, threshold: float = 20.0) -> C3DContent:
         check_parameter_section(file, read_parameter_section(file))
     except OSError as exc:
         raise InputFileError(f"{file}: cannot read ({_one_line(exc)})") from exc
+    content = run_isolated(_read_checked_file, (file, limit), file)
+    # A pickle does not keep numpy's read-only flag: the arrays are the file's, not to edit.
+    for array in content.markers.values():
+        array.setflags(write=False)
+    for plate in content.plates:
+        for array in (plate.force, plate.cop, plate.free_moment, plate.corners):
+            array.setflags(write=False)
+    return content
+
+
+def _read_checked_file(file: Path, limit: float) -> C3DContent:
+    """Parse a file that passed the header and parameter checks (in a child process)."""
     import ezc3d  # heavy import, only when reading
 
     try:
