@@ -148,3 +148,44 @@ def test_a_c3d_file_that_crashes_ezc3d_costs_one_line_not_the_process(tmp_path: 
     # The next read gets a new helper.
     good = Path(__import__("biomdp").__file__).parent / "tests" / "datasets" / "kistler_COP.c3d"
     assert len(read_c3d(good).plates) == 1
+
+
+def test_ctrl_c_stops_a_campaign_with_one_line_and_no_worker_traceback(tmp_path: Path) -> None:
+    """SIGINT reaches the whole process group, as Ctrl-C does: only the parent reports it."""
+    import signal
+    import time
+
+    out = tmp_path / "campaign"
+    args = ["campaign", "--x0", "0", "0.1", "0.02", "--xdot", "-3", "3", "0.05"]
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "pushrecovery",
+            *args,
+            "--out",
+            str(out),
+            "--no-plot",
+            "--batch-size",
+            "5",
+            "--workers",
+            "2",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    began = time.monotonic()
+    while not (out / "batches").exists() and time.monotonic() - began < HANG:
+        time.sleep(0.05)
+    time.sleep(1.0)  # the workers are running pushes
+    os.killpg(process.pid, signal.SIGINT)
+    _, err = process.communicate(timeout=HANG)
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert process.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    assert lines == [
+        f"pushrecovery: interrupted; the finished batches are in {out}; rerun with --resume "
+        "to complete the campaign"
+    ]

@@ -19,9 +19,12 @@ workers of a running ``dask.distributed`` scheduler at that address (``tcp://hos
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
+import signal
+import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
@@ -148,6 +151,24 @@ def _cores() -> int:
     return os.cpu_count() or 1
 
 
+def _ignore_interrupts() -> None:
+    """Worker initializer: SIGINT is the parent's to handle (no traceback from each worker)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextlib.contextmanager
+def _interrupts_ignored() -> Iterator[None]:
+    """Ignore SIGINT while worker processes start (they inherit it); main thread only."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _serial(spec: CampaignSpec, batches: list[int]) -> Iterator[tuple[int, list[dict]]]:
     for batch in batches:
         yield run_batch(spec, batch)
@@ -162,11 +183,18 @@ def _processes(
     # Not fork: the parent may already run OpenMP threads (numba's parallel surfaces), which a
     # forked child cannot use.
     method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+    pool = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context(method),
+        initializer=_ignore_interrupts,
+    )
     try:
-        pending: set[Future[tuple[int, list[dict]]]] = {
-            pool.submit(run_batch, spec, batch) for batch in batches
-        }
+        # Ctrl-C reaches the whole process group: the workers ignore it (started while this
+        # process ignores it, which they inherit), the parent stops them and says so once.
+        with _interrupts_ignored():
+            pending: set[Future[tuple[int, list[dict]]]] = {
+                pool.submit(run_batch, spec, batch) for batch in batches
+            }
         while pending:
             done, pending = wait(pending, return_when=FIRST_COMPLETED)
             for future in done:

@@ -35,7 +35,8 @@ def main(argv: list[str] | None = None) -> None:
         _fail(f"{type(exc).__name__}: {exc}")
     except MemoryError:
         _fail("not enough memory for this request: ask for fewer states, pushes or frames")
-    except click.Abort:
+    except click.Abort:  # Ctrl-C (click has ended the terminal's "^C" line)
+        print("pushrecovery: interrupted", file=sys.stderr)
         sys.exit(130)
     sys.exit(code if isinstance(code, int) else 0)
 
