@@ -189,3 +189,17 @@ def test_ctrl_c_stops_a_campaign_with_one_line_and_no_worker_traceback(tmp_path:
         f"pushrecovery: interrupted; the finished batches are in {out}; rerun with --resume "
         "to complete the campaign"
     ]
+
+
+def test_a_trial_without_a_valid_frame_plots_without_warnings(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """make fuzz (seed 0, case 463): an All-NaN median and empty legends warned."""
+    from pushrecovery.cli import main
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(SystemExit) as exit_info:
+            main(["analyze", str(DATA / "fuzz-no-valid-frame-kistler.c3d"), "--out", str(tmp_path)])
+    assert exit_info.value.code in (0, None), capsys.readouterr().err
+    assert (tmp_path / "time_series.png").is_file()

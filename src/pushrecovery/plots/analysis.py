@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -35,6 +35,18 @@ def _figure(rows: int, cols: int, width: float, height: float):  # type: ignore[
     return figure, figure.subplots(rows, cols, squeeze=False)
 
 
+def _median(values: np.ndarray, default: float = 0.0) -> float:
+    """Median of the finite values; ``default`` when there are none (no All-NaN warning)."""
+    finite = values[np.isfinite(values)]
+    return float(np.median(finite)) if finite.size else default
+
+
+def _legend(ax: Any, **options: Any) -> None:
+    """Draw a legend when something is labelled (a trial with no valid frame has nothing)."""
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(**options)
+
+
 def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
     """Draw CoM, CoP, CMP and capture point over time, per axis, with the regions shaded.
 
@@ -48,7 +60,7 @@ def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
     for ax, axis in zip(axes[:, 0], AXES, strict=True):
         # ap relative to the ankle (the paper's origin); ml to the middle of the base.
         centre = 0.5 * (columns[f"{axis}_base_min"] + columns[f"{axis}_base_max"])
-        origin = float(np.nanmedian(columns[f"{axis}_ankle"] if axis == "ap" else centre))
+        origin = _median(columns[f"{axis}_ankle"] if axis == "ap" else centre)
         lower = columns[f"{axis}_base_min"] - origin
         upper = columns[f"{axis}_base_max"] - origin
         reach = columns[f"{axis}_margin_cmp"] - columns[f"{axis}_margin_cop"]
@@ -92,7 +104,7 @@ def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
         )
         _limit(ax, columns, axis, origin)
     axes[-1, 0].set_xlabel("time [s]")
-    axes[0, 0].legend(loc="upper right", fontsize=7, ncols=3)
+    _legend(axes[0, 0], loc="upper right", fontsize=7, ncols=3)
     return save_figure(fig, path.with_suffix(""), [path.suffix.lstrip(".") or "png"])[0]
 
 
@@ -142,11 +154,9 @@ def plot_phase_portrait(analysis: TrialAnalysis, path: Path) -> Path:
         if finite.any():
             span = max(float(np.abs(x[finite]).max()), 0.05) * 1.3
             xs = np.linspace(-span, span, 50)
-            reach = float(
-                np.nanmedian(columns[f"{axis}_margin_cmp"] - columns[f"{axis}_margin_cop"])
-            )
+            reach = _median(columns[f"{axis}_margin_cmp"] - columns[f"{axis}_margin_cop"])
             for end, sign in (("min", -1.0), ("max", 1.0)):
-                edge = float(np.nanmedian(columns[f"{axis}_base_{end}"] - ankle))
+                edge = _median(columns[f"{axis}_base_{end}"] - ankle)
                 ax.plot(xs, omega * (edge - xs), color=RECOVER_COLOUR, lw=1.0, ls="--")
                 ax.plot(xs, omega * (edge + sign * reach - xs), color=HIP_COLOUR, lw=1.0, ls=":")
             ax.set_xlim(-span, span)
@@ -155,5 +165,5 @@ def plot_phase_portrait(analysis: TrialAnalysis, path: Path) -> Path:
         ax.set_title(_TITLES[axis], fontsize=10)
         ax.set_xlabel(f"CoM − stance ankle along {axis} [m]")
         ax.set_ylabel("CoM velocity [m/s]")
-        ax.legend(loc="upper right", fontsize=7, markerscale=3)
+        _legend(ax, loc="upper right", fontsize=7, markerscale=3)
     return save_figure(fig, path.with_suffix(""), [path.suffix.lstrip(".") or "png"])[0]

@@ -74,9 +74,14 @@ class _Helper:
 
     def stop(self) -> None:
         process, self.process = self.process, None
-        if process is not None and process.poll() is None:
+        if process is None:
+            return
+        if process.poll() is None:
             process.kill()
             process.wait()
+        for stream in (process.stdin, process.stdout):
+            if stream is not None:
+                stream.close()
 
     def ask(self, request: Any, timeout: float) -> tuple[str, Any]:
         """Return ("answer", message), ("crash", exit code) or ("timeout", None)."""
@@ -87,7 +92,7 @@ class _Helper:
                 write_message(process.stdin, request)
             except BrokenPipeError:
                 code = process.wait()
-                self.process = None
+                self.stop()
                 return "crash", code
             ready, _, _ = select.select([process.stdout], [], [], timeout)
             if not ready:
@@ -97,7 +102,7 @@ class _Helper:
                 return "answer", read_message(process.stdout)
             except EOFError:
                 code = process.wait()
-                self.process = None
+                self.stop()
                 return "crash", code
 
 
