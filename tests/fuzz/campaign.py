@@ -134,12 +134,9 @@ def main() -> int:
     work, kept = options.out / "work", options.out / "inputs"
     work.mkdir(parents=True)
     kept.mkdir()
-    rng = random.Random(options.seed)
-    todo: queue.Queue[tuple[int, fuzz_cases.Case, Path]] = queue.Queue()
+    todo: queue.Queue[int] = queue.Queue()
     for index in range(options.cases):
-        folder = work / f"{index % 64}"
-        folder.mkdir(exist_ok=True)
-        todo.put((index, generate(rng, folder, index, sources), folder))
+        todo.put(index)
     counts: collections.Counter[str] = collections.Counter()
     kinds: collections.Counter[str] = collections.Counter()
     slowest = [0.0, ""]
@@ -152,9 +149,13 @@ def main() -> int:
         worker = Worker(log)
         while True:
             try:
-                index, case, folder = todo.get_nowait()
+                index = todo.get_nowait()
             except queue.Empty:
                 break
+            # Each case from its own seed: the same cases whatever the threads' timing.
+            folder = work / f"{index}"
+            folder.mkdir()
+            case = generate(random.Random(options.seed * 1_000_003 + index), folder, index, sources)
             began = time.monotonic()
             status, answer = worker.ask(
                 {"id": index, "args": case.args, "cwd": str(folder)}, options.timeout
@@ -183,10 +184,7 @@ def main() -> int:
                         record["returncode"] = answer
                     failures.write(json.dumps(record) + "\n")
                     failures.flush()
-            for arg in case.args:  # the case's files and outputs
-                path = Path(arg)
-                if arg.startswith(f"{folder}/") and path.exists():
-                    shutil.rmtree(path) if path.is_dir() else path.unlink()
+            shutil.rmtree(folder, ignore_errors=True)  # the case's files and outputs
         worker.close()
 
     threads = [threading.Thread(target=serve) for _ in range(options.workers)]
