@@ -61,22 +61,74 @@ def _holds(call: Callable[[], Any]) -> None:
 
 def _catalogue() -> dict[str, Callable[[Any], Any]]:
     from pushrecovery.control.base import make_controller
-    from pushrecovery.models.flywheel import flywheel_discrete
+    from pushrecovery.ground import Support
+    from pushrecovery.models.flywheel import (
+        bang_bang_switch_time,
+        flywheel_discrete,
+        flywheel_propagate,
+    )
+    from pushrecovery.models.lipm import lipm_propagate, lipm_state, lipm_transition
     from pushrecovery.models.pendulum import pendulum_acceleration
     from pushrecovery.models.stepping import step_solution
-    from pushrecovery.surfaces.bounds import bounds_data
+    from pushrecovery.sim.critical import critical_push
+    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.simulate import simulate
+    from pushrecovery.surfaces.bounds import bounds_data, plane_bounds
+    from pushrecovery.surfaces.capture_region import capture_region
     from pushrecovery.surfaces.classify import classify
+    from pushrecovery.surfaces.classify_many import classify_states
+    from pushrecovery.surfaces.cmp import cmp_margin
     from pushrecovery.surfaces.cop import (
         capture_margin,
         capture_point,
+        cop_margin,
         cop_region,
         critical_velocity,
     )
-    from pushrecovery.surfaces.step import plan_steps
+    from pushrecovery.surfaces.monitor import BalanceMonitor
+    from pushrecovery.surfaces.step import plan_step, plan_steps, step_thresholds
 
     region = cop_region(PARAMS)
     pd = make_controller("ankle-pd", PARAMS)
+    support = Support.from_params(PARAMS)
+    monitor = BalanceMonitor(PARAMS)
+
+    def run(state: Any) -> Any:
+        plant = make_plant("pendulum", PARAMS)
+        return simulate(plant, make_controller("ankle-pd", PARAMS), state, duration=0.05)
+
     return {
+        "classify(params=v)": lambda v: classify(0.0, 0.1, v),
+        "classify(y=v)": lambda v: classify(0.0, 0.1, PARAMS, y=v),
+        "classify(support=v)": lambda v: classify(0.0, 0.1, PARAMS, support=v),
+        "classify_states(v)": lambda v: classify_states(v, 0.1, PARAMS),
+        "cop_margin(v)": lambda v: cop_margin(v, 0.1, PARAMS),
+        "cmp_margin(params=v)": lambda v: cmp_margin(0.0, 0.1, v),
+        "BalanceMonitor(v)": lambda v: BalanceMonitor(v),
+        "BalanceMonitor.query(v)": lambda v: monitor.query(v, 0.0, 0.1, 0.0),
+        "capture_region(x=v)": lambda v: capture_region(v, 0.0, 0.5, 0.0, PARAMS, support),
+        "capture_region(swing_time=v)": lambda v: capture_region(
+            0.0, 0.0, 0.5, 0.0, PARAMS, support, v
+        ),
+        "capture_region(steps=v)": lambda v: capture_region(
+            0.0, 0.0, 0.5, 0.0, PARAMS, support, steps=v
+        ),
+        "plane_bounds(support=v)": lambda v: plane_bounds(PARAMS, v),
+        "plan_step(v)": lambda v: plan_step(v, 0.5, PARAMS),
+        "step_thresholds(v)": lambda v: step_thresholds(v),
+        "lipm_state(t=v)": lambda v: lipm_state(v, 0.0, 0.1, 0.0, PARAMS.omega),
+        "lipm_propagate(omega=v)": lambda v: lipm_propagate(0.0, 0.1, 0.0, v, 0.01),
+        "lipm_transition(dt=v)": lambda v: lipm_transition(PARAMS.omega, v),
+        "flywheel_propagate(dt=v)": lambda v: flywheel_propagate(
+            np.zeros(4), (0.0, 0.0), PARAMS, v
+        ),
+        "bang_bang_switch_time(v)": lambda v: bang_bang_switch_time(
+            v, 0.0, PARAMS, cop=0.15, direction=1.0
+        ),
+        "make_plant(v)": lambda v: make_plant(v, PARAMS),
+        "make_controller(v)": lambda v: make_controller(v, PARAMS),
+        "simulate(initial_state=v)": run,
+        "critical_push(x0=v)": lambda v: critical_push(PARAMS, "lipm", "ankle-pd", v, "forward"),
         "load_params(overrides=v)": lambda v: load_params(overrides=v),
         "load_params(mass=v)": lambda v: load_params(overrides={"mass": v}),
         "load_params(gravity=v)": lambda v: bounds_data(load_params(overrides={"gravity": v})),

@@ -7,7 +7,15 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
+
+
+def require_type(name: str, value: object, kind: type | tuple[type, ...]) -> None:
+    """Raise :class:`ParameterTypeError` naming ``name`` unless ``value`` is a ``kind``."""
+    if not isinstance(value, kind):
+        kinds = kind if isinstance(kind, tuple) else (kind,)
+        expected = " or ".join(k.__name__ for k in kinds)
+        raise ParameterTypeError(f"{name} must be a {expected}, got {type(value).__name__}")
 
 
 def finite_float(name: str, value: object, unit: str = "", allowed: str = "") -> float:

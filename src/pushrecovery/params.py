@@ -12,7 +12,15 @@ from dataclasses import asdict, dataclass, field, fields
 from pushrecovery._validate import bounded_float, finite_float, positive_float
 from pushrecovery.errors import InvalidParameterError
 
-__all__ = ["FIELD_NAMES", "GROWTH_TOLERANCE", "LIMITS", "BodyParams", "default_max_steps"]
+__all__ = [
+    "FIELD_NAMES",
+    "GROWTH_TOLERANCE",
+    "LIMITS",
+    "OMEGA_MAX",
+    "OMEGA_MIN",
+    "BodyParams",
+    "default_max_steps",
+]
 
 #: Narrowest foot [m]: a narrower one is a line, whose distances are rounding noise.
 MIN_FOOT_WIDTH = 1e-3
@@ -32,6 +40,10 @@ LIMITS: dict[str, tuple[float, float, str]] = {
     "flywheel_angle_max": (1e-3, math.pi, "rad"),
     "leg_length": (1e-2, 10.0, "m"),
 }
+#: sqrt(g/L) over the bodies :data:`LIMITS` admits [1/s]: 0.1 to 100 (for functions that take
+#: ω itself rather than a body).
+OMEGA_MIN = math.sqrt(LIMITS["gravity"][0] / LIMITS["com_height"][1])
+OMEGA_MAX = math.sqrt(LIMITS["gravity"][1] / LIMITS["com_height"][0])
 
 
 @dataclass(frozen=True, slots=True)

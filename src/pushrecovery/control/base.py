@@ -34,7 +34,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, finite_float
+from pushrecovery._validate import finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.lipm import ANKLE_STATE
 from pushrecovery.params import BodyParams
@@ -203,6 +203,7 @@ def controller_class(name: str) -> type[Controller]:
     """
     from pushrecovery.control.registry import CONTROLLER_PATHS
 
+    require_type("name", name, str)
     if name not in CONTROLLERS and name in CONTROLLER_PATHS:
         module, _, _ = CONTROLLER_PATHS[name].partition(":")
         importlib.import_module(module)  # its @register fills CONTROLLERS

@@ -19,7 +19,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import positive_float
+from pushrecovery._validate import finite_float, positive_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
@@ -217,6 +217,11 @@ def bang_bang_switch_time(
     direction : float
         +1 or −1, sign of the first torque pulse.
     """
+    capture_point = finite_float("capture_point", capture_point, "m")
+    target = finite_float("target", target, "m")
+    cop = finite_float("cop", cop, "m")
+    if direction not in (1.0, -1.0):
+        raise InvalidParameterError(f"direction must be +1 or -1, got {direction!r}")
     spin_up = max_spin_up_time(params)
     a = direction * params.torque_max / params.weight
     if a == 0.0:

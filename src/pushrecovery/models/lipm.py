@@ -14,6 +14,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import finite_array, finite_float
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import OMEGA_MAX, OMEGA_MIN
+
 __all__ = [
     "ANKLE_STATE",
     "lipm_acceleration",
@@ -21,6 +25,21 @@ __all__ = [
     "lipm_state",
     "lipm_transition",
 ]
+
+#: Largest ω t the closed forms take: e^50 = 5e21, far from float64 overflow (ω t ≈ 710).
+MAX_OMEGA_T = 50.0
+
+
+def _omega(omega: object) -> float:
+    """ω as a float in [OMEGA_MIN, OMEGA_MAX] (sqrt(g/L) of any body), or a named error."""
+    value = finite_float("omega", omega, "1/s")
+    if not OMEGA_MIN <= value <= OMEGA_MAX:
+        raise InvalidParameterError(
+            f"omega must be in [{OMEGA_MIN:g}, {OMEGA_MAX:g}] 1/s (sqrt(g/L) of any body), "
+            f"got omega={value:g}"
+        )
+    return value
+
 
 FloatArray = NDArray[np.float64]
 
@@ -77,9 +96,15 @@ def lipm_state(
     x, xdot : ndarray
         CoM position [m] and velocity [m/s] at t, broadcast over the inputs.
     """
-    wt = omega * np.asarray(t, dtype=np.float64)
-    offset = np.asarray(x0, dtype=np.float64) - np.asarray(cop, dtype=np.float64)
-    xdot0 = np.asarray(xdot0, dtype=np.float64)
+    omega = _omega(omega)
+    times = finite_array("t", t)
+    if times.size and float(np.max(np.abs(times))) > MAX_OMEGA_T / omega:  # before ω t overflows
+        raise InvalidParameterError(
+            f"|t| must be <= {MAX_OMEGA_T:g}/omega = {MAX_OMEGA_T / omega:g} s, got t={t!r}"
+        )
+    wt = omega * times
+    offset = finite_array("x0", x0) - finite_array("cop", cop)
+    xdot0 = finite_array("xdot0", xdot0)
     cosh, sinh = np.cosh(wt), np.sinh(wt)
     x = np.asarray(cop, dtype=np.float64) + offset * cosh + xdot0 / omega * sinh
     xdot = omega * offset * sinh + xdot0 * cosh
@@ -108,6 +133,12 @@ def lipm_transition(omega: float, dt: float) -> tuple[FloatArray, FloatArray]:
     A : ndarray, shape (2, 2)
     B : ndarray, shape (2,)
     """
+    omega = _omega(omega)
+    dt = finite_float("dt", dt, "s")
+    if abs(dt) > MAX_OMEGA_T / omega:
+        raise InvalidParameterError(
+            f"|dt| must be <= {MAX_OMEGA_T:g}/omega = {MAX_OMEGA_T / omega:g} s, got dt={dt:g}"
+        )
     c, s = np.cosh(omega * dt), np.sinh(omega * dt)
     return np.array([[c, s / omega], [omega * s, c]]), np.array([1.0 - c, -omega * s])
 

@@ -49,6 +49,11 @@ def available_models(backend: str) -> tuple[str, ...]:
 
 def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plant:
     """Build the plant ``name`` of ``backend``; unknown names raise, naming the choices."""
+    from pushrecovery._validate import require_type
+    from pushrecovery.params import BodyParams as Body  # a runtime check, not an annotation
+
+    require_type("name", name, str)
+    require_type("params", params, Body)
     models = available_models(backend)
     if name not in models:
         other = next((b for b, names in PLANTS.items() if b != backend and name in names), None)

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pushrecovery._validate import finite_float, positive_float
+from pushrecovery._validate import finite_array, positive_float
 from pushrecovery.control.base import Command, Controller, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS
@@ -260,9 +260,12 @@ def check_run(
         raise InvalidParameterError(
             f"control_period must be <= duration = {duration:g} s, got {dt:g}"
         )
-    state = np.array(initial_state, dtype=np.float64)
-    for i, value in enumerate(state):
-        finite_float(f"initial_state[{i}]", value)
+    state = finite_array("initial_state", initial_state).copy()
+    if state.ndim != 1:  # its length is the plant's to check (check_state names the labels)
+        raise InvalidParameterError(
+            f"initial_state must be a 1-D array of {list(plant.state_labels)}, "
+            f"got shape {state.shape}"
+        )
     plant.check_state(state)
     missing = [label for label in controller.state_labels if label not in plant.state_labels]
     if missing:

@@ -15,7 +15,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array
+from pushrecovery._validate import finite_array, float_array, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
@@ -67,9 +67,8 @@ def classify_states(
     """
     if y is not None or ydot is not None or support is not None:
         return _plane_codes(x, xdot, params, y, ydot, support)
-    x, xdot = np.broadcast_arrays(
-        np.asarray(x, dtype=np.float64), np.asarray(xdot, dtype=np.float64)
-    )
+    require_type("params", params, BodyParams)
+    x, xdot = np.broadcast_arrays(float_array("x", x), float_array("xdot", xdot))
     codes = np.empty(x.shape, dtype=np.int8)
     if x.size == 0:
         return codes

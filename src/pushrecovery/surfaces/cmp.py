@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import require_type
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cop import CaptureInterval, capture_margin
@@ -72,6 +73,7 @@ def cmp_offset_roll(params: BodyParams) -> float:
 
 def cmp_region(params: BodyParams) -> CaptureInterval:
     """Capture-point bounds of CMP balancing, corrected Eq. (15) [m]."""
+    require_type("params", params, BodyParams)
     offset = cmp_offset(params)
     return CaptureInterval(params.heel - offset, params.toe + offset)
 
@@ -83,4 +85,5 @@ def cmp_margin(
 
     Vectorised like :func:`pushrecovery.surfaces.cop.cop_margin`.
     """
-    return capture_margin(x, xdot, params.omega, cmp_region(params), out=out)
+    region = cmp_region(params)  # checks params first
+    return capture_margin(x, xdot, params.omega, region, out=out)

@@ -22,9 +22,9 @@ from typing import overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, float_array, positive_float
+from pushrecovery._validate import finite_array, float_array, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.params import LIMITS, BodyParams
+from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 
 __all__ = [
     "CaptureInterval",
@@ -34,10 +34,6 @@ __all__ = [
     "cop_region",
     "critical_velocity",
 ]
-
-#: sqrt(g/L) over the bodies :data:`~pushrecovery.params.LIMITS` admits [1/s]: 0.1 to 100.
-OMEGA_MIN = math.sqrt(LIMITS["gravity"][0] / LIMITS["com_height"][1])
-OMEGA_MAX = math.sqrt(LIMITS["gravity"][1] / LIMITS["com_height"][0])
 
 # From this size on, one fused, multithreaded numba pass beats five numpy passes; below it the
 # numpy path avoids compiling the kernel at all.
@@ -115,6 +111,7 @@ def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> float | NDArra
 
 def cop_region(params: BodyParams) -> CaptureInterval:
     """Capture-point bounds of CoP balancing, Eq. (4): the foot itself, (δ⁻, δ⁺) [m]."""
+    require_type("params", params, BodyParams)
     return CaptureInterval(params.heel, params.toe)
 
 
@@ -131,7 +128,8 @@ def cop_margin(
     zero on the surface, negative outside; its magnitude is the distance of the capture point
     to the nearer foot edge. See :func:`capture_margin` for the arguments.
     """
-    return capture_margin(x, xdot, params.omega, cop_region(params), out=out)
+    region = cop_region(params)  # checks params first
+    return capture_margin(x, xdot, params.omega, region, out=out)
 
 
 def capture_margin(

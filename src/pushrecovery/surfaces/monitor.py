@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery._validate import require_type
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
@@ -128,6 +129,9 @@ class BalanceMonitor:
     def __init__(self, params: BodyParams, support: Support | None = None) -> None:
         from pushrecovery.surfaces._kernels import locate_steps
 
+        require_type("params", params, BodyParams)
+        if support is not None:
+            require_type("support", support, Support)
         self.params = params
         self._omega = params.omega
         self._locate: Callable[..., tuple[int, float]] = locate_steps
@@ -162,9 +166,17 @@ class BalanceMonitor:
         InvalidParameterError
             If a value is NaN or infinite.
         """
-        px = capture_point(x, xdot, self._omega)
-        py = capture_point(y, ydot, self._omega)
-        if not (math.isfinite(px) and math.isfinite(py) and math.isfinite(x + y)):
+        try:
+            px = capture_point(x, xdot, self._omega)
+            py = capture_point(y, ydot, self._omega)
+            finite = math.isfinite(px) and math.isfinite(py) and math.isfinite(x + y)
+        except (TypeError, ValueError):  # an array or text where a number belongs: no cost here
+            raise ParameterTypeError(
+                "x, y, xdot, ydot must be numbers (one state per query; classify_states for "
+                f"arrays), got {type(x).__name__}, {type(y).__name__}, {type(xdot).__name__}, "
+                f"{type(ydot).__name__}"
+            ) from None
+        if not finite:
             raise InvalidParameterError(
                 f"x, y, xdot, ydot must be finite, got {x!r}, {y!r}, {xdot!r}, {ydot!r}"
             )

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array
+from pushrecovery._validate import finite_array, require_type
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.models._step_scalar import step_line
@@ -102,6 +102,8 @@ def cmp_polygon(support: Support, params: BodyParams) -> ConvexPolygon:
     The box is aligned with the stance's heading (the upper body's pitch and roll axes). The
     last regions built are kept, keyed by the polygon's vertices and the box.
     """
+    require_type("support", support, Support)
+    require_type("params", params, BodyParams)
     vertices = support.polygon.vertices
     return _grown(
         vertices.tobytes(), len(vertices), cmp_offset(params), cmp_offset_roll(params), support.yaw

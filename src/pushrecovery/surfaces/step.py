@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array
+from pushrecovery._validate import finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models._step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
 from pushrecovery.models._step_scalar import decide, feasible
@@ -220,12 +220,14 @@ def plan_step(
     InvalidParameterError
         If ``heel`` is not behind ``toe``.
     """
-    back = params.heel if heel is None else float(heel)
-    front = params.toe if toe is None else float(toe)
+    require_type("params", params, BodyParams)
+    back = params.heel if heel is None else finite_float("heel", heel, "m")
+    front = params.toe if toe is None else finite_float("toe", toe, "m")
     if heel is not None or toe is not None:
         _check_edges(not back >= front, heel, toe)
     args = (params.com_height, params.gravity, params.max_step_length)
-    return StepDecision(*decide(float(x), float(xdot), back, front, *args))
+    state = finite_float("x", x, "m"), finite_float("xdot", xdot, "m/s")
+    return StepDecision(*decide(*state, back, front, *args))
 
 
 def step_feasible(x: float, xdot: float, heel: float, toe: float, params: BodyParams) -> bool:
@@ -316,6 +318,7 @@ def step_thresholds(params: BodyParams, *, tolerance: float = 1e-9) -> tuple[flo
     (v_back, v_fwd) : tuple of float
         Signed: v_back < 0 < v_fwd.
     """
+    require_type("params", params, BodyParams)
     return (
         step_critical_velocity(0.0, -1.0, params, tolerance=tolerance),
         step_critical_velocity(0.0, 1.0, params, tolerance=tolerance),
