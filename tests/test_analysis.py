@@ -505,3 +505,14 @@ def test_time_to_leave_a_subnormal_away_from_the_anchor_is_infinite_without_a_wa
         warnings.simplefilter("error")
         time = time_to_leave(np.array([1e-320]), np.array([0.0]), -0.05, 0.15, 3.13)
     assert time[0] == np.inf
+
+
+def test_a_number_with_a_form_feed_is_read_as_python_reads_it(tmp_path):
+    # Found by make fuzz (seed 0, case 7147): pyarrow typed the column as text, no cell failed
+    # float(), and the search for the bad cell ended in a StopIteration traceback.
+    path = tmp_path / "ff.csv"
+    rows = [f"{i / 100:.2f},{0.001 * i:.6f},0" for i in range(12)]
+    rows[5] = "0.05,0.005000\f,0"
+    path.write_text("time,com_ap,com_ml\n" + "\n".join(rows) + "\n")
+    recording = read_csv_recording(path)
+    assert recording.com[5, 0] == pytest.approx(0.005)

@@ -216,10 +216,19 @@ def _read_table(path: Path) -> dict[str, FloatArray]:
                 columns[name] = np.full(table.num_rows, np.nan)
                 continue
             values = column.to_pylist()
-            row = next(i for i, v in enumerate(values) if v is not None and not _is_number(v))
-            raise InputFileError(
-                f"{path}: column {name!r} row {row + 2} is not a number: {str(values[row])[:30]!r}"
+            row = next(
+                (i for i, v in enumerate(values) if v is not None and not _is_number(v)), None
             )
+            if row is not None:
+                raise InputFileError(
+                    f"{path}: column {name!r} row {row + 2} is not a number: "
+                    f"{str(values[row])[:30]!r}"
+                )
+            # Numbers pyarrow would not parse but Python does ("0.02\f": surrounding spaces).
+            columns[name] = np.array(
+                [np.nan if v is None else float(v) for v in values], dtype=np.float64
+            )
+            continue
         columns[name] = column.to_numpy(zero_copy_only=False).astype(np.float64)
     return columns
 
