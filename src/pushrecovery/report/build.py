@@ -6,24 +6,7 @@ directories (``OUT/campaign-*``: their Parquet pushes and summaries, reused by a
 the same grids) are written under ``OUT``; :func:`~pushrecovery.report.html.write_report`
 renders the page.
 
-Sections, in the page's order (key: content):
-
-- ``bounds``: the parameters, bounds and thresholds (``pushrecovery bounds``);
-- ``map``: the strategy map of the (x, ẋ) plane;
-- ``plane``: the capture-point plane of the ground-plane model in double and single support,
-  with the per-direction push thresholds;
-- ``steps``: one- and two-step capture regions for a few pushes, the N-step strategy map and
-  the N-step thresholds;
-- ``figures``: every reproduced figure of the paper;
-- ``analytic``: a campaign on the analytic ``stepping`` model with the ``recovery`` controller;
-- ``sweep``: the critical push of ``flywheel`` + ``mpc`` against the hip torque limit;
-- ``mujoco``: a campaign on the MuJoCo ``torso`` with ``mpc``;
-- ``biped``: a campaign on the MuJoCo ``biped`` with ``recovery``;
-- ``critical``: the MuJoCo critical-push table;
-- ``filmstrips``: one rendered MuJoCo run per strategy.
-
-The grids come in two sizes: ``small`` (the default, about a minute on two cores) and ``full``;
-any grid can be replaced (:class:`PushGrid`), any section left out (``skip``).
+The sections, their keys and the grids: :mod:`pushrecovery.report.html`.
 """
 
 from __future__ import annotations
