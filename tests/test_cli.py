@@ -266,6 +266,7 @@ def test_table_output_is_readable():
         (["simulate", "--model", "flywheel", "--controller", "recovery"], "stepping model"),
         (["simulate", "--duration", "1e12"], "duration must be in (0, 60] s, got duration=1e+12"),
         (["simulate", "--duration", "60", "--control-period", "1e-6"], "must be <= 1e+07 steps"),
+        (["simulate", "--control-period", "5e-324"], "must be <= 1e+07 steps, got inf"),
         (
             ["simulate", "--model", "flywheel", "--controller", "mpc", "--option", "horizon=3000"],
             "horizon must be an integer in [1, 200], got 3000",

@@ -278,11 +278,12 @@ def check_run(
             f"controller {controller.name!r} needs the state {list(controller.state_labels)}, "
             f"which model {plant.name!r} {list(plant.state_labels)} lacks{hint}"
         )
-    steps = math.ceil(duration / dt - 1e-9)
-    if steps > MAX_STEPS:
+    ratio = duration / dt  # +inf for a subnormal period: compared before any rounding
+    if ratio - 1e-9 > MAX_STEPS:
         raise InvalidParameterError(
-            f"duration / control_period must be <= {MAX_STEPS:g} steps, got {steps:g}"
+            f"duration / control_period must be <= {MAX_STEPS:g} steps, got {ratio:g}"
         )
+    steps = math.ceil(ratio - 1e-9)
     if plant.params.omega * dt > MAX_OMEGA_DT:
         raise InvalidParameterError(
             f"control_period must be <= {MAX_OMEGA_DT:g} / omega = "
