@@ -10,6 +10,8 @@ that overruns its time is killed; the next read starts a new one. A fresh interp
 ``multiprocessing``: no fork of a multi-threaded caller, and a user's script without an
 ``if __name__ == "__main__"`` guard is not run again in the child.
 
+POSIX only (``select`` on the helper's pipe), as the rest of the project's tooling.
+
 Protocol: 8-byte big-endian length, then a pickle; requests ``(module, function, args)``,
 answers ``(ok, value)`` (the value, or the exception the function raised).
 """
@@ -64,11 +66,15 @@ class _Helper:
 
     def start(self) -> subprocess.Popen[bytes]:
         if self.process is None or self.process.poll() is not None:
+            # The helper imports this very package, even one put on sys.path at run time.
+            root = str(Path(__file__).resolve().parents[3])
+            paths = [root, *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
             self.process = subprocess.Popen(
                 [sys.executable, "-m", "pushrecovery.analysis.c3d.server"],
                 stdin=subprocess.PIPE,
                 stdout=subprocess.PIPE,
                 stderr=subprocess.DEVNULL,  # ezc3d's own messages: the user gets one line
+                env={**os.environ, "PYTHONPATH": os.pathsep.join(paths)},
             )
         return self.process
 
