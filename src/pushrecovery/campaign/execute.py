@@ -19,18 +19,16 @@ workers of a running ``dask.distributed`` scheduler at that address (``tcp://hos
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import re
-import signal
-import threading
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pushrecovery.campaign.isolation import interrupts_ignored, new_pool, quarantine
 from pushrecovery.campaign.pushes import COLUMNS, run_batch
 from pushrecovery.campaign.spec import CampaignSpec
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
@@ -151,24 +149,6 @@ def _cores() -> int:
     return os.cpu_count() or 1
 
 
-def _ignore_interrupts() -> None:
-    """Worker initializer: SIGINT is the parent's to handle (no traceback from each worker)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-@contextlib.contextmanager
-def _interrupts_ignored() -> Iterator[None]:
-    """Ignore SIGINT while worker processes start (they inherit it); main thread only."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
 def _serial(spec: CampaignSpec, batches: list[int]) -> Iterator[tuple[int, list[dict]]]:
     for batch in batches:
         yield run_batch(spec, batch)
@@ -177,35 +157,37 @@ def _serial(spec: CampaignSpec, batches: list[int]) -> Iterator[tuple[int, list[
 def _processes(
     spec: CampaignSpec, batches: list[int], workers: int
 ) -> Iterator[tuple[int, list[dict]]]:
-    import multiprocessing
+    """Run ``batches`` on a pool of ``workers`` processes (docs: campaign/isolation.py).
+
+    If a worker dies, the batches it took down with the pool go on in quarantine: the push
+    that killed it becomes an ``error`` row, every other push is simulated.
+    """
     from concurrent.futures.process import BrokenProcessPool
 
-    # Not fork: the parent may already run OpenMP threads (numba's parallel surfaces), which a
-    # forked child cannot use.
-    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
-    pool = ProcessPoolExecutor(
-        max_workers=workers,
-        mp_context=multiprocessing.get_context(method),
-        initializer=_ignore_interrupts,
-    )
+    pool = new_pool(workers)
+    failed: list[int] = []
     try:
         # Ctrl-C reaches the whole process group: the workers ignore it (started while this
         # process ignores it, which they inherit), the parent stops them and says so once.
-        with _interrupts_ignored():
-            pending: set[Future[tuple[int, list[dict]]]] = {
-                pool.submit(run_batch, spec, batch) for batch in batches
+        with interrupts_ignored():
+            pending: dict[Future[tuple[int, list[dict]]], int] = {
+                pool.submit(run_batch, spec, batch): batch for batch in batches
             }
-        while pending:
-            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+        while pending and not failed:
+            done, _ = wait(pending, return_when=FIRST_COMPLETED)
             for future in done:
+                batch = pending.pop(future)
                 try:
-                    yield future.result()
+                    result = future.result()
                 except BrokenProcessPool:
-                    raise CampaignError(
-                        "a worker process died; the finished batches are saved, rerun with --resume"
-                    ) from None
+                    failed.append(batch)
+                    continue
+                yield result
+        failed += pending.values()
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+    if failed:
+        yield from quarantine(spec, sorted(failed))
 
 
 def _connect(scheduler: str) -> Any:
@@ -348,7 +330,10 @@ def finish(spec: CampaignSpec, directory: Path, ran: int = 0) -> CampaignResult:
     if missing:
         raise CampaignError(f"{len(missing)} batches missing in {directory}; rerun with --resume")
     parts = [pq.read_table(_batch_path(directory, b)) for b in spec.batch_indices()]
-    table = pa.concat_tables(parts) if parts else schema(spec).empty_table()
+    # Batches written before a column was added (a resumed old campaign) get it as nulls.
+    table = (
+        pa.concat_tables(parts, promote_options="default") if parts else schema(spec).empty_table()
+    )
     partial = directory / (PUSHES_FILE + ".partial")
     pq.write_table(table, partial)
     os.replace(partial, directory / PUSHES_FILE)

@@ -25,6 +25,8 @@ it, and what the simulation did. Columns, SI units, positions relative to the st
 ``cop_min, cop_max``   CoP excursion commanded over the run [m]
 ``time``               simulated time to the outcome [s]
 ``stop_impacts``       times the upper body hit its joint stop
+``error``              why the push has no outcome (``outcome`` = ``error``): the physics
+                       diverged, or its worker process died; null otherwise
 =====================  ======================================================================
 """
 
@@ -34,14 +36,15 @@ import math
 from typing import Any
 
 from pushrecovery.campaign.spec import CampaignSpec, Push
-from pushrecovery.control.base import make_controller
+from pushrecovery.control.base import controller_class, make_controller
+from pushrecovery.errors import SimulationDiverged
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import pushed_state
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify
 
-__all__ = ["COLUMNS", "run_batch", "run_push"]
+__all__ = ["COLUMNS", "error_row", "run_batch", "run_push"]
 
 
 #: Fixed columns after the ``param_<name>`` ones, with their Arrow type names.
@@ -65,6 +68,7 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("cop_max", "float64"),
     ("time", "float64"),
     ("stop_impacts", "int64"),
+    ("error", "string"),
 )
 
 
@@ -85,7 +89,11 @@ def run_push(
     plant, controller = cache[push.params]
     params = push.params
     state = pushed_state(plant, push.x0, push.xdot, force=spec.backend == "mujoco")
-    run = simulate(plant, controller, state, duration=spec.duration)
+    try:
+        run = simulate(plant, controller, state, duration=spec.duration)
+    except SimulationDiverged as exc:  # this push only: the others of the batch go on
+        del cache[push.params]  # the engine's state is not to be trusted any more
+        return error_row(spec, push, f"the physics diverged: {exc}")
     found = classify(push.x0, push.xdot, params)
     # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
     reach = STRATEGY_CODES.index(Strategy(controller.strategy))
@@ -117,6 +125,44 @@ def run_push(
         cop_max=float(cops.max()) if cops.size else math.nan,
         time=float(run.time[-1]),
         stop_impacts=run.stop_impacts,
+        error=None,
+    )
+    return row
+
+
+def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
+    """Return the row of a push without an outcome: the prediction, ``outcome`` = error.
+
+    The simulated columns are NaN (counts 0), ``used`` is ``error`` and ``error`` says why.
+    """
+    found = classify(push.x0, push.xdot, push.params)
+    strategy = controller_class(spec.controller).strategy
+    reach = STRATEGY_CODES.index(Strategy(strategy))
+    row: dict[str, Any] = {
+        f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
+    }
+    row.update(
+        index=push.index,
+        x0=push.x0,
+        xdot=push.xdot,
+        impulse=push.impulse,
+        predicted=found.strategy.value,
+        capture_point=found.capture_point,
+        cop_margin=found.margins["cop"],
+        cmp_margin=found.margins["cmp"],
+        step_margin=found.margins["step"],
+        predicted_steps=-1 if found.steps is None else found.steps,
+        predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
+        outcome="error",
+        used="error",
+        steps=0,
+        peak_hip_torque=math.nan,
+        peak_ankle_torque=math.nan,
+        cop_min=math.nan,
+        cop_max=math.nan,
+        time=math.nan,
+        stop_impacts=0,
+        error=reason,
     )
     return row
 

@@ -41,6 +41,8 @@ def boundary(spec: CampaignSpec, columns: dict[str, np.ndarray]) -> list[dict[st
     names = [f"param_{name}" for name in spec.sweeps]
     groups: dict[tuple[float, ...], list[int]] = defaultdict(list)
     for i in range(len(columns["x0"])):
+        if columns["outcome"][i] == "error":
+            continue  # no outcome: neither a recovery nor a fall
         key = (*(float(columns[n][i]) for n in names), float(columns["x0"][i]))
         groups[key].append(i)
     rows = []
@@ -83,21 +85,26 @@ def summarize(spec: CampaignSpec, table: Any) -> dict[str, Any]:
         name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names
     }
     outcome, predicted, used = columns["outcome"], columns["predicted"], columns["used"]
+    # A push without an outcome (its physics diverged, its worker died) is counted apart and
+    # left out of the confusion matrix, the accuracy and the critical pushes.
+    decided = outcome != "error"
     counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)
-    for p, u in zip(predicted, used, strict=True):
+    for p, u in zip(predicted[decided], used[decided], strict=True):
         counts[LABELS.index(p), LABELS.index(u)] += 1
     recovered = outcome == "recovered"
     total = len(outcome)
-    agree = int(np.sum(columns["predicted_recovers"] == recovered))
+    judged = int(np.sum(decided))
+    agree = int(np.sum((columns["predicted_recovers"] == recovered) & decided))
     return {
         "spec": spec.to_dict(),
         "pushes": total,
         "outcomes": {
-            name: int(np.sum(outcome == name)) for name in ("recovered", "fell", "undecided")
+            name: int(np.sum(outcome == name))
+            for name in ("recovered", "fell", "undecided", "error")
         },
         "predicted": {name: int(np.sum(predicted == name)) for name in LABELS},
         "used": {name: int(np.sum(used == name)) for name in LABELS},
-        "accuracy": agree / total if total else None,
+        "accuracy": agree / judged if judged else None,
         "confusion": {
             "labels": list(LABELS),
             "rows": "predicted",

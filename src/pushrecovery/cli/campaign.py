@@ -211,7 +211,10 @@ def campaign(
     click.echo(
         f"{summary['pushes']} pushes ({result.ran} of {spec.batches} batches run now): "
         f"{outcomes['recovered']} recovered, {outcomes['fell']} fell, "
-        f"{outcomes['undecided']} undecided; prediction accuracy {summary['accuracy']:.3f}"
+        f"{outcomes['undecided']} undecided"
+        + (f", {outcomes['error']} without an outcome" if outcomes.get("error") else "")
+        + "; prediction accuracy "
+        + ("n/a" if summary["accuracy"] is None else f"{summary['accuracy']:.3f}")
     )
     confusion = summary["confusion"]
     echo_confusion(

@@ -72,8 +72,9 @@ def _column(pushes: Any, name: str) -> np.ndarray:
 
 def _verdict_counts(pushes: Any, ident: str) -> VerdictCounts:
     """Count the surfaces' verdict (recovers or not) against the outcome, by push."""
-    verdict = _column(pushes, "predicted_recovers").astype(bool)
-    recovered = _column(pushes, "outcome") == "recovered"
+    decided = _column(pushes, "outcome") != "error"  # as the accuracy: pushes with an outcome
+    verdict = _column(pushes, "predicted_recovers").astype(bool)[decided]
+    recovered = (_column(pushes, "outcome") == "recovered")[decided]
     return VerdictCounts(
         recovers_recovered=int(np.sum(verdict & recovered)),
         recovers_not_recovered=int(np.sum(verdict & ~recovered)),
@@ -85,12 +86,14 @@ def _verdict_counts(pushes: Any, ident: str) -> VerdictCounts:
 
 def _disagreements(pushes: Any) -> Disagreements:
     """Count the pushes whose outcome the surfaces got wrong, by kind."""
-    verdict = _column(pushes, "predicted_recovers").astype(bool)
+    decided = _column(pushes, "outcome") != "error"
+    verdict = _column(pushes, "predicted_recovers").astype(bool) & decided
     recovered = _column(pushes, "outcome") == "recovered"
+    verdict_fails = ~_column(pushes, "predicted_recovers").astype(bool) & decided
     unexpected = (_column(pushes, "predicted") == "fall") & recovered
     return Disagreements(
         fell_inside=int(np.sum(verdict & ~recovered)),
-        recovered_beyond=int(np.sum(~verdict & recovered)),
+        recovered_beyond=int(np.sum(verdict_fails & recovered)),
         recovered_with_steps=int(np.sum(unexpected & (_column(pushes, "steps") >= 2))),
     )
 
@@ -116,6 +119,7 @@ def _campaign_section(
         recovered=int(outcomes["recovered"]),
         fell=int(outcomes["fell"]),
         undecided=int(outcomes["undecided"]),
+        errors=int(outcomes.get("error", 0)),
         accuracy=float(summary["accuracy"]),
         verdicts=_verdict_counts(result.table, f"verdicts-{key}"),
         confusion=_confusion(summary, f"confusion-{key}"),

@@ -215,6 +215,7 @@ class CampaignSection(Section):
     recovered: int
     fell: int
     undecided: int
+    errors: int  # pushes without an outcome (physics diverged, worker died): not in accuracy
     accuracy: float
     verdicts: VerdictCounts
     confusion: ConfusionMatrix
