@@ -9,6 +9,7 @@ from typing import Any
 import click
 
 from pushrecovery.cli.options import body_options, echo_confusion, emit, params_from
+from pushrecovery.cli.progress import Progress
 
 __all__ = ["campaign", "report"]
 
@@ -46,24 +47,6 @@ _scheduler = click.option(
     metavar="ADDRESS",
     help="Run the batches on a running dask.distributed scheduler (tcp://host:port).",
 )
-
-
-class _Progress:
-    """A tqdm bar over the pushes (rate and ETA), drawn on a terminal only."""
-
-    def __init__(self, total: int, label: str) -> None:
-        from tqdm import tqdm
-
-        # A piped stderr keeps its one-line errors.
-        self.bar = tqdm(
-            total=total, desc=label, unit="push", file=sys.stderr, disable=not sys.stderr.isatty()
-        )
-
-    def update(self, count: int) -> None:
-        self.bar.update(count)
-
-    def close(self) -> None:
-        self.bar.close()
 
 
 @click.command(short_help="Sweep pushes over starts, push sizes and parameters, at scale.")
@@ -172,7 +155,7 @@ def campaign(
             duration=duration,
             batch_size=batch_size,
         )
-    bar = _Progress(spec.size, "campaign")
+    bar = Progress(spec.size, "campaign", "push")
     try:
         result = run_campaign(
             spec,

@@ -17,6 +17,7 @@ from pushrecovery.cli.options import (
     emit,
     params_from,
 )
+from pushrecovery.cli.progress import Progress
 from pushrecovery.control.registry import CONTROLLER_NAMES
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
@@ -321,18 +322,23 @@ def critical_push(
     from pushrecovery.sim.critical import critical_push as search
 
     params = params_from(kwargs)
-    found = search(
-        params,
-        model,
-        controller,
-        x,
-        direction,
-        tolerance=tolerance,
-        duration=duration,
-        control_period=control_period,
-        controller_options=_options_for(controller, _controller_options(kp, kd, options)),
-        backend=backend,
-    )
+    bar = Progress(None, "critical push", "simulation")
+    try:
+        found = search(
+            params,
+            model,
+            controller,
+            x,
+            direction,
+            tolerance=tolerance,
+            duration=duration,
+            control_period=control_period,
+            controller_options=_options_for(controller, _controller_options(kp, kd, options)),
+            backend=backend,
+            progress=bar.update,
+        )
+    finally:
+        bar.close()
     emit(
         {
             "velocity": found.velocity,

@@ -195,6 +195,7 @@ def critical_push(
     controller_options: dict[str, Any] | None = None,
     backend: str = "analytic",
     force: bool | None = None,
+    progress: Callable[[int], None] | None = None,
 ) -> CriticalPush:
     """Critical push of a model + controller from CoM position ``x0``, with its prediction.
 
@@ -227,6 +228,9 @@ def critical_push(
     force : bool, optional
         Push with a real force (impulse m v over 10 ms at the CoM) instead of a velocity
         jump; only on the ``mujoco`` backend, where it is the default.
+    progress : callable, optional
+        Called with 1 after each simulation of the bisection (e.g. a progress bar's
+        ``update``).
 
     Returns
     -------
@@ -254,6 +258,8 @@ def critical_push(
     def outcome_of(velocity: float) -> Outcome:
         start = pushed_state(plant, x0, velocity, force=force)
         run = simulate(plant, ctrl, start, duration=duration, control_period=control_period)
+        if progress is not None:
+            progress(1)
         return run.outcome
 
     # Just below the models' validity limit (check_com_state).
