@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, fields
 
-from pushrecovery._validate import bounded_float, finite_float, positive_float
+from pushrecovery._validate import bounded_float, finite_float, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
@@ -306,6 +306,7 @@ def default_max_steps(params: BodyParams) -> int:
     :data:`GROWTH_TOLERANCE`. With Δt_s = 0 (the paper's instantaneous step) the regions never
     stop growing: N = 1, the paper's one step.
     """
+    require_type("params", params, BodyParams)
     beta = math.exp(-params.omega * params.min_step_time)
     size = params.max_step_length + 2.0 * params.foot_radius
     if beta >= 1.0:

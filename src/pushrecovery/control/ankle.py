@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float
+from pushrecovery._validate import finite_float, require_type
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -64,6 +64,7 @@ def default_pd_gains(params: BodyParams) -> tuple[float, float]:
     moves ξ monotonically back to 0 and, on the LIPM, every state inside Eq. (4) is
     recovered, exactly as predicted. ``docs/ankle_pd.md`` measures other gains.
     """
+    require_type("params", params, BodyParams)
     stiffness = 3.0 * params.weight * params.com_height
     return stiffness, stiffness / params.omega
 

@@ -22,7 +22,7 @@ from enum import StrEnum
 
 import numpy as np
 
-from pushrecovery._validate import finite_float
+from pushrecovery._validate import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull, rectangle
 from pushrecovery.ground.user_polygon import convex_polygon
@@ -82,6 +82,7 @@ class FootPose:
 
 def foot_shape(params: BodyParams) -> ConvexPolygon:
     """Return the left foot in its own frame: ``foot_polygon`` or the heel/toe/width rectangle."""
+    require_type("params", params, BodyParams)
     if params.foot_polygon is not None:
         return convex_polygon("foot_polygon", params.foot_polygon, contains_origin=True)
     return rectangle(params.heel, params.toe, params.foot_width)

@@ -19,7 +19,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_float, positive_float
+from pushrecovery._validate import finite_float, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
@@ -48,6 +48,7 @@ def max_spin_up_time(params: BodyParams) -> float:
 
     Returns ``inf`` when τmax = 0 (no hip torque: the flywheel never reaches its limit).
     """
+    require_type("params", params, BodyParams)
     if params.torque_max == 0.0:
         return math.inf
     return math.sqrt(params.flywheel_inertia * params.flywheel_angle_max / params.torque_max)
@@ -55,6 +56,7 @@ def max_spin_up_time(params: BodyParams) -> float:
 
 def flywheel_continuous(params: BodyParams) -> tuple[FloatArray, FloatArray]:
     """Continuous-time matrices (A, B) of Eq. (16): Ẋ = A X + B U, X = (x, θ, ẋ, θ̇), U = (δ, τ)."""
+    require_type("params", params, BodyParams)
     w2 = params.omega**2
     a = np.zeros((4, 4))
     a[0, 2] = a[1, 3] = 1.0
@@ -95,6 +97,7 @@ def flywheel_discrete(params: BodyParams, dt: float) -> tuple[FloatArray, FloatA
     InvalidParameterError
         If ``dt`` is not in (0, 50/ω].
     """
+    require_type("params", params, BodyParams)
     omega, weight, inertia = params.omega, params.weight, params.flywheel_inertia
     dt = positive_float("dt", dt, "s")
     if omega * dt > MAX_OMEGA_DT:

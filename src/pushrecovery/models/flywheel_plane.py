@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import require_type
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 
@@ -57,6 +58,7 @@ def roll_axis(params: BodyParams) -> BodyParams:
     The 1-D flywheel functions (:func:`~pushrecovery.models.flywheel.max_spin_up_time`,
     :func:`~pushrecovery.models.flywheel.flywheel_discrete`, ...) then describe the roll axis.
     """
+    require_type("params", params, BodyParams)
     return dataclasses.replace(
         params,
         flywheel_inertia=params.flywheel_inertia_roll,
@@ -73,6 +75,7 @@ def _axes(yaw: float) -> FloatArray:
 
 def plane_continuous(params: BodyParams, yaw: float = 0.0) -> tuple[FloatArray, FloatArray]:
     """Continuous-time matrices (A, B) of the planar model: Ẋ = A X + B U (module docstring)."""
+    require_type("params", params, BodyParams)
     w2 = params.omega**2
     a = np.zeros((8, 8))
     a[0:4, 4:8] = np.eye(4)
@@ -108,6 +111,7 @@ def plane_discrete(
     A : ndarray, shape (8, 8)
     B : ndarray, shape (8, 4)
     """
+    require_type("params", params, BodyParams)
     pitch_a, pitch_b = flywheel_discrete(params, dt)
     _, roll_b = flywheel_discrete(roll_axis(params), dt)
     axes = _axes(yaw)

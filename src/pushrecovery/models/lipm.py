@@ -64,7 +64,8 @@ def lipm_acceleration(x: ArrayLike, cop: ArrayLike, omega: float) -> FloatArray:
     ndarray
         ẍ = ω² (x − δ) [m/s²]; positive accelerates the CoM forward.
     """
-    return omega**2 * (np.asarray(x, dtype=np.float64) - np.asarray(cop, dtype=np.float64))
+    omega = _omega(omega)
+    return omega**2 * (finite_array("x", x) - finite_array("cop", cop))
 
 
 def lipm_state(

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 
 from pushrecovery._validate import bounded_float, finite_float
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import LIMITS
 
 __all__ = [
@@ -38,6 +39,15 @@ __all__ = [
     "pendulum_acceleration",
     "pendulum_step",
 ]
+
+
+def _body(mass: object, length: object, gravity: object) -> tuple[float, float, float]:
+    """M [kg], L [m] and g [m/s²] checked against :data:`~pushrecovery.params.LIMITS`."""
+    return (
+        bounded_float("mass", mass, *LIMITS["mass"]),
+        bounded_float("length", length, *LIMITS["com_height"]),
+        bounded_float("gravity", gravity, *LIMITS["gravity"]),
+    )
 
 
 def ankle_torque_for_cop(
@@ -86,6 +96,41 @@ def ankle_torque_for_cop(
         k = h cosθ − δ sinθ, B = δ m (g − L cosθ θ̇²) − h m L sinθ θ̇² (docs/errata.md, E3).
         0 when the foot is unloaded (F_z ≤ 0).
     """
+    theta, theta_rate, cop = (
+        finite_float(name, value)
+        for name, value in (("theta", theta), ("theta_rate", theta_rate), ("cop", cop))
+    )
+    mass, length, gravity = _body(mass, length, gravity)
+    if not abs(cop) < length:
+        raise InvalidParameterError(f"cop must satisfy |cop| < length = {length:g} m, got {cop:g}")
+    extras = {
+        name: finite_float(name, value)
+        for name, value in (
+            ("hip_torque", hip_torque),
+            ("push_force", push_force),
+            ("ankle_height", ankle_height),
+            ("foot_mass", foot_mass),
+            ("foot_centre", foot_centre),
+        )
+    }
+    return _ankle_torque_for_cop(theta, theta_rate, cop, mass, length, gravity, **extras)
+
+
+def _ankle_torque_for_cop(
+    theta: float,
+    theta_rate: float,
+    cop: float,
+    mass: float,
+    length: float,
+    gravity: float,
+    *,
+    hip_torque: float = 0.0,
+    push_force: float = 0.0,
+    ankle_height: float = 0.0,
+    foot_mass: float = 0.0,
+    foot_centre: float = 0.0,
+) -> float:
+    """:func:`ankle_torque_for_cop` unchecked: the kernel of the simulators' ticks."""
     cos, sin = math.cos(theta), math.sin(theta)
     spin = length * theta_rate * theta_rate
     if ankle_height == 0.0 and hip_torque == 0.0 and push_force == 0.0 and foot_mass == 0.0:
@@ -122,9 +167,7 @@ def pendulum_acceleration(
     """
     for name, value in (("theta", theta), ("theta_rate", theta_rate), ("cop", cop)):
         finite_float(name, value)
-    mass = bounded_float("mass", mass, *LIMITS["mass"])
-    length = bounded_float("length", length, *LIMITS["com_height"])
-    gravity = bounded_float("gravity", gravity, *LIMITS["gravity"])
+    mass, length, gravity = _body(mass, length, gravity)
     return _pendulum_acceleration(theta, theta_rate, cop, mass, length, gravity)
 
 
@@ -132,18 +175,47 @@ def _pendulum_acceleration(
     theta: float, theta_rate: float, cop: float, mass: float, length: float, gravity: float
 ) -> float:
     """:func:`pendulum_acceleration` unchecked: the kernel of :func:`pendulum_step`'s RK4."""
-    torque = ankle_torque_for_cop(theta, theta_rate, cop, mass, length, gravity)
+    torque = _ankle_torque_for_cop(theta, theta_rate, cop, mass, length, gravity)
     return gravity * math.sin(theta) / length - torque / (mass * length * length)
 
 
 def lean_from_com(x: float, xdot: float, length: float) -> tuple[float, float]:
-    """Lean angle and rate (θ, θ̇) from the CoM state (x, ẋ); needs |x| < L."""
+    """Lean angle and rate (θ, θ̇) from the CoM state (x, ẋ); needs |x| < L.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a value is not finite, ``length`` is outside [0.01, 10] m or |x| >= length.
+    """
+    x, xdot = finite_float("x", x, "m"), finite_float("xdot", xdot, "m/s")
+    length = bounded_float("length", length, *LIMITS["com_height"])
+    if not abs(x) < length:
+        raise InvalidParameterError(f"x must satisfy |x| < length = {length:g} m, got {x:g}")
+    return _lean_from_com(x, xdot, length)
+
+
+def _lean_from_com(x: float, xdot: float, length: float) -> tuple[float, float]:
+    """:func:`lean_from_com` unchecked (a plant's every step)."""
     theta = math.asin(x / length)
     return theta, xdot / (length * math.cos(theta))
 
 
 def com_from_lean(theta: float, theta_rate: float, length: float) -> tuple[float, float]:
-    """CoM state (x, ẋ) = (L sinθ, L cosθ θ̇) from the lean angle and rate."""
+    """CoM state (x, ẋ) = (L sinθ, L cosθ θ̇) from the lean angle and rate.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a value is not finite or ``length`` is outside [0.01, 10] m.
+    """
+    theta = finite_float("theta", theta, "rad")
+    theta_rate = finite_float("theta_rate", theta_rate, "rad/s")
+    length = bounded_float("length", length, *LIMITS["com_height"])
+    return _com_from_lean(theta, theta_rate, length)
+
+
+def _com_from_lean(theta: float, theta_rate: float, length: float) -> tuple[float, float]:
+    """:func:`com_from_lean` unchecked (a plant's every step)."""
     return length * math.sin(theta), length * math.cos(theta) * theta_rate
 
 
@@ -176,7 +248,35 @@ def pendulum_step(
     -------
     theta, theta_rate : float
         The state after dt.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a value is not finite, ``dt`` is not in (0, 1] s, ``substeps`` not a whole number
+        in [1, 1000], or the body is outside :data:`~pushrecovery.params.LIMITS`.
     """
+    for name, value in (("theta", theta), ("theta_rate", theta_rate), ("cop", cop)):
+        finite_float(name, value)
+    dt = bounded_float("dt", dt, 1e-9, 1.0, "s")
+    mass, length, gravity = _body(mass, length, gravity)
+    if isinstance(substeps, bool) or not isinstance(substeps, int) or not 1 <= substeps <= 1000:
+        raise InvalidParameterError(
+            f"substeps must be a whole number in [1, 1000], got {substeps!r}"
+        )
+    return _pendulum_step(theta, theta_rate, cop, dt, mass, length, gravity, substeps)
+
+
+def _pendulum_step(
+    theta: float,
+    theta_rate: float,
+    cop: float,
+    dt: float,
+    mass: float,
+    length: float,
+    gravity: float,
+    substeps: int = 1,
+) -> tuple[float, float]:
+    """:func:`pendulum_step` unchecked: the kernel of the pendulum plants' ticks."""
     h = dt / substeps
     args = (cop, mass, length, gravity)
     for _ in range(substeps):

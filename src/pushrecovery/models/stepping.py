@@ -40,9 +40,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import bounded_float, finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models._step_scalar import MAX_STEP_ANGLE as MAX_STEP_ANGLE
 from pushrecovery.models._step_scalar import step_angle
+from pushrecovery.params import LIMITS
 
 __all__ = [
     "STEPPING_STATE",
@@ -68,10 +70,36 @@ STEPPING_STATE = ("x", "theta", "z", "xdot", "theta_dot", "zdot")
 _PYTHON_MAX_SIZE = 32
 
 
+def _leg(length: object, gravity: object) -> tuple[float, float]:
+    """L [m] and g [m/s²] checked against :data:`~pushrecovery.params.LIMITS`."""
+    return (
+        bounded_float("length", length, *LIMITS["leg_length"]),
+        bounded_float("gravity", gravity, *LIMITS["gravity"]),
+    )
+
+
+def _angles(name: str, theta: ArrayLike) -> FloatArray:
+    """Stance-leg angles [rad] in [0, π/2): finite, leaning forward, the foot below the hip."""
+    values = finite_array(name, theta)
+    if values.size and not (float(values.min()) >= 0.0 and float(values.max()) < 0.5 * math.pi):
+        raise InvalidParameterError(f"{name} must lie in [0, pi/2) rad")
+    return values
+
+
+def _speeds(v0: ArrayLike, length: float, gravity: float, least: float = 0.0) -> FloatArray:
+    """CoM speeds [m/s] in [least, 10 sqrt(g L)): the models' validity (check_com_state)."""
+    values = finite_array("v0", v0)
+    limit = 10.0 * math.sqrt(gravity * length)
+    if values.size and not (float(values.min()) >= least and float(values.max()) < limit):
+        raise InvalidParameterError(f"v0 must lie in [{least:g}, 10 sqrt(g L) = {limit:g}) m/s")
+    return values
+
+
 def fall_rate(theta: ArrayLike, v0: ArrayLike, length: float, gravity: float) -> FloatArray:
     """Stance-leg rate θ̇ [rad/s] at lean θ [rad], from energy, starting at θ = 0 with v0 [m/s]."""
-    theta = np.asarray(theta, dtype=np.float64)
-    v0 = np.asarray(v0, dtype=np.float64)
+    length, gravity = _leg(length, gravity)
+    theta = _angles("theta", theta)
+    v0 = _speeds(v0, length, gravity)
     return np.sqrt((v0 / length) ** 2 + 2.0 * gravity / length * (1.0 - np.cos(theta)))
 
 
@@ -83,8 +111,9 @@ def time_to_angle(theta: ArrayLike, v0: ArrayLike, length: float, gravity: float
     """
     from scipy.special import ellipkinc
 
-    theta = np.asarray(theta, dtype=np.float64)
-    a = (np.asarray(v0, dtype=np.float64) / length) ** 2
+    length, gravity = _leg(length, gravity)
+    theta = _angles("theta", theta)
+    a = (_speeds(v0, length, gravity, MIN_V0) / length) ** 2
     return 2.0 / np.sqrt(a) * ellipkinc(0.5 * theta, -4.0 * gravity / length / a)
 
 
@@ -98,8 +127,9 @@ def impact_velocities(
     vx_before, vz_before, vx_after : ndarray
         [m/s]; v_z after the impact is 0 by assumption.
     """
-    theta = np.asarray(theta, dtype=np.float64)
-    theta_rate = np.asarray(theta_rate, dtype=np.float64)
+    length = bounded_float("length", length, *LIMITS["leg_length"])
+    theta = _angles("theta", theta)
+    theta_rate = finite_array("theta_rate", theta_rate)
     cos = np.cos(theta)
     return (
         length * cos * theta_rate,
@@ -112,7 +142,8 @@ def post_impact_capture_point(
     theta: ArrayLike, v0: ArrayLike, length: float, gravity: float
 ) -> FloatArray:
     """Capture point after landing at step angle θ, relative to the new ankle, ξ⁺(θ) [m]."""
-    theta = np.asarray(theta, dtype=np.float64)
+    length, gravity = _leg(length, gravity)
+    theta = _angles("theta", theta)
     rate = fall_rate(theta, v0, length, gravity)
     omega = math.sqrt(gravity / length)
     return length * (-np.sin(theta) + rate / omega * np.cos(2.0 * theta) / np.sqrt(np.cos(theta)))
@@ -136,6 +167,11 @@ def solve_step_angle(
     immediate step leaves the capture point behind the target, and π/4 when the target lies
     below −L/√2 (unreachable).
     """
+    length, gravity = _leg(length, gravity)
+    v0 = finite_array("v0", v0)
+    target = finite_array("target", target)
+    lean = _angles("lean", lean)
+    lean_rate = None if lean_rate is None else finite_array("lean_rate", lean_rate)
     omega2 = gravity / length
     lean = np.asarray(lean, dtype=np.float64)
     if lean_rate is None:
@@ -230,11 +266,9 @@ def step_solution(
         v0 < 1e-6 m/s, or |v0| >= 10 sqrt(g L) (ten times the speed at which the stance
         foot leaves the floor: no step of this model, and float64 overflow beyond).
     """
-    from pushrecovery._validate import bounded_float, finite_array
-    from pushrecovery.params import LIMITS
-
     length = bounded_float("length", length, *LIMITS["leg_length"])
     gravity = bounded_float("gravity", gravity, *LIMITS["gravity"])
+    heel, toe = finite_float("heel", heel, "m"), finite_float("toe", toe, "m")
     v0 = finite_array("v0", v0)
     limit = 10.0 * math.sqrt(gravity * length)
     if v0.size and float(np.min(v0)) < MIN_V0:

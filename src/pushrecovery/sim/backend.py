@@ -37,6 +37,7 @@ from typing import ClassVar, NamedTuple, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import finite_float, require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -148,7 +149,10 @@ def check_com_state(
     which an upright pendulum's foot unloads (docs/conventions.md). ``names`` are the
     coordinate's in the messages (``("y", "ydot")`` sideways).
     """
+    require_type("params", params, BodyParams)
     position, velocity = names
+    x = finite_float(names[0], x, "m")
+    xdot = finite_float(names[1], xdot, "m/s")
     if abs(x) >= params.com_height:
         raise InvalidParameterError(
             f"{position} must satisfy |{position}| < com_height = {params.com_height:g} m, "

@@ -14,11 +14,11 @@ Direction = str  # "forward" or "backward"
 
 def direction_sign(direction: str) -> float:
     """+1.0 for ``"forward"`` (+x), −1.0 for ``"backward"``; anything else raises."""
-    if direction == "forward":
-        return 1.0
-    if direction == "backward":
-        return -1.0
-    raise InvalidParameterError(f"direction must be 'forward' or 'backward', got {direction!r}")
+    if isinstance(direction, str) and direction in ("forward", "backward"):
+        return 1.0 if direction == "forward" else -1.0
+    raise InvalidParameterError(
+        f"direction must be 'forward' or 'backward', got {str(direction)[:40]!r}"
+    )
 
 
 @dataclass(frozen=True, slots=True)

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import require_type
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -229,6 +230,7 @@ def critical_table(
     -------
     list of CriticalRow
     """
+    require_type("params", params, BodyParams)
     for strategy in strategies:
         _setup(backend, strategy)  # every strategy checked before any simulation
     rows = []

@@ -26,7 +26,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float
+from pushrecovery._validate import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
@@ -140,6 +140,8 @@ def capture_region(
     -------
     CaptureRegion
     """
+    require_type("params", params, BodyParams)
+    require_type("support", support, Support)
     t = params.min_step_time if swing_time is None else finite_float("swing_time", swing_time, "s")
     if not 0.0 <= t <= 5.0:
         raise InvalidParameterError(f"swing_time must be in [0, 5] s, got {t:g}")

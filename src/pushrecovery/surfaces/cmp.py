@@ -54,6 +54,7 @@ def cmp_offset(params: BodyParams) -> float:
     a (1 − e^{−ω T_max})², a = τmax / (m g), corrected Eq. (15), for the pitch axis (x).
     Zero when τmax = 0.
     """
+    require_type("params", params, BodyParams)
     if params.torque_max == 0.0:
         return 0.0
     spin_up = max_spin_up_time(params)
@@ -62,6 +63,7 @@ def cmp_offset(params: BodyParams) -> float:
 
 def cmp_offset_roll(params: BodyParams) -> float:
     """:func:`cmp_offset` for the roll axis (the CMP moved sideways, y) [m]."""
+    require_type("params", params, BodyParams)
     return flywheel_offset(
         params.torque_max_roll,
         params.flywheel_inertia_roll,

@@ -96,7 +96,7 @@ def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> float | NDArra
     """
     try:
         valid = OMEGA_MIN <= omega <= OMEGA_MAX  # one comparison: this runs at every tick
-    except TypeError:
+    except (TypeError, ValueError):  # text, None, an array
         valid = False
     if not valid:
         raise InvalidParameterError(
@@ -106,7 +106,7 @@ def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> float | NDArra
     inv = 1.0 / omega  # multiplied, as the compiled kernels do: the same ξ to the bit
     if type(x) is float and type(xdot) is float:
         return x + xdot * inv
-    return np.asarray(x, dtype=np.float64) + np.asarray(xdot, dtype=np.float64) * inv
+    return float_array("x", x) + float_array("xdot", xdot) * inv
 
 
 def cop_region(params: BodyParams) -> CaptureInterval:

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float
+from pushrecovery._validate import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
@@ -179,6 +179,8 @@ def step_options(
 
     ``swing`` picks one foot from double support (it must be the free foot otherwise).
     """
+    require_type("params", params, BodyParams)
+    require_type("support", support, Support)
     if swing is not None:
         try:
             swing = Stance(swing)

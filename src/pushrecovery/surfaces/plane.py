@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, require_type
+from pushrecovery._validate import finite_array, finite_float, float_array, require_type
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.models._step_scalar import step_line
@@ -153,7 +153,10 @@ def capture_margin_xy(
     InvalidParameterError
         If a state is NaN or infinite.
     """
-    arrays = [np.asarray(a, dtype=np.float64) for a in (x, y, xdot, ydot)]
+    arrays = [
+        float_array(name, value)
+        for name, value in (("x", x), ("y", y), ("xdot", xdot), ("ydot", ydot))
+    ]
     shape = np.broadcast_shapes(*(a.shape for a in arrays))
     if (
         all(a.shape == shape for a in arrays)
@@ -192,6 +195,8 @@ def cop_margin_xy(
     out: NDArray[np.float64] | None = None,
 ) -> FloatArray:
     """Signed distance of ξ to the support polygon (CoP balancing, Eq. 4 in the plane) [m]."""
+    require_type("params", params, BodyParams)
+    require_type("support", support, Support)
     return capture_margin_xy(x, y, xdot, ydot, params.omega, support.polygon, out=out)
 
 
@@ -315,6 +320,10 @@ def plan_step_xy(
     (tuple of float, StepDecision or None)
         The line's unit vector e, and the plan (None when |s| >= leg_length: no step).
     """
+    require_type("params", params, BodyParams)
+    require_type("support", support, Support)
+    x, y = finite_float("x", x, "m"), finite_float("y", y, "m")
+    xdot, ydot = finite_float("xdot", xdot, "m/s"), finite_float("ydot", ydot, "m/s")
     ex, ey, along, speed, heel, toe = StepFrame.of(support).line(
         x, y, xdot, ydot, 1.0 / params.omega
     )

@@ -162,6 +162,7 @@ def plan_steps(
     InvalidParameterError
         If a heel is not behind its toe, or a state or an edge is NaN or infinite.
     """
+    require_type("params", params, BodyParams)
     back, front = _edges(params, heel, toe)
     xs, xds, backs, fronts = np.broadcast_arrays(
         *(
@@ -237,11 +238,12 @@ def step_feasible(x: float, xdot: float, heel: float, toe: float, params: BodyPa
     evaluations of the post-impact capture point instead of three Newton solves). Arguments
     as in :func:`plan_step`, the new foot's edges ``heel`` < ``toe`` [m] given.
     """
+    require_type("params", params, BodyParams)
     return feasible(
-        float(x),
-        float(xdot),
-        float(heel),
-        float(toe),
+        finite_float("x", x, "m"),
+        finite_float("xdot", xdot, "m/s"),
+        finite_float("heel", heel, "m"),
+        finite_float("toe", toe, "m"),
         params.com_height,
         params.gravity,
         params.max_step_length,
@@ -297,6 +299,10 @@ def step_critical_velocity(
     push: a harder push needs a longer step and loads the stance leg less). Pure Python: no
     numba or scipy is loaded.
     """
+    require_type("params", params, BodyParams)
+    x = finite_float("x", x, "m")
+    if finite_float("direction", direction) not in (1.0, -1.0):
+        raise InvalidParameterError(f"direction must be +1 or -1, got {direction!r}")
     sign = 1.0 if direction > 0.0 else -1.0
     args = (params.heel, params.toe, params.com_height, params.gravity, params.max_step_length)
     x = float(x)

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import require_type
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
@@ -146,6 +147,7 @@ def line_steps(
 
 def sagittal_step_interval(params: BodyParams, steps: int | None = None) -> CaptureInterval:
     """C_N on the sagittal line (module docstring) [m]; N defaults to ``max_steps``."""
+    require_type("params", params, BodyParams)
     count = params.max_steps if steps is None else steps
     low, high = line_step_bounds(params.heel, params.toe, 0.0, params, count)
     return CaptureInterval(float(low), float(high))

@@ -16,7 +16,7 @@ from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import FLYWHEEL_STATE
 from pushrecovery.models.lipm import ANKLE_STATE
-from pushrecovery.models.pendulum import ankle_torque_for_cop
+from pushrecovery.models.pendulum import _ankle_torque_for_cop
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, FOOT_MASS
 from pushrecovery.sim.mujoco.plant import (
@@ -89,7 +89,7 @@ class MujocoFootPlant(MujocoPlant):
         """Ankle torque (paper's sign) that puts the CoP at ``cop`` now [N m] (errata E3)."""
         p = self.params
         lean, rate = self.lean()
-        return ankle_torque_for_cop(
+        return _ankle_torque_for_cop(
             lean,
             rate,
             cop,
