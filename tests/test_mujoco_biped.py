@@ -180,3 +180,21 @@ def test_biped_kinematics_match_subtree_com():
             worst_x = max(worst_x, abs(x - (com[0] - ankle[0])), abs(z - (com[2] - ankle[2])))
         worst_v = max(worst_v, abs(xdot - velocity[0]), abs(zdot - velocity[2]))
     assert worst_x < 1e-12 and worst_v < 1e-12
+
+
+@pytest.mark.parametrize(("v", "steps"), [(-2.75, 2), (-3.0, 3)])
+def test_backward_pushes_take_the_predicted_steps_without_scuffing(v, steps):
+    # The report's campaign pushes (a force at the torso). The second swing passes under a
+    # hip lowered by the first landing: a swing leg that shortened only as steep as it was
+    # then scuffed the floor 0.36 m short, in front of the stance foot, and the body fell.
+    # The leg now shortens for the steepest angle it reaches within the knee's lag.
+    from pushrecovery.sim.critical import pushed_state
+    from pushrecovery.surfaces.classify import classify
+
+    assert classify(0.0, v, P).steps == steps
+    plant = MujocoBipedPlant(P)
+    controller = recovery()
+    result = simulate(plant, controller, pushed_state(plant, 0.0, v, force=True), duration=5.0)
+    assert result.recovered and len(controller.steps) == steps
+    # Every step lands behind the one before (the scuff landed the second one in front).
+    assert np.all(np.diff(result.footholds) < 0.0)

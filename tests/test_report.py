@@ -122,7 +122,7 @@ TINY = {
     "analytic_grid": PushGrid((0.0, 0.05, 0.05), (-1.0, 1.0, 0.5)),
     "sweep_grid": PushGrid((0.0, 0.0, 1.0), (-0.4, 0.8, 0.4), {"torque_max": (0.0, 100.0, 100.0)}),
 }
-SHOWN = ("bounds", "map", "plane", "steps", "figures", "analytic", "sweep")
+SHOWN = ("bounds", "map", "plane", "steps", "figures", "analytic", "planar", "sweep")
 
 
 @pytest.fixture(scope="module")
@@ -160,10 +160,17 @@ def test_report_sections_are_the_campaigns_numbers(
     # The sweep and its critical pushes; the verdict paragraph's scores.
     sweep = data.section("sweep")
     assert isinstance(sweep, SweepSection) and sweep.parameter == "torque_max"
+    planar = data.section("planar")
+    assert isinstance(planar, CampaignSection) and planar.model == "stepping-plane"
     assert [(title, pushes) for title, _, pushes in data.verdict.scores] == [
         (SECTIONS["sweep"], sweep.pushes),
         (SECTIONS["analytic"], section.pushes),
+        (SECTIONS["planar"], planar.pushes),
     ]
+    # On the model of the N-step analysis every push takes the steps its verdict names.
+    rows = pq.read_table(out / "campaign-planar" / "pushes.parquet").to_pylist()
+    assert rows and all(r["outcome"] == "recovered" for r in rows)
+    assert all(r["steps"] == max(r["predicted_steps"], 0) for r in rows)
     thresholds = bounds_data(load_params())["thresholds"]
     assert data.verdict.hip == thresholds["hip"][1]
     # Every figure is a PNG on disk; every section's wall time in the footer, as it ran.
@@ -184,13 +191,13 @@ def test_the_report_renders_one_self_contained_page(
     for forbidden in ('src="http', 'href="http', "<script", "<link", "url("):
         assert forbidden not in html
     images = re.findall(r'<img src="([^"]*)"', html)
-    assert len(images) >= 8 + 4  # the paper's figures, the map, the plane, two campaign plots
+    assert len(images) >= 8 + 5  # the paper's figures, the map, the plane, three campaign plots
     assert all(src.startswith("data:image/png;base64,") for src in images)
     titles = re.findall(r'<section id="(\w+)">\n<h2>([^<]*)</h2>', html)
     assert [(key, unescape(title)) for key, title in titles] == [(k, SECTIONS[k]) for k in SHOWN]
     for number in ("Eq. (4)", "Eq. (15)", "Eq. (12)", "Sec. IV"):
         assert number in html
-    assert html.count('<table class="confusion"') == 1
+    assert html.count('<table class="confusion"') == 2  # the two analytic campaigns
     assert html.index("<footer>") > html.index('<section id="sweep">')
 
 
@@ -210,7 +217,7 @@ def test_the_page_escapes_its_data(report: tuple[Report, Path, list[str]]) -> No
 
 
 def test_report_reuses_and_replaces_its_campaigns(params: BodyParams, tmp_path: Path) -> None:
-    skip = ("bounds", "map", "plane", "figures", "sweep")
+    skip = ("bounds", "map", "plane", "figures", "sweep", "planar")
     write_report(params, tmp_path, mujoco=False, skip=skip, workers=1, **TINY)
     batch = next((tmp_path / "campaign-analytic" / "batches").iterdir())
     stamp = batch.stat().st_mtime_ns

@@ -34,7 +34,7 @@ __all__ = [
 
 #: Backends a campaign runs on, with their models.
 BACKENDS: Mapping[str, tuple[str, ...]] = {
-    "analytic": ("lipm", "pendulum", "flywheel", "stepping"),
+    "analytic": ("lipm", "pendulum", "flywheel", "stepping", "stepping-plane"),
     "mujoco": ("foot", "torso", "biped"),
 }
 #: Largest campaign accepted [pushes].

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
-from pushrecovery.report.campaigns import _analytic, _biped, _mujoco, _sweep
+from pushrecovery.report.campaigns import _analytic, _biped, _mujoco, _planar, _sweep
 from pushrecovery.report.config import (
     _RUN_ORDER,
     MUJOCO_SECTIONS,
@@ -43,6 +43,7 @@ _BUILDERS: Mapping[str, Callable[[_Context], Section]] = {
     "steps": _steps,
     "figures": _figures,
     "analytic": _analytic,
+    "planar": _planar,
     "sweep": _sweep,
     "mujoco": _mujoco,
     "biped": _biped,

@@ -15,6 +15,7 @@ SECTIONS: Mapping[str, str] = {
     "steps": "Steps: capture regions and N-step capturability",
     "figures": "The paper's figures",
     "analytic": "Push campaign on the analytic models",
+    "planar": "Push campaign on the planar stepping model: N-step plans",
     "sweep": "Critical push against the hip torque limit",
     "mujoco": "Push campaign in MuJoCo: the hip strategy",
     "biped": "Push campaign in MuJoCo: stepping",
@@ -27,6 +28,7 @@ MUJOCO_SECTIONS = ("mujoco", "biped", "critical", "filmstrips")
 _RUN_ORDER = (
     "sweep",
     "analytic",
+    "planar",
     "mujoco",
     "biped",
     "bounds",
@@ -94,7 +96,8 @@ class ReportGrids:
     Parameters
     ----------
     analytic : PushGrid
-        ``stepping`` + ``recovery`` on the analytic backend.
+        ``stepping`` + ``recovery`` on the analytic backend; also the grid of the ``planar``
+        section (``stepping-plane`` + ``recovery-plane``, pushes along x).
     sweep : PushGrid
         ``flywheel`` + ``mpc`` on the analytic backend, sweeping one parameter.
     mujoco : PushGrid

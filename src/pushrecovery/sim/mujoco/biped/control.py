@@ -33,6 +33,9 @@ FOOT_GAINS = (100.0, 3.0)
 HEIGHT_GAINS = (3600.0, 120.0)
 #: Height of the swing sole above the floor until the leg nears its touchdown angle [m].
 CLEARANCE = 0.03
+#: How far ahead a leg in the air looks for the vertical it will swing through [s]: about
+#: the knee's lag (2 / BEND_RATE) with a margin.
+CLEARANCE_LEAD = 0.05
 #: Angle before the touchdown angle over which the clearance is let go [rad].
 CLEARANCE_ANGLE = 0.1
 #: Knee bend of a straight-standing swing leg at touchdown [rad]: shortens it by 2.8 mm.
@@ -229,7 +232,11 @@ class BipedServos:
         a2 = a1 + kappa
         beta = a2 + q[k + 2]
         w1 = v[_PITCH] + v[k]
-        cos = math.cos(a1 + 0.5 * kappa)
+        # The steepest the segment gets within the knee's lag: a leg swinging through the
+        # vertical must be short before it gets there, or its sole scuffs the floor.
+        now = a1 + 0.5 * kappa
+        ahead = now + (w1 + 0.5 * v[k + 1]) * CLEARANCE_LEAD
+        cos = 1.0 if now * ahead <= 0.0 else max(math.cos(now), math.cos(ahead))
         wanted = longest
         if cos > 0.0:
             wanted = min(wanted, (self._base_z + q[_Z] - ANKLE_HEIGHT - clearance) / cos)
