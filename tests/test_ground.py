@@ -228,3 +228,19 @@ def test_params_stay_hashable_and_comparable():
     b = load_params(overrides={"foot_polygon": FOOT})
     assert a == b and hash(a) == hash(b)
     assert isinstance(BodyParams(**{**P.to_dict(), "foot_width": 0.12}), BodyParams)
+
+
+def test_one_point_queries_equal_the_vectorised_ones():
+    # The plain-Python path of a controller's tick against the numpy path, on random hulls:
+    # inside, outside beside an edge and outside at a corner.
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        polygon = convex_hull(rng.normal(size=(int(rng.integers(3, 12)), 2)))
+        points = rng.normal(scale=2.0, size=(40, 2))
+        exact = polygon.signed_distance(points[:, 0], points[:, 1])
+        one = [polygon.point_signed_distance(float(x), float(y)) for x, y in points]
+        np.testing.assert_allclose(one, exact, rtol=0.0, atol=1e-14)
+        for (x, y), distance in zip(points, exact, strict=True):
+            nx, ny = polygon.nearest_point(float(x), float(y))
+            assert math.hypot(nx - x, ny - y) == pytest.approx(max(0.0, -distance), abs=1e-14)
+    assert math.isnan(polygon.point_signed_distance(math.nan, 0.0))

@@ -151,12 +151,15 @@ class PlaneRecoveryController(Controller):
             return Command(float(cop[0]), pitch, saturated, cop_y=float(cop[1]), roll_torque=roll)
         effective = xi - self._hip_remaining(t)
         polygon = self.support.polygon
-        if float(polygon.signed_distance(effective[0], effective[1])) > 0.0:
+        if polygon.point_signed_distance(float(effective[0]), float(effective[1])) > 0.0:
             self.mode = "ankle" if self._hip is None else self.mode
             return Command(float(effective[0]), pitch, cop_y=float(effective[1]), roll_torque=roll)
         if self._hip is None:
             canonical, ankle = self._canonical()
-            if bool(cmp_polygon(canonical, self.params).contains(*(xi - ankle))):
+            inside = cmp_polygon(canonical, self.params).point_signed_distance(
+                float(xi[0] - ankle[0]), float(xi[1] - ankle[1])
+            )
+            if inside > 0.0:
                 return self._start_hip(t, xi)
         return self._start_step(t, effective)
 

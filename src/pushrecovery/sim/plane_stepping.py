@@ -216,7 +216,7 @@ class PlaneSteppingPlant(PlantBase):
         return (
             self._swing is None
             and math.hypot(float(state[4]), float(state[5])) <= speed
-            and bool(self.support.polygon.contains(float(state[0]), float(state[1])))
+            and self.support.polygon.point_signed_distance(float(state[0]), float(state[1])) > 0.0
         )
 
     def falling(self, state: FloatArray) -> bool:
