@@ -94,3 +94,16 @@ def test_run_campaign_records_the_new_column(tmp_path: Any) -> None:
     result = run_campaign(SPEC, tmp_path, workers=1)
     assert result is not None
     assert result.table.column("error").null_count == result.table.num_rows
+
+
+def test_a_ctrl_c_while_workers_start_is_deferred_not_lost() -> None:
+    # The pool starts its workers inside this window; a Ctrl-C then used to be ignored, and
+    # the campaign ran to its end. Now this process gets it when the window closes.
+    from pushrecovery.campaign.isolation import interrupts_deferred
+
+    reached_end = False
+    with pytest.raises(KeyboardInterrupt):
+        with interrupts_deferred():
+            os.kill(os.getpid(), signal.SIGINT)
+            reached_end = True  # nothing was raised inside the window
+    assert reached_end

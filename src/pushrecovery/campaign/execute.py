@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from pushrecovery.campaign.isolation import interrupts_ignored, new_pool, quarantine
+from pushrecovery.campaign.isolation import interrupts_deferred, new_pool, quarantine
 from pushrecovery.campaign.pushes import COLUMNS, run_batch
 from pushrecovery.campaign.spec import CampaignSpec
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
@@ -169,7 +169,7 @@ def _processes(
     try:
         # Ctrl-C reaches the whole process group: the workers ignore it (started while this
         # process ignores it, which they inherit), the parent stops them and says so once.
-        with interrupts_ignored():
+        with interrupts_deferred():
             pending: dict[Future[tuple[int, list[dict]]], int] = {
                 pool.submit(run_batch, spec, batch): batch for batch in batches
             }

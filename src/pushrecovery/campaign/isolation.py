@@ -34,16 +34,30 @@ def _ignore_interrupts() -> None:
 
 
 @contextlib.contextmanager
-def interrupts_ignored() -> Iterator[None]:
-    """Ignore SIGINT while worker processes start (they inherit it); main thread only."""
+def interrupts_deferred() -> Iterator[None]:
+    """Hold SIGINT back while worker processes start; main thread only.
+
+    The processes started meanwhile inherit the blocked signal (a Ctrl-C to the process group
+    never reaches them before their initializer ignores it), and this process receives a
+    Ctrl-C that came meanwhile as soon as the block ends: it is deferred, not lost (ignoring
+    it instead lost a Ctrl-C pressed while the pool started). Where the OS has no signal
+    masks, SIGINT is ignored meanwhile.
+    """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - not POSIX
+        ignored = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, ignored)
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def new_pool(workers: int) -> ProcessPoolExecutor:
@@ -64,7 +78,7 @@ def _alone(function: Callable[..., Any], *args: Any) -> tuple[bool, Any]:
     """Run ``function(*args)`` in a one-worker pool; (False, None) if the worker died."""
     pool = new_pool(1)
     try:
-        with interrupts_ignored():
+        with interrupts_deferred():
             future = pool.submit(function, *args)
         try:
             return True, future.result()

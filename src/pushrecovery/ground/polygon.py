@@ -179,7 +179,11 @@ class ConvexPolygon:
         return np.asarray(gap.min(axis=0), dtype=np.float64)
 
     def point_signed_distance(self, px: float, py: float) -> float:
-        """:meth:`signed_distance` of one point (x, y) [m], as a float (NaN if not finite)."""
+        """:meth:`signed_distance` of one point (x, y) [m], as a float (NaN if not finite).
+
+        A tick's kernel: floats in, no type checks (the vectorised method checks nothing
+        either; callers validate states at their entry).
+        """
         if not (math.isfinite(px) and math.isfinite(py)):
             return math.nan
         excess = max(nx * px + ny * py - b for _, _, _, _, nx, ny, b in self._edges)
