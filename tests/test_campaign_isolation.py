@@ -28,6 +28,7 @@ SPEC = CampaignSpec(
     batch_size=4,
 )  # fmt: skip
 CRASH = 5  # the push that kills its process: in batch 1 of 3
+HANG = 6  # the push that never returns (tests with a short push_timeout)
 
 
 def crash_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]]:
@@ -39,6 +40,25 @@ def crash_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any
 def crash_push(spec: CampaignSpec, push: Any, cache: Any = None) -> dict[str, Any]:
     if push.index == CRASH:
         os.kill(os.getpid(), signal.SIGSEGV)
+    return run_push(spec, push, cache)
+
+
+def hang_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]]:
+    from pushrecovery.campaign import watchdog
+
+    rows = []
+    for push in spec.pushes(batch):
+        watchdog.arm(spec.push_timeout)  # as run_batch does
+        rows.append(hang_push(spec, push))
+    watchdog.disarm()
+    return batch, rows
+
+
+def hang_push(spec: CampaignSpec, push: Any, cache: Any = None) -> dict[str, Any]:
+    import time
+
+    while push.index == HANG:
+        time.sleep(1.0)  # outside the simulation: only the worker's watchdog ends it
     return run_push(spec, push, cache)
 
 
@@ -107,3 +127,105 @@ def test_a_ctrl_c_while_workers_start_is_deferred_not_lost() -> None:
             os.kill(os.getpid(), signal.SIGINT)
             reached_end = True  # nothing was raised inside the window
     assert reached_end
+
+
+def test_a_push_that_hangs_is_one_error_row() -> None:
+    import dataclasses
+
+    from pushrecovery.campaign.watchdog import hung_after
+
+    spec = dataclasses.replace(SPEC, push_timeout=0.5)
+    found = dict(quarantine(spec, [1], batch_runner=hang_batch, push_runner=hang_push))
+    expected = run_batch(spec, 1)[1]
+    for row, reference in zip(found[1], expected, strict=True):
+        if row["index"] == HANG:
+            assert row["outcome"] == "error"
+            assert row["error"] == (
+                f"it gave no answer for {hung_after(0.5):g} s of wall time; its worker process "
+                "was stopped"
+            )
+        else:
+            assert row == reference
+
+
+def test_a_push_slower_than_its_limit_is_one_error_row() -> None:
+    import dataclasses
+
+    # 0.1 ms of wall time: every push of the pendulum takes longer (thousands of ticks).
+    spec = dataclasses.replace(SPEC, push_timeout=1e-4)
+    _, rows = run_batch(spec, 0)
+    assert [row["outcome"] for row in rows] == ["error"] * len(rows)
+    assert all(row["error"].startswith("too slow: the run took more than its wall-time limit")
+               for row in rows)  # fmt: skip
+    assert rows[0]["predicted"] == run_batch(SPEC, 0)[1][0]["predicted"]
+
+
+def test_one_worker_still_runs_the_pushes_in_a_process_of_its_own(
+    tmp_path: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from pushrecovery.campaign import execute
+
+    def in_this_process(*args: Any) -> Any:
+        raise AssertionError("workers=1 ran the pushes in the campaign's own process")
+
+    monkeypatch.setattr(execute, "_serial", in_this_process)
+    result = run_campaign(SPEC, tmp_path / "one", workers=1)
+    assert result is not None and result.table.num_rows == SPEC.size
+    with pytest.raises(AssertionError, match="own process"):
+        run_campaign(SPEC, tmp_path / "here", workers=1, isolated=False)
+
+
+def test_push_timeout_is_checked_and_stored(tmp_path: Any) -> None:
+    import dataclasses
+
+    from pushrecovery.errors import InvalidParameterError
+
+    for bad in (0.0, -1.0, float("nan"), float("inf"), 3601.0, True, "60"):
+        with pytest.raises(InvalidParameterError, match="push_timeout must be in"):
+            dataclasses.replace(SPEC, push_timeout=bad)
+    spec = dataclasses.replace(SPEC, push_timeout=30.0)
+    assert CampaignSpec.from_dict(spec.to_dict()) == spec
+    old = SPEC.to_dict()
+    del old["push_timeout"]  # a campaign written before the limit existed
+    assert CampaignSpec.from_dict(old).push_timeout == 120.0
+
+
+def test_a_hung_worker_of_the_pool_ends_itself_and_the_campaign_goes_on(
+    tmp_path: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import dataclasses
+
+    from pushrecovery.campaign import execute
+
+    # The pool's batches hang at push HANG; the worker's watchdog ends it after
+    # hung_after(0.5) = 1 s, the pool breaks, and the quarantine (the real runners) finishes.
+    spec = dataclasses.replace(SPEC, push_timeout=0.5)
+    monkeypatch.setattr(execute, "run_batch", hang_batch)
+    result = run_campaign(spec, tmp_path / "c", workers=2)
+    assert result is not None
+    rows = result.table.to_pylist()
+    reference = [row for b in range(spec.batches) for row in run_batch(spec, b)[1]]
+    assert rows == reference
+
+
+def test_a_push_that_kills_its_dask_worker_is_one_error_row() -> None:
+    import dask
+    from distributed import Client, LocalCluster
+
+    from pushrecovery.campaign.execute import _dask
+
+    # The scheduler gives up on a task at once when its worker dies (the default retries on
+    # 3 more workers, each a crash); the nanny restarts the worker.
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        with LocalCluster(n_workers=1, threads_per_worker=1, processes=True) as cluster:
+            with Client(cluster, set_as_default=False) as client:
+                found = dict(
+                    _dask(SPEC, [0, 1], client, batch_runner=crash_batch, push_runner=crash_push)
+                )
+    assert sorted(found) == [0, 1]
+    for batch in (0, 1):
+        for row, reference in zip(found[batch], run_batch(SPEC, batch)[1], strict=True):
+            if row["index"] == CRASH:
+                assert row["outcome"] == "error" and row["error"] == "its worker process died"
+            else:
+                assert row == reference

@@ -14,6 +14,7 @@ __all__ = [
     "ParameterTypeError",
     "PushRecoveryError",
     "SimulationDiverged",
+    "SimulationTimeout",
 ]
 
 
@@ -41,3 +42,7 @@ class InputFileError(PushRecoveryError, ValueError):
 
 class SimulationDiverged(PushRecoveryError, RuntimeError):
     """The physics engine became unstable: the push or the state is beyond what it simulates."""
+
+
+class SimulationTimeout(PushRecoveryError, RuntimeError):
+    """A run took longer than its wall-time limit (``simulate(..., wall_limit=...)``)."""

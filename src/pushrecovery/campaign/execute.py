@@ -12,9 +12,9 @@ An interrupted campaign (Ctrl-C, a lost worker, a killed process) keeps every fi
 ``resume`` runs only the missing ones. Each push depends on the spec and its index only, so the
 result is the same whatever the number of workers and the order batches finish in.
 
-Workers: ``workers=1`` runs in this process; otherwise ``workers`` local processes
-(``concurrent.futures.ProcessPoolExecutor``, default: all cores), or, with ``scheduler``, the
-workers of a running ``dask.distributed`` scheduler at that address (``tcp://host:port``).
+Workers: ``workers`` local processes (``concurrent.futures.ProcessPoolExecutor``, default: all
+cores; ``workers=1, isolated=False``: this process), or, with ``scheduler``, the workers of a
+running ``dask.distributed`` scheduler at that address (``tcp://host:port``).
 """
 
 from __future__ import annotations
@@ -23,13 +23,20 @@ import json
 import os
 import re
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, wait
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from pushrecovery.campaign.isolation import interrupts_deferred, new_pool, quarantine
-from pushrecovery.campaign.pushes import COLUMNS, run_batch
+from pushrecovery.campaign.isolation import (
+    BatchRunner,
+    PushRunner,
+    batch_deadline,
+    interrupts_deferred,
+    new_pool,
+    quarantine,
+)
+from pushrecovery.campaign.pushes import COLUMNS, error_row, run_batch, run_push
 from pushrecovery.campaign.spec import CampaignSpec
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 
@@ -159,8 +166,10 @@ def _processes(
 ) -> Iterator[tuple[int, list[dict]]]:
     """Run ``batches`` on a pool of ``workers`` processes (docs: campaign/isolation.py).
 
-    If a worker dies, the batches it took down with the pool go on in quarantine: the push
-    that killed it becomes an ``error`` row, every other push is simulated.
+    If a worker dies or hangs, the batches it took down with the pool go on in quarantine:
+    the push that killed it becomes an ``error`` row, every other push is simulated. A worker
+    ends itself when a push hangs (its watchdog); should even that thread be stuck (a C call
+    holding the GIL), no batch finishing within :func:`batch_deadline` stops the pool here.
     """
     from concurrent.futures.process import BrokenProcessPool
 
@@ -168,13 +177,16 @@ def _processes(
     failed: list[int] = []
     try:
         # Ctrl-C reaches the whole process group: the workers ignore it (started while this
-        # process ignores it, which they inherit), the parent stops them and says so once.
+        # process blocks it, which they inherit), the parent stops them and says so once.
         with interrupts_deferred():
             pending: dict[Future[tuple[int, list[dict]]], int] = {
                 pool.submit(run_batch, spec, batch): batch for batch in batches
             }
         while pending and not failed:
-            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            done, _ = wait(pending, timeout=batch_deadline(spec), return_when=FIRST_COMPLETED)
+            if not done:
+                _stop_workers(pool)
+                break
             for future in done:
                 batch = pending.pop(future)
                 try:
@@ -188,6 +200,14 @@ def _processes(
         pool.shutdown(wait=True, cancel_futures=True)
     if failed:
         yield from quarantine(spec, sorted(failed))
+
+
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Kill the pool's processes (hung: they would never return their batches)."""
+    # concurrent.futures has no public way to stop a busy worker before Python 3.14's
+    # terminate_workers(); its process table is the one handle there is.
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.kill()
 
 
 def _connect(scheduler: str) -> Any:
@@ -214,25 +234,89 @@ def _connect(scheduler: str) -> Any:
         raise CampaignError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
 
 
-def _dask(spec: CampaignSpec, batches: list[int], client: Any) -> Iterator[tuple[int, list[dict]]]:
+def _dask(
+    spec: CampaignSpec,
+    batches: list[int],
+    client: Any,
+    *,
+    batch_runner: BatchRunner = run_batch,
+    push_runner: PushRunner = run_push,
+) -> Iterator[tuple[int, list[dict]]]:
+    """Run ``batches`` on the cluster; a batch whose worker died goes on push by push.
+
+    Dask itself gives a task whose worker died to another worker, up to its
+    ``distributed.scheduler.allowed-failures``, then fails it with ``KilledWorker``. Such a
+    batch is sent again one push per task: the push that kills its worker once more is an
+    ``error`` row, every other push is simulated. ``batch_runner`` and ``push_runner`` are
+    :func:`run_batch` and :func:`run_push` (replaceable for tests).
+    """
     from distributed import as_completed
 
     # pure=False: every batch runs, even if an identical task ran before on the cluster.
-    futures = [client.submit(run_batch, spec, batch, pure=False) for batch in batches]
+    futures = {client.submit(batch_runner, spec, batch, pure=False): batch for batch in batches}
     try:
-        for future in as_completed(futures, loop=client.loop):
+        for future in as_completed(list(futures), loop=client.loop):
             try:
                 result = future.result()
             except Exception as exc:  # a lost worker's KilledWorker, a failed task
-                if isinstance(exc, PushRecoveryError):
-                    raise
-                raise CampaignError(
-                    f"a batch failed on the Dask cluster ({type(exc).__name__}: {exc}); the "
-                    "finished batches are saved, rerun with --resume"
-                ) from None
+                if not _killed(exc):
+                    raise _cluster_error(exc) from None
+                result = _dask_pushes(spec, futures[future], client, push_runner)
             yield result
     finally:
+        client.cancel(list(futures))
+
+
+def _dask_pushes(
+    spec: CampaignSpec, batch: int, client: Any, push_runner: PushRunner
+) -> tuple[int, list[dict]]:
+    """Batch ``batch`` one push per task; a push whose worker died is an ``error`` row.
+
+    The pushes run in parallel first. A worker's death fails every task it held, so each push
+    that failed then runs again alone: the one that kills its worker by itself is the error.
+    """
+    pushes = spec.pushes(batch)
+    rows: list[dict | None] = list(_dask_rows(spec, pushes, client, push_runner))
+    for k, push in enumerate(pushes):
+        if rows[k] is None:
+            (row,) = _dask_rows(spec, [push], client, push_runner)
+            rows[k] = row or error_row(spec, push, "its worker process died")
+    return batch, [row for row in rows if row is not None]
+
+
+def _dask_rows(
+    spec: CampaignSpec, pushes: list[Any], client: Any, push_runner: PushRunner
+) -> list[dict | None]:
+    """Rows of ``pushes`` run as one task each; None where the task's worker died."""
+    futures = [client.submit(push_runner, spec, push, pure=False) for push in pushes]
+    rows: list[dict | None] = []
+    try:
+        for future in futures:
+            try:
+                rows.append(future.result())
+            except Exception as exc:
+                if not _killed(exc):
+                    raise _cluster_error(exc) from None
+                rows.append(None)
+    finally:
         client.cancel(futures)
+    return rows
+
+
+def _killed(exc: BaseException) -> bool:
+    from distributed.scheduler import KilledWorker
+
+    return isinstance(exc, KilledWorker)
+
+
+def _cluster_error(exc: Exception) -> Exception:
+    """Return the error to raise for a failed task: ours as it is, else a CampaignError."""
+    if isinstance(exc, PushRecoveryError):
+        return exc
+    return CampaignError(
+        f"a batch failed on the Dask cluster ({type(exc).__name__}: {exc}); the finished "
+        "batches are saved, rerun with --resume"
+    )
 
 
 def run_campaign(
@@ -244,6 +328,7 @@ def run_campaign(
     resume: bool = False,
     max_batches: int | None = None,
     progress: Callable[[int], None] | None = None,
+    isolated: bool = True,
 ) -> CampaignResult | None:
     """Run ``spec`` into ``directory``; return the result, or None if stopped by ``max_batches``.
 
@@ -254,8 +339,7 @@ def run_campaign(
     directory : path
         Where its files go (module docstring); created if missing.
     workers : int, optional
-        Local worker processes (1: this process); default all cores. Ignored with
-        ``scheduler``.
+        Local worker processes; default all cores. Ignored with ``scheduler``.
     scheduler : str, optional
         Address of a running ``dask.distributed`` scheduler to send the batches to.
     resume : bool
@@ -266,6 +350,11 @@ def run_campaign(
     progress : callable, optional
         Called with the number of pushes of each batch as it finishes (a progress bar's
         ``update``); first with the pushes already on disk.
+    isolated : bool
+        Run the pushes in worker processes even with ``workers=1`` (default), so that a push
+        that crashes or hangs costs one ``error`` row (:mod:`~pushrecovery.campaign.isolation`).
+        ``False`` with one worker: in this process (a debugger sees the pushes; a crash ends
+        the campaign, a hang is bounded only by ``push_timeout`` at the simulation's ticks).
 
     Raises
     ------
@@ -280,7 +369,7 @@ def run_campaign(
     # Connect first: an unreachable scheduler leaves no directory behind.
     client = _connect(scheduler) if scheduler is not None else None
     try:
-        return _run(spec, directory, workers, client, resume, max_batches, progress)
+        return _run(spec, directory, workers, client, resume, max_batches, progress, isolated)
     finally:
         if client is not None:
             client.close()
@@ -294,6 +383,7 @@ def _run(
     resume: bool,
     max_batches: int | None,
     progress: Callable[[int], None] | None,
+    isolated: bool,
 ) -> CampaignResult | None:
     _prepare(spec, directory, resume)
     todo = missing_batches(spec, directory)
@@ -306,7 +396,9 @@ def _run(
         todo = todo[:max_batches]
     if client is not None:
         results = _dask(spec, todo, client)
-    elif (workers or _cores()) == 1 or len(todo) <= 1:
+    elif not todo:
+        results = iter(())
+    elif (workers or _cores()) == 1 and not isolated:
         results = _serial(spec, todo)
     else:
         results = _processes(spec, todo, min(workers or _cores(), len(todo)))

@@ -26,7 +26,8 @@ it, and what the simulation did. Columns, SI units, positions relative to the st
 ``time``               simulated time to the outcome [s]
 ``stop_impacts``       times the upper body hit its joint stop
 ``error``              why the push has no outcome (``outcome`` = ``error``): the physics
-                       diverged, or its worker process died; null otherwise
+                       diverged, the push took more than ``push_timeout`` of wall time, or
+                       its worker process died or stopped answering; null otherwise
 =====================  ======================================================================
 """
 
@@ -35,9 +36,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.control.base import controller_class, make_controller
-from pushrecovery.errors import SimulationDiverged
+from pushrecovery.errors import SimulationDiverged, SimulationTimeout
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import pushed_state
 from pushrecovery.sim.registry import make_plant
@@ -90,10 +92,15 @@ def run_push(
     params = push.params
     state = pushed_state(plant, push.x0, push.xdot, force=spec.backend == "mujoco")
     try:
-        run = simulate(plant, controller, state, duration=spec.duration)
+        run = simulate(
+            plant, controller, state, duration=spec.duration, wall_limit=spec.push_timeout
+        )
     except SimulationDiverged as exc:  # this push only: the others of the batch go on
         del cache[push.params]  # the engine's state is not to be trusted any more
         return error_row(spec, push, f"the physics diverged: {exc}")
+    except SimulationTimeout as exc:
+        del cache[push.params]  # stopped mid-run: start the next push from a fresh engine
+        return error_row(spec, push, f"too slow: {exc}")
     found = classify(push.x0, push.xdot, params)
     # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
     reach = STRATEGY_CODES.index(Strategy(controller.strategy))
@@ -180,6 +187,11 @@ def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]
     numba.set_num_threads(1)
     try:
         cache: dict[BodyParams, Any] = {}
-        return batch, [run_push(spec, push, cache) for push in spec.pushes(batch)]
+        rows = []
+        for push in spec.pushes(batch):
+            watchdog.arm(spec.push_timeout)
+            rows.append(run_push(spec, push, cache))
+        return batch, rows
     finally:
+        watchdog.disarm()
         numba.set_num_threads(threads)

@@ -39,6 +39,9 @@ BACKENDS: Mapping[str, tuple[str, ...]] = {
 }
 #: Largest campaign accepted [pushes].
 MAX_PUSHES = 1_000_000
+#: Wall time a push may take by default, and at most [s].
+DEFAULT_PUSH_TIMEOUT = 120.0
+MAX_PUSH_TIMEOUT = 3600.0
 #: Pushes per batch when the spec does not say: about a second of work per batch.
 DEFAULT_BATCH = {"analytic": 100, "mujoco": 10}
 
@@ -123,6 +126,10 @@ class CampaignSpec:
         Longest simulated time per push [s], > 0.
     batch_size : int or None
         Pushes per task sent to a worker; ``None``: 100 analytic, 10 MuJoCo.
+    push_timeout : float
+        Wall time one push may take [s], in (0, 3600] (default 120): a push that takes longer
+        is an ``error`` row, and a worker that stops answering is stopped
+        (:mod:`~pushrecovery.campaign.isolation`).
     """
 
     backend: str
@@ -137,6 +144,7 @@ class CampaignSpec:
     seed: int = 0
     duration: float = 6.0
     batch_size: int | None = None
+    push_timeout: float = DEFAULT_PUSH_TIMEOUT
 
     def __post_init__(self) -> None:
         if self.backend not in BACKENDS:
@@ -171,6 +179,14 @@ class CampaignSpec:
             raise InvalidParameterError(f"seed must be >= 0, got {self.seed}")
         if not (math.isfinite(self.duration) and self.duration > 0.0):
             raise InvalidParameterError(f"duration must be > 0 s, got {self.duration:g}")
+        if not (
+            isinstance(self.push_timeout, int | float)
+            and not isinstance(self.push_timeout, bool)
+            and 0.0 < self.push_timeout <= MAX_PUSH_TIMEOUT
+        ):
+            raise InvalidParameterError(
+                f"push_timeout must be in (0, {MAX_PUSH_TIMEOUT:g}] s, got {self.push_timeout!r}"
+            )
         if self.batch_size is not None and self.batch_size < 1:
             raise InvalidParameterError(f"batch_size must be >= 1, got {self.batch_size}")
         # Every range, every body it sweeps and the setup are checked now, before any
@@ -308,6 +324,7 @@ class CampaignSpec:
             "duration": self.duration,
             "batch_size": self.batch,
             "pushes": self.size,
+            "push_timeout": self.push_timeout,
         }
 
     @classmethod
@@ -327,6 +344,7 @@ class CampaignSpec:
                 seed=data["seed"],
                 duration=data["duration"],
                 batch_size=data["batch_size"],
+                push_timeout=data.get("push_timeout", DEFAULT_PUSH_TIMEOUT),
             )
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InvalidParameterError(f"malformed campaign spec: {exc}") from None

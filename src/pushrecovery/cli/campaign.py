@@ -87,6 +87,13 @@ _scheduler = click.option(
     "--batch-size", type=int, default=None, help="Pushes per task (default 100 / 10 MuJoCo)."
 )
 @click.option(
+    "--push-timeout",
+    type=float,
+    default=120.0,
+    show_default=True,
+    help="Wall time a push may take [s]; a slower or hung push is an error row.",
+)
+@click.option(
     "--out", type=click.Path(file_okay=False), required=True, help="Directory of the campaign."
 )
 @_workers
@@ -110,6 +117,7 @@ def campaign(
     seed: int,
     duration: float,
     batch_size: int | None,
+    push_timeout: float,
     out: str,
     workers: int | None,
     scheduler: str | None,
@@ -154,6 +162,7 @@ def campaign(
             seed=seed,
             duration=duration,
             batch_size=batch_size,
+            push_timeout=push_timeout,
         )
     bar = Progress(spec.size, "campaign", "push")
     try:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -10,7 +11,7 @@ import numpy as np
 
 from pushrecovery._validate import finite_array, positive_float
 from pushrecovery.control.base import Command, Controller, StepInfo
-from pushrecovery.errors import InvalidParameterError, SimulationDiverged
+from pushrecovery.errors import InvalidParameterError, SimulationDiverged, SimulationTimeout
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS
 from pushrecovery.sim.events import (
     ForcePushing,
@@ -74,6 +75,7 @@ def simulate(
     plant_step: float | None = None,
     observers: Sequence[Observer] = (),
     keep_running: tuple[float, float] = (0.0, 0.0),
+    wall_limit: float | None = None,
 ) -> SimulationResult:
     """Simulate ``controller`` on ``plant`` from ``initial_state`` (sampled-data, ZOH).
 
@@ -111,6 +113,9 @@ def simulate(
     keep_running : (float, float)
         Keep simulating this long [s] after the run is decided as recovered, and as fell
         (``math.inf``: to the end of ``duration``); the outcome stays the first decision.
+    wall_limit : float, optional
+        Wall time the run may take [s], > 0: past it, at the next control tick,
+        :class:`~pushrecovery.errors.SimulationTimeout` is raised (a campaign's push limit).
 
     Returns
     -------
@@ -135,6 +140,11 @@ def simulate(
         raise InvalidParameterError(
             f"push time must be before the end of the run, {duration:g} s, got {push.time:g}"
         )
+    deadline = (
+        math.inf
+        if wall_limit is None
+        else time.perf_counter() + positive_float("wall_limit", wall_limit, "s")
+    )
     hold_until = -1  # the plant step at which the push is over
     settled = push is None  # rest counts once the push is over
 
@@ -164,6 +174,11 @@ def simulate(
         if not settled and k >= start >= 0 and push is not None and not push.react:
             command = Command(float(state[0]))  # holding still while the force acts
         elif k == next_tick:
+            if time.perf_counter() > deadline:
+                raise SimulationTimeout(
+                    f"the run took more than its wall-time limit of {wall_limit:g} s "
+                    f"(simulated {k * h:g} of {duration:g} s)"
+                )
             command = controller.compute(tick * dt, state)
             tick += 1
             next_tick = k + per_tick if per_tick else origin + round(tick * dt / h)
