@@ -349,7 +349,7 @@ def test_plans_keep_positive_margins_at_every_touchdown():
 
 def test_ray_distances_from_the_support_function_equal_the_polygon():
     # bounds measures the thresholds from (S2) without building C_N: the same distances.
-    from pushrecovery.surfaces.n_step import ray_distances
+    from pushrecovery.surfaces.n_step import _ray_distances
 
     headings = np.linspace(0.0, 2.0 * math.pi, 16, endpoint=False)
     for overrides in ({}, {"min_step_width": 0.05}, {"torque_max_roll": 0.0}, NO_HIP):
@@ -359,7 +359,7 @@ def test_ray_distances_from_the_support_function_equal_the_polygon():
             for steps in (0, 1, 3):
                 times = touchdowns(params, steps)
                 region = viable_region(params, option, times)
-                fast = ray_distances(params, option, times, support.ankle, headings)
+                fast = _ray_distances(params, option, times, support.ankle, headings)
                 inside = float(region.signed_distance(*support.ankle)) > 0.0
                 for heading, value in zip(headings, fast, strict=True):
                     exact = region.ray_distance(*support.ankle, heading) if inside else 0.0
@@ -405,7 +405,7 @@ def test_the_compiled_decomposition_and_sum_equal_numpys():
     # The plan's compiled twins (ground._kernels) against ground.minkowski on random sums.
     from pushrecovery.ground import convex_hull
     from pushrecovery.ground._kernels import decompose_loop, minkowski_loop
-    from pushrecovery.ground.minkowski import decompose, stacked_shapes
+    from pushrecovery.ground.minkowski import _stacked_shapes, decompose
 
     rng = np.random.default_rng(5)
     for _ in range(100):
@@ -415,7 +415,7 @@ def test_the_compiled_decomposition_and_sum_equal_numpys():
         terms.append((float(rng.uniform(0.1, 2.0)), np.array([[0.3, -0.2]])))
         offset = rng.normal(size=2)
         total = minkowski_sum(terms, offset)
-        stacked, counts, weights = stacked_shapes(terms)
+        stacked, counts, weights = _stacked_shapes(terms)
         loop = minkowski_loop(stacked, counts, weights, offset)
         np.testing.assert_allclose(loop, total.vertices, atol=1e-12)
         point = total.centroid + rng.uniform(-1.0, 1.0, 2) * 0.5

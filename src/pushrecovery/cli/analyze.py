@@ -122,7 +122,7 @@ def analyze(file: Path, out: Path, as_json: bool, **kwargs: Any) -> None:
     plates). Both directions are analysed, each with its own base of support; mass and CoM
     height come from the flags, else from the file, else (mass) from the force plates.
     """
-    from pushrecovery.analysis.output import json_safe, write_analysis
+    from pushrecovery.analysis.output import _json_safe, write_analysis
     from pushrecovery.analysis.readers import read_recording
     from pushrecovery.analysis.trial import AnalysisSettings, body_for
     from pushrecovery.analysis.trial import analyze as analyze_trial
@@ -163,7 +163,7 @@ def analyze(file: Path, out: Path, as_json: bool, **kwargs: Any) -> None:
 
         files["time_series"] = str(plot_time_series(result, out / "time_series.png"))
         files["phase_portrait"] = str(plot_phase_portrait(result, out / "phase_portrait.png"))
-    summary = json_safe(result.summary)
+    summary = _json_safe(result.summary)
     if as_json:
         emit({**summary, "files": files}, True)
         return

@@ -21,12 +21,9 @@ from pushrecovery.ground.polygon import ConvexPolygon, following
 __all__ = [
     "Shape",
     "clip",
-    "clip_halfplanes",
     "decompose",
     "minkowski_sum",
     "regular_polygon",
-    "stacked_shapes",
-    "sum_loop",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -92,7 +89,7 @@ def minkowski_sum(
     return _cleaned(vertices)
 
 
-def stacked_shapes(
+def _stacked_shapes(
     terms: Sequence[tuple[float, Shape]],
 ) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
     """Return the terms as the compiled kernels take them: (shapes (K, M, 2), counts, weights)."""
@@ -107,13 +104,13 @@ def stacked_shapes(
     return stacked, counts, weights
 
 
-def sum_loop(
+def _sum_loop(
     terms: Sequence[tuple[float, Shape]], offset: tuple[float, float] | FloatArray = (0.0, 0.0)
 ) -> FloatArray:
     """Return the vertex loop of :func:`minkowski_sum`, compiled, without building a polygon."""
     from pushrecovery.ground._kernels import minkowski_loop
 
-    stacked, counts, weights = stacked_shapes(terms)
+    stacked, counts, weights = _stacked_shapes(terms)
     return np.asarray(
         minkowski_loop(stacked, counts, weights, np.asarray(offset, dtype=np.float64))
     )
@@ -145,10 +142,10 @@ def _cleaned(vertices: FloatArray) -> ConvexPolygon:
 
 def clip(polygon: ConvexPolygon, window: ConvexPolygon) -> ConvexPolygon | None:
     """Intersection of two convex polygons, or None when it has no area [m]."""
-    return clip_halfplanes(polygon, window.normals, window.offsets)
+    return _clip_halfplanes(polygon, window.normals, window.offsets)
 
 
-def clip_halfplanes(
+def _clip_halfplanes(
     polygon: ConvexPolygon, normals: FloatArray, offsets: FloatArray
 ) -> ConvexPolygon | None:
     """``polygon`` ∩ {p : n_i · p <= b_i for all i}, or None when it has no area [m].

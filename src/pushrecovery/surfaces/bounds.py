@@ -89,7 +89,7 @@ def plane_bounds(params: BodyParams, support: Support) -> dict[str, Any]:
     left) [m]; with yawed feet these are not the world's x and y.
     """
     from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
-    from pushrecovery.surfaces.n_step import ray_distances, step_options
+    from pushrecovery.surfaces.n_step import _ray_distances, step_options
     from pushrecovery.surfaces.plane import (
         DIRECTIONS,
         cmp_polygon,
@@ -109,7 +109,7 @@ def plane_bounds(params: BodyParams, support: Support) -> dict[str, Any]:
         times = tuple(params.min_step_time * (k + 1) for k in range(n))
         for option in options:
             best = np.maximum(
-                best, omega * ray_distances(params, option, times, support.ankle, headings)
+                best, omega * _ray_distances(params, option, times, support.ankle, headings)
             )
         steps[str(n)] = {name: float(v) for name, v in zip(DIRECTIONS, best, strict=True)}
     return {

@@ -15,10 +15,10 @@ from numpy.typing import NDArray
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
+    _stacked_shapes,
+    _sum_loop,
     decompose,
     minkowski_sum,
-    stacked_shapes,
-    sum_loop,
 )
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance
@@ -26,10 +26,10 @@ from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_region import ORIGIN, step_terms
 from pushrecovery.surfaces.n_step import (
     StepOption,
-    check_touchdowns,
+    _check_touchdowns,
+    _sum_terms,
     hip_box,
     landing_foot,
-    sum_terms,
 )
 
 __all__ = ["CapturePlan", "capture_plan"]
@@ -116,7 +116,7 @@ def capture_plan(
     if not 0.0 <= first <= 5.0:  # NaN fails too
         raise InvalidParameterError(f"first_touchdown must be in [0, 5] s, got {first!r}")
     times = tuple(first + params.min_step_time * k for k in range(steps))
-    check_touchdowns(params, times)
+    _check_touchdowns(params, times)
     from pushrecovery.ground._kernels import decompose_loop, foothold_kernel, loop_signed_distance
 
     # Everything relative to the stance ankle a: the shapes then repeat from call to call and
@@ -209,8 +209,8 @@ def _viable_loop(
     """C_N's vertex loop relative to the stance ankle (read-only, kept)."""
     stance = np.frombuffer(stance_key, dtype=np.float64).reshape(-1, 2)
     option = StepOption(swing, ConvexPolygon._from_ccw(stance), ORIGIN, yaw)
-    terms, offset, _ = sum_terms(params, option, touchdowns, hip)
-    loop = sum_loop(terms, offset)
+    terms, offset, _ = _sum_terms(params, option, touchdowns, hip)
+    loop = _sum_loop(terms, offset)
     loop.flags.writeable = False
     return loop
 
@@ -232,10 +232,10 @@ def _numpy_foothold(  # pragma: no cover - only when the compiled simplex fails
     hip: bool,
 ) -> FloatArray | None:
     """Return the recommended foothold relative to the ankle, from the numpy region."""
-    from pushrecovery.surfaces.capture_region import foothold_and_centre
+    from pushrecovery.surfaces.capture_region import _foothold_and_centre
 
     option = _world_option(swing, yaw, stance_key, np.zeros(2))
-    _, foothold = foothold_and_centre(relative, params, option, touchdown, steps, hip)
+    _, foothold = _foothold_and_centre(relative, params, option, touchdown, steps, hip)
     return foothold
 
 
@@ -245,7 +245,7 @@ def _split(
     """Decompose ``target`` in the sum of ``split`` (compiled: a plan does it at every step)."""
     from pushrecovery.ground._kernels import decompose_loop, minkowski_loop
 
-    stacked, counts, weights = stacked_shapes(split)
+    stacked, counts, weights = _stacked_shapes(split)
     origin = np.zeros(2)
     total = minkowski_loop(stacked, counts, weights, origin)
     points, _ = decompose_loop(target, stacked, counts, weights, origin, total)
@@ -262,7 +262,7 @@ def _decomposed(
     margin: float,
 ) -> CapturePlan:
     """Return the plan of (S1)'s decomposition (every term equally deep), for ξ0 outside C_N."""
-    terms, offset, sides = sum_terms(params, option, times, hip)
+    terms, offset, sides = _sum_terms(params, option, times, hip)
     total = minkowski_sum(terms, offset)
     points, _ = decompose(xi, terms, offset, total)
     reach = np.cumsum(np.array(points[2 + steps :]), axis=0) + option.ankle

@@ -30,10 +30,10 @@ from pushrecovery._validate import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
+    _clip_halfplanes,
+    _stacked_shapes,
     clip,
-    clip_halfplanes,
     minkowski_sum,
-    stacked_shapes,
 )
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
@@ -50,7 +50,6 @@ __all__ = [
     "CaptureRegion",
     "capture_region",
     "chebyshev_centre",
-    "foothold_and_centre",
     "foothold_region",
 ]
 
@@ -158,7 +157,7 @@ def capture_region(
         swing = Stance.LEFT if lateral >= 0.0 else Stance.RIGHT
     option = step_options(params, support, swing)[0]
     if timing == "exact":  # the compiled pipeline: a balance loop asks at every tick
-        polygon, foothold = foothold_and_centre(xi, params, option, t, steps, hip)
+        polygon, foothold = _foothold_and_centre(xi, params, option, t, steps, hip)
         return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
     polygon = foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
     foothold = None if polygon is None else chebyshev_centre(polygon)
@@ -220,8 +219,8 @@ def step_terms(
         (scale - 1.0, stance),
         (1.0, landing),
     ]
-    foot_shapes, foot_counts, foot_weights = stacked_shapes(foot)
-    split_shapes, split_counts, split_weights = stacked_shapes(split)
+    foot_shapes, foot_counts, foot_weights = _stacked_shapes(foot)
+    split_shapes, split_counts, split_weights = _stacked_shapes(split)
     window = reach_polygon(params, swing, yaw)
     return StepTerms(
         scale,
@@ -238,7 +237,7 @@ def step_terms(
     )
 
 
-def foothold_and_centre(
+def _foothold_and_centre(
     xi: FloatArray,
     params: BodyParams,
     option: StepOption,
@@ -353,7 +352,7 @@ def _after(
     sides = np.where((np.sum(sides * rays[::-1], axis=1) > 0.0)[:, None], -sides, sides)
     normals = np.vstack([at.normals[keep], sides])
     offsets = np.concatenate([at.offsets[keep], (at.vertices @ sides.T).max(axis=0)])
-    return clip_halfplanes(window, normals, offsets)
+    return _clip_halfplanes(window, normals, offsets)
 
 
 def chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:

@@ -29,7 +29,7 @@ from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_margin, cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.step_impact import TouchdownImpact, plan_impacts
-from pushrecovery.surfaces.step_regions import StepRegions, line_steps, sagittal_plan
+from pushrecovery.surfaces.step_regions import StepRegions, _sagittal_plan, line_steps
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
 __all__ = [
@@ -175,7 +175,7 @@ def classify(
     line = line_steps(np.array([capture]), params.heel, params.toe, 0.0, params)
     steps, step_margin = int(line.steps[0]), float(line.margin[0])
     strategy = _strategy(cop, cmp, steps)
-    plan = sagittal_plan(capture, params, steps) if strategy is Strategy.STEP else None
+    plan = _sagittal_plan(capture, params, steps) if strategy is Strategy.STEP else None
     step = None
     if plan is not None:
         step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)

@@ -43,7 +43,7 @@ from pushrecovery._validate import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
-    clip_halfplanes,
+    _clip_halfplanes,
     minkowski_sum,
     regular_polygon,
 )
@@ -56,15 +56,12 @@ __all__ = [
     "REACH_SIDES",
     "StepOption",
     "capturability_distance",
-    "check_touchdowns",
     "default_max_steps",
     "hip_box",
     "landing_foot",
     "landing_viable",
-    "ray_distances",
     "reach_polygon",
     "step_options",
-    "sum_terms",
     "viable_region",
 ]
 
@@ -140,7 +137,7 @@ def reach_polygon(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon
         return disc
     outward = 1.0 if side is Stance.LEFT else -1.0
     normal = -outward * np.array([[-math.sin(yaw), math.cos(yaw)]])  # −(lateral, outward)
-    cut = clip_halfplanes(disc, normal, np.array([-params.min_step_width]))
+    cut = _clip_halfplanes(disc, normal, np.array([-params.min_step_width]))
     if cut is None:  # pragma: no cover - min_step_width < max_step_length is validated
         raise InvalidParameterError("min_step_width leaves no foothold within the reach")
     return cut
@@ -205,7 +202,7 @@ def step_options(
     return options
 
 
-def sum_terms(
+def _sum_terms(
     params: BodyParams, option: StepOption, touchdowns: tuple[float, ...], hip: bool
 ) -> tuple[list[tuple[float, Shape]], FloatArray, list[Stance]]:
     """Return the weighted shapes and the offset of (S1), and the landing sides.
@@ -229,7 +226,7 @@ def sum_terms(
     return terms, a[0] * option.ankle, sides
 
 
-def check_touchdowns(params: BodyParams, touchdowns: tuple[float, ...]) -> None:
+def _check_touchdowns(params: BodyParams, touchdowns: tuple[float, ...]) -> None:
     """Refuse touchdown times that are not finite or come sooner than min_step_time apart."""
     previous = 0.0
     for k, t in enumerate(touchdowns):
@@ -263,12 +260,12 @@ def viable_region(
     hip : bool
         Include the upper body's box H.
     """
-    check_touchdowns(params, touchdowns)
-    terms, offset, _ = sum_terms(params, option, tuple(touchdowns), hip)
+    _check_touchdowns(params, touchdowns)
+    terms, offset, _ = _sum_terms(params, option, tuple(touchdowns), hip)
     return minkowski_sum(terms, offset)
 
 
-def ray_distances(
+def _ray_distances(
     params: BodyParams,
     option: StepOption,
     touchdowns: tuple[float, ...],
@@ -284,8 +281,8 @@ def ray_distances(
     min over n · u > 0 of (h(n) − n · origin) / (n · u), with h of (S2): no polygon is built
     (``bounds`` needs only these distances). 0 when the origin is not inside C_N.
     """
-    check_touchdowns(params, touchdowns)
-    terms, offset, _ = sum_terms(params, option, tuple(touchdowns), hip)
+    _check_touchdowns(params, touchdowns)
+    terms, offset, _ = _sum_terms(params, option, tuple(touchdowns), hip)
     shapes: dict[int, tuple[FloatArray, list[float]]] = {}  # the reach repeats: one entry
     for weight, shape in terms:
         if weight != 0.0:

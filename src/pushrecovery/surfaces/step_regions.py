@@ -45,16 +45,14 @@ from pushrecovery.surfaces.n_step import (
 __all__ = [
     "LineSteps",
     "StepRegions",
-    "line_step_bounds",
     "line_steps",
-    "sagittal_plan",
     "sagittal_step_interval",
 ]
 
 FloatArray = NDArray[np.float64]
 
 
-def line_step_bounds(
+def _line_step_bounds(
     lower: FloatArray | float,
     upper: FloatArray | float,
     ankle: FloatArray | float,
@@ -114,14 +112,14 @@ def line_steps(
 
     The range of first steps is (S3) on the line: q_1 − q_0 in T ξ − T[−a, a] − (T − 1)[s⁻, s⁺]
     − V_{N−1} − q_0, V_{N−1} = [δ⁻ − l s_{N−1}, δ⁺ + l s_{N−1}], T = e^{ωΔt_s}, within ±l; the
-    recommended first step is its middle (the most robust, as :func:`sagittal_plan`).
+    recommended first step is its middle (the most robust, as :func:`_sagittal_plan`).
     """
     capture, lower, upper, ankle = np.broadcast_arrays(
         *(np.asarray(a, dtype=np.float64) for a in (capture, lower, upper, ankle))
     )
     steps = np.zeros(capture.shape, dtype=np.int64)
     for n in range(params.max_steps, 0, -1):
-        low, high = line_step_bounds(lower, upper, ankle, params, n)
+        low, high = _line_step_bounds(lower, upper, ankle, params, n)
         inside = (capture > low) & (capture < high)
         steps[inside] = n
         if n == params.max_steps:
@@ -149,11 +147,11 @@ def sagittal_step_interval(params: BodyParams, steps: int | None = None) -> Capt
     """C_N on the sagittal line (module docstring) [m]; N defaults to ``max_steps``."""
     require_type("params", params, BodyParams)
     count = params.max_steps if steps is None else steps
-    low, high = line_step_bounds(params.heel, params.toe, 0.0, params, count)
+    low, high = _line_step_bounds(params.heel, params.toe, 0.0, params, count)
     return CaptureInterval(float(low), float(high))
 
 
-def sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
+def _sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
     """Return the plan of :func:`~.capture_plan.capture_plan` on the sagittal line.
 
     Step by step: the first foothold is the middle of the interval of first footholds ((S3)
