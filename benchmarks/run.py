@@ -27,6 +27,8 @@
 10. The ground plane (``benchmarks/plane.py``): the real-time monitor's single-state query,
    ``bounds`` start-up, 2-D margins and ``classify_states`` on 10**7 states.
 11. Steps (``benchmarks/steps.py``): one-step capture regions, N-step thresholds and plans.
+12. The MPC at N = 50, 100, 200 (``benchmarks/mpc_horizons.py``): tick median and p99 against
+   a 100 x 100 mat-vec, and the growth with the horizon (issue 17).
 """
 
 from __future__ import annotations
@@ -329,11 +331,13 @@ def analysis() -> None:
 
 
 def main() -> int:
+    import mpc_horizons
     import plane
     import steps
 
     plane_failed = plane.main()
     steps_failed = steps.main()
+    mpc_failed = mpc_horizons.main()
     ratio = surface()
     cli = startup()
     realtime()
@@ -344,7 +348,7 @@ def main() -> int:
     campaigns()
     analysis()
     failed = ratio > 2.0 or cli > 1.5 or step_rate < 2e6 or step_ratio < 1000 or physics < 150
-    failed = failed or bool(plane_failed) or bool(steps_failed)
+    failed = failed or bool(plane_failed) or bool(steps_failed) or bool(mpc_failed)
     print("targets met" if not failed else "TARGET MISSED")
     return int(failed)
 

@@ -12,7 +12,7 @@ from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.qp import CondensedQP
-from pushrecovery.control.mpc.workspace import DaqpWorkspace
+from pushrecovery.control.mpc.workspace import PRIMAL_TOL, DaqpWorkspace
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import FLYWHEEL_STATE
 from pushrecovery.params import BodyParams
@@ -93,27 +93,38 @@ class MPCController(Controller):
             solution = self.workspace.solve(state)
         else:
             solution = self._solve_qpsolvers(state)
+        x0 = state.copy()  # the plan's own: the caller may reuse its array
         if solution is None or not np.isfinite(solution).all():
-            inputs = np.tile(self._fallback(state), (self.settings.horizon, 1))
-            return Plan(inputs, qp.predict(state, inputs), feasible=False)
-        inputs = qp.unscale(solution)
-        return Plan(inputs, qp.predict(state, inputs), feasible=True)
+            fallback = self._fallback(x0)
+            inputs = lambda: np.tile(fallback, (self.settings.horizon, 1))  # noqa: E731
+            return Plan(fallback, False, inputs, lambda: qp.simulate(x0, inputs()))
+        scaled = solution.copy()
+        return Plan(
+            qp.first_input(x0, scaled),
+            True,
+            lambda: qp.inputs(x0, scaled),
+            lambda: qp.predict(x0, scaled),
+        )
 
     def _solve_qpsolvers(self, state: NDArray[np.float64]) -> NDArray[np.float64] | None:
         from qpsolvers import solve_qp
         from qpsolvers.exceptions import ProblemError, SolverError
 
         qp = self.qp
-        q, h = qp.vectors(state)
+        q, lower, upper = qp.vectors(state)
+        rows = qp.scaled_inequality
+        # The workspace's tolerance for DAQP here too: its default (1e-6) is not exact.
+        options: dict[str, Any] = (
+            {"primal_tol": PRIMAL_TOL} if self.settings.solver == "daqp" else {}
+        )
         try:
             solution: NDArray[np.float64] | None = solve_qp(
                 qp.scaled_hessian,
                 q,
-                qp.scaled_inequality,
-                h,
-                lb=qp.scaled_lower,
-                ub=qp.scaled_upper,
+                np.vstack([rows, -rows]),
+                np.concatenate([upper, -lower]),
                 solver=self.settings.solver,
+                **options,
             )
         except (ProblemError, SolverError):
             return None
