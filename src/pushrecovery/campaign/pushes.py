@@ -34,6 +34,7 @@ it, and what the simulation did. Columns, SI units, positions relative to the st
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 from pushrecovery.campaign import watchdog
@@ -41,8 +42,11 @@ from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.control.base import controller_class, make_controller
 from pushrecovery.errors import SimulationDiverged, SimulationTimeout
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import check_com_state
+from pushrecovery.sim.batched import BATCHED
 from pushrecovery.sim.critical import pushed_state
 from pushrecovery.sim.registry import make_plant
+from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify
 
@@ -89,7 +93,6 @@ def run_push(
             make_controller(spec.controller, push.params),
         )
     plant, controller = cache[push.params]
-    params = push.params
     state = pushed_state(plant, push.x0, push.xdot, force=spec.backend == "mujoco")
     try:
         run = simulate(
@@ -101,13 +104,44 @@ def run_push(
     except SimulationTimeout as exc:
         del cache[push.params]  # stopped mid-run: start the next push from a fresh engine
         return error_row(spec, push, f"too slow: {exc}")
+    cops = run.cops
+    return _row(
+        spec,
+        push,
+        _Simulated(
+            outcome=run.outcome,
+            used=run.strategy_used() if run.recovered else Strategy.FALL,
+            steps=len(run.footholds) - 1,
+            peak_hip_torque=run.peak_hip_torque,
+            cop_min=float(cops.min()) if cops.size else math.nan,
+            cop_max=float(cops.max()) if cops.size else math.nan,
+            time=float(run.time[-1]),
+            stop_impacts=run.stop_impacts,
+        ),
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class _Simulated:
+    """What a run gives a row (either loop: one push, or the compiled batch)."""
+
+    outcome: Outcome
+    used: Strategy
+    steps: int
+    peak_hip_torque: float
+    cop_min: float
+    cop_max: float
+    time: float
+    stop_impacts: int
+
+
+def _row(spec: CampaignSpec, push: Push, run: _Simulated) -> dict[str, Any]:
+    """Return the row of a simulated push: inputs, prediction and run (module docstring)."""
+    params = push.params
     found = classify(push.x0, push.xdot, params)
     # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
-    reach = STRATEGY_CODES.index(Strategy(controller.strategy))
-    steps = len(run.footholds) - 1
-    hip = run.peak_hip_torque
-    cops = run.cops
-    used = run.strategy_used() if run.recovered else Strategy.FALL
+    reach = STRATEGY_CODES.index(Strategy(controller_class(spec.controller).strategy))
+    peak_cop = max(abs(run.cop_min), abs(run.cop_max))
     row: dict[str, Any] = {
         f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
     }
@@ -124,17 +158,52 @@ def run_push(
         predicted_steps=-1 if found.steps is None else found.steps,
         predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
         outcome=run.outcome.value,
-        used=used.value,
-        steps=steps,
-        peak_hip_torque=hip,
-        peak_ankle_torque=params.weight * float(abs(cops).max()) if cops.size else 0.0,
-        cop_min=float(cops.min()) if cops.size else math.nan,
-        cop_max=float(cops.max()) if cops.size else math.nan,
-        time=float(run.time[-1]),
+        used=run.used.value,
+        steps=run.steps,
+        peak_hip_torque=run.peak_hip_torque,
+        peak_ankle_torque=params.weight * peak_cop if math.isfinite(peak_cop) else 0.0,
+        cop_min=run.cop_min,
+        cop_max=run.cop_max,
+        time=run.time,
         stop_impacts=run.stop_impacts,
         error=None,
     )
     return row
+
+
+def _batched_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]]:
+    """Rows of pushes simulated together in a compiled loop (:mod:`pushrecovery.sim.batched`)."""
+    from pushrecovery.sim.batched import ankle_pd_pushes
+
+    for push in pushes:  # as the plants' reset does in the one-push loop
+        check_com_state(push.x0, push.xdot, push.params)
+    runs = ankle_pd_pushes(
+        spec.model,
+        [p.params for p in pushes],
+        [p.x0 for p in pushes],
+        [p.xdot for p in pushes],
+        duration=spec.duration,
+    )
+    rows = []
+    for k, push in enumerate(pushes):
+        outcome = runs.outcomes[k]
+        rows.append(
+            _row(
+                spec,
+                push,
+                _Simulated(
+                    outcome=outcome,
+                    used=Strategy.ANKLE if outcome is Outcome.RECOVERED else Strategy.FALL,
+                    steps=0,
+                    peak_hip_torque=0.0,
+                    cop_min=float(runs.cop_min[k]),
+                    cop_max=float(runs.cop_max[k]),
+                    time=float(runs.times[k]),
+                    stop_impacts=0,
+                ),
+            )
+        )
+    return rows
 
 
 def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
@@ -186,9 +255,12 @@ def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
     try:
+        pushes = spec.pushes(batch)
+        if spec.backend == "analytic" and (spec.model, spec.controller) in BATCHED:
+            return batch, _batched_rows(spec, pushes)
         cache: dict[BodyParams, Any] = {}
         rows = []
-        for push in spec.pushes(batch):
+        for push in pushes:
             watchdog.arm(spec.push_timeout)
             rows.append(run_push(spec, push, cache))
         return batch, rows
