@@ -24,7 +24,7 @@ from pushrecovery.errors import SimulationDiverged
 
 P = load_params()
 SPEC = CampaignSpec(
-    "analytic", "pendulum", "ankle-pd", P, x0=(0.0, 0.05, 0.05), xdot=(-0.4, 0.6, 0.2),
+    "analytic", "pendulum", "ankle-saturated", P, x0=(0.0, 0.05, 0.05), xdot=(-0.4, 0.6, 0.2),
     batch_size=4,
 )  # fmt: skip
 CRASH = 5  # the push that kills its process: in batch 1 of 3

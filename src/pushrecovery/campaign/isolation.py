@@ -39,11 +39,12 @@ def _ignore_interrupts() -> None:
 def interrupts_deferred() -> Iterator[None]:
     """Hold SIGINT back while worker processes start; main thread only.
 
-    The processes started meanwhile inherit the blocked signal (a Ctrl-C to the process group
-    never reaches them before their initializer ignores it), and this process receives a
-    Ctrl-C that came meanwhile as soon as the block ends: it is deferred, not lost (ignoring
-    it instead lost a Ctrl-C pressed while the pool started). Where the OS has no signal
-    masks, SIGINT is ignored meanwhile.
+    The processes started meanwhile inherit the main thread's blocked signal (a Ctrl-C to the
+    process group never reaches them before their initializer ignores it). This process gets a
+    Ctrl-C that came meanwhile once the window closes: it is deferred, not lost (ignoring it
+    instead lost a Ctrl-C pressed while the pool started). A signal the OS hands to another
+    thread (numpy's BLAS threads do not block it) runs a handler that only notes it. Where the
+    OS has no signal masks, SIGINT is ignored meanwhile.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -55,11 +56,16 @@ def interrupts_deferred() -> Iterator[None]:
         finally:
             signal.signal(signal.SIGINT, ignored)
         return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    noted: list[int] = []
+    handler = signal.signal(signal.SIGINT, lambda number, frame: noted.append(number))
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        signal.signal(signal.SIGINT, handler)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # one blocked here arrives now
+    if noted:
+        raise KeyboardInterrupt
 
 
 def _start_worker() -> None:
