@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from pushrecovery import InvalidParameterError, load_params
+from pushrecovery.errors import PushRecoveryError
 from pushrecovery.campaign import CampaignSpec
 from pushrecovery.campaign.pushes import run_batch, run_push
 from pushrecovery.sim.batched import ankle_pd_pushes
@@ -47,7 +48,7 @@ def test_bad_batches() -> None:
     with pytest.raises(InvalidParameterError, match="one entry per push"):
         ankle_pd_pushes("lipm", [P, P], [0.0], [0.1], duration=1.0)
     for duration in (0.0, -1.0, float("nan"), 61.0, "1"):
-        with pytest.raises(InvalidParameterError, match="duration must be in"):
+        with pytest.raises(PushRecoveryError, match="duration must be"):
             ankle_pd_pushes("lipm", [P], [0.0], [0.1], duration=duration)
 
 

@@ -42,7 +42,6 @@ from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.control.base import controller_class, make_controller
 from pushrecovery.errors import SimulationDiverged, SimulationTimeout
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.backend import check_com_state
 from pushrecovery.sim.batched import BATCHED
 from pushrecovery.sim.critical import pushed_state
 from pushrecovery.sim.registry import make_plant
@@ -175,8 +174,6 @@ def _batched_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]
     """Rows of pushes simulated together in a compiled loop (:mod:`pushrecovery.sim.batched`)."""
     from pushrecovery.sim.batched import ankle_pd_pushes
 
-    for push in pushes:  # as the plants' reset does in the one-push loop
-        check_com_state(push.x0, push.xdot, push.params)
     runs = ankle_pd_pushes(
         spec.model,
         [p.params for p in pushes],

@@ -16,9 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import bounded_float, require_type, sample_array
 from pushrecovery.control.ankle import default_pd_gains
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import check_com_state
 from pushrecovery.sim.plants import PendulumPlant
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import DEFAULT_CONTROL_PERIOD, MAX_DURATION, RestCriterion
@@ -67,8 +69,8 @@ def ankle_pd_pushes(
     bodies : sequence of BodyParams
         Each push's body (default PD gains, :func:`~pushrecovery.control.ankle.default_pd_gains`).
     x0, xdot : sequence of float
-        CoM position [m] and velocity [m/s] just after each push (finite; checked as the
-        plants' ``reset`` does by the caller).
+        CoM position [m] and velocity [m/s] just after each push (checked as the plants'
+        ``reset`` does).
     duration : float
         Longest simulated time per push [s], in (0, 60].
 
@@ -80,21 +82,30 @@ def ankle_pd_pushes(
     Raises
     ------
     InvalidParameterError
-        An unknown model, sequences of different lengths, a bad duration.
+        An unknown model, sequences of different lengths, a start no model can have, a
+        duration outside (0, 60] s.
+    ParameterTypeError
+        ``bodies`` not a list or tuple of BodyParams.
     """
     from pushrecovery.sim._batched_kernels import ankle_pd_pushes as kernel
 
-    if model not in ("pendulum", "lipm"):
-        raise InvalidParameterError(f"model must be 'pendulum' or 'lipm', got {model!r}")
-    if not len(bodies) == len(x0) == len(xdot):
+    if not (isinstance(model, str) and model in ("pendulum", "lipm")):
+        raise InvalidParameterError(f"model must be 'pendulum' or 'lipm', got {model!r:.40}")
+    require_type("bodies", bodies, (list, tuple))
+    for body in bodies:
+        require_type("bodies[i]", body, BodyParams)
+    starts = sample_array("x0", x0)
+    speeds = sample_array("xdot", xdot)
+    if not len(bodies) == len(starts) == len(speeds):
         raise InvalidParameterError(
-            f"bodies, x0 and xdot must have one entry per push, got {len(bodies)}, {len(x0)} "
-            f"and {len(xdot)}"
+            f"bodies, x0 and xdot must have one entry per push, got {len(bodies)}, "
+            f"{len(starts)} and {len(speeds)}"
         )
-    if not (isinstance(duration, int | float) and 0.0 < duration <= MAX_DURATION):
-        raise InvalidParameterError(
-            f"duration must be in (0, {MAX_DURATION:g}] s, got {duration!r}"
-        )
+    for body, start, speed in zip(bodies, starts.tolist(), speeds.tolist(), strict=True):
+        check_com_state(start, speed, body)  # as the plants' reset
+    bounded_float("duration", duration, 0.0, MAX_DURATION, "s")
+    if duration == 0.0:
+        raise InvalidParameterError(f"duration must be in (0, {MAX_DURATION:g}] s, got 0")
     dt = DEFAULT_CONTROL_PERIOD
     assert dt <= PendulumPlant.max_substep  # one RK4 substep per tick, as the kernel does
     rest = RestCriterion()
@@ -113,8 +124,8 @@ def ankle_pd_pushes(
     )
     kernel(
         model == "pendulum",
-        np.asarray(x0, dtype=np.float64),
-        np.asarray(xdot, dtype=np.float64),
+        starts,
+        speeds,
         mass,
         height,
         gravity,

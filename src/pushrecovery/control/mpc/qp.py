@@ -39,12 +39,12 @@ from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 
-__all__ = ["CondensedQP", "stabilising_gain"]
+__all__ = ["CondensedQP"]
 
 FloatArray = NDArray[np.float64]
 
 
-def stabilising_gain(a: FloatArray, b: FloatArray, settings: MPCSettings) -> FloatArray:
+def _stabilising_gain(a: FloatArray, b: FloatArray, settings: MPCSettings) -> FloatArray:
     """LQR gain K (u = K x) of the stage weights: A + B K is stable.
 
     Any stabilising K gives the same minimiser; this one makes the predictions decay fastest
@@ -92,7 +92,7 @@ class CondensedQP:
         n = settings.horizon
         a, b = self._a, self._b = flywheel_discrete(params, settings.dt)
         self.params, self.settings = params, settings
-        k = self.gain = stabilising_gain(a, b, settings)
+        k = self.gain = _stabilising_gain(a, b, settings)
         closed = a + b @ k
         powers = np.empty((n + 1, 4, 4))  # A_K^0..A_K^N
         powers[0] = np.eye(4)
