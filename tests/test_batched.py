@@ -47,7 +47,7 @@ def test_bad_batches() -> None:
         ankle_pd_pushes("flywheel", [P], [0.0], [0.1], duration=1.0)
     with pytest.raises(InvalidParameterError, match="one entry per push"):
         ankle_pd_pushes("lipm", [P, P], [0.0], [0.1], duration=1.0)
-    for duration in (0.0, -1.0, float("nan"), 61.0, "1"):
+    for duration in (0.0, -1.0, float("nan"), 61.0, "x", None):
         with pytest.raises(PushRecoveryError, match="duration must be"):
             ankle_pd_pushes("lipm", [P], [0.0], [0.1], duration=duration)
 

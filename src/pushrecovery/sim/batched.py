@@ -103,7 +103,7 @@ def ankle_pd_pushes(
         )
     for body, start, speed in zip(bodies, starts.tolist(), speeds.tolist(), strict=True):
         check_com_state(start, speed, body)  # as the plants' reset
-    bounded_float("duration", duration, 0.0, MAX_DURATION, "s")
+    duration = bounded_float("duration", duration, 0.0, MAX_DURATION, "s")
     if duration == 0.0:
         raise InvalidParameterError(f"duration must be in (0, {MAX_DURATION:g}] s, got 0")
     dt = DEFAULT_CONTROL_PERIOD
