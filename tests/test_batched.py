@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from pushrecovery import InvalidParameterError, load_params
-from pushrecovery.errors import PushRecoveryError
 from pushrecovery.campaign import CampaignSpec
 from pushrecovery.campaign.pushes import run_batch, run_push
+from pushrecovery.errors import PushRecoveryError
 from pushrecovery.sim.batched import ankle_pd_pushes
 
 P = load_params()

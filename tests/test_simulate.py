@@ -225,3 +225,35 @@ def test_summary_reports_the_applied_cop_range():
         make_plant("lipm", PARAMS), FixedCop(PARAMS, 0.1), np.array([0.1, 0.0]), duration=0.2
     )
     assert run.to_dict()["peak_cop"] == {"min": 0.1, "max": 0.1}
+
+
+def test_a_plant_whose_state_turns_nan_diverges() -> None:
+    # A non-finite state from the model is its numbers breaking down, not bad input.
+    import math
+
+    import numpy as np
+    import pytest
+
+    from pushrecovery import load_params
+    from pushrecovery.control.base import make_controller
+    from pushrecovery.errors import SimulationDiverged
+    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.simulate import simulate
+
+    params = load_params()
+    plant = make_plant("lipm", params)
+    advance = plant._advance
+
+    def breaking(command, dt):
+        state, applied = advance(command, dt)
+        return (np.array([math.nan, 0.0]) if plant_time[0] > 0.05 else state), applied
+
+    plant_time = [0.0]
+
+    def counting(command, dt):
+        plant_time[0] += dt
+        return breaking(command, dt)
+
+    plant._advance = counting
+    with pytest.raises(SimulationDiverged, match="not finite at t = 0.05"):
+        simulate(plant, make_controller("ankle-pd", params), plant.reset(0.0, 0.1), duration=1.0)

@@ -19,14 +19,19 @@ def require_type(name: str, value: object, kind: type | tuple[type, ...]) -> Non
 
 
 def finite_float(name: str, value: object, unit: str = "", allowed: str = "") -> float:
-    """Return ``value`` as a finite float or raise naming ``name`` (and ``allowed``, e.g. "> 0")."""
-    what = f"{name} must be a finite number{' ' + allowed if allowed else ''}{_unit(unit)}"
+    """Return ``value`` as a finite float or raise naming ``name`` (and ``allowed``, e.g. "> 0").
+
+    The message is built only on failure: the checks of a valid call cost a conversion and a
+    comparison (tens of nanoseconds), so that they fit functions called in loops.
+    """
     try:
         number = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError, OverflowError):
-        raise InvalidParameterError(f"{what}, got {str(value)[:40]!r}") from None
+        raise InvalidParameterError(
+            f"{_what(name, unit, allowed)}, got {str(value)[:40]!r}"
+        ) from None
     if not math.isfinite(number):
-        raise InvalidParameterError(f"{what}, got {number}")
+        raise InvalidParameterError(f"{_what(name, unit, allowed)}, got {number}")
     return number
 
 
@@ -40,16 +45,25 @@ def positive_float(name: str, value: object, unit: str = "") -> float:
 
 def bounded_float(name: str, value: object, low: float, high: float, unit: str = "") -> float:
     """Return ``value`` as a finite float in [``low``, ``high``] or raise naming the range."""
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError, OverflowError):
+        number = math.nan  # refused below, with finite_float's message
+    if low <= number <= high and math.isfinite(number):  # NaN fails the comparison
+        return number
     number = finite_float(name, value, unit, allowed=f"in [{low:g}, {high:g}]")
-    if not low <= number <= high:
-        raise InvalidParameterError(
-            f"{name} must be in [{low:g}, {high:g}]{_unit(unit)}, got {name}={number:g}"
-        )
-    return number
+    raise InvalidParameterError(
+        f"{name} must be in [{low:g}, {high:g}]{_unit(unit)}, got {name}={number:g}"
+    )
 
 
 def float_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
-    """Return ``value`` as a float64 array (values not checked), or raise naming ``name``."""
+    """Return ``value`` as a float64 array (values not checked), or raise naming ``name``.
+
+    None is refused (numpy would read it as NaN).
+    """
+    if value is None:
+        raise ParameterTypeError(f"{name} must be a number or an array of numbers, got None")
     try:
         return np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
@@ -69,3 +83,64 @@ def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
 
 def _unit(unit: str) -> str:
     return f" [{unit}]" if unit else ""
+
+
+def _what(name: str, unit: str, allowed: str) -> str:
+    return f"{name} must be a finite number{' ' + allowed if allowed else ''}{_unit(unit)}"
+
+
+def whole_number(name: str, value: object, low: int, high: int) -> int:
+    """Return ``value`` as an int in [``low``, ``high``], or raise naming ``name`` and the range.
+
+    An int or a float with no fractional part (``2.0``, as a TOML file may give it); a bool is
+    not a number here.
+    """
+    if type(value) is int and low <= value <= high:  # the common case, without the checks below
+        return value
+    what = f"{name} must be a whole number in [{low}, {high}]"
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+        raise ParameterTypeError(f"{what}, got {type(value).__name__}")
+    if isinstance(value, float | np.floating) and not float(value).is_integer():  # NaN, inf too
+        raise InvalidParameterError(f"{what}, got {name}={value!r}")
+    if not low <= value <= high:
+        raise InvalidParameterError(f"{what}, got {name}={value:g}")
+    return int(value)
+
+
+def finite_vector(
+    name: str, value: ArrayLike, size: int, bound: float = math.inf, unit: str = ""
+) -> NDArray[np.float64]:
+    """Return ``value`` as a finite float array of shape (``size``,), entries in ±``bound``."""
+    array = finite_array(name, value)
+    if array.shape != (size,):
+        raise InvalidParameterError(
+            f"{name} must be {size} numbers (shape ({size},)){_unit(unit)}, got shape {array.shape}"
+        )
+    if bound < math.inf and float(np.max(np.abs(array))) > bound:
+        raise InvalidParameterError(
+            f"{name} must have entries in [-{bound:g}, {bound:g}]{_unit(unit)}, "
+            f"got {array.tolist()}"
+        )
+    return array
+
+
+def sample_array(
+    name: str, value: ArrayLike, ndims: tuple[int, ...] = (1,), *, values: str = "finite"
+) -> NDArray[np.float64]:
+    """Return ``value`` as a float array of samples along axis 0, its ``ndim`` one of ``ndims``.
+
+    ``values``: ``"finite"`` refuses NaN and infinities, ``"nan"`` lets NaN mark a missing
+    sample (infinities refused), ``"any"`` checks no value.
+    """
+    array = float_array(name, value)
+    if array.ndim not in ndims:
+        shapes = " or ".join(["(n,)", "(n, k)", "(n, k, m)"][d - 1] for d in ndims)
+        raise InvalidParameterError(f"{name} must be an array of shape {shapes}, got {array.shape}")
+    if values != "any":
+        bad = np.isinf(array) if values == "nan" else ~np.isfinite(array)
+        if bad.any():
+            allowed = "finite or NaN (missing)" if values == "nan" else "finite"
+            raise InvalidParameterError(
+                f"{name} must be {allowed}, got {int(np.count_nonzero(bad))} bad value(s)"
+            )
+    return array

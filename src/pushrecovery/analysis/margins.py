@@ -28,7 +28,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.params import BodyParams
+from pushrecovery._validate import bounded_float, float_array, require_type, sample_array
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.cop import capture_point
@@ -99,8 +101,46 @@ def time_to_leave(
     -------
     ndarray
         Time [s] (module docstring): 0 outside the region, +inf when ξ equals the anchor, NaN
-        where an input is NaN.
+        where an input is NaN (a missing frame).
+
+    Raises
+    ------
+    InvalidParameterError
+        Values that are not numbers or are infinite, shapes that do not broadcast, a
+        ``lower`` above ``upper``, or ``omega`` outside [0.1, 100] 1/s
+        (:data:`~pushrecovery.params.OMEGA_MIN`, :data:`~pushrecovery.params.OMEGA_MAX`).
     """
+    capture, anchor, lower, upper = _frames(
+        capture=capture, anchor=anchor, lower=lower, upper=upper
+    )
+    with np.errstate(invalid="ignore"):
+        inverted = lower > upper
+    if inverted.any():
+        raise InvalidParameterError("lower must be <= upper (an empty or inverted region)")
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
+    return _time_to_leave(capture, anchor, lower, upper, omega)
+
+
+def _frames(**arrays: FloatArray) -> list[FloatArray]:
+    """Return the arrays as floats, NaN where missing, refusing infinities; shapes broadcast."""
+    checked = []
+    for name, value in arrays.items():
+        array = float_array(name, value)
+        if np.isinf(array).any():
+            raise InvalidParameterError(f"{name} must be finite or NaN (missing), got infinities")
+        checked.append(array)
+    try:
+        np.broadcast_shapes(*(a.shape for a in checked))
+    except ValueError:
+        shapes = ", ".join(f"{n} {a.shape}" for n, a in zip(arrays, checked, strict=True))
+        raise InvalidParameterError(f"the arrays' shapes must broadcast, got {shapes}") from None
+    return checked
+
+
+def _time_to_leave(
+    capture: FloatArray, anchor: FloatArray, lower: FloatArray, upper: FloatArray, omega: float
+) -> FloatArray:
+    """:func:`time_to_leave` of checked arguments."""
     anchor = np.clip(anchor, lower, upper)
     ahead = capture - anchor
     edge = np.where(ahead > 0.0, upper, lower) - anchor
@@ -147,7 +187,28 @@ def direction_margins(
     Returns
     -------
     DirectionMargins
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` is not a :class:`~pushrecovery.params.BodyParams`.
+    InvalidParameterError
+        Arrays that are not of shape (n,) and one n, or with infinite values.
     """
+    require_type("params", params, BodyParams)
+    given = {"com": com, "velocity": velocity, "lower": lower, "upper": upper, "ankle": ankle}
+    if cop is not None:
+        given["cop"] = cop
+    if cmp is not None:
+        given["cmp"] = cmp
+    checked = {name: sample_array(name, value, values="nan") for name, value in given.items()}
+    lengths = {name: len(array) for name, array in checked.items()}
+    if len(set(lengths.values())) > 1:
+        raise InvalidParameterError(f"the arrays must have one length, got {lengths}")
+    com, velocity, lower, upper, ankle = (
+        checked[n] for n in ("com", "velocity", "lower", "upper", "ankle")
+    )
+    cop, cmp = checked.get("cop"), checked.get("cmp")
     omega = params.omega
     capture = capture_point(com, velocity, omega)
     cop_margin = np.minimum(capture - lower, upper - capture)
@@ -178,8 +239,8 @@ def direction_margins(
         cmp=cmp_margin,
         step=np.where(known, plan.margin, np.where(valid, -np.inf, np.nan)),
         strategy=strategy,
-        time_to_leave_cop=time_to_leave(capture, cop_anchor, lower, upper, omega),
-        time_to_leave_cmp=time_to_leave(capture, cmp_anchor, lower - reach, upper + reach, omega),
+        time_to_leave_cop=_time_to_leave(capture, cop_anchor, lower, upper, omega),
+        time_to_leave_cmp=_time_to_leave(capture, cmp_anchor, lower - reach, upper + reach, omega),
         step_length=np.where(stepping, plan.step_length, np.nan),
         step_shortest=np.where(stepping, plan.shortest, np.nan),
         step_longest=np.where(stepping, plan.longest, np.nan),

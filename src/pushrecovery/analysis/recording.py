@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import finite_float, positive_float, require_type, whole_number
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = ["AXES", "LOADED", "Foot", "Recording", "Support", "fixed_feet", "support_from_feet"]
@@ -144,9 +145,19 @@ def support_from_feet(
     Returns
     -------
     Support
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``feet`` is not a tuple or list of :class:`Foot`.
+    InvalidParameterError
+        No foot, markers that are not (n, 3) arrays of the same n, a non-positive or
+        non-finite ``contact_height`` or ``foot_width``, or heel and toe markers on the wrong
+        side of the ankle markers.
     """
-    if not feet:
-        raise InvalidParameterError("feet must name at least one foot")
+    _check_feet(feet)
+    contact_height = positive_float("contact_height", contact_height, "m")
+    foot_width = positive_float("foot_width", foot_width, "m")
     heel = np.stack([f.heel for f in feet], axis=1)  # (n, k, 3)
     toe = np.stack([f.toe for f in feet], axis=1)
     ankle = np.stack([f.ankle for f in feet], axis=1)
@@ -192,6 +203,27 @@ def support_from_feet(
     return Support(lower, upper, ankles, foot, supporting)
 
 
+def _check_feet(feet: object) -> None:
+    """Refuse anything but a non-empty tuple or list of feet with (n, 3) markers of one n."""
+    require_type("feet", feet, (tuple, list))
+    assert isinstance(feet, tuple | list)
+    if not feet:
+        raise InvalidParameterError("feet must name at least one foot")
+    shapes = set()
+    for foot in feet:
+        require_type("each of feet", foot, Foot)
+        for part in (foot.heel, foot.toe, foot.ankle):
+            shapes.add(np.shape(part))
+    if len(shapes) != 1 or len(next(iter(shapes))) != 2 or next(iter(shapes))[1] != 3:
+        raise InvalidParameterError(
+            f"foot markers must be (n, 3) arrays of one n, got shapes {sorted(shapes)}"
+        )
+
+
+#: Most frames :func:`fixed_feet` builds (a day at 1 kHz).
+MAX_FRAMES = 100_000_000
+
+
 def fixed_feet(
     n: int, ankle_ap: float, ankle_ml: float, heel: float, toe: float, stance_width: float
 ) -> tuple[Foot, ...]:
@@ -199,7 +231,23 @@ def fixed_feet(
 
     Parameters are lab positions along the body axes and the foot's edges relative to the
     ankle [m]; markers are placed on the floor (up = 0).
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``n`` is not a whole number in [1, :data:`MAX_FRAMES`], a length is not finite,
+        ``heel`` >= ``toe`` or ``stance_width`` < 0.
     """
+    n = whole_number("n", n, 1, MAX_FRAMES)
+    ankle_ap = finite_float("ankle_ap", ankle_ap, "m")
+    ankle_ml = finite_float("ankle_ml", ankle_ml, "m")
+    heel = finite_float("heel", heel, "m")
+    toe = finite_float("toe", toe, "m")
+    stance_width = finite_float("stance_width", stance_width, "m", allowed=">= 0")
+    if heel >= toe:
+        raise InvalidParameterError(f"heel must be < toe, got heel={heel:g} m, toe={toe:g} m")
+    if stance_width < 0.0:
+        raise InvalidParameterError(f"stance_width must be >= 0 m, got {stance_width:g}")
     feet = []
     for name, side in (("left", 0.5), ("right", -0.5)):
         ml = ankle_ml + side * stance_width

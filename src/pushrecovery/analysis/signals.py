@@ -24,7 +24,14 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, sosfiltfilt
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery._validate import (
+    finite_float,
+    positive_float,
+    require_type,
+    sample_array,
+    whole_number,
+)
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 __all__ = [
     "FILTER_ORDER",
@@ -77,8 +84,44 @@ class Gap:
         }
 
 
+def _flags(name: str, value: object) -> NDArray[np.bool_]:
+    """Return ``value`` as a one-dimensional bool array, or raise naming ``name``."""
+    array = np.asarray(value)
+    if array.dtype != np.bool_ or array.ndim != 1:
+        raise ParameterTypeError(
+            f"{name} must be a one-dimensional bool array, got {array.dtype} of shape {array.shape}"
+        )
+    return array
+
+
+def _times(name: str, value: object) -> FloatArray:
+    """Return ``value`` as sample times: one-dimensional, finite, strictly increasing [s]."""
+    time = sample_array(name, value)  # type: ignore[arg-type]
+    if (np.diff(time) <= 0.0).any():
+        raise InvalidParameterError(f"{name} must increase strictly from sample to sample")
+    return time
+
+
+def _same_length(name: str, values: FloatArray, time: FloatArray, time_name: str) -> None:
+    if len(values) != len(time):
+        raise InvalidParameterError(
+            f"{name} must have one sample per {time_name} ({len(time)}), got {len(values)}"
+        )
+
+
 def find_gaps(missing: NDArray[np.bool_]) -> list[tuple[int, int]]:
-    """Index ranges [start, stop) of the runs of True in ``missing`` (one-dimensional)."""
+    """Index ranges [start, stop) of the runs of True in ``missing`` (one-dimensional).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``missing`` is not a one-dimensional bool array.
+    """
+    return _find_gaps(_flags("missing", missing))
+
+
+def _find_gaps(missing: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """:func:`find_gaps` of a checked array."""
     edges = np.diff(np.concatenate(([0], missing.astype(np.int8), [0])))
     return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True))
 
@@ -91,9 +134,9 @@ def repair_gaps(
     Parameters
     ----------
     time : ndarray, shape (n,)
-        Sample times [s], increasing.
+        Sample times [s], finite, strictly increasing.
     values : ndarray, shape (n,) or (n, k)
-        The signal; a sample is missing when any of its components is NaN.
+        The signal; a sample is missing when any of its components is NaN (or infinite).
     max_gap : float
         Longest gap that is interpolated, measured between the valid samples either side
         minus one sample period [s], >= 0.
@@ -105,8 +148,22 @@ def repair_gaps(
     (values, gaps)
         A copy with the short inner gaps filled (a not-a-knot cubic spline through all the
         valid samples), and the list of gaps in time order.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``name`` is not a str.
+    InvalidParameterError
+        Times that are not finite and increasing, values of another shape or length, or a
+        negative or non-finite ``max_gap``.
     """
-    values = np.array(values, dtype=np.float64)
+    time = _times("time", time)
+    values = np.array(sample_array("values", values, (1, 2), values="any"))
+    _same_length("values", values, time, "time")
+    max_gap = finite_float("max_gap", max_gap, "s", allowed=">= 0")
+    if max_gap < 0.0:
+        raise InvalidParameterError(f"max_gap must be >= 0 s, got {max_gap:g}")
+    require_type("name", name, str)
     flat = values.reshape(len(values), -1)
     missing = np.asarray(~np.isfinite(flat).all(axis=1))
     gaps: list[Gap] = []
@@ -114,7 +171,7 @@ def repair_gaps(
         return values, gaps
     valid = np.flatnonzero(~missing)
     spline = CubicSpline(time[valid], flat[valid], axis=0) if len(valid) >= 4 else None
-    for start, stop in find_gaps(missing):
+    for start, stop in _find_gaps(missing):
         inner = start > 0 and stop < len(time)
         # The gap's length: the time with no data, between the valid samples either side.
         span = time[stop] - time[start - 1] if inner else np.inf
@@ -128,8 +185,23 @@ def repair_gaps(
 
 
 def segments(valid: NDArray[np.bool_], shortest: int = 1) -> list[slice]:
-    """Contiguous runs of valid samples, as slices, keeping those at least ``shortest`` long."""
-    return [slice(a, b) for a, b in find_gaps(valid) if b - a >= shortest]
+    """Contiguous runs of valid samples, as slices, keeping those at least ``shortest`` long.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``valid`` is not a one-dimensional bool array.
+    InvalidParameterError
+        If ``shortest`` is not a whole number >= 1.
+    """
+    valid = _flags("valid", valid)
+    shortest = whole_number("shortest", shortest, 1, 2**62)
+    return _segments(valid, shortest)
+
+
+def _segments(valid: NDArray[np.bool_], shortest: int) -> list[slice]:
+    """:func:`segments` of checked arguments."""
+    return [slice(a, b) for a, b in _find_gaps(valid) if b - a >= shortest]
 
 
 def lowpass(values: FloatArray, rate: float, cutoff: float) -> FloatArray:
@@ -149,7 +221,26 @@ def lowpass(values: FloatArray, rate: float, cutoff: float) -> FloatArray:
     ndarray
         The filtered samples (the input itself when ``cutoff`` is 0 or the segment is too short
         to filter: fewer than 4 samples).
+
+    Raises
+    ------
+    InvalidParameterError
+        Values that are not finite or not of shape (n,) or (n, k), a non-positive ``rate``,
+        or a ``cutoff`` that is not 0 or in (0, rate/2).
     """
+    values = sample_array("values", values, (1, 2))
+    rate = positive_float("rate", rate, "Hz")
+    cutoff = finite_float("cutoff", cutoff, "Hz", allowed=f"0 or in (0, {0.5 * rate:g})")
+    if cutoff != 0.0 and not 0.0 < cutoff < 0.5 * rate:
+        raise InvalidParameterError(
+            f"cutoff must be 0 or in (0, {0.5 * rate:g}) Hz (half the sampling rate), "
+            f"got {cutoff:g}"
+        )
+    return _lowpass(values, rate, cutoff)
+
+
+def _lowpass(values: FloatArray, rate: float, cutoff: float) -> FloatArray:
+    """:func:`lowpass` of checked arguments."""
     if cutoff == 0.0 or len(values) < 4:
         return values
     if not 0.0 < cutoff < 0.5 * rate:
@@ -183,20 +274,57 @@ def smooth_and_differentiate(
     (smooth, rate_of_change)
         Both NaN where the signal is missing and on segments shorter than 3 samples (no
         derivative from fewer); rate of change in units per second.
+
+    Raises
+    ------
+    InvalidParameterError
+        Times that are not finite and strictly increasing, values of another shape or length,
+        or a ``cutoff`` that is not 0 or in (0, rate/2).
     """
+    time = _times("time", time)
+    values = sample_array("values", values, (1, 2), values="any")
+    _same_length("values", values, time, "time")
+    cutoff = finite_float("cutoff", cutoff, "Hz", allowed=">= 0")
+    if cutoff < 0.0:
+        raise InvalidParameterError(f"cutoff must be >= 0 Hz, got {cutoff:g}")
     rate = (len(time) - 1) / (time[-1] - time[0]) if len(time) > 1 else 1.0
     flat = values.reshape(len(values), -1)
     smooth = np.full_like(flat, np.nan)
     slope = np.full_like(flat, np.nan)
     finite = np.asarray(np.isfinite(flat).all(axis=1))
-    for part in segments(finite, shortest=3):
-        smooth[part] = lowpass(flat[part], rate, cutoff)
+    for part in _segments(finite, 3):
+        smooth[part] = _lowpass(flat[part], rate, cutoff)
         slope[part] = np.gradient(smooth[part], time[part], axis=0)
     return smooth.reshape(values.shape), slope.reshape(values.shape)
 
 
 def resample(source: FloatArray, values: FloatArray, target: FloatArray) -> FloatArray:
-    """Values (n, k) at other times, linearly; NaN beyond the ends and next to missing samples."""
+    """Values (n, k) at other times, linearly; NaN beyond the ends and next to missing samples.
+
+    Parameters
+    ----------
+    source : ndarray, shape (n,)
+        Times of the samples [s], finite, strictly increasing.
+    values : ndarray, shape (n, k)
+        The samples, NaN where missing.
+    target : ndarray, shape (m,)
+        The times wanted [s], finite.
+
+    Returns
+    -------
+    ndarray, shape (m, k)
+        ``values`` itself when the times are the same.
+
+    Raises
+    ------
+    InvalidParameterError
+        Arrays of other shapes or lengths, times that are not finite (source: not increasing),
+        or infinite values.
+    """
+    source = _times("source", source)
+    values = sample_array("values", values, (2,), values="nan")
+    _same_length("values", values, source, "source time")
+    target = sample_array("target", target)
     if len(source) == len(target) and np.array_equal(source, target):
         return values
     return np.column_stack(

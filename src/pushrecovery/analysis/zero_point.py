@@ -27,8 +27,10 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import cumulative_trapezoid
 
-from pushrecovery._validate import positive_float
+from pushrecovery._validate import bounded_float, finite_float, sample_array
+from pushrecovery.analysis.signals import _times
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import LIMITS
 
 __all__ = ["ZERO_FORCE", "com_from_force", "zero_points"]
 
@@ -49,7 +51,7 @@ def zero_points(
     Parameters
     ----------
     time : ndarray, shape (n,)
-        Sample times [s].
+        Sample times [s], finite, strictly increasing.
     force : ndarray, shape (n,)
         Horizontal ground reaction force [N], filtered (noise makes spurious crossings); NaN
         samples never count.
@@ -64,7 +66,41 @@ def zero_points(
     ndarray of int
         Increasing indices: of each sign change the sample of smaller |F|, and the first and
         last sample of each run with |F| <= tolerance.
+
+    Raises
+    ------
+    InvalidParameterError
+        Times that are not finite and strictly increasing, a force of another shape or length,
+        or a negative or non-finite ``tolerance`` or ``spacing``.
     """
+    time, force = _time_and_force(time, force)
+    tolerance = _non_negative("tolerance", tolerance, "N")
+    spacing = _non_negative("spacing", spacing, "s")
+    return _zero_points(time, force, tolerance, spacing)
+
+
+def _non_negative(name: str, value: float, unit: str) -> float:
+    number = finite_float(name, value, unit, allowed=">= 0")
+    if number < 0.0:
+        raise InvalidParameterError(f"{name} must be >= 0 [{unit}], got {number:g}")
+    return number
+
+
+def _time_and_force(time: FloatArray, force: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Return checked sample times and a horizontal force of one sample per time."""
+    time = _times("time", time)
+    force = sample_array("force", force, values="any")
+    if len(force) != len(time):
+        raise InvalidParameterError(
+            f"force must have one sample per time ({len(time)}), got {len(force)}"
+        )
+    return time, force
+
+
+def _zero_points(
+    time: FloatArray, force: FloatArray, tolerance: float, spacing: float
+) -> NDArray[np.intp]:
+    """:func:`zero_points` of checked arguments."""
     sign = np.sign(force)
     small = np.abs(force) <= tolerance
     edges = np.diff(np.concatenate(([0], small.astype(np.int8), [0])))
@@ -96,14 +132,14 @@ def com_from_force(
     Parameters
     ----------
     time : ndarray, shape (n,)
-        Sample times [s], increasing.
+        Sample times [s], finite, strictly increasing.
     force : ndarray, shape (n,)
         Horizontal ground reaction force on the body along one axis [N] (positive along the
         axis), low-pass filtered.
     cop : ndarray, shape (n,)
         CoP along the same axis [m], lab frame.
     mass : float
-        Body mass [kg], > 0.
+        Body mass [kg], in [0.01, 1e4] (:data:`~pushrecovery.params.LIMITS`).
     tolerance : float, optional
         |F| that counts as zero [N]; default ``ZERO_FORCE`` of the body weight (the CoM then
         lies within that fraction of its height of the point above the CoP: 0.2 mm per metre).
@@ -119,13 +155,23 @@ def com_from_force(
     Raises
     ------
     InvalidParameterError
-        Fewer than two zero points (nothing can be pinned), or a non-positive mass.
+        Fewer than two zero points (nothing can be pinned), a mass outside
+        :data:`~pushrecovery.params.LIMITS`, times that are not finite and strictly increasing,
+        a force or CoP of another shape or length, or a negative or non-finite ``tolerance``
+        or ``spacing``.
     """
-    mass = positive_float("mass", mass, "kg")
-    force = np.asarray(force, dtype=np.float64)
+    mass = bounded_float("mass", mass, *LIMITS["mass"])
+    time, force = _time_and_force(time, force)
+    cop = sample_array("cop", cop, values="any")
+    if len(cop) != len(time):
+        raise InvalidParameterError(
+            f"cop must have one sample per time ({len(time)}), got {len(cop)}"
+        )
     if tolerance is None:
         tolerance = ZERO_FORCE * mass * STANDARD_GRAVITY
-    pins = zero_points(time, np.where(np.isfinite(force), force, np.nan), tolerance, spacing)
+    tolerance = _non_negative("tolerance", tolerance, "N")
+    spacing = _non_negative("spacing", spacing, "s")
+    pins = _zero_points(time, np.where(np.isfinite(force), force, np.nan), tolerance, spacing)
     pins = pins[np.isfinite(cop[pins])]
     if len(pins) < 2:
         raise InvalidParameterError(

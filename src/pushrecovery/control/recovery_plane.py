@@ -37,13 +37,14 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import bounded_float, finite_float, positive_float
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.minkowski import Shape, decompose, minkowski_sum
+from pushrecovery.ground.minkowski import Shape, _decompose, _minkowski_sum
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, roll_axis
-from pushrecovery.params import BodyParams
+from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
@@ -62,7 +63,24 @@ def hip_share(elapsed: float, spin_up: float, omega: float) -> float:
     For c(s) = +1 on [0, T), −1 on [T, 2T), 0 after, the share ω∫_u^∞ e^{−ω(s−u)} c(s) ds at
     ``elapsed`` u [s]: 1 − 2 e^{−ω(T−u)} + e^{−ω(2T−u)} for u < T (which is (1 − e^{−ωT})²,
     corrected Eq. 15, at u = 0), −(1 − e^{−ω(2T−u)}) for T ≤ u < 2T, and 0 from 2T on.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``elapsed`` is negative or not finite, ``spin_up`` T is not finite and > 0, or
+        ``omega`` is outside [0.1, 100] 1/s (:data:`~pushrecovery.params.OMEGA_MIN`,
+        :data:`~pushrecovery.params.OMEGA_MAX`).
     """
+    elapsed = finite_float("elapsed", elapsed, "s", allowed=">= 0")
+    if elapsed < 0.0:
+        raise InvalidParameterError(f"elapsed must be >= 0 s, got {elapsed:g}")
+    spin_up = positive_float("spin_up", spin_up, "s")
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
+    return _hip_share(elapsed, spin_up, omega)
+
+
+def _hip_share(elapsed: float, spin_up: float, omega: float) -> float:
+    """:func:`hip_share` unchecked (the controller's tick; T = inf for an axis with no torque)."""
     if elapsed < spin_up:
         return (
             1.0
@@ -170,7 +188,7 @@ class PlaneRecoveryController(Controller):
             raise InvalidParameterError("no hip torque: the CMP region is the support")
         terms: list[tuple[float, Shape]] = [(1.0, box), (1.0, self.support.polygon)]
         origin = np.zeros(2)
-        points, _ = decompose(xi, terms, origin, minkowski_sum(terms, origin))
+        points, _ = _decompose(xi, terms, origin, _minkowski_sum(terms, origin))
         self._begin_hip(t, points[0])
         self.mode = "hip"
         pitch, roll = self._hip_torques(t)
@@ -270,7 +288,7 @@ class PlaneRecoveryController(Controller):
             return np.zeros(2)
         omega, weight = self.params.omega, self.params.weight
         along = [
-            fraction * torque / weight * hip_share(t - self._hip.start, spin_up, omega)
+            fraction * torque / weight * _hip_share(t - self._hip.start, spin_up, omega)
             for fraction, torque, spin_up in zip(
                 self._hip.fractions, self._torques, self._spin_up, strict=True
             )

@@ -15,7 +15,15 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery._validate import (
+    finite_array,
+    finite_float,
+    finite_vector,
+    positive_float,
+    require_type,
+    whole_number,
+)
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import ConvexPolygon, following
 
 __all__ = [
@@ -34,6 +42,35 @@ Shape = ConvexPolygon | FloatArray
 
 def _vertices(shape: Shape) -> FloatArray:
     return shape.vertices if isinstance(shape, ConvexPolygon) else np.asarray(shape, np.float64)
+
+
+def _checked_terms(terms: object, *, non_negative: bool = False) -> list[tuple[float, Shape]]:
+    """Return ``terms`` as (weight, shape) pairs, or raise naming the bad term.
+
+    Weights are finite (>= 0 with ``non_negative``); a shape is a :class:`ConvexPolygon` or
+    finite vertices of shape (n, 2), n >= 1.
+    """
+    if not isinstance(terms, list | tuple):
+        raise ParameterTypeError(
+            f"terms must be a list of (weight, shape) pairs, got {type(terms).__name__}"
+        )
+    checked: list[tuple[float, Shape]] = []
+    for k, term in enumerate(terms):
+        if not (isinstance(term, list | tuple) and len(term) == 2):
+            raise ParameterTypeError(f"terms[{k}] must be a (weight, shape) pair, got {term!r:.60}")
+        weight = finite_float(f"terms[{k}] weight", term[0])
+        if non_negative and weight < 0.0:
+            raise InvalidParameterError(f"terms[{k}] weight must be >= 0, got {weight:g}")
+        shape = term[1]
+        if not isinstance(shape, ConvexPolygon):
+            shape = finite_array(f"terms[{k}] shape", shape)
+            if shape.ndim != 2 or shape.shape[1] != 2 or len(shape) < 1:
+                raise InvalidParameterError(
+                    f"terms[{k}] shape must be a ConvexPolygon or vertices of shape (n, 2), "
+                    f"got shape {shape.shape}"
+                )
+        checked.append((weight, shape))
+    return checked
 
 
 #: Edges shorter than this fraction of the sum's size are dropped (rounding of collinear
@@ -60,7 +97,23 @@ def minkowski_sum(
     -------
     ConvexPolygon
         The sum, counter-clockwise, collinear vertices merged.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``terms`` is not a list of (weight, shape) pairs.
+    InvalidParameterError
+        A weight that is not finite, a shape that is not a polygon or finite (n, 2) vertices,
+        an ``offset`` that is not a finite (x, y), no term of non-zero weight, or a sum of
+        zero area.
     """
+    return _minkowski_sum(_checked_terms(terms), finite_vector("offset", offset, 2, unit="m"))
+
+
+def _minkowski_sum(
+    terms: Sequence[tuple[float, Shape]], offset: tuple[float, float] | FloatArray = (0.0, 0.0)
+) -> ConvexPolygon:
+    """:func:`minkowski_sum` of checked terms (the library's own calls)."""
     starts = []
     edges = []
     for weight, polygon in terms:
@@ -141,7 +194,15 @@ def _cleaned(vertices: FloatArray) -> ConvexPolygon:
 
 
 def clip(polygon: ConvexPolygon, window: ConvexPolygon) -> ConvexPolygon | None:
-    """Intersection of two convex polygons, or None when it has no area [m]."""
+    """Intersection of two convex polygons, or None when it has no area [m].
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``polygon`` or ``window`` is not a :class:`ConvexPolygon`.
+    """
+    require_type("polygon", polygon, ConvexPolygon)
+    require_type("window", window, ConvexPolygon)
     return _clip_halfplanes(polygon, window.normals, window.offsets)
 
 
@@ -179,6 +240,10 @@ def _clip_halfplanes(
         return None
 
 
+#: Most vertices of a :func:`regular_polygon` (its edges then lie within 5e-10 of the circle).
+MAX_SIDES = 100_000
+
+
 def regular_polygon(
     radius: float, sides: int, centre: tuple[float, float] = (0.0, 0.0), phase: float = 0.0
 ) -> ConvexPolygon:
@@ -186,13 +251,19 @@ def regular_polygon(
 
     Vertices at angles phase + 2πk/sides [rad] about ``centre``; its edges come within
     radius (1 − cos(π/sides)) of the circle.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``radius`` is not finite and > 0, ``sides`` is not a whole number in
+        [3, :data:`MAX_SIDES`], or ``centre`` or ``phase`` is not finite.
     """
-    if not (math.isfinite(radius) and radius > 0.0):
-        raise InvalidParameterError(f"radius must be > 0 m, got radius={radius!r}")
-    if sides < 3:
-        raise InvalidParameterError(f"sides must be >= 3, got sides={sides}")
+    radius = positive_float("radius", radius, "m")
+    sides = whole_number("sides", sides, 3, MAX_SIDES)
+    middle = finite_vector("centre", centre, 2, unit="m")
+    phase = finite_float("phase", phase, "rad")
     angle = phase + 2.0 * math.pi * np.arange(sides) / sides
-    vertices = np.column_stack([np.cos(angle), np.sin(angle)]) * radius + np.asarray(centre)
+    vertices = np.column_stack([np.cos(angle), np.sin(angle)]) * radius + middle
     return ConvexPolygon._from_ccw(vertices)
 
 
@@ -217,7 +288,30 @@ def decompose(
     (list of ndarray, float)
         The points p_k [m] (the centre c_k for zero weights) and s (> 1: the point is outside
         ``total``, and the points are those of the boundary point b).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``terms`` is not a list of (weight, shape) pairs or ``total`` not a
+        :class:`ConvexPolygon`.
+    InvalidParameterError
+        A negative or non-finite weight, a shape that is not a polygon or finite (n, 2)
+        vertices, or a ``point`` or ``offset`` that is not a finite (x, y).
     """
+    point = finite_vector("point", point, 2, unit="m")
+    terms = _checked_terms(terms, non_negative=True)
+    offset = finite_vector("offset", offset, 2, unit="m")
+    require_type("total", total, ConvexPolygon)
+    return _decompose(point, terms, offset, total)
+
+
+def _decompose(
+    point: FloatArray,
+    terms: Sequence[tuple[float, Shape]],
+    offset: FloatArray,
+    total: ConvexPolygon,
+) -> tuple[list[FloatArray], float]:
+    """:func:`decompose` of checked arguments."""
     shapes = [_vertices(shape) for _, shape in terms]
     weights = [float(weight) for weight, _ in terms]
     centres = [v.mean(axis=0) for v in shapes]

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery._validate import bounded_float, finite_array
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = ["ConvexPolygon", "convex_hull", "rectangle"]
@@ -287,7 +288,22 @@ class ConvexPolygon:
 
 
 def rectangle(heel: float, toe: float, width: float) -> ConvexPolygon:
-    """Return the foot [heel, toe] × [−width/2, width/2] [m] in its own frame."""
+    """Return the foot [heel, toe] × [−width/2, width/2] [m] in its own frame.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``heel`` or ``toe`` lies beyond ±:data:`MAX_COORDINATE` (1000 m, a user polygon's
+        range), ``toe`` − ``heel`` or ``width`` is shorter than :data:`MIN_EDGE` (1 µm), or
+        ``width`` exceeds 2 :data:`MAX_COORDINATE`.
+    """
+    heel = bounded_float("heel", heel, -MAX_COORDINATE, MAX_COORDINATE, "m")
+    toe = bounded_float("toe", toe, -MAX_COORDINATE, MAX_COORDINATE, "m")
+    width = bounded_float("width", width, MIN_EDGE, 2.0 * MAX_COORDINATE, "m")
+    if toe - heel < MIN_EDGE:
+        raise InvalidParameterError(
+            f"toe must be at least {MIN_EDGE:g} m ahead of heel, got heel={heel:g} m, toe={toe:g} m"
+        )
     half = 0.5 * width
     return ConvexPolygon._from_ccw(
         np.array([[heel, -half], [toe, -half], [toe, half], [heel, half]])
@@ -297,12 +313,21 @@ def rectangle(heel: float, toe: float, width: float) -> ConvexPolygon:
 def convex_hull(points: ArrayLike) -> ConvexPolygon:
     """Convex hull of points (Andrew's monotone chain); exactly collinear points dropped.
 
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        The points (x, y) [m], finite.
+
     Raises
     ------
     InvalidParameterError
-        If the hull has zero area (fewer than three non-collinear points).
+        If a point is not finite or not (x, y), or the hull has zero area (fewer than three
+        non-collinear points).
     """
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    pts = finite_array("points", points)
+    if pts.ndim == 0 or pts.shape[-1] != 2:
+        raise InvalidParameterError(f"points must be (x, y) pairs, shape (n, 2), got {pts.shape}")
+    pts = pts.reshape(-1, 2)
     # Sorted by x then y (np.unique(axis=0) would load numpy.ma: 10 ms of every start-up).
     pts = pts[np.lexsort((pts[:, 1], pts[:, 0]))]
     scale = max(1.0, float(np.abs(pts).max())) if pts.size else 1.0

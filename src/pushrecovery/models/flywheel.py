@@ -19,9 +19,16 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_float, positive_float, require_type
+from pushrecovery._validate import (
+    bounded_float,
+    finite_array,
+    finite_float,
+    float_array,
+    positive_float,
+    require_type,
+)
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.params import BodyParams
+from pushrecovery.params import LIMITS, BodyParams
 
 __all__ = [
     "FLYWHEEL_STATE",
@@ -127,9 +134,39 @@ def flywheel_discrete(params: BodyParams, dt: float) -> tuple[FloatArray, FloatA
 def flywheel_propagate(
     states: ArrayLike, inputs: ArrayLike, params: BodyParams, dt: float
 ) -> FloatArray:
-    """Advance arrays of states (..., 4) with inputs (..., 2) held for dt (exact, vectorised)."""
+    """Advance arrays of states (..., 4) with inputs (..., 2) held for dt (exact, vectorised).
+
+    Raises
+    ------
+    InvalidParameterError
+        States or inputs that are not finite or not of shape (..., 4) and (..., 2) with
+        leading shapes that broadcast, ``dt`` as in :func:`flywheel_discrete`, or states so
+        large that the result overflows.
+    """
     a, b = flywheel_discrete(params, dt)
-    return np.asarray(states, dtype=np.float64) @ a.T + np.asarray(inputs, dtype=np.float64) @ b.T
+    return _propagated(states, inputs, a, b)
+
+
+def _propagated(states: ArrayLike, inputs: ArrayLike, a: FloatArray, b: FloatArray) -> FloatArray:
+    """Return states @ A.T + inputs @ B.T for checked (..., n) states and (..., m) inputs."""
+    x = float_array("states", states)
+    u = float_array("inputs", inputs)
+    for name, array, size in (("states", x, a.shape[0]), ("inputs", u, b.shape[1])):
+        if array.ndim == 0 or array.shape[-1] != size:
+            raise InvalidParameterError(f"{name} must have shape (..., {size}), got {array.shape}")
+    try:
+        np.broadcast_shapes(x.shape[:-1], u.shape[:-1])
+    except ValueError:
+        raise InvalidParameterError(
+            f"states {x.shape} and inputs {u.shape} must have leading shapes that broadcast"
+        ) from None
+    with np.errstate(over="ignore", invalid="ignore"):  # reported below, as one error
+        result = x @ a.T + u @ b.T
+    if not np.isfinite(result).all():
+        finite_array("states", x)
+        finite_array("inputs", u)
+        raise InvalidParameterError("states or inputs are too large: the result overflows")
+    return np.asarray(result, dtype=np.float64)
 
 
 def bang_bang_torque(t: ArrayLike, switch_time: float, torque_max: float) -> FloatArray:
@@ -137,8 +174,16 @@ def bang_bang_torque(t: ArrayLike, switch_time: float, torque_max: float) -> Flo
 
     τ = +τmax on [0, T), −τmax on [T, 2T), 0 afterwards, i.e.
     τ(t) = τmax (1 − 2 u(t − T) + u(t − 2T)) with u the unit step.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a time is not finite, ``switch_time`` T is negative or not finite, or
+        ``torque_max`` is outside [0, 1e5] N m (:data:`~pushrecovery.params.LIMITS`).
     """
-    t = np.asarray(t, dtype=np.float64)
+    t = finite_array("t", t)
+    switch_time = _switch_time(switch_time)
+    torque_max = bounded_float("torque_max", torque_max, *LIMITS["torque_max"])
     return torque_max * np.where(t < switch_time, 1.0, np.where(t < 2.0 * switch_time, -1.0, 0.0))
 
 
@@ -183,7 +228,57 @@ def bang_bang_end_state(
         CoM position [m] and velocity [m/s] at 2T.
     theta, theta_dot : float
         Flywheel angle [rad] and rate [rad/s] at 2T.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` is not a :class:`~pushrecovery.params.BodyParams`.
+    InvalidParameterError
+        A state or ``cop`` that is not finite, ``direction`` other than ±1, a negative
+        ``switch_time`` or one with 2 ω T above 50 (:data:`MAX_OMEGA_DT`: cosh 2ωT leaves any
+        useful precision), or a state so large that the result overflows.
     """
+    require_type("params", params, BodyParams)
+    x0 = finite_array("x0", x0)
+    xdot0 = finite_array("xdot0", xdot0)
+    switch_time = _switch_time(switch_time)
+    if 2.0 * params.omega * switch_time > MAX_OMEGA_DT:
+        raise InvalidParameterError(
+            f"switch_time must be in [0, {MAX_OMEGA_DT:g}/(2 omega) = "
+            f"{MAX_OMEGA_DT / (2.0 * params.omega):g}] s, got {switch_time:g}"
+        )
+    cop = finite_float("cop", cop, "m")
+    direction = _direction(direction)
+    with np.errstate(over="ignore", invalid="ignore"):  # reported below, as one error
+        x, xdot, theta, rate = _end_state(x0, xdot0, params, switch_time, cop, direction)
+    if not (np.isfinite(x).all() and np.isfinite(xdot).all()):
+        raise InvalidParameterError("x0, xdot0 or cop are too large: the end state overflows")
+    return x, xdot, theta, rate
+
+
+def _switch_time(value: float) -> float:
+    switch_time = finite_float("switch_time", value, "s", allowed=">= 0")
+    if switch_time < 0.0:
+        raise InvalidParameterError(f"switch_time must be >= 0 s, got {switch_time:g}")
+    return switch_time
+
+
+def _direction(value: float) -> float:
+    direction = finite_float("direction", value, allowed="+1 or -1")
+    if direction not in (1.0, -1.0):
+        raise InvalidParameterError(f"direction must be +1 or -1, got {direction!r}")
+    return direction
+
+
+def _end_state(
+    x0: FloatArray,
+    xdot0: FloatArray,
+    params: BodyParams,
+    switch_time: float,
+    cop: float,
+    direction: float,
+) -> tuple[FloatArray, FloatArray, float, float]:
+    """:func:`bang_bang_end_state` of checked arguments."""
     omega, t = params.omega, switch_time
     a = direction * params.torque_max / params.weight
     offset = np.asarray(x0, dtype=np.float64) - cop
@@ -219,12 +314,18 @@ def bang_bang_switch_time(
         CoP δ held meanwhile [m].
     direction : float
         +1 or −1, sign of the first torque pulse.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` is not a :class:`~pushrecovery.params.BodyParams`.
+    InvalidParameterError
+        If a position is not finite or ``direction`` is not ±1.
     """
     capture_point = finite_float("capture_point", capture_point, "m")
     target = finite_float("target", target, "m")
     cop = finite_float("cop", cop, "m")
-    if direction not in (1.0, -1.0):
-        raise InvalidParameterError(f"direction must be +1 or -1, got {direction!r}")
+    direction = _direction(direction)
     spin_up = max_spin_up_time(params)
     a = direction * params.torque_max / params.weight
     if a == 0.0:

@@ -25,8 +25,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import require_type
-from pushrecovery.models.flywheel import flywheel_discrete
+from pushrecovery._validate import finite_float, require_type
+from pushrecovery.models.flywheel import _propagated, flywheel_discrete
 from pushrecovery.params import BodyParams
 
 __all__ = [
@@ -68,7 +68,11 @@ def roll_axis(params: BodyParams) -> BodyParams:
 
 
 def _axes(yaw: float) -> FloatArray:
-    """Columns e_p, e_r: the body's pitch (forward) and roll (left) axes in the world frame."""
+    """Columns e_p, e_r: the body's pitch (forward) and roll (left) axes in the world frame.
+
+    Checks ``yaw`` [rad] (finite), for the public functions that take it.
+    """
+    yaw = finite_float("yaw", yaw, "rad")
     c, s = math.cos(yaw), math.sin(yaw)
     return np.array([[c, -s], [s, c]])
 
@@ -132,6 +136,14 @@ def plane_discrete(
 def plane_propagate(
     states: ArrayLike, inputs: ArrayLike, params: BodyParams, dt: float, yaw: float = 0.0
 ) -> FloatArray:
-    """Advance arrays of states (..., 8) with inputs (..., 4) held for dt (exact, vectorised)."""
+    """Advance arrays of states (..., 8) with inputs (..., 4) held for dt (exact, vectorised).
+
+    Raises
+    ------
+    InvalidParameterError
+        States or inputs that are not finite or not of shape (..., 8) and (..., 4) with
+        leading shapes that broadcast, ``dt`` or ``yaw`` as in :func:`plane_discrete`, or
+        states so large that the result overflows.
+    """
     a, b = plane_discrete(params, dt, yaw)
-    return np.asarray(states, dtype=np.float64) @ a.T + np.asarray(inputs, dtype=np.float64) @ b.T
+    return _propagated(states, inputs, a, b)

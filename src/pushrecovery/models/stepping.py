@@ -166,12 +166,41 @@ def solve_step_angle(
     slow falls whose energy is below the top of the pendulum. Returns ``lean`` when even an
     immediate step leaves the capture point behind the target, and π/4 when the target lies
     below −L/√2 (unreachable).
+
+    Raises
+    ------
+    InvalidParameterError
+        A value that is not finite, a length or gravity out of
+        :data:`~pushrecovery.params.LIMITS`, a lean outside [0, π/2), |v0| >= 10 sqrt(g L)
+        or |lean_rate| >= 10 sqrt(g / L) (the models' validity, as :func:`step_solution`;
+        the squares overflow beyond), or shapes that do not broadcast.
     """
     length, gravity = _leg(length, gravity)
     v0 = finite_array("v0", v0)
+    limit = 10.0 * math.sqrt(gravity * length)
+    if v0.size and float(np.max(np.abs(v0))) >= limit:
+        raise InvalidParameterError(
+            f"v0 must satisfy |v0| < 10 sqrt(g L) = {limit:g} m/s, "
+            f"got {float(np.max(np.abs(v0))):g}"
+        )
     target = finite_array("target", target)
     lean = _angles("lean", lean)
     lean_rate = None if lean_rate is None else finite_array("lean_rate", lean_rate)
+    if lean_rate is not None and lean_rate.size:
+        largest = float(np.max(np.abs(lean_rate)))
+        if largest >= limit / length:
+            raise InvalidParameterError(
+                f"lean_rate must satisfy |lean_rate| < 10 sqrt(g / L) = {limit / length:g} "
+                f"rad/s, got {largest:g}"
+            )
+    speeds = ("v0", v0) if lean_rate is None else ("lean_rate", lean_rate)
+    try:
+        np.broadcast_shapes(speeds[1].shape, target.shape, lean.shape)
+    except ValueError:
+        raise InvalidParameterError(
+            f"{speeds[0]} {speeds[1].shape}, target {target.shape} and lean {lean.shape} "
+            "must broadcast"
+        ) from None
     omega2 = gravity / length
     lean = np.asarray(lean, dtype=np.float64)
     if lean_rate is None:

@@ -37,7 +37,7 @@ from typing import ClassVar, NamedTuple, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, require_type
+from pushrecovery._validate import finite_float, float_array, require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -167,9 +167,49 @@ def check_com_state(
 
 
 def over_foot_at_rest(state: FloatArray, params: BodyParams, speed: float) -> bool:
-    """Sagittal rest: |ẋ| <= ``speed`` [m/s] and the CoM strictly over the foot (heel, toe)."""
+    """Sagittal rest: |ẋ| <= ``speed`` [m/s] and the CoM strictly over the foot (heel, toe).
+
+    ``state`` is a plant's (the CoM position first, its velocity at ``len // 2``; only those
+    two are read). It runs at every control tick of a settled run: a float array, a body and
+    a Python float pass a few cheap tests; anything else is checked on the slow path.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` is not a :class:`~pushrecovery.params.BodyParams`.
+    InvalidParameterError
+        If ``state`` is not a one-dimensional array of at least two numbers with a finite
+        CoM position and velocity, or ``speed`` is negative or not finite.
+    """
+    if not (
+        type(state) is np.ndarray
+        and state.ndim == 1
+        and state.shape[0] >= 2
+        and type(speed) is float
+        and isinstance(params, BodyParams)
+    ):
+        state, speed = _rest_arguments(state, params, speed)
     x, xdot = float(state[0]), float(state[len(state) // 2])
+    if not (math.isfinite(x + xdot + speed) and speed >= 0.0):
+        state, speed = _rest_arguments(state, params, speed)
+        x, xdot = float(state[0]), float(state[len(state) // 2])  # pragma: no cover - overflow
     return abs(xdot) <= speed and params.heel < x < params.toe
+
+
+def _rest_arguments(state: object, params: object, speed: object) -> tuple[FloatArray, float]:
+    """Check the arguments of :func:`over_foot_at_rest` (its slow path), naming the first bad."""
+    require_type("params", params, BodyParams)
+    array = float_array("state", state)  # type: ignore[arg-type]
+    if array.ndim != 1 or array.shape[0] < 2:
+        raise InvalidParameterError(
+            f"state must be a one-dimensional array of at least 2 entries, got {array.shape}"
+        )
+    finite_float("state x", array[0], "m")
+    finite_float("state xdot", array[len(array) // 2], "m/s")
+    number = finite_float("speed", speed, "m/s", allowed=">= 0")
+    if number < 0.0:
+        raise InvalidParameterError(f"speed must be >= 0 m/s, got {number:g}")
+    return array, number
 
 
 class PlantBase:

@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, positive_float
+from pushrecovery._validate import finite_float, positive_float, require_type
 from pushrecovery.control.base import make_controller
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.push import Push, direction_sign
@@ -106,7 +106,7 @@ def find_critical_velocity(
     tolerance : float
         Width of the final bracket [m/s], in [1e-9, 0.1].
     max_velocity : float
-        Largest push searched [m/s].
+        Largest push searched [m/s], finite, > 0.
 
     Returns
     -------
@@ -115,10 +115,18 @@ def find_critical_velocity(
 
     Raises
     ------
+    ParameterTypeError
+        If ``outcome_of`` is not callable.
     InvalidParameterError
-        If the body falls without a push, or no push below ``max_velocity`` makes it fall.
+        If the body falls without a push, or no push below ``max_velocity`` makes it fall, or
+        an argument is out of its range (``max_velocity``: finite, > 0).
     """
+    if not callable(outcome_of):
+        raise ParameterTypeError(
+            f"outcome_of must be a callable (velocity -> Outcome), got {type(outcome_of).__name__}"
+        )
     sign = direction_sign(direction)
+    max_velocity = positive_float("max_velocity", max_velocity, "m/s")
     tolerance = positive_float("tolerance", tolerance, "m/s")
     if not TOLERANCE_RANGE[0] <= tolerance <= TOLERANCE_RANGE[1]:
         raise InvalidParameterError(
@@ -174,7 +182,18 @@ def predicted_critical_velocity(
 
     Eq. (4) for ``ankle``, corrected Eq. (15) for ``hip``, the single-step limit of
     :mod:`pushrecovery.surfaces.step` for ``step``.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` is not a :class:`~pushrecovery.params.BodyParams` or ``strategy`` not
+        a str.
+    InvalidParameterError
+        An unknown strategy or direction, or an ``x0`` that is not finite.
     """
+    require_type("params", params, BodyParams)
+    require_type("strategy", strategy, str)
+    x0 = finite_float("x0", x0, "m")
     sign = direction_sign(direction)
     if strategy == "step":
         return step_critical_velocity(x0, sign, params)

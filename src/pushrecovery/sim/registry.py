@@ -11,7 +11,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 if TYPE_CHECKING:  # listing the models must not load numpy (pushrecovery --help)
     from pushrecovery.params import BodyParams
@@ -41,7 +41,17 @@ MUJOCO_MODELS = tuple(PLANTS["mujoco"])
 
 
 def available_models(backend: str) -> tuple[str, ...]:
-    """Return the model names of ``backend`` (``analytic`` or ``mujoco``)."""
+    """Return the model names of ``backend`` (``analytic`` or ``mujoco``).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``backend`` is not a str.
+    InvalidParameterError
+        If it names no backend.
+    """
+    if not isinstance(backend, str):  # checked here: _validate would load numpy (--help)
+        raise ParameterTypeError(f"backend must be a str, got {type(backend).__name__}")
     if backend not in PLANTS:
         raise InvalidParameterError(f"backend must be one of {list(PLANTS)}, got {backend!r}")
     return tuple(PLANTS[backend])

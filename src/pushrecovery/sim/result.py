@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from enum import StrEnum
 
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import finite_float
 from pushrecovery.surfaces.classify import Strategy
 
 __all__ = ["HIP_TORQUE_THRESHOLD", "Outcome", "SimulationResult", "is_falling"]
@@ -34,7 +36,24 @@ def is_falling(x: float, xdot: float, lower: float, upper: float) -> bool:
     m L² θ̈ = m g L sinθ − τ and τ ≤ τ(δ⁺) < m g L sinθ when L sinθ > δ⁺ and θ̇ ≥ 0. With the
     limits at δ± ± τmax/(m g) the same holds for every CMP the flywheel model can produce
     (docs/conventions.md). Mirror for the lower limit.
+
+    It runs at every control tick: four finite Python floats pass one test (their types and
+    the finiteness of their sum); anything else is checked and converted on the slow path.
+
+    Raises
+    ------
+    InvalidParameterError
+        If an argument is not a finite number.
     """
+    if not (
+        type(x) is float
+        and type(xdot) is float
+        and type(lower) is float
+        and type(upper) is float
+        and math.isfinite(x + xdot + lower + upper)
+    ):
+        x, xdot = finite_float("x", x, "m"), finite_float("xdot", xdot, "m/s")
+        lower, upper = finite_float("lower", lower, "m"), finite_float("upper", upper, "m")
     return (x > upper and xdot >= 0.0) or (x < lower and xdot <= 0.0)
 
 

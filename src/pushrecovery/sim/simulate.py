@@ -199,7 +199,16 @@ def simulate(
         states[k] = state
         if k != next_tick or outcome is not Outcome.UNDECIDED:
             continue  # the criteria are judged at the end of a control tick
-        if plant.falling(state):
+        try:
+            fell = plant.falling(state)
+        except InvalidParameterError:
+            if np.isfinite(state).all():
+                raise
+            # Not the user's input: the model's own numbers broke down (as MuJoCo's warnings).
+            raise SimulationDiverged(
+                f"the {plant.name} model's state is not finite at t = {k * h:g} s"
+            ) from None
+        if fell:
             outcome, decided = Outcome.FELL, k
             end = min(end, k + _steps_after(keep_running[1], h))
             continue

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import require_type
+from pushrecovery._validate import finite_float, require_type
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -84,7 +84,18 @@ def _setup(backend: str, strategy: str) -> tuple[str, str]:
 
 
 def available_strategies(backend: str) -> tuple[str, ...]:
-    """Return the strategies whose model exists on ``backend``."""
+    """Return the strategies whose model exists on ``backend``.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``backend`` is not a str.
+    InvalidParameterError
+        If it names no backend.
+    """
+    require_type("backend", backend, str)
+    if backend not in SETUPS:
+        raise InvalidParameterError(f"backend must be one of {sorted(SETUPS)}, got {backend!r}")
     return tuple(
         strategy
         for strategy, (model, _) in SETUPS[backend].items()
@@ -111,9 +122,34 @@ def corrected_critical_velocity(
     steps of h = ``timestep`` [s] (semi-implicit Euler adds half a step to the exact D/2). The
     capture point after the push is x0 + v cos²φ0 ((D + h)/2 + 1/ω); solving for the region's
     edge e: v = (e − x0) / (cos²φ0 (1/ω + (D + h)/2)), signed like the push.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``strategy`` is not a str or ``params`` not a
+        :class:`~pushrecovery.params.BodyParams`.
+    InvalidParameterError
+        A strategy other than ``ankle`` or ``hip``, ``direction`` other than ±1, |x0| >=
+        ``com_height`` (the CoM above the ankle's horizon, as
+        :func:`~pushrecovery.sim.backend.check_com_state`; cos²φ0 vanishes there), a negative
+        or non-finite ``cop_margin``, ``push_duration`` or ``timestep``, or a margin that
+        leaves no foot.
     """
+    require_type("strategy", strategy, str)
     if strategy not in ("ankle", "hip"):
         raise InvalidParameterError(f"strategy must be 'ankle' or 'hip', got {strategy!r}")
+    require_type("params", params, BodyParams)
+    x0 = finite_float("x0", x0, "m")
+    if abs(x0) >= params.com_height:
+        raise InvalidParameterError(
+            f"x0 must satisfy |x0| < com_height = {params.com_height:g} m, got x0={x0:g}"
+        )
+    direction = finite_float("direction", direction, allowed="+1 or -1")
+    if direction not in (1.0, -1.0):
+        raise InvalidParameterError(f"direction must be +1 or -1, got {direction!r}")
+    cop_margin = _non_negative("cop_margin", cop_margin, "m")
+    push_duration = _non_negative("push_duration", push_duration, "s")
+    timestep = _non_negative("timestep", timestep, "s")
     shortened = dataclasses.replace(
         params, heel=params.heel + cop_margin, toe=params.toe - cop_margin
     )
@@ -121,6 +157,13 @@ def corrected_critical_velocity(
     edge = region.upper if direction > 0.0 else region.lower
     tangential = 1.0 - (x0 / params.com_height) ** 2  # cos² φ0
     return (edge - x0) / (tangential * (1.0 / params.omega + 0.5 * (push_duration + timestep)))
+
+
+def _non_negative(name: str, value: float, unit: str) -> float:
+    number = finite_float(name, value, unit, allowed=">= 0")
+    if number < 0.0:
+        raise InvalidParameterError(f"{name} must be >= 0 [{unit}], got {number:g}")
+    return number
 
 
 def mujoco_corrected_prediction(

@@ -12,18 +12,19 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import bounded_float, finite_float, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
+    _decompose,
+    _minkowski_sum,
     _stacked_shapes,
     _sum_loop,
-    decompose,
-    minkowski_sum,
 )
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_region import ORIGIN, step_terms
+from pushrecovery.surfaces.capture_region import MAX_CAPTURE_POINT, ORIGIN, step_terms
 from pushrecovery.surfaces.n_step import (
     StepOption,
     _check_touchdowns,
@@ -109,12 +110,32 @@ def capture_plan(
     centre is returned, with ``margin`` < 0. Touchdowns every ``min_step_time`` from
     ``first_touchdown`` (default: min_step_time). ``margin``, when known, skips computing the
     signed distance of ξ0 to C_N (the recursion knows it is inside).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params``, ``option`` or ``hip`` has the wrong type.
+    InvalidParameterError
+        A ξ0 that is not a finite (x, y) within ±``MAX_CAPTURE_POINT`` of the stance ankle
+        (:mod:`~pushrecovery.surfaces.capture_region`), ``steps`` not a whole number in
+        [1, 50], ``first_touchdown`` outside [0, 5] s, or a non-finite ``margin``.
     """
+    require_type("params", params, BodyParams)
+    require_type("option", option, StepOption)
+    xi = finite_vector("xi", xi, 2, unit="m")
+    if float(np.max(np.abs(xi - option.ankle))) > MAX_CAPTURE_POINT:
+        raise InvalidParameterError(
+            f"xi must lie within ±{MAX_CAPTURE_POINT:g} m of the stance ankle, got "
+            f"{xi.tolist()} (ankle {np.asarray(option.ankle).tolist()})"
+        )
     if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= 50:
         raise InvalidParameterError(f"steps must be a whole number in [1, 50], got {steps!r}")
     first = params.min_step_time if first_touchdown is None else first_touchdown
-    if not 0.0 <= first <= 5.0:  # NaN fails too
-        raise InvalidParameterError(f"first_touchdown must be in [0, 5] s, got {first!r}")
+    first = bounded_float("first_touchdown", first, 0.0, 5.0, "s")
+    require_type("hip", hip, (bool, np.bool_))
+    hip = bool(hip)
+    if margin is not None:
+        margin = finite_float("margin", margin, "m")
     times = tuple(first + params.min_step_time * k for k in range(steps))
     _check_touchdowns(params, times)
     from pushrecovery.ground._kernels import decompose_loop, foothold_kernel, loop_signed_distance
@@ -263,8 +284,8 @@ def _decomposed(
 ) -> CapturePlan:
     """Return the plan of (S1)'s decomposition (every term equally deep), for ξ0 outside C_N."""
     terms, offset, sides = _sum_terms(params, option, times, hip)
-    total = minkowski_sum(terms, offset)
-    points, _ = decompose(xi, terms, offset, total)
+    total = _minkowski_sum(terms, offset)
+    points, _ = _decompose(xi, terms, offset, total)
     reach = np.cumsum(np.array(points[2 + steps :]), axis=0) + option.ankle
     feet = np.array(points[2 : 2 + steps]) + reach
     cops = np.vstack([points[1], feet])

@@ -26,18 +26,18 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, require_type
+from pushrecovery._validate import bounded_float, finite_float, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
     _clip_halfplanes,
+    _minkowski_sum,
     _stacked_shapes,
     clip,
-    minkowski_sum,
 )
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
-from pushrecovery.params import BodyParams
+from pushrecovery.params import MAX_STEP_TIME, MAX_STEPS, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.n_step import (
     StepOption,
     hip_box,
@@ -54,6 +54,12 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
+
+#: Largest |x|, |y| [m] and |ẋ|, |ẏ| [m/s] of the states :func:`capture_region` takes, and so
+#: the largest |ξ| component (ω >= :data:`~pushrecovery.params.OMEGA_MIN`) [m].
+MAX_POSITION = 1e3
+MAX_SPEED = 1e2
+MAX_CAPTURE_POINT = MAX_POSITION + MAX_SPEED / OMEGA_MIN
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -148,6 +154,8 @@ def capture_region(
         raise InvalidParameterError(f"steps must be a whole number in [1, 50], got {steps!r}")
     if timing not in ("exact", "after"):
         raise InvalidParameterError(f"timing must be 'exact' or 'after', got {timing!r}")
+    require_type("hip", hip, (bool, np.bool_))
+    hip = bool(hip)
     xi = _capture_point(x, y, xdot, ydot, params)
     if swing is None and support.stance is Stance.DOUBLE:
         centre = support.ankle
@@ -159,8 +167,8 @@ def capture_region(
     if timing == "exact":  # the compiled pipeline: a balance loop asks at every tick
         polygon, foothold = _foothold_and_centre(xi, params, option, t, steps, hip)
         return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
-    polygon = foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
-    foothold = None if polygon is None else chebyshev_centre(polygon)
+    polygon = _foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
+    foothold = None if polygon is None else _chebyshev_centre(polygon)
     return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
 
 
@@ -267,8 +275,8 @@ def _foothold_and_centre(
         terms.window_offsets,
     )
     if not ok:  # pragma: no cover - the compiled simplex found no start: the numpy path
-        region = foothold_region(xi, params, option, t, steps, hip=hip)
-        return region, None if region is None else chebyshev_centre(region)
+        region = _foothold_region(xi, params, option, t, steps, hip=hip)
+        return region, None if region is None else _chebyshev_centre(region)
     if len(vertices) < 3:
         return None, None
     region = ConvexPolygon._from_ccw(vertices + ankle) if polygon else None
@@ -287,15 +295,50 @@ def foothold_region(
 ) -> ConvexPolygon | None:
     """(S3) for the capture point ξ0: first footholds of ``option``'s landing foot [m].
 
-    The checked-arguments core of :func:`capture_region`; ``touchdown`` t [s] after now, then
+    The core of :func:`capture_region`, given the capture point ξ0 [m] and the step option
+    (:func:`~pushrecovery.surfaces.n_step.step_options`); ``touchdown`` t [s] after now, then
     ``steps`` − 1 steps every Δt_s. None when no foothold within reach captures.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params``, ``option`` or ``hip`` has the wrong type.
+    InvalidParameterError
+        A ξ0 that is not a finite (x, y) within ±:data:`MAX_CAPTURE_POINT` (the capture
+        points of the states :func:`capture_region` takes), ``touchdown`` outside [0, 5] s,
+        ``steps`` not a whole number in [1, 50], or an unknown ``timing``.
     """
+    xi = finite_vector("xi", xi, 2, MAX_CAPTURE_POINT, "m")
+    require_type("params", params, BodyParams)
+    require_type("option", option, StepOption)
+    touchdown = bounded_float("touchdown", touchdown, 0.0, MAX_STEP_TIME, "s")
+    if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= MAX_STEPS:
+        raise InvalidParameterError(
+            f"steps must be a whole number in [1, {MAX_STEPS}], got {steps!r}"
+        )
+    if timing not in ("exact", "after"):
+        raise InvalidParameterError(f"timing must be 'exact' or 'after', got {timing!r}")
+    require_type("hip", hip, (bool, np.bool_))
+    return _foothold_region(xi, params, option, touchdown, steps, timing=timing, hip=bool(hip))
+
+
+def _foothold_region(
+    xi: FloatArray,
+    params: BodyParams,
+    option: StepOption,
+    touchdown: float,
+    steps: int,
+    *,
+    timing: Literal["exact", "after"] = "exact",
+    hip: bool = True,
+) -> ConvexPolygon | None:
+    """:func:`foothold_region` of checked arguments."""
     landing = landing_viable(params, option.swing, option.yaw, steps - 1)
     box = hip_box(params, option.yaw) if hip else None
     boxes: list[tuple[float, Shape]] = [] if box is None else [(1.0, box)]
     window = _window(params, option.swing, option.yaw, *(float(v) for v in option.ankle))
     scale = math.exp(params.omega * touchdown)
-    at = minkowski_sum(
+    at = _minkowski_sum(
         [(-scale * w, b) for w, b in boxes] + [(1.0 - scale, option.stance), (-1.0, landing)],
         scale * xi,
     )
@@ -319,9 +362,8 @@ def _capture_point(x: float, y: float, xdot: float, ydot: float, params: BodyPar
             ("x", "y", "xdot", "ydot"), (x, y, xdot, ydot), ("m", "m", "m/s", "m/s"), strict=True
         )
     ]
-    for name, value, bound in zip(
-        ("x", "y", "xdot", "ydot"), values, (1e3, 1e3, 1e2, 1e2), strict=True
-    ):
+    bounds = (MAX_POSITION, MAX_POSITION, MAX_SPEED, MAX_SPEED)
+    for name, value, bound in zip(("x", "y", "xdot", "ydot"), values, bounds, strict=True):
         if abs(value) > bound:
             raise InvalidParameterError(f"{name} must be in [-{bound:g}, {bound:g}], got {value:g}")
     return np.array([values[0] + values[2] / params.omega, values[1] + values[3] / params.omega])
@@ -335,7 +377,7 @@ def _after(
     window: ConvexPolygon,
 ) -> ConvexPolygon | None:
     """(Q_{T0} ⊕ cone(A)) ∩ window, A = ξ0 ⊕ (−H) ⊕ (−S) (module docstring)."""
-    growth = minkowski_sum([(-w, b) for w, b in boxes] + [(-1.0, stance)], xi)
+    growth = _minkowski_sum([(-w, b) for w, b in boxes] + [(-1.0, stance)], xi)
     if float(growth.signed_distance(0.0, 0.0)) > 0.0:
         return window  # already captured without a step: any later foothold
     # The cone's edges: the extreme directions of A's vertices seen from the origin.
@@ -362,7 +404,18 @@ def chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
     (``ground._kernels.chebyshev_centre``; scipy's HiGHS if it fails). When the largest disc
     can slide (two parallel edges hold it) the centres form a segment and its midpoint is
     returned: unique, and mirrored with the polygon.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``polygon`` is not a :class:`~pushrecovery.ground.polygon.ConvexPolygon`.
     """
+    require_type("polygon", polygon, ConvexPolygon)
+    return _chebyshev_centre(polygon)
+
+
+def _chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
+    """:func:`chebyshev_centre` of a polygon."""
     from pushrecovery.ground._kernels import chebyshev_centre as solve
 
     normals, offsets = polygon.normals, polygon.offsets

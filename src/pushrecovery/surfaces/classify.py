@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery._validate import finite_float
+from pushrecovery._validate import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
@@ -49,7 +49,17 @@ _REGIONS: dict[str, Callable[[BodyParams], CaptureInterval]] = {
 
 
 def strategy_region(strategy: str, params: BodyParams) -> CaptureInterval:
-    """Capture-point interval of a balancing strategy (``ankle`` or ``hip``) [m]."""
+    """Capture-point interval of a balancing strategy (``ankle`` or ``hip``) [m].
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``strategy`` is not a str or ``params`` not a
+        :class:`~pushrecovery.params.BodyParams`.
+    InvalidParameterError
+        If ``strategy`` names no balancing strategy.
+    """
+    require_type("strategy", strategy, str)
     try:
         return _REGIONS[strategy](params)
     except KeyError:

@@ -25,12 +25,19 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import require_type
+from pushrecovery._validate import bounded_float, require_type
 from pushrecovery.models.flywheel import max_spin_up_time
-from pushrecovery.params import BodyParams
+from pushrecovery.params import LIMITS, OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.cop import CaptureInterval, capture_margin
 
 __all__ = ["cmp_margin", "cmp_offset", "cmp_offset_roll", "cmp_region", "flywheel_offset"]
+
+
+#: m g over the bodies :data:`~pushrecovery.params.LIMITS` admits [N].
+_WEIGHT_RANGE = (
+    LIMITS["mass"][0] * LIMITS["gravity"][0],
+    LIMITS["mass"][1] * LIMITS["gravity"][1],
+)
 
 
 def flywheel_offset(
@@ -41,7 +48,27 @@ def flywheel_offset(
     a (1 − e^{−ω T_max})², a = τmax / (m g), T_max = sqrt(I θmax / τmax) (Eq. 12): corrected
     Eq. (15) for an axis with torque limit τmax [N m], inertia I [kg m²] and joint limit θmax
     [rad], for a body of weight m g [N] and ω = sqrt(g/L) [1/s]. Zero when τmax = 0.
+
+    Raises
+    ------
+    InvalidParameterError
+        If an argument is outside the range of the bodies
+        :data:`~pushrecovery.params.LIMITS` admits: τmax in [0, 1e5] N m, I in [1e-6, 1e4]
+        kg m², θmax in [1e-3, π] rad, m g in [1e-3, 1e6] N (mass times gravity) and ω in
+        [0.1, 100] 1/s.
     """
+    torque_max = bounded_float("torque_max", torque_max, *LIMITS["torque_max"])
+    inertia = bounded_float("inertia", inertia, *LIMITS["flywheel_inertia"])
+    angle_max = bounded_float("angle_max", angle_max, *LIMITS["flywheel_angle_max"])
+    weight = bounded_float("weight", weight, *_WEIGHT_RANGE, "N")
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
+    return _flywheel_offset(torque_max, inertia, angle_max, weight, omega)
+
+
+def _flywheel_offset(
+    torque_max: float, inertia: float, angle_max: float, weight: float, omega: float
+) -> float:
+    """:func:`flywheel_offset` of a checked body's values (a planar controller's tick)."""
     if torque_max == 0.0:
         return 0.0
     spin_up = math.sqrt(inertia * angle_max / torque_max)
@@ -64,7 +91,7 @@ def cmp_offset(params: BodyParams) -> float:
 def cmp_offset_roll(params: BodyParams) -> float:
     """:func:`cmp_offset` for the roll axis (the CMP moved sideways, y) [m]."""
     require_type("params", params, BodyParams)
-    return flywheel_offset(
+    return _flywheel_offset(
         params.torque_max_roll,
         params.flywheel_inertia_roll,
         params.flywheel_angle_max_roll,

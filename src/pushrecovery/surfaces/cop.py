@@ -165,9 +165,12 @@ def capture_margin(
 
     Raises
     ------
+    ParameterTypeError
+        If ``region`` is not a :class:`CaptureInterval`.
     InvalidParameterError
         If a state is NaN or infinite, or ``omega`` is not a finite number > 0.
     """
+    require_type("region", region, CaptureInterval)
     x = float_array("x", x)
     xdot = float_array("xdot", xdot)
     inv_omega = 1.0 / positive_float("omega", omega, "1/s")

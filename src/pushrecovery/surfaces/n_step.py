@@ -39,17 +39,30 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, require_type
+from pushrecovery._validate import (
+    bounded_float,
+    finite_float,
+    float_array,
+    require_type,
+    whole_number,
+)
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
     _clip_halfplanes,
-    minkowski_sum,
+    _minkowski_sum,
     regular_polygon,
 )
 from pushrecovery.ground.polygon import ConvexPolygon, following
 from pushrecovery.ground.support import Stance, Support, foot_shape
-from pushrecovery.params import BodyParams, default_max_steps
+from pushrecovery.params import (
+    LIMITS,
+    MAX_STEP_TIME,
+    OMEGA_MAX,
+    OMEGA_MIN,
+    BodyParams,
+    default_max_steps,
+)
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 
 __all__ = [
@@ -86,7 +99,61 @@ def capturability_distance(
     [m] along that direction, touchdowns every ``step_time`` Δt_s [s] from Δt_s on and a hip
     offset ``hip`` [m]: d_N = hip + r + l β (1 − β^N)/(1 − β), β = e^{−ωΔt_s} (Koolen et al.
     2012, with the hip added); ``steps`` may be ``math.inf``. Δt_s = 0 gives hip + r + N l.
+
+    Parameters
+    ----------
+    steps : int or math.inf
+        N, a whole number in [0, 2^53] (those a float holds exactly), or ``math.inf`` (the
+        limit, which needs Δt_s > 0).
+    omega : float
+        sqrt(g/L) [1/s], in [0.1, 100] (:data:`~pushrecovery.params.OMEGA_MIN`,
+        :data:`~pushrecovery.params.OMEGA_MAX`).
+    step_time : float
+        Δt_s [s], in [0, 5] (``min_step_time``'s range).
+    reach : float
+        l [m], in [0, 20] (``max_step_length`` < 2 ``leg_length`` <= 20 m).
+    foot_radius, hip : float
+        r and the hip offset [m], finite, >= 0.
+
+    Raises
+    ------
+    InvalidParameterError
+        If an argument is outside its range, or ``steps`` is ``math.inf`` with Δt_s = 0 (an
+        unbounded distance).
     """
+    if isinstance(steps, float) and steps == math.inf:
+        count: float = math.inf
+    else:
+        count = whole_number("steps", steps, 0, 2**53)
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
+    step_time = bounded_float("step_time", step_time, 0.0, MAX_STEP_TIME, "s")
+    reach = bounded_float("reach", reach, 0.0, 2.0 * LIMITS["leg_length"][1], "m")
+    foot_radius = _non_negative("foot_radius", foot_radius)
+    hip = _non_negative("hip", hip)
+    if count == math.inf and step_time == 0.0:
+        raise InvalidParameterError(
+            "steps=inf needs step_time > 0 s: infinitely many instantaneous steps reach "
+            "infinitely far"
+        )
+    return _capturability_distance(count, omega, step_time, reach, foot_radius, hip)
+
+
+def _non_negative(name: str, value: float) -> float:
+    number = finite_float(name, value, "m", allowed=">= 0")
+    if number < 0.0:
+        raise InvalidParameterError(f"{name} must be >= 0 m, got {number:g}")
+    return number
+
+
+def _capturability_distance(
+    steps: float,
+    omega: float,
+    step_time: float,
+    reach: float,
+    foot_radius: float = 0.0,
+    hip: float = 0.0,
+) -> float:
+    """:func:`capturability_distance` of checked arguments (the library's own loops)."""
     beta = math.exp(-omega * step_time)
     if steps == 0:
         return hip + foot_radius
@@ -259,10 +326,27 @@ def viable_region(
         t_1 < ... < t_N [s] from now, at least ``min_step_time`` apart; () gives S ⊕ H.
     hip : bool
         Include the upper body's box H.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params``, ``option`` or ``hip`` has the wrong type.
+    InvalidParameterError
+        Touchdown times that are not a one-dimensional sequence of finite numbers at least
+        ``min_step_time`` apart (the first >= 0).
     """
+    require_type("params", params, BodyParams)
+    require_type("option", option, StepOption)
+    require_type("hip", hip, (bool, np.bool_))
+    times = float_array("touchdowns", touchdowns)
+    if times.ndim != 1:
+        raise InvalidParameterError(
+            f"touchdowns must be a sequence of times (shape (N,)) [s], got shape {times.shape}"
+        )
+    touchdowns = tuple(float(t) for t in times)
     _check_touchdowns(params, touchdowns)
-    terms, offset, _ = _sum_terms(params, option, tuple(touchdowns), hip)
-    return minkowski_sum(terms, offset)
+    terms, offset, _ = _sum_terms(params, option, touchdowns, bool(hip))
+    return _minkowski_sum(terms, offset)
 
 
 def _ray_distances(

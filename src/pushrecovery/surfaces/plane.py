@@ -38,11 +38,19 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, finite_float, float_array, require_type
+from pushrecovery._validate import (
+    bounded_float,
+    finite_array,
+    finite_float,
+    finite_vector,
+    float_array,
+    require_type,
+)
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.models._step_scalar import step_line
-from pushrecovery.params import BodyParams
+from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import _fusable, capture_point
 from pushrecovery.surfaces.step import StepDecision, plan_step, step_feasible
@@ -150,14 +158,24 @@ def capture_margin_xy(
 
     Raises
     ------
+    ParameterTypeError
+        If ``polygon`` is not a :class:`~pushrecovery.ground.polygon.ConvexPolygon`.
     InvalidParameterError
-        If a state is NaN or infinite.
+        If a state is NaN or infinite, shapes do not broadcast, or ``omega`` is outside
+        [0.1, 100] 1/s (:data:`~pushrecovery.params.OMEGA_MIN`,
+        :data:`~pushrecovery.params.OMEGA_MAX`).
     """
+    require_type("polygon", polygon, ConvexPolygon)
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     arrays = [
         float_array(name, value)
         for name, value in (("x", x), ("y", y), ("xdot", xdot), ("ydot", ydot))
     ]
-    shape = np.broadcast_shapes(*(a.shape for a in arrays))
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in arrays))
+    except ValueError:
+        shapes = ", ".join(str(a.shape) for a in arrays)
+        raise InvalidParameterError(f"x, y, xdot and ydot must broadcast, got {shapes}") from None
     if (
         all(a.shape == shape for a in arrays)
         and _fusable(arrays[0], arrays[2], out)
@@ -223,9 +241,20 @@ def direction_thresholds(
     A push of speed v along heading ψ puts ξ at origin + (v/ω)(cos ψ, sin ψ): the critical
     speed is ω times the distance from the origin to the region's boundary along ψ [m/s]
     (unsigned; :data:`DIRECTIONS` names the headings).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``polygon`` is not a :class:`~pushrecovery.ground.polygon.ConvexPolygon`.
+    InvalidParameterError
+        If ``origin`` is not a finite (x, y) strictly inside the polygon, or ``omega`` is
+        outside [0.1, 100] 1/s.
     """
+    require_type("polygon", polygon, ConvexPolygon)
+    start = finite_vector("origin", origin, 2, unit="m")
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     return {
-        name: omega * polygon.ray_distance(origin[0], origin[1], heading)
+        name: omega * polygon.ray_distance(float(start[0]), float(start[1]), heading)
         for name, heading in DIRECTIONS.items()
     }
 
@@ -341,7 +370,19 @@ def step_threshold_xy(
     :func:`plan_step_xy` (monotone in the push along a fixed line, as on the sagittal line),
     tested without solving for the step angle (:func:`~pushrecovery.surfaces.step.step_feasible`).
     Along ±x on yaw-0 feet it is :func:`~pushrecovery.surfaces.step.step_thresholds`.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` or ``support`` has the wrong type.
+    InvalidParameterError
+        If ``heading`` is not finite or ``tolerance`` is outside [1e-12, 0.1] m/s (a
+        bisection of speeds up to sqrt(g L) <= 31.6 m/s ends at float resolution below).
     """
+    require_type("params", params, BodyParams)
+    require_type("support", support, Support)
+    heading = finite_float("heading", heading, "rad")
+    tolerance = bounded_float("tolerance", tolerance, 1e-12, 0.1, "m/s")
     ux, uy = math.cos(heading), math.sin(heading)
     frame = StepFrame.of(support)
     inv = 1.0 / params.omega

@@ -31,8 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import finite_float, finite_vector, require_type
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
+from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
 from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.n_step import landing_viable
 
@@ -106,10 +108,22 @@ def plan_impacts(
     -------
     list of TouchdownImpact
         One per touchdown. The LIPM state is carried on without the impact.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``plan`` or ``params`` has the wrong type.
+    InvalidParameterError
+        A position or velocity that is not a finite (x, y) within the state ranges of
+        :func:`~pushrecovery.surfaces.capture_region.capture_region` (±1000 m, ±100 m/s), or
+        a non-finite ``yaw``.
     """
+    require_type("plan", plan, CapturePlan)
+    r = finite_vector("position", position, 2, MAX_POSITION, "m")
+    v = finite_vector("velocity", velocity, 2, MAX_SPEED, "m/s")
+    require_type("params", params, BodyParams)
+    yaw = finite_float("yaw", yaw, "rad")
     omega, height = params.omega, params.com_height
-    r = np.array(position, dtype=np.float64)
-    v = np.array(velocity, dtype=np.float64)
     ankle = np.array(plan.ankle, dtype=np.float64)
     start = 0.0
     found = []

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import require_type
+from pushrecovery._validate import finite_array, require_type
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
@@ -37,7 +38,7 @@ from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.cop import CaptureInterval
 from pushrecovery.surfaces.n_step import (
     StepOption,
-    capturability_distance,
+    _capturability_distance,
     step_options,
     viable_region,
 )
@@ -63,7 +64,7 @@ def _line_step_bounds(
 ) -> tuple[FloatArray, FloatArray]:
     """C_N on a line (module docstring) for supports [lower, upper] and stance ankles [m]."""
     beta = math.exp(-params.omega * params.min_step_time)
-    grow = capturability_distance(
+    grow = _capturability_distance(
         steps,
         params.omega,
         params.min_step_time,
@@ -113,10 +114,48 @@ def line_steps(
     The range of first steps is (S3) on the line: q_1 − q_0 in T ξ − T[−a, a] − (T − 1)[s⁻, s⁺]
     − V_{N−1} − q_0, V_{N−1} = [δ⁻ − l s_{N−1}, δ⁺ + l s_{N−1}], T = e^{ωΔt_s}, within ±l; the
     recommended first step is its middle (the most robust, as :func:`_sagittal_plan`).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` is not a :class:`~pushrecovery.params.BodyParams`.
+    InvalidParameterError
+        Values that are not finite, shapes that do not broadcast, or positions so large that
+        the intervals or the first steps overflow.
     """
-    capture, lower, upper, ankle = np.broadcast_arrays(
-        *(np.asarray(a, dtype=np.float64) for a in (capture, lower, upper, ankle))
-    )
+    require_type("params", params, BodyParams)
+    given = {"capture": capture, "lower": lower, "upper": upper, "ankle": ankle}
+    arrays = [finite_array(name, value) for name, value in given.items()]
+    try:
+        capture, lower, upper, ankle = np.broadcast_arrays(*arrays)
+    except ValueError:
+        shapes = ", ".join(str(a.shape) for a in arrays)
+        raise InvalidParameterError(
+            f"capture, lower, upper and ankle must broadcast, got shapes {shapes}"
+        ) from None
+    with np.errstate(over="ignore", invalid="ignore"):  # reported below, as one error
+        found = _line_steps(capture, lower, upper, ankle, params)
+    stepping = found.steps > 0
+    if not (
+        np.isfinite(found.margin).all()
+        and np.isfinite(found.step_length[stepping]).all()
+        and np.isfinite(found.shortest[stepping]).all()
+        and np.isfinite(found.longest[stepping]).all()
+    ):
+        raise InvalidParameterError(
+            "positions are too large: the step intervals on the line overflow"
+        )
+    return found
+
+
+def _line_steps(
+    capture: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    ankle: FloatArray,
+    params: BodyParams,
+) -> LineSteps:
+    """:func:`line_steps` of checked, broadcast arrays."""
     steps = np.zeros(capture.shape, dtype=np.int64)
     for n in range(params.max_steps, 0, -1):
         low, high = _line_step_bounds(lower, upper, ankle, params, n)
@@ -130,7 +169,7 @@ def line_steps(
     scale = math.exp(params.omega * params.min_step_time)
     for n in np.unique(steps[steps > 0]):
         rows = steps == n
-        more = capturability_distance(int(n) - 1, params.omega, params.min_step_time, reach, 0.0)
+        more = _capturability_distance(int(n) - 1, params.omega, params.min_step_time, reach, 0.0)
         xi = capture[rows]
         first = scale * xi - scale * hip - (scale - 1.0) * upper[rows] - params.toe - more
         last = scale * xi + scale * hip - (scale - 1.0) * lower[rows] - params.heel + more
@@ -168,7 +207,9 @@ def _sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
     footholds, cops = np.zeros((steps, 2)), np.zeros((steps + 1, 2))
     ankle, capture, hip, share_hip = 0.0, xi, cmp_offset(params), 0.0
     for k in range(steps):
-        more = capturability_distance(steps - 1 - k, params.omega, params.min_step_time, reach, 0.0)
+        more = _capturability_distance(
+            steps - 1 - k, params.omega, params.min_step_time, reach, 0.0
+        )
         low = scale * capture - scale * hip - (scale - 1.0) * (ankle + params.toe)
         low -= params.toe + more
         high = scale * capture + scale * hip - (scale - 1.0) * (ankle + params.heel)

@@ -19,6 +19,7 @@ from pushrecovery.analysis.readers.common import (
     FOOT_MARKERS,
     STANDING_PERCENTILE,
     FloatArray,
+    _path,
     body_rotation,
 )
 
@@ -54,10 +55,17 @@ def read_c3d_recording(
     -------
     Recording
         At the marker rate when the CoM comes from markers, else at the force-plate rate.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``path`` is not a str or path, or ``ap_axis`` not a str.
+    InputFileError
+        A missing or malformed file, or markers it does not have.
     """
     from pushrecovery.analysis.c3d import read_c3d
 
-    path = Path(path)
+    path = _path(path)
     body_rotation(ap_axis)  # a bad axis name fails before the file is read
     content = read_c3d(path, threshold=LOADED)
     rotation = body_rotation(ap_axis, content.up)

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import require_type
 from pushrecovery.analysis.recording import Recording
 from pushrecovery.errors import InputFileError, InvalidParameterError
 
@@ -58,12 +60,19 @@ COM_MARKER = "CentreOfMass"
 
 
 def _unit_scale(units: str) -> float:
+    require_type("units", units, str)
     try:
         return LENGTH_UNITS[units]
     except KeyError:
         raise InvalidParameterError(
             f"units must be one of {', '.join(LENGTH_UNITS)}, got {units!r}"
         ) from None
+
+
+def _path(path: object) -> Path:
+    """Return ``path`` as a Path, or raise :class:`ParameterTypeError` unless str or PathLike."""
+    require_type("path", path, (str, os.PathLike))
+    return Path(path)  # type: ignore[arg-type]
 
 
 def _check_file(path: Path) -> None:
@@ -148,7 +157,15 @@ def body_rotation(ap_axis: str, up: FloatArray | None = None) -> FloatArray:
         Lab axis pointing forward: ``x``, ``-x``, ``y``, ``-y``, ``z`` or ``-z``.
     up : ndarray, optional
         The lab's up axis (unit, along a lab axis); default +z.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``ap_axis`` is not a str.
+    InvalidParameterError
+        If ``ap_axis`` is not one of the names, or not horizontal.
     """
+    require_type("ap_axis", ap_axis, str)
     if ap_axis not in AP_AXES:
         raise InvalidParameterError(f"ap_axis must be one of {', '.join(AP_AXES)}, got {ap_axis!r}")
     vertical = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, dtype=np.float64)

@@ -19,6 +19,7 @@ from pushrecovery.analysis.readers.common import (
     _check_file,
     _check_plausible,
     _check_time,
+    _path,
     _unit_scale,
 )
 
@@ -65,8 +66,15 @@ def read_recording(path: str | Path, **options: object) -> Recording:
     """Read a CSV or C3D trial, chosen by the file's extension (``.csv``, ``.c3d``).
 
     Options are passed to :func:`read_csv_recording` or :func:`read_c3d_recording`.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``path`` is not a str or path.
+    InputFileError
+        Missing or empty file, an unknown extension, or what the reader raises.
     """
-    path = Path(path)
+    path = _path(path)
     _check_file(path)
     suffix = path.suffix.lower()
     if suffix == ".csv":
@@ -93,11 +101,13 @@ def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
 
     Raises
     ------
+    ParameterTypeError
+        If ``path`` is not a str or path.
     InputFileError
         Missing, empty or malformed file, missing or non-numeric columns, a time column that
         is not increasing at a constant rate, or values implausible in the given units.
     """
-    path = Path(path)
+    path = _path(path)
     scale = _unit_scale(units)
     table = _read_table(path)
     data = {name: table[name] * (scale if name in _LENGTHS else 1.0) for name in table}
