@@ -116,27 +116,34 @@ def test_run_campaign_records_the_new_column(tmp_path: Any) -> None:
     assert result.table.column("error").null_count == result.table.num_rows
 
 
-def test_a_ctrl_c_while_workers_start_is_deferred_not_lost() -> None:
-    # The pool starts its workers inside this window; a Ctrl-C then used to be ignored, and
-    # the campaign ran to its end. Now this process gets it when the window closes.
-    # In a process of its own: the window works in the main thread, where pytest-xdist's
-    # workers do not run the tests.
+def test_workers_start_ignoring_ctrl_c_and_the_campaign_does_not(tmp_path: Any) -> None:
+    # A Ctrl-C while a pool started used to be ignored by the campaign itself (it ran to its
+    # end). Now the workers inherit an ignored SIGINT from the fork server and this process
+    # keeps its handler. In a process of its own: a fresh fork server, in the main thread.
     import subprocess
     import sys
 
     script = """
-import os, signal
-from pushrecovery.campaign.isolation import interrupts_deferred
-reached_end = False
-try:
-    with interrupts_deferred():
-        os.kill(os.getpid(), signal.SIGINT)
-        reached_end = True  # nothing was raised inside the window
-except KeyboardInterrupt:
-    print("interrupted after the window" if reached_end else "interrupted inside")
+import multiprocessing, signal
+from pushrecovery.campaign.isolation import quiet_worker_start
+
+def probe(queue):
+    queue.put(signal.getsignal(signal.SIGINT) is signal.SIG_IGN)
+
+if __name__ == "__main__":
+    context = multiprocessing.get_context("forkserver")
+    queue = context.Queue()
+    with quiet_worker_start():
+        here = signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        worker = context.Process(target=probe, args=(queue,))  # no initializer
+        worker.start()
+    print(here, queue.get(timeout=30))
+    worker.join()
 """
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
-    assert done.stdout.strip() == "interrupted after the window", done.stderr
+    path = tmp_path / "probe.py"  # a file: the workers import the probe from it
+    path.write_text(script)
+    done = subprocess.run([sys.executable, str(path)], capture_output=True, text=True)
+    assert done.stdout.split() == ["True", "True"], done.stderr
 
 
 def test_a_push_that_hangs_is_one_error_row() -> None:

@@ -445,3 +445,19 @@ def test_bad_plan_and_region_arguments_are_refused(call, match):
     option = step_options(params, Support.from_params(params, "left"))[0]
     with pytest.raises(InvalidParameterError, match=match):
         call(params, option)
+
+
+def test_line_steps_all_levels_at_once_equal_level_by_level(monkeypatch):
+    # Small inputs test every N at once; large ones loop over N: the same numbers.
+    from pushrecovery.surfaces import step_regions
+
+    P = load_params()
+    rng = np.random.default_rng(11)
+    capture = rng.normal(0.0, 1.5, 3000)
+    ankle = rng.normal(0.0, 0.05, 3000)
+    at_once = step_regions.line_steps(capture, P.heel, P.toe, ankle, P)
+    monkeypatch.setattr(step_regions, "_LEVELS_AT_ONCE", 0)
+    one_by_one = step_regions.line_steps(capture, P.heel, P.toe, ankle, P)
+    for name in ("steps", "margin", "step_length", "shortest", "longest"):
+        np.testing.assert_array_equal(getattr(at_once, name), getattr(one_by_one, name))
+    assert set(np.unique(at_once.steps)) >= {0, 1, 2, 3}

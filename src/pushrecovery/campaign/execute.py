@@ -32,9 +32,9 @@ from pushrecovery.campaign.isolation import (
     BatchRunner,
     PushRunner,
     batch_deadline,
-    interrupts_deferred,
     new_pool,
     quarantine,
+    quiet_worker_start,
 )
 from pushrecovery.campaign.pushes import COLUMNS, error_row, run_batch, run_push
 from pushrecovery.campaign.spec import CampaignSpec
@@ -176,9 +176,9 @@ def _processes(
     pool = new_pool(workers)
     failed: list[int] = []
     try:
-        # Ctrl-C reaches the whole process group: the workers ignore it (started while this
-        # process blocks it, which they inherit), the parent stops them and says so once.
-        with interrupts_deferred():
+        # Ctrl-C reaches the whole process group: the workers ignore it (inherited from the
+        # fork server), the parent stops them and says so once.
+        with quiet_worker_start():
             pending: dict[Future[tuple[int, list[dict]]], int] = {
                 pool.submit(run_batch, spec, batch): batch for batch in batches
             }

@@ -24,7 +24,7 @@ from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.pushes import error_row, run_batch, run_push
 from pushrecovery.campaign.spec import CampaignSpec
 
-__all__ = ["batch_deadline", "interrupts_deferred", "new_pool", "quarantine"]
+__all__ = ["batch_deadline", "new_pool", "quarantine", "quiet_worker_start"]
 
 BatchRunner = Callable[[CampaignSpec, int], tuple[int, list[dict[str, Any]]]]
 PushRunner = Callable[..., dict[str, Any]]
@@ -35,37 +35,51 @@ def _ignore_interrupts() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-@contextlib.contextmanager
-def interrupts_deferred() -> Iterator[None]:
-    """Hold SIGINT back while worker processes start; main thread only.
+_FORK_SERVER = {"started": False}
 
-    The processes started meanwhile inherit the main thread's blocked signal (a Ctrl-C to the
-    process group never reaches them before their initializer ignores it). This process gets a
-    Ctrl-C that came meanwhile once the window closes: it is deferred, not lost (ignoring it
-    instead lost a Ctrl-C pressed while the pool started). A signal the OS hands to another
-    thread (numpy's BLAS threads do not block it) runs a handler that only notes it. Where the
-    OS has no signal masks, SIGINT is ignored meanwhile.
+
+def _start_fork_server() -> None:
+    """Start this process's fork server with SIGINT ignored (once; main thread).
+
+    Every worker is forked from it and inherits the ignored SIGINT, so a Ctrl-C to the process
+    group never reaches a worker before its initializer, and the parent never ignores one.
     """
-    if threading.current_thread() is not threading.main_thread():
-        yield
+    from multiprocessing import forkserver
+
+    if _FORK_SERVER["started"]:
         return
-    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - not POSIX
-        ignored = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
         try:
-            yield
+            forkserver.ensure_running()
         finally:
-            signal.signal(signal.SIGINT, ignored)
-        return
-    noted: list[int] = []
-    handler = signal.signal(signal.SIGINT, lambda number, frame: noted.append(number))
-    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
+            signal.signal(signal.SIGINT, previous)
+    else:  # pragma: no cover - a library caller's thread: the workers' initializer only
+        forkserver.ensure_running()
+    _FORK_SERVER["started"] = True
+
+
+@contextlib.contextmanager
+def quiet_worker_start() -> Iterator[None]:
+    """Start worker processes inside this window: none sees a Ctrl-C before its initializer.
+
+    With the fork server (POSIX) the workers inherit its ignored SIGINT and this process keeps
+    its own: a Ctrl-C meanwhile interrupts it at once (ignoring SIGINT here while a pool
+    started lost such a Ctrl-C, and the campaign ran to its end). Without one (spawn), SIGINT
+    is ignored here while the window lasts (main thread only).
+    """
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        _start_fork_server()
         yield
-    finally:
-        signal.signal(signal.SIGINT, handler)
-        signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # one blocked here arrives now
-    if noted:
-        raise KeyboardInterrupt
+        return
+    if threading.current_thread() is not threading.main_thread():  # pragma: no cover
+        yield
+        return
+    ignored = signal.signal(signal.SIGINT, signal.SIG_IGN)  # pragma: no cover - not POSIX
+    try:  # pragma: no cover
+        yield
+    finally:  # pragma: no cover
+        signal.signal(signal.SIGINT, ignored)
 
 
 def _start_worker() -> None:
@@ -114,7 +128,7 @@ def _alone(function: Callable[..., Any], args: tuple[Any, ...], timeout: float) 
     no answer within ``timeout`` seconds (it is then killed).
     """
     receiver, sender = _context().Pipe(duplex=False)
-    with interrupts_deferred():
+    with quiet_worker_start():
         process = _context().Process(target=_child, args=(sender, function, args), daemon=True)
         process.start()
     sender.close()  # only the child writes: a dead child then reads as end-of-file

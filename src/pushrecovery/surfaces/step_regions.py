@@ -63,8 +63,17 @@ def _line_step_bounds(
     hip: bool = True,
 ) -> tuple[FloatArray, FloatArray]:
     """C_N on a line (module docstring) for supports [lower, upper] and stance ankles [m]."""
-    beta = math.exp(-params.omega * params.min_step_time)
-    grow = _capturability_distance(
+    beta, grows = _growth(params, hip)
+    grow = float(grows[steps]) if steps < len(grows) else _grow(params, hip, steps)
+    first = beta if steps > 0 else 0.0
+    low = first * (np.asarray(ankle) + params.heel) + (1.0 - first) * np.asarray(lower) - grow
+    high = first * (np.asarray(ankle) + params.toe) + (1.0 - first) * np.asarray(upper) + grow
+    return np.asarray(low, dtype=np.float64), np.asarray(high, dtype=np.float64)
+
+
+def _grow(params: BodyParams, hip: bool, steps: int) -> float:
+    """Return the growth l s_N (+ the hip's share) of C_N over the stance foot [m]."""
+    return _capturability_distance(
         steps,
         params.omega,
         params.min_step_time,
@@ -72,10 +81,19 @@ def _line_step_bounds(
         0.0,
         cmp_offset(params) if hip else 0.0,
     )
-    first = beta if steps > 0 else 0.0
-    low = first * (np.asarray(ankle) + params.heel) + (1.0 - first) * np.asarray(lower) - grow
-    high = first * (np.asarray(ankle) + params.toe) + (1.0 - first) * np.asarray(upper) + grow
-    return np.asarray(low, dtype=np.float64), np.asarray(high, dtype=np.float64)
+
+
+@functools.lru_cache(maxsize=128)
+def _growth(params: BodyParams, hip: bool) -> tuple[float, FloatArray]:
+    """e^{−ωΔt_s} and the growths of C_0..C_{max_steps}, once per body (the verdict's hot path)."""
+    beta = math.exp(-params.omega * params.min_step_time)
+    grows = np.array([_grow(params, hip, n) for n in range(params.max_steps + 1)])
+    grows.flags.writeable = False
+    return beta, grows
+
+
+#: Up to this many states, the levels N are tested all at once (a (levels, states) array).
+_LEVELS_AT_ONCE = 4096
 
 
 @dataclass(frozen=True, slots=True)
@@ -156,20 +174,33 @@ def _line_steps(
     params: BodyParams,
 ) -> LineSteps:
     """:func:`line_steps` of checked, broadcast arrays."""
-    steps = np.zeros(capture.shape, dtype=np.int64)
-    for n in range(params.max_steps, 0, -1):
-        low, high = _line_step_bounds(lower, upper, ankle, params, n)
+    top = params.max_steps
+    if capture.size <= _LEVELS_AT_ONCE:
+        # C_N = base ∓ grow_N for N >= 1, as _line_step_bounds computes it, all N at once.
+        beta, grows = _growth(params, True)
+        base_low = beta * (ankle + params.heel) + (1.0 - beta) * lower
+        base_high = beta * (ankle + params.toe) + (1.0 - beta) * upper
+        level = grows[1:].reshape((top,) + (1,) * capture.ndim)
+        low, high = base_low - level, base_high + level
         inside = (capture > low) & (capture < high)
-        steps[inside] = n
-        if n == params.max_steps:
-            margin = np.minimum(capture - low, high - capture)
+        steps = np.where(inside.any(axis=0), inside.argmax(axis=0) + 1, 0).astype(np.int64)
+        margin = np.minimum(capture - low[-1], high[-1] - capture)
+    else:
+        steps = np.zeros(capture.shape, dtype=np.int64)
+        for n in range(top, 0, -1):
+            low, high = _line_step_bounds(lower, upper, ankle, params, n)
+            inside = (capture > low) & (capture < high)
+            steps[inside] = n
+            if n == top:
+                margin = np.minimum(capture - low, high - capture)
     length = np.full(capture.shape, np.nan)
     shortest, longest = length.copy(), length.copy()
     reach, hip = params.max_step_length, cmp_offset(params)
     scale = math.exp(params.omega * params.min_step_time)
+    _, without_hip = _growth(params, False)
     for n in np.unique(steps[steps > 0]):
         rows = steps == n
-        more = _capturability_distance(int(n) - 1, params.omega, params.min_step_time, reach, 0.0)
+        more = float(without_hip[int(n) - 1])
         xi = capture[rows]
         first = scale * xi - scale * hip - (scale - 1.0) * upper[rows] - params.toe - more
         last = scale * xi + scale * hip - (scale - 1.0) * lower[rows] - params.heel + more
