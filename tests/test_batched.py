@@ -64,3 +64,24 @@ def test_a_start_off_the_model_is_refused_as_in_the_loop() -> None:
     with pytest.raises(InvalidParameterError):
         _batched_rows(campaign, [far])
     assert np.isfinite(ankle_pd_pushes("lipm", [P], [0.0], [0.1], duration=1.0).times).all()
+
+
+def test_row_predictions_are_classify_s() -> None:
+    # The rows' verdicts come from one vectorised call per body; classify, state by state,
+    # must give the same numbers, on a grid that reaches every strategy.
+    from pushrecovery.surfaces.classify import classify
+
+    campaign = CampaignSpec(
+        "analytic", "lipm", "ankle-pd", P, x0=(-0.04, 0.11, 0.05), xdot=(-4.5, 4.5, 0.25),
+        sweeps={"toe": (0.12, 0.18, 0.06)}, batch_size=1000,
+    )  # fmt: skip
+    _, rows = run_batch(campaign, 0)
+    assert {row["predicted"] for row in rows} == {"ankle", "hip", "step", "fall"}
+    for row, push in zip(rows, campaign.pushes(0), strict=True):
+        found = classify(push.x0, push.xdot, push.params)
+        assert row["predicted"] == found.strategy.value
+        assert row["capture_point"] == found.capture_point
+        assert (row["cop_margin"], row["cmp_margin"], row["step_margin"]) == (
+            found.margins["cop"], found.margins["cmp"], found.margins["step"]
+        )  # fmt: skip
+        assert row["predicted_steps"] == (-1 if found.steps is None else found.steps)

@@ -47,7 +47,11 @@ from pushrecovery.sim.critical import pushed_state
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
-from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify
+from pushrecovery.surfaces.classify import (
+    STRATEGY_CODES,
+    Strategy,
+    sagittal_verdicts,
+)
 
 __all__ = ["COLUMNS", "error_row", "run_batch", "run_push"]
 
@@ -134,10 +138,46 @@ class _Simulated:
     stop_impacts: int
 
 
-def _row(spec: CampaignSpec, push: Push, run: _Simulated) -> dict[str, Any]:
+@dataclass(frozen=True, slots=True)
+class _Prediction:
+    """What the surfaces predict for a push (the sagittal verdict of ``classify``)."""
+
+    strategy: Strategy
+    capture_point: float
+    cop_margin: float
+    cmp_margin: float
+    step_margin: float
+    steps: int | None
+
+
+def _predictions(pushes: list[Push]) -> list[_Prediction]:
+    """Return the pushes' verdicts: one vectorised call per body (no plans needed)."""
+    found: list[_Prediction | None] = [None] * len(pushes)
+    bodies: dict[BodyParams, list[int]] = {}
+    for k, push in enumerate(pushes):
+        bodies.setdefault(push.params, []).append(k)
+    for params, members in bodies.items():
+        verdicts = sagittal_verdicts(
+            [pushes[k].x0 for k in members], [pushes[k].xdot for k in members], params
+        )
+        for j, k in enumerate(members):
+            found[k] = _Prediction(
+                verdicts.strategies[j],
+                float(verdicts.capture_point[j]),
+                float(verdicts.cop_margin[j]),
+                float(verdicts.cmp_margin[j]),
+                float(verdicts.line.margin[j]),
+                verdicts.steps(j),
+            )
+    return [f for f in found if f is not None]
+
+
+def _row(
+    spec: CampaignSpec, push: Push, run: _Simulated, found: _Prediction | None = None
+) -> dict[str, Any]:
     """Return the row of a simulated push: inputs, prediction and run (module docstring)."""
     params = push.params
-    found = classify(push.x0, push.xdot, params)
+    found = found or _predictions([push])[0]
     # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
     reach = STRATEGY_CODES.index(Strategy(controller_class(spec.controller).strategy))
     peak_cop = max(abs(run.cop_min), abs(run.cop_max))
@@ -151,9 +191,9 @@ def _row(spec: CampaignSpec, push: Push, run: _Simulated) -> dict[str, Any]:
         impulse=push.impulse,
         predicted=found.strategy.value,
         capture_point=found.capture_point,
-        cop_margin=found.margins["cop"],
-        cmp_margin=found.margins["cmp"],
-        step_margin=found.margins["step"],
+        cop_margin=found.cop_margin,
+        cmp_margin=found.cmp_margin,
+        step_margin=found.step_margin,
         predicted_steps=-1 if found.steps is None else found.steps,
         predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
         outcome=run.outcome.value,
@@ -182,6 +222,7 @@ def _batched_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]
         duration=spec.duration,
     )
     rows = []
+    predictions = _predictions(pushes)
     for k, push in enumerate(pushes):
         outcome = runs.outcomes[k]
         rows.append(
@@ -198,6 +239,7 @@ def _batched_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]
                     time=float(runs.times[k]),
                     stop_impacts=0,
                 ),
+                predictions[k],
             )
         )
     return rows
@@ -208,7 +250,7 @@ def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
 
     The simulated columns are NaN (counts 0), ``used`` is ``error`` and ``error`` says why.
     """
-    found = classify(push.x0, push.xdot, push.params)
+    found = _predictions([push])[0]
     strategy = controller_class(spec.controller).strategy
     reach = STRATEGY_CODES.index(Strategy(strategy))
     row: dict[str, Any] = {
@@ -221,9 +263,9 @@ def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
         impulse=push.impulse,
         predicted=found.strategy.value,
         capture_point=found.capture_point,
-        cop_margin=found.margins["cop"],
-        cmp_margin=found.margins["cmp"],
-        step_margin=found.margins["step"],
+        cop_margin=found.cop_margin,
+        cmp_margin=found.cmp_margin,
+        step_margin=found.step_margin,
         predicted_steps=-1 if found.steps is None else found.steps,
         predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
         outcome="error",
