@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
@@ -369,3 +370,18 @@ def test_real_subprocess_and_module_entry_point():
     )
     assert bad.returncode == 2 and bad.stdout == ""
     assert bad.stderr.strip().startswith("pushrecovery: error: ")
+
+
+def test_figures_report_their_progress(monkeypatch):
+    # `figures` takes about 10 s: its bar advances once per figure (drawers stubbed here).
+    from pushrecovery import load_params
+    from pushrecovery.plots import figures as module
+
+    for name in ("fig3a", "fig3b", "fig5", "fig6", "fig9", "fig10", "plane", "steps"):
+        monkeypatch.setattr(module, name, lambda *args, **kwargs: [])
+    from types import SimpleNamespace
+
+    runs = SimpleNamespace(fig3a=[], fig3b=[], fig5=[], fig5_worst=[], fig6=[])
+    calls = []
+    module.write_figures(load_params(), runs, Path("unused"), progress=calls.append)
+    assert calls == [1] * module.FIGURE_COUNT

@@ -37,9 +37,16 @@ def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) ->
     polygon (ankle), the CMP region (hip) and pushes coloured by the strategy they need, in
     double, left and right support.
     """
+    from pushrecovery.cli.progress import Progress
     from pushrecovery.experiments.paper_figures import paper_runs
-    from pushrecovery.plots.figures import write_figures
+    from pushrecovery.plots.figures import FIGURE_COUNT, write_figures
 
     params = params_from(kwargs)
-    files = write_figures(params, paper_runs(params), Path(out), formats)
+    bar = Progress(FIGURE_COUNT + 1, "figures", "step")  # the runs, then each figure
+    try:
+        runs = paper_runs(params)
+        bar.update(1)
+        files = write_figures(params, runs, Path(out), formats, progress=bar.update)
+    finally:
+        bar.close()
     emit({"files": [str(f) for f in files]}, as_json)

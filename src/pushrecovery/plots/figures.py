@@ -8,7 +8,7 @@ plane of the ground-plane model (:mod:`pushrecovery.plots.plane`), and ``steps``
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import numpy as np
@@ -95,24 +95,36 @@ def write_figures(
     formats: Iterable[str] = ("png", "svg"),
     *,
     ground_plane: bool = True,
+    progress: Callable[[int], None] | None = None,
 ) -> list[Path]:
     """Draw every reproduced figure into ``out`` from ``runs``; return the files written.
 
     The paper's figures (:data:`PAPER_FIGURES`), the runs from
     :func:`~pushrecovery.experiments.paper_figures.paper_runs`, and, with ``ground_plane``,
-    ``plane`` and the step figures.
+    ``plane`` and the step figures. ``progress`` is called with 1 after each of them
+    (:data:`FIGURE_COUNT` in all, a progress bar's ``update``).
     """
     formats = tuple(formats)
-    return [
-        *fig3a(params, runs.fig3a, formats, out),
-        *fig3b(params, runs.fig3b, formats, out),
-        *fig5(params, runs.fig5, runs.fig5_worst, formats, out),
-        *fig6(params, runs.fig6, formats, out),
-        *fig9(params, formats, out),
-        *fig10(params, formats, out),
-        *(plane(params, formats, out) if ground_plane else []),
-        *(steps(params, formats, out) if ground_plane else []),
+    drawers: list[Callable[[], list[Path]]] = [
+        lambda: fig3a(params, runs.fig3a, formats, out),
+        lambda: fig3b(params, runs.fig3b, formats, out),
+        lambda: fig5(params, runs.fig5, runs.fig5_worst, formats, out),
+        lambda: fig6(params, runs.fig6, formats, out),
+        lambda: fig9(params, formats, out),
+        lambda: fig10(params, formats, out),
     ]
+    if ground_plane:
+        drawers += [lambda: plane(params, formats, out), lambda: steps(params, formats, out)]
+    files: list[Path] = []
+    for draw in drawers:
+        files += draw()
+        if progress is not None:
+            progress(1)
+    return files
+
+
+#: Figures :func:`write_figures` draws with the ground plane (its progress steps).
+FIGURE_COUNT = 8
 
 
 def steps(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
