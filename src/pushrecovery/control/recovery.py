@@ -52,7 +52,8 @@ class RecoveryController(Controller):
         super().__init__(params)
         self.control_period = 1e-3
         self.mode = "ankle"
-        self._bodies: dict[float, tuple[BodyParams, MPCController]] = {}
+        self._bodies: dict[float, BodyParams] = {}
+        self._mpcs: dict[float, MPCController] = {}
         self._swing_start: float | None = None
         self._held: Command | None = None
         self._held_until = -1.0
@@ -72,7 +73,14 @@ class RecoveryController(Controller):
         """Learn from the plant whether the feet carry the body (a landing ends a swing)."""
         self._stance = info.stance
 
-    def _body(self, height: float) -> tuple[BodyParams, MPCController]:
+    def _mpc(self, height: float) -> MPCController:
+        """Return the MPC of this stance height, built when the hip is first needed there."""
+        mpc = self._mpcs.get(height)
+        if mpc is None:
+            mpc = self._mpcs[height] = MPCController(self._body(height))
+        return mpc
+
+    def _body(self, height: float) -> BodyParams:
         entry = self._bodies.get(height)
         if entry is None:
             body = dataclasses.replace(self.params, com_height=height)
@@ -84,7 +92,7 @@ class RecoveryController(Controller):
                 0.5 * body.flywheel_angle_max,
             )
             limited = dataclasses.replace(body, flywheel_angle_max=body.flywheel_angle_max - margin)
-            entry = self._bodies[height] = (limited, MPCController(limited))
+            entry = self._bodies[height] = limited
         return entry
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
@@ -97,7 +105,7 @@ class RecoveryController(Controller):
                 brake = -p.flywheel_inertia * theta_rate / STEP_BRAKE_TIME
                 return Command(0.0, p.clip_hip_torque(brake))
             self._swing_start, self.mode, self._held = None, "ankle", None
-        body, mpc = self._body(z)
+        body = self._body(z)
         omega = math.sqrt(p.gravity / z)
         capture = capture_point(x, xdot, omega)
         upright = abs(theta) < _UPRIGHT and abs(theta_rate) < _UPRIGHT
@@ -114,7 +122,7 @@ class RecoveryController(Controller):
             effective = capture + scale * (omega * theta_rate + omega**2 * theta)
             reserve = scale * omega**2 * p.flywheel_angle_max
             hopeless = not p.heel - reserve < effective < p.toe + reserve
-            command = None if exhausted or hopeless else self._hip(t, state, mpc)
+            command = None if exhausted or hopeless else self._hip(t, state, z)
             if command is not None:
                 return command
             self.mode = "step"
@@ -125,9 +133,10 @@ class RecoveryController(Controller):
         cop, clipped = self.clip_cop(capture)
         return Command(cop, saturated=clipped)
 
-    def _hip(self, t: float, state: NDArray[np.float64], mpc: MPCController) -> Command | None:
+    def _hip(self, t: float, state: NDArray[np.float64], height: float) -> Command | None:
         if self._held is not None and t < self._held_until - 1e-9:
             return self._held
+        mpc = self._mpc(height)
         # The MPC's own command, with its clipping and saturation flag (rest criterion).
         command = mpc.compute(t, state[[0, 1, 3, 4]])
         if mpc.last_plan is None or not mpc.last_plan.feasible:
