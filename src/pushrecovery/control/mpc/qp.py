@@ -31,6 +31,9 @@ unit norm with its bounds. Building the matrices is vectorised
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+
 import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
@@ -57,6 +60,26 @@ def _stabilising_gain(a: FloatArray, b: FloatArray, settings: MPCSettings) -> Fl
     cost_to_go = scipy.linalg.solve_discrete_are(a, b, q, r)
     gain: FloatArray = -np.linalg.solve(r + b.T @ cost_to_go @ b, b.T @ cost_to_go @ a)
     return gain
+
+
+@functools.lru_cache(maxsize=256)
+def _nearby_gain(body: BodyParams, settings: MPCSettings) -> FloatArray:
+    """Return the LQR gain of ``body`` (one whose ω is rounded, see :func:`_gain`)."""
+    return _stabilising_gain(*flywheel_discrete(body, settings.dt), settings)
+
+
+def _gain(params: BodyParams, a: FloatArray, b: FloatArray, settings: MPCSettings) -> FloatArray:
+    """Return a stabilising gain for (A, B): the gain of ω rounded to 4 digits, if it stabilises.
+
+    Any stabilising gain gives the same minimiser. Solving the Riccati equation takes a few ms
+    (scipy); the stance heights of a stepping run share the gain of their rounded ω instead.
+    """
+    omega = float(f"{params.omega:.4g}")
+    nearby = dataclasses.replace(params, com_height=params.gravity / (omega * omega))
+    gain = _nearby_gain(nearby, settings)
+    if max(abs(np.linalg.eigvals(a + b @ gain))) < 0.95:
+        return gain
+    return _stabilising_gain(a, b, settings)  # pragma: no cover - ω far from its rounding
 
 
 def _block_toeplitz(blocks: FloatArray) -> FloatArray:
@@ -92,7 +115,7 @@ class CondensedQP:
         n = settings.horizon
         a, b = self._a, self._b = flywheel_discrete(params, settings.dt)
         self.params, self.settings = params, settings
-        k = self.gain = _stabilising_gain(a, b, settings)
+        k = self.gain = _gain(params, a, b, settings)
         closed = a + b @ k
         powers = np.empty((n + 1, 4, 4))  # A_K^0..A_K^N
         powers[0] = np.eye(4)
