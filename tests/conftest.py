@@ -14,3 +14,14 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 @pytest.fixture
 def params() -> BodyParams:
     return load_params()
+
+
+#: ``python *AS_FROM_A_TERMINAL ARGS`` runs ``pushrecovery ARGS`` with SIGINT at Python's
+#: default, as a shell on a terminal starts a command. A test worker's own disposition is not
+#: inherited: under a full pytest-xdist run a worker intermittently had SIGINT ignored (a
+#: child started then reported SIG_IGN), and its children then could not be Ctrl-C'ed at all.
+AS_FROM_A_TERMINAL = (
+    "-c",
+    "import runpy, signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+    "sys.argv[0] = 'pushrecovery'; runpy.run_module('pushrecovery', run_name='__main__')",
+)

@@ -15,6 +15,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from conftest import AS_FROM_A_TERMINAL
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.campaign import CampaignError, CampaignSpec, missing_batches, run_campaign
 from pushrecovery.sim.critical import predicted_critical_velocity
@@ -151,7 +152,8 @@ def test_cli_campaign_killed_then_resumed(tmp_path):
 def test_cli_campaign_ctrl_c_keeps_the_batches(tmp_path):
     args = SLOW_PUSHES
     out = tmp_path / "c"
-    proc = subprocess.Popen([*_cli(*args, "--out", str(out))], stderr=subprocess.PIPE, text=True)
+    command = [sys.executable, *AS_FROM_A_TERMINAL, "campaign", *args, "--out", str(out)]
+    proc = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while not ((out / "batches").is_dir() and any((out / "batches").glob("*.parquet"))):
         assert proc.poll() is None and time.monotonic() < deadline

@@ -131,6 +131,9 @@ def probe(queue):
     queue.put(signal.getsignal(signal.SIGINT) is signal.SIG_IGN)
 
 if __name__ == "__main__":
+    # As started from a terminal (here: not in the module's top level, which the fork server
+    # runs again when it preloads the main module).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     context = multiprocessing.get_context("forkserver")
     queue = context.Queue()
     with quiet_worker_start():

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import pytest
 
+from conftest import AS_FROM_A_TERMINAL
+
 DATA = Path(__file__).parent / "data"
 HANG = 60.0  # [s] a guard, not a speed test: every case below returns within about a second
 
@@ -160,8 +162,7 @@ def test_ctrl_c_stops_a_campaign_with_one_line_and_no_worker_traceback(tmp_path:
     process = subprocess.Popen(
         [
             sys.executable,
-            "-m",
-            "pushrecovery",
+            *AS_FROM_A_TERMINAL,
             *args,
             "--out",
             str(out),
