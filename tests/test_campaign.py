@@ -62,7 +62,9 @@ def test_same_results_on_one_two_and_dask_workers(tmp_path):
     spec = tiny()
     serial = run_campaign(spec, tmp_path / "one", workers=1)
     pair = run_campaign(spec, tmp_path / "two", workers=2)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+    ) as cluster:
         dask = run_campaign(spec, tmp_path / "dask", scheduler=cluster.scheduler_address)
     assert serial.table.num_rows == 26
     assert serial.table.equals(pair.table) and serial.table.equals(dask.table)

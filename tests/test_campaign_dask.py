@@ -33,7 +33,9 @@ SPEC = CampaignSpec(
 def test_a_worker_killed_mid_campaign_changes_nothing(tmp_path: Path) -> None:
     reference = run_campaign(SPEC, tmp_path / "whole", workers=1)
     assert reference is not None and SPEC.batches >= 8
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+    ) as cluster:
         with distributed.Client(cluster, set_as_default=False) as client:
             pids = list(client.run(os.getpid).values())
         killed: list[int] = []
@@ -58,7 +60,9 @@ def test_a_killed_client_resumes_on_the_cluster(tmp_path: Path) -> None:
         "--model stepping --controller recovery --x0 0 0.1 0.05 --xdot 2.6 3.0 0.1 "
         "--batch-size 1 --no-plot"
     ).split()
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+    ) as cluster:
         address = ["--scheduler", cluster.scheduler_address]
         out = tmp_path / "killed"
         proc = subprocess.Popen(

@@ -237,7 +237,9 @@ def test_a_push_that_kills_its_dask_worker_is_one_error_row() -> None:
     # The scheduler gives up on a task at once when its worker dies (the default retries on
     # 3 more workers, each a crash); the nanny restarts the worker.
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
-        with LocalCluster(n_workers=1, threads_per_worker=1, processes=True) as cluster:
+        with LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster:
             with Client(cluster, set_as_default=False) as client:
                 found = dict(
                     _dask(SPEC, [0, 1], client, batch_runner=crash_batch, push_runner=crash_push)
@@ -249,3 +251,25 @@ def test_a_push_that_kills_its_dask_worker_is_one_error_row() -> None:
                 assert row["outcome"] == "error" and row["error"] == "its worker process died"
             else:
                 assert row == reference
+
+
+def test_a_worker_whose_campaign_was_killed_ends_itself() -> None:
+    # A SIGKILL'ed campaign cannot stop its pool: its workers used to wait for work forever
+    # (100 MB each). The watchdog ends a worker whose campaign process is gone.
+    import subprocess
+    import sys
+    import time
+
+    from pushrecovery.campaign.watchdog import ORPHAN_EXIT, PERIOD
+
+    campaign = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    worker = subprocess.Popen([
+        sys.executable, "-c",
+        "import sys, time; from pushrecovery.campaign import watchdog; "
+        f"watchdog.start({campaign.pid}); time.sleep(60)",
+    ])  # fmt: skip
+    time.sleep(4 * PERIOD)
+    assert worker.poll() is None  # the campaign is alive: the worker waits
+    campaign.kill()
+    campaign.wait()
+    assert worker.wait(timeout=10) == ORPHAN_EXIT

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import multiprocessing
+import os
 import signal
 import threading
 from collections.abc import Callable, Iterator
@@ -82,10 +83,14 @@ def quiet_worker_start() -> Iterator[None]:
         signal.signal(signal.SIGINT, ignored)
 
 
-def _start_worker() -> None:
-    """Worker initializer: Ctrl-C is the parent's; a hung push kills this process (watchdog)."""
+def _start_worker(campaign: int | None = None) -> None:
+    """Worker initializer: Ctrl-C is the parent's.
+
+    A hung push, or the end of the ``campaign`` process, ends this one
+    (:mod:`~pushrecovery.campaign.watchdog`).
+    """
     _ignore_interrupts()
-    watchdog.start()
+    watchdog.start(campaign)
 
 
 def _context() -> multiprocessing.context.ForkServerContext | multiprocessing.context.SpawnContext:
@@ -106,7 +111,10 @@ def new_pool(workers: int) -> ProcessPoolExecutor:
     (:mod:`~pushrecovery.campaign.watchdog`).
     """
     return ProcessPoolExecutor(
-        max_workers=workers, mp_context=_context(), initializer=_start_worker
+        max_workers=workers,
+        mp_context=_context(),
+        initializer=_start_worker,
+        initargs=(os.getpid(),),
     )
 
 
@@ -115,8 +123,10 @@ def batch_deadline(spec: CampaignSpec) -> float:
     return spec.batch * watchdog.hung_after(spec.push_timeout) + watchdog.GRACE
 
 
-def _child(connection: Any, function: Callable[..., Any], args: tuple[Any, ...]) -> None:
-    _start_worker()
+def _child(
+    connection: Any, function: Callable[..., Any], args: tuple[Any, ...], campaign: int
+) -> None:
+    _start_worker(campaign)
     connection.send(function(*args))
     connection.close()
 
@@ -129,7 +139,9 @@ def _alone(function: Callable[..., Any], args: tuple[Any, ...], timeout: float) 
     """
     receiver, sender = _context().Pipe(duplex=False)
     with quiet_worker_start():
-        process = _context().Process(target=_child, args=(sender, function, args), daemon=True)
+        process = _context().Process(
+            target=_child, args=(sender, function, args, os.getpid()), daemon=True
+        )
         process.start()
     sender.close()  # only the child writes: a dead child then reads as end-of-file
     try:

@@ -16,15 +16,17 @@ import os
 import threading
 import time
 
-__all__ = ["GRACE", "HUNG_EXIT", "PERIOD", "arm", "disarm", "hung_after", "start"]
+__all__ = ["GRACE", "HUNG_EXIT", "ORPHAN_EXIT", "PERIOD", "arm", "disarm", "hung_after", "start"]
 
 #: Longest time a push gets beyond its wall-time limit before its worker counts as hung [s]:
 #: the simulation's own check comes first, at its next control tick.
 GRACE = 30.0
 #: How often the thread looks [s].
 PERIOD = 0.5
-#: Exit status of a process its watchdog ended (as timeout(1)'s).
+#: Exit status of a process its watchdog ended (as timeout(1)'s), and of a worker whose
+#: campaign is gone.
 HUNG_EXIT = 124
+ORPHAN_EXIT = 125
 
 _deadline = math.inf  # time.monotonic() past which the current push is hung
 _started = False
@@ -50,16 +52,36 @@ def disarm() -> None:
     _deadline = math.inf
 
 
-def _watch() -> None:
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` still exists (signal 0 only asks)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # pragma: no cover - exists, another user's
+        return True
+    return True
+
+
+def _watch(campaign: int | None) -> None:
     while True:
         time.sleep(PERIOD)
         if time.monotonic() > _deadline:
             os._exit(HUNG_EXIT)  # at once, whatever the main thread is stuck in
+        if campaign is not None and not _alive(campaign):
+            os._exit(ORPHAN_EXIT)  # the campaign was killed: nobody will collect the rows
 
 
-def start() -> None:
-    """Start the watching thread in this process (once; a worker's initializer)."""
+def start(campaign: int | None = None) -> None:
+    """Start the watching thread in this process (once; a worker's initializer).
+
+    ``campaign``: the pid of the campaign's process. A worker whose campaign was killed (a
+    SIGKILL leaves no time to stop the pool) ends itself within :data:`PERIOD` instead of
+    waiting for work forever.
+    """
     global _started
     if not _started:
         _started = True
-        threading.Thread(target=_watch, name="pushrecovery-watchdog", daemon=True).start()
+        threading.Thread(
+            target=_watch, args=(campaign,), name="pushrecovery-watchdog", daemon=True
+        ).start()
