@@ -199,9 +199,9 @@ def test_cli_bad_campaign_specs(tmp_path, args, words):
 
 
 def test_unreachable_scheduler(tmp_path, monkeypatch):
-    import pushrecovery.campaign.execute as execute
+    import pushrecovery.campaign.cluster as cluster
 
-    monkeypatch.setattr(execute, "CONNECT_TIMEOUT", 1.0)
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 1.0)
     with pytest.raises(
         CampaignError, match=r"cannot reach the Dask scheduler at tcp://127\.0\.0\.1:9"
     ):

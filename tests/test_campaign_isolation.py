@@ -232,7 +232,7 @@ def test_a_push_that_kills_its_dask_worker_is_one_error_row() -> None:
     import dask
     from distributed import Client, LocalCluster
 
-    from pushrecovery.campaign.execute import _dask
+    from pushrecovery.campaign.cluster import on_cluster as _dask
 
     # The scheduler gives up on a task at once when its worker dies (the default retries on
     # 3 more workers, each a crash); the nanny restarts the worker.

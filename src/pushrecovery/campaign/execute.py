@@ -28,17 +28,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pushrecovery.campaign.cluster import connect, on_cluster
 from pushrecovery.campaign.isolation import (
-    BatchRunner,
-    PushRunner,
     batch_deadline,
     new_pool,
     quarantine,
     quiet_worker_start,
 )
-from pushrecovery.campaign.pushes import COLUMNS, error_row, run_batch, run_push
-from pushrecovery.campaign.spec import CampaignSpec
-from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.campaign.pushes import COLUMNS, run_batch
+from pushrecovery.campaign.spec import CampaignError, CampaignSpec
+from pushrecovery.errors import InvalidParameterError
 
 __all__ = ["CampaignError", "CampaignResult", "missing_batches", "read_spec", "run_campaign"]
 
@@ -47,12 +46,6 @@ PUSHES_FILE = "pushes.parquet"
 SUMMARY_FILE = "summary.json"
 BATCH_DIR = "batches"
 _BATCH = re.compile(r"batch-(\d{6})\.parquet")
-#: Seconds to wait for a Dask scheduler to answer.
-CONNECT_TIMEOUT = 10.0
-
-
-class CampaignError(PushRecoveryError):
-    """A campaign cannot run: unreachable scheduler, a directory holding another campaign."""
 
 
 @dataclass(frozen=True)
@@ -210,115 +203,6 @@ def _stop_workers(pool: ProcessPoolExecutor) -> None:
         process.kill()
 
 
-def _connect(scheduler: str) -> Any:
-    """Connect to the scheduler at ``scheduler`` (a client that is not made the default)."""
-    from distributed import Client
-    from distributed.comm import parse_address
-
-    malformed = CampaignError(
-        f"--scheduler must be an address such as tcp://HOST:PORT, got {scheduler!r}"
-    )
-    try:
-        scheme, location = parse_address(scheduler, strict=True)
-    except ValueError:
-        raise malformed from None
-    # Dask accepts "tcp://" and then waits for the connect timeout: check host and port here.
-    host, _, port = location.rpartition(":")
-    if scheme in ("tcp", "tls", "ws", "wss") and not (
-        host.strip("[]") and port.isdigit() and 0 < int(port) < 65536
-    ):
-        raise malformed
-    try:
-        return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise CampaignError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-
-
-def _dask(
-    spec: CampaignSpec,
-    batches: list[int],
-    client: Any,
-    *,
-    batch_runner: BatchRunner = run_batch,
-    push_runner: PushRunner = run_push,
-) -> Iterator[tuple[int, list[dict]]]:
-    """Run ``batches`` on the cluster; a batch whose worker died goes on push by push.
-
-    Dask itself gives a task whose worker died to another worker, up to its
-    ``distributed.scheduler.allowed-failures``, then fails it with ``KilledWorker``. Such a
-    batch is sent again one push per task: the push that kills its worker once more is an
-    ``error`` row, every other push is simulated. ``batch_runner`` and ``push_runner`` are
-    :func:`run_batch` and :func:`run_push` (replaceable for tests).
-    """
-    from distributed import as_completed
-
-    # pure=False: every batch runs, even if an identical task ran before on the cluster.
-    futures = {client.submit(batch_runner, spec, batch, pure=False): batch for batch in batches}
-    try:
-        for future in as_completed(list(futures), loop=client.loop):
-            try:
-                result = future.result()
-            except Exception as exc:  # a lost worker's KilledWorker, a failed task
-                if not _killed(exc):
-                    raise _cluster_error(exc) from None
-                result = _dask_pushes(spec, futures[future], client, push_runner)
-            yield result
-    finally:
-        client.cancel(list(futures))
-
-
-def _dask_pushes(
-    spec: CampaignSpec, batch: int, client: Any, push_runner: PushRunner
-) -> tuple[int, list[dict]]:
-    """Batch ``batch`` one push per task; a push whose worker died is an ``error`` row.
-
-    The pushes run in parallel first. A worker's death fails every task it held, so each push
-    that failed then runs again alone: the one that kills its worker by itself is the error.
-    """
-    pushes = spec.pushes(batch)
-    rows: list[dict | None] = list(_dask_rows(spec, pushes, client, push_runner))
-    for k, push in enumerate(pushes):
-        if rows[k] is None:
-            (row,) = _dask_rows(spec, [push], client, push_runner)
-            rows[k] = row or error_row(spec, push, "its worker process died")
-    return batch, [row for row in rows if row is not None]
-
-
-def _dask_rows(
-    spec: CampaignSpec, pushes: list[Any], client: Any, push_runner: PushRunner
-) -> list[dict | None]:
-    """Rows of ``pushes`` run as one task each; None where the task's worker died."""
-    futures = [client.submit(push_runner, spec, push, pure=False) for push in pushes]
-    rows: list[dict | None] = []
-    try:
-        for future in futures:
-            try:
-                rows.append(future.result())
-            except Exception as exc:
-                if not _killed(exc):
-                    raise _cluster_error(exc) from None
-                rows.append(None)
-    finally:
-        client.cancel(futures)
-    return rows
-
-
-def _killed(exc: BaseException) -> bool:
-    from distributed.scheduler import KilledWorker
-
-    return isinstance(exc, KilledWorker)
-
-
-def _cluster_error(exc: Exception) -> Exception:
-    """Return the error to raise for a failed task: ours as it is, else a CampaignError."""
-    if isinstance(exc, PushRecoveryError):
-        return exc
-    return CampaignError(
-        f"a batch failed on the Dask cluster ({type(exc).__name__}: {exc}); the finished "
-        "batches are saved, rerun with --resume"
-    )
-
-
 def run_campaign(
     spec: CampaignSpec,
     directory: Path | str,
@@ -367,7 +251,7 @@ def run_campaign(
     if max_batches is not None and max_batches < 0:
         raise InvalidParameterError(f"max_batches must be >= 0, got {max_batches}")
     # Connect first: an unreachable scheduler leaves no directory behind.
-    client = _connect(scheduler) if scheduler is not None else None
+    client = connect(scheduler) if scheduler is not None else None
     try:
         return _run(spec, directory, workers, client, resume, max_batches, progress, isolated)
     finally:
@@ -395,7 +279,7 @@ def _run(
     if stopped:
         todo = todo[:max_batches]
     if client is not None:
-        results = _dask(spec, todo, client)
+        results = on_cluster(spec, todo, client)
     elif not todo:
         results = iter(())
     elif (workers or _cores()) == 1 and not isolated:

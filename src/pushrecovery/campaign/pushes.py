@@ -176,11 +176,27 @@ def _row(
     spec: CampaignSpec, push: Push, run: _Simulated, found: _Prediction | None = None
 ) -> dict[str, Any]:
     """Return the row of a simulated push: inputs, prediction and run (module docstring)."""
-    params = push.params
-    found = found or _predictions([push])[0]
+    peak_cop = max(abs(run.cop_min), abs(run.cop_max))
+    row = _inputs_and_prediction(spec, push, found or _predictions([push])[0])
+    row.update(
+        outcome=run.outcome.value,
+        used=run.used.value,
+        steps=run.steps,
+        peak_hip_torque=run.peak_hip_torque,
+        peak_ankle_torque=push.params.weight * peak_cop if math.isfinite(peak_cop) else 0.0,
+        cop_min=run.cop_min,
+        cop_max=run.cop_max,
+        time=run.time,
+        stop_impacts=run.stop_impacts,
+        error=None,
+    )
+    return row
+
+
+def _inputs_and_prediction(spec: CampaignSpec, push: Push, found: _Prediction) -> dict[str, Any]:
+    """Return the columns of a row that do not depend on the run: the push and its verdict."""
     # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
     reach = STRATEGY_CODES.index(Strategy(controller_class(spec.controller).strategy))
-    peak_cop = max(abs(run.cop_min), abs(run.cop_max))
     row: dict[str, Any] = {
         f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
     }
@@ -196,16 +212,6 @@ def _row(
         step_margin=found.step_margin,
         predicted_steps=-1 if found.steps is None else found.steps,
         predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
-        outcome=run.outcome.value,
-        used=run.used.value,
-        steps=run.steps,
-        peak_hip_torque=run.peak_hip_torque,
-        peak_ankle_torque=params.weight * peak_cop if math.isfinite(peak_cop) else 0.0,
-        cop_min=run.cop_min,
-        cop_max=run.cop_max,
-        time=run.time,
-        stop_impacts=run.stop_impacts,
-        error=None,
     )
     return row
 
@@ -250,24 +256,8 @@ def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
 
     The simulated columns are NaN (counts 0), ``used`` is ``error`` and ``error`` says why.
     """
-    found = _predictions([push])[0]
-    strategy = controller_class(spec.controller).strategy
-    reach = STRATEGY_CODES.index(Strategy(strategy))
-    row: dict[str, Any] = {
-        f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
-    }
+    row = _inputs_and_prediction(spec, push, _predictions([push])[0])
     row.update(
-        index=push.index,
-        x0=push.x0,
-        xdot=push.xdot,
-        impulse=push.impulse,
-        predicted=found.strategy.value,
-        capture_point=found.capture_point,
-        cop_margin=found.cop_margin,
-        cmp_margin=found.cmp_margin,
-        step_margin=found.step_margin,
-        predicted_steps=-1 if found.steps is None else found.steps,
-        predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
         outcome="error",
         used="error",
         steps=0,

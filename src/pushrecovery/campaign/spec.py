@@ -21,16 +21,22 @@ from typing import Any
 import numpy as np
 
 from pushrecovery.control.base import controller_class
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
 
 __all__ = [
     "BACKENDS",
     "MAX_PUSHES",
+    "CampaignError",
     "CampaignSpec",
     "Push",
     "value_range",
 ]
+
+
+class CampaignError(PushRecoveryError):
+    """A campaign cannot run: unreachable scheduler, a directory holding another campaign."""
+
 
 #: Backends a campaign runs on, with their models.
 BACKENDS: Mapping[str, tuple[str, ...]] = {
