@@ -32,6 +32,12 @@ from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import RecordedFrame, Step, check_com_state, over_foot_at_rest
+from pushrecovery.sim.mujoco.engine import (
+    floor_cop_world,
+    settle,
+    touches_floor,
+    unstable_warnings,
+)
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, MODEL_BUILDERS, TIMESTEP
 from pushrecovery.sim.push import Push
 
@@ -57,8 +63,6 @@ FOOT_TIP_LIMIT = 0.2
 TORQUE_HOLD = 0.01
 
 FloatArray = NDArray[np.float64]
-
-#: One recorded instant: time [s], qpos, CoM (x, z) [m], capture point x [m], CoP x [m] (world).
 
 
 class MujocoPlant:
@@ -132,11 +136,13 @@ class MujocoPlant:
         self._hold_steps = max(1, round(self.torque_hold / self._substep))
         self._steps_done = 0
         self._measuring = False
-        # MuJoCo resets the data after any of these (as dm_control's check_divergence reads).
-        warning = mujoco.mjtWarning
-        self._unstable = [
-            int(w) for w in (warning.mjWARN_BADQACC, warning.mjWARN_BADQVEL, warning.mjWARN_BADQPOS)
-        ]
+        # Counts of the warnings after which MuJoCo resets (a view of the data's: no copies).
+        self._warnings: NDArray[np.int32] = self.data.warning.number
+        self._unstable = unstable_warnings()
+        #: The state after settling (:meth:`reset`), kept: settling is the same every time.
+        self._settled: FloatArray | None = None
+        self._info_key: tuple[int, float] | None = None
+        self._info = StepInfo()
 
     @classmethod
     def build(cls, params: BodyParams) -> Any:
@@ -239,11 +245,10 @@ class MujocoPlant:
         """
         check_com_state(x, xdot, self.params)
         mj, d = self._mj, self.data
-        mj.mj_resetData(self.model, d)
         self._push_steps, self.push_now, self.stop_impacts = 0, 0.0, 0
         self._push_target = -1
-        d.ctrl[:] = 0.0
-        mj.mj_step(self.model, d, nstep=round(SETTLE_TIME / self._substep))
+        steps = round(SETTLE_TIME / self._substep)
+        self._settled = settle(self.model, d, steps, self._settled)  # once, then restored
         d.qvel[:] = 0.0
         self.pose(x, xdot)
         mj.mj_forward(self.model, d)
@@ -290,8 +295,13 @@ class MujocoPlant:
 
     def info(self) -> StepInfo:
         """Return the report of the run so far (contract item 5): stance, footholds, CoP."""
-        measured = self.measured_cops[-1] if self._measuring and self.measured_cops else None
-        return StepInfo(True, (self._first_ankle,), self.stop_impacts, measured)
+        if self._measuring:
+            measured = self.measured_cops[-1] if self.measured_cops else None
+            return StepInfo(True, (self._first_ankle,), self.stop_impacts, measured)
+        key = (self.stop_impacts, self._first_ankle)  # kept while it stays the same
+        if key != self._info_key:
+            self._info_key, self._info = key, StepInfo(True, (key[1],), key[0], None)
+        return self._info
 
     def at_rest(self, state: FloatArray, speed: float) -> bool:
         """:func:`~pushrecovery.sim.plants.over_foot_at_rest` on the stance foot."""
@@ -300,16 +310,7 @@ class MujocoPlant:
     # --- dynamics ------------------------------------------------------------------------
     def measured_cop_world(self) -> float:
         """World x of the CoP of the floor's normal forces on the soles [m]; NaN if airborne."""
-        moment = total = 0.0
-        d = self.data
-        for i in range(d.ncon):
-            contact = d.contact[i]
-            pair = (contact.geom1, contact.geom2)
-            if self._floor in pair and (pair[0] in self._soles or pair[1] in self._soles):
-                self._mj.mj_contactForce(self.model, d, i, self._force)
-                moment += self._force[0] * contact.pos[0]
-                total += self._force[0]
-        return moment / total if total > 0.0 else math.nan
+        return floor_cop_world(self.model, self.data, self._floor, self._soles, self._force)
 
     def measured_cop(self) -> float:
         """CoP of the floor's normal forces on the soles, relative to the stance ankle [m]."""
@@ -355,7 +356,8 @@ class MujocoPlant:
             torque = actuate(cop, command)
             mj_step(model, d, nstep=min(hold, steps))
             steps -= hold
-        if any(d.warning[w].number for w in self._unstable):
+        counts, (a, b, c) = self._warnings, self._unstable
+        if counts[a] or counts[b] or counts[c]:
             raise SimulationDiverged(
                 "MuJoCo's simulation became unstable (accelerations blew up); "
                 "the push or the state is beyond what the model can simulate"
@@ -381,13 +383,10 @@ class MujocoPlant:
 
     def falling(self, state: FloatArray) -> bool:
         """Anything but a sole on the floor, the CoM below half height, or a tipped foot."""
-        d, floor = self.data, self._floor
-        for g1, g2 in d.contact.geom.tolist():
-            other = g2 if g1 == floor else g1 if g2 == floor else -1
-            if other >= 0 and other not in self._soles:
-                return True
+        if touches_floor(self.data, self._floor, self._soles):
+            return True
         return bool(
-            d.subtree_com[0][2] < 0.5 * (self.params.com_height + ANKLE_HEIGHT)
+            self.data.subtree_com[0][2] < 0.5 * (self.params.com_height + ANKLE_HEIGHT)
             or self.foot_tipped()
         )
 
