@@ -45,7 +45,7 @@ from pushrecovery.params import BodyParams
 from pushrecovery.sim.batched import BATCHED
 from pushrecovery.sim.critical import pushed_state
 from pushrecovery.sim.registry import make_plant
-from pushrecovery.sim.result import Outcome
+from pushrecovery.sim.result import Outcome, strategy_used
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import (
     STRATEGY_CODES,
@@ -218,32 +218,37 @@ def _inputs_and_prediction(spec: CampaignSpec, push: Push, found: _Prediction) -
 
 def _batched_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]]:
     """Rows of pushes simulated together in a compiled loop (:mod:`pushrecovery.sim.batched`)."""
-    from pushrecovery.sim.batched import ankle_pd_pushes
+    from pushrecovery.sim.batched import ankle_pd_pushes, recovery_pushes
 
-    runs = ankle_pd_pushes(
-        spec.model,
-        [p.params for p in pushes],
-        [p.x0 for p in pushes],
-        [p.xdot for p in pushes],
-        duration=spec.duration,
-    )
+    bodies = [p.params for p in pushes]
+    starts, speeds = [p.x0 for p in pushes], [p.xdot for p in pushes]
+    if spec.controller == "recovery":
+        runs = recovery_pushes(bodies, starts, speeds, duration=spec.duration)
+    else:
+        runs = ankle_pd_pushes(spec.model, bodies, starts, speeds, duration=spec.duration)
     rows = []
     predictions = _predictions(pushes)
     for k, push in enumerate(pushes):
+        if runs.diverged[k]:
+            rows.append(error_row(spec, push, "the physics diverged: a state is not finite"))
+            continue
         outcome = runs.outcomes[k]
+        steps, peak = int(runs.steps[k]), float(runs.peak_hip_torque[k])
         rows.append(
             _row(
                 spec,
                 push,
                 _Simulated(
                     outcome=outcome,
-                    used=Strategy.ANKLE if outcome is Outcome.RECOVERED else Strategy.FALL,
-                    steps=0,
-                    peak_hip_torque=0.0,
+                    used=strategy_used(steps, peak)
+                    if outcome is Outcome.RECOVERED
+                    else Strategy.FALL,
+                    steps=steps,
+                    peak_hip_torque=peak,
                     cop_min=float(runs.cop_min[k]),
                     cop_max=float(runs.cop_max[k]),
                     time=float(runs.times[k]),
-                    stop_impacts=0,
+                    stop_impacts=int(runs.stop_impacts[k]),
                 ),
                 predictions[k],
             )

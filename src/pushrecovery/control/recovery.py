@@ -15,7 +15,7 @@ from pushrecovery.models.stepping import STEPPING_STATE
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import capture_point
-from pushrecovery.surfaces.step import plan_steps
+from pushrecovery.surfaces.step import compiled_plan_step
 
 __all__ = ["RecoveryController"]
 
@@ -145,10 +145,25 @@ class RecoveryController(Controller):
         return command
 
     def _step(self, t: float, x: float, xdot: float, body: BodyParams) -> Command | None:
-        plan = plan_steps(x, xdot, body)
-        if not bool(plan.ready):
+        ready, feasible, step_length = plan_step_now(x, xdot, body)
+        if not ready:
             return None  # the CoM is not yet falling toward the step: keep balancing meanwhile
         # Feasible: the recommended step; otherwise the best effort, the admissible step whose
         # capture point lands nearest the new foot.
         self._swing_start = t
-        return Command(0.0, step_length=float(plan.step_length), saturated=not plan.feasible)
+        return Command(0.0, step_length=step_length, saturated=not feasible)
+
+
+def plan_step_now(x: float, xdot: float, body: BodyParams) -> tuple[bool, bool, float]:
+    """Return ``plan_steps(x, xdot, body)``'s ready, feasible and step length [m], compiled.
+
+    Unchecked (not in ``__all__``): the loops' states are the plant's, already checked.
+
+    The controller's plan (:func:`~pushrecovery.surfaces.step.compiled_plan_step`, a few µs
+    where the interpreted one takes ~100 µs); the compiled batch of
+    :mod:`pushrecovery.sim.batched` asks it too, so both loops take the same steps to the bit.
+    """
+    _, ready, feasible, _, step_length, _, _, _ = compiled_plan_step()(
+        x, xdot, body.heel, body.toe, body.com_height, body.gravity, body.max_step_length
+    )
+    return bool(ready), bool(feasible), float(step_length)

@@ -136,9 +136,10 @@ class FlywheelPlant(PlantBase):
         super().__init__(params)
         # Beyond δ± ± τmax/(m g), moving outward, no CMP on offer can stop the CoM.
         self.fall_limits = params.hip_fall_limits
-        self._momentum = np.array([params.mass * params.com_height, params.flywheel_inertia])
+        self._momentum = (params.mass * params.com_height, params.flywheel_inertia)
         self._dt = -1.0
         self._a = self._b = np.empty(0)
+        self._rows: tuple[tuple[float, ...], ...] = ()
 
     def _start(self, x: float, xdot: float) -> FloatArray:
         return np.array([x, 0.0, xdot, 0.0])
@@ -175,14 +176,16 @@ class FlywheelPlant(PlantBase):
         if dt != self._dt:
             self._dt = dt
             self._a, self._b = flywheel_discrete(p, dt)
-        new = self._a @ state + self._b @ np.array([cop, torque])
+            rows: list[list[float]] = np.hstack([self._a, self._b]).tolist()
+            self._rows = tuple(tuple(row) for row in rows)
+        new = _held_step(self._rows, state, cop, torque)
         limit = p.flywheel_angle_max
         if abs(new[1]) > limit:
             new[1] = math.copysign(limit, new[1])
             new[2] += p.flywheel_inertia * new[3] / (p.mass * p.com_height)
             new[3] = 0.0
             self.stop_impacts += 1
-        return new, cop, torque
+        return np.array(new), cop, torque
 
     def at_rest(self, state: FloatArray, speed: float) -> bool:
         """:func:`over_foot_at_rest`."""
@@ -195,8 +198,24 @@ class FlywheelPlant(PlantBase):
         so ẋ can never turn back: the set is absorbing even with the joint stop.
         """
         x, xdot = float(state[0]), float(state[2])
-        momentum = float(self._momentum @ state[2:])
+        # m L ẋ + I θ̇, in this order (the compiled batch repeats it: sim/_batched_stepping.py)
+        momentum = self._momentum[0] * xdot + self._momentum[1] * float(state[3])
         lower, upper = self.fall_limits
         return (x > upper and xdot >= 0.0 and momentum >= 0.0) or (
             x < lower and xdot <= 0.0 and momentum <= 0.0
         )
+
+
+def _held_step(
+    rows: tuple[tuple[float, ...], ...], state: FloatArray, cop: float, torque: float
+) -> list[float]:
+    """X' = A X + B U for rows (A_i0..A_i3, B_i0, B_i1), summed left to right in floats.
+
+    One fixed order of operations (numpy's mat-vec may take another, e.g. fused multiply-adds),
+    so that the compiled batch of :mod:`pushrecovery.sim._batched_stepping` gives the same bits.
+    """
+    s0, s1, s2, s3 = (float(v) for v in state)
+    return [
+        a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3 + (b0 * cop + b1 * torque)
+        for a0, a1, a2, a3, b0, b1 in rows
+    ]

@@ -10,9 +10,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery._validate import finite_float
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.surfaces.classify import Strategy
 
-__all__ = ["HIP_TORQUE_THRESHOLD", "Outcome", "SimulationResult", "is_falling"]
+__all__ = ["HIP_TORQUE_THRESHOLD", "Outcome", "SimulationResult", "is_falling", "strategy_used"]
 
 #: Largest |hip torque| [N m] that still counts as not using the hip: a solver's rounding or
 #: a servo holding the upper body still (the MPC leaves 2e-5 N m on a push of 0), not CMP
@@ -129,11 +130,7 @@ class SimulationResult:
         ``step`` if a foot landed, else ``hip`` if the hip torque exceeded
         :data:`HIP_TORQUE_THRESHOLD`, else ``ankle``.
         """
-        if len(self.footholds) > 1:
-            return Strategy.STEP
-        if self.peak_hip_torque > HIP_TORQUE_THRESHOLD:
-            return Strategy.HIP
-        return Strategy.ANKLE
+        return strategy_used(len(self.footholds) - 1, self.peak_hip_torque)
 
     @property
     def recovered(self) -> bool:
@@ -168,3 +165,25 @@ class SimulationResult:
             "stop_impacts": self.stop_impacts,
             "footholds": list(self.footholds),
         } | ({"footholds_xy": [list(p) for p in self.footholds_xy]} if self.footholds_xy else {})
+
+
+def strategy_used(steps: int, peak_hip_torque: float) -> Strategy:
+    """Return the strategy a run used (the one definition).
+
+    ``step`` if a foot landed (``steps`` > 0), else ``hip`` if the largest |hip torque| [N m]
+    exceeded :data:`HIP_TORQUE_THRESHOLD`, else ``ankle``.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``steps`` is not an int >= 0 or ``peak_hip_torque`` not a number >= 0.
+    """
+    if not (isinstance(steps, int | np.integer) and steps >= 0):
+        raise InvalidParameterError(f"steps must be an int >= 0, got {steps!r:.40}")
+    if not finite_float("peak_hip_torque", peak_hip_torque, "N m", allowed=">= 0") >= 0.0:
+        raise InvalidParameterError(f"peak_hip_torque must be >= 0 N m, got {peak_hip_torque!r}")
+    if steps > 0:
+        return Strategy.STEP
+    if peak_hip_torque > HIP_TORQUE_THRESHOLD:
+        return Strategy.HIP
+    return Strategy.ANKLE

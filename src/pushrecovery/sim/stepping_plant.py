@@ -107,7 +107,9 @@ class SteppingPlant(PlantBase):
 
     def _start_swing(self, state: FloatArray, step_length: float) -> FloatArray:
         x, z, xdot = float(state[0]), float(state[2]), float(state[3])
-        length = math.hypot(x, z)
+        # sqrt(x² + z²) as written (math.hypot's algorithm varies between libraries; the
+        # compiled batch, sim/_batched_stepping.py, computes the same bits).
+        length = math.sqrt(x * x + z * z)
         sign = 1.0 if step_length > 0.0 else -1.0
         lean = math.atan2(x, z)
         # The foot cannot land behind the current lean: at the earliest it lands right away.
