@@ -77,6 +77,8 @@ class DaqpWorkspace:
             raise ImportError("this daqp Model ignores its primal_tol setting")
         self._model: Any = model
         self._warm = False
+        #: DAQP's multipliers of the last solution's rows (None after a failure).
+        self.multipliers: FloatArray | None = None
 
     def __reduce__(self) -> tuple[Any, ...]:
         # The C workspace cannot be pickled: rebuild it (cold) from the problem instead.
@@ -100,10 +102,26 @@ class DaqpWorkspace:
         else:
             self._cold.fill(0)
             model.update(f=self._linear, bupper=self._upper, blower=self._lower, sense=self._cold)
-        solution, _, flag, _ = model.solve()
+        solution, _, flag, info = model.solve()
         if flag <= 0 and self._warm:
             self._cold.fill(0)
             model.update(sense=self._cold)
-            solution, _, flag, _ = model.solve()
+            solution, _, flag, info = model.solve()
         self._warm = flag > 0
+        self.multipliers = info["lam"] if flag > 0 else None
         return solution if flag > 0 else None
+
+    def active_set(self) -> NDArray[np.int8] | None:
+        """Return the last solution's active set as (N, 3) rows (δ_i, τ_i, θ_{i+1}), ±1 at a bound.
+
+        From the signs of DAQP's multipliers (+ at an upper bound), in the layout of
+        :class:`~pushrecovery.control.mpc.riccati.RiccatiSolver`; None after a failure.
+        """
+        lam = self.multipliers
+        if lam is None:
+            return None
+        n = lam.size // 3
+        active = np.zeros((n, 3), dtype=np.int8)
+        active[:, :2] = np.sign(lam[: 2 * n]).reshape(n, 2)
+        active[:, 2] = np.sign(lam[2 * n :])
+        return active
