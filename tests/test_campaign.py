@@ -81,6 +81,18 @@ def test_summary_against_the_pushes_and_eq4(tmp_path):
     assert summary["accuracy"] == pytest.approx(agrees.mean())
     assert np.sum(summary["confusion"]["counts"]) == summary["pushes"] == 26
     assert summary["outcomes"]["recovered"] == recovered.sum()
+    # Joined and summarised batch by batch (6 batches: 6 row groups), the counts are the
+    # table's own.
+    import pyarrow.parquet as pq
+
+    assert pq.ParquetFile(result.pushes_file).metadata.num_row_groups == 6
+    labels = summary["confusion"]["labels"]
+    predicted = table.column("predicted").to_numpy(zero_copy_only=False)
+    used_by_run = table.column("used").to_numpy(zero_copy_only=False)
+    crosstab = [
+        [int(np.sum((predicted == p) & (used_by_run == u))) for u in labels] for p in labels
+    ]
+    assert summary["confusion"]["counts"] == crosstab
     # The PD falls within 1.3 % of Eq. (4) (docs/ankle_pd.md): the grid's bracket, 0.1 m/s
     # wide, must hold the analytic critical push up to that.
     for row in summary["boundary"]:

@@ -19,6 +19,7 @@ running ``dask.distributed`` scheduler at that address (``tcp://host:port``).
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -50,10 +51,9 @@ _BATCH = re.compile(r"batch-(\d{6})\.parquet")
 
 @dataclass(frozen=True)
 class CampaignResult:
-    """A finished campaign: its spec, the pushes (an Arrow table), the summary and files."""
+    """A finished campaign: its spec, the summary and files; the pushes read on demand."""
 
     spec: CampaignSpec
-    table: Any  # pyarrow.Table
     summary: dict[str, Any]
     directory: Path
     ran: int  # batches simulated by this call (the rest were on disk)
@@ -62,6 +62,17 @@ class CampaignResult:
     def pushes_file(self) -> Path:
         """The Parquet file of every push."""
         return self.directory / PUSHES_FILE
+
+    @functools.cached_property
+    def table(self) -> Any:
+        """Every push (a ``pyarrow.Table``), read from :attr:`pushes_file` on first use.
+
+        The whole table in memory: for campaigns too large for that, query the Parquet files
+        lazily instead (``pyarrow.dataset``, DuckDB, polars; docs/campaigns.md).
+        """
+        import pyarrow.parquet as pq
+
+        return pq.read_table(self.pushes_file)
 
 
 def schema(spec: CampaignSpec) -> Any:
@@ -296,25 +307,49 @@ def _run(
 
 
 def finish(spec: CampaignSpec, directory: Path, ran: int = 0) -> CampaignResult:
-    """Join the batch files into ``pushes.parquet`` and write ``summary.json``."""
-    import pyarrow as pa
+    """Join the batch files into ``pushes.parquet`` and write ``summary.json``.
+
+    One batch at a time: each is appended to the file as its row group(s) and added to the
+    summary's counts, so the memory is one batch's whatever the campaign's size.
+    """
     import pyarrow.parquet as pq
 
-    from pushrecovery.campaign.summary import summarize
+    from pushrecovery.campaign.summary import SummaryTally
 
     missing = missing_batches(spec, directory)
     if missing:
         raise CampaignError(f"{len(missing)} batches missing in {directory}; rerun with --resume")
-    parts = [pq.read_table(_batch_path(directory, b)) for b in spec.batch_indices()]
-    # Batches written before a column was added (a resumed old campaign) get it as nulls.
-    table = (
-        pa.concat_tables(parts, promote_options="default") if parts else schema(spec).empty_table()
-    )
+    full = schema(spec)
+    tally = SummaryTally(spec)
     partial = directory / (PUSHES_FILE + ".partial")
-    pq.write_table(table, partial)
+    with pq.ParquetWriter(partial, full) as writer:
+        for batch in spec.batch_indices():
+            part = _conform(pq.read_table(_batch_path(directory, batch)), full)
+            writer.write_table(part)
+            tally.add(part)
+        if not spec.batches:
+            writer.write_table(full.empty_table())
     os.replace(partial, directory / PUSHES_FILE)
-    summary = summarize(spec, table)
+    summary = tally.result()
     partial = directory / (SUMMARY_FILE + ".partial")
     partial.write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
     os.replace(partial, directory / SUMMARY_FILE)
-    return CampaignResult(spec, table, summary, directory, ran)
+    return CampaignResult(spec, summary, directory, ran)
+
+
+def _conform(table: Any, full: Any) -> Any:
+    """Return a batch's table with the campaign's columns in order.
+
+    Batches written before a column was added (a resumed old campaign) get it as nulls.
+    """
+    import pyarrow as pa
+
+    if table.schema.equals(full):
+        return table
+    columns = [
+        table.column(field.name).cast(field.type)
+        if field.name in table.column_names
+        else pa.nulls(table.num_rows, field.type)
+        for field in full
+    ]
+    return pa.Table.from_arrays(columns, schema=full)

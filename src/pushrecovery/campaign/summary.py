@@ -25,7 +25,7 @@ from pushrecovery.control.base import controller_class
 from pushrecovery.sim.critical import predicted_critical_velocity
 from pushrecovery.sim.validation import LABELS as VALIDATION_LABELS
 
-__all__ = ["LABELS", "boundary", "summarize"]
+__all__ = ["LABELS", "SummaryTally", "boundary", "summarize"]
 
 #: Rows and columns of the confusion matrix: the strategies, escalating (as ``validate``'s).
 LABELS = VALIDATION_LABELS
@@ -81,54 +81,107 @@ def boundary(spec: CampaignSpec, columns: dict[str, np.ndarray]) -> list[dict[st
 
 def summarize(spec: CampaignSpec, table: Any) -> dict[str, Any]:
     """Return the summary JSON of the pushes in ``table`` (a ``pyarrow.Table``)."""
-    columns = {
-        name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names
-    }
-    outcome, predicted, used = columns["outcome"], columns["predicted"], columns["used"]
-    # A push without an outcome (its physics diverged, its worker died) is counted apart and
-    # left out of the confusion matrix, the accuracy and the critical pushes.
-    decided = outcome != "error"
-    counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)
-    for p, u in zip(predicted[decided], used[decided], strict=True):
-        counts[LABELS.index(p), LABELS.index(u)] += 1
-    recovered = outcome == "recovered"
-    total = len(outcome)
-    judged = int(np.sum(decided))
-    agree = int(np.sum((columns["predicted_recovers"] == recovered) & decided))
-    return {
-        "spec": spec.to_dict(),
-        "pushes": total,
-        "outcomes": {
-            name: int(np.sum(outcome == name))
-            for name in ("recovered", "fell", "undecided", "error")
-        },
-        "predicted": {name: int(np.sum(predicted == name)) for name in LABELS},
-        "used": {name: int(np.sum(used == name)) for name in LABELS},
-        "accuracy": agree / judged if judged else None,
-        "confusion": {
-            "labels": list(LABELS),
-            "rows": "predicted",
-            "columns": "used",
-            "counts": counts.tolist(),
-        },
-        "boundary": boundary(spec, columns) if spec.samples is None else [],
-        "steps": _steps(columns, recovered),
-    }
+    tally = SummaryTally(spec)
+    tally.add(table)
+    return tally.result()
 
 
-def _steps(columns: dict[str, Any], recovered: Any) -> dict[str, Any]:
-    """N-step predictions against the steps taken.
+class SummaryTally:
+    """The summary of a campaign, added up one table of pushes (a batch) at a time.
 
-    ``predicted``: pushes per predicted number of steps (key "-1": fall); ``taken``: per
-    number of steps the run took; ``exact``: the share of recovered pushes predicted to need
-    steps that took exactly the predicted number (None without such pushes).
+    Only counts are kept, and for grid campaigns the few columns of the boundary (the swept
+    parameters, x0, ẋ and whether the push recovered or has no outcome): a campaign of 10⁸
+    random pushes is summarised in the memory of one batch.
     """
-    if "predicted_steps" not in columns:  # a table written before the column existed
-        return {"predicted": {}, "taken": {}, "exact": None}
-    predicted, taken = columns["predicted_steps"], columns["steps"]
-    stepping = recovered & (predicted > 0)
-    return {
-        "predicted": {str(int(n)): int(np.sum(predicted == n)) for n in np.unique(predicted)},
-        "taken": {str(int(n)): int(np.sum(taken == n)) for n in np.unique(taken)},
-        "exact": float(np.mean(taken[stepping] == predicted[stepping])) if stepping.any() else None,
-    }
+
+    def __init__(self, spec: CampaignSpec) -> None:
+        self.spec = spec
+        self.total = self.judged = self.agree = 0
+        self.outcomes = dict.fromkeys(("recovered", "fell", "undecided", "error"), 0)
+        self.predicted = dict.fromkeys(LABELS, 0)
+        self.used = dict.fromkeys(LABELS, 0)
+        self.counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)
+        self.steps_predicted: dict[int, int] = defaultdict(int)
+        self.steps_taken: dict[int, int] = defaultdict(int)
+        self.stepping = self.exact = 0
+        self.has_steps = True
+        self.boundary_names = [f"param_{name}" for name in spec.sweeps] + ["x0", "xdot"]
+        self.boundary_parts: list[dict[str, np.ndarray]] = []
+
+    def add(self, table: Any) -> None:
+        """Count the pushes of ``table`` (a ``pyarrow.Table`` of the campaign's columns)."""
+        columns = {
+            name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names
+        }
+        outcome, predicted, used = columns["outcome"], columns["predicted"], columns["used"]
+        # A push without an outcome (its physics diverged, its worker died) is counted apart
+        # and left out of the confusion matrix, the accuracy and the critical pushes.
+        decided = outcome != "error"
+        for p, u in zip(predicted[decided], used[decided], strict=True):
+            self.counts[LABELS.index(p), LABELS.index(u)] += 1
+        recovered = outcome == "recovered"
+        self.total += len(outcome)
+        self.judged += int(np.sum(decided))
+        self.agree += int(np.sum((columns["predicted_recovers"] == recovered) & decided))
+        for name in self.outcomes:
+            self.outcomes[name] += int(np.sum(outcome == name))
+        for name in LABELS:
+            self.predicted[name] += int(np.sum(predicted == name))
+            self.used[name] += int(np.sum(used == name))
+        self._add_steps(columns, recovered)
+        if self.spec.samples is None:
+            part = {name: columns[name] for name in self.boundary_names}
+            self.boundary_parts.append(part | {"outcome": outcome})
+
+    def _add_steps(self, columns: dict[str, Any], recovered: Any) -> None:
+        if "predicted_steps" not in columns:  # a table written before the column existed
+            self.has_steps = False
+            return
+        predicted, taken = columns["predicted_steps"], columns["steps"]
+        for counter, values in ((self.steps_predicted, predicted), (self.steps_taken, taken)):
+            found, counts = np.unique(values, return_counts=True)
+            for value, count in zip(found.tolist(), counts.tolist(), strict=True):
+                counter[int(value)] += int(count)
+        stepping = recovered & (predicted > 0)
+        self.stepping += int(np.sum(stepping))
+        self.exact += int(np.sum(taken[stepping] == predicted[stepping]))
+
+    def result(self) -> dict[str, Any]:
+        """Return the summary JSON of every push added (module docstring)."""
+        if self.boundary_parts:
+            names = [*self.boundary_names, "outcome"]
+            columns = {n: np.concatenate([p[n] for p in self.boundary_parts]) for n in names}
+            found = boundary(self.spec, columns)
+        else:
+            found = []
+        return {
+            "spec": self.spec.to_dict(),
+            "pushes": self.total,
+            "outcomes": dict(self.outcomes),
+            "predicted": dict(self.predicted),
+            "used": dict(self.used),
+            "accuracy": self.agree / self.judged if self.judged else None,
+            "confusion": {
+                "labels": list(LABELS),
+                "rows": "predicted",
+                "columns": "used",
+                "counts": self.counts.tolist(),
+            },
+            "boundary": found,
+            "steps": self._steps(),
+        }
+
+    def _steps(self) -> dict[str, Any]:
+        """N-step predictions against the steps taken.
+
+        ``predicted``: pushes per predicted number of steps (key "-1": fall); ``taken``: per
+        number of steps the run took; ``exact``: the share of recovered pushes predicted to
+        need steps that took exactly the predicted number (None without such pushes).
+        """
+        if not self.has_steps:
+            return {"predicted": {}, "taken": {}, "exact": None}
+        return {
+            "predicted": {str(n): self.steps_predicted[n] for n in sorted(self.steps_predicted)},
+            "taken": {str(n): self.steps_taken[n] for n in sorted(self.steps_taken)},
+            "exact": self.exact / self.stepping if self.stepping else None,
+        }
