@@ -1,0 +1,92 @@
+"""The Riccati active-set route of the MPC against an independent solution of Eq. (17)."""
+
+import numpy as np
+import pytest
+
+from pushrecovery.control.mpc import MPCController, MPCSettings
+from pushrecovery.control.mpc.riccati import RiccatiSolver
+from pushrecovery.sim.registry import make_plant
+from pushrecovery.sim.simulate import simulate
+from test_mpc import P, sparse_solution
+
+SCALE = np.array([P.toe - P.heel, P.torque_max])
+
+
+@pytest.mark.parametrize("horizon", [50, 100, 200])
+def test_verified_riccati_solutions_equal_the_sparse_qp(horizon):
+    # Random states, most with the CoP or torque bounds active: the Riccati passes, started
+    # from DAQP's active set, must verify the KKT conditions and give quadprog's first input
+    # of the uncondensed QP (states kept as variables) to 1e-6 of the ranges.
+    settings = MPCSettings(horizon=horizon)
+    controller = MPCController(P, settings)
+    solver = RiccatiSolver(P, settings)
+    rng = np.random.default_rng(horizon)
+    constrained = 0
+    for _ in range(6):
+        x0 = rng.uniform([-0.03, -0.5, -0.5, -1.0], [0.1, 0.5, 0.6, 1.0])
+        assert controller.workspace is not None
+        if controller.workspace.solve(x0) is None:
+            continue
+        active = controller.workspace.active_set()
+        solver.seed(active)
+        if (active[:, 1] * active[:, 2] != 0).any():
+            # τ_i and θ_{i+1} both at a bound: a state constraint the passes do not handle;
+            # they must refuse it (the controller then keeps DAQP's solution).
+            assert not solver.solve(x0, shift=False)
+            continue
+        assert solver.solve(x0, shift=False)
+        assert solver.passes == 1
+        constrained += bool(np.abs(solver.active).sum())
+        reference = sparse_solution(x0, settings)
+        np.testing.assert_allclose(solver.inputs[0] / SCALE, reference[0] / SCALE, atol=1e-6)
+        # The predicted states are the inputs simulated (states kept, not condensed).
+        np.testing.assert_allclose(
+            solver.states, controller.qp.simulate(x0, solver.inputs), rtol=0, atol=1e-9
+        )
+    assert constrained >= 2
+
+
+@pytest.mark.parametrize("horizon", [50, 200])
+def test_closed_loop_ticks_take_the_riccati_route_and_are_exact(horizon):
+    # A pushed run: the ticks after the first start from the last active set shifted by a stage
+    # and are verified by the passes (DAQP only where they are not); sampled ticks against the
+    # sparse QP to 1e-6.
+    plant = make_plant("flywheel", P)
+    run = simulate(plant, MPCController(P, horizon=horizon), plant.reset(0.0, 0.55))
+    controller = MPCController(P, horizon=horizon)
+    controller.reset(run.states[0])
+    verified = []
+    for k, state in enumerate(run.states[:-1]):
+        plan = controller.plan(state)
+        verified.append(controller.riccati.passes > 0)
+        if k % 15 == 1:
+            reference = sparse_solution(state, controller.settings)
+            np.testing.assert_allclose(plan.first_input / SCALE, reference[0] / SCALE, atol=1e-6)
+    assert np.mean(verified) > 0.9
+
+
+def test_a_wrong_active_set_is_not_accepted():
+    # The KKT check can fail: with one pass allowed and a wrong start, the solve is refused.
+    settings = MPCSettings()
+    solver = RiccatiSolver(P, settings)
+    x0 = np.array([0.0, 0.0, 0.6, 0.0])
+    assert not solver.solve(x0)  # from the empty set in one pass... within MAX_PASSES
+    solver.active[:, 1] = 1  # full torque forward over the whole horizon: wrong
+    guess = solver.active.copy()
+    from pushrecovery.control.mpc._riccati_kernels import CHANGED, _pass
+
+    outcome = _pass(
+        x0, solver.a, solver.b, solver.wx, solver.wu, guess, solver.bounds, solver.tols,
+        1e-9, solver.inputs, solver.states, solver._gains, solver._offsets, solver._curvature,
+        solver.multipliers,
+    )  # fmt: skip
+    assert outcome == CHANGED
+
+
+def test_without_hip_torque_the_controller_skips_the_riccati_route():
+    from pushrecovery import load_params
+
+    no_hip = load_params(overrides={"torque_max": 0.0})
+    assert MPCController(no_hip).riccati is None
+    assert MPCController(P).riccati is not None
+    assert MPCController(P, solver="quadprog").riccati is None
