@@ -105,3 +105,31 @@ def test_no_pushes_give_no_runs():
 def test_params_must_be_a_body():
     with pytest.raises(ParameterTypeError, match="params"):
         ankle_pd_rollout("body", [0.0], [0.1], duration=1.0)
+
+
+def test_a_campaign_batch_of_foot_and_ankle_pd_runs_in_lockstep():
+    # run_batch takes the lockstep rollout for MuJoCo's foot + ankle-pd; its rows are the
+    # one-push loop's: the same verdicts, times within one tick, CoP excursions within 1 µm.
+    from pushrecovery.campaign import CampaignSpec
+    from pushrecovery.campaign.pushes import ROLLOUT, run_batch, run_push
+
+    assert ("foot", "ankle-pd") in ROLLOUT
+    campaign = CampaignSpec(
+        "mujoco", "foot", "ankle-pd", P, x0=(0.0, 0.04, 0.04), xdot=(-0.6, 0.6, 0.3),
+        sweeps={"toe": (0.12, 0.16, 0.04)}, duration=4.0, batch_size=100,
+    )  # fmt: skip
+    _, rows = run_batch(campaign, 0)
+    cache: dict = {}
+    outcomes = set()
+    for row, push in zip(rows, campaign.pushes(0), strict=True):
+        loop = run_push(campaign, push, cache)
+        outcomes.add(loop["outcome"])
+        close = ("time", "cop_min", "cop_max", "peak_ankle_torque")
+        exact = {k: v for k, v in loop.items() if k not in close}
+        assert {k: row[k] for k in exact} == exact, push
+        assert abs(row["peak_ankle_torque"] - loop["peak_ankle_torque"]) < P.weight * 1e-6
+        assert abs(row["time"] - loop["time"]) <= 1e-3 + 1e-12
+        assert abs(row["cop_min"] - loop["cop_min"]) < 1e-6
+        assert abs(row["cop_max"] - loop["cop_max"]) < 1e-6
+    assert outcomes == {"recovered", "fell"}
+    assert campaign.size == len(rows) == 20

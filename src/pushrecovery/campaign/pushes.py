@@ -42,7 +42,7 @@ from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.control.base import controller_class, make_controller
 from pushrecovery.errors import SimulationDiverged, SimulationTimeout
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.batched import BATCHED
+from pushrecovery.sim.batched import BATCHED, BatchedRuns
 from pushrecovery.sim.critical import pushed_state
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.result import Outcome, strategy_used
@@ -53,7 +53,10 @@ from pushrecovery.surfaces.classify import (
     sagittal_verdicts,
 )
 
-__all__ = ["COLUMNS", "error_row", "run_batch", "run_push"]
+__all__ = ["COLUMNS", "ROLLOUT", "error_row", "run_batch", "run_push"]
+
+#: (model, controller) pairs of the MuJoCo backend simulated in lockstep with mujoco.rollout.
+ROLLOUT = frozenset({("foot", "ankle-pd")})
 
 
 #: Fixed columns after the ``param_<name>`` ones, with their Arrow type names.
@@ -226,6 +229,48 @@ def _batched_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]
         runs = recovery_pushes(bodies, starts, speeds, duration=spec.duration)
     else:
         runs = ankle_pd_pushes(spec.model, bodies, starts, speeds, duration=spec.duration)
+    return _rows_of_runs(spec, pushes, runs)
+
+
+def _rollout_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]]:
+    """Rows of MuJoCo pushes simulated in lockstep (:mod:`pushrecovery.sim.mujoco.rollout`).
+
+    One call per body, the pushes of each in batch order; the rows in push order.
+    """
+    import numpy as np
+
+    from pushrecovery.sim.batched import BatchedRuns
+    from pushrecovery.sim.mujoco.rollout import ankle_pd_rollout
+
+    bodies: dict[BodyParams, list[int]] = {}
+    for k, push in enumerate(pushes):
+        bodies.setdefault(push.params, []).append(k)
+    count = len(pushes)
+    outcomes: list[Outcome] = [Outcome.UNDECIDED] * count
+    times, cop_min, cop_max = np.empty(count), np.empty(count), np.empty(count)
+    diverged = np.zeros(count, dtype=np.bool_)
+    for params, members in bodies.items():
+        runs = ankle_pd_rollout(
+            params,
+            [pushes[k].x0 for k in members],
+            [pushes[k].xdot for k in members],
+            duration=spec.duration,
+        )
+        for j, k in enumerate(members):
+            outcomes[k] = runs.outcomes[j]
+        times[members], cop_min[members] = runs.times, runs.cop_min
+        cop_max[members], diverged[members] = runs.cop_max, runs.diverged
+    zeros = np.zeros(count, dtype=np.int64)
+    batched = BatchedRuns(
+        tuple(outcomes), times, cop_min, cop_max, zeros, np.zeros(count), zeros, diverged
+    )
+    return _rows_of_runs(spec, pushes, batched)
+
+
+def _rows_of_runs(
+    spec: CampaignSpec, pushes: list[Push], runs: BatchedRuns
+) -> list[dict[str, Any]]:
+    """Rows of pushes simulated together: each run's outcome with the push's verdict."""
     rows = []
     predictions = _predictions(pushes)
     for k, push in enumerate(pushes):
@@ -292,6 +337,10 @@ def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]
         pushes = spec.pushes(batch)
         if spec.backend == "analytic" and (spec.model, spec.controller) in BATCHED:
             return batch, _batched_rows(spec, pushes)
+        if spec.backend == "mujoco" and (spec.model, spec.controller) in ROLLOUT:
+            # The whole batch at once: the pushes' time limits add up.
+            watchdog.arm(spec.push_timeout * len(pushes))
+            return batch, _rollout_rows(spec, pushes)
         cache: dict[BodyParams, Any] = {}
         rows = []
         for push in pushes:
