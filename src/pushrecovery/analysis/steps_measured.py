@@ -5,23 +5,24 @@
 below ``threshold``, default 20 N); a foot-off at the first unloaded sample of a run, a
 foot-contact at the first loaded sample after it.
 
-**Foot on the floor from markers** (:func:`foot_events_from_markers`). Each of the foot's heel
-and toe markers is on the floor in a frame when both hold:
+**Foot on the floor from markers** (:func:`foot_events_from_markers`), from the heel and toe
+markers' heights above the floor, the floor of each marker being the lowest it gets in the trial
+(a heel marker sits higher than a toe marker; the rule of
+:func:`~pushrecovery.analysis.recording.support_from_feet`), and their vertical speeds from the
+low-passed heights (zero-lag Butterworth, ``cutoff``,
+:func:`~pushrecovery.analysis.signals.smooth_and_differentiate`). With hysteresis:
 
-* its height above the floor is at most ``contact_height``, the floor being the lowest the
-  marker gets in the trial (each marker has its own: a heel marker sits higher than a toe
-  marker; the rule of :func:`~pushrecovery.analysis.recording.support_from_feet`), as the
-  position constraint of O'Connor et al. (2007, Gait Posture 25:469-474);
-* its vertical speed, from the low-passed height (zero-lag Butterworth, ``cutoff``,
-  :func:`~pushrecovery.analysis.signals.smooth_and_differentiate`), is at most ``max_speed``:
-  a marker on the floor is still, the velocity-threshold principle of Ghoussayni et al. (2004,
-  Gait Posture 20:266-272), here on the vertical speed only so that a foot carried by a
-  moving belt still counts as on the floor.
+* foot-contact at the first frame in which a marker is low (at most ``contact_height`` above
+  its floor, the position constraint of O'Connor et al. 2007, Gait Posture 25:469-474) *and*
+  still (vertical speed at most ``max_speed``: the velocity threshold of Ghoussayni et al.
+  2004, Gait Posture 20:266-272, on the vertical speed only, so that a foot carried by a belt
+  counts as on the floor);
+* foot-off at the first frame in which no marker is low any more (a foot rolling over its toes
+  moves its markers before it leaves: a speed criterion would fire early).
 
-The foot is on the floor while either marker is (heel-first and toe-first contacts, heel raised
-at push-off). Runs shorter than ``min_duration`` are merged away as in
-:func:`~pushrecovery.analysis.events.flight_phases`. A foot-off is the first frame off the
-floor, a foot-contact the first frame on it again. Missing frames keep the state before them.
+Off-floor runs and contacts shorter than ``min_duration`` are merged away as in
+:func:`~pushrecovery.analysis.events.flight_phases`; missing frames keep the state before them.
+A step whose markers never rise ``contact_height`` (a shuffle) is not seen.
 
 **Measured steps** (:func:`measured_steps`): each foot-off of a foot paired with its next
 foot-contact. The foot's position is the midpoint of its heel and toe markers along ap and ml
@@ -195,7 +196,7 @@ def foot_events_from_markers(
     time: ArrayLike,
     foot: Foot,
     *,
-    contact_height: float = 0.02,
+    contact_height: float = 0.03,
     max_speed: float = 0.1,
     cutoff: float = 10.0,
     min_duration: float = MIN_DURATION,
@@ -251,21 +252,25 @@ def foot_events_from_markers(
         warnings.simplefilter("ignore", RuntimeWarning)
         floor = np.nanmin(smooth, axis=0)
     known = np.isfinite(smooth) & np.isfinite(speed)
-    with np.errstate(invalid="ignore"):
-        down = known & (smooth - floor <= contact_height) & (np.abs(speed) <= max_speed)
-    any_known = known.any(axis=1)
-    on_floor = down.any(axis=1)
-    if not any_known.any():
+    if not known.any():
         return []
+    with np.errstate(invalid="ignore"):
+        low = known & (smooth - floor <= contact_height)
+        landing = (low & (np.abs(speed) <= max_speed)).any(axis=1)
     # Missing frames keep the state before them (the first known state before the first).
-    indices = np.where(any_known, np.arange(len(time)), -1)
+    indices = np.where(known.any(axis=1), np.arange(len(time)), -1)
     last_known = np.maximum.accumulate(indices)
-    last_known[last_known < 0] = int(np.flatnonzero(any_known)[0])
-    on_floor = on_floor[last_known]
+    last_known[last_known < 0] = int(np.flatnonzero(indices >= 0)[0])
+    low_foot, landing = low.any(axis=1)[last_known], landing[last_known]
+    # Hysteresis: on the floor from the first low and still frame of a low run to its end.
+    on_floor = np.zeros(len(time), dtype=bool)
+    for start, stop in _find_gaps(low_foot):
+        still = np.flatnonzero(landing[start:stop])
+        if len(still):
+            on_floor[start + still[0] : stop] = True
     off = np.zeros(len(time), dtype=bool)
     for start, stop in _runs(~on_floor, _period(time), min_duration):
         off[start:stop] = True
-    # A short contact merged away between two flights leaves the foot off throughout.
     return _events_from_mask(foot.name, time, off, "markers")
 
 
