@@ -92,6 +92,9 @@ VALID: dict[str, Any] = {
     "missing": np.zeros(10, dtype=bool), "valid": np.ones(10, dtype=bool),
     "source": TIME, "outcome_of": lambda v: Outcome.RECOVERED if abs(v) < 1.0 else Outcome.FELL,
     "guess": 0.5, "max_velocity": 4.0,
+    # Events of measured trials.
+    "signal": SWAY, "vertical_force": np.full(len(TIME), 700.0), "windows": [(0.0, 1.0)],
+    "events": [],
 }  # fmt: skip
 #: Arguments whose example depends on the function (the same name, another meaning).
 OVERRIDES: dict[str, dict[str, Any]] = {
@@ -107,6 +110,13 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     },
     "pushrecovery.analysis.signals.smooth_and_differentiate": {"values": np.sin(TIME)},
     "pushrecovery.analysis.zero_point.com_from_force": {"cop": 0.02 + SWAY},
+    "pushrecovery.analysis.steps_measured.foot_events_from_force": {"foot": "left"},
+    "pushrecovery.analysis.steps_measured.foot_events_from_markers": {
+        "foot": fixed_feet(len(TIME), 0.0, 0.1, -0.05, 0.15, 0.2)[0]
+    },
+    "pushrecovery.analysis.steps_measured.measured_steps": {
+        "feet": fixed_feet(len(TIME), 0.0, 0.1, -0.05, 0.15, 0.2)
+    },
     "pushrecovery.ground.minkowski.decompose": {
         "point": np.array([0.05, 0.01]), "offset": np.zeros(2),
         "total": minkowski_sum(TERMS, (0.0, 0.0)),
