@@ -149,6 +149,13 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         "cop_margin": 0.0, "push_duration": 0.01
     },
     "pushrecovery.sim.critical.find_critical_velocity": {"direction": "forward"},
+    # Posturography: 10 s of CoP (ap, ml) [m] at 100 Hz (the spectrum needs >= 1 / 0.15 Hz).
+    **{f"pushrecovery.analysis.posturography.{name}": {
+        "cop": 0.01 * np.column_stack([np.sin(np.arange(1000) / 20), np.cos(np.arange(1000) / 13)]),
+        "series": 0.01 * np.sin(np.arange(1000) / 20),
+    } for name in ("path_length", "mean_velocity", "mean_distance", "rms_distance",
+                   "mean_frequency", "prediction_ellipse", "sway_spectrum", "sway_measures",
+                   "quiet_standing")},
 }  # fmt: skip
 #: Public functions the sweep leaves to their own tests, and why.
 NOT_SWEPT = {
