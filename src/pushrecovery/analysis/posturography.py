@@ -64,7 +64,7 @@ class Spectrum:
 
     ``total_power`` μ₀ [m²]; ``f50``, ``f95`` the lowest PSD frequencies below which 50 %
     (95 %) of the band power lies [Hz]; ``centroidal_frequency`` √(μ₂/μ₀) [Hz];
-    ``frequency_dispersion`` √(1 − μ₁²/(μ₀ μ₂)) [-] (0 for a pure tone, 0.5 for a flat spectrum from 0 Hz).
+    ``frequency_dispersion`` √(1 − μ₁²/(μ₀ μ₂)) [-] (0: a pure tone; 0.5: flat from 0 Hz).
     """
 
     total_power: float
