@@ -145,7 +145,9 @@ def test_bad_inputs_are_one_line(tmp_path, capsys):
     trial = _trial(tmp_path / "trial.csv")
     out = str(tmp_path / "o")
     assert "not found" in _fail(capsys, "analyze", str(tmp_path / "none.csv"), "--out", out)
-    assert "directory" in _fail(capsys, "analyze", str(tmp_path), "--out", out)
+    empty = tmp_path / "empty"
+    empty.mkdir()  # a folder is a batch of trials (issue 18), but this one has none
+    assert "no .csv or .c3d trial" in _fail(capsys, "analyze", str(empty), "--out", out)
     assert "'furlongs'" in _fail(capsys, "analyze", str(trial), "--units", "furlongs", "--out", out)
     assert "units" in _fail(capsys, "analyze", str(trial), "--out", out)  # mm read as m
     text = tmp_path / "trial.txt"

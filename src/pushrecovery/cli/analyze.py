@@ -30,14 +30,40 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     return name, parts[0], parts[1], parts[2]
 
 
-@click.command(short_help="Per-frame margins and strategies of a measured trial (CSV, C3D).")
-@click.argument("file", type=click.Path(dir_okay=True, path_type=Path))
+@click.command(short_help="Per-frame margins and strategies of measured trials (CSV, C3D).")
+@click.argument("inputs", nargs=-1, required=True, metavar="FILE|FOLDER|GLOB...")
 @click.option(
     "--out",
     "out",
     type=click.Path(file_okay=False, path_type=Path),
     required=True,
-    help="Directory for frames.parquet, frames.csv, summary.json and the plots.",
+    help="Directory for frames.parquet, frames.csv, summary.json and the plots (one file); "
+    "for many, trials/<trial>/ per trial and trials, events (Parquet, CSV) and summary.json.",
+)
+@click.option(
+    "--subjects",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="CSV of subjects: pattern, subject, mass, leg_length, com_height, foot_length, "
+    "foot_width (docs/analysis.md).",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="Local worker processes for many trials.",
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Dask scheduler (tcp://HOST:PORT) to analyse many trials on.",
+)
+@click.option(
+    "--resume",
+    is_flag=True,
+    help="Keep the trials already finished in --out.",
 )
 @click.option(
     "--units",
@@ -115,28 +141,26 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     help="Write time_series.png and phase_portrait.png.",
 )
 @body_options
-def analyze(file: Path, out: Path, as_json: bool, **kwargs: Any) -> None:
-    """Analyse a measured trial: capture point, margins, strategy and step per frame.
+def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) -> None:
+    """Analyse measured trials: capture point, margins, strategy and step per frame.
 
-    FILE is a CSV (columns documented in docs/analysis.md) or a C3D file (markers and force
-    plates). Both directions are analysed, each with its own base of support; mass and CoM
-    height come from the flags, else from the file, else (mass) from the force plates.
+    Each input is a CSV (columns documented in docs/analysis.md) or C3D file (markers and
+    force plates), a folder (every .csv and .c3d below it) or a glob pattern. Both directions
+    are analysed, each with its own base of support; mass and CoM height come from the
+    subjects table, the flags, the file, else (mass) the force plates. One file writes its
+    outputs into OUT; many write one folder per trial and the tables of trials and events.
     """
-    from pushrecovery.analysis.output import _json_safe, write_analysis
-    from pushrecovery.analysis.readers import read_recording
-    from pushrecovery.analysis.trial import AnalysisSettings, body_for
-    from pushrecovery.analysis.trial import analyze as analyze_trial
-    from pushrecovery.presets import load_params
+    from pushrecovery.analysis.trial import AnalysisSettings
 
-    options: dict[str, Any] = {}
-    suffix = file.suffix.lower()
-    if suffix == ".csv":
-        options["units"] = kwargs.pop("units")
-    elif suffix == ".c3d":
-        options["ap_axis"] = kwargs.pop("ap_axis")
-        options["com_markers"] = list(kwargs.pop("com_markers")) or None
-        feet = kwargs.pop("feet")
-        options["feet"] = [_foot(text) for text in feet] if feet else None
+    feet = kwargs.pop("feet")
+    reader: dict[str, dict[str, Any]] = {
+        ".csv": {"units": kwargs.pop("units")},
+        ".c3d": {
+            "ap_axis": kwargs.pop("ap_axis"),
+            "com_markers": list(kwargs.pop("com_markers")) or None,
+            "feet": [_foot(text) for text in feet] if feet else None,
+        },
+    }
     settings = AnalysisSettings(
         cutoff=kwargs.pop("cutoff"),
         force_cutoff=kwargs.pop("force_cutoff"),
@@ -145,8 +169,31 @@ def analyze(file: Path, out: Path, as_json: bool, **kwargs: Any) -> None:
         ankle_ap=kwargs.pop("ankle_ap"),
         ankle_ml=kwargs.pop("ankle_ml"),
     )
+    single = len(inputs) == 1 and Path(inputs[0]).is_file()
+    batch = {name: kwargs.pop(name) for name in ("subjects", "workers", "scheduler", "resume")}
+    if single and batch["subjects"] is None:
+        _single(Path(inputs[0]), out, as_json, reader, settings, **kwargs)
+    else:
+        _batch(inputs, out, as_json, reader, settings, batch, **kwargs)
+
+
+def _single(
+    file: Path,
+    out: Path,
+    as_json: bool,
+    reader: dict[str, dict[str, Any]],
+    settings: Any,
+    **kwargs: Any,
+) -> None:
+    """One trial, its outputs straight into ``out`` (the first releases' contract)."""
+    from pushrecovery.analysis.output import _json_safe, write_analysis
+    from pushrecovery.analysis.readers import read_recording
+    from pushrecovery.analysis.trial import analyze as analyze_trial
+    from pushrecovery.analysis.trial import body_for
+    from pushrecovery.presets import load_params
+
     plot = kwargs.pop("plot")
-    recording = read_recording(file, **options)
+    recording = read_recording(file, **reader.get(file.suffix.lower(), {}))
     overrides = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
     preset = load_params(kwargs["preset"], kwargs["params_file"], overrides)
     found, sources = body_for(
@@ -159,15 +206,75 @@ def analyze(file: Path, out: Path, as_json: bool, **kwargs: Any) -> None:
     result = analyze_trial(recording, params, settings, sources=sources)
     files = {name: str(path) for name, path in write_analysis(result, out).items()}
     if plot:
-        from pushrecovery.plots.analysis import plot_phase_portrait, plot_time_series
-
-        files["time_series"] = str(plot_time_series(result, out / "time_series.png"))
-        files["phase_portrait"] = str(plot_phase_portrait(result, out / "phase_portrait.png"))
+        files.update(plot_trial(result, out))
     summary = _json_safe(result.summary)
     if as_json:
         emit({**summary, "files": files}, True)
         return
     emit(_brief(summary, files), False)
+
+
+def plot_trial(result: Any, out: Path) -> dict[str, str]:
+    """Draw a trial's time series and phase portrait into ``out``; return the files."""
+    from pushrecovery.plots.analysis import plot_phase_portrait, plot_time_series
+
+    return {
+        "time_series": str(plot_time_series(result, out / "time_series.png")),
+        "phase_portrait": str(plot_phase_portrait(result, out / "phase_portrait.png")),
+    }
+
+
+def _batch(
+    inputs: tuple[str, ...],
+    out: Path,
+    as_json: bool,
+    reader: dict[str, dict[str, Any]],
+    settings: Any,
+    batch: dict[str, Any],
+    **kwargs: Any,
+) -> None:
+    """Many trials: one folder each, the tables of trials and events, the summary."""
+    from pushrecovery.campaign.subjects import read_subjects
+    from pushrecovery.campaign.trials import find_trials, run_trials, trial_jobs
+    from pushrecovery.cli.progress import Progress
+
+    plot = kwargs.pop("plot")
+    flags = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
+    subjects = read_subjects(batch["subjects"]) if batch["subjects"] is not None else ()
+    trials, root = find_trials(inputs)
+    if batch["subjects"] is not None:  # the table may sit among the trials it describes
+        trials = [t for t in trials if t != batch["subjects"].resolve()]
+    jobs = trial_jobs(
+        trials, root, subjects, reader=reader, flags=flags, preset=kwargs["preset"],
+        params_file=kwargs["params_file"], settings=settings,
+    )  # fmt: skip
+    bar = Progress(len(jobs), "analyze", "trial")
+    try:
+        result = run_trials(
+            jobs,
+            out,
+            workers=batch["workers"],
+            scheduler=batch["scheduler"],
+            resume=batch["resume"],
+            after=plot_trial if plot else None,
+            progress=bar.update,
+        )
+    finally:
+        bar.close()
+    files = {name: str(path) for name, path in result.files.items()}
+    data = {**result.summary, "root": str(root), "analysed_now": result.ran, "files": files}
+    if as_json:
+        emit(data, True)
+        return
+    emit(
+        {
+            "trials": f"{result.summary['analysed']} of {result.summary['trials']} analysed "
+            f"({result.summary['failed']} failed)",
+            "subjects": len(result.summary["subjects"]),
+            "files": files,
+        },
+        False,
+    )
 
 
 def _brief(summary: dict[str, Any], files: dict[str, str]) -> dict[str, Any]:

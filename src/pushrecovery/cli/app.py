@@ -18,7 +18,7 @@ __all__ = ["COMMANDS", "cli"]
 COMMANDS: dict[str, tuple[str, str]] = {
     "analyze": (
         "pushrecovery.cli.analyze:analyze",
-        "Per-frame margins and strategies of a measured trial (CSV, C3D).",
+        "Per-frame margins and strategies of measured trials (CSV, C3D).",
     ),
     "bounds": ("pushrecovery.cli.surfaces:bounds", "Capture-point bounds of each strategy."),
     "campaign": (

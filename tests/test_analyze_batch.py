@@ -1,0 +1,189 @@
+"""Many trials in one command (issue 18, item 1).
+
+Files, folders and globs, a subjects table, local processes and a Dask cluster with the same
+tables, a bad file among good ones.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from pushrecovery import InvalidParameterError, load_params
+from pushrecovery.campaign.subjects import read_subjects, subject_for
+from pushrecovery.campaign.trials import find_trials, run_trials, trial_jobs
+
+P = load_params()
+OMEGA = P.omega
+RATE = 100.0
+
+
+def lipm_trial(push: float, azimuth: float, duration: float = 3.0, seed: int = 0) -> str:
+    """CSV text of a 2-D LIPM trial: standing, a velocity push at 0.5 s toward ``azimuth``
+    [rad] (0 forward, π/2 to the left), the CoP at the capture point clipped to the foot
+    (exact ZOH per axis at 100 Hz); the base is the foot's rectangle."""
+    rng = np.random.default_rng(seed)
+    low = np.array([P.heel, -0.5 * P.foot_width])
+    high = np.array([P.toe, 0.5 * P.foot_width])
+    dt = 1.0 / RATE
+    ch, sh = math.cosh(OMEGA * dt), math.sinh(OMEGA * dt)
+    x, v = np.array([0.02, 0.0]), np.zeros(2)
+    lines = ["time,com_ap,com_ml,cop_ap,cop_ml,base_ap_min,base_ap_max,base_ml_min,base_ml_max"]
+    for k in range(int(duration * RATE)):
+        if k == int(0.5 * RATE):
+            v = v + push * np.array([math.cos(azimuth), math.sin(azimuth)])
+        cop = np.clip(x + 2.0 * v / OMEGA, low, high)
+        noise = rng.normal(0.0, 1e-4, 2)
+        com = x + noise
+        lines.append(
+            f"{k * dt:.4f},{com[0]:.6f},{com[1]:.6f},{cop[0]:.6f},{cop[1]:.6f},"
+            f"{low[0]},{high[0]},{low[1]},{high[1]}"
+        )
+        offset = x - cop
+        x, v = cop + offset * ch + v / OMEGA * sh, OMEGA * offset * sh + v * ch
+        if np.any(np.abs(x) > 0.6):
+            break
+    return "\n".join(lines) + "\n"
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    """Two subjects' folders of trials (pushes from eight directions) and a bad file."""
+    root = tmp_path_factory.mktemp("study")
+    for s, subject in enumerate(("s01", "s02")):
+        folder = root / subject
+        folder.mkdir()
+        for k in range(8):
+            push = 0.1 + 0.05 * k
+            (folder / f"trial{k:02d}.csv").write_text(lipm_trial(push, k * math.pi / 4, seed=s))
+    (root / "s02" / "broken.csv").write_text("time,com_ap\n0.0,abc\n")
+    (root / "subjects.csv").write_text(  # in the study's folder: the CLI leaves it out
+        "pattern,subject,mass,leg_length,com_height,foot_length,foot_width\n"
+        "s01/*,S1,70,0.95,1.0,,\n"
+        "s02/*,S2,80,,,0.26,0.1\n"
+    )
+    return root
+
+
+def test_files_folders_and_globs(study):
+    folder, root = find_trials([study / "s01"])
+    assert len(folder) == 8 and root == study / "s01"
+    pattern, root = find_trials([str(study / "s0*" / "trial0[0-3].csv")])
+    assert len(pattern) == 8 and root == study
+    both, _ = find_trials([study / "s01", study / "s01" / "trial00.csv"])  # each once
+    assert len(both) == 8
+    for bad, words in (
+        ([], "at least one"),
+        ([study / "nothing"], "not found"),
+        ([study / "subjects.csv", study / "x.txt"], "not found"),
+        ([str(study / "*.nope")], "no .csv or .c3d"),
+    ):
+        with pytest.raises(InvalidParameterError, match=words):
+            find_trials(bad)
+
+
+def test_a_batch_on_one_and_two_workers_gives_the_same_tables(study, tmp_path):
+    trials, root = find_trials([study])
+    trials.remove(study / "subjects.csv")  # a CSV file, but the subjects' table
+    jobs = trial_jobs(trials, root, read_subjects(study / "subjects.csv"))
+    from distributed import LocalCluster
+
+    one = run_trials(jobs, tmp_path / "one", workers=1)
+    two = run_trials(jobs, tmp_path / "two", workers=2)
+    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0") as cluster:
+        dask = run_trials(jobs, tmp_path / "dask", scheduler=cluster.scheduler_address)
+    for name in ("trials", "events"):
+        table = pq.read_table(tmp_path / "one" / f"{name}.parquet")
+        assert table.equals(pq.read_table(tmp_path / "two" / f"{name}.parquet"))
+        assert table.equals(pq.read_table(tmp_path / "dask" / f"{name}.parquet"))
+    assert one.summary == two.summary == dask.summary
+    # 17 trials: 16 analysed, the broken one a failed row per axis, the batch went on.
+    assert one.summary["trials"] == 17 and one.summary["failed"] == 1
+    failed = [row for row in one.trials if row["status"] == "failed"]
+    assert [row["axis"] for row in failed] == ["ap", "ml"]
+    assert "broken.csv: needs at least 10 rows" in failed[0]["error"]
+    # The subjects table: S1's mass and leg length, S2's foot length scaled from the preset's.
+    s1 = next(r for r in one.trials if r["subject"] == "S1" and r["status"] == "analysed")
+    assert (s1["mass"], s1["leg_length"]) == (70.0, 0.95)
+    assert s1["mass_source"] == "subjects table"
+    s2 = [r for r in one.trials if r["subject"] == "S2" and r["status"] == "analysed"]
+    assert s2 and all(r["mass"] == 80.0 for r in s2)
+    assert set(one.summary["subjects"]) == {"S1", "S2"}
+    # Pushes grow with the trial number: the larger ones need more than the ankles.
+    demanding = {r["most_demanding"] for r in one.trials if r["status"] == "analysed"}
+    assert "ankle" in demanding and demanding - {"ankle"}
+
+
+def test_a_resumed_batch_keeps_finished_trials(study, tmp_path):
+    trials, root = find_trials([study / "s01"])
+    jobs = trial_jobs(trials, root)
+    whole = run_trials(jobs[:3], tmp_path / "b", workers=1)
+    assert whole.ran == 3
+    resumed = run_trials(jobs, tmp_path / "b", workers=1, resume=True)
+    assert resumed.ran == 5 and resumed.summary["trials"] == 8
+
+
+def test_bad_subjects_tables(tmp_path):
+    cases = {
+        "pattern,mass\nx,70\n": "needs the columns pattern and subject",
+        "pattern,subject,height\nx,a,1\n": "unknown columns height",
+        "pattern,subject,mass\nx,a,heavy\n": "line 2: mass must be a number",
+        "pattern,subject,mass\nx,a,-3\n": "line 2: mass must be in",
+        "pattern,subject\n,a\n": "line 2: pattern and subject must not be empty",
+        "pattern,subject\n": "has no rows",
+        "pattern,subject\nx,a,3\n": "line 2: more cells than columns",
+    }
+    for text, words in cases.items():
+        path = tmp_path / "subjects.csv"
+        path.write_text(text)
+        with pytest.raises(InvalidParameterError, match=words):
+            read_subjects(path)
+    with pytest.raises(InvalidParameterError, match="cannot read"):
+        read_subjects(tmp_path / "missing.csv")
+    table = read_subjects(_write(tmp_path / "ok.csv", "pattern,subject\nA/*,a\n*.c3d,b\n"))
+    assert subject_for("A/t1.csv", table).subject == "a"
+    assert subject_for("B/t1.c3d", table).subject == "b"
+    assert subject_for("B/t1.csv", table) is None
+
+
+def test_bad_batch_arguments(study, tmp_path):
+    trials, root = find_trials([study / "s01"])
+    jobs = trial_jobs(trials, root)
+    for workers in (0, -1, 1.5, True):
+        with pytest.raises(InvalidParameterError, match="workers"):
+            run_trials(jobs, tmp_path / "x", workers=workers)
+    with pytest.raises(InvalidParameterError, match="no trials"):
+        run_trials([], tmp_path / "x")
+
+
+def test_the_cli_analyses_a_folder_in_one_command(study, tmp_path, capsys):
+    from pushrecovery.cli import main
+
+    out = tmp_path / "cli"
+    args = ["analyze", str(study), "--out", str(out), "--subjects", str(study / "subjects.csv")]
+    with pytest.raises(SystemExit) as done:
+        main([*args, "--no-plot", "--json", "--workers", "2"])
+    assert done.value.code == 0
+    data = json.loads(capsys.readouterr().out)
+    assert (data["trials"], data["analysed"], data["failed"]) == (17, 16, 1)
+    assert (out / "trials.csv").exists() and (out / "events.parquet").exists()
+    assert (out / "trials" / "s01__trial00.csv" / "frames.parquet").exists()
+    for bad, words in (
+        ([str(tmp_path / "none")], "not found"),
+        ([str(study), "--subjects", str(tmp_path / "none.csv")], "cannot read the subjects"),
+        ([str(study), "--workers", "0"], "--workers"),
+    ):
+        with pytest.raises(SystemExit) as done:
+            main(["analyze", *bad, "--out", str(out)])
+        assert done.value.code == 2
+        error = capsys.readouterr().err
+        assert words in error and len(error.strip().splitlines()) == 1, error
+
+
+def _write(path, text):
+    path.write_text(text)
+    return path
