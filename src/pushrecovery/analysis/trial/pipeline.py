@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.analysis.margins import DirectionMargins, direction_margins
+from pushrecovery.analysis.posturography import quiet_standing, sway_measures
 from pushrecovery.analysis.recording import (
     AXES,
     LOADED,
@@ -20,6 +21,7 @@ from pushrecovery.analysis.signals import (
     resample,
     smooth_and_differentiate,
 )
+from pushrecovery.analysis.trial.checks import check_frames
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
 from pushrecovery.analysis.trial.summary import _exclusions, _interpolated, _names, _summary
 from pushrecovery.analysis.trial.support import _repair_loaded, _support
@@ -115,12 +117,20 @@ def analyze(
             "force, so its impulse is missing between the zero points around it"
         )
 
+    plate_force, plate_cop = force, cop  # at the plates' own rate
     if force is not None and force_time is not None:
         force = resample(force_time, force, time)
     if cop is not None and force_time is not None:
         cop = resample(force_time, cop, time)
     support, support_source, found = _support(recording, time, com, cop, params, settings)
     gaps += found
+    checks = check_frames(time, force_time, plate_force, cop, support.lower, support.upper)
+    if checks.base_rejected:
+        notes.append(
+            f"the measured CoP lies beyond the computed base of support ({support_source}) "
+            f"by more than {checks.tolerance * 100:g} cm in {int(checks.contradicted.sum())} "
+            f"of {checks.loaded_frames} loaded frames: the base is wrong, no verdict is given"
+        )
 
     columns: dict[str, NDArray[Any]] = {"time": time}
     per_axis: dict[str, DirectionMargins] = {}
@@ -149,6 +159,7 @@ def analyze(
             cop=axis_cop,
             cmp=cmp,
         )
+        _withhold(margins, checks.withheld)  # no verdict where the data contradict it
         per_axis[axis] = margins
         nan = np.full(len(time), np.nan)
         columns.update(
@@ -179,6 +190,8 @@ def analyze(
     columns["strategy"] = _names(codes)
     columns["valid"] = ~invalid
     columns["interpolated"] = _interpolated(time, gaps)
+    columns["flight"] = checks.flight
+    columns["cop_outside_base"] = checks.contradicted
 
     summary = _summary(
         recording,
@@ -194,6 +207,45 @@ def analyze(
         com_source=com_source,
         support_source=support_source,
         notes=notes,
-        reasons=_exclusions(com, velocity, support, invalid),
+        reasons={
+            **_exclusions(com, velocity, support, invalid & ~checks.withheld),
+            **checks.reasons(),
+        },
     )
+    summary["checks"] = checks.to_dict()
+    summary["posturography"] = _posturography(force_time, plate_cop, plate_force, settings)
     return TrialAnalysis(columns, summary)
+
+
+def _withhold(margins: DirectionMargins, frames: NDArray[np.bool_]) -> None:
+    """Withhold the verdicts of ``frames``: margins against the base NaN, strategy invalid."""
+    for name in ("cop", "cmp", "step", "time_to_leave_cop", "time_to_leave_cmp"):
+        getattr(margins, name)[frames] = np.nan
+    for name in ("step_length", "step_shortest", "step_longest"):
+        getattr(margins, name)[frames] = np.nan
+    margins.strategy[frames] = -1
+    margins.steps[frames] = -1
+
+
+def _posturography(
+    force_time: FloatArray | None,
+    cop: FloatArray | None,
+    force: FloatArray | None,
+    settings: AnalysisSettings,
+) -> dict[str, Any] | None:
+    """Sway measures of a quiet-standing trial (docs/posturography.md), else None.
+
+    The whole trial at the plates' rate, its CoP low-passed at ``force_cutoff``; None when
+    the plates are missing or :func:`~pushrecovery.analysis.posturography.quiet_standing`
+    says it is no quiet standing, or it is too short for the spectra.
+    """
+    if force_time is None or cop is None or len(force_time) < 2:
+        return None
+    rate = 1.0 / float(np.median(np.diff(force_time)))
+    try:
+        if not quiet_standing(cop, rate, force=force):
+            return None
+        measures = sway_measures(cop, rate).to_dict()
+    except InvalidParameterError:  # too short for the spectra, or a gap in the CoP
+        return None
+    return {**measures, "cop_cutoff": settings.force_cutoff, "rate": rate}

@@ -137,14 +137,41 @@ def body_for(
         values["mass"], sources["mass"] = mass, "flag"
     elif recording.mass is not None:
         values["mass"], sources["mass"] = recording.mass, "file"
-    elif recording.force is not None:
-        vertical = recording.force[:, 2]
-        loaded = vertical[vertical > LOADED]
-        if len(loaded):
-            values["mass"] = float(np.mean(loaded)) / gravity
-            sources["mass"] = "force plates (mean vertical force / g)"
+    elif recording.force is not None and recording.force_time is not None:
+        mass, source = _weighed(recording.force_time, recording.force[:, 2], gravity)
+        if mass is not None:
+            values["mass"], sources["mass"] = mass, source
     if com_height is not None:
         values["com_height"], sources["com_height"] = com_height, "flag"
     elif recording.com_height is not None:
         values["com_height"], sources["com_height"] = recording.com_height, "file"
     return values, sources
+
+
+def _weighed(time: FloatArray, vertical: FloatArray, gravity: float) -> tuple[float | None, str]:
+    """Mass from the plates: the quiet windows' mean vertical force / g, with its spread.
+
+    Push-offs, landings and flights bias any mean over the loaded samples (84.0 kg against
+    78.1 kg standing on biomdp's countermovement jump): only quiet windows weigh the subject
+    (:func:`~pushrecovery.analysis.events.mass_from_quiet`). Without one, the mean over the
+    loaded samples, said to be biased.
+    """
+    from pushrecovery.analysis.events import mass_from_quiet, quiet_windows
+
+    finite = np.isfinite(vertical)
+    if finite.sum() >= 2:
+        windows = quiet_windows(time[finite], vertical[finite], gravity=gravity)
+        if windows:
+            found = mass_from_quiet(time[finite], vertical[finite], gravity, windows)
+            spread = "" if found.spread is None else f", spread {found.spread:.2g} kg"
+            return found.mass, (
+                f"force plates (quiet windows: mean vertical force / g over {found.windows} "
+                f"windows, {found.duration:.3g} s{spread})"
+            )
+    loaded = vertical[finite & (vertical > LOADED)]
+    if not len(loaded):
+        return None, ""
+    return float(np.mean(loaded)) / gravity, (
+        "force plates (mean vertical force / g while loaded: no quiet window, biased by any "
+        "push-off or landing)"
+    )
