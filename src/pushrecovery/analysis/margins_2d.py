@@ -163,7 +163,7 @@ def _ray(base: BasePolygons, origin: FloatArray, direction: FloatArray) -> Float
 
 
 def _nearest(base: BasePolygons, p: FloatArray) -> FloatArray:
-    """The polygon's point nearest each p (p itself inside) [m]."""
+    """Return the polygon's point nearest each p (p itself inside) [m]."""
     start, vector, _, length = _geometry(base)
     rel = p[:, None, :] - start
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -226,7 +226,7 @@ def time_to_boundary_xcom(
 def phase_supports(
     base: BasePolygons, params: BodyParams
 ) -> tuple[tuple[Support | None, ...], NDArray[np.int64], BodyParams | None]:
-    """The library's Support of each stance phase, the phase of each frame, and the body.
+    """Return the Support of each stance phase, the phase of each frame, and the body.
 
     Stated feet: their Support in every frame. Foot markers (two feet named left and right):
     one Support per run of frames with the same supporting feet, the feet at the run's median
@@ -343,6 +343,7 @@ def margins_2d(
     omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     with np.errstate(over="ignore", invalid="ignore"):
         xi = r + v / omega
+    xi[~(np.isfinite(r) & np.isfinite(v)).all(axis=1)] = np.nan  # a frame is known or missing
     if not np.isfinite(xi[np.isfinite(r) & np.isfinite(v)]).all():
         raise InvalidParameterError("states are too large: the XCoM overflows")
     mos = _signed(base, xi)
@@ -362,7 +363,10 @@ def margins_2d(
     mos_cmp = nan.copy()
     if verdicts:
         _verdicts(base, r, v, params, codes, mos_cmp)
-    return Margins2D(xi, mos, *toward, *sides, mos_cmp, ttb_cop, ttb_xcom, base.area, codes)
+    return Margins2D(
+        xi, mos, toward[0], toward[1], sides[0], sides[1], sides[2], sides[3], mos_cmp,
+        ttb_cop, ttb_xcom, base.area, codes,
+    )  # fmt: skip
 
 
 def _verdicts(
