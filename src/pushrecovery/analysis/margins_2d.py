@@ -343,9 +343,10 @@ def margins_2d(
     omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     with np.errstate(over="ignore", invalid="ignore"):
         xi = r + v / omega
-    xi[~(np.isfinite(r) & np.isfinite(v)).all(axis=1)] = np.nan  # a frame is known or missing
-    if not np.isfinite(xi[np.isfinite(r) & np.isfinite(v)]).all():
+    known = (np.isfinite(r) & np.isfinite(v)).all(axis=1)
+    if not np.isfinite(xi[known]).all():
         raise InvalidParameterError("states are too large: the XCoM overflows")
+    xi[~known] = np.nan  # a frame is known or missing
     mos = _signed(base, xi)
     xmin, xmax, ymin, ymax = base.extents()
     sides = (xmax - xi[:, 0], xi[:, 0] - xmin, ymax - xi[:, 1], xi[:, 1] - ymin)
