@@ -25,6 +25,7 @@ import pytest
 
 import pushrecovery
 from pushrecovery import load_params
+from pushrecovery.analysis.base_polygon import FootModel, base_from_params
 from pushrecovery.analysis.c3d import write_c3d
 from pushrecovery.analysis.recording import fixed_feet
 from pushrecovery.errors import PushRecoveryError
@@ -105,6 +106,17 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         "ankle": np.zeros(2),
     },
     "pushrecovery.analysis.readers.c3d_files.read_c3d_recording": {"path": _trial_c3d()},
+    # The 2-D base of support and margins (issue 18): three frames of stated feet.
+    **{f"pushrecovery.analysis.base_polygon.{name}": {
+        "model": FootModel(), "foot": fixed_feet(3, 0.0, 0.1, -0.05, 0.15, 0.2)[0],
+        "vertices": np.tile([[-0.05, -0.15], [0.15, -0.15], [0.15, 0.15]], (3, 1, 1)),
+    } for name in ("foot_soles", "base_from_feet", "base_from_vertices", "base_from_params")},
+    **{f"pushrecovery.analysis.margins_2d.{name}": {
+        "base": base_from_params(P, 3), "com": np.zeros((3, 2)), "velocity": np.ones((3, 2)),
+        "points": np.zeros((3, 2)), "cop": np.zeros((3, 2)), "cop_velocity": np.ones((3, 2)),
+        "xcom": np.full((3, 2), 0.05),
+    } for name in ("margins_2d", "signed_distance", "time_to_boundary_cop",
+                   "time_to_boundary_xcom", "phase_supports")},
     "pushrecovery.analysis.signals.resample": {
         "values": np.column_stack([np.sin(TIME), np.cos(TIME)]), "target": TIME[::2]
     },
