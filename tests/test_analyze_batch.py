@@ -23,7 +23,7 @@ RATE = 100.0
 
 
 def lipm_trial(push: float, azimuth: float, duration: float = 3.0, seed: int = 0) -> str:
-    """CSV text of a 2-D LIPM trial: standing, a velocity push at 0.5 s toward ``azimuth``
+    """CSV text of a 2-D LIPM trial: standing, a velocity push at 1 s toward ``azimuth``
     [rad] (0 forward, π/2 to the left), the CoP at the capture point clipped to the foot
     (exact ZOH per axis at 100 Hz); the base is the foot's rectangle."""
     rng = np.random.default_rng(seed)
@@ -34,7 +34,7 @@ def lipm_trial(push: float, azimuth: float, duration: float = 3.0, seed: int = 0
     x, v = np.array([0.02, 0.0]), np.zeros(2)
     lines = ["time,com_ap,com_ml,cop_ap,cop_ml,base_ap_min,base_ap_max,base_ml_min,base_ml_max"]
     for k in range(int(duration * RATE)):
-        if k == int(0.5 * RATE):
+        if k == int(1.0 * RATE):
             v = v + push * np.array([math.cos(azimuth), math.sin(azimuth)])
         cop = np.clip(x + 2.0 * v / OMEGA, low, high)
         noise = rng.normal(0.0, 1e-4, 2)
@@ -114,8 +114,18 @@ def test_a_batch_on_one_and_two_workers_gives_the_same_tables(study, tmp_path):
     assert s2 and all(r["mass"] == 80.0 for r in s2)
     assert set(one.summary["subjects"]) == {"S1", "S2"}
     # Pushes grow with the trial number: the larger ones need more than the ankles.
-    demanding = {r["most_demanding"] for r in one.trials if r["status"] == "analysed"}
+    analysed = [r for r in one.trials if r["status"] == "analysed"]
+    demanding = {r["most_demanding"] for r in analysed}
     assert "ankle" in demanding and demanding - {"ankle"}
+    # The checks and events of every analysed trial are in its rows: the CoP stays on the
+    # foot by construction, and the push at 1 s is the onset (zero-lag filter: up to 1/fc =
+    # 0.17 s early with this little noise).
+    assert all(r["cop_outside_base_frames"] == 0 and not r["base_rejected"] for r in analysed)
+    assert all(1.0 - 1.0 / 6.0 <= r["onset"] <= 1.01 for r in analysed), [
+        r["onset"] for r in analysed
+    ]
+    onsets = [e for e in one.events if e["kind"] == "onset"]
+    assert len(onsets) == 2 * 16  # one per analysed trial and axis
 
 
 def test_a_resumed_batch_keeps_finished_trials(study, tmp_path):

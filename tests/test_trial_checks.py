@@ -99,3 +99,78 @@ def test_quiet_standing_gets_its_sway_measures(tmp_path):
     # The 95 % prediction ellipse holds the CoP (order of magnitude of a standing subject).
     assert 1e-5 < sway["ellipse_area"] < 1e-2
     json.dumps(sway, allow_nan=False)
+
+
+def _stepping_recording():
+    """A subject standing on two feet (markers at 100 Hz), pushed forward at 1.0 s (the CoM
+    from the exact LIPM with the CoP at the toe), who lifts the right foot at 1.5 s and puts
+    it down 0.30 m ahead and 0.02 m outward at 1.9 s."""
+    import math
+
+    from pushrecovery.analysis.recording import Foot, Recording
+
+    n, rate = 300, 100.0
+    t = np.arange(n) / rate
+    omega = P.omega
+    x = np.full(n, 0.02)
+    v = np.zeros(n)
+    for k in range(101, n):  # standing still (CoP under the CoM) until the push
+        push = 0.5 if k == 101 else 0.0
+        offset, speed = x[k - 1] - P.toe, v[k - 1] + push
+        ch, sh = math.cosh(omega / rate), math.sinh(omega / rate)
+        x[k] = P.toe + offset * ch + speed / omega * sh
+        v[k] = omega * offset * sh + speed * ch
+    noise = np.random.default_rng(3).normal(0.0, 5e-4, (n, 2))  # markers' noise [m]
+    com = np.column_stack([x + noise[:, 0], noise[:, 1], np.full(n, 1.0)])
+
+    def foot(name, ml, moves):
+        heel = np.zeros((n, 3))
+        heel[:, 0], heel[:, 1], heel[:, 2] = -0.05, ml, 0.02
+        if moves:
+            swing = (t >= 1.5) & (t < 1.9)
+            phase = np.clip((t - 1.5) / 0.4, 0.0, 1.0)
+            heel[:, 0] += 0.30 * phase
+            heel[:, 1] -= 0.02 * phase
+            heel[swing, 2] += 0.08 * np.sin(np.pi * phase[swing])
+        toe = heel + np.array([0.20, 0.0, 0.0])
+        ankle = heel + np.array([0.05, 0.0, 0.06])
+        return Foot(name, heel, toe, ankle)
+
+    feet = (foot("left", 0.1, False), foot("right", -0.1, True))
+    return Recording(time=t, com=com, feet=feet, source="generated")
+
+
+def test_a_step_is_detected_measured_and_given_its_margins():
+    import math
+
+    result = analyze(_stepping_recording(), P)
+    events = result.summary["events"]
+    onset = events["onset"]["time"]
+    # The push, from the CoM acceleration, low-passed at 6 Hz forward and backward: the zero-lag
+    # filter spreads the push over about +-1/fc, and with little noise the threshold is crossed
+    # early in that spread: up to 1/fc = 0.17 s before the push, never after it.
+    assert 1.0 - 1.0 / 6.0 <= onset <= 1.0 + 0.01
+    kinds = [(e["foot"], e["kind"]) for e in events["foot_events"]]
+    assert kinds == [("right", "foot-off"), ("right", "foot-contact")]
+    off, contact = (e["time"] for e in events["foot_events"])
+    # The markers method (docs/events.md): off once the foot is 3 cm up (0.08 sin(pi s / 0.4 s)
+    # reaches 3 cm 49 ms after the lift), down when within 3 cm and slower than 0.1 m/s.
+    lifted = 1.5 + 0.4 * math.asin(0.03 / 0.08) / math.pi
+    assert off == pytest.approx(lifted, abs=0.011) and 1.85 <= contact <= 1.95
+    (step,) = events["measured_steps"]
+    assert step["length"] == pytest.approx(0.30, abs=1e-3)
+    assert step["width"] == pytest.approx(-0.02, abs=1e-3)
+    assert step["latency"] == pytest.approx(off - onset)
+    # The margins at foot-off are the frame's own.
+    frame = int(np.argmin(np.abs(result.time - off)))
+    at_off = step["margins_at_foot_off"]["ap"]
+    assert at_off["capture_point"] == pytest.approx(result.columns["ap_capture_point"][frame])
+    assert at_off["strategy"] == result.columns["ap_strategy"][frame]
+    compared = step["against_recommended"]["ap"]
+    assert compared["taken"] == step["length"]
+    recommended = result.columns["ap_step_length"][frame]
+    if np.isfinite(recommended):
+        assert compared["recommended"] == pytest.approx(recommended)
+        assert isinstance(compared["within"], bool)
+    else:
+        assert compared["within"] is None

@@ -1,28 +1,27 @@
-"""The rows of a batch of measured trials: one per trial and axis, one per event; the summary.
+"""The rows of a batch of measured trials: one per trial and axis; the summary across trials.
 
 Columns of ``trials.parquet`` (:class:`TrialRow`; SI units, axes ap and ml as in
-:mod:`pushrecovery.analysis.recording`) and of ``events.parquet`` (:class:`EventRow`). These
-tables are contracts: columns are added, never renamed or dropped.
+:mod:`pushrecovery.analysis.recording`); the events are in
+:mod:`pushrecovery.campaign.trial_events`. These tables are contracts: columns are added,
+never renamed or dropped.
 """
 
 from __future__ import annotations
 
 import math
 import statistics
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
 from pushrecovery.params import BodyParams
 
 __all__ = [
-    "EVENT_FIELDS",
     "TRIAL_FIELDS",
-    "EventRow",
     "TrialRow",
     "batch_summary",
     "failed_rows",
-    "trial_events",
+    "subject_name",
     "trial_rows",
     "write_table",
 ]
@@ -68,6 +67,23 @@ class TrialRow:
         Range of the capture point along the axis [m].
     step_events : int
         Runs of frames that needed a step along this axis.
+    flight_frames, cop_outside_base_frames : int
+        Frames withheld: in flight, and (this axis) with the CoP beyond the base by more than
+        ``cop_tolerance`` [m] (docs/analysis.md, "Data checks").
+    base_rejected : bool
+        The CoP contradicts the base in most loaded frames: ``status`` is ``not classified``.
+    onset : float
+        Perturbation onset [s] (docs/events.md), null if none was found.
+    steps_taken : int
+        Steps measured from the foot markers (both axes' rows give the trial's count).
+    sway_path_length, sway_mean_velocity, sway_rms_distance, sway_range : float
+        Quiet standing only (docs/posturography.md): the CoP's path [m], mean speed [m/s],
+        RMS distance from its mean [m] and range [m] along this axis.
+    sway_f50, sway_f95 : float
+        Frequencies below which 50 % and 95 % of the axis' sway power lies [Hz].
+    sway_ellipse_area, sway_mean_velocity_total : float
+        The 95 % prediction ellipse [m²] and the resultant mean speed [m/s] (the same on both
+        axes' rows).
     """
 
     trial: str
@@ -106,45 +122,29 @@ class TrialRow:
     capture_point_min: float | None = None
     capture_point_max: float | None = None
     step_events: int | None = None
-
-
-@dataclass(frozen=True, slots=True)
-class EventRow:
-    """One event of a trial.
-
-    Attributes
-    ----------
-    trial, subject, axis : str
-        The trial, its subject and the axis of the event.
-    kind : str
-        ``step needed``: a run of frames whose capture point needed a step.
-    time, end : float
-        Start and end of the event [s].
-    step_length, step_length_min, step_length_max : float
-        The recommended step (Eq. 21, median over the event) and its admissible range [m].
-    capture_point : float
-        Capture point at the start [m], relative to the lab origin along the axis.
-    """
-
-    trial: str
-    subject: str
-    axis: str
-    kind: str
-    time: float | None
-    end: float | None = None
-    step_length: float | None = None
-    step_length_min: float | None = None
-    step_length_max: float | None = None
-    capture_point: float | None = None
+    flight_frames: int | None = None
+    cop_outside_base_frames: int | None = None
+    cop_tolerance: float | None = None
+    base_rejected: bool | None = None
+    onset: float | None = None
+    steps_taken: int | None = None
+    sway_path_length: float | None = None
+    sway_mean_velocity: float | None = None
+    sway_rms_distance: float | None = None
+    sway_range: float | None = None
+    sway_f50: float | None = None
+    sway_f95: float | None = None
+    sway_ellipse_area: float | None = None
+    sway_mean_velocity_total: float | None = None
 
 
 #: Arrow types of the columns, in order.
 TRIAL_FIELDS: tuple[tuple[str, str], ...] = tuple((f.name, str(f.type)) for f in fields(TrialRow))
-EVENT_FIELDS: tuple[tuple[str, str], ...] = tuple((f.name, str(f.type)) for f in fields(EventRow))
 
 
-def _subject(job: Any) -> str:
-    return "" if job.subject is None else job.subject.subject
+def subject_name(job: Any) -> str:
+    """Return the job's subject ("" without a subjects table)."""
+    return "" if job.subject is None else str(job.subject.subject)
 
 
 def trial_rows(
@@ -159,7 +159,7 @@ def trial_rows(
         row = TrialRow(
             trial=job.name,
             path=str(job.path),
-            subject=_subject(job),
+            subject=subject_name(job),
             axis=axis,
             status="analysed",
             error=None,
@@ -193,37 +193,54 @@ def trial_rows(
             capture_point_min=data["capture_point_range"][0],
             capture_point_max=data["capture_point_range"][1],
             step_events=sum(1 for e in summary["step_events"] if e["axis"] == axis),
+            **_checked(summary, axis),
+            **_sway(summary.get("posturography"), axis),
         )
+        if row.base_rejected:
+            row = replace(
+                row, status="not classified", error="the CoP contradicts the base of support"
+            )
         rows.append(asdict(row))
     return rows
+
+
+def _checked(summary: dict[str, Any], axis: str) -> dict[str, Any]:
+    """Return the data checks and events of a trial row."""
+    checks, events = summary.get("checks"), summary.get("events")
+    found: dict[str, Any] = {}
+    if checks is not None:
+        found.update(
+            flight_frames=checks["flight_frames"],
+            cop_outside_base_frames=checks["cop_outside_base_frames"][axis],
+            cop_tolerance=checks["cop_tolerance"],
+            base_rejected=checks["base_rejected"],
+        )
+    if events is not None:
+        found.update(onset=events["onset"]["time"], steps_taken=len(events["measured_steps"]))
+    return found
+
+
+def _sway(sway: dict[str, Any] | None, axis: str) -> dict[str, Any]:
+    """Return a trial row's quiet-standing measures (none if the trial is no quiet standing)."""
+    if sway is None:
+        return {}
+    return {
+        "sway_path_length": sway[f"path_length_{axis}"],
+        "sway_mean_velocity": sway[f"mean_velocity_{axis}"],
+        "sway_rms_distance": sway[f"rms_distance_{axis}"],
+        "sway_range": sway[f"range_{axis}"],
+        "sway_f50": sway[f"{axis}_f50"],
+        "sway_f95": sway[f"{axis}_f95"],
+        "sway_ellipse_area": sway["ellipse_area"],
+        "sway_mean_velocity_total": sway["mean_velocity"],
+    }
 
 
 def failed_rows(job: Any, reason: str) -> list[dict[str, Any]]:
     """Return the rows of a trial that failed: ``status`` failed and the reason."""
     return [
-        asdict(TrialRow(job.name, str(job.path), _subject(job), axis, "failed", reason))
+        asdict(TrialRow(job.name, str(job.path), subject_name(job), axis, "failed", reason))
         for axis in ("ap", "ml")
-    ]
-
-
-def trial_events(job: Any, summary: dict[str, Any]) -> list[dict[str, Any]]:
-    """Return the events of an analysed trial, in time order."""
-    return [
-        asdict(
-            EventRow(
-                trial=job.name,
-                subject=_subject(job),
-                axis=event["axis"],
-                kind="step needed",
-                time=event["time"],
-                end=event["end"],
-                step_length=event["step_length"],
-                step_length_min=event["step_length_range"][0],
-                step_length_max=event["step_length_range"][1],
-                capture_point=event["capture_point"],
-            )
-        )
-        for event in summary["step_events"]
     ]
 
 
@@ -235,7 +252,7 @@ def write_table(
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
-    types = {"str": pa.string(), "int": pa.int64(), "float": pa.float64()}
+    types = {"str": pa.string(), "int": pa.int64(), "float": pa.float64(), "bool": pa.bool_()}
     schema = pa.schema(
         [(name, types[kind.split(" ")[0].split("|")[0].strip()]) for name, kind in columns]
     )

@@ -11,7 +11,7 @@ a trial with that file is finished, and ``resume`` skips it), then joins them in
   assumption came from, the data-quality flags; a trial that could not be read or analysed
   is a row with ``status`` = ``failed`` and the reason);
 - ``OUT/events.parquet`` and ``events.csv``: one row per event
-  (:class:`~pushrecovery.campaign.trial_rows.EventRow`);
+  (:class:`~pushrecovery.campaign.trial_events.EventRow`);
 - ``OUT/summary.json``: counts and the measures across trials per subject.
 
 A trial's body comes from the subjects table (:mod:`pushrecovery.campaign.subjects`), then the
@@ -31,13 +31,8 @@ from pathlib import Path
 from typing import Any
 
 from pushrecovery.campaign.subjects import Subject, subject_for
-from pushrecovery.campaign.trial_rows import (
-    EVENT_FIELDS,
-    TRIAL_FIELDS,
-    failed_rows,
-    trial_events,
-    trial_rows,
-)
+from pushrecovery.campaign.trial_events import EVENT_FIELDS, trial_events
+from pushrecovery.campaign.trial_rows import TRIAL_FIELDS, failed_rows, trial_rows
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 
 __all__ = [

@@ -22,6 +22,7 @@ from pushrecovery.analysis.signals import (
     smooth_and_differentiate,
 )
 from pushrecovery.analysis.trial.checks import check_frames
+from pushrecovery.analysis.trial.events import trial_events
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
 from pushrecovery.analysis.trial.summary import _exclusions, _interpolated, _names, _summary
 from pushrecovery.analysis.trial.support import _repair_loaded, _support
@@ -213,6 +214,7 @@ def analyze(
         },
     )
     summary["checks"] = checks.to_dict()
+    summary["events"] = trial_events(recording, time, velocity, per_axis, params.mass)
     summary["posturography"] = _posturography(force_time, plate_cop, plate_force, settings)
     return TrialAnalysis(columns, summary)
 

@@ -1,0 +1,161 @@
+"""A trial's events: perturbation onset, foot-off and foot-contact, the steps taken (issue 18).
+
+The detections are :mod:`pushrecovery.analysis.events` and
+:mod:`pushrecovery.analysis.steps_measured` (docs/events.md); here they are run on a trial and
+given what a reader of the trial asks of them:
+
+- **onset**: from the horizontal ground reaction force over the mass (the CoM acceleration by
+  Newton, when the plates carry the only horizontal external force) when the trial has plates,
+  else from the CoM acceleration of the kinematics; the resultant of ap and ml, its baseline
+  the trial's first 0.5 s (:func:`~pushrecovery.analysis.events.perturbation_onset`, k = 3 SD
+  for 20 ms). The kinematics are low-passed forward and backward (zero lag), which spreads an
+  abrupt push over about ±1/f_c; the less noise, the earlier in that spread the threshold is
+  crossed: an onset found on them may lead the true one by up to 1/f_c (0.17 s at 6 Hz),
+  never lag it (tests/test_trial_checks.py). Prefer plates.
+- **foot events** from the foot markers (``foot-off``, ``foot-contact``), and the **steps**
+  they make (latency from the onset, length, width, duration).
+- **margins at each event**: the frame nearest the event's time, per axis: capture point, CoP
+  margin, strategy and time to leave.
+- **the step taken against the recommended one**: at the step's foot-off frame, per axis, the
+  step the surfaces recommend there (Eq. 21 on the axis' line) and the range of first steps that
+  capture the state (the capture region on that line); ``within`` says whether the foot's
+  displacement along the axis lies in that range (None where the frame needed no step).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.analysis.events import perturbation_onset
+from pushrecovery.analysis.margins import DirectionMargins
+from pushrecovery.analysis.recording import AXES, Recording
+from pushrecovery.analysis.steps_measured import (
+    FootEvent,
+    foot_events_from_markers,
+    measured_steps,
+)
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.surfaces.classify import STRATEGY_CODES
+
+__all__: list[str] = []  # the pipeline's (pushrecovery.analysis.trial.pipeline)
+
+FloatArray = NDArray[np.float64]
+
+#: Baseline of the onset detection: the trial's first seconds [s].
+ONSET_BASELINE = 0.5
+
+
+def _value(array: NDArray[Any], frame: int) -> float | None:
+    value = float(array[frame])
+    return value if math.isfinite(value) else None
+
+
+def _margins_at(
+    time: FloatArray, when: float, per_axis: dict[str, DirectionMargins]
+) -> dict[str, Any]:
+    """Return the margins of the frame nearest ``when`` [s], per axis."""
+    frame = int(np.argmin(np.abs(time - when)))
+    found: dict[str, Any] = {"frame_time": float(time[frame])}
+    for axis, margins in per_axis.items():
+        code = int(margins.strategy[frame])
+        found[axis] = {
+            "capture_point": _value(margins.capture_point, frame),
+            "cop_margin": _value(margins.cop, frame),
+            "cmp_margin": _value(margins.cmp, frame),
+            "time_to_leave_cop": _value(margins.time_to_leave_cop, frame),
+            "strategy": STRATEGY_CODES[code].value if code >= 0 else None,
+        }
+    return found
+
+
+def _onset(
+    recording: Recording, time: FloatArray, velocity: FloatArray, mass: float
+) -> tuple[float | None, str]:
+    """Perturbation onset [s] and the signal it was found on (module docstring)."""
+    if recording.force is not None and recording.force_time is not None:
+        signal_time = recording.force_time
+        signal = np.hypot(recording.force[:, 0], recording.force[:, 1]) / mass
+        source = "horizontal ground reaction force / mass"
+    else:
+        signal_time = time
+        acceleration = np.gradient(velocity, time, axis=0)
+        signal = np.hypot(acceleration[:, 0], acceleration[:, 1])
+        source = "CoM acceleration of the kinematics"
+    try:
+        return perturbation_onset(signal_time, signal, baseline=ONSET_BASELINE), source
+    except InvalidParameterError:  # too short, or a baseline without samples
+        return None, source
+
+
+def _compared(
+    step: dict[str, Any], time: FloatArray, per_axis: dict[str, DirectionMargins]
+) -> dict[str, Any]:
+    """Compare the step taken with the recommended one and the capture range at foot-off."""
+    frame = int(np.argmin(np.abs(time - step["off_time"])))
+    taken = {"ap": step["length"], "ml": step["width"]}
+    result = {}
+    for axis, margins in per_axis.items():
+        recommended = _value(margins.step_length, frame)
+        shortest = _value(margins.step_shortest, frame)
+        longest = _value(margins.step_longest, frame)
+        moved = taken[axis]
+        within = None
+        if recommended is not None and shortest is not None and longest is not None:
+            # The range is unsigned, in the direction of the recommended step.
+            along = None if moved is None else math.copysign(1.0, recommended) * moved
+            within = along is not None and shortest <= along <= longest
+        result[axis] = {
+            "taken": moved,
+            "recommended": recommended,
+            "capture_range": [shortest, longest],
+            "within": within,
+        }
+    return result
+
+
+def trial_events(
+    recording: Recording,
+    time: FloatArray,
+    velocity: FloatArray,
+    per_axis: dict[str, DirectionMargins],
+    mass: float,
+) -> dict[str, Any]:
+    """Return the trial's onset, foot events and steps with their margins (module docstring).
+
+    ``time`` [s] and ``velocity`` (n, 2) [m/s] are the analysis' frames, ``per_axis`` their
+    margins, ``mass`` the subject's [kg].
+    """
+    onset, onset_source = _onset(recording, time, velocity, mass)
+    events: list[FootEvent] = []
+    for foot in recording.feet:
+        try:
+            events += foot_events_from_markers(recording.time, foot)
+        except InvalidParameterError:  # a foot whose markers are missing throughout
+            continue
+    events.sort(key=lambda event: event.time)
+    steps = measured_steps(recording.time, recording.feet, events, onset=onset) if events else []
+    return {
+        "onset": {
+            "time": onset,
+            "signal": onset_source,
+            "margins": None if onset is None else _margins_at(time, onset, per_axis),
+        },
+        "foot_events": [
+            {**event.to_dict(), "margins": _margins_at(time, event.time, per_axis)}
+            for event in events
+        ],
+        "measured_steps": [
+            {
+                **row,
+                "margins_at_foot_off": _margins_at(time, step.off_time, per_axis),
+                "margins_at_foot_contact": _margins_at(time, step.contact_time, per_axis),
+                "against_recommended": _compared(row, time, per_axis),
+            }
+            for step, row in ((step, step.to_dict()) for step in steps)
+        ],
+        "axes": list(AXES),
+    }

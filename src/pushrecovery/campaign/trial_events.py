@@ -1,0 +1,145 @@
+"""The events of a batch of measured trials: one row per event (and axis).
+
+Columns of ``events.parquet`` (:class:`EventRow`; SI units). A contract: columns are added,
+never renamed or dropped.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Any
+
+from pushrecovery.campaign.trial_rows import subject_name
+
+__all__ = ["EVENT_FIELDS", "EventRow", "trial_events"]
+
+
+@dataclass(frozen=True, slots=True)
+class EventRow:
+    """One event of a trial.
+
+    Attributes
+    ----------
+    trial, subject, axis : str
+        The trial, its subject and the axis of the event.
+    kind : str
+        ``step needed`` (a run of frames whose capture point needed a step), ``onset``,
+        ``flight``, ``foot-off``, ``foot-contact`` or ``step`` (a measured step, at its
+        foot-off); ``axis`` is empty for flights.
+    time, end : float
+        Start and end of the event [s] (a step: foot-off and foot-contact).
+    step_length, step_length_min, step_length_max : float
+        ``step needed``: the recommended step (Eq. 21, median over the event) and its
+        admissible range [m]; ``step``: the recommended step at foot-off and the range of
+        first steps that capture the state there (the capture region on the axis' line).
+    capture_point : float
+        Capture point at the start [m], relative to the lab origin along the axis.
+    foot, source : str
+        The foot of a foot event or step, and what detected it (``markers``, ``plate``).
+    cop_margin, strategy : float, str
+        The axis' CoP margin [m] and the strategy its frame needed, at the event's time.
+    taken, latency, duration : float
+        A step's displacement along the axis [m], its foot-off after the onset [s] and its
+        swing time [s].
+    within : bool
+        A step: whether ``taken`` lies in [step_length_min, step_length_max] (null where its
+        foot-off frame needed no step).
+    """
+
+    trial: str
+    subject: str
+    axis: str
+    kind: str
+    time: float | None
+    end: float | None = None
+    step_length: float | None = None
+    step_length_min: float | None = None
+    step_length_max: float | None = None
+    capture_point: float | None = None
+    foot: str | None = None
+    source: str | None = None
+    cop_margin: float | None = None
+    strategy: str | None = None
+    taken: float | None = None
+    latency: float | None = None
+    duration: float | None = None
+    within: bool | None = None
+
+
+#: Arrow types of the columns, in order.
+EVENT_FIELDS: tuple[tuple[str, str], ...] = tuple((f.name, str(f.type)) for f in fields(EventRow))
+
+
+def trial_events(job: Any, summary: dict[str, Any]) -> list[dict[str, Any]]:
+    """Return the events of an analysed trial, in time order (:class:`EventRow`)."""
+    subject = subject_name(job)
+    rows = [
+        EventRow(
+            trial=job.name,
+            subject=subject,
+            axis=event["axis"],
+            kind="step needed",
+            time=event["time"],
+            end=event["end"],
+            step_length=event["step_length"],
+            step_length_min=event["step_length_range"][0],
+            step_length_max=event["step_length_range"][1],
+            capture_point=event["capture_point"],
+        )
+        for event in summary["step_events"]
+    ]
+    for flight in (summary.get("checks") or {}).get("flight_phases", []):
+        rows.append(EventRow(job.name, subject, "", "flight", flight["start"], flight["end"]))
+    events = summary.get("events") or {}
+    onset = events.get("onset") or {}
+    for axis in ("ap", "ml"):
+        if onset.get("time") is not None:
+            rows.append(_at(job.name, subject, axis, "onset", onset["time"], onset["margins"]))
+        for foot in events.get("foot_events", []):
+            rows.append(
+                replace(
+                    _at(job.name, subject, axis, foot["kind"], foot["time"], foot["margins"]),
+                    foot=foot["foot"],
+                    source=foot["source"],
+                )
+            )
+        for step in events.get("measured_steps", []):
+            compared = step["against_recommended"][axis]
+            row = _at(
+                job.name, subject, axis, "step", step["off_time"], step["margins_at_foot_off"]
+            )
+            rows.append(
+                replace(
+                    row,
+                    end=step["contact_time"],
+                    foot=step["foot"],
+                    source="markers",
+                    step_length=compared["recommended"],
+                    step_length_min=compared["capture_range"][0],
+                    step_length_max=compared["capture_range"][1],
+                    taken=compared["taken"],
+                    latency=step["latency"],
+                    duration=step["duration"],
+                    within=compared["within"],
+                )
+            )
+    rows.sort(key=lambda r: (math.inf if r.time is None else r.time, r.kind, r.axis))
+    return [asdict(row) for row in rows]
+
+
+def _at(
+    trial: str, subject: str, axis: str, kind: str, time: float, margins: dict[str, Any] | None
+) -> EventRow:
+    """Return an event row with the axis' margins at the event's frame."""
+    here = (margins or {}).get(axis) or {}
+    return EventRow(
+        trial=trial,
+        subject=subject,
+        axis=axis,
+        kind=kind,
+        time=time,
+        capture_point=here.get("capture_point"),
+        cop_margin=here.get("cop_margin"),
+        strategy=here.get("strategy"),
+    )
