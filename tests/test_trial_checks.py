@@ -174,3 +174,22 @@ def test_a_step_is_detected_measured_and_given_its_margins():
         assert isinstance(compared["within"], bool)
     else:
         assert compared["within"] is None
+
+
+def test_the_plane_margin_is_the_xcom_distance_to_the_base_polygon(tmp_path):
+    # Standing still at (0.02, 0.03) over a base [-0.05, 0.15] x [-0.15, 0.15] (CSV columns):
+    # the XCoM is the CoM, 0.07 m from the rear edge and 0.12 m from the left edge.
+    n = 300
+    lines = ["time,com_ap,com_ml,base_ap_min,base_ap_max,base_ml_min,base_ml_max"]
+    lines += [f"{k / 100:.2f},0.02,0.03,-0.05,0.15,-0.15,0.15" for k in range(n)]
+    path = tmp_path / "still.csv"
+    path.write_text("\n".join(lines) + "\n")
+    result = analyze(read_recording(path), P)
+    mos = result.columns["mos"]
+    assert mos == pytest.approx(np.full(n, 0.07), abs=1e-9)
+    plane = result.summary["plane"]
+    assert plane["min_mos"]["value"] == pytest.approx(0.07, abs=1e-9)
+    assert plane["base_source"] == "base columns"
+    # The 2-D verdicts classify against feet (a Support): a base given as columns has none.
+    assert plane["most_demanding"] is None
+    assert result.columns["base_area"] == pytest.approx(np.full(n, 0.2 * 0.3))

@@ -79,6 +79,16 @@ class TrialRow:
     sway_path_length, sway_mean_velocity, sway_rms_distance, sway_range : float
         Quiet standing only (docs/posturography.md): the CoP's path [m], mean speed [m/s],
         RMS distance from its mean [m] and range [m] along this axis.
+    min_mos, min_mos_time : float
+        Smallest signed distance of the XCoM to the base polygon (Hof's margin of stability
+        in the plane, + inside) [m] and its time [s] (the same on both axes' rows).
+    min_mos_axis : float
+        Smallest component margin along this axis, toward the side the CoM moves [m].
+    min_time_to_boundary_cop, min_time_to_boundary_xcom : float
+        Shortest times to the base's boundary of the CoP and of the XCoM [s]
+        (docs/base_polygon.md).
+    most_demanding_2d : str
+        The most demanding strategy of the 2-D verdicts against the base polygon.
     sway_f50, sway_f95 : float
         Frequencies below which 50 % and 95 % of the axis' sway power lies [Hz].
     sway_ellipse_area, sway_mean_velocity_total : float
@@ -128,6 +138,12 @@ class TrialRow:
     base_rejected: bool | None = None
     onset: float | None = None
     steps_taken: int | None = None
+    min_mos: float | None = None
+    min_mos_time: float | None = None
+    min_mos_axis: float | None = None
+    min_time_to_boundary_cop: float | None = None
+    min_time_to_boundary_xcom: float | None = None
+    most_demanding_2d: str | None = None
     sway_path_length: float | None = None
     sway_mean_velocity: float | None = None
     sway_rms_distance: float | None = None
@@ -194,6 +210,7 @@ def trial_rows(
             capture_point_max=data["capture_point_range"][1],
             step_events=sum(1 for e in summary["step_events"] if e["axis"] == axis),
             **_checked(summary, axis),
+            **_planar(summary.get("plane"), axis),
             **_sway(summary.get("posturography"), axis),
         )
         if row.base_rejected:
@@ -218,6 +235,20 @@ def _checked(summary: dict[str, Any], axis: str) -> dict[str, Any]:
     if events is not None:
         found.update(onset=events["onset"]["time"], steps_taken=len(events["measured_steps"]))
     return found
+
+
+def _planar(plane: dict[str, Any] | None, axis: str) -> dict[str, Any]:
+    """Return a trial row's measures against the base polygon."""
+    if plane is None:
+        return {}
+    return {
+        "min_mos": plane["min_mos"]["value"],
+        "min_mos_time": plane["min_mos"]["time"],
+        "min_mos_axis": plane[f"min_mos_{axis}"]["value"],
+        "min_time_to_boundary_cop": plane["min_time_to_boundary_cop"]["value"],
+        "min_time_to_boundary_xcom": plane["min_time_to_boundary_xcom"]["value"],
+        "most_demanding_2d": plane["most_demanding"],
+    }
 
 
 def _sway(sway: dict[str, Any] | None, axis: str) -> dict[str, Any]:

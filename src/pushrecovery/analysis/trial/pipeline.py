@@ -8,7 +8,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.analysis.base_polygon import BasePolygons
 from pushrecovery.analysis.margins import DirectionMargins, direction_margins
+from pushrecovery.analysis.margins_2d import Margins2D, margins_2d
 from pushrecovery.analysis.posturography import quiet_standing, sway_measures
 from pushrecovery.analysis.recording import (
     AXES,
@@ -24,7 +26,14 @@ from pushrecovery.analysis.signals import (
 from pushrecovery.analysis.trial.checks import check_frames
 from pushrecovery.analysis.trial.events import trial_events
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
-from pushrecovery.analysis.trial.summary import _exclusions, _interpolated, _names, _summary
+from pushrecovery.analysis.trial.summary import (
+    _exclusions,
+    _extreme,
+    _interpolated,
+    _most_demanding,
+    _names,
+    _summary,
+)
 from pushrecovery.analysis.trial.support import _repair_loaded, _support
 from pushrecovery.analysis.zero_point import ZERO_FORCE, com_from_force
 from pushrecovery.errors import InvalidParameterError
@@ -123,7 +132,7 @@ def analyze(
         force = resample(force_time, force, time)
     if cop is not None and force_time is not None:
         cop = resample(force_time, cop, time)
-    support, support_source, found = _support(recording, time, com, cop, params, settings)
+    support, base, support_source, found = _support(recording, time, com, cop, params, settings)
     gaps += found
     checks = check_frames(time, force_time, plate_force, cop, support.lower, support.upper)
     if checks.base_rejected:
@@ -185,6 +194,9 @@ def analyze(
                 f"{axis}_steps": margins.steps,
             }
         )
+    plane = _plane(base, com, velocity, cop, time, params, checks.withheld)
+    columns.update(plane.to_columns())
+    columns["strategy_2d"] = _names(plane.strategy)
     codes = np.maximum(per_axis["ap"].strategy, per_axis["ml"].strategy)
     invalid = (per_axis["ap"].strategy < 0) | (per_axis["ml"].strategy < 0)
     codes[invalid] = -1
@@ -214,9 +226,45 @@ def analyze(
         },
     )
     summary["checks"] = checks.to_dict()
+    summary["plane"] = _plane_summary(plane, time, support_source)
     summary["events"] = trial_events(recording, time, velocity, per_axis, params.mass)
     summary["posturography"] = _posturography(force_time, plate_cop, plate_force, settings)
     return TrialAnalysis(columns, summary)
+
+
+def _plane(
+    base: BasePolygons,
+    com: FloatArray,
+    velocity: FloatArray,
+    cop: FloatArray | None,
+    time: FloatArray,
+    params: BodyParams,
+    withheld: NDArray[np.bool_],
+) -> Margins2D:
+    """Return the 2-D margins against the base polygon (docs/base_polygon.md), withheld NaN."""
+    cop_velocity = None
+    if cop is not None:
+        _, cop_velocity = smooth_and_differentiate(time, cop, 0.0)  # already low-passed
+    plane = margins_2d(base, com, velocity, params, cop=cop, cop_velocity=cop_velocity)
+    for values in plane.to_columns().values():  # views of the measures' own arrays
+        if values.dtype.kind == "f":
+            values[withheld] = np.nan
+    plane.strategy[withheld] = -1
+    return plane
+
+
+def _plane_summary(plane: Margins2D, time: FloatArray, source: str) -> dict[str, Any]:
+    """Return the smallest 2-D margins and times to boundary, and the 2-D verdict."""
+    return {
+        "base_source": source,
+        "min_mos": _extreme(plane.mos, time),
+        "min_mos_ap": _extreme(plane.mos_ap, time),
+        "min_mos_ml": _extreme(plane.mos_ml, time),
+        "min_mos_cmp": _extreme(plane.mos_cmp, time),
+        "min_time_to_boundary_cop": _extreme(plane.ttb_cop, time),
+        "min_time_to_boundary_xcom": _extreme(plane.ttb_xcom, time),
+        "most_demanding": _most_demanding(plane.strategy),
+    }
 
 
 def _withhold(margins: DirectionMargins, frames: NDArray[np.bool_]) -> None:

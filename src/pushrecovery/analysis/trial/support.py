@@ -5,6 +5,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.analysis.base_polygon import (
+    BasePolygons,
+    FootModel,
+    base_from_feet,
+    base_from_vertices,
+)
 from pushrecovery.analysis.recording import (
     AXES,
     LOADED,
@@ -44,8 +50,14 @@ def _support(
     cop: FloatArray | None,
     params: BodyParams,
     settings: AnalysisSettings,
-) -> tuple[Support, str, list[Gap]]:
-    """Build the base of support from the feet, CSV columns, or two assumed fixed feet."""
+) -> tuple[Support, BasePolygons, str, list[Gap]]:
+    """Build the base of support from the feet, CSV columns, or two assumed fixed feet.
+
+    Per axis (the intervals of :class:`Support`) and in the plane (the polygon of the
+    supporting soles, :mod:`pushrecovery.analysis.base_polygon`, the foot model's width the
+    settings' foot width).
+    """
+    model = FootModel(width=settings.widths(params)[0])
     gaps: list[Gap] = []
     if recording.feet:
         measured: list[Foot] = []
@@ -62,9 +74,11 @@ def _support(
             contact_height=settings.contact_height,
             foot_width=settings.widths(params)[0],
         )
-        return support, "foot markers", gaps
+        plane = base_from_feet(measured, model, contact_height=settings.contact_height)
+        return support, plane, "foot markers", gaps
     if recording.base:
-        return _explicit_support(recording, time, params, settings), "base columns", gaps
+        support = _explicit_support(recording, time, params, settings)
+        return support, _rectangles(support), "base columns", gaps
     centre = cop if cop is not None and np.isfinite(cop).any() else com
     if not np.isfinite(centre).any():
         raise InvalidParameterError(
@@ -84,10 +98,19 @@ def _support(
     foot_width, stance_width = settings.widths(params)
     feet = fixed_feet(len(time), ankle_ap, ankle_ml, params.heel, params.toe, stance_width)
     support = support_from_feet(feet, contact_height=settings.contact_height, foot_width=foot_width)
+    plane = base_from_feet(feet, model, contact_height=settings.contact_height)
     source = "fixed feet (heel/toe flags, --stance-width)"
     if assumed:
         source += ": " + ", ".join(assumed)
-    return support, source, gaps
+    return support, plane, source, gaps
+
+
+def _rectangles(support: Support) -> BasePolygons:
+    """Return the plane's base of CSV base columns: each frame's rectangle of intervals."""
+    lo_ap, hi_ap = support.lower["ap"], support.upper["ap"]
+    lo_ml, hi_ml = support.lower["ml"], support.upper["ml"]
+    corners = [(lo_ap, lo_ml), (hi_ap, lo_ml), (hi_ap, hi_ml), (lo_ap, hi_ml)]
+    return base_from_vertices(np.stack([np.column_stack(c) for c in corners], axis=1))
 
 
 def _explicit_support(
