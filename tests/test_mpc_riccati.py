@@ -90,3 +90,24 @@ def test_without_hip_torque_the_controller_skips_the_riccati_route():
     assert MPCController(no_hip).riccati is None
     assert MPCController(P).riccati is not None
     assert MPCController(P, solver="quadprog").riccati is None
+
+
+def test_daqp_seeded_with_the_verified_set_ends_on_it():
+    # The verified set of the passes, as DAQP's sense flags, is DAQP's own optimal set.
+    controller = MPCController(P)
+    solver = controller.riccati
+    assert solver is not None
+    x0 = np.array([0.06, 0.2, 0.45, -1.0])
+    solver.reset()
+    verified = solver.solve(x0, shift=False) or solver.solve(x0, shift=False)
+    if not verified:  # a cold start the passes cannot take: seed them from DAQP first
+        controller.workspace.solve(x0)
+        solver.seed(controller.workspace.active_set())
+        assert solver.solve(x0, shift=False)
+    workspace = controller.workspace
+    workspace.seed(solver.active)
+    scaled = workspace.solve(x0)
+    assert scaled is not None
+    np.testing.assert_array_equal(workspace.active_set(), solver.active)
+    first = controller.qp.first_input(x0, scaled)
+    np.testing.assert_allclose(first / SCALE, solver.inputs[0] / SCALE, atol=1e-6)

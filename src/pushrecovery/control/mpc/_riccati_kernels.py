@@ -319,3 +319,45 @@ def solve_active_set(  # type: ignore[no-untyped-def]
         if outcome == DEGENERATE:
             return -1
     return -1
+
+
+@numba.njit(cache=True, nogil=True)
+def solve_from(  # type: ignore[no-untyped-def]
+    x0,
+    shift,
+    active,
+    guess,
+    a,
+    b,
+    wx,
+    wu,
+    bounds,
+    tols,
+    dual_tol,
+    max_passes,
+    inputs,
+    states,
+    gains,
+    offsets,
+    curvature,
+    mult,
+):
+    """:func:`solve_active_set` started from ``active`` (shifted one stage if ``shift``).
+
+    The passes work on ``guess`` (the start is copied there: ``active[i + 1]`` to stage i,
+    the last stage keeping its rows); on success the verified set is copied back into
+    ``active``, on failure ``active`` is left as it was. One call per tick, so the Python
+    side does no array work.
+    """
+    n = active.shape[0]
+    for i in range(n):
+        src = i + 1 if shift and i < n - 1 else i
+        for j in range(3):
+            guess[i, j] = active[src, j]
+    passes = solve_active_set(x0, a, b, wx, wu, guess, bounds, tols, dual_tol, max_passes,
+                              inputs, states, gains, offsets, curvature, mult)  # fmt: skip
+    if passes > 0:
+        for i in range(n):
+            for j in range(3):
+                active[i, j] = guess[i, j]
+    return passes

@@ -123,16 +123,27 @@ class MPCController(Controller):
     def plan(self, state: NDArray[np.float64]) -> Plan:
         """Solve the QP from ``state``; the fallback plan if it is infeasible."""
         riccati = self.riccati
+        # Whether the previous tick was verified by the passes: DAQP did not solve it, and
+        # riccati.active holds its optimal set (kept by a failed solve) to start DAQP from.
+        previous_verified = riccati is not None and riccati.verified
         if riccati is not None and riccati.solve(state):
-            inputs, states = riccati.inputs.copy(), riccati.states.copy()
-            return Plan(inputs[0], True, lambda: inputs, lambda: states)
+            # Fresh arrays each verified solve: the plan keeps them as they are.
+            inputs = riccati.inputs
+            return Plan(inputs[0], True, inputs, riccati.states)
         # Only the solvers' own failures mean "infeasible"; any other exception is a bug.
         workspace = self.workspace
         if workspace is not None:
+            if riccati is not None and previous_verified:
+                # As warm as if DAQP had solved the previous tick itself (it ends there).
+                workspace.seed(riccati.active)
             solution = workspace.solve(state)
             active = workspace.active_set()
-            if riccati is not None and active is not None:
-                riccati.seed(active)  # the next tick starts from DAQP's active set
+            if riccati is not None:
+                # The next tick's passes start from DAQP's active set, or the empty one.
+                if active is not None:
+                    riccati.seed(active)
+                else:
+                    riccati.reset()
         else:
             solution = self._solve_qpsolvers(state)
         qp = self.qp
@@ -178,16 +189,16 @@ class MPCController(Controller):
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """First input of the plan from ``state`` (δ [m], τ [N m])."""
-        plan = self.plan(np.asarray(state, dtype=np.float64))
-        self.last_plan = plan
-        cop, torque = plan.first_input
+        plan = self.last_plan = self.plan(np.asarray(state, dtype=np.float64))
+        cop, torque = plan.first_input.tolist()
         p = self.params
-        # Clip what the solver's tolerance may leave a hair outside the limits.
-        cop, torque = p.clip_cop(float(cop)), p.clip_hip_torque(float(torque))
-        at_limit = cop in (p.heel, p.toe) or (
-            p.torque_max > 0.0 and abs(torque) >= p.torque_max * (1 - 1e-9)
-        )
-        return Command(cop, torque, saturated=at_limit or not plan.feasible)
+        # Clip what the solver's tolerance may leave a hair outside the limits (as
+        # BodyParams.clip_cop and clip_hip_torque, inlined: this is the tick's hot path).
+        heel, toe, limit = p.heel, p.toe, p.torque_max
+        cop = min(toe, max(heel, cop))
+        torque = min(limit, max(-limit, torque))
+        at_limit = cop == heel or cop == toe or (limit > 0.0 and abs(torque) >= limit * (1 - 1e-9))
+        return Command(cop, torque, at_limit or not plan.feasible)
 
     def _fallback(self, state: NDArray[np.float64]) -> NDArray[np.float64]:
         p = self.params

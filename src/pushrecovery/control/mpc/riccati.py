@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.mpc._riccati_kernels import solve_active_set
+from pushrecovery.control.mpc._riccati_kernels import solve_from
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
@@ -77,6 +77,10 @@ class RiccatiSolver:
         Its active set: rows (δ_i, τ_i, θ_{i+1}), −1 at the lower bound, +1 at the upper.
     passes : int
         Passes of the last solve (−1: not verified).
+    verified : bool
+        Whether the last solve verified its optimum (``active`` is then its active set).
+        After a failed solve ``active`` still holds the set the solve started from (shifted
+        back): the last verified set or a seed, which the caller may hand to DAQP.
     """
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
@@ -100,6 +104,13 @@ class RiccatiSolver:
         self._offsets = np.zeros((n, 2))
         self._curvature = np.zeros((n, 2))
         self.passes = 0
+        self.verified = False
+        # The kernel's arguments, bound once (a tick makes one call).
+        self._args = (
+            self.active, self._guess, self.a, self.b, self.wx, self.wu, self.bounds, self.tols,
+            DUAL_TOL, MAX_PASSES,
+        )  # fmt: skip
+        self._scratch = (self._gains, self._offsets, self._curvature, self.multipliers)
 
     @staticmethod
     def applies(params: BodyParams) -> bool:
@@ -109,31 +120,29 @@ class RiccatiSolver:
     def reset(self) -> None:
         """Start the next solve from the empty active set."""
         self.active.fill(0)
+        self.verified = False
 
     def seed(self, active: NDArray[np.int8]) -> None:
         """Start the next solve from ``active`` (N, 3), e.g. the active set DAQP found."""
         self.active[...] = active
+        self.verified = False
 
     def solve(self, x0: FloatArray, shift: bool = True) -> bool:
         """Solve from ``x0`` = [x, θ, ẋ, θ̇]; True if the KKT conditions were verified.
 
         The passes start from the last active set shifted by one stage (``shift``), the
         receding horizon's guess; the last stage keeps its rows. On failure the attributes
-        hold no solution and the next solve starts from the empty set.
+        hold no solution, ``active`` is left as it was (the caller may hand it to DAQP) and
+        the next solve starts from it again unless :meth:`seed` or :meth:`reset` is called.
         """
-        guess = self._guess
-        if shift:
-            guess[:-1] = self.active[1:]
-            guess[-1] = self.active[-1]
-        else:
-            guess[...] = self.active
-        self.passes = solve_active_set(
-            x0, self.a, self.b, self.wx, self.wu, guess, self.bounds, self.tols, DUAL_TOL,
-            MAX_PASSES, self.inputs, self.states, self._gains, self._offsets, self._curvature,
-            self.multipliers,
-        )  # fmt: skip
-        if self.passes < 0:
-            self.active.fill(0)
+        n = self.active.shape[0]
+        # Fresh output arrays each solve: a verified solution is the caller's to keep (the
+        # controller's plan holds them without copying).
+        inputs, states = np.empty((n, 2)), np.empty((n + 1, 4))
+        self.passes = passes = solve_from(x0, shift, *self._args, inputs, states, *self._scratch)
+        if passes < 0:
+            self.verified = False
             return False
-        self.active, self._guess = guess, self.active
+        self.inputs, self.states = inputs, states
+        self.verified = True
         return True

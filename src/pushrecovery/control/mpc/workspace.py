@@ -35,6 +35,10 @@ FloatArray = NDArray[np.float64]
 #: Largest constraint violation DAQP accepts (scaled units; its default is 1e-6).
 PRIMAL_TOL = 1e-9
 
+# DAQP's ``sense`` flags (daqp constants.h): bit 0 active, bit 1 at the lower bound. Indexed by
+# side + 1 of the active sets below: −1 (lower) → 3, 0 → 0, +1 (upper) → 1.
+_SENSE_OF_SIDE = np.array([3, 0, 1], dtype=np.intc)
+
 
 class DaqpWorkspace:
     """A ``daqp.Model`` of one :class:`CondensedQP`, solved from a state each tick.
@@ -64,6 +68,8 @@ class DaqpWorkspace:
         self._lower = np.zeros(rows)
         self._upper = np.zeros(rows)
         self._cold = np.zeros(rows, dtype=np.intc)  # no constraint active
+        self._sense = np.zeros(rows, dtype=np.intc)  # a seeded start (see seed())
+        self._seeded = False
         model = daqp.Model()
         # The same contiguous buffers, rewritten in place, are handed to update() each tick.
         flag, _ = model.setup(
@@ -87,6 +93,23 @@ class DaqpWorkspace:
     def reset(self) -> None:
         """Start the next solve cold, from an empty active set."""
         self._warm = False
+        self._seeded = False
+
+    def seed(self, active: NDArray[np.int8]) -> None:
+        """Start the next solve from ``active``, an optimal active set of a recent tick.
+
+        ``active`` has shape (N, 3), rows (δ_i, τ_i, θ_{i+1}) with −1 at the lower bound, +1
+        at the upper, in the layout of :meth:`active_set` (condensed rows: δ_i at 2i, τ_i at
+        2i + 1, θ_{i+1} at 2N + i). Meant for the verified set of the Riccati passes' last
+        tick: exactly the set this workspace would have ended with had it solved that tick,
+        so the next solve starts as warm as if DAQP ran every tick. A seeded solve that
+        fails is retried cold, as any warm one.
+        """
+        n = active.shape[0]
+        sides = active.astype(np.intp) + 1
+        self._sense[: 2 * n] = _SENSE_OF_SIDE[sides[:, :2].ravel()]
+        self._sense[2 * n :] = _SENSE_OF_SIDE[sides[:, 2]]
+        self._seeded = True
 
     def solve(self, x0: FloatArray) -> FloatArray | None:
         """Scaled inputs Ũ of the QP from state ``x0``, or None if DAQP found no solution.
@@ -97,13 +120,17 @@ class DaqpWorkspace:
         """
         model = self._model
         self.qp.vectors_into(x0, self._linear, self._lower, self._upper)
-        if self._warm:
+        warm = self._warm or self._seeded
+        if self._seeded:
+            model.update(f=self._linear, bupper=self._upper, blower=self._lower, sense=self._sense)
+            self._seeded = False
+        elif self._warm:
             model.update(f=self._linear, bupper=self._upper, blower=self._lower)
         else:
             self._cold.fill(0)
             model.update(f=self._linear, bupper=self._upper, blower=self._lower, sense=self._cold)
         solution, _, flag, info = model.solve()
-        if flag <= 0 and self._warm:
+        if flag <= 0 and warm:
             self._cold.fill(0)
             model.update(sense=self._cold)
             solution, _, flag, info = model.solve()
