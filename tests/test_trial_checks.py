@@ -193,3 +193,29 @@ def test_the_plane_margin_is_the_xcom_distance_to_the_base_polygon(tmp_path):
     # The 2-D verdicts classify against feet (a Support): a base given as columns has none.
     assert plane["most_demanding"] is None
     assert result.columns["base_area"] == pytest.approx(np.full(n, 0.2 * 0.3))
+
+
+def test_a_base_polygon_from_vertex_columns(tmp_path):
+    # A triangle base (vertices in mm): the 2-D margin of a still CoM is its distance to the
+    # nearest edge; a vertex given without its partner column is refused.
+    n = 300
+    head = "time,com_ap,com_ml,base_ap1,base_ml1,base_ap2,base_ml2,base_ap3,base_ml3"
+    rows = [f"{k / 100:.2f},0,0,-50,-100,150,0,-50,100" for k in range(n)]
+    path = tmp_path / "triangle.csv"
+    path.write_text("\n".join([head, *rows]) + "\n")
+    recording = read_recording(path, units="mm")
+    assert recording.base_vertices.shape == (n, 3, 2)
+    result = analyze(recording, P)
+    # Distance from (0, 0) to the edge from (0.15, 0) to (-0.05, 0.1): |0.1*0 + 0.2*0 - 0.015|
+    # / hypot(0.1, 0.2) (the line 0.1 x + 0.2 y = 0.015), and to the rear edge x = -0.05.
+    expected = min(0.015 / np.hypot(0.1, 0.2), 0.05)
+    assert result.columns["mos"] == pytest.approx(np.full(n, expected), abs=1e-9)
+    assert result.summary["support_source"] == "base polygon columns"
+    assert result.columns["ap_base_min"] == pytest.approx(np.full(n, -0.05))
+    path.write_text(
+        "\n".join([head.replace(",base_ml3", ""), *(r.rsplit(",", 1)[0] for r in rows)])
+    )
+    from pushrecovery.errors import InputFileError
+
+    with pytest.raises(InputFileError, match="base_ml3 is missing"):
+        read_recording(path, units="mm")

@@ -79,6 +79,9 @@ class Recording:
         File the trial came from.
     notes : list of str
         What the reader repaired or assumed.
+    base_vertices : ndarray, shape (n, k, 2) or None
+        The base of support as polygon vertices (ap, ml) per frame [m] (CSV columns
+        ``base_ap1, base_ml1, ...``); NaN marks an absent vertex.
     """
 
     time: FloatArray
@@ -94,6 +97,7 @@ class Recording:
     com_height: float | None = None
     source: str = ""
     notes: list[str] = field(default_factory=list)
+    base_vertices: FloatArray | None = None
 
 
 @dataclass(frozen=True, slots=True)

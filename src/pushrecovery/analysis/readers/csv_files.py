@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -52,6 +53,8 @@ _FORCES = ("force_ap", "force_ml", "force_v")
 
 #: Every column the CSV reader knows.
 CSV_COLUMNS: tuple[str, ...] = ("time", *_LENGTHS, *_FORCES)
+#: The base polygon's vertex columns, ``base_ap1, base_ml1, ..., base_apK, base_mlK`` [length].
+VERTEX_COLUMN = re.compile(r"base_(ap|ml)([1-9][0-9]?)")
 
 
 _PAIRS = (
@@ -110,7 +113,8 @@ def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
     path = _path(path)
     scale = _unit_scale(units)
     table = _read_table(path)
-    data = {name: table[name] * (scale if name in _LENGTHS else 1.0) for name in table}
+    lengths = {name for name in table if name in _LENGTHS or VERTEX_COLUMN.fullmatch(name)}
+    data = {name: table[name] * (scale if name in lengths else 1.0) for name in table}
     time = data["time"]
     _check_time(path, time)
     for first, second in _PAIRS:
@@ -168,6 +172,7 @@ def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
         if present
     }
     ankle = {axis: data[f"ankle_{axis}"] for axis in AXES if f"ankle_{axis}" in data}
+    vertices = _vertices(path, data)
     com_height = None
     if "com_height" in data and np.isfinite(data["com_height"]).any():
         com_height = float(np.nanmedian(data["com_height"]))
@@ -182,9 +187,39 @@ def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
         cop=cop,
         com_height=com_height,
         source=str(path),
+        base_vertices=vertices,
     )
     _check_plausible(path, recording, units)
     return recording
+
+
+def _vertices(path: Path, data: dict[str, FloatArray]) -> FloatArray | None:
+    """Return the base polygon's vertices (n, K, 2) from ``base_apK``/``base_mlK``, or None.
+
+    Vertex k needs both its columns; K = 3 at least (docs/base_polygon.md). NaN cells are
+    absent vertices of that frame (the base is the hull of the others).
+    """
+    found: dict[int, dict[str, FloatArray]] = {}
+    for name, values in data.items():
+        match = VERTEX_COLUMN.fullmatch(name)
+        if match:
+            found.setdefault(int(match.group(2)), {})[match.group(1)] = values
+    if not found:
+        return None
+    for k in sorted(found):
+        for axis in AXES:
+            if axis not in found[k]:
+                raise InputFileError(
+                    f"{path}: column base_{axis}{k} is missing: vertex {k} needs both"
+                )
+    if len(found) < 3:
+        raise InputFileError(
+            f"{path}: a base polygon needs at least 3 vertices (base_ap1, base_ml1, ...), "
+            f"got {len(found)}"
+        )
+    return np.stack(
+        [np.column_stack([found[k]["ap"], found[k]["ml"]]) for k in sorted(found)], axis=1
+    )
 
 
 def _read_table(path: Path) -> dict[str, FloatArray]:
@@ -219,7 +254,7 @@ def _read_table(path: Path) -> dict[str, FloatArray]:
         )
     columns: dict[str, FloatArray] = {}
     for name, column in zip(names, table.columns, strict=True):
-        if name not in CSV_COLUMNS:
+        if name not in CSV_COLUMNS and not VERTEX_COLUMN.fullmatch(name):
             continue  # other columns are the user's own
         if not (pa.types.is_integer(column.type) or pa.types.is_floating(column.type)):
             if pa.types.is_null(column.type):

@@ -76,6 +76,12 @@ def _support(
         )
         plane = base_from_feet(measured, model, contact_height=settings.contact_height)
         return support, plane, "foot markers", gaps
+    if recording.base_vertices is not None:
+        plane = base_from_vertices(_resampled(recording.time, recording.base_vertices, time))
+        low_ap, high_ap, low_ml, high_ml = plane.extents()
+        edges = {"ap": np.column_stack([low_ap, high_ap]), "ml": np.column_stack([low_ml, high_ml])}
+        support = _explicit_support(recording, time, params, settings, edges)
+        return support, plane, "base polygon columns", gaps
     if recording.base:
         support = _explicit_support(recording, time, params, settings)
         return support, _rectangles(support), "base columns", gaps
@@ -113,18 +119,31 @@ def _rectangles(support: Support) -> BasePolygons:
     return base_from_vertices(np.stack([np.column_stack(c) for c in corners], axis=1))
 
 
+def _resampled(source: FloatArray, vertices: FloatArray, time: FloatArray) -> FloatArray:
+    """Vertices (m, k, 2) at ``source`` times, at the frames' ``time`` (the same: as is)."""
+    if len(source) == len(time) and np.array_equal(source, time):
+        return vertices
+    flat = resample(source, vertices.reshape(len(source), -1), time)
+    return flat.reshape(len(time), *vertices.shape[1:])
+
+
 def _explicit_support(
-    recording: Recording, time: FloatArray, params: BodyParams, settings: AnalysisSettings
+    recording: Recording,
+    time: FloatArray,
+    params: BodyParams,
+    settings: AnalysisSettings,
+    base: dict[str, FloatArray] | None = None,
 ) -> Support:
-    """Support from CSV columns: base edges, optionally the stance ankle, per axis."""
+    """Support from CSV columns: base edges (or ``base``), optionally the stance ankle."""
     lower, upper, ankles = {}, {}, {}
+    base = recording.base if base is None else base
     for axis in AXES:
-        if axis not in recording.base:
+        if axis not in base:
             raise InvalidParameterError(
                 f"give the base of support along both axes: base_{axis}_min and base_{axis}_max "
                 "columns are missing"
             )
-        edges = recording.base[axis]
+        edges = base[axis]
         lower[axis], upper[axis] = edges[:, 0], edges[:, 1]
         if axis in recording.ankle:
             ankle = recording.ankle[axis]
