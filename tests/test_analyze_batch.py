@@ -197,3 +197,21 @@ def test_the_cli_analyses_a_folder_in_one_command(study, tmp_path, capsys):
 def _write(path, text):
     path.write_text(text)
     return path
+
+
+def test_the_batch_tables_are_typed_and_read_by_pandas(study, tmp_path):
+    from pushrecovery.campaign.trial_rows import TrialRow
+
+    trials, root = find_trials([study / "s01"])
+    result = run_trials(trial_jobs(trials, root), tmp_path / "t", workers=1)
+    rows = result.trial_rows()
+    assert all(isinstance(row, TrialRow) for row in rows) and len(rows) == 16
+    frame = result.to_pandas("trials")
+    assert len(frame) == 16 and frame["min_mos"].notna().all()
+    assert (frame["min_mos_normalised"] * frame["leg_length"]).to_numpy() == pytest.approx(
+        frame["min_mos"].to_numpy()
+    )
+    events = result.to_pandas("events")
+    assert set(events["kind"]) >= {"onset"}
+    with pytest.raises(InvalidParameterError, match="table must be"):
+        result.to_pandas("frames")

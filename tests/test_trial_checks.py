@@ -219,3 +219,31 @@ def test_a_base_polygon_from_vertex_columns(tmp_path):
 
     with pytest.raises(InputFileError, match="base_ml3 is missing"):
         read_recording(path, units="mm")
+
+
+def test_normalised_columns_and_typed_tables(tmp_path):
+    # Hof's dimensionless margins: the still CoM of the rectangle base above, 0.07 m inside,
+    # for a leg of 0.875 m: 0.08; velocities over sqrt(g l).
+    import dataclasses
+
+    from pushrecovery.analysis.trial import AnalysisSettings
+
+    n = 300
+    lines = ["time,com_ap,com_ml,base_ap_min,base_ap_max,base_ml_min,base_ml_max"]
+    lines += [f"{k / 100:.2f},0.02,0.03,-0.05,0.15,-0.15,0.15" for k in range(n)]
+    path = tmp_path / "still.csv"
+    path.write_text("\n".join(lines) + "\n")
+    body = dataclasses.replace(P, leg_length=0.875)
+    plain = analyze(read_recording(path), body)
+    assert "mos_norm" not in plain.columns
+    result = analyze(read_recording(path), body, AnalysisSettings(normalise=True))
+    assert result.columns["mos_norm"] == pytest.approx(np.full(n, 0.08), abs=1e-9)
+    assert result.columns["ap_margin_cop_norm"] == pytest.approx(
+        result.columns["ap_margin_cop"] / 0.875
+    )
+    # Typed tables: arrow and pandas, the same frames as frames.parquet.
+    table = result.to_arrow()
+    assert table.num_rows == n and table.column("mos_norm").null_count == 0
+    frames = result.to_pandas()
+    assert list(frames.columns) == list(result.columns)
+    assert frames["mos"].to_numpy() == pytest.approx(result.columns["mos"])

@@ -45,21 +45,12 @@ def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Pa
     dict
         ``frames_parquet``, ``frames_csv`` and ``summary`` paths.
     """
-    import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    arrays = {}
-    for name, values in analysis.columns.items():
-        if values.dtype == object:
-            arrays[name] = pa.array(list(values), type=pa.string())
-        elif values.dtype == bool:
-            arrays[name] = pa.array(values)
-        else:
-            arrays[name] = pa.array(values, mask=np.isnan(values))
-    table = pa.table(arrays)
+    table = analysis.to_arrow()
     paths = {
         "frames_parquet": out / FRAME_FILES[0],
         "frames_csv": out / FRAME_FILES[1],

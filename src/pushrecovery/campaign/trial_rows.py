@@ -82,6 +82,8 @@ class TrialRow:
     min_mos, min_mos_time : float
         Smallest signed distance of the XCoM to the base polygon (Hof's margin of stability
         in the plane, + inside) [m] and its time [s] (the same on both axes' rows).
+    min_mos_normalised : float
+        ``min_mos`` / ``leg_length``: Hof's dimensionless margin.
     min_mos_axis : float
         Smallest component margin along this axis, toward the side the CoM moves [m].
     min_time_to_boundary_cop, min_time_to_boundary_xcom : float
@@ -140,6 +142,7 @@ class TrialRow:
     steps_taken: int | None = None
     min_mos: float | None = None
     min_mos_time: float | None = None
+    min_mos_normalised: float | None = None
     min_mos_axis: float | None = None
     min_time_to_boundary_cop: float | None = None
     min_time_to_boundary_xcom: float | None = None
@@ -210,7 +213,7 @@ def trial_rows(
             capture_point_max=data["capture_point_range"][1],
             step_events=sum(1 for e in summary["step_events"] if e["axis"] == axis),
             **_checked(summary, axis),
-            **_planar(summary.get("plane"), axis),
+            **_planar(summary.get("plane"), axis, params.leg_length),
             **_sway(summary.get("posturography"), axis),
         )
         if row.base_rejected:
@@ -237,12 +240,14 @@ def _checked(summary: dict[str, Any], axis: str) -> dict[str, Any]:
     return found
 
 
-def _planar(plane: dict[str, Any] | None, axis: str) -> dict[str, Any]:
+def _planar(plane: dict[str, Any] | None, axis: str, leg_length: float) -> dict[str, Any]:
     """Return a trial row's measures against the base polygon."""
     if plane is None:
         return {}
+    mos = plane["min_mos"]["value"]
     return {
-        "min_mos": plane["min_mos"]["value"],
+        "min_mos": mos,
+        "min_mos_normalised": None if mos is None else mos / leg_length,
         "min_mos_time": plane["min_mos"]["time"],
         "min_mos_axis": plane[f"min_mos_{axis}"]["value"],
         "min_time_to_boundary_cop": plane["min_time_to_boundary_cop"]["value"],

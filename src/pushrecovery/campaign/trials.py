@@ -31,8 +31,8 @@ from pathlib import Path
 from typing import Any
 
 from pushrecovery.campaign.subjects import Subject, subject_for
-from pushrecovery.campaign.trial_events import EVENT_FIELDS, trial_events
-from pushrecovery.campaign.trial_rows import TRIAL_FIELDS, failed_rows, trial_rows
+from pushrecovery.campaign.trial_events import EVENT_FIELDS, EventRow, trial_events
+from pushrecovery.campaign.trial_rows import TRIAL_FIELDS, TrialRow, failed_rows, trial_rows
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 
 __all__ = [
@@ -132,13 +132,46 @@ def trial_jobs(
 
 @dataclass(frozen=True)
 class TrialsResult:
-    """A finished batch: the rows of the trials and events, the summary and the files."""
+    """A finished batch: the rows of the trials and events, the summary and the files.
+
+    ``trials`` and ``events`` are the rows of ``trials.parquet`` and ``events.parquet``
+    (:class:`~pushrecovery.campaign.trial_rows.TrialRow` and
+    :class:`~pushrecovery.campaign.trial_events.EventRow` as dicts).
+    """
 
     trials: list[dict[str, Any]]
     events: list[dict[str, Any]]
     summary: dict[str, Any]
     files: dict[str, Path]
     ran: int  # trials analysed by this call (the rest were finished on disk)
+
+    def trial_rows(self) -> list[TrialRow]:
+        """Return the trials' rows as typed objects."""
+        return [TrialRow(**row) for row in self.trials]
+
+    def event_rows(self) -> list[EventRow]:
+        """Return the events' rows as typed objects."""
+        return [EventRow(**row) for row in self.events]
+
+    def to_pandas(self, table: str = "trials") -> Any:
+        """Return ``trials`` or ``events`` as a ``pandas.DataFrame`` (the ``tables`` extra).
+
+        Raises
+        ------
+        InvalidParameterError
+            Another table name, or pandas is not installed.
+        """
+        import pyarrow.parquet as pq
+
+        if table not in ("trials", "events"):
+            raise InvalidParameterError(f"table must be 'trials' or 'events', got {table!r:.40}")
+        try:
+            import pandas  # noqa: F401
+        except ImportError:
+            raise InvalidParameterError(
+                "to_pandas needs pandas: pip install 'pushrecovery[tables]'"
+            ) from None
+        return pq.read_table(self.files[table]).to_pandas()
 
 
 def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict[str, Any]:

@@ -135,6 +135,12 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     help="Lab position of the fixed feet along ml [m] (default: the mean CoP).",
 )
 @click.option(
+    "--normalise",
+    is_flag=True,
+    help="Add Hof's dimensionless columns (*_norm): lengths / leg length l, velocities / "
+    "sqrt(g l), times * sqrt(g/l).",
+)
+@click.option(
     "--plot/--no-plot",
     default=True,
     show_default=True,
@@ -168,6 +174,7 @@ def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) ->
         contact_height=kwargs.pop("contact_height"),
         ankle_ap=kwargs.pop("ankle_ap"),
         ankle_ml=kwargs.pop("ankle_ml"),
+        normalise=kwargs.pop("normalise"),
     )
     single = len(inputs) == 1 and Path(inputs[0]).is_file()
     batch = {name: kwargs.pop(name) for name in ("subjects", "workers", "scheduler", "resume")}

@@ -225,11 +225,32 @@ def analyze(
             **checks.reasons(),
         },
     )
+    if settings.normalise:
+        columns.update(_normalised(columns, params))
     summary["checks"] = checks.to_dict()
     summary["plane"] = _plane_summary(plane, time, support_source)
     summary["events"] = trial_events(recording, time, velocity, per_axis, params.mass)
     summary["posturography"] = _posturography(force_time, plate_cop, plate_force, settings)
     return TrialAnalysis(columns, summary)
+
+
+#: Columns that are lengths (margins) and times, and velocities, made dimensionless.
+_LENGTH_COLUMNS = ("mos", "mos_ap", "mos_ml", "mos_cmp", "ap_margin_cop", "ml_margin_cop",
+                   "ap_margin_cmp", "ml_margin_cmp")  # fmt: skip
+_TIME_COLUMNS = ("ttb_cop", "ttb_xcom", "ap_time_to_leave_cop", "ml_time_to_leave_cop")
+_VELOCITY_COLUMNS = ("ap_com_velocity", "ml_com_velocity")
+
+
+def _normalised(columns: dict[str, NDArray[Any]], params: BodyParams) -> dict[str, NDArray[Any]]:
+    """Return Hof's dimensionless columns (``*_norm``), l the leg length (Hof 2008).
+
+    Lengths over l, velocities over sqrt(g l), times times sqrt(g / l).
+    """
+    leg = params.leg_length
+    scales = {name: 1.0 / leg for name in _LENGTH_COLUMNS}
+    scales.update({name: 1.0 / np.sqrt(params.gravity * leg) for name in _VELOCITY_COLUMNS})
+    scales.update({name: np.sqrt(params.gravity / leg) for name in _TIME_COLUMNS})
+    return {f"{name}_norm": columns[name] * k for name, k in scales.items() if name in columns}
 
 
 def _plane(

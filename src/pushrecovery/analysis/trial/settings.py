@@ -55,6 +55,9 @@ class AnalysisSettings:
     ankle_ap, ankle_ml : float or None
         Lab position of the fixed feet (midpoint of the ankles) [m]; default from the mean
         CoP (ap: ``COP_AHEAD_OF_ANKLE`` behind it) or, without a CoP, the mean CoM.
+    normalise : bool
+        Add Hof's dimensionless columns (Hof 2008, J Biomech 41:1171): lengths over the leg
+        length l (``BodyParams.leg_length``), velocities over sqrt(g l): ``*_norm``.
     """
 
     cutoff: float = 6.0
@@ -65,6 +68,7 @@ class AnalysisSettings:
     stance_width: float | None = None
     ankle_ap: float | None = None
     ankle_ml: float | None = None
+    normalise: bool = False
 
     def widths(self, params: BodyParams) -> tuple[float, float]:
         """Foot width and stance width [m]: these settings', else the body's."""
@@ -94,7 +98,11 @@ class AnalysisSettings:
 
 @dataclass(frozen=True, slots=True)
 class TrialAnalysis:
-    """Result of :func:`analyze`: the per-frame table and the summary (``summary.json``)."""
+    """Result of :func:`analyze`: the per-frame table and the summary (``summary.json``).
+
+    ``columns`` are the per-frame columns of ``frames.parquet`` (docs/analysis.md: SI units,
+    NaN where unknown, strategies as text, None where withheld); ``summary`` the trial's.
+    """
 
     columns: dict[str, NDArray[Any]]
     summary: dict[str, Any]
@@ -103,6 +111,35 @@ class TrialAnalysis:
     def time(self) -> FloatArray:
         """Frame times [s]."""
         return self.columns["time"]
+
+    def to_arrow(self) -> Any:
+        """Return the frames as a ``pyarrow.Table`` (NaN as null, as in ``frames.parquet``)."""
+        import pyarrow as pa
+
+        arrays = {}
+        for name, values in self.columns.items():
+            if values.dtype == object:
+                arrays[name] = pa.array(list(values), type=pa.string())
+            elif values.dtype.kind in "biu":
+                arrays[name] = pa.array(values)
+            else:
+                arrays[name] = pa.array(values, mask=np.isnan(values))
+        return pa.table(arrays)
+
+    def to_pandas(self) -> Any:
+        """Return the frames as a ``pandas.DataFrame`` (needs the ``tables`` extra: pandas)."""
+        return _pandas(self.to_arrow())
+
+
+def _pandas(table: Any) -> Any:
+    """Return a pyarrow table as a pandas DataFrame, or say how to get pandas."""
+    try:
+        import pandas  # noqa: F401
+    except ImportError:
+        raise InvalidParameterError(
+            "to_pandas needs pandas: pip install 'pushrecovery[tables]'"
+        ) from None
+    return table.to_pandas()
 
 
 def body_for(
