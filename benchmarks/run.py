@@ -33,6 +33,11 @@
    (ankle, hip with the MPC, steps, falls; the batch builds its own MPCs). Target: >= 500/s.
 13. The MPC at N = 50, 100, 200 (``benchmarks/mpc_horizons.py``): tick median and p99 against
    a 100 x 100 mat-vec, and the growth with the horizon (issue 17).
+14. MuJoCo at its own speed (``benchmarks/mujoco_speed.py``, issue 17): ``torso`` + MPC against
+   MuJoCo alone on the same trajectory, and the lockstep rollout of ``foot`` + ankle PD.
+15. Batch analysis of measured trials (``benchmarks/trials.py``, issue 18): 200 generated
+   trials on 1 and 2 workers and a Dask LocalCluster (the same tables), trials per second and
+   the time per trial-second against reading the files alone.
 """
 
 from __future__ import annotations
@@ -400,12 +405,16 @@ def analysis() -> None:
 
 def main() -> int:
     import mpc_horizons
+    import mujoco_speed
     import plane
     import steps
+    import trials
 
     plane_failed = plane.main()
     steps_failed = steps.main()
     mpc_failed = mpc_horizons.main()
+    mujoco_failed = mujoco_speed.main()
+    trials_failed = trials.main()
     ratio = surface()
     cli = startup()
     realtime()
@@ -419,6 +428,7 @@ def main() -> int:
     analysis()
     failed = ratio > 2.0 or cli > 1.5 or step_rate < 2e6 or step_ratio < 1000 or physics < 150
     failed = failed or bool(plane_failed) or bool(steps_failed) or bool(mpc_failed)
+    failed = failed or bool(mujoco_failed) or bool(trials_failed)
     failed = failed or batch_rate < 5000 or step_batch_rate < 500
     print("targets met" if not failed else "TARGET MISSED")
     return int(failed)
