@@ -25,9 +25,12 @@ if TYPE_CHECKING:
 __all__ = [
     "STRATEGY_COLOURS",
     "WITHHELD_COLOURS",
+    "phase_coordinates",
+    "phase_portrait_figure",
     "plot_phase_portrait",
     "plot_time_series",
     "strategy_label",
+    "time_series_figure",
     "withheld_frames",
 ]
 
@@ -123,7 +126,7 @@ def _events(analysis: TrialAnalysis) -> list[tuple[float, str, str]]:
     return sorted(found)
 
 
-def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
+def time_series_figure(analysis: TrialAnalysis) -> Figure:
     """Draw CoM, CoP, CMP and capture point over time, per axis, with the regions shaded.
 
     Green band: the base of support (CoP region, Eq. 4); orange: what the hip strategy adds
@@ -187,7 +190,17 @@ def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
         _limit(ax, columns, axis, origin)
     axes[-1, 0].set_xlabel("time [s]   (strip at the bottom: the strategy each frame needs)")
     figure_legend(fig, fontsize=7, ncols=4)
-    return _save(fig, path)
+    return fig
+
+
+def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
+    """Write :func:`time_series_figure` to ``path`` (format from its suffix, default PNG)."""
+    return _save(time_series_figure(analysis), path)
+
+
+def plot_phase_portrait(analysis: TrialAnalysis, path: Path) -> Path:
+    """Write :func:`phase_portrait_figure` to ``path`` (format from its suffix, default PNG)."""
+    return _save(phase_portrait_figure(analysis), path)
 
 
 def _title(analysis: TrialAnalysis, axis: str) -> str:
@@ -265,7 +278,7 @@ def phase_coordinates(analysis: TrialAnalysis, axis: str) -> tuple[np.ndarray, n
     return position, columns[f"{axis}_com_velocity"]
 
 
-def plot_phase_portrait(analysis: TrialAnalysis, path: Path) -> Path:
+def phase_portrait_figure(analysis: TrialAnalysis) -> Figure:
     """Plot each axis's capture point within the frame's own base against the CoM velocity.
 
     The horizontal coordinate is :func:`phase_coordinates`' normalised position: the frame's
@@ -310,7 +323,7 @@ def plot_phase_portrait(analysis: TrialAnalysis, path: Path) -> Path:
         )
         ax.set_ylabel(f"CoM velocity along {axis} [m/s]")
     figure_legend(fig, fontsize=7, ncols=2, markerscale=3)
-    return _save(fig, path)
+    return fig
 
 
 def _hip_edges(ax: Axes, analysis: TrialAnalysis, axis: str) -> None:
@@ -323,7 +336,7 @@ def _hip_edges(ax: Axes, analysis: TrialAnalysis, axis: str) -> None:
     if not reach.size or reach.max() <= 0:
         return
     near, far = float(reach.min()), float(reach.max())
-    label = "hip (CMP) region edge, corr. Eq. (15): r / L beyond the base"
+    label = f"{axis}: hip (CMP) region edge, corr. Eq. (15): r / L beyond the base"
     if far - near > 1e-3:
         label += f" ({near:.2f}–{far:.2f}, band: L varies)"
         for a, b in ((-far, -near), (1 + near, 1 + far)):
@@ -340,7 +353,9 @@ def _phase_limits(ax: Axes, position: np.ndarray, velocity: np.ndarray) -> None:
     if position.size:
         low = min(low, float(np.quantile(position, 0.01)) - 0.1)
         high = max(high, float(np.quantile(position, 0.99)) + 0.1)
-    ax.set_xlim(max(low, -4.0), min(high, 5.0))
+    low, high = max(low, -4.0), min(high, 5.0)
+    ax.set_xlim(low, high)
+    velocity = velocity[(position >= low) & (position <= high)]
     if velocity.size:
-        vmax = max(float(np.quantile(np.abs(velocity), 0.99)), 0.05) * 1.3
+        vmax = max(float(np.abs(velocity).max()), 0.05) * 1.3
         ax.set_ylim(-vmax, vmax)

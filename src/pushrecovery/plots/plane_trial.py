@@ -31,8 +31,9 @@ from pushrecovery.plots.analysis import (
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
-__all__ = ["base_moments", "plot_plane"]
+__all__ = ["base_moments", "plane_figure", "plot_plane"]
 
 #: Outline colours of the base at successive moments (none of them a strategy's).
 MOMENT_COLOURS = ("0.15", "#00838f", "#ad1457", "#6d4c41", "#3949ab", "#827717", "#4e342e")
@@ -92,6 +93,26 @@ def _rectangles(analysis: TrialAnalysis) -> BasePolygons:
 
 
 def plot_plane(analysis: TrialAnalysis, base: BasePolygons | None, path: Path) -> Path:
+    """Write :func:`plane_figure` to ``path`` (format from its suffix, default PNG).
+
+    Parameters
+    ----------
+    analysis : TrialAnalysis
+        The analysed trial.
+    base : BasePolygons or None
+        The plane's base per frame (see :func:`plane_figure`).
+    path : Path
+        The image to write.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    return _save(plane_figure(analysis, base), path)
+
+
+def plane_figure(analysis: TrialAnalysis, base: BasePolygons | None = None) -> Figure:
     """Draw the trial in the ground plane: base outlines, XCoM, CoM and CoP paths, events.
 
     Parameters
@@ -102,13 +123,15 @@ def plot_plane(analysis: TrialAnalysis, base: BasePolygons | None, path: Path) -
         The plane's base per frame, as the analysis built it (one polygon per frame of
         ``analysis``); None: the rectangles of the per-axis extents (``{axis}_base_min`` and
         ``_max``), said so in the title.
-    path : Path
-        The image to write (its suffix the format, default PNG).
 
     Returns
     -------
-    Path
-        The file written.
+    Figure
+
+    Raises
+    ------
+    ValueError
+        If ``base`` has not one polygon per frame of ``analysis``.
     """
     columns = analysis.columns
     time = columns["time"]
@@ -138,7 +161,7 @@ def plot_plane(analysis: TrialAnalysis, base: BasePolygons | None, path: Path) -
     xcom = np.column_stack([columns["ap_capture_point"], columns["ml_capture_point"]])
     which = _xcom_paths(ax, analysis, xcom)
     _mark(ax, analysis, base, xcom)
-    _limits(ax, [*shown, cop, xcom, com])
+    note = _limits(ax, [*shown, cop], np.concatenate([xcom, com]))
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("ap position [m]   (forward +, to the right)")
     ax.set_ylabel("ml position [m]   (subject's left +, up)")
@@ -146,10 +169,11 @@ def plot_plane(analysis: TrialAnalysis, base: BasePolygons | None, path: Path) -
     if base.source.startswith("per-axis"):
         source = base.source
     ax.set_title(
-        f"Ground plane seen from above; XCoM coloured by {which}\nbase: {source}", fontsize=9
+        f"Ground plane seen from above; XCoM coloured by {which}{note}\nbase: {source}",
+        fontsize=9,
     )
     figure_legend(fig, fontsize=7, ncols=2, markerscale=1.0)
-    return _save(fig, path)
+    return fig
 
 
 def _xcom_paths(ax: Axes, analysis: TrialAnalysis, xcom: np.ndarray) -> str:
@@ -199,18 +223,26 @@ def _mark(ax: Axes, analysis: TrialAnalysis, base: BasePolygons, xcom: np.ndarra
                 f"({smallest['time']:.2f} s)")  # fmt: skip
 
 
-def _limits(ax: Axes, paths: list[np.ndarray]) -> None:
-    """Frame the outlined bases and most of each path (a fall's runaway tail may leave it)."""
-    points = []
-    for path in paths:
-        finite = path[np.isfinite(path).all(axis=1)]
-        if len(finite) > 20:
-            finite = np.quantile(finite, [0.01, 0.99], axis=0)
-        points.append(finite)
-    every = np.concatenate([p for p in points if len(p)]) if any(len(p) for p in points) else None
-    if every is None:
-        return
-    low, high = every.min(axis=0), every.max(axis=0)
+def _limits(ax: Axes, body: list[np.ndarray], xcom: np.ndarray) -> str:
+    """Frame the outlined bases and the CoP, and the CoM and XCoM up to 0.5 m beyond them.
+
+    Returns a note for the title when the CoM or XCoM leaves the view (a fall's runaway tail).
+    """
+    reach = xcom[np.isfinite(xcom).all(axis=1)]
+    inner = [p[np.isfinite(p).all(axis=1)] for p in body]
+    inner = [p for p in inner if len(p)] or ([reach] if len(reach) else [])
+    if not inner:
+        return ""
+    low = np.min([p.min(axis=0) for p in inner], axis=0)
+    high = np.max([p.max(axis=0) for p in inner], axis=0)
+    note = ""
+    if len(reach):
+        low = np.minimum(low, np.maximum(reach.min(axis=0), low - 0.5))
+        high = np.maximum(high, np.minimum(reach.max(axis=0), high + 0.5))
+        outside = ((reach < low) | (reach > high)).any(axis=1)
+        if outside.any():
+            note = f"\nthe CoM or XCoM leaves the view in {int(outside.sum())} frames"
     pad = 0.08 * float(max(high - low)) + 0.02
     ax.set_xlim(low[0] - pad, high[0] + pad)
     ax.set_ylim(low[1] - pad, high[1] + pad)
+    return note
