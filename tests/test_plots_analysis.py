@@ -19,7 +19,6 @@ from pushrecovery import load_params
 from pushrecovery.analysis.readers import read_recording
 from pushrecovery.analysis.trial import AnalysisSettings, analyze, body_for
 from pushrecovery.analysis.trial.checks import COP_TOLERANCE
-from pushrecovery.analysis.trial.support import _support
 from pushrecovery.plots.analysis import (
     STRATEGY_COLOURS,
     WITHHELD_COLOURS,
@@ -50,13 +49,10 @@ def trial(request, tmp_path_factory):
         recording = read_recording(DATA / "kistler_COP.c3d")
         found, _ = body_for(recording, mass=None, com_height=None, gravity=9.81)
         params = load_params(overrides=found)
-    settings = AnalysisSettings()
-    analysis = analyze(recording, params, settings)
-    columns = analysis.columns
-    com = np.column_stack([columns["ap_com"], columns["ml_com"]])
-    cop = np.column_stack([columns["ap_cop"], columns["ml_cop"]])
-    _, base, _, _ = _support(recording, columns["time"], com, cop, params, settings)
-    return request.param, analysis, base
+    analysis = analyze(recording, params, AnalysisSettings())
+    # The pipeline's own base of support per frame in the plane, kept with the analysis.
+    assert analysis.base is not None and len(analysis.base) == len(analysis.time)
+    return request.param, analysis, analysis.base
 
 
 def _legend_texts(figure):

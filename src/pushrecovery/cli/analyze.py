@@ -222,12 +222,14 @@ def _single(
 
 
 def plot_trial(result: Any, out: Path) -> dict[str, str]:
-    """Draw a trial's time series and phase portrait into ``out``; return the files."""
+    """Draw a trial's time series, phase portrait and plane into ``out``; return the files."""
     from pushrecovery.plots.analysis import plot_phase_portrait, plot_time_series
+    from pushrecovery.plots.plane_trial import plot_plane
 
     return {
         "time_series": str(plot_time_series(result, out / "time_series.png")),
         "phase_portrait": str(plot_phase_portrait(result, out / "phase_portrait.png")),
+        "plane": str(plot_plane(result, result.base, out / "plane.png")),
     }
 
 

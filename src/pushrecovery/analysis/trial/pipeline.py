@@ -231,7 +231,15 @@ def analyze(
     summary["plane"] = _plane_summary(plane, time, support_source)
     summary["events"] = trial_events(recording, time, velocity, per_axis, params.mass)
     summary["posturography"] = _posturography(force_time, plate_cop, plate_force, settings)
-    return TrialAnalysis(columns, summary)
+    if summary["posturography"] is not None and summary["events"]["onset"]["time"] is not None:
+        # Quiet standing has no perturbation: its sway crosses any threshold of a short baseline.
+        summary["events"]["onset"] = {
+            "time": None,
+            "signal": summary["events"]["onset"]["signal"],
+            "margins": None,
+            "note": "quiet standing: no perturbation",
+        }
+    return TrialAnalysis(columns, summary, base)
 
 
 #: Columns that are lengths (margins) and times, and velocities, made dimensionless.

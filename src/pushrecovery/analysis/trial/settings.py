@@ -101,11 +101,14 @@ class TrialAnalysis:
     """Result of :func:`analyze`: the per-frame table and the summary (``summary.json``).
 
     ``columns`` are the per-frame columns of ``frames.parquet`` (docs/analysis.md: SI units,
-    NaN where unknown, strategies as text, None where withheld); ``summary`` the trial's.
+    NaN where unknown, strategies as text, None where withheld); ``summary`` the trial's;
+    ``base`` the base of support per frame in the plane (a
+    :class:`~pushrecovery.analysis.base_polygon.BasePolygons`; None when not computed).
     """
 
     columns: dict[str, NDArray[Any]]
     summary: dict[str, Any]
+    base: Any = None
 
     @property
     def time(self) -> FloatArray:
