@@ -247,3 +247,24 @@ def test_normalised_columns_and_typed_tables(tmp_path):
     frames = result.to_pandas()
     assert list(frames.columns) == list(result.columns)
     assert frames["mos"].to_numpy() == pytest.approx(result.columns["mos"])
+
+
+def test_foot_events_from_each_plate_of_a_drop_jump():
+    # biomdp's drop jump on two Kistler plates: off the box's plate (2) into the first flight,
+    # down on plate 1, off it into the jump's flight and back on it. Each plate's events are
+    # the flights' ends (within 20 ms: the plates' own threshold and merging, docs/events.md).
+    recording = read_recording(DATA / "kistler_DJ_2plates.c3d")
+    assert len(recording.plates) == 2
+    found, _ = body_for(recording, mass=None, com_height=None, gravity=9.81)
+    result = analyze(recording, load_params(overrides=found))
+    events = [(e["foot"], e["kind"], e["time"]) for e in result.summary["events"]["foot_events"]]
+    assert [(foot, kind) for foot, kind, _ in events] == [
+        ("plate 2", "foot-off"),
+        ("plate 1", "foot-contact"),
+        ("plate 1", "foot-off"),
+        ("plate 1", "foot-contact"),
+    ]
+    flights = result.summary["checks"]["flight_phases"]
+    edges = [flights[0]["start"], flights[0]["end"], flights[1]["start"], flights[1]["end"]]
+    for (_, _, time), edge in zip(events, edges, strict=True):
+        assert time == pytest.approx(edge, abs=0.02)

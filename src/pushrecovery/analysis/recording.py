@@ -82,6 +82,9 @@ class Recording:
     base_vertices : ndarray, shape (n, k, 2) or None
         The base of support as polygon vertices (ap, ml) per frame [m] (CSV columns
         ``base_ap1, base_ml1, ...``); NaN marks an absent vertex.
+    plates : tuple of (ndarray, ndarray)
+        Each force plate's vertical force (m,) [N] and CoP (m, 2) (ap, ml) [m] at
+        ``force_time`` (C3D files with more than one plate): the foot events per plate.
     """
 
     time: FloatArray
@@ -98,6 +101,7 @@ class Recording:
     source: str = ""
     notes: list[str] = field(default_factory=list)
     base_vertices: FloatArray | None = None
+    plates: tuple[tuple[FloatArray, FloatArray], ...] = ()
 
 
 @dataclass(frozen=True, slots=True)

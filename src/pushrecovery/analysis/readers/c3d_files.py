@@ -98,6 +98,7 @@ def read_c3d_recording(
             # Standing height: a step or a crouch lowers the CoM for part of a trial.
             com_height = float(np.nanpercentile(height, STANDING_PERCENTILE))
     force = cop = force_time = None
+    plates: tuple[tuple[FloatArray, FloatArray], ...] = ()
     if content.plates:
         force_time = content.analog_time
         total = np.sum([plate.force for plate in content.plates], axis=0)
@@ -106,6 +107,10 @@ def read_c3d_recording(
         cop = cop[:, :2]
         if len(content.plates) > 1:
             notes.append(f"{len(content.plates)} force plates: forces summed, CoPs combined")
+            plates = tuple(
+                ((plate.force @ rotation.T)[:, 2], (plate.cop @ rotation.T)[:, :2])
+                for plate in content.plates
+            )
     if com is None and force is None:
         raise InputFileError(
             f"{path}: neither a CoM marker ({COM_MARKER!r} or --com-marker) nor force plates"
@@ -128,6 +133,7 @@ def read_c3d_recording(
         com_height=com_height,
         source=str(path),
         notes=notes,
+        plates=plates,
     )
 
 

@@ -12,8 +12,10 @@ given what a reader of the trial asks of them:
   abrupt push over about ±1/f_c; the less noise, the earlier in that spread the threshold is
   crossed: an onset found on them may lead the true one by up to 1/f_c (0.17 s at 6 Hz),
   never lag it (tests/test_trial_checks.py). Prefer plates.
-- **foot events** from the foot markers (``foot-off``, ``foot-contact``), and the **steps**
-  they make (latency from the onset, length, width, duration).
+- **foot events** (``foot-off``, ``foot-contact``): from a foot's own force plate where each
+  foot stands on one plate of a C3D file with several (the plate whose loaded CoP lies nearest
+  the foot's heel-toe midpoint; 20 N), else from the foot markers; and the **steps** they make
+  (latency from the onset, length, width, duration; the positions from the markers).
 - **margins at each event**: the frame nearest the event's time, per axis: capture point, CoP
   margin, strategy and time to leave.
 - **the step taken against the recommended one**: at the step's foot-off frame, per axis, the
@@ -35,6 +37,7 @@ from pushrecovery.analysis.margins import DirectionMargins
 from pushrecovery.analysis.recording import AXES, Recording
 from pushrecovery.analysis.steps_measured import (
     FootEvent,
+    foot_events_from_force,
     foot_events_from_markers,
     measured_steps,
 )
@@ -117,6 +120,53 @@ def _compared(
     return result
 
 
+def _plate_feet(recording: Recording) -> dict[int, str]:
+    """Return plate number -> the foot standing on it (``plate k`` without one).
+
+    The foot whose heel-toe midpoint lies nearest the plate's median loaded CoP; when two
+    plates would go to one foot, the plates keep their own names.
+    """
+    if recording.force_time is None or not recording.plates:
+        return {}
+    centres = {}
+    for foot in recording.feet:
+        middle = 0.5 * (foot.heel[:, :2] + foot.toe[:, :2])
+        centres[foot.name] = np.nanmedian(middle, axis=0)
+    owners: dict[int, str] = {}
+    for k, (_, cop) in enumerate(recording.plates):
+        loaded = np.isfinite(cop).all(axis=1)
+        if not loaded.any():
+            continue
+        where = np.median(cop[loaded], axis=0)
+        owners[k] = f"plate {k + 1}"
+        if centres:
+            distance = {name: float(np.hypot(*(where - c))) for name, c in centres.items()}
+            owners[k] = min(distance, key=lambda name: distance[name])
+    if len(set(owners.values())) != len(owners):  # two plates under one foot: by plate
+        owners = {k: f"plate {k + 1}" for k in owners}
+    return owners
+
+
+def _foot_events(recording: Recording) -> list[FootEvent]:
+    """Foot events from each foot's own plate where it has one, else from its markers."""
+    events: list[FootEvent] = []
+    owners = _plate_feet(recording)
+    for k, name in owners.items():
+        vertical = recording.plates[k][0]
+        assert recording.force_time is not None
+        finite = np.isfinite(vertical)
+        events += foot_events_from_force(recording.force_time[finite], vertical[finite], name)
+    on_plates = set(owners.values())
+    for foot in recording.feet:
+        if foot.name in on_plates:
+            continue
+        try:
+            events += foot_events_from_markers(recording.time, foot)
+        except InvalidParameterError:  # a foot whose markers are missing throughout
+            continue
+    return sorted(events, key=lambda event: event.time)
+
+
 def trial_events(
     recording: Recording,
     time: FloatArray,
@@ -130,14 +180,12 @@ def trial_events(
     margins, ``mass`` the subject's [kg].
     """
     onset, onset_source = _onset(recording, time, velocity, mass)
-    events: list[FootEvent] = []
-    for foot in recording.feet:
-        try:
-            events += foot_events_from_markers(recording.time, foot)
-        except InvalidParameterError:  # a foot whose markers are missing throughout
-            continue
-    events.sort(key=lambda event: event.time)
-    steps = measured_steps(recording.time, recording.feet, events, onset=onset) if events else []
+    events = _foot_events(recording)
+    steps = (
+        measured_steps(recording.time, recording.feet, events, onset=onset)
+        if events and recording.feet
+        else []
+    )
     return {
         "onset": {
             "time": onset,
