@@ -23,7 +23,7 @@ import numpy as np
 
 from pushrecovery import load_params
 from pushrecovery.control.base import make_controller
-from pushrecovery.control.mpc import MPCController
+from pushrecovery.control.mpc import FlywheelFeasibility, MPCController, MPCSettings
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 
@@ -45,8 +45,12 @@ def _matvec_us(calls: int = 2000) -> float:
 WARM_UP_PUSH, MEASURED_PUSHES = 0.6, (0.55, -0.4, 0.3, 0.65)
 
 
-def _ticks_us(horizon: int) -> tuple[np.ndarray, float, float]:
-    """Every measured tick [µs], the build time [ms] and the share verified by Riccati passes."""
+def _ticks_us(horizon: int) -> tuple[np.ndarray, float, float, tuple[int, int]]:
+    """Every measured tick [µs], the build time [ms], the share verified by Riccati passes.
+
+    And the fallback ticks: (exactly infeasible, exactly feasible but failed by DAQP), by the
+    gauge of the flywheel's viable set (``FlywheelFeasibility``).
+    """
     params = load_params()
     start = time.perf_counter()
     controller = MPCController(params, horizon=horizon)
@@ -57,6 +61,7 @@ def _ticks_us(horizon: int) -> tuple[np.ndarray, float, float]:
         for v in (WARM_UP_PUSH, *MEASURED_PUSHES)
     ]
     clock, times, verified = time.perf_counter_ns, [], 0
+    exact, infeasible, failed = FlywheelFeasibility(params, MPCSettings(horizon=horizon)), 0, 0
     for run, states in enumerate(runs):
         controller.reset(states[0])
         for k, state in enumerate(states):
@@ -65,7 +70,10 @@ def _ticks_us(horizon: int) -> tuple[np.ndarray, float, float]:
             if run:
                 times.append(clock() - begin)
                 verified += controller.riccati is not None and controller.riccati.passes > 0
-    return np.array(times) / 1e3, build, verified / len(times)
+                if controller.last_plan is not None and not controller.last_plan.feasible:
+                    outside = exact.gauge(state) > 1.0
+                    infeasible, failed = infeasible + outside, failed + (not outside)
+    return np.array(times) / 1e3, build, verified / len(times), (infeasible, failed)
 
 
 def _recovery_ticks_ms() -> tuple[float, int, int]:
@@ -95,7 +103,7 @@ def _recovery_ticks_ms() -> tuple[float, int, int]:
 def main() -> int:
     medians, failed = {}, False
     for horizon in HORIZONS:
-        ticks, build, verified = _ticks_us(horizon)
+        ticks, build, verified, (infeasible, failed) = _ticks_us(horizon)
         baseline = _matvec_us()
         median, p99 = float(np.median(ticks)), float(np.percentile(ticks, 99))
         medians[horizon] = median
@@ -103,7 +111,8 @@ def main() -> int:
             f"MPC tick, N = {horizon}: median {median:.0f} µs ({median / baseline:.0f}x a 100x100 "
             f"mat-vec of {baseline:.2f} µs), p99 {p99:.0f} µs ({p99 / median:.1f}x the median), "
             f"largest {ticks.max():.0f} µs; build {build:.1f} ms; {verified:.0%} of "
-            f"{ticks.size} ticks verified by the Riccati passes (the rest: DAQP)"
+            f"{ticks.size} ticks verified by the Riccati passes (the rest: DAQP); fallbacks: "
+            f"{infeasible} infeasible QPs, {failed} feasible QPs DAQP failed"
         )
         if horizon == 50:
             failed |= median > 15.0 * baseline

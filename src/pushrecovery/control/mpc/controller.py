@@ -9,9 +9,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command, Controller, register
+from pushrecovery.control.mpc.feasibility import FlywheelFeasibility
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.problem import MPCSettings
-from pushrecovery.control.mpc.qp import CondensedQP
+from pushrecovery.control.mpc.qp import CondensedQP, shared_qp
 from pushrecovery.control.mpc.riccati import RiccatiSolver
 from pushrecovery.control.mpc.workspace import PRIMAL_TOL, DaqpWorkspace
 from pushrecovery.errors import InvalidParameterError
@@ -29,7 +30,9 @@ class MPCController(Controller):
     ``[x, θ, ẋ, θ̇]`` and returns its first input. If the QP is infeasible (the flywheel cannot
     avoid its joint limit) the command is a saturated fallback, ``saturated=True``, and
     ``last_plan.feasible`` is False: CoP at the capture point clipped to the foot, full torque
-    braking the flywheel. It never raises inside the loop.
+    braking the flywheel. It never raises inside the loop. On the default route a tick whose
+    (θ, θ̇) is outside the flywheel's exact N-step viable set by more than every solver's
+    tolerance (:class:`FlywheelFeasibility`) gets the fallback without asking DAQP.
 
     With the default ``daqp`` solver the QP lives in a DAQP workspace (:class:`DaqpWorkspace`,
     the attribute ``workspace``), set up once and warm-started from the previous tick's active
@@ -76,13 +79,15 @@ class MPCController(Controller):
         self._qp: CondensedQP | None = None
         self._workspace: DaqpWorkspace | None = None
         self._use_workspace = settings.solver == "daqp"
+        # The exact feasibility test, built (cached per flywheel, dt and N) on first need.
+        self._feasibility: FlywheelFeasibility | None = None
         self.last_plan: Plan | None = None
 
     @property
     def qp(self) -> CondensedQP:
         """The condensed, pre-stabilised QP (built on first use)."""
         if self._qp is None:
-            self._qp = CondensedQP(self.params, self.settings)
+            self._qp = shared_qp(self.params, self.settings)  # immutable, shared
         return self._qp
 
     @property
@@ -130,6 +135,15 @@ class MPCController(Controller):
             # Fresh arrays each verified solve: the plan keeps them as they are.
             inputs = riccati.inputs
             return Plan(inputs[0], True, inputs, riccati.states)
+        x0 = state.copy()  # the plan's own: the caller may reuse its array
+        if self._use_workspace and self._provably_infeasible(x0):
+            # DAQP would fail, warm and then cold (up to ~1000 iterations): leave both solvers
+            # as that failure would (cold next tick) without asking it.
+            if self._workspace is not None:
+                self._workspace.reset()
+            if riccati is not None:
+                riccati.reset()
+            return self._fallback_plan(x0)
         # Only the solvers' own failures mean "infeasible"; any other exception is a bug.
         workspace = self.workspace
         if workspace is not None:
@@ -146,15 +160,9 @@ class MPCController(Controller):
                     riccati.reset()
         else:
             solution = self._solve_qpsolvers(state)
-        qp = self.qp
-        x0 = state.copy()  # the plan's own: the caller may reuse its array
         if solution is None or not np.isfinite(solution).all():
-            fallback = self._fallback(x0)
-            horizon = self.settings.horizon
-            return Plan(
-                fallback, False, lambda: np.tile(fallback, (horizon, 1)),
-                lambda: qp.simulate(x0, np.tile(fallback, (horizon, 1))),
-            )  # fmt: skip
+            return self._fallback_plan(x0)
+        qp = self.qp
         scaled = solution.copy()
         return Plan(
             qp.first_input(x0, scaled),
@@ -162,6 +170,21 @@ class MPCController(Controller):
             lambda: qp.inputs(x0, scaled),
             lambda: qp.predict(x0, scaled),
         )
+
+    def _provably_infeasible(self, x0: NDArray[np.float64]) -> bool:
+        """Tell whether (θ, θ̇) of x0 is outside S_N beyond the solvers' tolerances."""
+        feasibility = self._feasibility
+        if feasibility is None:
+            if not FlywheelFeasibility.applies(self.params):
+                return False
+            feasibility = self._feasibility = FlywheelFeasibility(self.params, self.settings)
+        return feasibility.infeasible(x0)
+
+    def _fallback_plan(self, x0: NDArray[np.float64]) -> Plan:
+        """Return the infeasible tick's plan: the fallback over the horizon, states on demand."""
+        fallback = self._fallback(x0)
+        inputs = np.tile(fallback, (self.settings.horizon, 1))
+        return Plan(fallback, False, inputs, lambda: self.qp.simulate(x0, inputs))
 
     def _solve_qpsolvers(self, state: NDArray[np.float64]) -> NDArray[np.float64] | None:
         from qpsolvers import solve_qp
@@ -176,7 +199,7 @@ class MPCController(Controller):
         )
         try:
             solution: NDArray[np.float64] | None = solve_qp(
-                qp.scaled_hessian,
+                np.array(qp.scaled_hessian),  # writable: quadprog refuses read-only buffers
                 q,
                 np.vstack([rows, -rows]),
                 np.concatenate([upper, -lower]),

@@ -42,7 +42,7 @@ from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 
-__all__ = ["CondensedQP"]
+__all__ = ["CondensedQP", "shared_qp"]
 
 FloatArray = NDArray[np.float64]
 
@@ -198,3 +198,19 @@ class CondensedQP:
         for i, u in enumerate(inputs):
             states[i + 1] = self._a @ states[i] + self._b @ u
         return states
+
+
+@functools.lru_cache(maxsize=8)
+def shared_qp(params: BodyParams, settings: MPCSettings) -> CondensedQP:
+    """Return the :class:`CondensedQP` of (params, settings), built once per process (8 kept).
+
+    Its arrays are made read-only (solvers get copies), so the controllers of one body and
+    settings (the recovery controller builds one per stance height and push) share it; each
+    keeps its own DAQP workspace. A build costs 4-40 ms (N = 50-200), a hit ~1 µs; 8 QPs at
+    N = 200 hold ~60 MB.
+    """
+    qp = CondensedQP(params, settings)
+    for value in vars(qp).values():
+        if isinstance(value, np.ndarray):
+            value.setflags(write=False)
+    return qp

@@ -72,10 +72,13 @@ class DaqpWorkspace:
         self._seeded = False
         model = daqp.Model()
         # The same contiguous buffers, rewritten in place, are handed to update() each tick.
+        # The matrices are this workspace's own copies: daqp takes writable buffers only, and
+        # the QP's are read-only (shared by the controllers of one body and settings).
+        self._hessian = np.array(qp.scaled_hessian)
+        self._rows = np.array(qp.scaled_inequality)
         flag, _ = model.setup(
-            qp.scaled_hessian, self._linear, qp.scaled_inequality, self._upper, self._lower,
-            self._cold,
-        )  # fmt: skip
+            self._hessian, self._linear, self._rows, self._upper, self._lower, self._cold
+        )
         if flag < 0:
             raise RuntimeError(f"daqp could not set up the MPC problem (exit flag {flag})")
         model.settings = {"primal_tol": PRIMAL_TOL}

@@ -1,0 +1,162 @@
+r"""Exact feasibility of Eq. (17): the flywheel's N-step viable set, a polygon in (θ, θ̇).
+
+Only two of Eq. (17)'s constraints can conflict. The CoP rows δ⁻ ≤ δ_i ≤ δ⁺ bound inputs that
+no other row involves (there is no constraint on x), and the exact discretisation of Eq. (16)
+(:func:`~pushrecovery.models.flywheel.flywheel_discrete`) leaves the flywheel a double
+integrator of its own: with s = (θ, θ̇), h = dt²/(2I) and g = dt/I,
+
+.. math:: s_{i+1} = A s_i + b τ_i, \qquad A = \begin{bmatrix} 1 & dt \\ 0 & 1 \end{bmatrix},
+          \quad b = \begin{bmatrix} h \\ g \end{bmatrix}.
+
+So the QP is feasible exactly when s_0 = (θ_0, θ̇_0) lies in the N-step viable set
+S_N = {s_0 : ∃ |τ_i| ≤ τmax, i < N, with |θ_i| ≤ θmax, i = 1..N}, whatever x_0, ẋ_0. With
+C = {|θ| ≤ θmax} and W = {τ b : |τ| ≤ τmax} (a segment), S_0 = R² and
+
+.. math:: S_k = \{ s : ∃ τ,\ A s + b τ ∈ C ∩ S_{k−1} \} = A^{−1} \bigl( (C ∩ S_{k−1}) ⊕ W \bigr),
+
+since A s + b τ ∈ P ⇔ A s ∈ P ⊕ (−W) = P ⊕ W. Each step maps a convex polygon to a convex
+polygon: a Minkowski sum with a segment (each vertex moved by ±τmax b, the two vertices where
+the move changes sign doubled), a clip by the strip C and the shear A^{−1}. Exact for any N ≥ 2
+when C ∩ S_0 is replaced by C ∩ {|θ̇| ≤ V}, V = 2 ((2 θmax + h τmax)/dt + g τmax): along any
+feasible plan |θ̇_{N−1}| ≤ (2 θmax + h τmax)/dt (from θ_N − θ_{N−1} = dt θ̇_{N−1} + h τ_{N−1})
+and |θ̇_N| ≤ |θ̇_{N−1}| + g τmax, so the box cuts nothing. For N = 1 the set is the strip
+|θ + dt θ̇| ≤ θmax + h τmax. The polygon has 68 vertices for the paper's body at N = 50, 100
+and 200 and is built once per (I, τmax, θmax, dt, N) in a few ms.
+
+The test is a gauge. Scaling τmax and θmax by t scales S_N by t (the system is linear), so with
+S_N = {s : n_k · s ≤ 1} the gauge γ(s) = max(0, max_k n_k · s) is the smallest t for which the
+QP with bounds t τmax, t θmax is feasible, and the QP is feasible exactly when γ(s_0) ≤ 1.
+The controller skips DAQP only when γ(s_0) > 1 + :data:`BAND`: a solver that accepts each row
+violated by up to a fraction ε of its bound returns a plan only for γ(s_0) ≤ 1 + ε, and DAQP's
+largest ε (1e−9 on rows of unit norm in its scaled variables) is 1.5e−8 at N = 50, 2.0e−7 at
+N = 100 and 4.0e−5 at N = 200 (late-horizon torque rows), the Riccati passes' 2e−9; inside the
+band DAQP decides, as before.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.control.mpc.problem import MPCSettings
+from pushrecovery.params import BodyParams
+
+__all__ = ["BAND", "FlywheelFeasibility", "viable_facets"]
+
+FloatArray = NDArray[np.float64]
+
+#: Relative margin beyond the exact boundary (γ > 1 + BAND) from which DAQP is not asked.
+BAND = 1e-4
+
+
+def _add_segment(poly: FloatArray, w: FloatArray) -> FloatArray:
+    """Minkowski sum of a convex polygon (counter-clockwise vertices) and the segment [−w, w]."""
+    edges = np.roll(poly, -1, axis=0) - poly
+    # Edge i moves by +w when its outward normal (e_y, −e_x) points along w, else by −w.
+    out = np.where(w[0] * edges[:, 1] - w[1] * edges[:, 0] >= 0.0, 1.0, -1.0)
+    into = np.roll(out, 1)  # the sign of the edge ending at vertex i
+    doubled = into != out
+    counts = np.where(doubled, 2, 1)
+    moves = np.repeat(out, counts)
+    moves[(np.cumsum(counts) - counts)[doubled]] = into[doubled]  # first copy: the old side
+    return _distinct(np.repeat(poly, counts, axis=0) + moves[:, None] * w)
+
+
+def _clip(poly: FloatArray, limit: float) -> FloatArray:
+    """Return the convex polygon ∩ {|θ| ≤ limit} (θ the first coordinate)."""
+    for sign in (1.0, -1.0):
+        value = sign * poly[:, 0] - limit  # ≤ 0 inside
+        after = np.roll(value, -1)
+        nxt = np.roll(poly, -1, axis=0)
+        inside = value <= 0.0
+        crossing = inside != (after <= 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.where(crossing, value / (value - after), 0.0)
+        cut = poly + t[:, None] * (nxt - poly)
+        cut[:, 0] = np.where(crossing, sign * limit, cut[:, 0])  # exactly on the line
+        candidates = np.stack([poly, cut], axis=1).reshape(-1, 2)
+        keep = np.stack([inside, crossing], axis=1).reshape(-1)
+        poly = _distinct(candidates[keep])
+    return poly
+
+
+def _distinct(poly: FloatArray) -> FloatArray:
+    """Drop vertices equal to their successor (to 1e−14 of the polygon's size)."""
+    size = np.abs(poly).max()
+    step = np.abs(np.roll(poly, -1, axis=0) - poly).max(axis=1)
+    return poly[step > 1e-14 * size]
+
+
+@functools.lru_cache(maxsize=64)
+def viable_facets(
+    inertia: float, torque_max: float, angle_max: float, dt: float, horizon: int
+) -> FloatArray:
+    """Facets of S_N as rows n_k, S_N = {s = (θ, θ̇) : n_k · s ≤ 1}; read-only, cached.
+
+    Requires τmax > 0 and θmax > 0 (S_N then contains a neighbourhood of the origin).
+    """
+    h, g = 0.5 * dt * dt / inertia, dt / inertia
+    if horizon == 1:
+        facets = np.array([[1.0, dt], [-1.0, -dt]]) / (angle_max + h * torque_max)
+    else:
+        w = np.array([h, g]) * torque_max
+        bound = 2.0 * ((2.0 * angle_max + h * torque_max) / dt + g * torque_max)
+        poly = np.array(
+            [[-angle_max, -bound], [angle_max, -bound], [angle_max, bound], [-angle_max, bound]]
+        )
+        previous = None
+        for k in range(horizon):  # S_{k+1} from C ∩ S_k (C ∩ box for k = 0)
+            poly = _add_segment(poly, w)
+            poly[:, 0] -= dt * poly[:, 1]  # A^{-1}: θ − dt θ̇
+            # S_{k+1} = S_k (as sets, bit for bit): a fixed point of the recursion, every
+            # later S_j is the same (the paper's body: from k = 55; equal to 1e-14 from 34).
+            ordered = poly[np.lexsort(poly.T[::-1])]
+            if previous is not None and np.array_equal(ordered, previous):
+                break
+            previous = ordered
+            if k < horizon - 1:
+                poly = _clip(poly, angle_max)
+        nxt = np.roll(poly, -1, axis=0)
+        normals = np.stack([nxt[:, 1] - poly[:, 1], poly[:, 0] - nxt[:, 0]], axis=1)
+        facets = normals / np.einsum("ij,ij->i", normals, poly)[:, None]
+    facets.setflags(write=False)
+    return facets
+
+
+class FlywheelFeasibility:
+    """Whether Eq. (17) is feasible from a state, exactly: the gauge of S_N (module docstring).
+
+    Parameters
+    ----------
+    params : BodyParams
+        I, τmax and θmax (τmax > 0, see :meth:`applies`).
+    settings : MPCSettings
+        dt and N.
+    """
+
+    __slots__ = ("facets",)
+
+    def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
+        self.facets = viable_facets(
+            params.flywheel_inertia, params.torque_max, params.flywheel_angle_max,
+            settings.dt, settings.horizon,
+        )  # fmt: skip
+
+    @staticmethod
+    def applies(params: BodyParams) -> bool:
+        """Tell whether S_N has an interior (τmax > 0, finite θmax > 0)."""
+        return params.torque_max > 0.0 and 0.0 < params.flywheel_angle_max < math.inf
+
+    def gauge(self, state: FloatArray) -> float:
+        """γ(θ_0, θ̇_0) of ``state`` = [x, θ, ẋ, θ̇]: feasible exactly when <= 1.
+
+        The smallest t for which the QP with bounds t τmax and t θmax is feasible.
+        """
+        return max(0.0, float((self.facets @ state[1::2]).max()))
+
+    def infeasible(self, state: FloatArray) -> bool:
+        """Tell whether the QP is infeasible beyond every solver's tolerance (γ > 1 + BAND)."""
+        return bool((self.facets @ state[1::2]).max() > 1.0 + BAND)
