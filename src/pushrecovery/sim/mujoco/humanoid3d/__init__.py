@@ -1,0 +1,9 @@
+"""3-D humanoids in MuJoCo: a biped generated from the body parameters and real robots.
+
+:mod:`.biped3d` builds the biped from a :class:`~pushrecovery.params.BodyParams`;
+:mod:`.robots` finds the Unitree G1 (and H1) of the ``robots`` extra and derives their body
+parameters; :mod:`.standing` holds a standing posture with a joint-space PD
+(docs/humanoid3d.md).
+"""
+
+from __future__ import annotations
