@@ -69,12 +69,14 @@ def _nearby_gain(body: BodyParams, settings: MPCSettings) -> FloatArray:
 
 
 def _gain(params: BodyParams, a: FloatArray, b: FloatArray, settings: MPCSettings) -> FloatArray:
-    """Return a stabilising gain for (A, B): the gain of ω rounded to 4 digits, if it stabilises.
+    """Return a stabilising gain for (A, B): the gain of ω rounded to 2 digits, if it stabilises.
 
     Any stabilising gain gives the same minimiser. Solving the Riccati equation takes a few ms
     (scipy); the stance heights of a stepping run share the gain of their rounded ω instead.
     """
-    omega = float(f"{params.omega:.4g}")
+    # 2 digits: the stance heights of a campaign's steps (thousands) share a few gains; with 4
+    # a batch of 1,410 stepping pushes solved 32 Riccati equations (0.5 s of its 2.5 s).
+    omega = float(f"{params.omega:.2g}")
     nearby = dataclasses.replace(params, com_height=params.gravity / (omega * omega))
     gain = _nearby_gain(nearby, settings)
     if max(abs(np.linalg.eigvals(a + b @ gain))) < 0.95:
