@@ -31,7 +31,8 @@ from pushrecovery.campaign import CampaignSpec, run_campaign
 
 model, controller, size, batch, where, out = sys.argv[1:7]
 spec = CampaignSpec("analytic", model, controller, load_params(), samples=int(size), seed=0,
-                    x0=(-0.04, 0.11), xdot=(-0.9, 0.9) if model == "pendulum" else (-3.5, 3.5),
+                    x0=(-0.04, 0.11, 1.0),
+                    xdot=(-0.9, 0.9, 1.0) if model == "pendulum" else (-3.5, 3.5, 1.0),
                     batch_size=int(batch))
 kwargs = {"workers": int(where)} if where.isdigit() else {"scheduler": where}
 start = time.perf_counter()
@@ -41,7 +42,7 @@ peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 print(json.dumps({"wall": wall, "peak_mb": peak}))
 """
 
-#: (model, controller, sizes, batch size): batches of about 1-2 s of work each.
+#: (model, controller, sizes, largest batch): batches of at most about 2 s of work each.
 CASES = (
     ("pendulum", "ankle-pd", (10**3, 10**4, 10**5), 10_000),
     ("stepping", "recovery", (10**3, 10**4), 1_000),
@@ -51,9 +52,9 @@ CASES = (
 def _run(model: str, controller: str, size: int, batch: int, where: str, root: Path) -> dict:
     out = tempfile.mkdtemp(dir=root)
     args = [model, controller, str(size), str(batch), where, out]
-    done = subprocess.run(
-        [sys.executable, "-c", RUN, *args], capture_output=True, text=True, check=True
-    )
+    done = subprocess.run([sys.executable, "-c", RUN, *args], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"{model} + {controller}, {size} pushes on {where}:\n{done.stderr}")
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
@@ -72,8 +73,10 @@ def main() -> int:
             for where in ("1", address):
                 _run(model, controller, 200, 100, where, root)
             for size in sizes:
+                # At least 8 batches, so that 2 workers share the work; at most ``batch``.
+                batch_size = max(min(batch, size // 8), 1)
                 walls = {
-                    label: _run(model, controller, size, min(batch, size), where, root)
+                    label: _run(model, controller, size, batch_size, where, root)
                     for label, where in (("1", "1"), ("2", "2"), ("dask", address))
                 }
                 one, two, dask = (walls[k]["wall"] for k in ("1", "2", "dask"))
@@ -81,7 +84,7 @@ def main() -> int:
                     "model": model,
                     "controller": controller,
                     "pushes": size,
-                    "batch_size": min(batch, size),
+                    "batch_size": batch_size,
                     "wall_1": one,
                     "wall_2": two,
                     "wall_dask": dask,
