@@ -77,11 +77,14 @@ def _ticks_us(horizon: int) -> tuple[np.ndarray, float, float, tuple[int, int]]:
 
 
 def _recovery_ticks_ms() -> tuple[float, int, int]:
-    """Recovery controller on the stepping model: largest tick [ms] after a warm-up run."""
+    """Recovery controller on the stepping model: largest tick [ms] after warm-up runs.
+
+    The first two runs (a hip push and a step push) load the caches and are not counted.
+    """
     params = load_params()
     plant = make_plant("stepping", params)
     largest, over, count = 0.0, 0, 0
-    for run, push in enumerate((0.5, 0.45, -0.35, 0.8, 1.3, 2.6, -1.0, -2.6)):
+    for run, push in enumerate((0.5, 1.3, 0.45, -0.35, 0.8, 2.6, -1.0, -2.6, 1.7)):
         controller = make_controller("recovery", params)
         compute, ticks = controller.compute, []
 
@@ -93,7 +96,7 @@ def _recovery_ticks_ms() -> tuple[float, int, int]:
 
         controller.compute = timed  # type: ignore[method-assign]
         simulate(plant, controller, plant.reset(0.0, push))
-        if run:
+        if run > 1:
             largest = max(largest, max(ticks) / 1e6)
             over += sum(t > 2e6 for t in ticks)
             count += len(ticks)
@@ -103,7 +106,7 @@ def _recovery_ticks_ms() -> tuple[float, int, int]:
 def main() -> int:
     medians, failed = {}, False
     for horizon in HORIZONS:
-        ticks, build, verified, (infeasible, failed) = _ticks_us(horizon)
+        ticks, build, verified, (infeasible, daqp_failed) = _ticks_us(horizon)
         baseline = _matvec_us()
         median, p99 = float(np.median(ticks)), float(np.percentile(ticks, 99))
         medians[horizon] = median
@@ -112,7 +115,7 @@ def main() -> int:
             f"mat-vec of {baseline:.2f} µs), p99 {p99:.0f} µs ({p99 / median:.1f}x the median), "
             f"largest {ticks.max():.0f} µs; build {build:.1f} ms; {verified:.0%} of "
             f"{ticks.size} ticks verified by the Riccati passes (the rest: DAQP); fallbacks: "
-            f"{infeasible} infeasible QPs, {failed} feasible QPs DAQP failed"
+            f"{infeasible} infeasible QPs, {daqp_failed} feasible QPs DAQP failed"
         )
         if horizon == 50:
             failed |= median > 15.0 * baseline
