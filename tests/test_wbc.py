@@ -1,0 +1,197 @@
+"""The whole-body QP on the 3-D biped (issue 19 item 3): standing, ankle pushes, contact limits."""
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.support import Support
+from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
+from pushrecovery.sim.mujoco.humanoid3d.wbc import Task, WholeBodyQP, foot_contact
+from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WbcGains, WholeBodyController
+from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos, push_biped3d
+
+#: DAQP's primal tolerance (1e-6, absolute) on rows in newtons, with room for rounding [N].
+FORCE_TOL = 1e-5
+#: A foot whose sole rises this high has lifted [m] (soft contact sinks a sole ~0.1 mm).
+LIFT = 3e-3
+#: Fraction of the CoP region's critical push of the pushes "well inside the ankle region".
+INSIDE = 0.3
+
+
+@pytest.fixture(scope="module")
+def params():
+    return load_params()
+
+
+@pytest.fixture(scope="module")
+def model(params):
+    return biped3d_model(params)
+
+
+def ankle_impulse(params, azimuth):
+    """The CoP region's critical impulse at ``azimuth`` [N s]: m ω × (distance to P's edge).
+
+    The capture point ξ = c + ċ/ω of a body at rest over the ankles' midpoint, after an impulse
+    J along u, is at (J / m ω) u: inside the double-support polygon P while J/(m ω) is below
+    the ray distance from the CoM to P's boundary (docs/plane.md).
+    """
+    polygon = Support.from_params(params).polygon
+    return params.mass * params.omega * polygon.ray_distance(0.0, 0.0, azimuth)
+
+
+@pytest.fixture(scope="module")
+def runs(params, model):
+    return {
+        "standing": push_biped3d(params, 0.0, duration=2.0, model=model),
+        "forward": push_biped3d(
+            params, INSIDE * ankle_impulse(params, 0.0), 0.0, duration=3.0, model=model
+        ),
+        "left": push_biped3d(
+            params,
+            INSIDE * ankle_impulse(params, math.pi / 2),
+            math.pi / 2,
+            duration=3.0,
+            model=model,
+        ),
+    }
+
+
+def test_standing_without_a_push_stays_still(runs):
+    run = runs["standing"]
+    assert run.ok.all()
+    assert np.abs(run.pelvis - run.pelvis[0]).max() < 1e-3
+    assert run.torso_tilt.max() < 1e-3
+    assert run.sole_lift.max() < LIFT
+
+
+@pytest.mark.parametrize("name", ["forward", "left"])
+def test_a_push_well_inside_the_ankle_region_recovers_with_the_ankles(runs, name):
+    run = runs[name]
+    assert run.ok.all()
+    # It moved: the push's velocity J/m, then back to rest near where it started.
+    assert np.linalg.norm(run.com_velocity, axis=1).max() > 0.05
+    assert np.linalg.norm(run.com_velocity[-1]) < 5e-3
+    assert np.linalg.norm(run.com[-1, :2] - run.com[0, :2]) < 5e-3
+    # The ankles only: no foot lifts, the torso stays upright (no hip strategy), no step.
+    assert run.sole_lift.max() < LIFT
+    assert run.torso_tilt.max() < 0.02
+    # The CoP was used toward the push (the law's CoP left the CoM's ground point).
+    axis = 0 if name == "forward" else 1
+    assert run.desired_cop[:, axis].max() > run.com[0, axis] + 0.03
+
+
+@pytest.mark.parametrize("name", ["standing", "forward", "left"])
+def test_contact_wrenches_satisfy_friction_pyramids_and_cop_limits_at_every_tick(
+    runs, params, name
+):
+    run = runs[name]
+    for foot, wrenches in zip(run.controller.feet, np.moveaxis(run.wrenches, 1, 0), strict=True):
+        rows = foot.constraint_rows()
+        assert (wrenches @ rows.T).max() <= FORCE_TOL
+        force, torque = wrenches[:, :3], wrenches[:, 3:]
+        assert (force[:, 2] > 0.0).all()
+        mu = foot.mu
+        assert mu == pytest.approx(1.0 / math.sqrt(2.0))  # the default geom friction 1, /√2
+        assert (np.abs(force[:, :2]) <= mu * force[:, 2:3] + FORCE_TOL).all()
+        # The CoP (−T_y, T_x)/F_z inside the box sole [heel, toe] × [−w/2, w/2] (sole frame).
+        cop_x, cop_y = -torque[:, 1] / force[:, 2], torque[:, 0] / force[:, 2]
+        slack = FORCE_TOL / force[:, 2].min()
+        assert (cop_x >= params.heel - slack).all() and (cop_x <= params.toe + slack).all()
+        assert (np.abs(cop_y) <= 0.5 * params.foot_width + slack).all()
+
+
+def test_the_solution_satisfies_the_floating_base_dynamics_and_fixed_feet(model):
+    data = mujoco.MjData(model)
+    data.qpos[:] = bent_knee_qpos(model)
+    mujoco.mj_forward(model, data)
+    controller = WholeBodyController(model)
+    controller.reset(data)
+    data.qvel[:] = np.linspace(-0.2, 0.2, model.nv)  # a moving state, feet not still
+    mujoco.mj_forward(model, data)
+    ctrl = controller.compute(0.0, data)
+    solution = controller.last
+    assert solution is not None and solution.ok
+    qp = controller.qp
+    mass = np.zeros((model.nv, model.nv))
+    if hasattr(data, "qM"):  # MuJoCo 3
+        mujoco.mj_fullM(model, mass, data.qM)
+    else:  # MuJoCo 4
+        mujoco.mj_fullM(model, data, mass)
+    jac, jac_dot, local = qp.contact_jacobians(data)
+    generalised = np.zeros(model.nv)
+    generalised[qp.actuated] = ctrl * qp.gear
+    contact = local.T @ solution.wrenches.ravel()
+    residual = mass @ solution.qacc + data.qfrc_bias - generalised - contact
+    assert np.abs(residual).max() < 1e-5
+    assert np.abs(jac @ solution.qacc + jac_dot).max() < 1e-6
+    assert (np.abs(ctrl) <= model.actuator_ctrlrange[:, 1] + 1e-9).all()
+
+
+def test_constraint_rows_put_a_cop_on_the_sole_polygon(model):
+    data = mujoco.MjData(model)
+    data.qpos[:] = bent_knee_qpos(model)
+    mujoco.mj_forward(model, data)
+    foot = foot_contact(model, data, "left_foot")
+    rows = foot.constraint_rows()
+    params = load_params()
+    weight = 100.0
+    # A CoP at the toe's middle: T_y = −x F_z; the toe edge's row is exactly 0 (active).
+    wrench = np.array([0.0, 0.0, weight, 0.0, -params.toe * weight, 0.0])
+    assert (rows @ wrench).max() == pytest.approx(0.0, abs=1e-9)
+    wrench[4] *= 1.01  # 1 % past the toe
+    assert (rows @ wrench).max() > 0.0
+    sliding = np.array([0.8 * weight, 0.0, weight, 0.0, 0.0, 0.0])  # 0.8 > 1/√2
+    assert (rows @ sliding).max() > 0.0
+
+
+def test_bad_inputs_are_refused_naming_the_parameter(params, model):
+    with pytest.raises(InvalidParameterError, match="impulse"):
+        push_biped3d(params, -1.0, model=model)
+    with pytest.raises(InvalidParameterError, match="azimuth"):
+        push_biped3d(params, 1.0, math.nan, model=model)
+    with pytest.raises(InvalidParameterError, match="duration"):
+        push_biped3d(params, 1.0, duration=61.0, model=model)
+    with pytest.raises(InvalidParameterError, match="knee"):
+        bent_knee_qpos(model, 2.0)
+    with pytest.raises(InvalidParameterError, match="dcm"):
+        WbcGains(dcm=-1.0)
+    with pytest.raises(InvalidParameterError, match="com_weight"):
+        WbcGains(com_weight=0.0)
+    with pytest.raises(InvalidParameterError, match="feet"):
+        WholeBodyController(model, feet=())
+    with pytest.raises(InvalidParameterError, match="no body"):
+        WholeBodyController(model, feet=("left_foot", "nose"))
+    with pytest.raises(InvalidParameterError, match="gains"):
+        WholeBodyController(model, gains={"dcm": 1.0})
+    with pytest.raises(InvalidParameterError, match="reset"):
+        WholeBodyController(model).compute(0.0, mujoco.MjData(model))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    with pytest.raises(InvalidParameterError, match="feet"):
+        foot_contact(model, data, "nose")
+    foot = foot_contact(model, data, "left_foot")
+    with pytest.raises(InvalidParameterError, match="feet"):
+        WholeBodyQP(model, [])
+    with pytest.raises(InvalidParameterError, match="wrench_regularisation"):
+        WholeBodyQP(model, [foot], wrench_regularisation=0.0)
+
+
+def test_no_task_breaks_the_hard_contact_constraints(model):
+    data = mujoco.MjData(model)
+    data.qpos[:] = bent_knee_qpos(model)
+    mujoco.mj_forward(model, data)
+    controller = WholeBodyController(model)
+    controller.reset(data)
+    first = controller.compute(0.0, data).copy()
+    qp = controller.qp
+    # An impossible CoM task cannot break the hard constraints: the wrenches stay feasible.
+    size = qp.size
+    pull = np.zeros((1, size))
+    pull[0, qp.nv + 2] = pull[0, qp.nv + 8] = 1.0  # total F_z
+    solution = qp.solve(data, [Task("lift", pull, np.array([-1e4]), 1.0)])
+    assert solution.ok and (solution.wrenches[:, 2] >= -FORCE_TOL).all()
+    assert np.isfinite(first).all()
