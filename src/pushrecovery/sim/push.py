@@ -1,13 +1,31 @@
-"""What a push is: an instantaneous jump of the CoM velocity (docs/conventions.md)."""
+"""What a push is: an instantaneous jump of the CoM velocity (docs/conventions.md).
+
+In 3-D (:class:`Push3D`, docs/humanoid3d.md) a push is an impulse J [N s] on a named body,
+horizontal, at an azimuth ψ in degrees: 0 forward (+x), 90 to the left (+y).
+"""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-from pushrecovery._validate import finite_float, positive_float
+from pushrecovery._validate import bounded_float, finite_float, positive_float
 from pushrecovery.errors import InvalidParameterError
 
-__all__ = ["Direction", "Push", "direction_sign"]
+__all__ = [
+    "AZIMUTH_MAX",
+    "IMPULSE_MAX",
+    "Direction",
+    "Push",
+    "Push3D",
+    "direction_sign",
+    "push_direction",
+]
+
+#: Largest |azimuth| [deg] a 3-D push accepts (one turn either way).
+AZIMUTH_MAX = 360.0
+#: Largest impulse [N s] a 3-D push accepts (a thousand times what topples a person).
+IMPULSE_MAX = 1e4
 
 Direction = str  # "forward" or "backward"
 
@@ -46,3 +64,70 @@ class Push:
     def impulse(self, mass: float) -> float:
         """Return the impulse J = m Δẋ [N s] of this push on a body of mass m [kg]."""
         return mass * self.delta_velocity
+
+
+def push_direction(azimuth: float) -> tuple[float, float]:
+    """Return the horizontal unit vector (cos ψ, sin ψ) of azimuth ψ [deg].
+
+    0 is forward (+x), 90 to the left (+y), 180 backward, −90 (or 270) to the right.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``azimuth`` is not a finite number in [−360, 360] deg.
+    """
+    angle = math.radians(bounded_float("azimuth", azimuth, -AZIMUTH_MAX, AZIMUTH_MAX, "deg"))
+    return math.cos(angle), math.sin(angle)
+
+
+@dataclass(frozen=True, slots=True)
+class Push3D:
+    """A horizontal impulsive push on a named body of a 3-D model (docs/humanoid3d.md).
+
+    Parameters
+    ----------
+    impulse : float
+        J in [0, :data:`IMPULSE_MAX`] N s.
+    azimuth : float
+        ψ in [−360, 360] deg, 0 forward (+x), 90 to the left (+y).
+    body : str
+        The pushed body: ``"torso"`` (the default) is each model's torso (the biped3d's
+        ``torso``, the G1's ``torso_link``); any other name is a body of the model.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a field is out of its range or ``body`` is not a non-empty name (at most 100
+        characters).
+    """
+
+    impulse: float
+    azimuth: float = 0.0
+    body: str = "torso"
+
+    def __post_init__(self) -> None:
+        impulse = bounded_float("impulse", self.impulse, 0.0, IMPULSE_MAX, "N s")
+        azimuth = bounded_float("azimuth", self.azimuth, -AZIMUTH_MAX, AZIMUTH_MAX, "deg")
+        if not (isinstance(self.body, str) and 0 < len(self.body) <= 100):
+            raise InvalidParameterError(
+                f"body must be a body name of 1 to 100 characters, got {str(self.body)[:40]!r}"
+            )
+        object.__setattr__(self, "impulse", impulse)
+        object.__setattr__(self, "azimuth", azimuth)
+
+    @property
+    def direction(self) -> tuple[float, float]:
+        """The push's horizontal unit vector (cos ψ, sin ψ)."""
+        return push_direction(self.azimuth)
+
+    def force(self, duration: float) -> tuple[float, float, float]:
+        """Return the constant force J/Δ (cos ψ, sin ψ, 0) [N] that gives J over Δ [s] > 0."""
+        size = self.impulse / positive_float("duration", duration, "s")
+        dx, dy = self.direction
+        return size * dx, size * dy, 0.0
+
+    def delta_velocity(self, mass: float) -> tuple[float, float]:
+        """Return the CoM velocity jump (Δẋ, Δẏ) = J/m (cos ψ, sin ψ) [m/s] on mass m [kg]."""
+        size = self.impulse / positive_float("mass", mass, "kg")
+        dx, dy = self.direction
+        return size * dx, size * dy
