@@ -13,6 +13,8 @@ from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.wbc import Task, WholeBodyQP, foot_contact
 from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WbcGains, WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos, push_biped3d
+from pushrecovery.surfaces.cmp import cmp_offset
+from pushrecovery.surfaces.plane import cmp_polygon
 
 #: DAQP's primal tolerance (1e-6, absolute) on rows in newtons, with room for rounding [N].
 FORCE_TOL = 1e-5
@@ -195,3 +197,68 @@ def test_no_task_breaks_the_hard_contact_constraints(model):
     solution = qp.solve(data, [Task("lift", pull, np.array([-1e4]), 1.0)])
     assert solution.ok and (solution.wrenches[:, 2] >= -FORCE_TOL).all()
     assert np.isfinite(first).all()
+
+
+def critical_impulses(params, azimuth):
+    """The CoP and CMP regions' critical impulses at ``azimuth`` from rest at the origin [N s]."""
+    support = Support.from_params(params)
+    reach = support.polygon.ray_distance(0.0, 0.0, azimuth)
+    hip_reach = cmp_polygon(support, params).ray_distance(0.0, 0.0, azimuth)
+    return params.mass * params.omega * reach, params.mass * params.omega * hip_reach
+
+
+#: Where in the gap between the ankle's and the hip's critical impulse the hip test pushes.
+BETWEEN = 0.1
+
+
+@pytest.fixture(scope="module")
+def hip_runs(params, model):
+    ankle, hip = critical_impulses(params, 0.0)
+    impulse = ankle + BETWEEN * (hip - ankle)
+    return {
+        "ankle only": push_biped3d(params, impulse, duration=2.0, model=model),
+        "hip": push_biped3d(params, impulse, duration=3.0, model=model, hip=True),
+    }
+
+
+def test_a_push_between_the_ankle_and_cmp_regions_needs_the_hip(params, hip_runs):
+    ankle, hip = critical_impulses(params, 0.0)
+    assert hip > 1.3 * ankle  # the surfaces put a real CMP band past the CoP region
+    fell = hip_runs["ankle only"]
+    assert fell.com[-1, 2] < 0.8 * fell.com[0, 2] or fell.sole_lift.max() > LIFT
+    run = hip_runs["hip"]
+    assert run.ok.all()
+    assert run.sole_lift.max() < LIFT  # feet flat: no toe-off, no step
+    assert run.cmp_offset[:, 0].max() > 0.1  # the CMP left the foot: the hip acted
+    assert run.torso_tilt.max() > 0.1  # the torso turned ...
+    assert run.torso_tilt.max() < params.flywheel_angle_max  # ... within its limit
+    assert np.linalg.norm(run.com_velocity[-1]) < 0.05  # and the body came to rest
+    assert run.com[-1, 2] > 0.95 * run.com[0, 2]
+    assert run.controller.hip is not None
+
+
+def test_hip_run_wrenches_satisfy_friction_pyramids_and_cop_limits(hip_runs):
+    run = hip_runs["hip"]
+    for foot, wrenches in zip(run.controller.feet, np.moveaxis(run.wrenches, 1, 0), strict=True):
+        assert (wrenches @ foot.constraint_rows().T).max() <= FORCE_TOL
+        assert (wrenches[:, 2] > 0.0).all()
+
+
+def test_the_hip_law_decides_with_the_surfaces(params, model):
+    data = mujoco.MjData(model)
+    data.qpos[:] = bent_knee_qpos(model)
+    mujoco.mj_forward(model, data)
+    controller = WholeBodyController(model, hip=params)
+    controller.reset(data)
+    law = controller.hip
+    support = law.support
+    beyond = cmp_offset(params)
+    assert law.decide(np.array([0.0, 0.0])) == "ankle"
+    assert law.decide(np.array([support.xmax + 0.5 * beyond, 0.0])) == "hip"
+    assert law.decide(np.array([support.xmax + 2.0 * beyond, 0.0])) == "step"
+    # Beyond the toe, at rest: push the CMP forward by a = τmax/(m g).
+    offset = law.update(np.array([support.xmax + 0.01, 0.0]), np.zeros(2), np.zeros(2))
+    assert offset[0] == pytest.approx(params.torque_max / params.weight)
+    assert offset[1] == 0.0
+    with pytest.raises(InvalidParameterError, match="hip"):
+        WholeBodyController(model, hip="g1")

@@ -21,7 +21,13 @@ Tasks, each an acceleration a PD law asks for (world frame, x forward, y left, z
 * **Posture**: q̈_j = k_q (q_j0 − q_j) − d_q q̇_j of every joint dof [rad/s²].
 
 Weights (:class:`WbcGains`): CoM 10, torso 1, pelvis 1, posture 0.01: the CoM law dominates,
-the torso stays upright (no hip strategy) and the posture fills the null space.
+the torso stays upright and the posture fills the null space.
+
+* **Hip, CMP balancing** (``hip=params``, :mod:`.wbc_hip`): when the capture point leaves the
+  CoP region, the bang-bang law of Stephens Sec. III commands a CMP offset δ beyond the foot:
+  a momentum task L̇_xy = m g (−δ_y, δ_x) (weight 10), the CoM task c̈ = ω² (c − p_des − δ)
+  with p_des on the edge, the torso task relaxed (weight 1e-3) while it acts; afterwards the
+  torso returns upright under k_R = 4, d_R = 4 until within 0.01 rad.
 
 Contract: :class:`WholeBodyController` has the ``reset(state)`` / ``compute(t, state)`` pair of
 :class:`~pushrecovery.control.base.Controller`, with one deviation: its ``state`` is the
@@ -41,6 +47,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
+from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points
 from pushrecovery.sim.mujoco.humanoid3d.wbc import (
     FootContact,
@@ -49,6 +56,7 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc import (
     WholeBodyQP,
     foot_contact,
 )
+from pushrecovery.sim.mujoco.humanoid3d.wbc_hip import UPRIGHT, HipLaw, momentum_rows
 from pushrecovery.surfaces.plane import capture_point_xy
 
 FloatArray = NDArray[np.float64]
@@ -72,6 +80,12 @@ class WbcGains:
         k_q [1/s²], d_q [1/s].
     com_weight, torso_weight, height_weight, posture_weight : float
         W of each task (> 0).
+    hip_weight : float
+        W of the centroidal momentum task L̇_{x,y} while the hip acts (> 0, :mod:`.wbc_hip`).
+    hip_torso_weight : float
+        The torso task's W while the hip acts (> 0): relaxed, the torso turns.
+    return_stiffness, return_damping : float
+        k_R [1/s²] and d_R [1/s] of the torso's return to upright after the hip acted.
     """
 
     dcm: float = 2.0
@@ -85,6 +99,10 @@ class WbcGains:
     torso_weight: float = 1.0
     height_weight: float = 1.0
     posture_weight: float = 0.01
+    hip_weight: float = 10.0
+    hip_torso_weight: float = 1e-3
+    return_stiffness: float = 4.0
+    return_damping: float = 4.0
 
     def __post_init__(self) -> None:
         for item in fields(self):
@@ -122,6 +140,9 @@ class WholeBodyController:
         Name of the body held upright (its origin's height is the pelvis task).
     gains : WbcGains, optional
         Task gains and weights.
+    hip : BodyParams, optional
+        The flywheel limits (τmax, I, θmax per axis) of the hip (CMP) task, :mod:`.wbc_hip`;
+        None (the default) balances with the ankles only.
 
     Raises
     ------
@@ -140,6 +161,8 @@ class WholeBodyController:
         feet: Sequence[str] = ("left_foot", "right_foot"),
         torso: str = "torso",
         gains: WbcGains | None = None,
+        *,
+        hip: BodyParams | None = None,
     ) -> None:
         if isinstance(feet, str) or not feet or len(set(feet)) != len(feet):
             raise InvalidParameterError(f"feet must be distinct body names, got {feet!r}")
@@ -164,6 +187,14 @@ class WholeBodyController:
         self.support: ConvexPolygon | None = None
         self.last: WbcSolution | None = None
         self.desired_cop = np.zeros(2)
+        self.cmp_offset = np.zeros(2)
+        self.capture_point = np.zeros(2)
+        if hip is not None and not isinstance(hip, BodyParams):
+            raise InvalidParameterError(f"hip must be a BodyParams, got {type(hip).__name__}")
+        self.hip_params = hip
+        self.hip: HipLaw | None = None
+        self.cmp_target = np.zeros(2)
+        self.returning = False
 
     def reset(self, state: Any) -> None:
         """Take the reference posture, feet and balance point from ``state`` (an MjData).
@@ -183,6 +214,14 @@ class WholeBodyController:
         self.height = float(data.xpos[self.torso][2])
         self.upright = np.array(data.xmat[self.torso], dtype=float).reshape(3, 3)
         self.last = None
+        self._bodies = np.array([foot.body for foot in self.feet], dtype=np.intp)
+        self._origins = np.array([foot.origin for foot in self.feet])
+        self.hip = None
+        if self.hip_params is not None:
+            weight = self.mass * float(np.linalg.norm(self.gravity))
+            self.hip = HipLaw(self.hip_params, self.support, weight, self.omega,
+                              self.control_period)  # fmt: skip
+        self.returning = False
 
     def cop_target(self, data: Any) -> FloatArray:
         """Return the DCM law's CoP p_des clipped to the support polygon [m] (world xy).
@@ -196,27 +235,49 @@ class WholeBodyController:
         velocity = np.asarray(data.subtree_linvel[0])
         xi_x, xi_y = capture_point_xy(com[0], com[1], velocity[0], velocity[1], self.omega)
         xi = np.array([float(xi_x), float(xi_y)])
+        self.capture_point = xi
         cop = xi + (self.gains.dcm / self.omega) * (xi - self.rest)
+        self.cmp_target = cop
         assert self.support is not None
         if not bool(self.support.contains(cop[0], cop[1])):
             cop = np.array(self.support.nearest_point(float(cop[0]), float(cop[1])))
         return cop
 
     def tasks(self, data: Any) -> list[Task]:
-        """Return the QP's tasks at the state in ``data`` (module docstring)."""
+        """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.wbc_hip`)."""
         import mujoco
 
         assert self.qp is not None
         model, gains, nv, size = self.model, self.gains, self.qp.nv, self.qp.size
-        # CoM: m c̈ = m g + Σ R_i F_i, rows x and y.
+        # Torso orientation error and the hip law's CMP offset δ (zero with the ankles only).
+        rot = np.asarray(data.xmat[self.torso]).reshape(3, 3)
+        error = _rotation_vector(rot @ self.upright.T)
         com = np.asarray(data.subtree_com[0])
-        self.desired_cop = self.cop_target(data)
-        com_acc = self.omega**2 * (com[:2] - self.desired_cop)
+        self.desired_cop = self.cop_target(data)  # also the capture point, mj_subtreeVel
+        hip_active = False
+        if self.hip is not None:
+            momentum = np.asarray(data.subtree_angmom[0])
+            self.cmp_offset = self.hip.update(
+                self.capture_point,
+                np.array([momentum[1], -momentum[0]]),
+                np.array([error[1], -error[0]]),
+            )
+            hip_active = self.hip.active
+            if hip_active:
+                self.desired_cop = self.hip.saturate(self.desired_cop)
+            self.returning = self.returning or hip_active
+        # CoM: m c̈ = m g + Σ R_i F_i, rows x and y; c̈ = ω² (c − p_des − δ).
+        com_acc = self.omega**2 * (com[:2] - self.desired_cop - self.cmp_offset)
+        rots = np.asarray(data.xmat)[self._bodies].reshape(-1, 3, 3)
         com_rows = np.zeros((2, size))
-        for i, foot in enumerate(self.feet):
-            rot = np.array(data.xmat[foot.body], dtype=float).reshape(3, 3)
-            com_rows[:, nv + 6 * i : nv + 6 * i + 3] = rot[:2] / self.mass
+        for i in range(len(self.feet)):
+            com_rows[:, nv + 6 * i : nv + 6 * i + 3] = rots[i, :2] / self.mass
         tasks = [Task("com", com_rows, com_acc - self.gravity[:2], gains.com_weight)]
+        if hip_active:  # L̇_x = −m g δ_y, L̇_y = m g δ_x
+            rows = momentum_rows(data, self._bodies, size, nv, com, self._origins)[:2]
+            weight = self.mass * float(np.linalg.norm(self.gravity))
+            rate = weight * np.array([-self.cmp_offset[1], self.cmp_offset[0]])
+            tasks.append(Task("momentum", rows, rate, gains.hip_weight))
         # Torso orientation and pelvis height: J q̈ + J̇ q̇ = a_des.
         point = np.array(data.xpos[self.torso], dtype=float)
         jacp, jacr = np.zeros((3, nv)), np.zeros((3, nv))
@@ -224,12 +285,18 @@ class WholeBodyController:
         mujoco.mj_jac(model, data, jacp, jacr, point, self.torso)
         mujoco.mj_jacDot(model, data, dotp, dotr, point, self.torso)
         qvel = np.asarray(data.qvel, dtype=float)
-        rot = np.array(data.xmat[self.torso], dtype=float).reshape(3, 3)
-        error = _rotation_vector(rot @ self.upright.T)
         spin = jacr @ qvel
-        alpha = -gains.torso_stiffness * error - gains.torso_damping * spin - dotr @ qvel
+        stiffness, damping = gains.torso_stiffness, gains.torso_damping
+        torso_weight = gains.torso_weight
+        if hip_active:
+            torso_weight = gains.hip_torso_weight
+        elif self.returning:  # gently back upright, then the usual gains
+            stiffness, damping = gains.return_stiffness, gains.return_damping
+            if np.linalg.norm(error) < UPRIGHT and np.linalg.norm(spin) < UPRIGHT:
+                self.returning = False
+        alpha = -stiffness * error - damping * spin - dotr @ qvel
         tasks.append(Task("torso", np.hstack([jacr, np.zeros((3, size - nv))]), alpha,
-                          gains.torso_weight))  # fmt: skip
+                          torso_weight))  # fmt: skip
         rise = float(jacp[2] @ qvel)
         climb = gains.height_stiffness * (self.height - point[2]) - gains.height_damping * rise
         height_row = np.zeros((1, size))

@@ -58,6 +58,8 @@ class WbcRun:
         The QP's wrench per foot (F, T) in its sole frame [N, N m].
     desired_cop : float array, shape (n, 2)
         The DCM law's CoP [m] (world xy).
+    cmp_offset : float array, shape (n, 2)
+        The hip law's CMP offset δ from the CoP [m] (0 with the ankles only, :mod:`.wbc_hip`).
     ok : bool array, shape (n,)
         Whether DAQP solved the tick.
     solve_time, control_time, physics_time : float arrays, shape (n,)
@@ -75,6 +77,7 @@ class WbcRun:
     sole_lift: FloatArray
     wrenches: FloatArray
     desired_cop: FloatArray
+    cmp_offset: FloatArray
     ok: NDArray[np.bool_]
     solve_time: FloatArray
     control_time: FloatArray
@@ -123,6 +126,7 @@ def push_biped3d(
     push_time: float = 0.1,
     gains: WbcGains | None = None,
     model: Any = None,
+    hip: bool = False,
 ) -> WbcRun:
     """Push the biped3d of ``params`` and run the whole-body controller (module docstring).
 
@@ -142,6 +146,8 @@ def push_biped3d(
         The controller's gains.
     model : mujoco.MjModel, optional
         A compiled ``biped3d_model(params)`` to reuse.
+    hip : bool
+        Enable the hip (CMP) task with ``params``' flywheel limits (:mod:`.wbc_hip`).
     """
     import mujoco
 
@@ -150,7 +156,7 @@ def push_biped3d(
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)
     mujoco.mj_forward(model, data)
-    controller = WholeBodyController(model, gains=gains)
+    controller = WholeBodyController(model, gains=gains, hip=params if hip else None)
     controller.reset(data)
     torso = body_id(model, "torso")
     feet = [body_id(model, f"{side}_foot") for side in SIDES]
@@ -177,6 +183,7 @@ def push_biped3d(
         columns["sole_lift"].append([float(sole_points(model, data, f)[:, 2].max()) for f in feet])
         columns["wrenches"].append(solution.wrenches)
         columns["desired_cop"].append(controller.desired_cop.copy())
+        columns["cmp_offset"].append(controller.cmp_offset.copy())
         columns["ok"].append(solution.ok)
         columns["solve_time"].append(solution.solve_time)
         columns["control_time"].append(control)

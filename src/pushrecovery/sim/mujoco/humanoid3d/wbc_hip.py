@@ -1,0 +1,233 @@
+r"""The hip (CMP balancing) law of the whole-body controller: Stephens Sec. III as a feedback.
+
+Centroidal angular momentum (Lee & Goswami 2012; Orin, Goswami & Lee 2013): the floor's
+wrenches w_i = (F_i, T_i) (sole frames, orientation R_i, origin p_i) change the whole body's
+angular momentum about its CoM c at the rate
+
+.. math:: \dot{\mathbf L} = \sum_i (\mathbf p_i - \mathbf c) \times R_i \mathbf F_i
+          + R_i \mathbf T_i ,
+
+linear in w (:func:`momentum_rows`). With the total vertical force F_z ≈ m g and the CoM at a
+constant height, the horizontal CoM dynamics are those of the LIPM about the centroidal moment
+pivot (CMP; Popovic, Hofmann & Herr 2005, Hofmann et al. 2009):
+
+.. math:: \ddot c_x = \omega^2 (c_x - p_x - \delta_x), \quad
+          \ddot c_y = \omega^2 (c_y - p_y - \delta_y), \qquad
+          \delta_x = \dot L_y / (m g), \quad \delta_y = -\dot L_x / (m g),
+
+p the CoP and δ the CMP's offset from it: Stephens' Eq. (6) with δ = τ/(m g), τ the torque
+the hips put on the upper body (the flywheel). δ_x > 0 (the CMP ahead of the CoP, against a
+forward fall) needs L̇_y > 0: the upper body pitches forward; δ_y > 0 needs L̇_x < 0: it
+rolls to the left. Both into the fall, as in Hofmann et al.'s Fig. 1.
+
+**The law** (per horizontal axis k ∈ {x, y}, :class:`HipLaw`): Stephens' bang-bang torque
+profile (Eqs. 8-12: +τmax for T₁, then −τmax until the flywheel is at rest) run as a switching
+feedback on the measured state. With a_k = τmax,k/(m g), δ⁺ the support polygon's edge on the
+side of the fall (its bounding box, the stance facing +x), s = ±1 that side, h = s L (the
+flywheel's momentum into the fall, L the centroidal angular momentum about the axis: L_y for
+x, −L_x for y), θ = s φ the upper body's tilt into the fall (φ from the torso's rotation since
+reset), I the flywheel's inertia and θmax its angle limit:
+
+* *idle → push* when the library's decision (:meth:`HipLaw.decide`: the capture point ξ
+  outside the CoP region P, the support polygon; inside the CMP region P ⊕ box(a'_x, a'_y) of
+  :func:`~pushrecovery.surfaces.plane.cmp_polygon`, a' the corrected Eq. (15) offsets, is
+  "hip", beyond it "step") says ξ left P, on the side where ξ_k is beyond P's bounding box;
+  the commanded offset is δ_k = s a_k;
+* *push → brake* when braking now (δ_k = −s a_k for T_b = h/τmax, the CoP on δ⁺) would still
+  bring ξ back to μ_ξ inside the edge, s(ξ_k − δ⁺) ≤ −a_k (1 − e^{−ω T_b}) − μ_ξ (from
+  ξ̇ = ω(ξ − δ⁺ − δ), integrated over T_b; the margin μ_ξ = 2 cm absorbs the model's errors:
+  F_z ≠ m g while the torso turns, the CoM's height drop, and leaves the ankles room to bring
+  the torso back), or when the flywheel would not stop before its limit,
+  θ + h²/(2 I τmax) ≥ θmax;
+* *brake → idle* when h ≤ 0; the brake's torque is min(τmax, h/Δt) so it ends at rest.
+
+While an axis acts, the torso-upright task is relaxed (its weight × ``torso_relaxed``) and the
+momentum task L̇_{x,y} = m g (−δ_y, δ_x) and the CoM task c̈ = ω²(c − p_des − δ) drive the QP;
+afterwards the torso comes back upright under the gentle ``torso_return`` gains (a slow return
+costs the ankles little CoP), and the usual gains once it is within :data:`UPRIGHT` of
+upright.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+
+FloatArray = NDArray[np.float64]
+
+__all__ = ["BRAKE", "IDLE", "PUSH", "UPRIGHT", "HipLaw", "momentum_rows"]
+
+#: Phases of an axis.
+IDLE, PUSH, BRAKE = 0, 1, 2
+#: Torso tilt [rad] (and spin [rad/s]) under which the return gains hand back to the usual.
+UPRIGHT = 0.01
+
+
+def momentum_rows(
+    data: Any, bodies: NDArray[np.intp], size: int, nv: int, com: FloatArray, origins: FloatArray
+) -> FloatArray:
+    """Return the 3 × size rows A with A x = L̇ (module docstring) [N m per unit of w].
+
+    Parameters
+    ----------
+    data : mujoco.MjData
+        After ``mj_kinematics``: the feet's orientations ``xmat`` and positions ``xpos``.
+    bodies : int array
+        The feet's body ids, in the QP's order.
+    size, nv : int
+        The QP's unknowns (nv accelerations then 6 per foot).
+    com : float array, shape (3,)
+        The CoM c [m].
+    origins : float array, shape (n, 3)
+        Each sole frame's origin in its body frame [m].
+    """
+    rows = np.zeros((3, size))
+    rot = np.asarray(data.xmat)[bodies].reshape(-1, 3, 3)
+    points = np.asarray(data.xpos)[bodies] + np.einsum("nij,nj->ni", rot, origins)
+    for i, (r, lever) in enumerate(zip(rot, points - com, strict=True)):
+        skew = np.array(
+            [[0.0, -lever[2], lever[1]], [lever[2], 0.0, -lever[0]], [-lever[1], lever[0], 0.0]]
+        )
+        rows[:, nv + 6 * i : nv + 6 * i + 3] = skew @ r
+        rows[:, nv + 6 * i + 3 : nv + 6 * i + 6] = r
+    return rows
+
+
+class HipLaw:
+    """Bang-bang CMP balancing per horizontal axis, as a switching feedback (module docstring).
+
+    Parameters
+    ----------
+    params : BodyParams
+        The flywheel's limits: τmax (``torque_max``, ``torque_max_roll``) [N m], I
+        (``flywheel_inertia``, ``flywheel_inertia_roll``) [kg m²], θmax
+        (``flywheel_angle_max``, ``flywheel_angle_max_roll``) [rad].
+    support : ConvexPolygon
+        The CoP region P (both soles' hull) [m], world xy.
+    weight : float
+        m g of the model [N] (> 0).
+    omega : float
+        ω = sqrt(g / z_c) [1/s] (> 0).
+    period : float
+        The control period Δt [s] (> 0).
+    margin : float
+        μ_ξ, how far inside the edge the brake aims ξ [m] (≥ 0).
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``params`` is not a BodyParams or a number is out of range.
+    """
+
+    def __init__(
+        self, params: BodyParams, support: ConvexPolygon, weight: float, omega: float,
+        period: float, margin: float = 0.02,
+    ) -> None:  # fmt: skip
+        if not isinstance(params, BodyParams):
+            raise InvalidParameterError(f"hip must be a BodyParams, got {type(params).__name__}")
+        for name, value in (("weight", weight), ("omega", omega), ("period", period)):
+            if not (math.isfinite(value) and 0.0 < value <= 1e7):
+                raise InvalidParameterError(f"{name} must be in (0, 1e7], got {value!r}")
+        if not (math.isfinite(margin) and 0.0 <= margin <= 1.0):
+            raise InvalidParameterError(f"margin must be in [0, 1] m, got {margin!r}")
+        self.torque = np.array([params.torque_max, params.torque_max_roll])
+        self.inertia = np.array([params.flywheel_inertia, params.flywheel_inertia_roll])
+        self.angle_max = np.array([params.flywheel_angle_max, params.flywheel_angle_max_roll])
+        self.weight, self.omega, self.period = float(weight), float(omega), float(period)
+        self.margin = float(margin)
+        self.reach = self.torque / self.weight  # a = τmax / (m g) [m]
+        self.support = support
+        self.cmp_region = support.grown(cmp_offset(params), cmp_offset_roll(params), 0.0)
+        self.low = np.array([support.xmin, support.ymin])
+        self.high = np.array([support.xmax, support.ymax])
+        self.phase = np.full(2, IDLE)
+        self.side = np.zeros(2)
+        self.decision = "ankle"
+
+    def reset(self) -> None:
+        """Both axes idle."""
+        self.phase[:] = IDLE
+        self.side[:] = 0.0
+        self.decision = "ankle"
+
+    @property
+    def active(self) -> bool:
+        """Whether an axis pushes or brakes."""
+        return bool((self.phase != IDLE).any())
+
+    def decide(self, xi: FloatArray) -> str:
+        """Return the library's decision for capture point ``xi`` [m]: ankle, hip or step.
+
+        "ankle": ξ inside the CoP region P (Eq. 4); "hip": outside P, inside the CMP region
+        P ⊕ box(a'_x, a'_y) (corrected Eq. 15, :func:`~pushrecovery.surfaces.plane.cmp_polygon`);
+        "step": beyond both.
+        """
+        if bool(self.support.contains(xi[0], xi[1])):
+            return "ankle"
+        if bool(self.cmp_region.contains(xi[0], xi[1])):
+            return "hip"
+        return "step"
+
+    def saturate(self, cop: FloatArray) -> FloatArray:
+        """Return ``cop`` [m] with each acting axis's CoP on the edge δ⁺ (the ankle saturated).
+
+        Stephens' bang-bang assumes the CoP stays on the edge while the flywheel acts; the
+        DCM law would pull it back inside as soon as ξ re-enters P, slowing the capture.
+        """
+        out = np.array(cop, dtype=float)
+        for k in range(2):
+            if self.phase[k] != IDLE:
+                out[k] = self.high[k] if self.side[k] > 0 else self.low[k]
+        return out
+
+    def update(self, xi: FloatArray, momentum: FloatArray, tilt: FloatArray) -> FloatArray:
+        """Advance each axis's phase and return the CMP offset δ = (δ_x, δ_y) [m].
+
+        Parameters
+        ----------
+        xi : float array, shape (2,)
+            The capture point [m] (world xy).
+        momentum : float array, shape (2,)
+            (L_y, −L_x): the centroidal angular momentum about the axis that moves the CMP
+            along x, then y [N m s].
+        tilt : float array, shape (2,)
+            The upper body's pitch and −roll since reset [rad] (the same signs).
+        """
+        self.decision = self.decide(xi)
+        offset = np.zeros(2)
+        for k in range(2):
+            if self.phase[k] == IDLE and self.decision != "ankle":
+                if xi[k] > self.high[k]:
+                    self.phase[k], self.side[k] = PUSH, 1.0
+                elif xi[k] < self.low[k]:
+                    self.phase[k], self.side[k] = PUSH, -1.0
+            if self.phase[k] == IDLE:
+                continue
+            side = self.side[k]
+            spin = side * float(momentum[k])
+            torque, reach = float(self.torque[k]), float(self.reach[k])
+            if self.phase[k] == PUSH:
+                edge = self.high[k] if side > 0 else self.low[k]
+                inside = side * (float(xi[k]) - edge)
+                braking = max(spin, 0.0) / torque
+                stop = side * float(tilt[k])
+                stop += max(spin, 0.0) ** 2 / (2.0 * self.inertia[k] * torque)
+                aim = -reach * (1.0 - math.exp(-self.omega * braking)) - self.margin
+                if inside <= aim or stop >= self.angle_max[k]:
+                    self.phase[k] = BRAKE
+                else:
+                    offset[k] = side * reach
+            if self.phase[k] == BRAKE:
+                if spin <= 0.0:
+                    self.phase[k] = IDLE
+                else:
+                    offset[k] = -side * min(torque, spin / self.period) / self.weight
+        return offset
