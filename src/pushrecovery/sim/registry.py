@@ -17,7 +17,15 @@ if TYPE_CHECKING:  # listing the models must not load numpy (pushrecovery --help
     from pushrecovery.params import BodyParams
     from pushrecovery.sim.plants import Plant
 
-__all__ = ["MODELS", "MUJOCO_MODELS", "PLANTS", "available_models", "make_plant"]
+__all__ = [
+    "MODELS",
+    "MUJOCO_3D_MODELS",
+    "MUJOCO_MODELS",
+    "PLANTS",
+    "PLANTS_3D",
+    "available_models",
+    "make_plant",
+]
 
 #: Backend -> model name -> "module:Class" of its plant.
 PLANTS: dict[str, dict[str, str]] = {
@@ -34,10 +42,19 @@ PLANTS: dict[str, dict[str, str]] = {
         "biped": "pushrecovery.sim.mujoco.biped:MujocoBipedPlant",
     },
 }
+#: The MuJoCo backend's 3-D humanoids (docs/humanoid3d.md): their state is the CoM's in 3-D
+#: and their controller the whole-body QP, so they are apart from the sagittal models above
+#: (``MUJOCO_MODELS``, which the sagittal loop, validation and campaigns iterate).
+PLANTS_3D: dict[str, str] = {
+    "biped3d": "pushrecovery.sim.mujoco.humanoid3d.plant3d:Biped3DPlant",
+    "g1": "pushrecovery.sim.mujoco.humanoid3d.plant3d:G1Plant",
+}
 #: Models of the analytic backend.
 MODELS = tuple(PLANTS["analytic"])
 #: Models of the MuJoCo backend (:mod:`pushrecovery.sim.mujoco`).
 MUJOCO_MODELS = tuple(PLANTS["mujoco"])
+#: The 3-D models of the MuJoCo backend (``make_plant(name, params, "mujoco")`` builds them).
+MUJOCO_3D_MODELS = tuple(PLANTS_3D)
 
 
 def available_models(backend: str) -> tuple[str, ...]:
@@ -58,20 +75,26 @@ def available_models(backend: str) -> tuple[str, ...]:
 
 
 def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plant:
-    """Build the plant ``name`` of ``backend``; unknown names raise, naming the choices."""
+    """Build the plant ``name`` of ``backend``; unknown names raise, naming the choices.
+
+    The MuJoCo backend also builds the 3-D models of :data:`PLANTS_3D` (the G1's ``params``
+    must be ``robot_params("g1")``).
+    """
     from pushrecovery._validate import require_type
     from pushrecovery.params import BodyParams as Body  # a runtime check, not an annotation
 
     require_type("name", name, str)
     require_type("params", params, Body)
-    models = available_models(backend)
+    models = available_models(backend) + (MUJOCO_3D_MODELS if backend == "mujoco" else ())
+    table = PLANTS[backend] | (PLANTS_3D if backend == "mujoco" else {})
     if name not in models:
-        other = next((b for b, names in PLANTS.items() if b != backend and name in names), None)
+        every = PLANTS | {"mujoco": PLANTS["mujoco"] | PLANTS_3D}
+        other = next((b for b, names in every.items() if b != backend and name in names), None)
         hint = f" ({name!r} is a {other} model: use backend {other!r})" if other else ""
         raise InvalidParameterError(
             f"model must be one of {list(models)} for the {backend} backend, "
             f"got model={name!r}{hint}"
         )
-    module, _, attribute = PLANTS[backend][name].partition(":")
+    module, _, attribute = table[name].partition(":")
     plant: Plant = getattr(importlib.import_module(module), attribute)(params)
     return plant

@@ -1,0 +1,498 @@
+r"""The 3-D humanoids as plants: the backend contract where it fits, a 3-D push, the WBC's loop.
+
+:class:`Biped3DPlant` (``biped3d``, the biped of :mod:`.biped3d` with its knees bent as in
+:mod:`.wbc_push`) and :class:`G1Plant` (``g1``, the Unitree G1 of the ``robots`` extra) keep
+their state in MuJoCo and report the contract's (docs/architecture.md) where it is 3-D:
+
+* **State** (:data:`STATE_LABELS`): the whole-body CoM ``x, y, z`` [m] and its velocity
+  ``xdot, ydot, zdot`` [m/s], world frame (x forward, y left, z up, the floor at 0):
+  positions then velocities, ``x`` first and ``xdot`` at ``len // 2`` as item 1 asks.
+* **reset(x, xdot)** stands the body still (``x = xdot = 0`` only: the standing posture puts
+  the CoM over the feet; a push is :meth:`~Humanoid3DPlant.apply_push`).
+* **begin(state)** starts a run from the plant's own current state only (MuJoCo's state is
+  not a function of the CoM's).
+* **apply_push(push)** takes a :class:`~pushrecovery.sim.push.Push3D` (or a sagittal
+  :class:`~pushrecovery.sim.push.Push`, as J = m Δẋ at azimuth 0 or 180 on the torso) and
+  applies the constant force J/Δ (cos ψ, sin ψ, 0) for Δ = :data:`PUSH_DURATION` (10 ms) at
+  the pushed body's centre of mass (``xfrc_applied``), the motors holding their last ``ctrl``
+  meanwhile: the whole body's momentum gains J, minus what the floor's friction takes.
+* **step(ctrl, dt)** holds the motor commands ``ctrl`` [N m] (the
+  :class:`~.wbc_control.WholeBodyController`'s output: not a ``Command``), clipped to the
+  motors' ranges, for dt (rounded to physics steps); ``applied`` is the clipped ``ctrl``
+  (``input_labels``: the motors' names).
+* **falling(state)**: the capture point ξ = c_xy + ċ_xy/ω (ω = sqrt(g/z₀), z₀ the CoM's
+  standing height above the soles) farther than :meth:`~Humanoid3DPlant.fall_margin` =
+  2 max(τmax, τmax_roll)/(m g) outside the support polygon P (the hull of both soles at
+  reset): beyond what both hips' CMP offsets could bring back, the LIPM with a flywheel
+  falls; or the CoM below :data:`FALL_HEIGHT` z₀ (the body is down).
+* **at_rest(state, speed)**: |ċ_xy| <= speed and the CoM's ground point strictly inside P.
+
+:func:`simulate_push3d` is the loop of these plants (the one loop, ``sim.simulate``, hands the
+controller the state vector; the WBC reads the ``MjData``): quiet standing until
+``push_time``, the push, then the controller every :data:`CONTROL_PERIOD` until the fall
+set, rest over P for ``rest_duration``, or ``duration``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery._validate import bounded_float, finite_float, require_type
+from pushrecovery.control.base import StepInfo
+from pushrecovery.errors import InvalidParameterError, SimulationDiverged
+from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
+from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import Step
+from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
+from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points
+from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
+from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
+from pushrecovery.sim.push import Push, Push3D
+from pushrecovery.sim.result import Outcome
+
+FloatArray = NDArray[np.float64]
+
+__all__ = [
+    "CONTROL_PERIOD",
+    "FALL_HEIGHT",
+    "HIP_TILT_THRESHOLD",
+    "PUSH_DURATION",
+    "STATE_LABELS",
+    "Biped3DPlant",
+    "G1Plant",
+    "Humanoid3DPlant",
+    "Push3DRun",
+    "simulate_push3d",
+    "wbc_for",
+]
+
+#: The 3-D plants' state: the whole-body CoM and its velocity (world frame).
+STATE_LABELS = ("x", "y", "z", "xdot", "ydot", "zdot")
+#: The WBC's period [s] (500 Hz).
+CONTROL_PERIOD = 0.002
+#: A CoM below this fraction of its standing height above the soles is down (fallen).
+FALL_HEIGHT = 0.7
+#: Largest torso tilt from its standing orientation [rad] that still counts as the ankle
+#: strategy (the upper body held upright); beyond it the hips turned it: ``hip``.
+HIP_TILT_THRESHOLD = 0.05
+
+
+class Humanoid3DPlant:
+    """A 3-D humanoid in MuJoCo behind the backend contract where it fits (module docstring).
+
+    Parameters
+    ----------
+    params : BodyParams
+        The body (its mass, gravity and hip torque limits enter the fall set).
+    model : mujoco.MjModel
+        The humanoid: a free root joint first, torque motors.
+    qpos : float array
+        Its standing posture, soles on the floor.
+    feet : tuple of str
+        The foot bodies (left, right).
+    torso : str
+        The body a push named ``"torso"`` acts on.
+    upright : str
+        The body the WBC holds upright (its origin's height is the pelvis task).
+    """
+
+    name: ClassVar[str] = "humanoid3d"
+    state_labels: ClassVar[tuple[str, ...]] = STATE_LABELS
+
+    def __init__(
+        self,
+        params: BodyParams,
+        model: Any,
+        qpos: FloatArray,
+        feet: tuple[str, ...],
+        torso: str,
+        upright: str,
+    ) -> None:
+        import mujoco
+
+        require_type("params", params, BodyParams)
+        self.params, self.model = params, model
+        self.qpos = np.array(qpos, dtype=float)
+        self.feet, self.torso, self.upright = feet, torso, upright
+        self.data = mujoco.MjData(model)
+        self.input_labels: tuple[str, ...] = tuple(model.actuator(i).name for i in range(model.nu))
+        self.ctrl_range = np.array(model.actuator_ctrlrange, dtype=float)
+        limited = np.asarray(model.actuator_ctrllimited, dtype=bool)
+        self.ctrl_range[~limited] = (-np.inf, np.inf)
+        self.hip_motors = [
+            i for i, label in enumerate(self.input_labels)
+            if "hip_pitch" in label or "hip_roll" in label
+        ]  # fmt: skip
+        self.steps_per_tick = max(1, round(CONTROL_PERIOD / float(model.opt.timestep)))
+        self.state = np.zeros(len(STATE_LABELS))
+        self.ctrl = np.zeros(int(model.nu))
+        self.support: ConvexPolygon | None = None
+        self.floor = 0.0
+        self.standing_height = 1.0
+        self.omega = 1.0
+        self.reset()
+
+    # -- contract items 2-3 ----------------------------------------------------------------
+
+    def reset(self, x: float = 0.0, xdot: float = 0.0) -> FloatArray:
+        """Stand still in the standing posture (contract item 2, ``x = xdot = 0`` only).
+
+        Raises
+        ------
+        InvalidParameterError
+            If ``x`` or ``xdot`` is not 0 (the posture sets the CoM; push with apply_push).
+        """
+        import mujoco
+
+        for label, value in (("x", x), ("xdot", xdot)):
+            if finite_float(label, value) != 0.0:
+                raise InvalidParameterError(
+                    f"{label} must be 0 on the 3-D models (the standing posture puts the CoM "
+                    f"over the feet; push with apply_push), got {label}={float(value):g}"
+                )
+        model, data = self.model, self.data
+        mujoco.mj_resetData(model, data)
+        data.qpos[:] = self.qpos
+        mujoco.mj_forward(model, data)
+        soles = np.vstack([sole_points(model, data, body_id(model, foot)) for foot in self.feet])
+        self.support = convex_hull(soles[:, :2])
+        self.floor = float(soles[:, 2].mean())
+        self.standing_height = float(data.subtree_com[0][2]) - self.floor
+        gravity = float(np.linalg.norm(model.opt.gravity))
+        self.omega = math.sqrt(gravity / self.standing_height)
+        self.ctrl = np.zeros(int(model.nu))
+        self.state = self._read()
+        return self.state.copy()
+
+    def check_state(self, state: FloatArray) -> None:
+        """Require a finite state of :data:`STATE_LABELS` (contract item 3)."""
+        array = np.asarray(state, dtype=float)
+        if array.shape != (len(STATE_LABELS),) or not np.all(np.isfinite(array)):
+            raise InvalidParameterError(
+                f"state must be 6 finite numbers {list(STATE_LABELS)}, got shape {array.shape}"
+            )
+
+    def begin(self, state: FloatArray) -> FloatArray:
+        """Start a run from the plant's current state (``reset``'s or ``apply_push``'s).
+
+        Raises
+        ------
+        InvalidParameterError
+            If ``state`` is not the plant's current one (MuJoCo's state is not a function of
+            the CoM's: a deviation from contract item 3).
+        """
+        self.check_state(state)
+        if not np.allclose(np.asarray(state, dtype=float), self.state, rtol=0.0, atol=1e-12):
+            raise InvalidParameterError(
+                "state must be the 3-D plant's current state (from reset or apply_push)"
+            )
+        return self.state.copy()
+
+    # -- contract items 4-6 ----------------------------------------------------------------
+
+    def body_of(self, name: str) -> int:
+        """Return the id of the pushed body ``name`` (``"torso"``: the model's torso)."""
+        target = self.torso if name == "torso" else name
+        try:
+            return body_id(self.model, target)
+        except KeyError:
+            raise InvalidParameterError(
+                f"body must be a body of the {self.name} model, got {name[:40]!r}"
+            ) from None
+
+    def apply_push(self, push: Push3D | Push) -> FloatArray:
+        """Push now: J/Δ for Δ = 10 ms at the body's CoM, the motors holding (contract item 4)."""
+        import mujoco
+
+        if isinstance(push, Push):
+            size = push.impulse(self.params.mass)
+            push = Push3D(abs(size), 0.0 if size >= 0.0 else 180.0)
+        require_type("push", push, Push3D)
+        body = self.body_of(push.body)
+        force = np.array(push.force(PUSH_DURATION))
+        model, data = self.model, self.data
+        steps = max(1, round(PUSH_DURATION / float(model.opt.timestep)))
+        data.ctrl[:] = self.ctrl
+        data.xfrc_applied[body, :3] = force
+        try:
+            mujoco.mj_step2(model, data)
+            for _ in range(steps - 1):
+                mujoco.mj_step(model, data)
+        finally:
+            data.xfrc_applied[body, :3] = 0.0
+        mujoco.mj_step1(model, data)
+        self.state = self._read()
+        return self.state.copy()
+
+    def step(self, command: Any, dt: float) -> Step:
+        """Hold the motor commands ``command`` [N m] (clipped) for ``dt`` [s] (item 5)."""
+        import mujoco
+
+        ctrl = np.asarray(command, dtype=float)
+        if ctrl.shape != (self.model.nu,) or not np.all(np.isfinite(ctrl)):
+            raise InvalidParameterError(
+                f"command must be {self.model.nu} finite motor commands, got shape {ctrl.shape}"
+            )
+        seconds = bounded_float("dt", dt, 1e-6, 1.0, "s")
+        self.ctrl = np.clip(ctrl, self.ctrl_range[:, 0], self.ctrl_range[:, 1])
+        model, data = self.model, self.data
+        data.ctrl[:] = self.ctrl
+        mujoco.mj_step2(model, data)
+        for _ in range(max(1, round(seconds / float(model.opt.timestep))) - 1):
+            mujoco.mj_step(model, data)
+        mujoco.mj_step1(model, data)
+        self.state = self._read()
+        return Step(self.state, tuple(float(v) for v in self.ctrl), StepInfo(True, (0.0,), 0))
+
+    def fall_margin(self) -> float:
+        """Return 2 max(τmax, τmax_roll)/(m g) [m]: both hips' largest CMP offset."""
+        p = self.params
+        return 2.0 * max(p.torque_max, p.torque_max_roll) / (p.mass * p.gravity)
+
+    def capture_point(self, state: FloatArray) -> tuple[float, float]:
+        """Return ξ = c_xy + ċ_xy/ω [m] of ``state`` (world)."""
+        return (
+            float(state[0]) + float(state[3]) / self.omega,
+            float(state[1]) + float(state[4]) / self.omega,
+        )
+
+    def xcom_outside(self, state: FloatArray) -> float:
+        """Return how far ξ is outside the support polygon [m] (0 inside)."""
+        assert self.support is not None
+        xi = self.capture_point(state)
+        near = self.support.nearest_point(*xi)
+        return math.hypot(xi[0] - near[0], xi[1] - near[1])
+
+    def falling(self, state: FloatArray) -> bool:
+        """Whether ``state`` is in the fall set (module docstring, contract item 6)."""
+        self.check_state(state)
+        if float(state[2]) - self.floor < FALL_HEIGHT * self.standing_height:
+            return True
+        return self.xcom_outside(state) > self.fall_margin()
+
+    def at_rest(self, state: FloatArray, speed: float) -> bool:
+        """Whether |ċ_xy| <= ``speed`` [m/s] with the CoM over the support (item 6)."""
+        self.check_state(state)
+        limit = finite_float("speed", speed, "m/s", allowed=">= 0")
+        if limit < 0.0:
+            raise InvalidParameterError(f"speed must be >= 0 m/s, got {limit:g}")
+        assert self.support is not None
+        inside = bool(self.support.contains(float(state[0]), float(state[1])))
+        return inside and math.hypot(float(state[3]), float(state[4])) <= limit
+
+    # -- measurements ----------------------------------------------------------------------
+
+    def _read(self) -> FloatArray:
+        """Return the state from ``data`` (after ``mj_step1``: the CoM's velocity computed)."""
+        import mujoco
+
+        data = self.data
+        if not (np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel))):
+            raise SimulationDiverged(f"the {self.name} physics diverged at t={data.time:.4g} s")
+        mujoco.mj_subtreeVel(self.model, data)
+        return np.concatenate([data.subtree_com[0], data.subtree_linvel[0]]).astype(float)
+
+    def torso_tilt(self) -> float:
+        """Return the angle between the upright body's z axis and the vertical [rad]."""
+        upright = self.data.xmat[body_id(self.model, self.upright)]
+        return math.acos(max(-1.0, min(1.0, float(upright[8]))))
+
+
+class Biped3DPlant(Humanoid3DPlant):
+    """The biped3d of ``params`` standing with its knees bent 0.3 rad (:mod:`.wbc_push`)."""
+
+    name: ClassVar[str] = "biped3d"
+
+    def __init__(self, params: BodyParams) -> None:
+        require_type("params", params, BodyParams)
+        model = biped3d_model(params)
+        super().__init__(
+            params,
+            model,
+            bent_knee_qpos(model),
+            tuple(f"{side}_foot" for side in SIDES),
+            torso="torso",
+            upright="torso",
+        )
+
+
+class G1Plant(Humanoid3DPlant):
+    """The Unitree G1 of the ``robots`` extra at its standing pose (``robots.describe_robot``).
+
+    Its body is the robot's: ``params`` must be ``robot_params("g1")`` (the CLI passes it).
+    A push named ``"torso"`` acts on ``torso_link``; the WBC holds the ``pelvis`` upright.
+
+    Raises
+    ------
+    RobotsExtraMissing
+        Without the ``robots`` extra (one line saying how to get it).
+    InvalidParameterError
+        If ``params`` are not the G1's.
+    """
+
+    name: ClassVar[str] = "g1"
+
+    def __init__(self, params: BodyParams) -> None:
+        from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
+
+        require_type("params", params, BodyParams)
+        described = describe_robot("g1")
+        if params != described.params:
+            raise InvalidParameterError(
+                "params of the g1 model must be the robot's own (robot_params('g1'))"
+            )
+        model = described.model
+        feet = tuple(model.body(int(foot)).name for foot in described.feet)
+        super().__init__(params, model, described.qpos, feet, torso="torso_link",
+                         upright="pelvis")  # fmt: skip
+
+
+def wbc_for(plant: Humanoid3DPlant) -> WholeBodyController:
+    """Return the whole-body controller of ``plant``'s model, feet and upright body."""
+    return WholeBodyController(plant.model, feet=plant.feet, torso=plant.upright)
+
+
+@dataclass(frozen=True)
+class Push3DRun:
+    """The outcome of :func:`simulate_push3d`.
+
+    Attributes
+    ----------
+    outcome : Outcome
+        recovered (at rest over P for ``rest_duration``), fell (the fall set) or undecided.
+    push : Push3D
+        The push.
+    time : float array, shape (n,)
+        Time of each control tick since reset [s].
+    states : float array, shape (n, 6)
+        The plant's state at each tick (:data:`STATE_LABELS`).
+    after_push : float array, shape (6,)
+        The state as the push ended.
+    before_push : float array, shape (6,)
+        The state as the push began.
+    peak_hip_torque : float
+        Largest |hip pitch or roll motor command − its value before the push| after it [N m].
+    max_torso_tilt : float
+        Largest tilt of the upright body from the vertical after the push [rad].
+    peak_torque : float
+        Largest |motor command| of the run [N m].
+    failed_ticks : int
+        Ticks DAQP did not solve (the last command repeated).
+    """
+
+    outcome: Outcome
+    push: Push3D
+    time: FloatArray
+    states: FloatArray
+    after_push: FloatArray
+    before_push: FloatArray
+    peak_hip_torque: float
+    max_torso_tilt: float
+    peak_torque: float
+    failed_ticks: int
+
+    @property
+    def recovered(self) -> bool:
+        """True when the body came to rest over its feet."""
+        return self.outcome is Outcome.RECOVERED
+
+    @property
+    def steps(self) -> int:
+        """Steps taken: 0 (the WBC has no stepping task yet)."""
+        return 0
+
+    def strategy_used(self) -> str:
+        """``hip`` if the torso tilted beyond :data:`HIP_TILT_THRESHOLD`, else ``ankle``.
+
+        The WBC's hip motors always work after a torso push (they stop the torso's spin), so
+        the torque alone does not tell; the upper body turning (CMP balancing) does.
+        """
+        return "hip" if self.max_torso_tilt > HIP_TILT_THRESHOLD else "ankle"
+
+
+def simulate_push3d(
+    plant: Humanoid3DPlant,
+    controller: WholeBodyController,
+    push: Push3D,
+    *,
+    duration: float = 3.0,
+    push_time: float = 0.1,
+    rest_speed: float = 5e-3,
+    rest_duration: float = 0.5,
+) -> Push3DRun:
+    """Stand, push, and run the whole-body controller until a decision (module docstring).
+
+    Parameters
+    ----------
+    plant : Humanoid3DPlant
+        The plant (reset here).
+    controller : WholeBodyController
+        Its controller (:func:`wbc_for`), reset here on the standing state.
+    push : Push3D
+        The push, at ``push_time``.
+    duration : float
+        Longest simulated time after the push, in (0, 60] s.
+    push_time : float
+        Quiet standing before the push, in [0, 10] s.
+    rest_speed, rest_duration : float
+        Recovered after |ċ_xy| <= rest_speed [m/s] over P for rest_duration [s] (both > 0).
+    """
+    require_type("plant", plant, Humanoid3DPlant)
+    require_type("controller", controller, WholeBodyController)
+    require_type("push", push, Push3D)
+    duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
+    push_time = bounded_float("push_time", push_time, 0.0, 10.0, "s")
+    rest_speed = bounded_float("rest_speed", rest_speed, 1e-6, 10.0, "m/s")
+    rest_duration = bounded_float("rest_duration", rest_duration, 0.0, 60.0, "s")
+    state = plant.reset()
+    controller.reset(plant.data)
+    times, states = [float(plant.data.time)], [state]
+    failed = 0
+
+    def tick() -> FloatArray:
+        nonlocal failed
+        ctrl = controller.compute(float(plant.data.time), plant.data)
+        failed += 0 if controller.last is None or controller.last.ok else 1
+        return plant.step(ctrl, CONTROL_PERIOD).state
+
+    for _ in range(round(push_time / CONTROL_PERIOD)):
+        state = tick()
+    before, held = state.copy(), plant.ctrl.copy()
+    after = plant.apply_push(push)
+    times.append(float(plant.data.time))
+    states.append(after)
+    hip_peak, tilt_peak, peak = 0.0, plant.torso_tilt(), float(np.abs(held).max(initial=0.0))
+    outcome, resting = Outcome.UNDECIDED, 0.0
+    for _ in range(max(1, round(duration / CONTROL_PERIOD))):
+        state = tick()
+        times.append(float(plant.data.time))
+        states.append(state)
+        ctrl = plant.ctrl
+        peak = max(peak, float(np.abs(ctrl).max(initial=0.0)))
+        if plant.hip_motors:
+            hip_peak = max(hip_peak, float(np.abs(ctrl - held)[plant.hip_motors].max()))
+        tilt_peak = max(tilt_peak, plant.torso_tilt())
+        if plant.falling(state):
+            outcome = Outcome.FELL
+            break
+        resting = resting + CONTROL_PERIOD if plant.at_rest(state, rest_speed) else 0.0
+        if resting >= rest_duration - 1e-9:
+            outcome = Outcome.RECOVERED
+            break
+    return Push3DRun(
+        outcome=outcome,
+        push=push,
+        time=np.array(times),
+        states=np.array(states),
+        after_push=after,
+        before_push=before,
+        peak_hip_torque=hip_peak,
+        max_torso_tilt=tilt_peak,
+        peak_torque=peak,
+        failed_ticks=failed,
+    )
