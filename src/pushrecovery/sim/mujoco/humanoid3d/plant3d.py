@@ -53,14 +53,13 @@ from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points
 from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
 from pushrecovery.sim.push import Push, Push3D
-from pushrecovery.sim.result import Outcome
+from pushrecovery.sim.result import Outcome, strategy_used
 
 FloatArray = NDArray[np.float64]
 
 __all__ = [
     "CONTROL_PERIOD",
     "FALL_HEIGHT",
-    "HIP_TILT_THRESHOLD",
     "PUSH_DURATION",
     "STATE_LABELS",
     "Biped3DPlant",
@@ -77,9 +76,6 @@ STATE_LABELS = ("x", "y", "z", "xdot", "ydot", "zdot")
 CONTROL_PERIOD = 0.002
 #: A CoM below this fraction of its standing height above the soles is down (fallen).
 FALL_HEIGHT = 0.7
-#: Largest torso tilt from its standing orientation [rad] that still counts as the ankle
-#: strategy (the upper body held upright); beyond it the hips turned it: ``hip``.
-HIP_TILT_THRESHOLD = 0.05
 
 
 class Humanoid3DPlant:
@@ -352,9 +348,16 @@ class G1Plant(Humanoid3DPlant):
                          upright="pelvis")  # fmt: skip
 
 
-def wbc_for(plant: Humanoid3DPlant) -> WholeBodyController:
-    """Return the whole-body controller of ``plant``'s model, feet and upright body."""
-    return WholeBodyController(plant.model, feet=plant.feet, torso=plant.upright)
+def wbc_for(plant: Humanoid3DPlant, *, hip: bool = True) -> WholeBodyController:
+    """Return the whole-body controller of ``plant``'s model, feet and upright body.
+
+    With ``hip`` (the default) its hip (CMP) task uses the flywheel limits of
+    ``plant.params`` (:mod:`.wbc_hip`); without, it balances with the ankles only.
+    """
+    require_type("plant", plant, Humanoid3DPlant)
+    return WholeBodyController(
+        plant.model, feet=plant.feet, torso=plant.upright, hip=plant.params if hip else None
+    )
 
 
 @dataclass(frozen=True)
@@ -376,7 +379,11 @@ class Push3DRun:
     before_push : float array, shape (6,)
         The state as the push began.
     peak_hip_torque : float
-        Largest |hip pitch or roll motor command − its value before the push| after it [N m].
+        Largest flywheel torque the WBC's hip law commanded after the push, m g |δ| (δ its
+        CMP offset) [N m]: 0 when the ankles sufficed.
+    peak_hip_motor_torque : float
+        Largest |hip pitch or roll motor command − its value before the push| after it [N m]
+        (the hips also stop the torso's spin after a torso push, whatever the strategy).
     max_torso_tilt : float
         Largest tilt of the upright body from the vertical after the push [rad].
     peak_torque : float
@@ -392,6 +399,7 @@ class Push3DRun:
     after_push: FloatArray
     before_push: FloatArray
     peak_hip_torque: float
+    peak_hip_motor_torque: float
     max_torso_tilt: float
     peak_torque: float
     failed_ticks: int
@@ -407,12 +415,11 @@ class Push3DRun:
         return 0
 
     def strategy_used(self) -> str:
-        """``hip`` if the torso tilted beyond :data:`HIP_TILT_THRESHOLD`, else ``ankle``.
+        """Return ``hip`` or ``ankle`` by the one definition (``sim.result.strategy_used``).
 
-        The WBC's hip motors always work after a torso push (they stop the torso's spin), so
-        the torque alone does not tell; the upper body turning (CMP balancing) does.
+        No step was taken, so ``hip`` if ``peak_hip_torque`` exceeded its threshold (1 N m).
         """
-        return "hip" if self.max_torso_tilt > HIP_TILT_THRESHOLD else "ankle"
+        return strategy_used(self.steps, self.peak_hip_torque).value
 
 
 def simulate_push3d(
@@ -466,7 +473,9 @@ def simulate_push3d(
     after = plant.apply_push(push)
     times.append(float(plant.data.time))
     states.append(after)
-    hip_peak, tilt_peak, peak = 0.0, plant.torso_tilt(), float(np.abs(held).max(initial=0.0))
+    weight = plant.params.mass * plant.params.gravity
+    hip_peak, motor_peak = 0.0, 0.0
+    tilt_peak, peak = plant.torso_tilt(), float(np.abs(held).max(initial=0.0))
     outcome, resting = Outcome.UNDECIDED, 0.0
     for _ in range(max(1, round(duration / CONTROL_PERIOD))):
         state = tick()
@@ -475,7 +484,8 @@ def simulate_push3d(
         ctrl = plant.ctrl
         peak = max(peak, float(np.abs(ctrl).max(initial=0.0)))
         if plant.hip_motors:
-            hip_peak = max(hip_peak, float(np.abs(ctrl - held)[plant.hip_motors].max()))
+            motor_peak = max(motor_peak, float(np.abs(ctrl - held)[plant.hip_motors].max()))
+        hip_peak = max(hip_peak, weight * float(np.hypot(*controller.cmp_offset)))
         tilt_peak = max(tilt_peak, plant.torso_tilt())
         if plant.falling(state):
             outcome = Outcome.FELL
@@ -492,6 +502,7 @@ def simulate_push3d(
         after_push=after,
         before_push=before,
         peak_hip_torque=hip_peak,
+        peak_hip_motor_torque=motor_peak,
         max_torso_tilt=tilt_peak,
         peak_torque=peak,
         failed_ticks=failed,
