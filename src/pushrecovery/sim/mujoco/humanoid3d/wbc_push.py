@@ -28,7 +28,14 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WbcGains, WholeBodyCo
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["KNEE_BEND", "PUSH_DURATION", "WbcRun", "bent_knee_qpos", "push_biped3d"]
+__all__ = [
+    "KNEE_BEND",
+    "PUSH_DURATION",
+    "WbcRun",
+    "bent_knee_qpos",
+    "push_biped3d",
+    "push_humanoid",
+]
 
 #: Knee flexion of the standing posture [rad].
 KNEE_BEND = 0.3
@@ -149,20 +156,45 @@ def push_biped3d(
     hip : bool
         Enable the hip (CMP) task with ``params``' flywheel limits (:mod:`.wbc_hip`).
     """
+    _check_push(impulse, azimuth, duration, push_time)
+    model = biped3d_model(params) if model is None else model
+    controller = WholeBodyController(model, gains=gains, hip=params if hip else None)
+    feet = tuple(f"{side}_foot" for side in SIDES)
+    return push_humanoid(model, bent_knee_qpos(model), controller, feet, "torso", impulse,
+                         azimuth, duration=duration, push_time=push_time)  # fmt: skip
+
+
+def push_humanoid(
+    model: Any,
+    qpos: FloatArray,
+    controller: WholeBodyController,
+    feet: tuple[str, ...],
+    torso: str,
+    impulse: float,
+    azimuth: float = 0.0,
+    *,
+    duration: float = 3.0,
+    push_time: float = 0.1,
+) -> WbcRun:
+    """Stand ``model`` at ``qpos``, push body ``torso`` and run ``controller`` (module docstring).
+
+    The controller runs every round(:attr:`~.WholeBodyController.control_period` / timestep)
+    physics steps (4 at 0.5 ms, 2 at the robots' 1 ms). ``feet`` names the foot bodies whose
+    sole lift is recorded. Arguments as :func:`push_biped3d`.
+    """
     import mujoco
 
     _check_push(impulse, azimuth, duration, push_time)
-    model = biped3d_model(params) if model is None else model
     data = mujoco.MjData(model)
-    data.qpos[:] = bent_knee_qpos(model)
+    data.qpos[:] = qpos
     mujoco.mj_forward(model, data)
-    controller = WholeBodyController(model, gains=gains, hip=params if hip else None)
     controller.reset(data)
-    torso = body_id(model, "torso")
-    feet = [body_id(model, f"{side}_foot") for side in SIDES]
+    body = body_id(model, torso)
+    soles = [body_id(model, name) for name in feet]
     force = impulse / PUSH_DURATION * np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
     dt = float(model.opt.timestep)
-    ticks = round(duration / (STEPS_PER_TICK * dt))
+    per_tick = max(1, round(controller.control_period / dt))
+    ticks = round(duration / (per_tick * dt))
     start_step = round(push_time / dt)
     stop_step = start_step + round(PUSH_DURATION / dt)
     columns: dict[str, list[Any]] = {
@@ -178,9 +210,9 @@ def push_biped3d(
         columns["time"].append(float(data.time))
         columns["com"].append(np.array(data.subtree_com[0]))
         columns["com_velocity"].append(np.array(data.subtree_linvel[0]))
-        columns["pelvis"].append(np.array(data.xpos[torso]))
-        columns["torso_tilt"].append(math.acos(min(1.0, float(data.xmat[torso][8]))))
-        columns["sole_lift"].append([float(sole_points(model, data, f)[:, 2].max()) for f in feet])
+        columns["pelvis"].append(np.array(data.xpos[body]))
+        columns["torso_tilt"].append(math.acos(min(1.0, float(data.xmat[body][8]))))
+        columns["sole_lift"].append([float(sole_points(model, data, f)[:, 2].max()) for f in soles])
         columns["wrenches"].append(solution.wrenches)
         columns["desired_cop"].append(controller.desired_cop.copy())
         columns["cmp_offset"].append(controller.cmp_offset.copy())
@@ -188,9 +220,9 @@ def push_biped3d(
         columns["solve_time"].append(solution.solve_time)
         columns["control_time"].append(control)
         began = time.perf_counter()
-        for sub in range(STEPS_PER_TICK):
-            step = tick * STEPS_PER_TICK + sub
-            data.xfrc_applied[torso, :3] = force if start_step <= step < stop_step else 0.0
+        for sub in range(per_tick):
+            step = tick * per_tick + sub
+            data.xfrc_applied[body, :3] = force if start_step <= step < stop_step else 0.0
             if sub == 0:
                 mujoco.mj_step2(model, data)
             else:

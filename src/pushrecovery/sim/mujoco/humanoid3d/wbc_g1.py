@@ -1,0 +1,71 @@
+"""The Unitree G1 under the whole-body controller (docs/humanoid3d.md).
+
+The G1 of :func:`~.robots.describe_robot` (torque motors, 1 ms steps, its ``stand`` keyframe
+lowered onto the floor): feet ``left_ankle_roll_link`` and ``right_ankle_roll_link`` (four
+contact spheres each; the sole frame and polygon come from their bottoms, as
+:func:`~.robots.robot_params` measures them), ``torso_link`` held upright and at its height,
+and every other joint (legs, waist, arms) in the posture task. Pushes at ``torso_link``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pushrecovery.ground.polygon import convex_hull
+from pushrecovery.sim.mujoco.humanoid3d.measure import sole_points
+from pushrecovery.sim.mujoco.humanoid3d.robots import RobotDescription, describe_robot
+from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WbcGains, WholeBodyController
+from pushrecovery.sim.mujoco.humanoid3d.wbc_push import WbcRun, push_humanoid
+
+__all__ = ["G1_FEET", "G1_TORSO", "g1_ankle_impulse", "g1_controller", "push_g1"]
+
+#: The G1's foot bodies (left, right) and the body the torso task holds upright.
+G1_FEET = ("left_ankle_roll_link", "right_ankle_roll_link")
+G1_TORSO = "torso_link"
+
+
+def g1_controller(
+    robot: RobotDescription, gains: WbcGains | None = None, *, hip: bool = False
+) -> WholeBodyController:
+    """Return a :class:`WholeBodyController` for the G1 ``robot`` (its params for the hip)."""
+    return WholeBodyController(robot.model, G1_FEET, G1_TORSO, gains,
+                               hip=robot.params if hip else None)  # fmt: skip
+
+
+def g1_ankle_impulse(robot: RobotDescription, azimuth: float = 0.0) -> float:
+    """Return the CoP region's critical impulse m ω × (CoM's ray to the soles' hull) [N s]."""
+    import mujoco
+
+    model, params = robot.model, robot.params
+    data = mujoco.MjData(model)
+    data.qpos[:] = robot.qpos
+    mujoco.mj_forward(model, data)
+    hull = convex_hull(_soles(model, data, robot.feet)[:, :2])
+    com = data.subtree_com[0]
+    return params.mass * params.omega * hull.ray_distance(float(com[0]), float(com[1]), azimuth)
+
+
+def _soles(model: Any, data: Any, feet: list[int]) -> Any:
+    import numpy as np
+
+    return np.vstack([sole_points(model, data, foot) for foot in feet])
+
+
+def push_g1(
+    impulse: float,
+    azimuth: float = 0.0,
+    *,
+    duration: float = 2.0,
+    push_time: float = 0.1,
+    robot: RobotDescription | None = None,
+    gains: WbcGains | None = None,
+    hip: bool = False,
+) -> WbcRun:
+    """Push the G1 at ``torso_link`` and run the whole-body controller (:func:`push_humanoid`).
+
+    ``robot`` reuses a :func:`~.robots.describe_robot` ("g1"); needs the ``robots`` extra.
+    """
+    robot = describe_robot("g1") if robot is None else robot
+    controller = g1_controller(robot, gains, hip=hip)
+    return push_humanoid(robot.model, robot.qpos, controller, G1_FEET, G1_TORSO, impulse,
+                         azimuth, duration=duration, push_time=push_time)  # fmt: skip
