@@ -63,6 +63,9 @@ _scheduler = click.option(
     help="Plant (default: stepping on analytic, torso on mujoco).",
 )
 @click.option("--controller", default=None, help="Controller (default: recovery / mpc).")
+@click.option(
+    "--azimuth", type=float, default=None, help="3-D models (biped3d, g1): not available yet."
+)
 @click.option("--x0", "x0", **_triple, help="CoM positions before the push [m].")
 @click.option("--xdot", **_triple, help="Pushes as CoM velocities [m/s].")
 @click.option("--impulse", **_triple, help="Pushes as impulses at the CoM [N s].")
@@ -109,6 +112,7 @@ def campaign(
     backend: str,
     model: str | None,
     controller: str | None,
+    azimuth: float | None,
     x0: tuple[float, float, float] | None,
     xdot: tuple[float, float, float] | None,
     impulse: tuple[float, float, float] | None,
@@ -137,7 +141,14 @@ def campaign(
     """
     from pushrecovery.campaign import CampaignSpec, read_spec, run_campaign
     from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.sim.registry import MUJOCO_3D_MODELS
 
+    if model in MUJOCO_3D_MODELS or azimuth is not None:
+        raise InvalidParameterError(
+            "campaign does not run the 3-D models (biped3d, g1) yet: it needs an impulse x "
+            "azimuth grid in CampaignSpec and Parquet rows of the 3-D state; use simulate or "
+            "critical-push --azimuth"
+        )
     params = params_from(kwargs)
     directory = Path(out)
     if resume and x0 is None and xdot is None and impulse is None:

@@ -19,13 +19,15 @@ from pushrecovery.cli.options import (
 )
 from pushrecovery.cli.progress import Progress
 from pushrecovery.control.registry import CONTROLLER_NAMES
-from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
+from pushrecovery.sim.registry import MODELS, MUJOCO_3D_MODELS, MUJOCO_MODELS
 
 __all__ = ["critical_push", "simulate"]
 
 #: The ``--model`` and ``--controller`` choices.
 MODEL_CHOICES = MODELS
 MUJOCO_MODEL_CHOICES = MUJOCO_MODELS
+#: The 3-D models (MuJoCo, the whole-body controller; docs/humanoid3d.md).
+MUJOCO_3D_MODEL_CHOICES = MUJOCO_3D_MODELS
 CONTROLLER_CHOICES = CONTROLLER_NAMES
 
 
@@ -88,12 +90,19 @@ _backend = click.option(
 )
 _model = click.option(
     "--model",
-    type=click.Choice((*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES)),
+    type=click.Choice((*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES, *MUJOCO_3D_MODEL_CHOICES)),
     default="lipm",
     show_default=True,
     help="Plant. Analytic: lipm, pendulum, flywheel, stepping, stepping-plane (on the ground "
     "plane, with recovery-plane; simulate only); MuJoCo: foot (ankle), torso (hip), biped "
-    "(stepping).",
+    "(stepping); 3-D MuJoCo (the whole-body controller, --azimuth): biped3d, g1 (the robots "
+    "extra).",
+)
+_azimuth = click.option(
+    "--azimuth",
+    type=float,
+    default=None,
+    help="3-D models only: the push's direction [deg], 0 forward (+x), 90 left (+y); default 0.",
 )
 _controller = click.option(
     "--controller",
@@ -126,7 +135,7 @@ def _with(*decorators: Any) -> Any:
 
 
 @click.command(short_help="Simulate a push; report recovered or fell.")
-@_with(_backend, _model, _controller, *_gains)
+@_with(_backend, _model, _controller, *_gains, _azimuth)
 @click.option(
     "--x", "x", type=float, default=0.0, show_default=True, help="CoM position before the push [m]."
 )
@@ -148,9 +157,11 @@ def _with(*decorators: Any) -> Any:
 )
 @click.option(
     "--impulse",
+    "--push",
+    "impulse",
     type=float,
     default=None,
-    help="Push as an impulse on the CoM [N s] (instead of --xdot).",
+    help="Push as an impulse on the CoM [N s] (instead of --xdot); on the 3-D models at the torso.",
 )
 @click.option(
     "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
@@ -182,6 +193,7 @@ def simulate(
     kp: float | None,
     kd: float | None,
     options: tuple[str, ...],
+    azimuth: float | None,
     x: float,
     xdot: float | None,
     y: float,
@@ -199,7 +211,9 @@ def simulate(
     With --backend mujoco, --impulse is a real force at the CoM over 10 ms (the body holding
     still meanwhile) and the run starts as the push ends. With --model stepping-plane
     (controller recovery-plane) the body stands on both feet of the ground plane and --y,
-    --ydot add the sideways part (--impulse pushes along x).
+    --ydot add the sideways part (--impulse pushes along x). The 3-D models (--backend
+    mujoco --model biped3d or g1) take --impulse/--push at the torso at --azimuth and run
+    the whole-body controller (docs/humanoid3d.md).
     """
     from pushrecovery.control.base import make_controller
     from pushrecovery.sim.backend import Measuring, Recording
@@ -208,6 +222,21 @@ def simulate(
     from pushrecovery.sim.simulate import simulate as run
     from pushrecovery.surfaces.classify import classify as classify_state
 
+    if model in MUJOCO_3D_MODEL_CHOICES or azimuth is not None:
+        _check_3d(backend, model, controller, kp, kd, options, kwargs)
+        if not (x == 0.0 and xdot is None and y == 0.0 and ydot == 0.0):
+            from pushrecovery.errors import InvalidParameterError
+
+            raise InvalidParameterError(
+                f"--model {model} starts standing still: push it with --impulse and --azimuth "
+                "(no --x, --xdot, --y, --ydot)"
+            )
+        if plot or render:
+            from pushrecovery.errors import InvalidParameterError
+
+            raise InvalidParameterError(f"--plot and --render are not available for {model} yet")
+        emit(_simulate_3d(model, _params_3d(model, kwargs), impulse, azimuth, duration), as_json)
+        return
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)
     plane = model == "stepping-plane"
@@ -270,7 +299,7 @@ def simulate(
 
 
 @click.command("critical-push", short_help="Largest recoverable push, vs Eq. 4.")
-@_with(_backend, _model, _controller, *_gains)
+@_with(_backend, _model, _controller, *_gains, _azimuth)
 @click.option(
     "--x",
     "x",
@@ -310,6 +339,7 @@ def critical_push(
     kp: float | None,
     kd: float | None,
     options: tuple[str, ...],
+    azimuth: float | None,
     x: float,
     direction: str,
     tolerance: float,
@@ -318,9 +348,25 @@ def critical_push(
     as_json: bool,
     **kwargs: Any,
 ) -> None:
-    """Largest recoverable push from x by bisection, against the strategy's surface."""
+    """Largest recoverable push from x by bisection, against the strategy's surface.
+
+    On the 3-D models (--backend mujoco --model biped3d or g1) the impulse at --azimuth is
+    bisected between a run that stands and one that falls within --duration (keep it short:
+    the whole-body controller runs about 5x real time), to --tolerance times the mass.
+    """
     from pushrecovery.sim.critical import critical_push as search
 
+    if model in MUJOCO_3D_MODEL_CHOICES or azimuth is not None:
+        _check_3d(backend, model, controller, kp, kd, options, kwargs)
+        if x != 0.0 or direction != "forward":
+            from pushrecovery.errors import InvalidParameterError
+
+            raise InvalidParameterError(
+                f"--model {model} starts standing still and takes --azimuth (no --x, --direction)"
+            )
+        params = _params_3d(model, kwargs)
+        emit(_critical_3d(model, params, azimuth, tolerance, duration), as_json)
+        return
     params = params_from(kwargs)
     bar = Progress(None, "critical push", "simulation")
     try:
@@ -383,3 +429,133 @@ def _critical_prediction(
         data["corrected_velocity"] = corrected
         data["corrected_impulse"] = params.mass * corrected
     return data
+
+
+def _check_3d(
+    backend: str,
+    model: str,
+    controller: str,
+    kp: float | None,
+    kd: float | None,
+    options: tuple[str, ...],
+    kwargs: dict[str, Any],
+) -> None:
+    """Refuse the options a 3-D run does not take, in one line each."""
+    from pushrecovery.errors import InvalidParameterError
+
+    if model not in MUJOCO_3D_MODEL_CHOICES:
+        raise InvalidParameterError(
+            f"--azimuth needs a 3-D model (--backend mujoco --model biped3d or g1), got {model!r}"
+        )
+    if backend != "mujoco":
+        raise InvalidParameterError(f"--model {model} is a 3-D MuJoCo model: use --backend mujoco")
+    if controller != "ankle-pd" or kp is not None or kd is not None or options:
+        raise InvalidParameterError(
+            f"--controller, --kp, --kd and --option do not apply to {model}: it runs the "
+            "whole-body controller"
+        )
+
+
+def _params_3d(model: str, kwargs: dict[str, Any]) -> Any:
+    """Return the body of a 3-D model: the options' (biped3d) or the robot's own (g1)."""
+    if model != "g1":
+        return params_from(kwargs)
+    from pushrecovery.cli.options import PARAM_FLAGS
+    from pushrecovery.errors import InvalidParameterError
+
+    given = [flag for flag, field, _ in PARAM_FLAGS if kwargs.get(field) is not None]
+    if given or kwargs.get("params_file") or kwargs.get("preset", "paper") != "paper":
+        raise InvalidParameterError(
+            "--model g1 has the robot's own body: no --preset, --params or body flags "
+            f"(got {(given or ['--preset/--params'])[0]})"
+        )
+    from pushrecovery.sim.mujoco.humanoid3d.robots import robot_params
+
+    return robot_params("g1")
+
+
+def _simulate_3d(
+    model: str, params: Any, impulse: float | None, azimuth: float | None, duration: float
+) -> dict[str, Any]:
+    """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON)."""
+    import numpy as np
+
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
+        STATE_LABELS,
+        simulate_push3d,
+        wbc_for,
+    )
+    from pushrecovery.sim.push import Push3D
+    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.surfaces.classify import classify as classify_state
+
+    push = Push3D(0.0 if impulse is None else impulse, 0.0 if azimuth is None else azimuth)
+    dvx, dvy = push.delta_velocity(params.mass)
+    predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
+    plant: Any = make_plant(model, params, "mujoco")
+    run = simulate_push3d(plant, wbc_for(plant), push, duration=duration)
+    states, before, after = run.states, run.before_push, run.after_push
+    return {
+        "recovered": run.recovered,
+        "outcome": run.outcome.value,
+        "model": model,
+        "controller": "wbc",
+        "duration": float(run.time[-1]),
+        "final_state": dict(zip(STATE_LABELS, (float(v) for v in states[-1]), strict=True)),
+        "max_excursion": float(
+            np.hypot(states[:, 0] - states[0, 0], states[:, 1] - states[0, 1]).max()
+        ),
+        "peak_torque": run.peak_torque,
+        "stop_impacts": 0,
+        "initial_state": {"x": 0.0, "xdot": 0.0, "y": 0.0, "ydot": 0.0},
+        "predicted": predicted.to_dict(),
+        "after_push": {
+            "x": float(after[0]),
+            "xdot": float(after[3]),
+            "y": float(after[1]),
+            "ydot": float(after[4]),
+        },
+        "backend": "mujoco",
+        "azimuth": push.azimuth,
+        "impulse": push.impulse,
+        "push_body": push.body,
+        "delta_velocity": {
+            "expected": [dvx, dvy],
+            "measured": [float(after[3] - before[3]), float(after[4] - before[4])],
+        },
+        "steps": run.steps,
+        "strategy": run.strategy_used(),
+        "peak_hip_torque": run.peak_hip_torque,
+        "peak_hip_motor_torque": run.peak_hip_motor_torque,
+        "max_torso_tilt": run.max_torso_tilt,
+        "failed_ticks": run.failed_ticks,
+    }
+
+
+def _critical_3d(
+    model: str, params: Any, azimuth: float | None, tolerance: float, duration: float
+) -> dict[str, Any]:
+    """Bisect the impulse at ``azimuth`` on a 3-D model (the JSON)."""
+    from pushrecovery._validate import positive_float
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import critical_push3d
+    from pushrecovery.sim.registry import make_plant
+
+    width = positive_float("tolerance", tolerance, "m/s") * params.mass
+    plant: Any = make_plant(model, params, "mujoco")
+    found = critical_push3d(
+        plant, 0.0 if azimuth is None else azimuth, tolerance=width, duration=duration
+    )
+    low, high = found.bracket
+    return {
+        "velocity": found.impulse / params.mass,
+        "impulse": found.impulse,
+        "bracket": [low / params.mass, high / params.mass],
+        "impulse_bracket": [low, high],
+        "simulations": found.simulations,
+        "model": model,
+        "controller": "wbc",
+        "x": 0.0,
+        "azimuth": 0.0 if azimuth is None else azimuth,
+        "backend": "mujoco",
+        "strategy": found.strategy,
+    }

@@ -33,6 +33,14 @@ __all__ = ["validate"]
     help="Strategies to validate (repeatable; default all the backend has models for).",
 )
 @click.option(
+    "--model",
+    "model3d",
+    type=click.Choice(("biped3d", "g1")),
+    default=None,
+    help="3-D models: not available yet.",
+)
+@click.option("--azimuth", type=float, default=None, help="3-D models: not available yet.")
+@click.option(
     "--x0",
     "x0s",
     type=float,
@@ -68,6 +76,8 @@ __all__ = ["validate"]
 def validate(
     backend: str,
     strategies: tuple[str, ...],
+    model3d: str | None,
+    azimuth: float | None,
     x0s: tuple[float, ...],
     tolerance: float,
     duration: float,
@@ -96,6 +106,12 @@ def validate(
         critical_table,
     )
 
+    if model3d is not None or azimuth is not None:
+        raise InvalidParameterError(
+            "validate does not run the 3-D models (biped3d, g1) yet: it needs the ground "
+            "plane's critical impulse per azimuth to compare with (the polar validation); use "
+            "critical-push --azimuth"
+        )
     params = params_from(kwargs)
     strategies = strategies or available_strategies(backend)
     missing = set(strategies) - set(available_strategies(backend))

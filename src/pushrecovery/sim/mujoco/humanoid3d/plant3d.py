@@ -63,9 +63,11 @@ __all__ = [
     "PUSH_DURATION",
     "STATE_LABELS",
     "Biped3DPlant",
+    "CriticalPush3D",
     "G1Plant",
     "Humanoid3DPlant",
     "Push3DRun",
+    "critical_push3d",
     "simulate_push3d",
     "wbc_for",
 ]
@@ -507,3 +509,73 @@ def simulate_push3d(
         peak_torque=peak,
         failed_ticks=failed,
     )
+
+
+@dataclass(frozen=True)
+class CriticalPush3D:
+    """The largest recovered impulse at one azimuth (:func:`critical_push3d`).
+
+    Attributes
+    ----------
+    impulse : float
+        The largest impulse that did not fall [N s] (the bracket's low end).
+    bracket : tuple of float
+        (stood, fell) impulses [N s], at most ``tolerance`` apart.
+    simulations : int
+        Runs made.
+    strategy : str
+        The strategy of the run at ``impulse``.
+    """
+
+    impulse: float
+    bracket: tuple[float, float]
+    simulations: int
+    strategy: str
+
+
+def critical_push3d(
+    plant: Humanoid3DPlant,
+    azimuth: float,
+    *,
+    tolerance: float = 0.5,
+    duration: float = 3.0,
+    body: str = "torso",
+) -> CriticalPush3D:
+    """Bisect the impulse at ``azimuth`` [deg] between a run that stands and one that falls.
+
+    The upper end starts at m · 0.25 m/s and doubles while the body recovers (up to the
+    push's largest impulse); then the bracket halves until it is at most ``tolerance`` [N s]
+    wide (in (0, 1e3]). Each run is :func:`simulate_push3d` with the WBC and its hip task,
+    ``duration`` [s] after the push; a run that has not fallen by then (recovered or still
+    undecided) counts as standing: falls are decided within a second, rest takes seconds.
+    """
+    from pushrecovery.sim.push import IMPULSE_MAX
+
+    require_type("plant", plant, Humanoid3DPlant)
+    tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
+    Push3D(0.0, azimuth, body)  # checks azimuth and body
+
+    def recovers(impulse: float) -> tuple[bool, str]:
+        run = simulate_push3d(plant, wbc_for(plant), Push3D(impulse, azimuth, body),
+                              duration=duration)  # fmt: skip
+        return run.outcome is not Outcome.FELL, run.strategy_used()
+
+    low, high, runs, strategy = 0.0, 0.25 * plant.params.mass, 0, "ankle"
+    while True:
+        runs += 1
+        ok, used = recovers(high)
+        if not ok:
+            break
+        low, strategy = high, used
+        if high >= IMPULSE_MAX:
+            return CriticalPush3D(low, (low, low), runs, strategy)
+        high = min(2.0 * high, IMPULSE_MAX)
+    while high - low > tolerance:
+        middle = 0.5 * (low + high)
+        runs += 1
+        ok, used = recovers(middle)
+        if ok:
+            low, strategy = middle, used
+        else:
+            high = middle
+    return CriticalPush3D(low, (low, high), runs, strategy)

@@ -1,0 +1,150 @@
+"""Pushes from any direction on the 3-D models (issue 19 item 4): Push3D, plant3d, the CLI."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.cli import main
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.mujoco.humanoid3d import robots
+from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
+    CONTROL_PERIOD,
+    STATE_LABELS,
+    Biped3DPlant,
+    wbc_for,
+)
+from pushrecovery.sim.push import Push, Push3D, push_direction
+
+P = load_params()
+#: The CoM's velocity jump of a 10 ms torso push against J/m: the floor's friction and the
+#: motors holding the standing torques take or add a few per cent while the force acts
+#: (measured: +2 to +4 %).
+MOMENTUM_TOLERANCE = 0.06
+
+
+def test_push_direction_components():
+    assert push_direction(0.0) == (1.0, 0.0)
+    for azimuth, expected in ((90.0, (0.0, 1.0)), (180.0, (-1.0, 0.0)), (-90.0, (0.0, -1.0)),
+                              (270.0, (0.0, -1.0)), (45.0, (math.sqrt(0.5),) * 2)):  # fmt: skip
+        assert push_direction(azimuth) == pytest.approx(expected, abs=1e-12)
+    push = Push3D(7.2, 90.0)
+    assert push.body == "torso"
+    assert push.delta_velocity(72.0) == pytest.approx((0.0, 0.1), abs=1e-12)
+    assert push.force(0.01) == pytest.approx((0.0, 720.0, 0.0), abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"impulse": -1.0}, "impulse must be in [0, 10000]"),
+        ({"impulse": math.nan}, "impulse"),
+        ({"impulse": 1.0, "azimuth": 361.0}, "azimuth must be in [-360, 360]"),
+        ({"impulse": 1.0, "azimuth": "left"}, "azimuth"),
+        ({"impulse": 1.0, "body": ""}, "body must be"),
+        ({"impulse": 1.0, "body": 3}, "body must be"),
+    ],
+)
+def test_bad_pushes_name_the_argument_and_range(kwargs, words):
+    with pytest.raises(InvalidParameterError) as caught:
+        Push3D(**kwargs)
+    assert words in str(caught.value)
+    with pytest.raises(InvalidParameterError, match="azimuth"):
+        push_direction(math.inf)
+
+
+def test_the_plant_keeps_the_contract_where_it_is_3d():
+    plant = Biped3DPlant(P)
+    state = plant.reset()
+    assert plant.state_labels == STATE_LABELS and state.shape == (6,)
+    assert plant.state_labels[len(state) // 2] == "xdot"
+    assert plant.begin(state) == pytest.approx(state)
+    assert plant.at_rest(state, 1e-3) and not plant.falling(state)
+    with pytest.raises(InvalidParameterError, match="x must be 0"):
+        plant.reset(0.01, 0.0)
+    with pytest.raises(InvalidParameterError, match="body must be a body of the biped3d"):
+        plant.apply_push(Push3D(1.0, 0.0, "nose"))
+    with pytest.raises(InvalidParameterError, match="command must be 12"):
+        plant.step(np.zeros(3), 0.002)
+    # The capture point beyond the hips' reach outside the feet is the fall set.
+    assert plant.falling(np.array([0.0, 0.0, state[2], 5.0, 0.0, 0.0]))
+
+
+def standing(plant, seconds=0.05):
+    """Reset ``plant`` and stand it under the WBC (the motors then hold through a push)."""
+    state = plant.reset()
+    controller = wbc_for(plant)
+    controller.reset(plant.data)
+    for _ in range(round(seconds / CONTROL_PERIOD)):
+        state = plant.step(controller.compute(0.0, plant.data), CONTROL_PERIOD).state
+    return state
+
+
+@pytest.mark.parametrize("azimuth", [0.0, 90.0, -135.0])
+def test_a_push_changes_the_com_velocity_by_j_over_m_at_its_azimuth(azimuth):
+    plant = Biped3DPlant(P)
+    before = standing(plant)
+    impulse = 15.0
+    after = plant.apply_push(Push3D(impulse, azimuth))
+    change = after[3:5] - before[3:5]
+    expected = impulse / P.mass * np.array(push_direction(azimuth))
+    # Along the azimuth J/m within the tolerance; across it < 3 % of J/m (1.4 % diagonally:
+    # the feet's contacts resist x and y differently).
+    along = change @ np.array(push_direction(azimuth))
+    assert along == pytest.approx(impulse / P.mass, rel=MOMENTUM_TOLERANCE)
+    assert np.linalg.norm(change - along * np.array(push_direction(azimuth))) < 0.03 * (
+        np.linalg.norm(expected)
+    )
+    # A sagittal Push is J = m Δẋ forward (or backward) on the torso.
+    before = standing(plant)
+    back = plant.apply_push(Push(-0.1)) - before
+    assert back[3] == pytest.approx(-0.1, rel=MOMENTUM_TOLERANCE) and abs(back[4]) < 1e-3
+
+
+def run_cli(capsys, *args):
+    with pytest.raises(SystemExit) as caught:
+        main(list(args))
+    out, err = capsys.readouterr()
+    return caught.value.code, out, err
+
+
+def test_simulate_biped3d_recovers_a_small_push_and_reports_the_new_keys(capsys):
+    args = ("--backend", "mujoco", "--model", "biped3d", "--azimuth", "60", "--push", "8")
+    code, out, err = run_cli(capsys, "simulate", *args, "--duration", "4", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["recovered"] is True and data["outcome"] == "recovered"
+    assert data["steps"] == 0 and data["strategy"] == "ankle"
+    assert data["azimuth"] == 60.0 and data["impulse"] == 8.0 and data["push_body"] == "torso"
+    assert data["controller"] == "wbc" and data["backend"] == "mujoco"
+    assert set(data["final_state"]) == set(STATE_LABELS)
+    measured, expected = data["delta_velocity"]["measured"], data["delta_velocity"]["expected"]
+    assert measured == pytest.approx(expected, rel=MOMENTUM_TOLERANCE, abs=1e-3)
+    assert {"peak_hip_torque", "max_torso_tilt", "after_push", "predicted"} <= set(data)
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (("simulate", "--backend", "mujoco", "--model", "biped3d", "--azimuth", "400"),
+         "azimuth must be in [-360, 360]"),
+        (("simulate", "--model", "biped3d"), "use --backend mujoco"),
+        (("simulate", "--azimuth", "30"), "--azimuth needs a 3-D model"),
+        (("campaign", "--backend", "mujoco", "--model", "biped3d", "--out", "x"),
+         "campaign does not run the 3-D models"),
+        (("validate", "--model", "g1", "--azimuth", "30"), "validate does not run the 3-D"),
+    ],
+)  # fmt: skip
+def test_bad_3d_requests_are_one_line_and_exit_2(capsys, args, words):
+    code, _, err = run_cli(capsys, *args)
+    assert code == 2 and err.count("\n") == 1 and words in err and "Traceback" not in err
+
+
+def test_g1_without_the_robots_extra_is_one_line_and_exit_2(capsys, monkeypatch):
+    monkeypatch.setattr(robots.importlib.util, "find_spec", lambda name: None)
+    code, _, err = run_cli(capsys, "simulate", "--backend", "mujoco", "--model", "g1",
+                           "--push", "3")  # fmt: skip
+    assert code == 2 and err.count("\n") == 1
+    assert "the G1 model needs the robots extra: pip install 'pushrecovery[robots]'" in err
