@@ -323,7 +323,8 @@ class G1Plant(Humanoid3DPlant):
     """The Unitree G1 of the ``robots`` extra at its standing pose (``robots.describe_robot``).
 
     Its body is the robot's: ``params`` must be ``robot_params("g1")`` (the CLI passes it).
-    A push named ``"torso"`` acts on ``torso_link``; the WBC holds the ``pelvis`` upright.
+    A push named ``"torso"`` acts on ``torso_link``, which the WBC also holds upright (the
+    feet and torso of :mod:`.wbc_g1`).
 
     Raises
     ------
@@ -337,6 +338,7 @@ class G1Plant(Humanoid3DPlant):
 
     def __init__(self, params: BodyParams) -> None:
         from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
+        from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import G1_FEET, G1_TORSO
 
         require_type("params", params, BodyParams)
         described = describe_robot("g1")
@@ -344,10 +346,8 @@ class G1Plant(Humanoid3DPlant):
             raise InvalidParameterError(
                 "params of the g1 model must be the robot's own (robot_params('g1'))"
             )
-        model = described.model
-        feet = tuple(model.body(int(foot)).name for foot in described.feet)
-        super().__init__(params, model, described.qpos, feet, torso="torso_link",
-                         upright="pelvis")  # fmt: skip
+        super().__init__(params, described.model, described.qpos, G1_FEET, torso=G1_TORSO,
+                         upright=G1_TORSO)  # fmt: skip
 
 
 def wbc_for(plant: Humanoid3DPlant, *, hip: bool = True) -> WholeBodyController:
