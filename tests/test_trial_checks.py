@@ -101,7 +101,7 @@ def test_quiet_standing_gets_its_sway_measures(tmp_path):
     json.dumps(sway, allow_nan=False)
 
 
-def _stepping_recording():
+def _stepping_recording(step=(0.30, -0.02)):
     """A subject standing on two feet (markers at 100 Hz), pushed forward at 1.0 s (the CoM
     from the exact LIPM with the CoP at the toe), who lifts the right foot at 1.5 s and puts
     it down 0.30 m ahead and 0.02 m outward at 1.9 s."""
@@ -129,8 +129,8 @@ def _stepping_recording():
         if moves:
             swing = (t >= 1.5) & (t < 1.9)
             phase = np.clip((t - 1.5) / 0.4, 0.0, 1.0)
-            heel[:, 0] += 0.30 * phase
-            heel[:, 1] -= 0.02 * phase
+            heel[:, 0] += step[0] * phase
+            heel[:, 1] += step[1] * phase
             heel[swing, 2] += 0.08 * np.sin(np.pi * phase[swing])
         toe = heel + np.array([0.20, 0.0, 0.0])
         ankle = heel + np.array([0.05, 0.0, 0.06])
@@ -268,3 +268,17 @@ def test_foot_events_from_each_plate_of_a_drop_jump():
     edges = [flights[0]["start"], flights[0]["end"], flights[1]["start"], flights[1]["end"]]
     for (_, _, time), edge in zip(events, edges, strict=True):
         assert time == pytest.approx(edge, abs=0.02)
+
+
+def test_a_step_is_judged_against_the_capture_region_at_its_foot_off():
+    # The landing 0.30 m ahead misses the one-step capture region of the state at foot-off
+    # (the push was large); landing at the foothold the region recommends is inside it.
+    first = analyze(_stepping_recording(), P).summary["events"]["measured_steps"][0]
+    region = first["capture_region"]
+    assert region["landing_ankle"] == pytest.approx([0.30, -0.12], abs=1e-9)
+    assert region["within"] is False and region["margin"] < 0.0
+    foothold = region["recommended_foothold"]
+    step = (foothold[0] - 0.0, foothold[1] - (-0.1))  # from the right ankle at (0, -0.1)
+    again = analyze(_stepping_recording(step), P).summary["events"]["measured_steps"][0]
+    assert again["capture_region"]["within"] is True
+    assert again["capture_region"]["margin"] > 0.01

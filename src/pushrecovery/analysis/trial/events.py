@@ -21,7 +21,9 @@ given what a reader of the trial asks of them:
 - **the step taken against the recommended one**: at the step's foot-off frame, per axis, the
   step the surfaces recommend there (Eq. 21 on the axis' line) and the range of first steps that
   capture the state (the capture region on that line); ``within`` says whether the foot's
-  displacement along the axis lies in that range (None where the frame needed no step).
+  displacement along the axis lies in that range (None where the frame needed no step); and in
+  the plane, the landing ankle against the one-step **capture region** of the state at
+  foot-off (``capture_region``: its signed margin, + inside, and the recommended foothold).
 """
 
 from __future__ import annotations
@@ -34,14 +36,18 @@ from numpy.typing import NDArray
 
 from pushrecovery.analysis.events import perturbation_onset
 from pushrecovery.analysis.margins import DirectionMargins
+from pushrecovery.analysis.margins_2d import phase_supports
 from pushrecovery.analysis.recording import AXES, Recording
 from pushrecovery.analysis.steps_measured import (
     FootEvent,
+    MeasuredStep,
     foot_events_from_force,
     foot_events_from_markers,
     measured_steps,
 )
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.capture_region import capture_region
 from pushrecovery.surfaces.classify import STRATEGY_CODES
 
 __all__: list[str] = []  # the pipeline's (pushrecovery.analysis.trial.pipeline)
@@ -167,17 +173,76 @@ def _foot_events(recording: Recording) -> list[FootEvent]:
     return sorted(events, key=lambda event: event.time)
 
 
+def _in_capture_region(
+    step: MeasuredStep,
+    time: FloatArray,
+    com: FloatArray,
+    velocity: FloatArray,
+    plane: tuple[Any, BodyParams] | None,
+) -> dict[str, Any] | None:
+    """Judge the step's landing against the one-step capture region at its foot-off.
+
+    The region (:func:`~pushrecovery.surfaces.capture_region.capture_region`, issue 9: the
+    landing foot's ankle positions that capture the state with this step, the foot landing
+    after the measured swing time, the hip helping) of the CoM state at the foot-off frame and
+    the support just before it; the landing is the stepping foot's ankle at its contact frame.
+    None without a two-foot base (feet named left and right) or where the library refuses.
+    """
+    if plane is None:
+        return None
+    base, params = plane
+    supports, phase, body = phase_supports(base, params)
+    names = [name.lower() for name in base.names]
+    if body is None or base.poses is None or step.foot.lower() not in names:
+        return None
+    off = int(np.argmin(np.abs(time - step.off_time)))
+    contact = int(np.argmin(np.abs(time - step.contact_time)))
+    before = phase[max(off - 1, 0)]
+    landing = base.poses[contact, names.index(step.foot.lower()), :2]
+    state = (*com[off], *velocity[off])
+    if before < 0 or supports[before] is None or not np.isfinite([*state, *landing]).all():
+        return None
+    swing_time = min(max(step.contact_time - step.off_time, 0.0), 5.0)
+    try:
+        x, y, xdot, ydot = (float(v) for v in state)
+        region = capture_region(
+            x, y, xdot, ydot, body, supports[before], swing_time, swing=step.foot.lower()
+        )
+    except PushRecoveryError:  # a state or support the surfaces refuse
+        return None
+    margin = (
+        None
+        if region.polygon is None
+        else float(region.polygon.signed_distance(landing[0], landing[1]))
+    )
+    return {
+        "landing_ankle": [float(landing[0]), float(landing[1])],
+        "swing_time": swing_time,
+        "margin": margin,
+        "within": None if margin is None else margin >= 0.0,
+        "empty": region.polygon is None,
+        "recommended_foothold": None
+        if region.foothold is None
+        else [float(v) for v in region.foothold],
+    }
+
+
 def trial_events(
     recording: Recording,
     time: FloatArray,
     velocity: FloatArray,
     per_axis: dict[str, DirectionMargins],
     mass: float,
+    *,
+    com: FloatArray | None = None,
+    plane: tuple[Any, BodyParams] | None = None,
 ) -> dict[str, Any]:
     """Return the trial's onset, foot events and steps with their margins (module docstring).
 
     ``time`` [s] and ``velocity`` (n, 2) [m/s] are the analysis' frames, ``per_axis`` their
-    margins, ``mass`` the subject's [kg].
+    margins, ``mass`` the subject's [kg]; with ``com`` (n, 2) [m] and ``plane`` (the base
+    polygons and the body), each step is also judged against the 2-D capture region at its
+    foot-off (``capture_region``).
     """
     onset, onset_source = _onset(recording, time, velocity, mass)
     events = _foot_events(recording)
@@ -202,6 +267,9 @@ def trial_events(
                 "margins_at_foot_off": _margins_at(time, step.off_time, per_axis),
                 "margins_at_foot_contact": _margins_at(time, step.contact_time, per_axis),
                 "against_recommended": _compared(row, time, per_axis),
+                "capture_region": None
+                if com is None
+                else _in_capture_region(step, time, com, velocity, plane),
             }
             for step, row in ((step, step.to_dict()) for step in steps)
         ],

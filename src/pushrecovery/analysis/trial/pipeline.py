@@ -229,7 +229,9 @@ def analyze(
         columns.update(_normalised(columns, params))
     summary["checks"] = checks.to_dict()
     summary["plane"] = _plane_summary(plane, time, support_source)
-    summary["events"] = trial_events(recording, time, velocity, per_axis, params.mass)
+    summary["events"] = trial_events(
+        recording, time, velocity, per_axis, params.mass, com=com, plane=(base, params)
+    )
     summary["posturography"] = _posturography(force_time, plate_cop, plate_force, settings)
     if summary["posturography"] is not None and summary["events"]["onset"]["time"] is not None:
         # Quiet standing has no perturbation: its sway crosses any threshold of a short baseline.
