@@ -45,6 +45,10 @@ class EventRow:
     within : bool
         A step: whether ``taken`` lies in [step_length_min, step_length_max] (null where its
         foot-off frame needed no step).
+    capture_region_margin, in_capture_region : float, bool
+        A step: the landing ankle's signed distance to the 2-D one-step capture region of the
+        state at foot-off [m] (+ inside), and whether it lies inside (null without two named
+        feet; the same on both axes' rows).
     """
 
     trial: str
@@ -65,6 +69,8 @@ class EventRow:
     latency: float | None = None
     duration: float | None = None
     within: bool | None = None
+    capture_region_margin: float | None = None
+    in_capture_region: bool | None = None
 
 
 #: Arrow types of the columns, in order.
@@ -122,6 +128,8 @@ def trial_events(job: Any, summary: dict[str, Any]) -> list[dict[str, Any]]:
                     latency=step["latency"],
                     duration=step["duration"],
                     within=compared["within"],
+                    capture_region_margin=(step.get("capture_region") or {}).get("margin"),
+                    in_capture_region=(step.get("capture_region") or {}).get("within"),
                 )
             )
     rows.sort(key=lambda r: (math.inf if r.time is None else r.time, r.kind, r.axis))
