@@ -1,0 +1,482 @@
+r"""The 2-D prediction of the critical push against the 3-D bodies, from every direction.
+
+Issue 19 item 5 (first part). For a 3-D model (``biped3d``, or ``g1`` with the ``robots``
+extra) and a list of push azimuths ψ (0 forward +x, 90 left +y, degrees), each strategy's
+**predicted** critical impulse comes from the ground plane's surfaces (``docs/plane.md``) and
+its **measured** one from the whole-body controller in MuJoCo.
+
+**Prediction.** A push of impulse J [N s] at azimuth ψ gives the standing body (CoM ground
+point r₀, at rest) the velocity J/m (cos ψ, sin ψ), so its capture point jumps to
+
+.. math:: \boldsymbol\xi = \mathbf r_0 + \frac{J}{m\,\omega}\,(\cos\psi, \sin\psi).
+
+A strategy recovers while ξ is inside its region R (open): the CoP region R = P, the support
+polygon (the hull of both feet, ``Support.from_params``), for the ankle; the CMP region
+R = P ⊕ box(a_pitch, a_roll) (``surfaces.plane.cmp_polygon``, the corrected Eq. 15 offsets)
+for the hip. The critical impulse is where ξ reaches R's boundary along ψ:
+
+.. math:: J^*_R(\psi) = m\,\omega\,\rho_R(\mathbf r_0, \psi),
+
+ρ_R the distance from r₀ to R's boundary along ψ (``ConvexPolygon.ray_distance``) [m]. For a
+rectangle foot [heel, toe] × [±w/2] with the ankles at y = ±s/2 and r₀ = (x₀, 0): forward
+J* = m ω (toe − x₀), left J* = m ω (s/2 + w/2). Here ω = sqrt(g/L) of the body's params and
+r₀ the plant's own standing CoM (the biped3d's is 1 cm ahead of the ankles).
+
+**Corrected prediction (the push's height).** The plants push the torso's CoM, d [m] above
+the whole-body CoM, not the CoM itself: the push also gives the body the centroidal angular
+momentum L₀ = J d (pitching it into the fall). The WBC holds the torso upright, so the floor
+must take L₀ out again through the CMP: ∫ m g δ dt = −L₀ with δ the CMP's offset from the CoP
+*against* the recovery. Taken out fast (within a fraction of 1/ω), it moves the capture point
+by ω L₀ / (m g) = J d/(m ω z₀) more (ω² = g/z₀), so
+
+.. math:: \boldsymbol\xi_{eff} = \mathbf r_0 + \frac{J}{m\,\omega}\Bigl(1 + \frac{d}{z_0}\Bigr)
+          (\cos\psi, \sin\psi), \qquad
+          J^{*}_{corr} = \frac{J^*}{1 + d/z_0},
+
+z₀ the CoM's standing height above the soles [m]. It is an approximation: slower removal
+(weighted by e^{−ωs}) costs less, so the corrected value is a lower estimate.
+
+**Measurement.** The largest impulse at ψ that does not fall within ``duration`` (the plant's
+fall set: ξ beyond P by both hips' CMP reach, or the CoM down; a run still undecided counts as
+standing, as in ``critical_push3d``), under the WBC with the ankles only (``hip=False``) for the
+ankle and with its hip task for the hip. The bracket starts at 0.8 and 1.2 times the corrected
+prediction, widens (×0.7 down, ×1.3 up) until it holds a stand and a fall, then halves until
+it is at most ``rel_tolerance`` × the prediction wide; the measured value is its low end.
+
+**Relative error** (measured − predicted)/predicted, negative when the body does worse than
+the simple model.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from pushrecovery._validate import bounded_float, finite_float, finite_vector, require_type
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.support import Support
+from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
+from pushrecovery.surfaces.plane import cmp_polygon
+
+__all__ = [
+    "DEFAULT_AZIMUTHS",
+    "MODELS",
+    "STRATEGIES",
+    "MeasuredCritical",
+    "Validation3D",
+    "ValidationRow",
+    "critical_impulse_along",
+    "measure_critical_impulse",
+    "predicted_critical_impulses",
+    "push_lever",
+    "run_validation3d",
+]
+
+#: Push azimuths of the validation [deg]: every 30°.
+DEFAULT_AZIMUTHS: tuple[float, ...] = tuple(float(a) for a in range(0, 360, 30))
+#: Strategies with a 2-D prediction and a WBC that uses only them (no stepping task yet).
+STRATEGIES: tuple[str, ...] = ("ankle", "hip")
+#: The 3-D models (``sim.registry.PLANTS_3D``).
+MODELS: tuple[str, ...] = ("biped3d", "g1")
+#: Most runs of one bisection (the bracket's widening included).
+MAX_RUNS = 40
+
+
+def critical_impulse_along(
+    region: ConvexPolygon, origin: tuple[float, float], azimuth: float, mass: float, omega: float
+) -> float:
+    """Return m ω ρ_R(r₀, ψ): the impulse that puts ξ on the region's boundary [N s].
+
+    Parameters
+    ----------
+    region : ConvexPolygon
+        The capture-point region R (world frame) [m].
+    origin : (float, float)
+        The standing CoM's ground point r₀, strictly inside R [m].
+    azimuth : float
+        The push's heading ψ, counter-clockwise from +x, in [−360, 360] deg.
+    mass : float
+        m > 0 [kg].
+    omega : float
+        ω = sqrt(g/L), in [0.1, 100] 1/s.
+
+    Raises
+    ------
+    InvalidParameterError
+        For an origin outside R, a non-finite or out-of-range azimuth, mass or omega.
+    """
+    require_type("region", region, ConvexPolygon)
+    start = finite_vector("origin", origin, 2, unit="m")
+    heading = bounded_float("azimuth", azimuth, -360.0, 360.0, "deg")
+    mass = finite_float("mass", mass, "kg")
+    if mass <= 0.0:
+        raise InvalidParameterError(f"mass must be > 0 kg, got {mass:g}")
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
+    if not bool(region.contains(float(start[0]), float(start[1]))):
+        raise InvalidParameterError(
+            f"origin ({start[0]:g}, {start[1]:g}) m must lie strictly inside the region"
+        )
+    distance = region.ray_distance(float(start[0]), float(start[1]), math.radians(heading))
+    return mass * omega * distance
+
+
+def predicted_critical_impulses(
+    params: BodyParams,
+    azimuth: float,
+    *,
+    origin: tuple[float, float] | None = None,
+    omega: float | None = None,
+) -> dict[str, float]:
+    """Return each strategy's predicted critical impulse at ``azimuth`` [N s] (module doc).
+
+    Parameters
+    ----------
+    params : BodyParams
+        The body: mass, feet and stance (double support, default foot poses), hip limits.
+    azimuth : float
+        ψ [deg], 0 forward, 90 left.
+    origin : (float, float), optional
+        The standing CoM's ground point r₀ [m]; default the ankles' midpoint.
+    omega : float, optional
+        ω [1/s]; default ``params.omega`` = sqrt(g/L).
+
+    Returns
+    -------
+    dict
+        ``{"ankle": m ω ρ_P, "hip": m ω ρ_(P ⊕ box)}``.
+    """
+    require_type("params", params, BodyParams)
+    support = Support.from_params(params)
+    start = support.ankle if origin is None else origin
+    rate = params.omega if omega is None else omega
+    regions = {"ankle": support.polygon, "hip": cmp_polygon(support, params)}
+    return {
+        name: critical_impulse_along(region, start, azimuth, params.mass, rate)
+        for name, region in regions.items()
+    }
+
+
+def push_lever(plant: Any) -> tuple[float, float]:
+    """Return (d, z₀): the pushed torso's CoM height above the whole-body CoM, and z₀ [m].
+
+    ``plant`` is a freshly reset 3-D plant (``sim.mujoco.humanoid3d.plant3d``).
+    """
+    data = plant.data
+    torso = plant.body_of("torso")
+    lever = float(data.xipos[torso][2]) - float(data.subtree_com[0][2])
+    return lever, float(plant.standing_height)
+
+
+@dataclass(frozen=True)
+class MeasuredCritical:
+    """One measured critical impulse (:func:`measure_critical_impulse`).
+
+    Attributes
+    ----------
+    impulse : float
+        The largest impulse that stood (the bracket's low end) [N s].
+    bracket : (float, float)
+        (stood, fell) [N s].
+    runs : int
+        Simulations made.
+    strategy_used : str
+        The strategy of the run at ``impulse`` (``sim.result.strategy_used``).
+    """
+
+    impulse: float
+    bracket: tuple[float, float]
+    runs: int
+    strategy_used: str
+
+
+def measure_critical_impulse(
+    plant: Any,
+    azimuth: float,
+    *,
+    hip: bool,
+    guess: float,
+    rel_tolerance: float = 0.01,
+    duration: float = 3.0,
+) -> MeasuredCritical:
+    """Bracket and bisect the critical impulse at ``azimuth`` under the WBC (module doc).
+
+    Parameters
+    ----------
+    plant : Humanoid3DPlant
+        The 3-D plant (reset by each run).
+    azimuth : float
+        ψ [deg].
+    hip : bool
+        Whether the WBC has its hip task (False: ankles only).
+    guess : float
+        Where the bracket starts, 0.8 and 1.2 × guess (> 0) [N s].
+    rel_tolerance : float
+        The final bracket's width as a fraction of ``guess``, in [1e-4, 0.5].
+    duration : float
+        Simulated time after the push, in (0, 60] s.
+
+    Raises
+    ------
+    InvalidParameterError
+        For a non-positive guess, a tolerance or duration out of range.
+    """
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import simulate_push3d, wbc_for
+    from pushrecovery.sim.push import IMPULSE_MAX, Push3D
+    from pushrecovery.sim.result import Outcome
+
+    guess = bounded_float("guess", guess, 1e-6, IMPULSE_MAX, "N s")
+    rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-4, 0.5)
+    duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
+    Push3D(0.0, azimuth)  # checks the azimuth
+    runs = 0
+
+    def stands(impulse: float) -> tuple[bool, str]:
+        nonlocal runs
+        runs += 1
+        if runs > MAX_RUNS:
+            raise InvalidParameterError(
+                f"guess {guess:g} N s: no stand/fall bracket within {MAX_RUNS} runs"
+            )
+        run = simulate_push3d(
+            plant, wbc_for(plant, hip=hip), Push3D(impulse, azimuth), duration=duration
+        )
+        return run.outcome is not Outcome.FELL, run.strategy_used()
+
+    low, high = 0.8 * guess, min(1.2 * guess, IMPULSE_MAX)
+    ok, used = stands(low)
+    while not ok:
+        high, low = low, 0.7 * low
+        ok, used = stands(low)
+    while True:
+        stood, high_used = stands(high)
+        if not stood:
+            break
+        low, used = high, high_used
+        if high >= IMPULSE_MAX:
+            return MeasuredCritical(low, (low, low), runs, used)
+        high = min(1.3 * high, IMPULSE_MAX)
+    while high - low > rel_tolerance * guess:
+        middle = 0.5 * (low + high)
+        ok, middle_used = stands(middle)
+        if ok:
+            low, used = middle, middle_used
+        else:
+            high = middle
+    return MeasuredCritical(low, (low, high), runs, used)
+
+
+@dataclass(frozen=True)
+class ValidationRow:
+    """One azimuth and strategy of the validation.
+
+    Attributes
+    ----------
+    azimuth : float
+        ψ [deg].
+    strategy : str
+        ``ankle`` or ``hip``.
+    predicted : float
+        m ω ρ_R (module docstring) [N s].
+    corrected : float
+        predicted / (1 + d/z₀): the push at the torso's height [N s].
+    measured : float
+        The largest impulse that stood [N s].
+    bracket : (float, float)
+        (stood, fell) [N s].
+    runs : int
+        Simulations of the bisection.
+    strategy_used : str
+        The strategy of the run at ``measured``.
+    """
+
+    azimuth: float
+    strategy: str
+    predicted: float
+    corrected: float
+    measured: float
+    bracket: tuple[float, float]
+    runs: int
+    strategy_used: str
+
+    @property
+    def relative_error(self) -> float:
+        """(measured − predicted)/predicted [-]."""
+        return (self.measured - self.predicted) / self.predicted
+
+    @property
+    def corrected_error(self) -> float:
+        """(measured − corrected)/corrected [-]."""
+        return (self.measured - self.corrected) / self.corrected
+
+
+@dataclass(frozen=True)
+class Validation3D:
+    """The validation of one model (:func:`run_validation3d`).
+
+    Attributes
+    ----------
+    model : str
+        ``biped3d`` or ``g1``.
+    rows : tuple of ValidationRow
+        Azimuth-major, strategies in the order asked.
+    mass, omega : float
+        m [kg] and ω [1/s] of the prediction.
+    origin : (float, float)
+        The standing CoM's ground point r₀ [m].
+    lever, standing_height : float
+        d and z₀ of the correction [m].
+    rel_tolerance, duration : float
+        The bisection's width (fraction of the prediction) and each run's time after the push
+        [s].
+    """
+
+    model: str
+    rows: tuple[ValidationRow, ...]
+    mass: float
+    omega: float
+    origin: tuple[float, float]
+    lever: float
+    standing_height: float
+    rel_tolerance: float
+    duration: float
+    strategies: tuple[str, ...] = field(default=STRATEGIES)
+
+    def rows_for(self, strategy: str) -> tuple[ValidationRow, ...]:
+        """Return the rows of ``strategy``, by azimuth."""
+        return tuple(row for row in self.rows if row.strategy == strategy)
+
+    def worst_error(self, strategy: str, *, corrected: bool = False) -> float:
+        """Largest |relative error| of ``strategy`` (against the corrected value if asked)."""
+        errors = [
+            abs(row.corrected_error if corrected else row.relative_error)
+            for row in self.rows_for(strategy)
+        ]
+        if not errors:
+            raise InvalidParameterError(f"strategy {strategy!r} was not run")
+        return max(errors)
+
+    def to_table(self) -> str:
+        """Return the rows as a markdown table (impulses [N s], errors in %)."""
+        lines = [
+            "| azimuth [deg] | strategy | predicted [N s] | measured [N s] | error | "
+            "corrected [N s] | error vs corrected | used |",
+            "|---:|---|---:|---:|---:|---:|---:|---|",
+        ]
+        for row in self.rows:
+            lines.append(
+                f"| {row.azimuth:g} | {row.strategy} | {row.predicted:.1f} | "
+                f"{row.measured:.1f} (fell {row.bracket[1]:.1f}) | "
+                f"{100 * row.relative_error:+.1f} % | {row.corrected:.1f} | "
+                f"{100 * row.corrected_error:+.1f} % | {row.strategy_used} |"
+            )
+        return "\n".join(lines)
+
+
+def _plant(model: str, params: BodyParams | None) -> Any:
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, G1Plant
+
+    if model == "biped3d":
+        if params is None:
+            from pushrecovery.presets import load_params
+
+            params = load_params()
+        return Biped3DPlant(params)
+    from pushrecovery.sim.mujoco.humanoid3d.robots import robot_params
+
+    return G1Plant(robot_params("g1") if params is None else params)
+
+
+def run_validation3d(
+    model: str = "biped3d",
+    azimuths: Sequence[float] = DEFAULT_AZIMUTHS,
+    strategies: Sequence[str] = STRATEGIES,
+    *,
+    params: BodyParams | None = None,
+    rel_tolerance: float = 0.01,
+    duration: float = 3.0,
+) -> Validation3D:
+    """Predict and measure each strategy's critical impulse at each azimuth (module doc).
+
+    Parameters
+    ----------
+    model : str
+        ``biped3d`` or ``g1`` (needs the ``robots`` extra: ``RobotsExtraMissing`` otherwise).
+    azimuths : sequence of float
+        ψ [deg], each in [−360, 360]; at least one, at most 72.
+    strategies : sequence of str
+        Among ``ankle`` and ``hip``, without repeats.
+    params : BodyParams, optional
+        The biped3d's body (default the ``paper`` preset); the G1's must be its own.
+    rel_tolerance : float
+        The bisection's final width as a fraction of the prediction, in [1e-4, 0.5].
+    duration : float
+        Simulated time after each push, in (0, 60] s (a run not fallen by then stands).
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming the bad argument.
+    """
+    if model not in MODELS:
+        raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
+    if isinstance(azimuths, str) or not isinstance(azimuths, Sequence):
+        raise InvalidParameterError("azimuths must be a sequence of angles [deg]")
+    if not 1 <= len(azimuths) <= 72:
+        raise InvalidParameterError(f"azimuths must hold 1 to 72 angles, got {len(azimuths)}")
+    angles = [bounded_float("azimuths", a, -360.0, 360.0, "deg") for a in azimuths]
+    if isinstance(strategies, str) or not isinstance(strategies, Sequence):
+        raise InvalidParameterError(f"strategies must be a sequence of {list(STRATEGIES)}")
+    chosen = tuple(strategies)
+    if not chosen or len(set(chosen)) != len(chosen) or not set(chosen) <= set(STRATEGIES):
+        raise InvalidParameterError(
+            f"strategies must be distinct names among {list(STRATEGIES)}, got {list(chosen)}"
+        )
+    rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-4, 0.5)
+    duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
+    if params is not None:
+        require_type("params", params, BodyParams)
+    plant = _plant(model, params)
+    body = plant.params
+    state = plant.reset()
+    origin = (float(state[0]), float(state[1]))
+    lever, height = push_lever(plant)
+    factor = 1.0 / (1.0 + lever / height)
+    rows = []
+    for angle in angles:
+        predicted = predicted_critical_impulses(body, angle, origin=origin)
+        for strategy in chosen:
+            found = measure_critical_impulse(
+                plant,
+                angle,
+                hip=strategy == "hip",
+                guess=factor * predicted[strategy],
+                rel_tolerance=rel_tolerance,
+                duration=duration,
+            )
+            rows.append(
+                ValidationRow(
+                    azimuth=angle,
+                    strategy=strategy,
+                    predicted=predicted[strategy],
+                    corrected=factor * predicted[strategy],
+                    measured=found.impulse,
+                    bracket=found.bracket,
+                    runs=found.runs,
+                    strategy_used=found.strategy_used,
+                )
+            )
+    return Validation3D(
+        model=model,
+        rows=tuple(rows),
+        mass=body.mass,
+        omega=body.omega,
+        origin=origin,
+        lever=lever,
+        standing_height=height,
+        rel_tolerance=rel_tolerance,
+        duration=duration,
+        strategies=chosen,
+    )

@@ -1,0 +1,60 @@
+"""The polar plot of the 3-D validation: critical impulse against push azimuth, per strategy.
+
+Radius: the critical impulse [N s]; angle: the push's azimuth ψ (0 forward +x, 90 left +y,
+counter-clockwise, as seen from above). Per strategy (colour): the 2-D prediction m ω ρ_R
+(solid line), the prediction corrected for the push's height (dashed), and the measured
+critical impulses (markers, with a bar to the lowest impulse that fell). The lines close the
+circle only when the azimuths cover it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, cast
+
+from pushrecovery.experiments.validation3d import Validation3D
+from pushrecovery.plots.common import HIP_COLOUR, RECOVER_COLOUR
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+    from matplotlib.projections.polar import PolarAxes
+
+__all__ = ["STRATEGY_COLOURS", "validation3d_figure"]
+
+#: One colour per strategy.
+STRATEGY_COLOURS = {"ankle": RECOVER_COLOUR, "hip": HIP_COLOUR}
+
+
+def validation3d_figure(result: Validation3D) -> Figure:
+    """Return the polar plot of ``result`` (module docstring) as a matplotlib Figure."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 6.4))
+    ax = cast("PolarAxes", fig.add_subplot(projection="polar"))
+    for strategy in result.strategies:
+        rows = sorted(result.rows_for(strategy), key=lambda row: row.azimuth % 360.0)
+        if not rows:
+            continue
+        colour = STRATEGY_COLOURS.get(strategy, "0.3")
+        angles = [math.radians(row.azimuth) for row in rows]
+        closed = len(rows) > 2
+        loop = (lambda values: [*values, values[0]]) if closed else (lambda values: values)
+        ax.plot(loop(angles), loop([row.predicted for row in rows]), "-", color=colour,
+                label=f"{strategy}: 2-D prediction")  # fmt: skip
+        ax.plot(loop(angles), loop([row.corrected for row in rows]), "--", color=colour,
+                label=f"{strategy}: corrected (push height)")  # fmt: skip
+        ax.errorbar(
+            angles,
+            [row.measured for row in rows],
+            yerr=[[0.0] * len(rows), [row.bracket[1] - row.measured for row in rows]],
+            fmt="o",
+            color=colour,
+            label=f"{strategy}: measured (WBC)",
+        )
+    ax.set_theta_zero_location("E")
+    ax.set_theta_direction(1)
+    ax.set_rlabel_position(112.5)
+    ax.set_title(f"{result.model}: critical push [N s] by azimuth (0° forward, 90° left)", pad=18)
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.28), ncol=2, fontsize="small")
+    fig.subplots_adjust(bottom=0.22)
+    return fig
