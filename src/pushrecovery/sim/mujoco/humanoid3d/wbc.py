@@ -16,8 +16,11 @@ subject to
   inertia M (``mj_fullM``, armature included) and bias h = ``qfrc_bias`` − ``qfrc_passive``
   (Coriolis, centrifugal and gravity, minus springs and damping) [N, N m]:
   M_u q̈ + h_u = J_{c,u}^T w (the actuated rows give the torques τ = M_a q̈ + h_a − J_{c,a}^T w);
-* each foot fixed on the floor: J_i q̈ + J̇_i q̇ = 0 with J_i the 6 × nv world Jacobian of the
-  sole frame (``mj_jac``) and J̇_i q̇ its bias acceleration (``mj_jacDot``) [m/s², rad/s²];
+* each foot fixed on the floor: J_i q̈ + J̇_i q̇ = −k_c J_i q̇ with J_i the 6 × nv world Jacobian
+  of the sole frame (``mj_jac``), J̇_i q̇ its bias acceleration (``mj_jacDot``) [m/s², rad/s²]
+  and k_c ≥ 0 (``contact_damping``, 0 by default) a damping of a drifting foot [1/s];
+  a foot off the floor (:meth:`WholeBodyQP.set_contacts`, a swing) has w_i = 0 instead and no
+  wrench inequalities (its motion is a task, :mod:`.wbc_step`);
 * unilateral contact F_z ≥ 0 and a linearised friction pyramid |F_x|, |F_y| ≤ μ' F_z with
   μ' = μ/√2 (the square inscribed in Coulomb's cone of μ; μ the larger sliding friction of
   the sole's and the floor's geoms, MuJoCo's mixing rule);
@@ -66,10 +69,8 @@ class FootContact:
 
     Attributes
     ----------
-    name : str
-        The foot body's name.
-    body : int
-        Its body id.
+    name, body : str, int
+        The foot body's name and id.
     origin : float array, shape (3,)
         The sole frame's origin in the foot body's frame [m]: under the body origin, on the
         sole plane.
@@ -173,10 +174,8 @@ class Task:
     ----------
     name : str
         For reports.
-    matrix : float array, shape (k, nv + 6 n_feet)
-        A, over x = (q̈, w_1, …).
-    target : float array, shape (k,)
-        b [the task's acceleration units: m/s² or rad/s²].
+    matrix, target : float arrays, shapes (k, nv + 6 n_feet) and (k,)
+        A over x = (q̈, w_1, …), and b [the task's units: m/s² or rad/s²].
     weight : float
         W > 0 [-].
     """
@@ -201,10 +200,8 @@ class WbcSolution:
         Motor commands τ_a / gear [N m], within ``actuator_ctrlrange``.
     ok : bool
         False when DAQP found no solution (``ctrl`` is then the last good one).
-    solve_time : float
-        Wall time of DAQP's update (its factorisation of H and A) and solve [s] (diagnostics).
-    iterations : int
-        DAQP's iterations.
+    solve_time, iterations : float, int
+        Wall time of DAQP's update (its factorisation) and solve [s], and its iterations.
     """
 
     qacc: FloatArray
@@ -231,7 +228,7 @@ class WholeBodyQP:
         A floating-base model (free joint first) whose actuators are motors on hinge or slide
         joints (``actuator_trntype`` joint, gear in ``actuator_gear[:, 0]``).
     feet : sequence of FootContact
-        The feet on the floor (:func:`foot_contact`), all in contact at every tick.
+        The feet (:func:`foot_contact`), all on the floor until :meth:`set_contacts`.
     acc_regularisation, wrench_regularisation : float
         ε_a [(s²)² weight per (m/s²)²] and ε_f [per N²] of the module docstring, > 0: keep the
         Hessian positive definite.
@@ -258,10 +255,8 @@ class WholeBodyQP:
             raise InvalidParameterError("model's actuators must all drive joints")
         if not feet or not all(isinstance(f, FootContact) for f in feet):
             raise InvalidParameterError("feet must be a non-empty sequence of FootContact")
-        for name, value in (
-            ("acc_regularisation", acc_regularisation),
-            ("wrench_regularisation", wrench_regularisation),
-        ):
+        for name, value in (("acc_regularisation", acc_regularisation),
+                            ("wrench_regularisation", wrench_regularisation)):  # fmt: skip
             if not (isinstance(value, int | float) and 0.0 < value <= 1.0):
                 raise InvalidParameterError(f"{name} must be in (0, 1], got {value!r}")
         self.model = model
@@ -281,16 +276,17 @@ class WholeBodyQP:
         )
         self._foot_rows = [foot.constraint_rows() for foot in self.feet]
         self._n_equal = self.unactuated.size + nf
-        self._n_rows = self._n_equal + sum(g.shape[0] for g in self._foot_rows) + model.nu
+        self.contacts = np.ones(len(self.feet), dtype=bool)
         self._buf = _Buffers(np.zeros((nv, nv)), np.zeros((nf, nv)), np.zeros(nf))
         self._model: Any = None
         self._last_ctrl = np.zeros(model.nu)
+        self.contact_damping = 0.0  # k_c [1/s]: J q̈ + J̇ q̇ = −k_c J q̇ holds a foot still
 
     def _setup(self, hessian: FloatArray, linear: FloatArray, rows: FloatArray,
                upper: FloatArray, lower: FloatArray) -> None:  # fmt: skip
         import daqp
 
-        sense = np.zeros(self._n_rows, dtype=np.intc)
+        sense = np.zeros(rows.shape[0], dtype=np.intc)
         sense[: self._n_equal] = _EQUALITY
         self._model = daqp.Model()
         flag, _ = self._model.setup(hessian, linear, rows, upper, lower, sense)
@@ -298,9 +294,27 @@ class WholeBodyQP:
             raise RuntimeError(f"daqp could not set up the whole-body QP (exit flag {flag})")
 
     def reset(self) -> None:
-        """Forget the warm start: the next solve sets DAQP up afresh."""
+        """Forget the warm start (the next solve sets DAQP up afresh); every foot in contact."""
         self._model = None
         self._last_ctrl = np.zeros(self.model.nu)
+        self.contacts[:] = True
+
+    def set_contacts(self, contacts: Sequence[bool]) -> None:
+        """Set which feet are on the floor (one bool per foot); a change sets DAQP up afresh.
+
+        A foot off the floor has its wrench forced to zero and no fixed-foot rows.
+
+        Raises
+        ------
+        InvalidParameterError
+            If ``contacts`` is not one bool per foot.
+        """
+        mask = np.asarray(contacts)
+        if mask.shape != self.contacts.shape or mask.dtype != np.bool_:
+            raise InvalidParameterError(f"contacts must be one bool per foot, got {contacts!r}")
+        if not np.array_equal(mask, self.contacts):
+            self.contacts = mask.copy()
+            self._model = None  # other rows: no warm start
 
     def contact_jacobians(self, data: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Return each foot's world Jacobian J (6 n × nv), J̇ q̇ (6 n) and sole-frame Jacobian.
@@ -344,21 +358,24 @@ class WholeBodyQP:
             hessian += weighted.T @ task.matrix
             linear -= weighted.T @ task.target
         dynamics = np.hstack([buf.mass, -local.T])  # M q̈ − J_cᵀ w = −h (+ τ on actuated rows)
-        blocks = [
-            dynamics[self.unactuated],
-            np.hstack([jac, np.zeros((jac.shape[0], jac.shape[0]))]),
-        ]
-        upper = [-bias[self.unactuated], -jac_dot]
-        lower = [-bias[self.unactuated], -jac_dot]
+        fixed = np.hstack([jac, np.zeros((jac.shape[0], jac.shape[0]))])
+        target = -jac_dot - self.contact_damping * (jac @ np.asarray(data.qvel))
+        for i in map(int, np.flatnonzero(~self.contacts)):  # swing: w_i = 0 replaces the fixed rows
+            fixed[6 * i : 6 * i + 6] = 0.0
+            fixed[6 * i : 6 * i + 6, nv + 6 * i : nv + 6 * i + 6] = np.eye(6)
+            target[6 * i : 6 * i + 6] = 0.0
+        blocks = [dynamics[self.unactuated], fixed]
+        upper = [-bias[self.unactuated], target]
+        lower = [-bias[self.unactuated], target]
         for i, g in enumerate(self._foot_rows):
+            if not self.contacts[i]:
+                continue
             block = np.zeros((g.shape[0], self.size))
             block[:, nv + 6 * i : nv + 6 * i + 6] = g
             blocks.append(block)
             upper.append(np.zeros(g.shape[0]))
             lower.append(np.full(g.shape[0], -_INF))
-        torque_rows = (
-            dynamics[self.actuated] / self.gear[:, None]
-        )  # ctrl = (M_a q̈ + h_a − J_aᵀ w)/gear
+        torque_rows = dynamics[self.actuated] / self.gear[:, None]  # (M_a q̈ + h_a − J_aᵀ w)/gear
         offset = bias[self.actuated] / self.gear
         blocks.append(torque_rows)
         upper.append(np.minimum(self.ctrl_high - offset, _INF))
@@ -371,20 +388,12 @@ class WholeBodyQP:
         else:
             self._model.update(H=hessian, f=linear, A=rows, bupper=high, blower=low)
         x, _, flag, info = self._model.solve()
-        elapsed = time.perf_counter() - start
+        elapsed, feet, steps = time.perf_counter() - start, len(self.feet), int(info["iterations"])
         if flag <= 0:
             self._model = None  # the next tick starts cold
-            zeros = np.zeros((len(self.feet), 6))
             last = self._last_ctrl.copy()
-            return WbcSolution(np.zeros(nv), zeros, last, False, elapsed, int(info["iterations"]))
+            return WbcSolution(np.zeros(nv), np.zeros((feet, 6)), last, False, elapsed, steps)
         x = np.asarray(x, dtype=float)
         ctrl = np.clip(torque_rows @ x + offset, self.ctrl_low, self.ctrl_high)
         self._last_ctrl = ctrl
-        return WbcSolution(
-            qacc=x[:nv].copy(),
-            wrenches=x[nv:].reshape(len(self.feet), 6).copy(),
-            ctrl=ctrl,
-            ok=True,
-            solve_time=elapsed,
-            iterations=int(info["iterations"]),
-        )
+        return WbcSolution(x[:nv].copy(), x[nv:].reshape(feet, 6), ctrl, True, elapsed, steps)

@@ -29,6 +29,11 @@ the torso stays upright and the posture fills the null space.
   with p_des on the edge, the torso task relaxed (weight 1e-3) while it acts; afterwards the
   torso returns upright under k_R = 4, d_R = 4 until within 0.01 rad.
 
+* **Stepping** (``stepping=True``, :mod:`.wbc_step`): when ξ is beyond the ankles' (and the
+  hip's) region, the foot on ξ's side leaves the contacts and a swing-foot task carries it to
+  the capture region's recommended foothold, re-planned during the swing; at touchdown it
+  rejoins the contacts and the ankles balance about the new feet's midpoint.
+
 Contract: :class:`WholeBodyController` has the ``reset(state)`` / ``compute(t, state)`` pair of
 :class:`~pushrecovery.control.base.Controller`, with one deviation: its ``state`` is the
 ``mujoco.MjData`` (positions, velocities and everything ``mj_forward`` computed from them),
@@ -57,6 +62,7 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc import (
     foot_contact,
 )
 from pushrecovery.sim.mujoco.humanoid3d.wbc_hip import UPRIGHT, HipLaw, momentum_rows
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings
 from pushrecovery.surfaces.plane import capture_point_xy
 
 FloatArray = NDArray[np.float64]
@@ -143,6 +149,12 @@ class WholeBodyController:
     hip : BodyParams, optional
         The flywheel limits (τmax, I, θmax per axis) of the hip (CMP) task, :mod:`.wbc_hip`;
         None (the default) balances with the ankles only.
+    stepping : bool
+        Step when the ankles (and hip) cannot recover (:mod:`.wbc_step`); needs two feet.
+    params : BodyParams, optional
+        The body the step plans are for (default ``hip``); required with ``stepping``.
+    step_settings : StepSettings, optional
+        The stepping task's settings.
 
     Raises
     ------
@@ -163,6 +175,9 @@ class WholeBodyController:
         gains: WbcGains | None = None,
         *,
         hip: BodyParams | None = None,
+        stepping: bool = False,
+        params: BodyParams | None = None,
+        step_settings: StepSettings | None = None,
     ) -> None:
         if isinstance(feet, str) or not feet or len(set(feet)) != len(feet):
             raise InvalidParameterError(f"feet must be distinct body names, got {feet!r}")
@@ -195,6 +210,15 @@ class WholeBodyController:
         self.hip: HipLaw | None = None
         self.cmp_target = np.zeros(2)
         self.returning = False
+        if not isinstance(stepping, bool):
+            raise InvalidParameterError(f"stepping must be a bool, got {stepping!r}")
+        params = hip if params is None else params
+        if stepping and (not isinstance(params, BodyParams) or len(feet) != 2):
+            raise InvalidParameterError("stepping needs params (a BodyParams) and two feet")
+        if not isinstance(step_settings, StepSettings | None):
+            raise InvalidParameterError(f"step_settings must be StepSettings: {step_settings!r}")
+        self.stepping, self.step_params, self.step_settings = stepping, params, step_settings
+        self.stepper: Stepper | None = None
 
     def reset(self, state: Any) -> None:
         """Take the reference posture, feet and balance point from ``state`` (an MjData).
@@ -222,6 +246,51 @@ class WholeBodyController:
             self.hip = HipLaw(self.hip_params, self.support, weight, self.omega,
                               self.control_period)  # fmt: skip
         self.returning = False
+        self.stepper = None
+        self._soles = {  # each sole's points in its foot's frame, for the supports of steps
+            f.body: (sole_points(model, data, f.body) - np.asarray(data.xpos[f.body]))
+            @ np.asarray(data.xmat[f.body]).reshape(3, 3) for f in self.feet
+        }  # fmt: skip
+        if self.stepping:
+            assert self.step_params is not None
+            lateral = np.asarray(data.xpos)[self._bodies] - np.asarray(data.xpos[self.torso])
+            left = int(np.argmax(lateral @ self.upright[:, 1]))
+            self.stepper = Stepper(model, self.step_params, self.feet, left, floor,
+                                   com[2] - floor, self.step_settings)  # fmt: skip
+            self.qp.contact_damping = self.stepper.settings.contact_damping
+
+    def _set_support(self, data: Any, contacts: list[bool]) -> None:
+        """Set the feet in contact, re-measure the support polygon and rebuild the hip law."""
+        assert self.qp is not None
+        self.qp.set_contacts(contacts)
+        on = [foot for foot, c in zip(self.feet, contacts, strict=True) if c]
+        soles = [np.asarray(data.xpos[f.body]) + self._soles[f.body]
+                 @ np.asarray(data.xmat[f.body]).reshape(3, 3).T for f in on]  # fmt: skip
+        self.support = convex_hull(np.vstack(soles)[:, :2])
+        if self.hip_params is not None:
+            weight = self.mass * float(np.linalg.norm(self.gravity))
+            self.hip = HipLaw(self.hip_params, self.support, weight, self.omega,
+                              self.control_period)  # fmt: skip
+
+    def _step(self, data: Any) -> bool:
+        """Run the stepping decision, lift-off, re-plan and touchdown; True if contacts changed."""
+        stepper = self.stepper
+        assert stepper is not None and self.support is not None
+        if stepper.swing is None:
+            region = self.hip.cmp_region if self.hip is not None else self.support
+            if not stepper.decide(self.capture_point, region):
+                return False
+            swing = stepper.lift_off(data)
+            self._set_support(data, [i != swing for i in range(len(self.feet))])
+            return True
+        if not stepper.landed(data):
+            stepper.replan(data)
+            return False
+        self._set_support(data, [True] * len(self.feet))
+        ankles = np.array([stepper.sole(data, i)[0][:2] for i in range(len(self.feet))])
+        self.rest = ankles.mean(axis=0)
+        self.posture = np.array(data.qpos[7:], dtype=float)
+        return True
 
     def cop_target(self, data: Any) -> FloatArray:
         """Return the DCM law's CoP p_des clipped to the support polygon [m] (world xy).
@@ -254,6 +323,8 @@ class WholeBodyController:
         error = _rotation_vector(rot @ self.upright.T)
         com = np.asarray(data.subtree_com[0])
         self.desired_cop = self.cop_target(data)  # also the capture point, mj_subtreeVel
+        if self.stepper is not None and self._step(data):
+            self.desired_cop = self.cop_target(data)  # the new support polygon
         hip_active = False
         if self.hip is not None:
             momentum = np.asarray(data.subtree_angmom[0])
@@ -310,6 +381,8 @@ class WholeBodyController:
         target = gains.posture_stiffness * (self.posture - angles)
         target -= gains.posture_damping * qvel[6:]
         tasks.append(Task("posture", joints, target, gains.posture_weight))
+        if self.stepper is not None and self.stepper.swing is not None:
+            tasks.append(self.stepper.task(data, size, nv))
         return tasks
 
     def compute(self, t: float, state: Any) -> FloatArray:

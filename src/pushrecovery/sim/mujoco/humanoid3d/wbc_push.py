@@ -25,6 +25,7 @@ from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points, standing_qpos
 from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WbcGains, WholeBodyController
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step import StepSettings
 
 FloatArray = NDArray[np.float64]
 
@@ -134,6 +135,8 @@ def push_biped3d(
     gains: WbcGains | None = None,
     model: Any = None,
     hip: bool = False,
+    stepping: bool = False,
+    step_settings: StepSettings | None = None,
 ) -> WbcRun:
     """Push the biped3d of ``params`` and run the whole-body controller (module docstring).
 
@@ -155,10 +158,16 @@ def push_biped3d(
         A compiled ``biped3d_model(params)`` to reuse.
     hip : bool
         Enable the hip (CMP) task with ``params``' flywheel limits (:mod:`.wbc_hip`).
+    stepping : bool
+        Enable the stepping task, planned for ``params`` (:mod:`.wbc_step`).
+    step_settings : StepSettings, optional
+        Its settings.
     """
     _check_push(impulse, azimuth, duration, push_time)
     model = biped3d_model(params) if model is None else model
-    controller = WholeBodyController(model, gains=gains, hip=params if hip else None)
+    controller = WholeBodyController(model, gains=gains, hip=params if hip else None,
+                                     stepping=stepping, params=params,
+                                     step_settings=step_settings)  # fmt: skip
     feet = tuple(f"{side}_foot" for side in SIDES)
     return push_humanoid(model, bent_knee_qpos(model), controller, feet, "torso", impulse,
                          azimuth, duration=duration, push_time=push_time)  # fmt: skip

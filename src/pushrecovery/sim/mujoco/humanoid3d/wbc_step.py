@@ -1,0 +1,367 @@
+r"""The stepping task of the whole-body controller: decide, plan, swing and land a foot.
+
+World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
+:class:`~.wbc_control.WholeBodyController` (``stepping=True``) at every control tick:
+
+* **Decision** (double support): step when the capture point ξ = c + ċ/ω is beyond what the
+  ankles (and the hip, if enabled) recover: its signed distance to the CoP region P (or the
+  CMP region P ⊕ box(a'_x, a'_y), :class:`~.wbc_hip.HipLaw`) below −``margin``.
+* **Plan**: the library's one-step capture region
+  (:func:`~pushrecovery.surfaces.capture_region.capture_region`) of the state now, the measured
+  feet as a :class:`~pushrecovery.ground.support.Support`, touchdown after
+  t_s = ``swing_time`` (default the body's ``min_step_time``) and, in double support, the foot
+  on the side of ξ swinging; its recommended ``foothold`` (the region's Chebyshev centre) is
+  the landing ankle's target. An empty one-step region falls back to the first foothold of
+  a two-step plan, then to the stance ankle plus ξ's offset clipped to the step length.
+* **Swing**: the foot is dropped from the QP's contacts (:meth:`~.wbc.WholeBodyQP.set_contacts`)
+  and its sole frame tracks a reference: in x, y a quintic from the reference's position,
+  velocity and acceleration to the foothold with zero velocity and acceleration at the
+  touchdown time t_1; in z, with s = (t − t_0)/(t_1 − t_0),
+
+  .. math:: z(s) = z_0 + (z_1 - z_0)(10 s^3 - 15 s^4 + 6 s^5) + 64 h\, s^3 (1 - s)^3,
+
+  h the lift [m], z_1 = z_0 − ``sink`` (aimed just below the floor so that the sole meets
+  it); after t_1 the reference keeps sinking at ``sink_speed``. The task is the sole frame's
+  acceleration J q̈ + J̇ q̇ = a_ref + k_p (p_ref − p) + k_d (v_ref − v) (linear) and
+  −k_R e − d_R ω (angular, e the rotation vector from the lift-off orientation).
+* **Re-plan**: every ``replan_period`` until ``replan_fraction`` of the swing, the foothold
+  is recomputed from the current state in single support with the remaining swing time, and
+  the x, y quintic restarts from the reference's current state.
+* **Touchdown**: after half the swing, when the foot's lowest sole point is within ``contact``
+  of the floor; the foot rejoins the contacts, the support polygon and the balance point (the
+  ankles' midpoint) are re-measured, and the ankles balance: a second step follows if ξ is
+  still beyond the new region.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.support import FootPose, Stance, Support
+from pushrecovery.params import BodyParams
+from pushrecovery.sim.mujoco.humanoid3d.measure import sole_points
+from pushrecovery.sim.mujoco.humanoid3d.wbc import FootContact, Task
+from pushrecovery.surfaces.capture_region import capture_region
+
+FloatArray = NDArray[np.float64]
+
+__all__ = ["StepRecord", "StepSettings", "Stepper", "quintic"]
+
+
+@dataclass(frozen=True)
+class StepSettings:
+    """The stepping task's settings (module docstring); all finite.
+
+    Attributes
+    ----------
+    swing_time : float or None
+        t_s, lift-off to touchdown [s] in [0.05, 2]; None: the body's ``min_step_time``
+        (at least 0.05 s).
+    lift : float
+        h, the swing's apex above the straight line [m], in [0, 0.5].
+    sink, sink_speed : float
+        How far below the floor the reference ends [m] and its speed after t_1 [m/s], ≥ 0.
+    contact_damping : float
+        k_c of the feet in contact [1/s] (:class:`~.wbc.WholeBodyQP`): a foot unloaded beside
+        the stance foot stays down.
+    contact : float
+        Touchdown when the lowest sole point is this close to the floor [m], > 0.
+    margin : float
+        Step when ξ is this far outside the recoverable region [m], ≥ 0.
+    stiffness, damping : float
+        k_p [1/s²] and d_p [1/s] of the foot's position, ≥ 0.
+    turn_stiffness, turn_damping : float
+        k_R [1/s²] and d_R [1/s] of its orientation, ≥ 0.
+    weight : float
+        The foot task's W, > 0.
+    replan_period : float
+        Re-plan period during the swing [s], > 0.
+    replan_fraction : float
+        Re-plan only in this first fraction of the swing, in [0, 1].
+    """
+
+    swing_time: float | None = 0.3
+    lift: float = 0.05
+    sink: float = 0.01
+    sink_speed: float = 0.2
+    contact: float = 2e-3
+    contact_damping: float = 20.0
+    margin: float = 0.01
+    stiffness: float = 900.0
+    damping: float = 60.0
+    turn_stiffness: float = 400.0
+    turn_damping: float = 40.0
+    weight: float = 10.0
+    replan_period: float = 0.02
+    replan_fraction: float = 0.6
+
+    def __post_init__(self) -> None:
+        for item in fields(self):
+            value = getattr(self, item.name)
+            if value is None and item.name == "swing_time":
+                continue
+            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0.0):
+                raise InvalidParameterError(f"{item.name} must be finite and ≥ 0, got {value!r}")
+        bounds = {
+            "lift": (0.0, 0.5),
+            "replan_fraction": (0.0, 1.0),
+            "contact": (1e-6, 0.1),
+            "weight": (1e-9, 1e6),
+            "replan_period": (1e-4, 10.0),
+            "stiffness": (0.0, 1e6),
+        }
+        if self.swing_time is not None:
+            bounds["swing_time"] = (0.05, 2.0)
+        for name, (low, high) in bounds.items():  # fmt: skip
+            value = getattr(self, name)
+            if not low <= value <= high:
+                raise InvalidParameterError(f"{name} must be in [{low:g}, {high:g}], got {value!r}")
+
+
+@dataclass
+class StepRecord:
+    """One step: the swing foot, its timing [s] and its footholds [m] (world xy).
+
+    ``plans`` lists (time, foothold x, foothold y) of the first plan and every re-plan;
+    ``landed`` is the ankle's ground point at touchdown (None while in the air).
+    """
+
+    foot: str
+    liftoff: float
+    planned_touchdown: float
+    plans: list[tuple[float, float, float]] = field(default_factory=list)
+    touchdown: float | None = None
+    landed: FloatArray | None = None
+
+    @property
+    def foothold(self) -> FloatArray:
+        """Return the last planned foothold [m]."""
+        return np.array(self.plans[-1][1:])
+
+    @property
+    def error(self) -> float:
+        """Distance from the landed ankle to the last planned foothold [m] (nan in the air)."""
+        if self.landed is None:
+            return math.nan
+        return float(np.linalg.norm(self.landed - self.foothold))
+
+
+def quintic(p0: FloatArray, v0: FloatArray, a0: FloatArray, p1: FloatArray,
+            duration: float) -> FloatArray:  # fmt: skip
+    """Return c (6, d) with p(τ) = Σ_k c_k τ^k from (p0, v0, a0) to (p1, 0, 0) at τ = duration.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``duration`` is not positive.
+    """
+    if not duration > 0.0:
+        raise InvalidParameterError(f"duration must be > 0 s, got {duration!r}")
+    t = duration
+    gap = p1 - p0 - v0 * t - 0.5 * a0 * t**2
+    rate, curve = -v0 - a0 * t, -a0
+    c3 = (10.0 * gap - 4.0 * rate * t + 0.5 * curve * t**2) / t**3
+    c4 = (-15.0 * gap + 7.0 * rate * t - curve * t**2) / t**4
+    c5 = (6.0 * gap - 3.0 * rate * t + 0.5 * curve * t**2) / t**5
+    return np.array([p0, v0, 0.5 * a0, c3, c4, c5])
+
+
+def _evaluate(coeffs: FloatArray, tau: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    powers = tau ** np.arange(6)
+    k = np.arange(6)
+    p = powers @ coeffs
+    v = (k[1:] * powers[:-1]) @ coeffs[1:]
+    a = (k[2:] * (k[2:] - 1) * powers[:-2]) @ coeffs[2:]
+    return p, v, a
+
+
+def _yaw(rot: FloatArray) -> float:
+    return math.atan2(float(rot[1, 0]), float(rot[0, 0]))
+
+
+def _rotation_vector(rot: FloatArray) -> FloatArray:
+    angle = math.acos(max(-1.0, min(1.0, 0.5 * (float(np.trace(rot)) - 1.0))))
+    axial = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
+    return axial if angle < 1e-9 else axial * (angle / math.sin(angle))
+
+
+class Stepper:
+    """Stepping decisions, plans and the swing-foot task of one two-footed model.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The humanoid.
+    params : BodyParams
+        The body the plans are for (foot shape, step length, ``min_step_time``); its
+        ``com_height`` is replaced by ``com_height`` here.
+    feet : tuple of FootContact
+        The two feet, in the controller's order.
+    left : int
+        Index in ``feet`` of the left foot (+y of the body).
+    floor, com_height : float
+        The floor's height under the soles [m] and the CoM's above it [m] at reset.
+    settings : StepSettings, optional
+    """
+
+    def __init__(
+        self, model: Any, params: BodyParams, feet: tuple[FootContact, ...], left: int,
+        floor: float, com_height: float, settings: StepSettings | None = None,
+    ) -> None:  # fmt: skip
+        if not isinstance(params, BodyParams):
+            raise InvalidParameterError(f"params must be a BodyParams, got {type(params).__name__}")
+        if len(feet) != 2:
+            raise InvalidParameterError(f"stepping needs two feet, got {len(feet)}")
+        settings = StepSettings() if settings is None else settings
+        if not isinstance(settings, StepSettings):
+            raise InvalidParameterError(
+                f"step settings must be a StepSettings, got {type(settings).__name__}"
+            )
+        self._model = model
+        self.params = replace(params, com_height=com_height)
+        self.feet, self.left, self.floor, self.settings = feet, left, floor, settings
+        self.swing_time = max(0.05, params.min_step_time if settings.swing_time is None
+                              else settings.swing_time)  # fmt: skip
+        self.swing: int | None = None
+        self.steps: list[StepRecord] = []
+        self._coeffs = np.zeros((6, 2))
+        self._start = self._end = self._planned = 0.0
+        self._z = np.zeros(2)
+        self._rot = np.eye(3)
+
+    def _side(self, index: int) -> Stance:
+        return Stance.LEFT if index == self.left else Stance.RIGHT
+
+    def _support(self, data: Any, stance: Stance) -> Support:
+        poses = {}
+        for i, foot in enumerate(self.feet):
+            rot = np.asarray(data.xmat[foot.body]).reshape(3, 3)
+            x, y = np.asarray(data.xpos[foot.body])[:2]
+            poses[self._side(i).value] = FootPose(float(x), float(y), _yaw(rot))
+        return Support.from_params(self.params, stance, **poses)
+
+    def _foothold(self, data: Any, swing: Stance | None, stance: Stance, t: float) -> tuple[
+        Stance, FloatArray
+    ]:  # fmt: skip
+        com, vel = np.asarray(data.subtree_com[0]), np.asarray(data.subtree_linvel[0])
+        support = self._support(data, stance)
+        state = (float(com[0]), float(com[1]), float(vel[0]), float(vel[1]))
+        region = capture_region(*state, self.params, support, t, swing=swing)
+        if region.foothold is None:
+            region = capture_region(*state, self.params, support, t, swing=region.swing, steps=2)
+        if region.foothold is not None:
+            return region.swing, np.asarray(region.foothold, dtype=float)
+        pose = support.right if region.swing is Stance.LEFT else support.left
+        xi = com[:2] + vel[:2] / self.params.omega
+        offset = xi - np.array([pose.x, pose.y])
+        offset *= min(1.0, self.params.max_step_length / max(float(np.linalg.norm(offset)), 1e-9))
+        return region.swing, np.array([pose.x, pose.y]) + offset
+
+    def decide(self, xi: FloatArray, region: ConvexPolygon) -> bool:
+        """Whether ξ [m] is more than ``margin`` outside ``region`` (P or the CMP region)."""
+        distance = float(region.signed_distance(float(xi[0]), float(xi[1])))
+        return self.swing is None and distance < -self.settings.margin
+
+    def sole(self, data: Any, index: int) -> tuple[FloatArray, FloatArray]:
+        """Return the sole frame's origin [m] and orientation of foot ``index``."""
+        foot = self.feet[index]
+        rot = np.asarray(data.xmat[foot.body], dtype=float).reshape(3, 3)
+        return np.asarray(data.xpos[foot.body]) + rot @ foot.origin, rot
+
+    def lift_off(self, data: Any) -> int:
+        """Plan a step from double support and start its swing; return the swing foot's index."""
+        t = float(data.time)
+        side, foothold = self._foothold(data, None, Stance.DOUBLE, self.swing_time)
+        index = self.left if side is Stance.LEFT else 1 - self.left
+        point, self._rot = self.sole(data, index)
+        self.swing, self._start = index, t
+        self._end = t + self.swing_time
+        self._planned = t
+        self._z = np.array([point[2], self.floor - self.settings.sink])
+        self._coeffs = quintic(point[:2], np.zeros(2), np.zeros(2), foothold, self.swing_time)
+        record = StepRecord(self.feet[index].name, t, self._end)
+        record.plans.append((t, float(foothold[0]), float(foothold[1])))
+        self.steps.append(record)
+        return index
+
+    def reference(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Return the swing foot's reference position [m], velocity [m/s], acceleration [m/s²]."""
+        span = self._end - self._start
+        tau = min(t, self._end) - self._planned
+        xy, vxy, axy = _evaluate(self._coeffs, tau)
+        if t >= self._end:
+            z = self._z[1] - self.settings.sink_speed * (t - self._end)
+            return (np.array([*xy, z]), np.array([0.0, 0.0, -self.settings.sink_speed]),
+                    np.zeros(3))  # fmt: skip
+        s = (t - self._start) / span
+        drop = self._z[1] - self._z[0]
+        lift = 64.0 * self.settings.lift
+        z = self._z[0] + drop * (10 * s**3 - 15 * s**4 + 6 * s**5) + lift * s**3 * (1 - s) ** 3
+        dz = drop * (30 * s**2 - 60 * s**3 + 30 * s**4) + lift * (
+            3 * s**2 * (1 - s) ** 3 - 3 * s**3 * (1 - s) ** 2
+        )
+        ddz = drop * (60 * s - 180 * s**2 + 120 * s**3) + lift * (
+            6 * s * (1 - s) ** 3 - 18 * s**2 * (1 - s) ** 2 + 6 * s**3 * (1 - s)
+        )
+        return (np.array([*xy, z]), np.array([*vxy, dz / span]),
+                np.array([*axy, ddz / span**2]))  # fmt: skip
+
+    def replan(self, data: Any) -> None:
+        """Re-plan the foothold from the current state if it is time (module docstring)."""
+        t, s = float(data.time), self.settings
+        if self.swing is None or t >= self._start + s.replan_fraction * (self._end - self._start):
+            return
+        record = self.steps[-1]
+        if t - record.plans[-1][0] < s.replan_period - 1e-9:
+            return
+        stance = self._side(1 - self.swing)
+        _, foothold = self._foothold(data, self._side(self.swing), stance, self._end - t)
+        xy, vxy, axy = _evaluate(self._coeffs, t - self._planned)
+        self._coeffs, self._planned = quintic(xy, vxy, axy, foothold, self._end - t), t
+        record.plans.append((t, float(foothold[0]), float(foothold[1])))
+
+    def task(self, data: Any, size: int, nv: int) -> Task:
+        """Return the swing foot's task: J q̈ = a_des − J̇ q̇ over 6 rows (linear, angular)."""
+        import mujoco
+
+        assert self.swing is not None
+        s, model = self.settings, self._model
+        foot = self.feet[self.swing]
+        point, rot = self.sole(data, self.swing)
+        jacp, jacr = np.zeros((3, nv)), np.zeros((3, nv))
+        dotp, dotr = np.zeros((3, nv)), np.zeros((3, nv))
+        mujoco.mj_jac(model, data, jacp, jacr, point, foot.body)
+        mujoco.mj_jacDot(model, data, dotp, dotr, point, foot.body)
+        qvel = np.asarray(data.qvel, dtype=float)
+        p_ref, v_ref, a_ref = self.reference(float(data.time))
+        linear = a_ref + s.stiffness * (p_ref - point) + s.damping * (v_ref - jacp @ qvel)
+        error = _rotation_vector(rot @ self._rot.T)
+        angular = -s.turn_stiffness * error - s.turn_damping * (jacr @ qvel)
+        matrix = np.zeros((6, size))
+        matrix[:3, :nv], matrix[3:, :nv] = jacp, jacr
+        target = np.concatenate([linear - dotp @ qvel, angular - dotr @ qvel])
+        return Task("swing", matrix, target, s.weight)
+
+    def landed(self, data: Any) -> bool:
+        """Detect touchdown (module docstring); on it, record the landing and end the swing."""
+        if self.swing is None:
+            return False
+        t = float(data.time)
+        if t < 0.5 * (self._start + self._end):
+            return False
+        foot = self.feet[self.swing]
+        lowest = float(sole_points(self._model, data, foot.body)[:, 2].min())
+        if lowest > self.floor + self.settings.contact:
+            return False
+        record = self.steps[-1]
+        record.touchdown = t
+        record.landed = np.array(data.xpos[foot.body][:2], dtype=float)
+        self.swing = None
+        return True
