@@ -133,3 +133,11 @@ def test_bad_controller_inputs(model, kwargs, name):
 def test_bad_step_settings(kwargs, name):
     with pytest.raises(InvalidParameterError, match=name):
         StepSettings(**kwargs)
+
+
+def test_plant_controller_with_stepping(params):
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, wbc_for
+
+    plant = Biped3DPlant(params)
+    assert wbc_for(plant, stepping=True).stepping
+    assert not wbc_for(plant).stepping

@@ -350,16 +350,21 @@ class G1Plant(Humanoid3DPlant):
                          upright=G1_TORSO)  # fmt: skip
 
 
-def wbc_for(plant: Humanoid3DPlant, *, hip: bool = True) -> WholeBodyController:
+def wbc_for(
+    plant: Humanoid3DPlant, *, hip: bool = True, stepping: bool = False
+) -> WholeBodyController:
     """Return the whole-body controller of ``plant``'s model, feet and upright body.
 
     With ``hip`` (the default) its hip (CMP) task uses the flywheel limits of
-    ``plant.params`` (:mod:`.wbc_hip`); without, it balances with the ankles only.
+    ``plant.params`` (:mod:`.wbc_hip`); without, it balances with the ankles only. With
+    ``stepping`` it steps, planned for ``plant.params`` (:mod:`.wbc_step`), when neither
+    recovers.
     """
     require_type("plant", plant, Humanoid3DPlant)
     return WholeBodyController(
-        plant.model, feet=plant.feet, torso=plant.upright, hip=plant.params if hip else None
-    )
+        plant.model, feet=plant.feet, torso=plant.upright, hip=plant.params if hip else None,
+        stepping=stepping, params=plant.params,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
