@@ -16,39 +16,14 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 import pyarrow.parquet as pq
 
 from pushrecovery import load_params
+from pushrecovery.experiments.synthetic_trials import lipm_trial_csv
 
 TRIALS = 200
 RATE = 100.0
 DURATION = 3.0
-
-
-def _trial(push: float, azimuth: float, seed: int) -> str:
-    params = load_params()
-    omega, dt = params.omega, 1.0 / RATE
-    rng = np.random.default_rng(seed)
-    low = np.array([params.heel, -0.5 * params.foot_width])
-    high = np.array([params.toe, 0.5 * params.foot_width])
-    ch, sh = math.cosh(omega * dt), math.sinh(omega * dt)
-    x, v = np.array([0.02, 0.0]), np.zeros(2)
-    lines = ["time,com_ap,com_ml,cop_ap,cop_ml,base_ap_min,base_ap_max,base_ml_min,base_ml_max"]
-    for k in range(int(DURATION * RATE)):
-        if k == int(RATE):
-            v = v + push * np.array([math.cos(azimuth), math.sin(azimuth)])
-        cop = np.clip(x + 2.0 * v / omega, low, high)
-        com = x + rng.normal(0.0, 1e-4, 2)
-        lines.append(
-            f"{k * dt:.4f},{com[0]:.6f},{com[1]:.6f},{cop[0]:.6f},{cop[1]:.6f},"
-            f"{low[0]},{high[0]},{low[1]},{high[1]}"
-        )
-        offset = x - cop
-        x, v = cop + offset * ch + v / omega * sh, omega * offset * sh + v * ch
-        if np.any(np.abs(x) > 0.6):
-            break
-    return "\n".join(lines) + "\n"
 
 
 def main() -> int:
@@ -63,7 +38,7 @@ def main() -> int:
         folder.mkdir()
         for k in range(TRIALS):
             push = 0.1 + 0.6 * (k % 25) / 24
-            text = _trial(push, (k % 8) * math.pi / 4, seed=k)
+            text = lipm_trial_csv(load_params(), push, (k % 8) * math.pi / 4, seed=k)
             (folder / f"trial{k:03d}.csv").write_text(text)
         trials, base = find_trials([folder])
         jobs = trial_jobs(trials, base)

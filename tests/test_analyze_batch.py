@@ -9,45 +9,22 @@ from __future__ import annotations
 import json
 import math
 
-import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.campaign.subjects import read_subjects, subject_for
 from pushrecovery.campaign.trials import find_trials, run_trials, trial_jobs
+from pushrecovery.experiments.synthetic_trials import lipm_trial_csv
 
 P = load_params()
 OMEGA = P.omega
 RATE = 100.0
 
 
-def lipm_trial(push: float, azimuth: float, duration: float = 3.0, seed: int = 0) -> str:
-    """CSV text of a 2-D LIPM trial: standing, a velocity push at 1 s toward ``azimuth``
-    [rad] (0 forward, π/2 to the left), the CoP at the capture point clipped to the foot
-    (exact ZOH per axis at 100 Hz); the base is the foot's rectangle."""
-    rng = np.random.default_rng(seed)
-    low = np.array([P.heel, -0.5 * P.foot_width])
-    high = np.array([P.toe, 0.5 * P.foot_width])
-    dt = 1.0 / RATE
-    ch, sh = math.cosh(OMEGA * dt), math.sinh(OMEGA * dt)
-    x, v = np.array([0.02, 0.0]), np.zeros(2)
-    lines = ["time,com_ap,com_ml,cop_ap,cop_ml,base_ap_min,base_ap_max,base_ml_min,base_ml_max"]
-    for k in range(int(duration * RATE)):
-        if k == int(1.0 * RATE):
-            v = v + push * np.array([math.cos(azimuth), math.sin(azimuth)])
-        cop = np.clip(x + 2.0 * v / OMEGA, low, high)
-        noise = rng.normal(0.0, 1e-4, 2)
-        com = x + noise
-        lines.append(
-            f"{k * dt:.4f},{com[0]:.6f},{com[1]:.6f},{cop[0]:.6f},{cop[1]:.6f},"
-            f"{low[0]},{high[0]},{low[1]},{high[1]}"
-        )
-        offset = x - cop
-        x, v = cop + offset * ch + v / OMEGA * sh, OMEGA * offset * sh + v * ch
-        if np.any(np.abs(x) > 0.6):
-            break
-    return "\n".join(lines) + "\n"
+def lipm_trial(push: float, azimuth: float, seed: int = 0) -> str:
+    """A 2-D LIPM trial pushed at 1 s (``pushrecovery.experiments.synthetic_trials``)."""
+    return lipm_trial_csv(P, push, azimuth, seed=seed)
 
 
 @pytest.fixture(scope="module")
@@ -215,3 +192,16 @@ def test_the_batch_tables_are_typed_and_read_by_pandas(study, tmp_path):
     assert set(events["kind"]) >= {"onset"}
     with pytest.raises(InvalidParameterError, match="table must be"):
         result.to_pandas("frames")
+
+
+def test_synthetic_trials_refuse_bad_arguments():
+    bad = (("push", -1.0), ("azimuth", float("nan")), ("rate", 0.0), ("duration", 0.0),
+           ("x0", 1.0), ("noise", -1e-3), ("seed", -1))  # fmt: skip
+    for name, value in bad:
+        kwargs = {"push": 0.3, "azimuth": 0.0, name: value}
+        push, azimuth = kwargs.pop("push"), kwargs.pop("azimuth")
+        with pytest.raises(InvalidParameterError, match=name):
+            lipm_trial_csv(P, push, azimuth, **kwargs)
+    # Known truth: no push, the CoM stays where it stood (the noise apart).
+    rows = lipm_trial_csv(P, 0.0, 0.0, noise=0.0).splitlines()[1:]
+    assert {row.split(",")[1] for row in rows} == {"0.020000"}
