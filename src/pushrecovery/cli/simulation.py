@@ -480,11 +480,8 @@ def _simulate_3d(
     """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON)."""
     import numpy as np
 
-    from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
-        STATE_LABELS,
-        simulate_push3d,
-        wbc_for,
-    )
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import STATE_LABELS, wbc_for
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
     from pushrecovery.sim.push import Push3D
     from pushrecovery.sim.registry import make_plant
     from pushrecovery.surfaces.classify import classify as classify_state
@@ -537,7 +534,7 @@ def _critical_3d(
 ) -> dict[str, Any]:
     """Bisect the impulse at ``azimuth`` on a 3-D model (the JSON)."""
     from pushrecovery._validate import positive_float
-    from pushrecovery.sim.mujoco.humanoid3d.plant3d import critical_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d
     from pushrecovery.sim.registry import make_plant
 
     width = positive_float("tolerance", tolerance, "m/s") * params.mass

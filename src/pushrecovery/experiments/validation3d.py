@@ -223,7 +223,8 @@ def measure_critical_impulse(
     InvalidParameterError
         For a non-positive guess, a tolerance or duration out of range.
     """
-    from pushrecovery.sim.mujoco.humanoid3d.plant3d import simulate_push3d, wbc_for
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import wbc_for
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
     from pushrecovery.sim.push import IMPULSE_MAX, Push3D
     from pushrecovery.sim.result import Outcome
 

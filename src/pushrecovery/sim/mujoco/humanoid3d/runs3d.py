@@ -1,0 +1,249 @@
+"""The loop of the 3-D plants and the critical push from any direction (issue 19, item 4).
+
+:func:`simulate_push3d`: quiet standing until ``push_time``, the push
+(:class:`~pushrecovery.sim.push.Push3D`), then the whole-body controller every
+:data:`~.plant3d.CONTROL_PERIOD` until the plant's fall set, rest over the support polygon for
+``rest_duration``, or ``duration`` (the one loop, ``sim.simulate``, hands its controller the
+state vector; the WBC reads MuJoCo's data). :func:`critical_push3d`: the largest impulse at an
+azimuth that does not fall. The plants are :mod:`.plant3d`'s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery._validate import bounded_float, require_type
+from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
+    CONTROL_PERIOD,
+    Humanoid3DPlant,
+    wbc_for,
+)
+from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
+from pushrecovery.sim.push import Push3D
+from pushrecovery.sim.result import Outcome, strategy_used
+
+FloatArray = NDArray[np.float64]
+
+__all__ = ["CriticalPush3D", "Push3DRun", "critical_push3d", "simulate_push3d"]
+
+
+@dataclass(frozen=True)
+class Push3DRun:
+    """The outcome of :func:`simulate_push3d`.
+
+    Attributes
+    ----------
+    outcome : Outcome
+        recovered (at rest over P for ``rest_duration``), fell (the fall set) or undecided.
+    push : Push3D
+        The push.
+    time : float array, shape (n,)
+        Time of each control tick since reset [s].
+    states : float array, shape (n, 6)
+        The plant's state at each tick (:data:`STATE_LABELS`).
+    after_push : float array, shape (6,)
+        The state as the push ended.
+    before_push : float array, shape (6,)
+        The state as the push began.
+    peak_hip_torque : float
+        Largest flywheel torque the WBC's hip law commanded after the push, m g |δ| (δ its
+        CMP offset) [N m]: 0 when the ankles sufficed.
+    peak_hip_motor_torque : float
+        Largest |hip pitch or roll motor command − its value before the push| after it [N m]
+        (the hips also stop the torso's spin after a torso push, whatever the strategy).
+    max_torso_tilt : float
+        Largest tilt of the upright body from the vertical after the push [rad].
+    peak_torque : float
+        Largest |motor command| of the run [N m].
+    failed_ticks : int
+        Ticks DAQP did not solve (the last command repeated).
+    """
+
+    outcome: Outcome
+    push: Push3D
+    time: FloatArray
+    states: FloatArray
+    after_push: FloatArray
+    before_push: FloatArray
+    peak_hip_torque: float
+    peak_hip_motor_torque: float
+    max_torso_tilt: float
+    peak_torque: float
+    failed_ticks: int
+
+    @property
+    def recovered(self) -> bool:
+        """True when the body came to rest over its feet."""
+        return self.outcome is Outcome.RECOVERED
+
+    @property
+    def steps(self) -> int:
+        """Steps taken: 0 (the WBC has no stepping task yet)."""
+        return 0
+
+    def strategy_used(self) -> str:
+        """Return ``hip`` or ``ankle`` by the one definition (``sim.result.strategy_used``).
+
+        No step was taken, so ``hip`` if ``peak_hip_torque`` exceeded its threshold (1 N m).
+        """
+        return strategy_used(self.steps, self.peak_hip_torque).value
+
+
+def simulate_push3d(
+    plant: Humanoid3DPlant,
+    controller: WholeBodyController,
+    push: Push3D,
+    *,
+    duration: float = 3.0,
+    push_time: float = 0.1,
+    rest_speed: float = 5e-3,
+    rest_duration: float = 0.5,
+) -> Push3DRun:
+    """Stand, push, and run the whole-body controller until a decision (module docstring).
+
+    Parameters
+    ----------
+    plant : Humanoid3DPlant
+        The plant (reset here).
+    controller : WholeBodyController
+        Its controller (:func:`wbc_for`), reset here on the standing state.
+    push : Push3D
+        The push, at ``push_time``.
+    duration : float
+        Longest simulated time after the push, in (0, 60] s.
+    push_time : float
+        Quiet standing before the push, in [0, 10] s.
+    rest_speed, rest_duration : float
+        Recovered after |ċ_xy| <= rest_speed [m/s] over P for rest_duration [s] (both > 0).
+    """
+    require_type("plant", plant, Humanoid3DPlant)
+    require_type("controller", controller, WholeBodyController)
+    require_type("push", push, Push3D)
+    duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
+    push_time = bounded_float("push_time", push_time, 0.0, 10.0, "s")
+    rest_speed = bounded_float("rest_speed", rest_speed, 1e-6, 10.0, "m/s")
+    rest_duration = bounded_float("rest_duration", rest_duration, 0.0, 60.0, "s")
+    state = plant.reset()
+    controller.reset(plant.data)
+    times, states = [float(plant.data.time)], [state]
+    failed = 0
+
+    def tick() -> FloatArray:
+        nonlocal failed
+        ctrl = controller.compute(float(plant.data.time), plant.data)
+        failed += 0 if controller.last is None or controller.last.ok else 1
+        return plant.step(ctrl, CONTROL_PERIOD).state
+
+    for _ in range(round(push_time / CONTROL_PERIOD)):
+        state = tick()
+    before, held = state.copy(), plant.ctrl.copy()
+    after = plant.apply_push(push)
+    times.append(float(plant.data.time))
+    states.append(after)
+    weight = plant.params.mass * plant.params.gravity
+    hip_peak, motor_peak = 0.0, 0.0
+    tilt_peak, peak = plant.torso_tilt(), float(np.abs(held).max(initial=0.0))
+    outcome, resting = Outcome.UNDECIDED, 0.0
+    for _ in range(max(1, round(duration / CONTROL_PERIOD))):
+        state = tick()
+        times.append(float(plant.data.time))
+        states.append(state)
+        ctrl = plant.ctrl
+        peak = max(peak, float(np.abs(ctrl).max(initial=0.0)))
+        if plant.hip_motors:
+            motor_peak = max(motor_peak, float(np.abs(ctrl - held)[plant.hip_motors].max()))
+        hip_peak = max(hip_peak, weight * float(np.hypot(*controller.cmp_offset)))
+        tilt_peak = max(tilt_peak, plant.torso_tilt())
+        if plant.falling(state):
+            outcome = Outcome.FELL
+            break
+        resting = resting + CONTROL_PERIOD if plant.at_rest(state, rest_speed) else 0.0
+        if resting >= rest_duration - 1e-9:
+            outcome = Outcome.RECOVERED
+            break
+    return Push3DRun(
+        outcome=outcome,
+        push=push,
+        time=np.array(times),
+        states=np.array(states),
+        after_push=after,
+        before_push=before,
+        peak_hip_torque=hip_peak,
+        peak_hip_motor_torque=motor_peak,
+        max_torso_tilt=tilt_peak,
+        peak_torque=peak,
+        failed_ticks=failed,
+    )
+
+
+@dataclass(frozen=True)
+class CriticalPush3D:
+    """The largest recovered impulse at one azimuth (:func:`critical_push3d`).
+
+    Attributes
+    ----------
+    impulse : float
+        The largest impulse that did not fall [N s] (the bracket's low end).
+    bracket : tuple of float
+        (stood, fell) impulses [N s], at most ``tolerance`` apart.
+    simulations : int
+        Runs made.
+    strategy : str
+        The strategy of the run at ``impulse``.
+    """
+
+    impulse: float
+    bracket: tuple[float, float]
+    simulations: int
+    strategy: str
+
+
+def critical_push3d(
+    plant: Humanoid3DPlant,
+    azimuth: float,
+    *,
+    tolerance: float = 0.5,
+    duration: float = 3.0,
+    body: str = "torso",
+) -> CriticalPush3D:
+    """Bisect the impulse at ``azimuth`` [deg] between a run that stands and one that falls.
+
+    The upper end starts at m · 0.25 m/s and doubles while the body recovers (up to the
+    push's largest impulse); then the bracket halves until it is at most ``tolerance`` [N s]
+    wide (in (0, 1e3]). Each run is :func:`simulate_push3d` with the WBC and its hip task,
+    ``duration`` [s] after the push; a run that has not fallen by then (recovered or still
+    undecided) counts as standing: falls are decided within a second, rest takes seconds.
+    """
+    from pushrecovery.sim.push import IMPULSE_MAX
+
+    require_type("plant", plant, Humanoid3DPlant)
+    tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
+    Push3D(0.0, azimuth, body)  # checks azimuth and body
+
+    def recovers(impulse: float) -> tuple[bool, str]:
+        run = simulate_push3d(plant, wbc_for(plant), Push3D(impulse, azimuth, body),
+                              duration=duration)  # fmt: skip
+        return run.outcome is not Outcome.FELL, run.strategy_used()
+
+    low, high, runs, strategy = 0.0, 0.25 * plant.params.mass, 0, "ankle"
+    while True:
+        runs += 1
+        ok, used = recovers(high)
+        if not ok:
+            break
+        low, strategy = high, used
+        if high >= IMPULSE_MAX:
+            return CriticalPush3D(low, (low, low), runs, strategy)
+        high = min(2.0 * high, IMPULSE_MAX)
+    while high - low > tolerance:
+        middle = 0.5 * (low + high)
+        runs += 1
+        ok, used = recovers(middle)
+        if ok:
+            low, strategy = middle, used
+        else:
+            high = middle
+    return CriticalPush3D(low, (low, high), runs, strategy)
