@@ -1,0 +1,142 @@
+"""The 3-D models of ``simulate`` and ``critical-push`` (issue 19): checks, body, runs.
+
+``--backend mujoco --model biped3d|g1 --azimuth DEG``: the whole-body controller after a push
+from any direction (:mod:`pushrecovery.sim.mujoco.humanoid3d.runs3d`); the helpers of
+:mod:`pushrecovery.cli.simulation`, apart so that each module holds one concept.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pushrecovery.cli.options import params_from
+from pushrecovery.sim.registry import MUJOCO_3D_MODELS
+
+__all__: list[str] = []
+
+
+def _check_3d(
+    backend: str,
+    model: str,
+    controller: str,
+    kp: float | None,
+    kd: float | None,
+    options: tuple[str, ...],
+    kwargs: dict[str, Any],
+) -> None:
+    """Refuse the options a 3-D run does not take, in one line each."""
+    from pushrecovery.errors import InvalidParameterError
+
+    if model not in MUJOCO_3D_MODELS:
+        raise InvalidParameterError(
+            f"--azimuth needs a 3-D model (--backend mujoco --model biped3d or g1), got {model!r}"
+        )
+    if backend != "mujoco":
+        raise InvalidParameterError(f"--model {model} is a 3-D MuJoCo model: use --backend mujoco")
+    if controller != "ankle-pd" or kp is not None or kd is not None or options:
+        raise InvalidParameterError(
+            f"--controller, --kp, --kd and --option do not apply to {model}: it runs the "
+            "whole-body controller"
+        )
+
+
+def _params_3d(model: str, kwargs: dict[str, Any]) -> Any:
+    """Return the body of a 3-D model: the options' (biped3d) or the robot's own (g1)."""
+    if model != "g1":
+        return params_from(kwargs)
+    from pushrecovery.cli.options import PARAM_FLAGS
+    from pushrecovery.errors import InvalidParameterError
+
+    given = [flag for flag, field, _ in PARAM_FLAGS if kwargs.get(field) is not None]
+    if given or kwargs.get("params_file") or kwargs.get("preset", "paper") != "paper":
+        raise InvalidParameterError(
+            "--model g1 has the robot's own body: no --preset, --params or body flags "
+            f"(got {(given or ['--preset/--params'])[0]})"
+        )
+    from pushrecovery.sim.mujoco.humanoid3d.robots import robot_params
+
+    return robot_params("g1")
+
+
+def _simulate_3d(
+    model: str, params: Any, impulse: float | None, azimuth: float | None, duration: float
+) -> dict[str, Any]:
+    """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON)."""
+    import numpy as np
+
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import STATE_LABELS, wbc_for
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
+    from pushrecovery.sim.push import Push3D
+    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.surfaces.classify import classify as classify_state
+
+    push = Push3D(0.0 if impulse is None else impulse, 0.0 if azimuth is None else azimuth)
+    dvx, dvy = push.delta_velocity(params.mass)
+    predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
+    plant: Any = make_plant(model, params, "mujoco")
+    run = simulate_push3d(plant, wbc_for(plant), push, duration=duration)
+    states, before, after = run.states, run.before_push, run.after_push
+    return {
+        "recovered": run.recovered,
+        "outcome": run.outcome.value,
+        "model": model,
+        "controller": "wbc",
+        "duration": float(run.time[-1]),
+        "final_state": dict(zip(STATE_LABELS, (float(v) for v in states[-1]), strict=True)),
+        "max_excursion": float(
+            np.hypot(states[:, 0] - states[0, 0], states[:, 1] - states[0, 1]).max()
+        ),
+        "peak_torque": run.peak_torque,
+        "stop_impacts": 0,
+        "initial_state": {"x": 0.0, "xdot": 0.0, "y": 0.0, "ydot": 0.0},
+        "predicted": predicted.to_dict(),
+        "after_push": {
+            "x": float(after[0]),
+            "xdot": float(after[3]),
+            "y": float(after[1]),
+            "ydot": float(after[4]),
+        },
+        "backend": "mujoco",
+        "azimuth": push.azimuth,
+        "impulse": push.impulse,
+        "push_body": push.body,
+        "delta_velocity": {
+            "expected": [dvx, dvy],
+            "measured": [float(after[3] - before[3]), float(after[4] - before[4])],
+        },
+        "steps": run.steps,
+        "strategy": run.strategy_used(),
+        "peak_hip_torque": run.peak_hip_torque,
+        "peak_hip_motor_torque": run.peak_hip_motor_torque,
+        "max_torso_tilt": run.max_torso_tilt,
+        "failed_ticks": run.failed_ticks,
+    }
+
+
+def _critical_3d(
+    model: str, params: Any, azimuth: float | None, tolerance: float, duration: float
+) -> dict[str, Any]:
+    """Bisect the impulse at ``azimuth`` on a 3-D model (the JSON)."""
+    from pushrecovery._validate import positive_float
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d
+    from pushrecovery.sim.registry import make_plant
+
+    width = positive_float("tolerance", tolerance, "m/s") * params.mass
+    plant: Any = make_plant(model, params, "mujoco")
+    found = critical_push3d(
+        plant, 0.0 if azimuth is None else azimuth, tolerance=width, duration=duration
+    )
+    low, high = found.bracket
+    return {
+        "velocity": found.impulse / params.mass,
+        "impulse": found.impulse,
+        "bracket": [low / params.mass, high / params.mass],
+        "impulse_bracket": [low, high],
+        "simulations": found.simulations,
+        "model": model,
+        "controller": "wbc",
+        "x": 0.0,
+        "azimuth": 0.0 if azimuth is None else azimuth,
+        "backend": "mujoco",
+        "strategy": found.strategy,
+    }
