@@ -49,17 +49,18 @@ the simple model.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from pushrecovery._validate import bounded_float, finite_float, finite_vector, require_type
+from pushrecovery._validate import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import Support
-from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
-from pushrecovery.surfaces.plane import cmp_polygon
+from pushrecovery.experiments.validation3d_predict import (
+    critical_impulse_along,
+    predicted_critical_impulses,
+    push_lever,
+)
+from pushrecovery.params import BodyParams
 
 __all__ = [
     "DEFAULT_AZIMUTHS",
@@ -83,91 +84,6 @@ STRATEGIES: tuple[str, ...] = ("ankle", "hip")
 MODELS: tuple[str, ...] = ("biped3d", "g1")
 #: Most runs of one bisection (the bracket's widening included).
 MAX_RUNS = 40
-
-
-def critical_impulse_along(
-    region: ConvexPolygon, origin: tuple[float, float], azimuth: float, mass: float, omega: float
-) -> float:
-    """Return m ω ρ_R(r₀, ψ): the impulse that puts ξ on the region's boundary [N s].
-
-    Parameters
-    ----------
-    region : ConvexPolygon
-        The capture-point region R (world frame) [m].
-    origin : (float, float)
-        The standing CoM's ground point r₀, strictly inside R [m].
-    azimuth : float
-        The push's heading ψ, counter-clockwise from +x, in [−360, 360] deg.
-    mass : float
-        m > 0 [kg].
-    omega : float
-        ω = sqrt(g/L), in [0.1, 100] 1/s.
-
-    Raises
-    ------
-    InvalidParameterError
-        For an origin outside R, a non-finite or out-of-range azimuth, mass or omega.
-    """
-    require_type("region", region, ConvexPolygon)
-    start = finite_vector("origin", origin, 2, unit="m")
-    heading = bounded_float("azimuth", azimuth, -360.0, 360.0, "deg")
-    mass = finite_float("mass", mass, "kg")
-    if mass <= 0.0:
-        raise InvalidParameterError(f"mass must be > 0 kg, got {mass:g}")
-    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
-    if not bool(region.contains(float(start[0]), float(start[1]))):
-        raise InvalidParameterError(
-            f"origin ({start[0]:g}, {start[1]:g}) m must lie strictly inside the region"
-        )
-    distance = region.ray_distance(float(start[0]), float(start[1]), math.radians(heading))
-    return mass * omega * distance
-
-
-def predicted_critical_impulses(
-    params: BodyParams,
-    azimuth: float,
-    *,
-    origin: tuple[float, float] | None = None,
-    omega: float | None = None,
-) -> dict[str, float]:
-    """Return each strategy's predicted critical impulse at ``azimuth`` [N s] (module doc).
-
-    Parameters
-    ----------
-    params : BodyParams
-        The body: mass, feet and stance (double support, default foot poses), hip limits.
-    azimuth : float
-        ψ [deg], 0 forward, 90 left.
-    origin : (float, float), optional
-        The standing CoM's ground point r₀ [m]; default the ankles' midpoint.
-    omega : float, optional
-        ω [1/s]; default ``params.omega`` = sqrt(g/L).
-
-    Returns
-    -------
-    dict
-        ``{"ankle": m ω ρ_P, "hip": m ω ρ_(P ⊕ box)}``.
-    """
-    require_type("params", params, BodyParams)
-    support = Support.from_params(params)
-    start = support.ankle if origin is None else origin
-    rate = params.omega if omega is None else omega
-    regions = {"ankle": support.polygon, "hip": cmp_polygon(support, params)}
-    return {
-        name: critical_impulse_along(region, start, azimuth, params.mass, rate)
-        for name, region in regions.items()
-    }
-
-
-def push_lever(plant: Any) -> tuple[float, float]:
-    """Return (d, z₀): the pushed torso's CoM height above the whole-body CoM, and z₀ [m].
-
-    ``plant`` is a freshly reset 3-D plant (``sim.mujoco.humanoid3d.plant3d``).
-    """
-    data = plant.data
-    torso = plant.body_of("torso")
-    lever = float(data.xipos[torso][2]) - float(data.subtree_com[0][2])
-    return lever, float(plant.standing_height)
 
 
 @dataclass(frozen=True)
