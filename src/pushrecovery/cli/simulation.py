@@ -1,8 +1,7 @@
 """Commands that simulate one push or bisect one: ``simulate`` and ``critical-push``.
 
-The model and controller choices are read from the registries
-(:mod:`pushrecovery.sim.registry`, :mod:`pushrecovery.control.registry`), which name them
-without importing them.
+Their shared options are in :mod:`pushrecovery.cli.simulation_options`, the 3-D models'
+helpers in :mod:`pushrecovery.cli.simulation3d`.
 """
 
 from __future__ import annotations
@@ -19,120 +18,21 @@ from pushrecovery.cli.options import (
 )
 from pushrecovery.cli.progress import Progress
 from pushrecovery.cli.simulation3d import _check_3d, _critical_3d, _params_3d, _simulate_3d
-from pushrecovery.control.registry import CONTROLLER_NAMES
-from pushrecovery.sim.registry import MODELS, MUJOCO_3D_MODELS, MUJOCO_MODELS
+from pushrecovery.cli.simulation_options import (
+    MUJOCO_3D_MODEL_CHOICES,
+    _azimuth,
+    _backend,
+    _controller,
+    _controller_options,
+    _gains,
+    _measured_cop,
+    _model,
+    _options_for,
+    _push_velocity,
+    _with,
+)
 
 __all__ = ["critical_push", "simulate"]
-
-#: The ``--model`` and ``--controller`` choices.
-MODEL_CHOICES = MODELS
-MUJOCO_MODEL_CHOICES = MUJOCO_MODELS
-#: The 3-D models (MuJoCo, the whole-body controller; docs/humanoid3d.md).
-MUJOCO_3D_MODEL_CHOICES = MUJOCO_3D_MODELS
-CONTROLLER_CHOICES = CONTROLLER_NAMES
-
-
-def _push_velocity(xdot: float | None, impulse: float | None, mass: float) -> float:
-    from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.sim.push import Push
-
-    if xdot is not None and impulse is not None:
-        raise InvalidParameterError("give either --xdot [m/s] or --impulse [N s], not both")
-    if impulse is not None:
-        return Push.from_impulse(impulse, mass).delta_velocity
-    return 0.0 if xdot is None else xdot
-
-
-def _measured_cop(cops: list[float]) -> dict[str, float | None]:
-    """Range of the CoP MuJoCo measured from the contact forces, relative to the ankle [m]."""
-    import math
-
-    finite = [cop for cop in cops if not math.isnan(cop)]
-    if not finite:
-        return {"min": None, "max": None}
-    return {"min": min(finite), "max": max(finite)}
-
-
-def _controller_options(
-    kp: float | None, kd: float | None, pairs: tuple[str, ...] = ()
-) -> dict[str, Any]:
-    from pushrecovery.errors import InvalidParameterError
-
-    options: dict[str, Any] = {"stiffness": kp, "damping": kd}
-    for pair in pairs:
-        name, sep, text = pair.partition("=")
-        if not sep or not name:
-            raise InvalidParameterError(f"--option must be NAME=VALUE, got {pair!r}")
-        try:
-            value: Any = int(text) if text.lstrip("+-").isdigit() else float(text)
-        except ValueError:
-            raise InvalidParameterError(f"--option {name} must be a number, got {text!r}") from None
-        options[name.replace("-", "_")] = value
-    return {k: v for k, v in options.items() if v is not None}
-
-
-def _options_for(controller: str, options: dict[str, Any]) -> dict[str, Any]:
-    """Drop the ankle-pd gain flags for other controllers (they default to None anyway)."""
-    if controller != "ankle-pd":
-        for gain in ("stiffness", "damping"):
-            if gain in options:
-                from pushrecovery.errors import InvalidParameterError
-
-                raise InvalidParameterError(f"--kp/--kd apply to ankle-pd, not {controller!r}")
-    return options
-
-
-_backend = click.option(
-    "--backend",
-    type=click.Choice(("analytic", "mujoco")),
-    default="analytic",
-    show_default=True,
-    help="Physics: the analytic models, or MuJoCo (models foot, torso, biped).",
-)
-_model = click.option(
-    "--model",
-    type=click.Choice((*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES, *MUJOCO_3D_MODEL_CHOICES)),
-    default="lipm",
-    show_default=True,
-    help="Plant. Analytic: lipm, pendulum, flywheel, stepping, stepping-plane (on the ground "
-    "plane, with recovery-plane; simulate only); MuJoCo: foot (ankle), torso (hip), biped "
-    "(stepping); 3-D MuJoCo (the whole-body controller, --azimuth): biped3d, g1 (the robots "
-    "extra).",
-)
-_azimuth = click.option(
-    "--azimuth",
-    type=float,
-    default=None,
-    help="3-D models only: the push's direction [deg], 0 forward (+x), 90 left (+y); default 0.",
-)
-_controller = click.option(
-    "--controller",
-    type=click.Choice(CONTROLLER_CHOICES),
-    default="ankle-pd",
-    show_default=True,
-    help="Controller.",
-)
-_gains = (
-    click.option("--kp", type=float, default=None, help="ankle-pd stiffness [N m/rad]."),
-    click.option("--kd", type=float, default=None, help="ankle-pd damping [N m s/rad]."),
-    click.option(
-        "--option",
-        "options",
-        multiple=True,
-        metavar="NAME=VALUE",
-        help="Controller option, repeatable: e.g. horizon=30, gamma=1, dt=0.01 (mpc); "
-        "switch_time=0.2 (bang-bang).",
-    ),
-)
-
-
-def _with(*decorators: Any) -> Any:
-    def apply(func: Any) -> Any:
-        for decorator in reversed(decorators):
-            func = decorator(func)
-        return func
-
-    return apply
 
 
 @click.command(short_help="Simulate a push; report recovered or fell.")
