@@ -148,3 +148,18 @@ def test_g1_without_the_robots_extra_is_one_line_and_exit_2(capsys, monkeypatch)
                            "--push", "3")  # fmt: skip
     assert code == 2 and err.count("\n") == 1
     assert "the G1 model needs the robots extra: pip install 'pushrecovery[robots]'" in err
+
+
+def test_the_critical_impulse_search_brackets_a_known_threshold():
+    # A body that stands below 12.3 N s (ankle below 10, hip above): the search of both
+    # critical_push3d (from 0, doubling) and the validation (from a guess, shrinking) finds it.
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical
+
+    def stands(impulse):
+        return impulse < 12.3, "ankle" if impulse < 10.0 else "hip"
+
+    for start, kwargs in ((dict(low=0.0, high=1.0)), {}), ((dict(low=16.0, high=24.0)),
+                          {"grow": 1.3, "shrink": 0.7}):  # fmt: skip
+        found, (low, high), strategy = bisect_critical(stands, **start, tolerance=0.01, **kwargs)
+        assert low <= 12.3 < high and high - low <= 0.01 and found == low
+        assert strategy == "hip"

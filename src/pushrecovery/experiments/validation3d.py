@@ -140,7 +140,7 @@ def measure_critical_impulse(
         For a non-positive guess, a tolerance or duration out of range.
     """
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import wbc_for
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical, simulate_push3d
     from pushrecovery.sim.push import IMPULSE_MAX, Push3D
     from pushrecovery.sim.result import Outcome
 
@@ -162,27 +162,11 @@ def measure_critical_impulse(
         )
         return run.outcome is not Outcome.FELL, run.strategy_used()
 
-    low, high = 0.8 * guess, min(1.2 * guess, IMPULSE_MAX)
-    ok, used = stands(low)
-    while not ok:
-        high, low = low, 0.7 * low
-        ok, used = stands(low)
-    while True:
-        stood, high_used = stands(high)
-        if not stood:
-            break
-        low, used = high, high_used
-        if high >= IMPULSE_MAX:
-            return MeasuredCritical(low, (low, low), runs, used)
-        high = min(1.3 * high, IMPULSE_MAX)
-    while high - low > rel_tolerance * guess:
-        middle = 0.5 * (low + high)
-        ok, middle_used = stands(middle)
-        if ok:
-            low, used = middle, middle_used
-        else:
-            high = middle
-    return MeasuredCritical(low, (low, high), runs, used)
+    low, bracket, used = bisect_critical(
+        stands, 0.8 * guess, min(1.2 * guess, IMPULSE_MAX), rel_tolerance * guess,
+        grow=1.3, shrink=0.7,
+    )  # fmt: skip
+    return MeasuredCritical(low, bracket, runs, used)
 
 
 @dataclass(frozen=True)

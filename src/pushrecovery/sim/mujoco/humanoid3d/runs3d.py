@@ -10,6 +10,7 @@ azimuth that does not fall. The plants are :mod:`.plant3d`'s.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,7 +28,13 @@ from pushrecovery.sim.result import Outcome, strategy_used
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["CriticalPush3D", "Push3DRun", "critical_push3d", "simulate_push3d"]
+__all__ = [
+    "CriticalPush3D",
+    "Push3DRun",
+    "bisect_critical",
+    "critical_push3d",
+    "simulate_push3d",
+]
 
 
 @dataclass(frozen=True)
@@ -217,33 +224,61 @@ def critical_push3d(
     ``duration`` [s] after the push; a run that has not fallen by then (recovered or still
     undecided) counts as standing: falls are decided within a second, rest takes seconds.
     """
-    from pushrecovery.sim.push import IMPULSE_MAX
-
     require_type("plant", plant, Humanoid3DPlant)
     tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
     Push3D(0.0, azimuth, body)  # checks azimuth and body
 
+    runs = 0
+
     def recovers(impulse: float) -> tuple[bool, str]:
+        nonlocal runs
+        runs += 1
         run = simulate_push3d(plant, wbc_for(plant), Push3D(impulse, azimuth, body),
                               duration=duration)  # fmt: skip
         return run.outcome is not Outcome.FELL, run.strategy_used()
 
-    low, high, runs, strategy = 0.0, 0.25 * plant.params.mass, 0, "ankle"
+    low, bracket, strategy = bisect_critical(recovers, 0.0, 0.25 * plant.params.mass, tolerance)
+    return CriticalPush3D(low, bracket, runs, strategy)
+
+
+def bisect_critical(
+    stands: Callable[[float], tuple[bool, str]],
+    low: float,
+    high: float,
+    tolerance: float,
+    *,
+    grow: float = 2.0,
+    shrink: float | None = None,
+) -> tuple[float, tuple[float, float], str]:
+    """Bracket and bisect the largest impulse [N s] that ``stands`` (a run: stood?, strategy).
+
+    With ``shrink`` the lower end is run first and multiplied by it until it stands; without,
+    ``low`` is taken to stand (0: no push). The upper end grows by ``grow`` (up to the push's
+    largest impulse) while it stands; then the bracket halves until at most ``tolerance`` [N s]
+    wide. Returns the largest impulse that stood, the bracket and that run's strategy
+    ("ankle" when none stood but the assumed ``low``).
+    """
+    from pushrecovery.sim.push import IMPULSE_MAX
+
+    strategy = "ankle"
+    if shrink is not None:
+        stood, strategy = stands(low)
+        while not stood:
+            high, low = low, shrink * low
+            stood, strategy = stands(low)
     while True:
-        runs += 1
-        ok, used = recovers(high)
-        if not ok:
+        stood, used = stands(high)
+        if not stood:
             break
         low, strategy = high, used
         if high >= IMPULSE_MAX:
-            return CriticalPush3D(low, (low, low), runs, strategy)
-        high = min(2.0 * high, IMPULSE_MAX)
+            return low, (low, low), strategy
+        high = min(grow * high, IMPULSE_MAX)
     while high - low > tolerance:
         middle = 0.5 * (low + high)
-        runs += 1
-        ok, used = recovers(middle)
-        if ok:
+        stood, used = stands(middle)
+        if stood:
             low, strategy = middle, used
         else:
             high = middle
-    return CriticalPush3D(low, (low, high), runs, strategy)
+    return low, (low, high), strategy
