@@ -67,6 +67,9 @@ class Push3DRun:
         Largest |motor command| of the run [N m].
     failed_ticks : int
         Ticks DAQP did not solve (the last command repeated).
+    qpos, qvel, ctrl : float arrays, shapes (n, nq), (n, nv), (n, nu), or None
+        MuJoCo's ``qpos``, ``qvel`` and the held motor commands at each row of ``time``
+        (``simulate_push3d(..., record=True)``: to replay and render the run); None otherwise.
     """
 
     outcome: Outcome
@@ -80,6 +83,9 @@ class Push3DRun:
     max_torso_tilt: float
     peak_torque: float
     failed_ticks: int
+    qpos: FloatArray | None = None
+    qvel: FloatArray | None = None
+    ctrl: FloatArray | None = None
 
     @property
     def recovered(self) -> bool:
@@ -108,6 +114,7 @@ def simulate_push3d(
     push_time: float = 0.1,
     rest_speed: float = 5e-3,
     rest_duration: float = 0.5,
+    record: bool = False,
 ) -> Push3DRun:
     """Stand, push, and run the whole-body controller until a decision (module docstring).
 
@@ -125,6 +132,8 @@ def simulate_push3d(
         Quiet standing before the push, in [0, 10] s.
     rest_speed, rest_duration : float
         Recovered after |ċ_xy| <= rest_speed [m/s] over P for rest_duration [s] (both > 0).
+    record : bool
+        Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (:class:`Push3DRun`), for rendering.
     """
     require_type("plant", plant, Humanoid3DPlant)
     require_type("controller", controller, WholeBodyController)
@@ -137,6 +146,14 @@ def simulate_push3d(
     controller.reset(plant.data)
     times, states = [float(plant.data.time)], [state]
     failed = 0
+    frames: list[FloatArray] = []
+
+    def keep() -> None:
+        if record:
+            data = plant.data
+            frames.append(np.concatenate([data.qpos, data.qvel, plant.ctrl]))
+
+    keep()
 
     def tick() -> FloatArray:
         nonlocal failed
@@ -150,6 +167,7 @@ def simulate_push3d(
     after = plant.apply_push(push)
     times.append(float(plant.data.time))
     states.append(after)
+    keep()
     weight = plant.params.mass * plant.params.gravity
     hip_peak, motor_peak = 0.0, 0.0
     tilt_peak, peak = plant.torso_tilt(), float(np.abs(held).max(initial=0.0))
@@ -158,6 +176,7 @@ def simulate_push3d(
         state = tick()
         times.append(float(plant.data.time))
         states.append(state)
+        keep()
         ctrl = plant.ctrl
         peak = max(peak, float(np.abs(ctrl).max(initial=0.0)))
         if plant.hip_motors:
@@ -183,7 +202,16 @@ def simulate_push3d(
         max_torso_tilt=tilt_peak,
         peak_torque=peak,
         failed_ticks=failed,
+        **_split(plant, frames),
     )
+
+
+def _split(plant: Humanoid3DPlant, frames: list[FloatArray]) -> dict[str, FloatArray]:
+    """Return the recorded rows as ``qpos``, ``qvel`` and ``ctrl`` arrays (none if empty)."""
+    if not frames:
+        return {}
+    rows, nq, nv = np.array(frames), int(plant.model.nq), int(plant.model.nv)
+    return {"qpos": rows[:, :nq], "qvel": rows[:, nq : nq + nv], "ctrl": rows[:, nq + nv :]}
 
 
 @dataclass(frozen=True)
