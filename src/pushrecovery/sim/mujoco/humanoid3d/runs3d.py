@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from pushrecovery._validate import bounded_float, require_type
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
+    FALL_HEIGHT,
     Humanoid3DPlant,
     wbc_for,
 )
@@ -70,6 +71,8 @@ class Push3DRun:
     qpos, qvel, ctrl : float arrays, shapes (n, nq), (n, nv), (n, nu), or None
         MuJoCo's ``qpos``, ``qvel`` and the held motor commands at each row of ``time``
         (``simulate_push3d(..., record=True)``: to replay and render the run); None otherwise.
+    steps : int
+        Steps that landed (the controller's stepping task; 0 without it).
     """
 
     outcome: Outcome
@@ -86,21 +89,18 @@ class Push3DRun:
     qpos: FloatArray | None = None
     qvel: FloatArray | None = None
     ctrl: FloatArray | None = None
+    steps: int = 0
 
     @property
     def recovered(self) -> bool:
         """True when the body came to rest over its feet."""
         return self.outcome is Outcome.RECOVERED
 
-    @property
-    def steps(self) -> int:
-        """Steps taken: 0 (the WBC has no stepping task yet)."""
-        return 0
-
     def strategy_used(self) -> str:
-        """Return ``hip`` or ``ankle`` by the one definition (``sim.result.strategy_used``).
+        """Return ``step``, ``hip`` or ``ankle`` by the one definition (``sim.result``).
 
-        No step was taken, so ``hip`` if ``peak_hip_torque`` exceeded its threshold (1 N m).
+        ``step`` if a step landed, else ``hip`` if ``peak_hip_torque`` exceeded its threshold
+        (1 N m), else ``ankle``.
         """
         return strategy_used(self.steps, self.peak_hip_torque).value
 
@@ -183,10 +183,11 @@ def simulate_push3d(
             motor_peak = max(motor_peak, float(np.abs(ctrl - held)[plant.hip_motors].max()))
         hip_peak = max(hip_peak, weight * float(np.hypot(*controller.cmp_offset)))
         tilt_peak = max(tilt_peak, plant.torso_tilt())
-        if plant.falling(state):
+        fell, still = _judge(plant, controller, state, rest_speed)
+        if fell:
             outcome = Outcome.FELL
             break
-        resting = resting + CONTROL_PERIOD if plant.at_rest(state, rest_speed) else 0.0
+        resting = resting + CONTROL_PERIOD if still else 0.0
         if resting >= rest_duration - 1e-9:
             outcome = Outcome.RECOVERED
             break
@@ -202,8 +203,34 @@ def simulate_push3d(
         max_torso_tilt=tilt_peak,
         peak_torque=peak,
         failed_ticks=failed,
+        steps=_landed(controller),
         **_split(plant, frames),
     )
+
+
+def _judge(
+    plant: Humanoid3DPlant, controller: WholeBodyController, state: FloatArray, speed: float
+) -> tuple[bool, bool]:
+    """Return (fallen, at rest) of ``state``: the plant's fall set and rest, or with steps.
+
+    With the stepping task the feet move: the support polygon is the controller's (the feet
+    in contact), ξ beyond it is what a step answers (the controller steps), so the fall is
+    the CoM down only (below ``FALL_HEIGHT`` z₀), and rest needs both feet on the floor.
+    """
+    stepper = controller.stepper
+    if stepper is None:
+        return plant.falling(state), plant.at_rest(state, speed)
+    plant.support = controller.support
+    down = float(state[2]) - plant.floor < FALL_HEIGHT * plant.standing_height
+    return down, stepper.swing is None and plant.at_rest(state, speed)
+
+
+def _landed(controller: WholeBodyController) -> int:
+    """Return the steps of ``controller``'s stepping task that touched down."""
+    stepper = controller.stepper
+    if stepper is None:
+        return 0
+    return sum(1 for step in stepper.steps if step.touchdown is not None)
 
 
 def _split(plant: Humanoid3DPlant, frames: list[FloatArray]) -> dict[str, FloatArray]:
