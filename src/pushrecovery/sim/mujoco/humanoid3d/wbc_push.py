@@ -73,6 +73,8 @@ class WbcRun:
     solve_time, control_time, physics_time : float arrays, shape (n,)
         Wall time of the DAQP solve, of the whole controller tick, and of the tick's physics
         steps [s] (diagnostics, not for tests).
+    qpos, qvel, ctrl : float arrays, shapes (n, nq), (n, nv), (n, nu)
+        MuJoCo's state and the tick's motor commands (to replay and render the run).
     controller : WholeBodyController
         The controller after the run (its feet's constraints and support polygon).
     """
@@ -90,6 +92,9 @@ class WbcRun:
     solve_time: FloatArray
     control_time: FloatArray
     physics_time: FloatArray
+    qpos: FloatArray
+    qvel: FloatArray
+    ctrl: FloatArray
     controller: WholeBodyController
 
 
@@ -228,6 +233,8 @@ def push_humanoid(
         columns["ok"].append(solution.ok)
         columns["solve_time"].append(solution.solve_time)
         columns["control_time"].append(control)
+        for name in ("qpos", "qvel", "ctrl"):
+            columns[name].append(np.array(getattr(data, name)))
         began = time.perf_counter()
         for sub in range(per_tick):
             step = tick * per_tick + sub
