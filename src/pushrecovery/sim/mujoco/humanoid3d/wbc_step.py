@@ -6,13 +6,13 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
 * **Decision** (double support): step when the capture point ξ = c + ċ/ω is beyond what the
   ankles (and the hip, if enabled) recover: its signed distance to the CoP region P (or the
   CMP region P ⊕ box(a'_x, a'_y), :class:`~.wbc_hip.HipLaw`) below −``margin``.
-* **Plan**: the library's one-step capture region
-  (:func:`~pushrecovery.surfaces.capture_region.capture_region`) of the state now, the measured
-  feet as a :class:`~pushrecovery.ground.support.Support`, touchdown after
-  t_s = ``swing_time`` (default the body's ``min_step_time``) and, in double support, the foot
-  on the side of ξ swinging; its recommended ``foothold`` (the region's Chebyshev centre) is
-  the landing ankle's target. An empty one-step region falls back to the first foothold of
-  a two-step plan, then to the stance ankle plus ξ's offset clipped to the step length.
+* **Plan** (:mod:`.wbc_step_plan`): the foot on ξ's side of the ankles' midpoint swings; the
+  library's one-step capture region of the state now, the stance foot's measured pose, a
+  touchdown after t_s, and (when the controller has its hip task) the hip's box; its
+  recommended ``foothold`` (the region's Chebyshev centre) is the landing ankle's target.
+  t_s starts at ``swing_time`` (default the body's ``min_step_time``) and grows to what a
+  share ``torque_share`` of the swing hip's motor limit needs for that foothold (the plan
+  redone for the longer time), up to ``max_swing_time``.
 * **Swing**: the foot is dropped from the QP's contacts (:meth:`~.wbc.WholeBodyQP.set_contacts`)
   and its sole frame tracks a reference: in x, y a quintic from the reference's position,
   velocity and acceleration to the foothold with zero velocity and acceleration at the
@@ -23,7 +23,11 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
   h the lift [m], z_1 = z_0 − ``sink`` (aimed just below the floor so that the sole meets
   it); after t_1 the reference keeps sinking at ``sink_speed``. The task is the sole frame's
   acceleration J q̈ + J̇ q̇ = a_ref + k_p (p_ref − p) + k_d (v_ref − v) (linear) and
-  −k_R e − d_R ω (angular, e the rotation vector from the lift-off orientation).
+  −k_R e − d_R ω (angular, e the rotation vector from the lift-off orientation); its vertical
+  row weighs ``lift_weight`` times more (a foot that stays on the floor cannot step).
+* **Knee guard** (always, with stepping): a knee below ``knee_min`` or reaching it within
+  50 ms gets the task q̈ = k_p (q_min − q) − d_p q̇: the QP does not model the joint stop, and
+  a stance knee driven onto it made the QP infeasible (torque limits with the contact rows).
 * **Re-plan**: every ``replan_period`` until ``replan_fraction`` of the swing, the foothold
   is recomputed from the current state in single support with the remaining swing time, and
   the x, y quintic restarts from the reference's current state.
@@ -36,7 +40,7 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, fields, replace
 from typing import Any
 
 import numpy as np
@@ -44,11 +48,18 @@ from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import FootPose, Stance, Support
+from pushrecovery.ground.support import FootPose, Stance
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.humanoid3d.measure import sole_points
 from pushrecovery.sim.mujoco.humanoid3d.wbc import FootContact, Task
-from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import (
+    StepRecord,
+    evaluate,
+    leg_joints,
+    leg_swing_time,
+    plan_foothold,
+    quintic,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -85,6 +96,20 @@ class StepSettings:
         Re-plan period during the swing [s], > 0.
     replan_fraction : float
         Re-plan only in this first fraction of the swing, in [0, 1].
+    torque_share : float or None
+        κ in [0.001, 1]: the share of the swing hip's motor limit the swing may take; the
+        swing lasts at least what that torque needs (:func:`~.wbc_step_plan.leg_swing_time`),
+        up to ``max_swing_time``. None: always ``swing_time``.
+    max_swing_time : float
+        The longest swing [s], in [0.05, 2], ≥ ``swing_time``.
+    knee_min : float
+        The knee guard [rad] in [0, 1]: a knee below it (or reaching it within 50 ms) is
+        pulled back, q̈ = k_p (q_min − q) − d_p q̇ (the QP does not model the joint stop).
+    knee_weight : float
+        The knee guard's W, > 0.
+    lift_weight : float
+        The swing foot's vertical row weighs this times W, in [0.001, 1000]: a foot that
+        does not leave the floor cannot step.
     """
 
     swing_time: float | None = 0.3
@@ -101,11 +126,16 @@ class StepSettings:
     weight: float = 10.0
     replan_period: float = 0.02
     replan_fraction: float = 0.6
+    torque_share: float | None = 1.0
+    max_swing_time: float = 0.6
+    knee_min: float = 0.1
+    knee_weight: float = 10.0
+    lift_weight: float = 30.0
 
     def __post_init__(self) -> None:
         for item in fields(self):
             value = getattr(self, item.name)
-            if value is None and item.name == "swing_time":
+            if value is None and item.name in ("swing_time", "torque_share"):
                 continue
             if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0.0):
                 raise InvalidParameterError(f"{item.name} must be finite and ≥ 0, got {value!r}")
@@ -116,70 +146,24 @@ class StepSettings:
             "weight": (1e-9, 1e6),
             "replan_period": (1e-4, 10.0),
             "stiffness": (0.0, 1e6),
+            "max_swing_time": (0.05, 2.0),
+            "knee_min": (0.0, 1.0),
+            "knee_weight": (1e-9, 1e6),
+            "lift_weight": (1e-3, 1e3),
         }
+        if self.torque_share is not None:
+            bounds["torque_share"] = (1e-3, 1.0)
         if self.swing_time is not None:
             bounds["swing_time"] = (0.05, 2.0)
         for name, (low, high) in bounds.items():  # fmt: skip
             value = getattr(self, name)
             if not low <= value <= high:
                 raise InvalidParameterError(f"{name} must be in [{low:g}, {high:g}], got {value!r}")
-
-
-@dataclass
-class StepRecord:
-    """One step: the swing foot, its timing [s] and its footholds [m] (world xy).
-
-    ``plans`` lists (time, foothold x, foothold y) of the first plan and every re-plan;
-    ``landed`` is the ankle's ground point at touchdown (None while in the air).
-    """
-
-    foot: str
-    liftoff: float
-    planned_touchdown: float
-    plans: list[tuple[float, float, float]] = field(default_factory=list)
-    touchdown: float | None = None
-    landed: FloatArray | None = None
-
-    @property
-    def foothold(self) -> FloatArray:
-        """Return the last planned foothold [m]."""
-        return np.array(self.plans[-1][1:])
-
-    @property
-    def error(self) -> float:
-        """Distance from the landed ankle to the last planned foothold [m] (nan in the air)."""
-        if self.landed is None:
-            return math.nan
-        return float(np.linalg.norm(self.landed - self.foothold))
-
-
-def quintic(p0: FloatArray, v0: FloatArray, a0: FloatArray, p1: FloatArray,
-            duration: float) -> FloatArray:  # fmt: skip
-    """Return c (6, d) with p(τ) = Σ_k c_k τ^k from (p0, v0, a0) to (p1, 0, 0) at τ = duration.
-
-    Raises
-    ------
-    InvalidParameterError
-        If ``duration`` is not positive.
-    """
-    if not duration > 0.0:
-        raise InvalidParameterError(f"duration must be > 0 s, got {duration!r}")
-    t = duration
-    gap = p1 - p0 - v0 * t - 0.5 * a0 * t**2
-    rate, curve = -v0 - a0 * t, -a0
-    c3 = (10.0 * gap - 4.0 * rate * t + 0.5 * curve * t**2) / t**3
-    c4 = (-15.0 * gap + 7.0 * rate * t - curve * t**2) / t**4
-    c5 = (6.0 * gap - 3.0 * rate * t + 0.5 * curve * t**2) / t**5
-    return np.array([p0, v0, 0.5 * a0, c3, c4, c5])
-
-
-def _evaluate(coeffs: FloatArray, tau: float) -> tuple[FloatArray, FloatArray, FloatArray]:
-    powers = tau ** np.arange(6)
-    k = np.arange(6)
-    p = powers @ coeffs
-    v = (k[1:] * powers[:-1]) @ coeffs[1:]
-    a = (k[2:] * (k[2:] - 1) * powers[:-2]) @ coeffs[2:]
-    return p, v, a
+        if self.swing_time is not None and self.swing_time > self.max_swing_time:
+            raise InvalidParameterError(
+                f"swing_time must be ≤ max_swing_time {self.max_swing_time:g} s, "
+                f"got {self.swing_time!r}"
+            )
 
 
 def _yaw(rot: FloatArray) -> float:
@@ -209,11 +193,14 @@ class Stepper:
     floor, com_height : float
         The floor's height under the soles [m] and the CoM's above it [m] at reset.
     settings : StepSettings, optional
+    hip : bool
+        The controller's hip (CMP) task helps: the plans count on the hip's box H.
     """
 
     def __init__(
         self, model: Any, params: BodyParams, feet: tuple[FootContact, ...], left: int,
-        floor: float, com_height: float, settings: StepSettings | None = None,
+        floor: float, com_height: float, settings: StepSettings | None = None, *,
+        hip: bool = False,
     ) -> None:  # fmt: skip
         if not isinstance(params, BodyParams):
             raise InvalidParameterError(f"params must be a BodyParams, got {type(params).__name__}")
@@ -224,9 +211,13 @@ class Stepper:
             raise InvalidParameterError(
                 f"step settings must be a StepSettings, got {type(settings).__name__}"
             )
+        if not isinstance(hip, bool):
+            raise InvalidParameterError(f"hip must be a bool, got {hip!r}")
         self._model = model
         self.params = replace(params, com_height=com_height)
         self.feet, self.left, self.floor, self.settings = feet, left, floor, settings
+        self.hip = hip
+        self.legs = tuple(leg_joints(model, foot.body) for foot in feet)
         self.swing_time = max(0.05, params.min_step_time if settings.swing_time is None
                               else settings.swing_time)  # fmt: skip
         self.swing: int | None = None
@@ -239,30 +230,30 @@ class Stepper:
     def _side(self, index: int) -> Stance:
         return Stance.LEFT if index == self.left else Stance.RIGHT
 
-    def _support(self, data: Any, stance: Stance) -> Support:
-        poses = {}
-        for i, foot in enumerate(self.feet):
-            rot = np.asarray(data.xmat[foot.body]).reshape(3, 3)
-            x, y = np.asarray(data.xpos[foot.body])[:2]
-            poses[self._side(i).value] = FootPose(float(x), float(y), _yaw(rot))
-        return Support.from_params(self.params, stance, **poses)
+    def _pose(self, data: Any, index: int) -> FootPose:
+        body = self.feet[index].body
+        rot = np.asarray(data.xmat[body]).reshape(3, 3)
+        x, y = np.asarray(data.xpos[body])[:2]
+        return FootPose(float(x), float(y), _yaw(rot))
 
-    def _foothold(self, data: Any, swing: Stance | None, stance: Stance, t: float) -> tuple[
-        Stance, FloatArray
-    ]:  # fmt: skip
+    def _foothold(self, data: Any, swing: int, t: float) -> tuple[FloatArray, int]:
+        """Plan the foothold of foot ``swing`` for a touchdown after t [s] (wbc_step_plan)."""
         com, vel = np.asarray(data.subtree_com[0]), np.asarray(data.subtree_linvel[0])
-        support = self._support(data, stance)
         state = (float(com[0]), float(com[1]), float(vel[0]), float(vel[1]))
-        region = capture_region(*state, self.params, support, t, swing=swing)
-        if region.foothold is None:
-            region = capture_region(*state, self.params, support, t, swing=region.swing, steps=2)
-        if region.foothold is not None:
-            return region.swing, np.asarray(region.foothold, dtype=float)
-        pose = support.right if region.swing is Stance.LEFT else support.left
+        stance = (self._side(1 - swing), self._pose(data, 1 - swing))
+        return plan_foothold(self.params, state, stance, self._pose(data, swing), t, hip=self.hip)
+
+    def _swing_foot(self, data: Any) -> int:
+        """Return the foot on the capture point's side of the ankles' midpoint (library rule)."""
+        com, vel = np.asarray(data.subtree_com[0]), np.asarray(data.subtree_linvel[0])
         xi = com[:2] + vel[:2] / self.params.omega
-        offset = xi - np.array([pose.x, pose.y])
-        offset *= min(1.0, self.params.max_step_length / max(float(np.linalg.norm(offset)), 1e-9))
-        return region.swing, np.array([pose.x, pose.y]) + offset
+        poses = [self._pose(data, i) for i in range(2)]
+        middle = 0.5 * np.array([poses[0].x + poses[1].x, poses[0].y + poses[1].y])
+        left = poses[self.left].yaw
+        right = poses[1 - self.left].yaw
+        yaw = math.atan2(math.sin(left) + math.sin(right), math.cos(left) + math.cos(right))
+        lateral = -math.sin(yaw) * (xi[0] - middle[0]) + math.cos(yaw) * (xi[1] - middle[1])
+        return self.left if lateral >= 0.0 else 1 - self.left
 
     def decide(self, xi: FloatArray, region: ConvexPolygon) -> bool:
         """Whether ξ [m] is more than ``margin`` outside ``region`` (P or the CMP region)."""
@@ -276,18 +267,33 @@ class Stepper:
         return np.asarray(data.xpos[foot.body]) + rot @ foot.origin, rot
 
     def lift_off(self, data: Any) -> int:
-        """Plan a step from double support and start its swing; return the swing foot's index."""
-        t = float(data.time)
-        side, foothold = self._foothold(data, None, Stance.DOUBLE, self.swing_time)
-        index = self.left if side is Stance.LEFT else 1 - self.left
+        """Plan a step from double support and start its swing; return the swing foot's index.
+
+        The swing time starts at ``swing_time`` and grows to what the swing hip needs for the
+        planned foothold (:func:`~.wbc_step_plan.leg_swing_time`, ``torque_share``), the
+        foothold re-planned for it, until the two agree within 10 ms or ``max_swing_time``.
+        """
+        t0, s = float(data.time), self.settings
+        index = self._swing_foot(data)
+        cop = np.asarray(data.xpos[self.feet[1 - index].body][:2], dtype=float)
+        span = self.swing_time
+        foothold, _ = self._foothold(data, index, span)
+        for _ in range(8 if s.torque_share is not None else 0):
+            assert s.torque_share is not None
+            need = leg_swing_time(self._model, data, self.legs[index], foothold, cop,
+                                  self.params.omega, span, s.torque_share)  # fmt: skip
+            if need <= span + 0.01 or span >= s.max_swing_time:
+                break
+            span = min(s.max_swing_time, need)
+            foothold, _ = self._foothold(data, index, span)
         point, self._rot = self.sole(data, index)
-        self.swing, self._start = index, t
-        self._end = t + self.swing_time
-        self._planned = t
-        self._z = np.array([point[2], self.floor - self.settings.sink])
-        self._coeffs = quintic(point[:2], np.zeros(2), np.zeros(2), foothold, self.swing_time)
-        record = StepRecord(self.feet[index].name, t, self._end)
-        record.plans.append((t, float(foothold[0]), float(foothold[1])))
+        self.swing, self._start = index, t0
+        self._end = t0 + span
+        self._planned = t0
+        self._z = np.array([point[2], self.floor - s.sink])
+        self._coeffs = quintic(point[:2], np.zeros(2), np.zeros(2), foothold, span)
+        record = StepRecord(self.feet[index].name, t0, self._end)
+        record.plans.append((t0, float(foothold[0]), float(foothold[1])))
         self.steps.append(record)
         return index
 
@@ -295,7 +301,7 @@ class Stepper:
         """Return the swing foot's reference position [m], velocity [m/s], acceleration [m/s²]."""
         span = self._end - self._start
         tau = min(t, self._end) - self._planned
-        xy, vxy, axy = _evaluate(self._coeffs, tau)
+        xy, vxy, axy = evaluate(self._coeffs, tau)
         if t >= self._end:
             z = self._z[1] - self.settings.sink_speed * (t - self._end)
             return (np.array([*xy, z]), np.array([0.0, 0.0, -self.settings.sink_speed]),
@@ -321,9 +327,8 @@ class Stepper:
         record = self.steps[-1]
         if t - record.plans[-1][0] < s.replan_period - 1e-9:
             return
-        stance = self._side(1 - self.swing)
-        _, foothold = self._foothold(data, self._side(self.swing), stance, self._end - t)
-        xy, vxy, axy = _evaluate(self._coeffs, t - self._planned)
+        foothold, _ = self._foothold(data, self.swing, self._end - t)
+        xy, vxy, axy = evaluate(self._coeffs, t - self._planned)
         self._coeffs, self._planned = quintic(xy, vxy, axy, foothold, self._end - t), t
         record.plans.append((t, float(foothold[0]), float(foothold[1])))
 
@@ -347,7 +352,37 @@ class Stepper:
         matrix = np.zeros((6, size))
         matrix[:3, :nv], matrix[3:, :nv] = jacp, jacr
         target = np.concatenate([linear - dotp @ qvel, angular - dotr @ qvel])
+        scale = math.sqrt(s.lift_weight)  # the vertical row weighs lift_weight × W
+        matrix[2] *= scale
+        target[2] *= scale
         return Task("swing", matrix, target, s.weight)
+
+    def knee_guard(self, data: Any, size: int, nv: int) -> list[Task]:
+        """Return a task per knee below ``knee_min`` or reaching it within 50 ms (settings)."""
+        s, model = self.settings, self._model
+        rows, targets = [], []
+        qvel = np.asarray(data.qvel, dtype=float)
+        for leg in self.legs:
+            if leg.knee < 0:
+                continue
+            angle = float(data.qpos[int(model.jnt_qposadr[leg.knee])])
+            dof = int(model.jnt_dofadr[leg.knee])
+            if angle + 0.05 * min(float(qvel[dof]), 0.0) >= s.knee_min:
+                continue
+            row = np.zeros(size)
+            row[dof] = 1.0
+            rows.append(row)
+            targets.append(s.stiffness * (s.knee_min - angle) - s.damping * float(qvel[dof]))
+        if not rows:
+            return []
+        return [Task("knee guard", np.array(rows), np.array(targets), s.knee_weight)]
+
+    def tasks(self, data: Any, size: int, nv: int) -> list[Task]:
+        """Return the stepping tasks now: the swing foot's (while it swings), the knee guard."""
+        tasks = self.knee_guard(data, size, nv)
+        if self.swing is not None:
+            tasks.append(self.task(data, size, nv))
+        return tasks
 
     def landed(self, data: Any) -> bool:
         """Detect touchdown (module docstring); on it, record the landing and end the swing."""

@@ -1,0 +1,258 @@
+r"""Planning a step of the whole-body controller: the swing leg, its foothold and swing time.
+
+World frame, x forward, y left, z up, SI units. Used by :class:`~.wbc_step.Stepper`.
+
+* **Foothold** (:func:`plan_foothold`): the library's one-step capture region
+  (:func:`~pushrecovery.surfaces.capture_region.capture_region`) of the CoM state for a
+  touchdown after t, the stance foot's measured pose as a single-support
+  :class:`~pushrecovery.ground.support.Support` (a crossed or touching pair of feet is no
+  valid double support; the swing foot is named instead); its recommended ``foothold`` (the
+  region's Chebyshev centre). An empty region falls back to the first foothold of a two-step
+  plan, then to the stance ankle plus the capture point's offset clipped to the step length.
+* **Swing time** (:func:`leg_swing_time`): the step time of the plan is what the swing hip
+  can drive. The swing foot's quintic (rest to rest, distance d in time T) peaks at
+  a = (10/√3) d / T²; the leg swings about the hip, so with Δθ = d/ℓ (ℓ the hip's height
+  above the floor), I the leg's inertia about the hip axis and a share κ of the hip motor's
+  limit τ,
+
+  .. math:: T \ge \sqrt{\frac{10}{\sqrt 3}\,\frac{\Delta\theta\, I}{\kappa\, \tau}}
+
+  per axis (pitch for the forward part of d, roll for the lateral part, in the pelvis'
+  heading), d the change of the foot's offset from the hip: the hip moves with the CoM,
+  c(T) = p + (c − p) cosh ωT + (ċ/ω) sinh ωT (the LIPM on the stance ankle p).
+  :class:`~.wbc_step.Stepper` re-plans with the longer time until the two agree.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.support import FootPose, Stance, Support
+from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.capture_region import capture_region
+
+FloatArray = NDArray[np.float64]
+
+__all__ = [
+    "Leg",
+    "StepRecord",
+    "axis_inertia",
+    "evaluate",
+    "leg_joints",
+    "leg_swing_time",
+    "lipm_com",
+    "plan_foothold",
+    "quintic",
+]
+
+#: Peak acceleration of a rest-to-rest quintic over its distance / duration² [-]: 10/√3.
+QUINTIC_PEAK = 10.0 / math.sqrt(3.0)
+
+
+@dataclass
+class StepRecord:
+    """One step: the swing foot, its timing [s] and its footholds [m] (world xy).
+
+    ``plans`` lists (time, foothold x, foothold y) of the first plan and every re-plan;
+    ``landed`` is the ankle's ground point at touchdown (None while in the air).
+    """
+
+    foot: str
+    liftoff: float
+    planned_touchdown: float
+    plans: list[tuple[float, float, float]] = field(default_factory=list)
+    touchdown: float | None = None
+    landed: FloatArray | None = None
+
+    @property
+    def foothold(self) -> FloatArray:
+        """Return the last planned foothold [m]."""
+        return np.array(self.plans[-1][1:])
+
+    @property
+    def error(self) -> float:
+        """Distance from the landed ankle to the last planned foothold [m] (nan in the air)."""
+        if self.landed is None:
+            return math.nan
+        return float(np.linalg.norm(self.landed - self.foothold))
+
+
+def quintic(p0: FloatArray, v0: FloatArray, a0: FloatArray, p1: FloatArray,
+            duration: float) -> FloatArray:  # fmt: skip
+    """Return c (6, d) with p(τ) = Σ_k c_k τ^k from (p0, v0, a0) to (p1, 0, 0) at τ = duration.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``duration`` is not positive.
+    """
+    if not duration > 0.0:
+        raise InvalidParameterError(f"duration must be > 0 s, got {duration!r}")
+    t = duration
+    gap = p1 - p0 - v0 * t - 0.5 * a0 * t**2
+    rate, curve = -v0 - a0 * t, -a0
+    c3 = (10.0 * gap - 4.0 * rate * t + 0.5 * curve * t**2) / t**3
+    c4 = (-15.0 * gap + 7.0 * rate * t - curve * t**2) / t**4
+    c5 = (6.0 * gap - 3.0 * rate * t + 0.5 * curve * t**2) / t**5
+    return np.array([p0, v0, 0.5 * a0, c3, c4, c5])
+
+
+def evaluate(coeffs: FloatArray, tau: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Return p, ṗ, p̈ of the polynomial Σ_k c_k τ^k (c from :func:`quintic`) at τ [s]."""
+    powers = tau ** np.arange(6)
+    k = np.arange(6)
+    p = powers @ coeffs
+    v = (k[1:] * powers[:-1]) @ coeffs[1:]
+    a = (k[2:] * (k[2:] - 1) * powers[:-2]) @ coeffs[2:]
+    return p, v, a
+
+
+@dataclass(frozen=True)
+class Leg:
+    """The hinge joints of one leg that the swing time and the knee guard need (ids or −1).
+
+    Found by name on the bodies from the foot up to the root: ``hip_pitch``, ``hip_roll``,
+    ``knee`` (the biped3d's ``left_hip_pitch``, the G1's ``left_hip_pitch_joint``).
+    """
+
+    foot: int
+    hip_pitch: int = -1
+    hip_roll: int = -1
+    knee: int = -1
+
+
+def leg_joints(model: Any, foot: int) -> Leg:
+    """Return the :class:`Leg` of foot body ``foot`` in ``model``."""
+    import mujoco
+
+    found: dict[str, int] = {}
+    body = foot
+    while body > 0:
+        for joint in range(int(model.njnt)):
+            if int(model.jnt_bodyid[joint]) != body:
+                continue
+            if int(model.jnt_type[joint]) != mujoco.mjtJoint.mjJNT_HINGE:
+                continue
+            name = model.joint(joint).name
+            for key in ("hip_pitch", "hip_roll", "knee"):
+                if key in name and key not in found:
+                    found[key] = joint
+        body = int(model.body_parentid[body])
+    return Leg(foot, **found)
+
+
+def axis_inertia(model: Any, data: Any, joint: int) -> float:
+    """Return the inertia of ``joint``'s subtree about its axis [kg m²], armature included.
+
+    I = Σ_b m_b |a × (c_b − o)|² + aᵀ R_b I_b R_bᵀ a over the bodies b below the joint (a its
+    unit axis, o its anchor, after ``mj_kinematics``).
+    """
+    axis = np.asarray(data.xaxis[joint], dtype=float)
+    anchor = np.asarray(data.xanchor[joint], dtype=float)
+    first = int(model.jnt_bodyid[joint])
+    total = float(model.dof_armature[int(model.jnt_dofadr[joint])])
+    for body in range(first, int(model.nbody)):
+        parent = body
+        while parent > first:
+            parent = int(model.body_parentid[parent])
+        if parent != first:
+            continue
+        lever = np.cross(axis, np.asarray(data.xipos[body]) - anchor)
+        rot = np.asarray(data.ximat[body], dtype=float).reshape(3, 3)
+        local = rot.T @ axis
+        total += float(model.body_mass[body]) * float(lever @ lever)
+        total += float(local @ (np.asarray(model.body_inertia[body]) * local))
+    return total
+
+
+def lipm_com(com: FloatArray, vel: FloatArray, cop: FloatArray, omega: float,
+             t: float) -> FloatArray:  # fmt: skip
+    """Return the LIPM's CoM [m] after t [s] on a still CoP: p + (c − p) cosh ωt + ċ/ω sinh ωt."""
+    return cop + (com - cop) * math.cosh(omega * t) + vel / omega * math.sinh(omega * t)
+
+
+def plan_foothold(
+    params: BodyParams,
+    state: tuple[float, float, float, float],
+    stance: tuple[Stance, FootPose],
+    swing_pose: FootPose,
+    t: float,
+    *,
+    hip: bool,
+) -> tuple[FloatArray, int]:
+    """Return the foothold [m] (ankle, world xy) of the free foot and the plan's step count.
+
+    ``state`` is (x, y, ẋ, ẏ) of the CoM [m, m/s], ``stance`` the stance side and its pose,
+    ``swing_pose`` the swing foot's pose now, ``t`` the time to touchdown [s]; ``hip``: the
+    controller's hip task helps (the region's box H). Step count 1 or 2, 0 for the clipped
+    fallback (module docstring).
+    """
+    side, pose = stance
+    poses = {"left": pose, "right": swing_pose} if side is Stance.LEFT else {
+        "left": swing_pose, "right": pose}  # fmt: skip
+    support = Support.from_params(params, side, **poses)
+    for steps in (1, 2):
+        region = capture_region(*state, params, support, t, steps=steps, hip=hip)
+        if region.foothold is not None:
+            return np.asarray(region.foothold, dtype=float), steps
+    xi = np.array(state[:2]) + np.array(state[2:]) / params.omega
+    offset = xi - np.array([pose.x, pose.y])
+    offset *= min(1.0, params.max_step_length / max(float(np.linalg.norm(offset)), 1e-9))
+    return np.array([pose.x, pose.y]) + offset, 0
+
+
+def leg_swing_time(
+    model: Any,
+    data: Any,
+    leg: Leg,
+    foothold: FloatArray,
+    cop: FloatArray,
+    omega: float,
+    t: float,
+    torque_share: float,
+) -> float:
+    """Return the shortest swing T [s] the hip of ``leg`` drives to ``foothold`` (module doc).
+
+    ``cop`` is the stance ankle the LIPM turns about [m], ``t`` the swing time the foothold
+    was planned for [s] (the hip's displacement is taken over it), ``torque_share`` κ in
+    (0, 1]. 0 when the leg has no hip joints named as :func:`leg_joints` finds them.
+    """
+    import mujoco
+
+    if leg.hip_pitch < 0 and leg.hip_roll < 0:
+        return 0.0
+    mujoco.mj_subtreeVel(model, data)
+    com = np.asarray(data.subtree_com[0][:2], dtype=float)
+    vel = np.asarray(data.subtree_linvel[0][:2], dtype=float)
+    hip_joint = leg.hip_pitch if leg.hip_pitch >= 0 else leg.hip_roll
+    hip = np.asarray(data.xanchor[hip_joint], dtype=float)
+    foot = np.asarray(data.xpos[leg.foot][:2], dtype=float)
+    moved = lipm_com(com, vel, cop, omega, t) - com
+    change = (foothold - (hip[:2] + moved)) - (foot - hip[:2])
+    height = max(float(hip[2]) - float(data.xpos[leg.foot][2]), 0.1)
+    # The pelvis' heading: the hip pitch axis is its lateral (y) direction.
+    lateral = np.asarray(data.xaxis[hip_joint][:2], dtype=float)
+    if leg.hip_pitch < 0 or float(np.linalg.norm(lateral)) < 1e-9:
+        lateral = np.array([0.0, 1.0])
+    lateral = lateral / float(np.linalg.norm(lateral))
+    forward = np.array([lateral[1], -lateral[0]])
+    need = 0.0
+    for joint, part in ((leg.hip_pitch, forward @ change), (leg.hip_roll, lateral @ change)):
+        if joint < 0:
+            continue
+        actuators = np.flatnonzero(np.asarray(model.actuator_trnid[:, 0]) == joint)
+        if actuators.size == 0:
+            continue
+        limit = float(np.abs(model.actuator_ctrlrange[actuators[0]]).min())
+        limit *= abs(float(model.actuator_gear[actuators[0], 0])) * torque_share
+        if limit <= 0.0:
+            continue
+        angle = abs(float(part)) / height
+        need = max(need, math.sqrt(QUINTIC_PEAK * angle * axis_inertia(model, data, joint) / limit))
+    return need
