@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.errors import InvalidParameterError
 
@@ -19,8 +19,10 @@ if TYPE_CHECKING:
 __all__ = [
     "Frame",
     "FrameLike",
+    "select_indices",
     "select_times",
     "subsample",
+    "subsample_indices",
 ]
 
 
@@ -97,6 +99,58 @@ def _nearest(times: NDArray[np.float64], targets: NDArray[np.float64]) -> list[i
     return [int(i) for i in np.unique(idx)]
 
 
+def subsample_indices(times: ArrayLike, fps: float) -> list[int]:
+    """Return the indices of the times nearest to a grid of ``fps`` per second (ends kept).
+
+    Parameters
+    ----------
+    times : Sequence[float]
+        Frame times [s], finite and non-decreasing (any frames: 2-D or 3-D).
+    fps : float
+        Target frame rate [1/s], > 0.
+
+    Returns
+    -------
+    list[int]
+        Increasing indices, at most about ``duration * fps + 1`` of them.
+    """
+    if not (math.isfinite(fps) and fps > 0.0):
+        raise InvalidParameterError(f"fps must be > 0 1/s, got {fps:g}")
+    t = _checked_times(times)
+    count = math.floor((t[-1] - t[0]) * fps + 1e-9) + 1
+    return _nearest(t, np.append(t[0] + np.arange(count) / fps, t[-1]))
+
+
+def select_indices(times: ArrayLike, count: int) -> list[int]:
+    """Return the indices of the times nearest to ``count`` evenly spaced times.
+
+    Parameters
+    ----------
+    times : Sequence[float]
+        Frame times [s], finite and non-decreasing.
+    count : int
+        Number of frames wanted, >= 1 (fewer are returned if there are fewer distinct ones).
+
+    Returns
+    -------
+    list[int]
+        Increasing indices.
+    """
+    if count < 1:
+        raise InvalidParameterError(f"count must be >= 1, got {count}")
+    t = _checked_times(times)
+    return _nearest(t, np.linspace(t[0], t[-1], count))
+
+
+def _checked_times(times: ArrayLike) -> NDArray[np.float64]:
+    t = np.asarray(times, dtype=float).reshape(-1)
+    if t.size == 0:
+        raise InvalidParameterError("frames must not be empty")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0.0):
+        raise InvalidParameterError("frame times must be finite and non-decreasing")
+    return t
+
+
 def subsample(frames: Sequence[FrameLike], fps: float) -> list[Frame]:
     """Frames nearest to a regular grid of ``fps`` frames per second (first and last kept).
 
@@ -115,10 +169,7 @@ def subsample(frames: Sequence[FrameLike], fps: float) -> list[Frame]:
     if not (math.isfinite(fps) and fps > 0.0):
         raise InvalidParameterError(f"fps must be > 0 1/s, got {fps:g}")
     frames = _as_frames(frames)
-    times = _times(frames)
-    count = math.floor((times[-1] - times[0]) * fps + 1e-9) + 1
-    targets = np.append(times[0] + np.arange(count) / fps, times[-1])
-    return [frames[i] for i in _nearest(times, targets)]
+    return [frames[i] for i in subsample_indices(_times(frames), fps)]
 
 
 def select_times(frames: Sequence[FrameLike], count: int) -> list[Frame]:
@@ -139,5 +190,4 @@ def select_times(frames: Sequence[FrameLike], count: int) -> list[Frame]:
     if count < 1:
         raise InvalidParameterError(f"count must be >= 1, got {count}")
     frames = _as_frames(frames)
-    times = _times(frames)
-    return [frames[i] for i in _nearest(times, np.linspace(times[0], times[-1], count))]
+    return [frames[i] for i in select_indices(_times(frames), count)]

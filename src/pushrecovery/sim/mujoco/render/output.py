@@ -57,11 +57,17 @@ def _rgb(rgba: tuple[float, float, float, float]) -> tuple[int, int, int]:
     return (round(255 * rgba[0]), round(255 * rgba[1]), round(255 * rgba[2]))
 
 
-def _draw_legend(draw: Any, x: int, y: int, height: int, font: Any) -> None:
+#: A legend: (label, RGBA colour) per marker.
+Legend = Sequence[tuple[str, tuple[float, float, float, float]]]
+
+
+def _draw_legend(
+    draw: Any, x: int, y: int, height: int, font: Any, legend: Legend = LEGEND
+) -> None:
     """Coloured dots and names of the markers, starting at (x, y) in a strip of ``height``."""
     r = max(3, height // 4)
     cy = y + height // 2
-    for name, rgba in LEGEND:
+    for name, rgba in legend:
         draw.ellipse((x, cy - r, x + 2 * r, cy + r), fill=_rgb(rgba))
         x += 2 * r + 4
         draw.text((x, cy), name, fill=(0, 0, 0), font=font, anchor="lm")
@@ -93,6 +99,7 @@ def write_filmstrip(
     path: Path,
     *,
     title: str | None = None,
+    legend: Legend = LEGEND,
 ) -> Path:
     """Write the images side by side, each labelled ``t = ... s``, with a legend, as a PNG.
 
@@ -106,6 +113,8 @@ def write_filmstrip(
         Output file (PNG, 256-colour palette to keep it small); parents are created.
     title : str or None
         Optional line of text above the panels.
+    legend : sequence of (str, RGBA)
+        The markers' names and colours (default the side view's CoM, capture point, CoP).
 
     Returns
     -------
@@ -132,13 +141,17 @@ def write_filmstrip(
             (x + w // 2, top + _LABEL_HEIGHT // 2), label, fill=(0, 0, 0), font=font, anchor="mm"
         )
         canvas.paste(Image.fromarray(np.asarray(image, dtype=np.uint8)), (x, top + _LABEL_HEIGHT))
-    _draw_legend(draw, _GAP, top + _LABEL_HEIGHT + h, _LEGEND_HEIGHT, font)
+    _draw_legend(draw, _GAP, top + _LABEL_HEIGHT + h, _LEGEND_HEIGHT, font, legend)
     paletted = canvas.quantize(colors=256, dither=Image.Dither.NONE)
     return _save(paletted, Path(path), optimize=True)
 
 
 def write_animation(
-    images: Sequence[NDArray[np.uint8]], times: Sequence[float], path: Path
+    images: Sequence[NDArray[np.uint8]],
+    times: Sequence[float],
+    path: Path,
+    *,
+    legend: Legend = LEGEND,
 ) -> Path:
     """Write the images as a looping GIF played in real time, with time label and legend.
 
@@ -151,6 +164,8 @@ def write_animation(
         GIF's 10 ms unit without drift); the last frame is held ``HOLD_LAST`` s.
     path : Path
         Output file (GIF); parents are created.
+    legend : sequence of (str, RGBA)
+        The markers' names and colours (default the side view's CoM, capture point, CoP).
 
     Returns
     -------
@@ -172,7 +187,7 @@ def write_animation(
         canvas = Image.new("RGB", (w, h + _LEGEND_HEIGHT), "white")
         canvas.paste(Image.fromarray(np.asarray(image, dtype=np.uint8)), (0, 0))
         draw = ImageDraw.Draw(canvas)
-        _draw_legend(draw, _GAP, h, _LEGEND_HEIGHT, font)
+        _draw_legend(draw, _GAP, h, _LEGEND_HEIGHT, font, legend)
         draw.text(
             (w - _GAP, h + _LEGEND_HEIGHT // 2),
             f"t = {time:.2f} s",
