@@ -17,7 +17,14 @@ from pushrecovery.cli.options import (
     params_from,
 )
 from pushrecovery.cli.progress import Progress
-from pushrecovery.cli.simulation3d import _check_3d, _critical_3d, _params_3d, _simulate_3d
+from pushrecovery.cli.simulation3d import (
+    _check_3d,
+    _check_views,
+    _critical_3d,
+    _params_3d,
+    _render_options,
+    _simulate_3d,
+)
 from pushrecovery.cli.simulation_options import (
     MUJOCO_3D_MODEL_CHOICES,
     _azimuth,
@@ -29,6 +36,7 @@ from pushrecovery.cli.simulation_options import (
     _model,
     _options_for,
     _push_velocity,
+    _views,
     _with,
 )
 
@@ -84,8 +92,10 @@ __all__ = ["critical_push", "simulate"]
     type=click.Path(dir_okay=False),
     default=None,
     help="MuJoCo only: write a filmstrip PNG of the run to this file and an animated GIF "
-    "beside it (CoM, capture point and CoP drawn).",
+    "beside it (CoM, capture point and CoP drawn; on the 3-D models also the support polygon, "
+    "from a tracking camera: --view-azimuth, --view-elevation, --frame-times).",
 )
+@_with(*_views)
 @body_options
 def simulate(
     backend: str,
@@ -104,6 +114,9 @@ def simulate(
     control_period: float | None,
     plot: str | None,
     render: str | None,
+    view_azimuth: float | None,
+    view_elevation: float | None,
+    frame_times: str | None,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
@@ -132,12 +145,21 @@ def simulate(
                 f"--model {model} starts standing still: push it with --impulse and --azimuth "
                 "(no --x, --xdot, --y, --ydot)"
             )
-        if plot or render:
+        if plot:
             from pushrecovery.errors import InvalidParameterError
 
-            raise InvalidParameterError(f"--plot and --render are not available for {model} yet")
-        emit(_simulate_3d(model, _params_3d(model, kwargs), impulse, azimuth, duration), as_json)
+            raise InvalidParameterError(f"--plot is not available for {model} yet")
+        if not render:
+            _check_views(view_azimuth, view_elevation, frame_times)
+        pictures = _render_options(azimuth, view_azimuth, view_elevation, frame_times)
+        body = _params_3d(model, kwargs)
+        if render:
+            from pushrecovery.sim.mujoco.render import require_offscreen_gl
+
+            require_offscreen_gl()  # fail before the run, not after it
+        emit(_simulate_3d(model, body, impulse, azimuth, duration, render, pictures), as_json)
         return
+    _check_views(view_azimuth, view_elevation, frame_times)
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)
     plane = model == "stepping-plane"

@@ -58,10 +58,99 @@ def _params_3d(model: str, kwargs: dict[str, Any]) -> Any:
     return robot_params("g1")
 
 
-def _simulate_3d(
-    model: str, params: Any, impulse: float | None, azimuth: float | None, duration: float
+def _check_views(
+    view_azimuth: float | None, view_elevation: float | None, frame_times: str | None
+) -> None:
+    """Refuse the 3-D camera flags where they do not apply (a planar model, no --render)."""
+    from pushrecovery.errors import InvalidParameterError
+
+    if view_azimuth is not None or view_elevation is not None or frame_times is not None:
+        raise InvalidParameterError(
+            "--view-azimuth, --view-elevation and --frame-times apply to --render of the 3-D "
+            "models (--model biped3d or g1)"
+        )
+
+
+def _render_options(
+    azimuth: float | None,
+    view_azimuth: float | None,
+    view_elevation: float | None,
+    frame_times: str | None,
 ) -> dict[str, Any]:
-    """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON)."""
+    """Return the camera and filmstrip times of the 3-D ``--render`` (checked before the run)."""
+    import itertools
+    import math
+
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.sim.mujoco.humanoid3d.render3d import default_camera
+    from pushrecovery.sim.mujoco.render.scene3d import Camera3D
+
+    camera = default_camera(0.0 if azimuth is None else azimuth)
+    try:
+        camera = Camera3D(
+            camera.azimuth if view_azimuth is None else view_azimuth,
+            camera.elevation if view_elevation is None else view_elevation,
+        )
+    except InvalidParameterError as exc:  # name the flag: "--view-elevation must be ..."
+        raise InvalidParameterError(f"--view-{exc}") from None
+    times = None
+    if frame_times is not None:
+        try:
+            times = [float(t) for t in frame_times.split(",")]
+        except ValueError:
+            times = [math.nan]
+        if not (
+            1 <= len(times) <= 20
+            and all(math.isfinite(t) and t >= 0.0 for t in times)
+            and all(b > a for a, b in itertools.pairwise(times))
+        ):
+            raise InvalidParameterError(
+                "--frame-times must be 1 to 20 increasing times >= 0 s separated by commas, "
+                f"got {frame_times[:40]!r}"
+            )
+    return {"camera": camera, "times": times}
+
+
+def _render_3d(plant: Any, run: Any, path: str, options: dict[str, Any]) -> dict[str, Any]:
+    """Write the filmstrip PNG and GIF of a recorded 3-D run (the JSON's new keys)."""
+    import shutil
+    from pathlib import Path
+
+    from pushrecovery.errors import PushRecoveryError
+    from pushrecovery.sim.mujoco.humanoid3d.render3d import Recording3D, render_recording3d
+
+    png, gif = render_recording3d(Recording3D.of_plant_run(plant, run), Path(path), **options)
+    camera = options["camera"]
+    data: dict[str, Any] = {
+        "render": [str(png), str(gif)],
+        "view": {"azimuth": camera.azimuth, "elevation": camera.elevation},
+    }
+    if plant.name == "g1":  # pictures of the robot's meshes: its licence beside them
+        from pushrecovery.sim.mujoco.humanoid3d.robots import robot_licence
+
+        licence = png.with_suffix(".LICENSE")
+        try:
+            shutil.copyfile(robot_licence("g1"), licence)
+        except OSError as exc:
+            raise PushRecoveryError(f"cannot write {licence}: {exc.strerror or exc}") from exc
+        data["licence"] = str(licence)
+    return data
+
+
+def _simulate_3d(
+    model: str,
+    params: Any,
+    impulse: float | None,
+    azimuth: float | None,
+    duration: float,
+    render: str | None = None,
+    render_options: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON).
+
+    With ``render`` (``--render FILE``) the run is recorded and its filmstrip PNG and GIF
+    written (``render_options``: :func:`_render_options`).
+    """
     import numpy as np
 
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import STATE_LABELS, wbc_for
@@ -74,7 +163,7 @@ def _simulate_3d(
     dvx, dvy = push.delta_velocity(params.mass)
     predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
     plant: Any = make_plant(model, params, "mujoco")
-    run = simulate_push3d(plant, wbc_for(plant), push, duration=duration)
+    run = simulate_push3d(plant, wbc_for(plant), push, duration=duration, record=bool(render))
     states, before, after = run.states, run.before_push, run.after_push
     return {
         "recovered": run.recovered,
@@ -110,7 +199,7 @@ def _simulate_3d(
         "peak_hip_motor_torque": run.peak_hip_motor_torque,
         "max_torso_tilt": run.max_torso_tilt,
         "failed_ticks": run.failed_ticks,
-    }
+    } | (_render_3d(plant, run, render, render_options or {}) if render else {})
 
 
 def _critical_3d(

@@ -97,6 +97,29 @@ _azimuth = click.option(
     default=None,
     help="3-D models only: the push's direction [deg], 0 forward (+x), 90 left (+y); default 0.",
 )
+_views = (
+    click.option(
+        "--view-azimuth",
+        type=float,
+        default=None,
+        help="3-D models, --render: where the camera stands [deg], 0 in front of the body, 90 on "
+        "its left; default the push's azimuth - 90 (the push goes left to right).",
+    ),
+    click.option(
+        "--view-elevation",
+        type=float,
+        default=None,
+        help="3-D models, --render: the camera's elevation above the horizon [deg], in [-30, 89]; "
+        "default 25.",
+    ),
+    click.option(
+        "--frame-times",
+        default=None,
+        metavar="T1,T2,...",
+        help="3-D models, --render: the filmstrip's frame times [s] after the start, increasing "
+        "(default 6 evenly spaced).",
+    ),
+)
 _controller = click.option(
     "--controller",
     type=click.Choice(CONTROLLER_CHOICES),
