@@ -1,4 +1,4 @@
-"""The stepping task of the whole-body controller (issue 19 item 3): a lateral capture step."""
+"""The stepping task of the whole-body controller (issue 19 item 3): steps in every direction."""
 
 import math
 
@@ -12,7 +12,8 @@ from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.wbc import WholeBodyQP, foot_contact
 from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos, push_biped3d
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step import StepSettings, quintic
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings, quintic
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import axis_inertia, leg_joints, lipm_com
 
 #: The push, in CoP-region critical impulses (docs/plane.md): well outside the ankle region.
 OUTSIDE = 1.5
@@ -73,10 +74,82 @@ def test_side_push_recovers_with_a_lateral_step(runs):
     assert run.sole_lift[:, 1].max() < 0.01  # an edge of the stance sole rises a few mm
 
 
-def test_wrenches_satisfy_friction_and_cop_rows_at_every_tick(runs):
-    run = runs[True]
+#: Forward and diagonal pushes: azimuth [deg] -> the foot that must step (the push's side).
+DIRECTIONS = {0.0: None, 30.0: "left_foot"}
+
+
+@pytest.fixture(scope="module")
+def direction_runs(params, model):
+    """OUTSIDE × the ankle's critical impulse along each azimuth, without and with stepping."""
+    polygon = Support.from_params(params).polygon
+    runs = {}
+    for azimuth in DIRECTIONS:
+        heading = math.radians(azimuth)
+        impulse = OUTSIDE * params.mass * params.omega * polygon.ray_distance(0.0, 0.0, heading)
+        for stepping in (False, True):
+            runs[azimuth, stepping] = push_biped3d(
+                params, impulse, heading, duration=2.0, model=model, stepping=stepping,
+                step_settings=StepSettings(swing_time=0.2),
+            )  # fmt: skip
+    return runs
+
+
+@pytest.mark.parametrize("azimuth", sorted(DIRECTIONS))
+def test_forward_and_diagonal_pushes_fall_without_and_recover_with_a_step(direction_runs, azimuth):
+    fell = direction_runs[azimuth, False]
+    assert fell.com[-1, 2] < 0.6 or fell.torso_tilt.max() > 1.0
+    run = direction_runs[azimuth, True]
+    assert run.ok.all()
+    assert run.com[-1, 2] > 0.85 and run.torso_tilt.max() < 0.5
+    assert np.linalg.norm(run.com_velocity[-1, :2]) < 0.1
+    steps = run.controller.stepper.steps
+    assert steps and all(step.landed is not None for step in steps)
+    heading = np.array([math.cos(math.radians(azimuth)), math.sin(math.radians(azimuth))])
+    first = steps[0]
+    assert (first.landed - first.origin) @ heading > 0.2  # a step along the push, > 20 cm
+    if DIRECTIONS[azimuth] is not None:
+        assert first.foot == DIRECTIONS[azimuth]
+    # The CoM ends over the feet it stands on: ahead of where it started, along the push.
+    assert (run.com[-1, :2] - run.com[0, :2]) @ heading > 0.1
+
+
+@pytest.mark.parametrize("case", ["side", 0.0, 30.0])
+def test_wrenches_satisfy_friction_and_cop_rows_at_every_tick(runs, direction_runs, case):
+    run = runs[True] if case == "side" else direction_runs[case, True]
     for foot, rows in enumerate(f.constraint_rows() for f in run.controller.feet):
         assert np.all(run.wrenches[:, foot] @ rows.T <= FORCE_TOL)
+    # A swinging foot carries nothing: from lift-off to touchdown its wrench is 0.
+    names = [f.name for f in run.controller.feet]
+    for step in run.controller.stepper.steps:
+        end = math.inf if step.touchdown is None else step.touchdown
+        swing = (run.time > step.liftoff + 1e-9) & (run.time < end - 1e-9)
+        assert np.allclose(run.wrenches[swing, names.index(step.foot)], 0.0, atol=FORCE_TOL)
+
+
+def test_leg_inertia_matches_the_joint_space_inertia(model):
+    """I about the hip axes (a sum over bodies) against M's diagonal (MuJoCo's own route)."""
+    import mujoco
+
+    data = mujoco.MjData(model)
+    data.qpos[:] = bent_knee_qpos(model)
+    mujoco.mj_forward(model, data)
+    full = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, full)  # MuJoCo 4 (the project pins it)
+    leg = leg_joints(model, model.body("left_foot").id)
+    assert min(leg.hip_pitch, leg.hip_roll, leg.knee) >= 0
+    for joint in (leg.hip_pitch, leg.hip_roll, leg.knee):
+        dof = model.jnt_dofadr[joint]
+        assert axis_inertia(model, data, joint) == pytest.approx(full[dof, dof], rel=1e-9)
+
+
+def test_lipm_com_obeys_the_lipm():
+    """c̈ = ω² (c − p) by central differences [m/s²], and c(0) = c, ċ(0) = v."""
+    com, vel, cop, omega, h = np.array([0.1, -0.2]), np.array([0.5, 0.3]), np.zeros(2), 3.0, 1e-4
+    assert np.allclose(lipm_com(com, vel, cop, omega, 0.0), com)
+    assert np.allclose((lipm_com(com, vel, cop, omega, h) - com) / h, vel, atol=1e-3)
+    at = [lipm_com(com, vel, cop, omega, 0.3 + k * h) for k in (-1, 0, 1)]
+    accel = (at[0] - 2 * at[1] + at[2]) / h**2
+    assert np.allclose(accel, omega**2 * (at[1] - cop), rtol=1e-4)
 
 
 def test_quintic_meets_its_ends():
@@ -128,6 +201,15 @@ def test_bad_controller_inputs(model, kwargs, name):
         ({"weight": 0.0}, "weight"),
         ({"replan_fraction": 2.0}, "replan_fraction"),
         ({"contact": math.nan}, "contact"),
+        ({"torque_share": 0.0}, "torque_share"),
+        ({"torque_share": 1.5}, "torque_share"),
+        ({"max_swing_time": 3.0}, "max_swing_time"),
+        ({"swing_time": 0.5, "max_swing_time": 0.4}, "swing_time"),
+        ({"knee_min": -0.1}, "knee_min"),
+        ({"knee_min": 1.5}, "knee_min"),
+        ({"knee_weight": 0.0}, "knee_weight"),
+        ({"lift_weight": 0.0}, "lift_weight"),
+        ({"lift_weight": math.inf}, "lift_weight"),
     ],
 )
 def test_bad_step_settings(kwargs, name):
@@ -141,3 +223,14 @@ def test_plant_controller_with_stepping(params):
     plant = Biped3DPlant(params)
     assert wbc_for(plant, stepping=True).stepping
     assert not wbc_for(plant).stepping
+
+
+def test_stepper_refuses_a_non_bool_hip(model, params):
+    import mujoco
+
+    data = mujoco.MjData(model)
+    data.qpos[:] = bent_knee_qpos(model)
+    mujoco.mj_forward(model, data)
+    feet = tuple(foot_contact(model, data, n) for n in ("left_foot", "right_foot"))
+    with pytest.raises(InvalidParameterError, match="hip"):
+        Stepper(model, params, feet, 0, 0.0, 1.0, hip="yes")

@@ -59,6 +59,8 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import (
     leg_swing_time,
     plan_foothold,
     quintic,
+    rotation_vector,
+    yaw_of,
 )
 
 FloatArray = NDArray[np.float64]
@@ -166,16 +168,6 @@ class StepSettings:
             )
 
 
-def _yaw(rot: FloatArray) -> float:
-    return math.atan2(float(rot[1, 0]), float(rot[0, 0]))
-
-
-def _rotation_vector(rot: FloatArray) -> FloatArray:
-    angle = math.acos(max(-1.0, min(1.0, 0.5 * (float(np.trace(rot)) - 1.0))))
-    axial = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
-    return axial if angle < 1e-9 else axial * (angle / math.sin(angle))
-
-
 class Stepper:
     """Stepping decisions, plans and the swing-foot task of one two-footed model.
 
@@ -234,7 +226,7 @@ class Stepper:
         body = self.feet[index].body
         rot = np.asarray(data.xmat[body]).reshape(3, 3)
         x, y = np.asarray(data.xpos[body])[:2]
-        return FootPose(float(x), float(y), _yaw(rot))
+        return FootPose(float(x), float(y), yaw_of(rot))
 
     def _foothold(self, data: Any, swing: int, t: float) -> tuple[FloatArray, int]:
         """Plan the foothold of foot ``swing`` for a touchdown after t [s] (wbc_step_plan)."""
@@ -293,6 +285,7 @@ class Stepper:
         self._z = np.array([point[2], self.floor - s.sink])
         self._coeffs = quintic(point[:2], np.zeros(2), np.zeros(2), foothold, span)
         record = StepRecord(self.feet[index].name, t0, self._end)
+        record.origin = np.array(data.xpos[self.feet[index].body][:2], dtype=float)
         record.plans.append((t0, float(foothold[0]), float(foothold[1])))
         self.steps.append(record)
         return index
@@ -347,7 +340,7 @@ class Stepper:
         qvel = np.asarray(data.qvel, dtype=float)
         p_ref, v_ref, a_ref = self.reference(float(data.time))
         linear = a_ref + s.stiffness * (p_ref - point) + s.damping * (v_ref - jacp @ qvel)
-        error = _rotation_vector(rot @ self._rot.T)
+        error = rotation_vector(rot @ self._rot.T)
         angular = -s.turn_stiffness * error - s.turn_damping * (jacr @ qvel)
         matrix = np.zeros((6, size))
         matrix[:3, :nv], matrix[3:, :nv] = jacp, jacr

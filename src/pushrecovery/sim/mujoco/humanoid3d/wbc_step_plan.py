@@ -49,6 +49,8 @@ __all__ = [
     "lipm_com",
     "plan_foothold",
     "quintic",
+    "rotation_vector",
+    "yaw_of",
 ]
 
 #: Peak acceleration of a rest-to-rest quintic over its distance / duration² [-]: 10/√3.
@@ -60,7 +62,8 @@ class StepRecord:
     """One step: the swing foot, its timing [s] and its footholds [m] (world xy).
 
     ``plans`` lists (time, foothold x, foothold y) of the first plan and every re-plan;
-    ``landed`` is the ankle's ground point at touchdown (None while in the air).
+    ``origin`` is the ankle's ground point at lift-off, ``landed`` at touchdown (None while
+    in the air).
     """
 
     foot: str
@@ -69,6 +72,14 @@ class StepRecord:
     plans: list[tuple[float, float, float]] = field(default_factory=list)
     touchdown: float | None = None
     landed: FloatArray | None = None
+    origin: FloatArray | None = None
+
+    @property
+    def length(self) -> float:
+        """Distance from the lift-off ankle to the landed one [m] (nan in the air)."""
+        if self.landed is None or self.origin is None:
+            return math.nan
+        return float(np.linalg.norm(self.landed - self.origin))
 
     @property
     def foothold(self) -> FloatArray:
@@ -111,6 +122,18 @@ def evaluate(coeffs: FloatArray, tau: float) -> tuple[FloatArray, FloatArray, Fl
     v = (k[1:] * powers[:-1]) @ coeffs[1:]
     a = (k[2:] * (k[2:] - 1) * powers[:-2]) @ coeffs[2:]
     return p, v, a
+
+
+def yaw_of(rot: FloatArray) -> float:
+    """Return the heading [rad] of rotation matrix ``rot``: atan2(R_10, R_00)."""
+    return math.atan2(float(rot[1, 0]), float(rot[0, 0]))
+
+
+def rotation_vector(rot: FloatArray) -> FloatArray:
+    """Return the rotation vector (axis × angle) of rotation matrix ``rot`` [rad]."""
+    angle = math.acos(max(-1.0, min(1.0, 0.5 * (float(np.trace(rot)) - 1.0))))
+    axial = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
+    return axial if angle < 1e-9 else axial * (angle / math.sin(angle))
 
 
 @dataclass(frozen=True)

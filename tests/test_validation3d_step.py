@@ -1,0 +1,89 @@
+"""The step column of the 3-D validation (issue 19 item 5): prediction and a short measurement."""
+
+import math
+from dataclasses import replace
+
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.experiments.validation3d_step import (
+    StepRow,
+    measure_step_critical,
+    predicted_step_critical,
+    run_step_validation,
+)
+from pushrecovery.ground.support import Support
+
+
+@pytest.fixture(scope="module")
+def params():
+    return load_params()
+
+
+def test_left_push_prediction_is_the_closed_form_of_s1(params):
+    """ρ = w/2 − s/2 + e^{−ωΔt} l along +y for a left step of a rectangle foot (S1, N = 1)."""
+    reach = math.exp(-params.omega * params.min_step_time) * params.max_step_length
+    rho = 0.5 * params.foot_width - 0.5 * params.stance_width + reach
+    expected = params.mass * params.omega * rho
+    assert predicted_step_critical(params, 90.0, origin=(0.0, 0.0)) == pytest.approx(expected)
+
+
+def test_prediction_is_mirror_symmetric_and_beyond_the_ankle(params):
+    ankle = Support.from_params(params).polygon
+    for azimuth in range(0, 360, 30):
+        left = predicted_step_critical(params, azimuth)
+        assert left == pytest.approx(predicted_step_critical(params, -azimuth), rel=1e-9)
+        # One step reaches farther than the feet where they stand.
+        rho = ankle.ray_distance(0.0, 0.0, math.radians(azimuth))
+        assert left > params.mass * params.omega * rho
+
+
+def test_a_slower_step_or_a_shorter_reach_shrinks_the_prediction(params):
+    quick = predicted_step_critical(params, 0.0)
+    assert predicted_step_critical(params, 0.0, step_time=0.4) < quick
+    short = replace(params, max_step_length=0.5)
+    assert predicted_step_critical(short, 0.0) < quick
+
+
+def test_measured_step_critical_is_beyond_the_ankle_and_below_the_prediction(params):
+    """A short bisection to the left: stepping stands more than the CoP region allows."""
+    ankle = params.mass * params.omega * 0.15  # the CoP region's edge, 0.15 m to the left
+    measured, bracket, runs, run = measure_step_critical(
+        params, 90.0, guess=60.0, rel_tolerance=0.2, duration=2.0
+    )
+    assert bracket[0] == measured < bracket[1] <= measured + 0.2 * 60.0 + 1e-9
+    assert 1.2 * ankle < measured < predicted_step_critical(params, 90.0)
+    assert run.stood and run.steps >= 1 and run.step_length > 0.2
+    assert runs <= 12
+
+
+def test_row_errors_and_cause(params):
+    row = StepRow(0.0, 100.0, 80.0, 60.0, (60.0, 61.0), 5, 2, 0.3, 0.5)
+    assert row.relative_error == pytest.approx(-0.4)
+    assert row.corrected_error == pytest.approx(-0.25)
+    cause = row.cause(params)
+    assert "swing 0.30 s" in cause and "step 0.50 m" in cause and "2 steps" in cause
+    close = StepRow(0.0, 100.0, 80.0, 85.0, (85.0, 86.0), 5, 1, 0.2, 0.9)
+    assert close.cause(params) == ""
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda p: predicted_step_critical(p, 400.0), "azimuth"),
+        (lambda p: predicted_step_critical(p, 0.0, step_time=-1.0), "step_time"),
+        (lambda p: predicted_step_critical("body", 0.0), "params"),
+        (lambda p: measure_step_critical(p, 0.0, guess=0.0), "guess"),
+        (lambda p: measure_step_critical(p, 0.0, guess=10.0, rel_tolerance=0.9), "rel_tolerance"),
+        (lambda p: measure_step_critical(p, 0.0, guess=10.0, duration=0.0), "duration"),
+        (lambda p: measure_step_critical(p, 500.0, guess=10.0), "azimuth"),
+        (lambda p: run_step_validation([]), "azimuths"),
+        (lambda p: run_step_validation("0"), "azimuths"),
+        (lambda p: run_step_validation([0.0], params="body"), "params"),
+        (lambda p: run_step_validation([0.0], rel_tolerance=0.0), "rel_tolerance"),
+    ],
+)
+def test_bad_inputs(params, call, name):
+    with pytest.raises((InvalidParameterError, PushRecoveryError), match=name):
+        call(params)
