@@ -38,6 +38,9 @@
 15. Batch analysis of measured trials (``benchmarks/trials.py``, issue 18): 200 generated
    trials on 1 and 2 workers and a Dask LocalCluster (the same tables), trials per second and
    the time per trial-second against reading the files alone.
+16. The whole-body QP (``benchmarks/wbc.py``, issue 19): the G1 (skipped with a one-line
+   reason without the robots extra) and biped3d under the WBC at 500 Hz against MuJoCo alone
+   on the same controls, the solve and tick median and p99. Target: ratio >= 0.5.
 """
 
 from __future__ import annotations
@@ -409,12 +412,14 @@ def main() -> int:
     import plane
     import steps
     import trials
+    import wbc
 
     plane_failed = plane.main()
     steps_failed = steps.main()
     mpc_failed = mpc_horizons.main()
     mujoco_failed = mujoco_speed.main()
     trials_failed = trials.main()
+    wbc_failed = wbc.main()
     ratio = surface()
     cli = startup()
     realtime()
@@ -428,7 +433,7 @@ def main() -> int:
     analysis()
     failed = ratio > 2.0 or cli > 1.5 or step_rate < 2e6 or step_ratio < 1000 or physics < 150
     failed = failed or bool(plane_failed) or bool(steps_failed) or bool(mpc_failed)
-    failed = failed or bool(mujoco_failed) or bool(trials_failed)
+    failed = failed or bool(mujoco_failed) or bool(trials_failed) or bool(wbc_failed)
     failed = failed or batch_rate < 5000 or step_batch_rate < 500
     print("targets met" if not failed else "TARGET MISSED")
     return int(failed)

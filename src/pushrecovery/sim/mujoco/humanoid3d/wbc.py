@@ -35,12 +35,14 @@ acceleration, exact from Newton's law on the wrenches, m c̈ = m g + Σ_i R_i F_
 angular acceleration J_r q̈ + J̇_r q̇; the pelvis height z̈ = J_z q̈ + J̇_z q̇; and the posture
 q̈_j. Solved with DAQP (a dense dual active-set solver) in one ``daqp.Model`` kept between
 ticks: the equality rows are flagged immutable, and the active set of the last tick is its
-warm start. MuJoCo's types appear as ``Any``: its bindings ship no type information.
+warm start. Each tick is assembled in place by the compiled kernels of :mod:`._wbc_kernels`,
+which also hand DAQP the problem in its own least-distance form (H factored on its envelope:
+the same QP, a fifth of DAQP's update time). MuJoCo's types appear as ``Any``: its bindings
+ship no type information.
 """
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -50,110 +52,24 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.polygon import convex_hull
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, colliding_geoms, sole_points
+from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
+    add_task,
+    constraints,
+    least_distance,
+    recover,
+    sole_frames,
+    sole_origins,
+)
+from pushrecovery.sim.mujoco.humanoid3d.wbc_feet import FootContact, foot_contact
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["FootContact", "Task", "WbcSolution", "WholeBodyQP", "foot_contact"]
+__all__ = ["FootContact", "Task", "WbcProblem", "WbcSolution", "WholeBodyQP", "foot_contact"]
 
 #: Bounds DAQP treats as infinite.
 _INF = 1e30
 #: DAQP's sense flags: an active, immutable row (an equality).
 _EQUALITY = 5
-
-
-@dataclass(frozen=True)
-class FootContact:
-    """A foot's sole frame and its wrench constraints.
-
-    Attributes
-    ----------
-    name, body : str, int
-        The foot body's name and id.
-    origin : float array, shape (3,)
-        The sole frame's origin in the foot body's frame [m]: under the body origin, on the
-        sole plane.
-    edges : float array, shape (k, 3)
-        Rows (n_x, n_y, d) with n·p ≤ d for a CoP p inside the sole polygon, in the sole frame
-        [-, -, m] (n a unit outward normal).
-    mu : float
-        Friction coefficient of the pyramid, μ' = μ/√2 [-].
-    yaw_radius : float
-        Inscribed radius r of the sole polygon about the frame's origin [m] (|T_z| ≤ μ' r F_z).
-    """
-
-    name: str
-    body: int
-    origin: FloatArray
-    edges: FloatArray
-    mu: float
-    yaw_radius: float
-
-    def constraint_rows(self) -> FloatArray:
-        """Return G with G w ≤ 0 for this foot's wrench w = (F, T) [rows, 6].
-
-        Rows: −F_z ≤ 0; ±F_x − μ' F_z ≤ 0; ±F_y − μ' F_z ≤ 0; per edge
-        n_y T_x − n_x T_y − d F_z ≤ 0; ±T_z − μ' r F_z ≤ 0.
-        """
-        mu, rows = self.mu, [[0.0, 0.0, -1.0, 0.0, 0.0, 0.0]]
-        for sign in (1.0, -1.0):
-            rows.append([sign, 0.0, -mu, 0.0, 0.0, 0.0])
-            rows.append([0.0, sign, -mu, 0.0, 0.0, 0.0])
-        for nx, ny, d in self.edges:
-            rows.append([0.0, 0.0, -d, ny, -nx, 0.0])
-        for sign in (1.0, -1.0):
-            rows.append([0.0, 0.0, -mu * self.yaw_radius, 0.0, 0.0, sign])
-        return np.array(rows, dtype=float)
-
-
-def foot_contact(model: Any, data: Any, name: str) -> FootContact:
-    """Return the :class:`FootContact` of foot body ``name``, measured in ``data``'s pose.
-
-    The sole polygon is the convex hull of the sole points (:func:`~.measure.sole_points`,
-    after ``mj_kinematics``) in the foot body's frame; the sole frame's origin is the body
-    origin moved along the body's z onto the sole plane. μ is the largest sliding friction of
-    the foot's colliding geoms and every geom they can touch (the floor), as MuJoCo mixes two
-    geoms' friction by their maximum.
-
-    Raises
-    ------
-    InvalidParameterError
-        If ``name`` is not a body of ``model`` with colliding geoms, or its sole polygon does
-        not contain the sole frame's origin (the yaw bound needs it inside).
-    """
-    try:
-        body = body_id(model, name)
-    except KeyError:
-        raise InvalidParameterError(f"feet must name bodies of the model, got {name!r}") from None
-    geoms = colliding_geoms(model, body)
-    if not geoms:
-        raise InvalidParameterError(f"feet: body {name!r} has no colliding geom (no sole)")
-    rot = np.array(data.xmat[body], dtype=float).reshape(3, 3)
-    local = (sole_points(model, data, body) - np.asarray(data.xpos[body])) @ rot
-    polygon = convex_hull(local[:, :2])
-    vertices, following = polygon.vertices, np.roll(polygon.vertices, -1, axis=0)
-    direction = following - vertices
-    normal = np.column_stack([direction[:, 1], -direction[:, 0]])
-    normal /= np.linalg.norm(normal, axis=1)[:, None]
-    offset = np.einsum("ij,ij->i", normal, vertices)
-    if np.any(offset <= 0.0):
-        raise InvalidParameterError(
-            f"feet: the sole polygon of {name!r} must contain the point under its body origin"
-        )
-    others = [
-        g for g in range(model.ngeom) if int(model.geom_bodyid[g]) != body
-        and int(model.geom_conaffinity[g]) & int(model.geom_contype[geoms[0]])
-    ]  # fmt: skip
-    mu = max(float(model.geom_friction[g, 0]) for g in geoms + others)
-    return FootContact(
-        name=name,
-        body=body,
-        origin=np.array([0.0, 0.0, float(local[:, 2].mean())]),
-        edges=np.column_stack([normal, offset]),
-        mu=mu / math.sqrt(2.0),
-        yaw_radius=float(offset.min()),
-    )
 
 
 def _full_inertia(model: Any, data: Any, out: FloatArray) -> None:
@@ -174,8 +90,9 @@ class Task:
     ----------
     name : str
         For reports.
-    matrix, target : float arrays, shapes (k, nv + 6 n_feet) and (k,)
-        A over x = (q̈, w_1, …), and b [the task's units: m/s² or rad/s²].
+    matrix, target : float arrays, shapes (k, m) and (k,)
+        A over the first m ≤ nv + 6 n_feet unknowns of x = (q̈, w_1, …) (m = nv: a task on
+        q̈ alone), and b [the task's units: m/s² or rad/s²].
     weight : float
         W > 0 [-].
     """
@@ -184,6 +101,28 @@ class Task:
     matrix: FloatArray
     target: FloatArray
     weight: float
+
+
+@dataclass(frozen=True)
+class WbcProblem:
+    """The QP min ½ xᵀ H x + fᵀ x s.t. l ≤ A x ≤ u of one tick (:meth:`WholeBodyQP.assemble`).
+
+    Attributes
+    ----------
+    hessian, linear : float arrays, shapes (size, size) and (size,)
+        H = Σ_k W_k A_kᵀ A_k + diag(ε) and f = −Σ_k W_k A_kᵀ b_k.
+    rows, upper, lower : float arrays, shapes (m, size), (m,), (m,)
+        A, u and l (±1e30: unbounded); the first ``equalities`` rows have l = u.
+    equalities : int
+        The number of equality rows (the unactuated dynamics, then six per foot).
+    """
+
+    hessian: FloatArray
+    linear: FloatArray
+    rows: FloatArray
+    upper: FloatArray
+    lower: FloatArray
+    equalities: int
 
 
 @dataclass
@@ -212,11 +151,21 @@ class WbcSolution:
     iterations: int
 
 
-@dataclass
 class _Buffers:
-    mass: FloatArray
-    jac: FloatArray
-    jac_dot: FloatArray
+    """Every array of a tick, allocated once (``rows`` for all feet in contact)."""
+
+    def __init__(self, nv: int, nf: int, rows: int, nu: int) -> None:
+        size = nv + nf
+        self.offset = np.zeros(nu)
+        self.mass, self.jac, self.local = np.zeros((nv, nv)), np.zeros((nf, nv)), np.zeros((nf, nv))
+        self.jac_dot, self.dots = np.zeros(nf), np.zeros((nf, nv))
+        self.points = np.zeros((nf // 6, 3))
+        self.hessian, self.linear, self.x = np.zeros((size, size)), np.zeros(size), np.zeros(size)
+        self.factor, self.shift = np.zeros((size, size)), np.zeros(size)
+        self.first = np.zeros(size, np.int64)
+        self.rows, self.upper, self.lower = np.zeros((rows, size)), np.zeros(rows), np.zeros(rows)
+        self.ldp_rows, self.ldp_upper = np.zeros((rows, size)), np.zeros(rows)
+        self.ldp_lower = np.zeros(rows)
 
 
 class WholeBodyQP:
@@ -265,7 +214,7 @@ class WholeBodyQP:
         self.nv, self.size = nv, nv + nf
         joints = np.asarray(model.actuator_trnid[:, 0], dtype=int)
         self.actuated = np.asarray(model.jnt_dofadr[joints], dtype=int)
-        self.gear = np.asarray(model.actuator_gear[:, 0], dtype=float)
+        self.gear = np.ascontiguousarray(model.actuator_gear[:, 0], dtype=float)
         self.unactuated = np.setdiff1d(np.arange(nv), self.actuated)
         ranges = np.asarray(model.actuator_ctrlrange, dtype=float)
         limited = np.asarray(model.actuator_ctrllimited, dtype=bool)
@@ -274,22 +223,30 @@ class WholeBodyQP:
         self._regular = np.concatenate(
             [np.full(nv, acc_regularisation), np.full(nf, wrench_regularisation)]
         )
-        self._foot_rows = [foot.constraint_rows() for foot in self.feet]
+        foot_rows = [foot.constraint_rows() for foot in self.feet]
+        self._foot_rows = np.ascontiguousarray(np.vstack(foot_rows))
+        self._foot_start = np.cumsum([0] + [g.shape[0] for g in foot_rows], dtype=np.int64)
+        self._bodies = np.array([foot.body for foot in self.feet], dtype=np.int64)
+        self._origins = np.array([foot.origin for foot in self.feet], dtype=float)
         self._n_equal = self.unactuated.size + nf
         self.contacts = np.ones(len(self.feet), dtype=bool)
-        self._buf = _Buffers(np.zeros((nv, nv)), np.zeros((nf, nv)), np.zeros(nf))
+        rows = self._n_equal + self._foot_rows.shape[0] + int(model.nu)
+        self._buf = _Buffers(nv, nf, rows, int(model.nu))
+        self._regular_matrix = np.diag(self._regular)
+        self._model_rows = 0
+        self._identity, self._zeros = np.eye(self.size), np.zeros(self.size)
         self._model: Any = None
         self._last_ctrl = np.zeros(model.nu)
         self.contact_damping = 0.0  # k_c [1/s]: J q̈ + J̇ q̇ = −k_c J q̇ holds a foot still
 
-    def _setup(self, hessian: FloatArray, linear: FloatArray, rows: FloatArray,
-               upper: FloatArray, lower: FloatArray) -> None:  # fmt: skip
+    def _setup(self, rows: FloatArray, upper: FloatArray, lower: FloatArray) -> None:
+        """Set DAQP up afresh on the least-distance rows (H = I, f = 0; :mod:`._wbc_kernels`)."""
         import daqp
 
         sense = np.zeros(rows.shape[0], dtype=np.intc)
         sense[: self._n_equal] = _EQUALITY
         self._model = daqp.Model()
-        flag, _ = self._model.setup(hessian, linear, rows, upper, lower, sense)
+        flag, _ = self._model.setup(self._identity, self._zeros, rows, upper, lower, sense)
         if flag < 0:
             raise RuntimeError(f"daqp could not set up the whole-body QP (exit flag {flag})")
 
@@ -321,24 +278,53 @@ class WholeBodyQP:
 
         Rows per foot: linear then angular. The sole-frame Jacobian is blockwise Rᵀ J, R the
         foot's orientation: its transpose maps a sole-frame wrench to generalised forces.
+        Written in place into the QP's buffers: valid until the next call.
         """
         import mujoco
 
-        buf, nv = self._buf, self.nv
-        local = np.empty_like(buf.jac)
-        for i, foot in enumerate(self.feet):
-            rot = np.array(data.xmat[foot.body], dtype=float).reshape(3, 3)
-            point = np.asarray(data.xpos[foot.body]) + rot @ foot.origin
-            jacp, jacr = buf.jac[6 * i : 6 * i + 3], buf.jac[6 * i + 3 : 6 * i + 6]
-            mujoco.mj_jac(self.model, data, jacp, jacr, point, foot.body)
-            dotp, dotr = np.zeros((3, nv)), np.zeros((3, nv))
-            mujoco.mj_jacDot(self.model, data, dotp, dotr, point, foot.body)
-            qvel = np.asarray(data.qvel)
-            buf.jac_dot[6 * i : 6 * i + 3] = dotp @ qvel
-            buf.jac_dot[6 * i + 3 : 6 * i + 6] = dotr @ qvel
-            local[6 * i : 6 * i + 3] = rot.T @ jacp
-            local[6 * i + 3 : 6 * i + 6] = rot.T @ jacr
-        return buf.jac, buf.jac_dot, local
+        buf, model = self._buf, self.model
+        xmat, qvel = data.xmat, data.qvel
+        sole_origins(data.xpos, xmat, self._bodies, self._origins, buf.points)
+        for i, body in enumerate(self._bodies):
+            point, rows = buf.points[i], slice(6 * i, 6 * i + 3)
+            spin = slice(6 * i + 3, 6 * i + 6)
+            mujoco.mj_jac(model, data, buf.jac[rows], buf.jac[spin], point, body)
+            mujoco.mj_jacDot(model, data, buf.dots[rows], buf.dots[spin], point, body)
+        sole_frames(xmat, self._bodies, buf.jac, buf.dots, qvel, buf.jac_dot, buf.local)
+        return buf.jac, buf.jac_dot, buf.local
+
+    def assemble(self, data: Any, tasks: Sequence[Task]) -> WbcProblem:
+        """Build the QP of the module docstring at the state in ``data`` (:meth:`solve`).
+
+        Written in place into the QP's buffers: the arrays are valid until the next call.
+
+        Raises
+        ------
+        InvalidParameterError
+            If a task's matrix is not (k, m ≤ ``size``) with a target of k rows.
+        """
+        buf = self._buf
+        _full_inertia(self.model, data, buf.mass)
+        self.contact_jacobians(data)
+        np.copyto(buf.hessian, self._regular_matrix)
+        buf.linear.fill(0.0)
+        for task in tasks:
+            matrix = np.ascontiguousarray(task.matrix, dtype=np.float64)
+            target = np.ascontiguousarray(task.target, dtype=np.float64)
+            if matrix.ndim != 2 or matrix.shape[1] > self.size or target.shape != matrix.shape[:1]:
+                raise InvalidParameterError(
+                    f"task {task.name!r}: matrix must be (k, m ≤ {self.size}) and target (k,), "
+                    f"got {matrix.shape} and {target.shape}"
+                )
+            add_task(buf.hessian, buf.linear, matrix, target, float(task.weight))
+        count = constraints(
+            buf.mass, data.qfrc_bias, data.qfrc_passive, buf.jac, buf.jac_dot, buf.local,
+            data.qvel, self.contacts, self.unactuated, self.actuated, self.gear, self.ctrl_low,
+            self.ctrl_high, self._foot_rows, self._foot_start, float(self.contact_damping),
+            buf.rows, buf.upper, buf.lower, buf.offset,
+        )  # fmt: skip
+        return WbcProblem(buf.hessian, buf.linear, buf.rows[:count], buf.upper[:count],
+                          buf.lower[:count], self._n_equal)  # fmt: skip
 
     def solve(self, data: Any, tasks: Sequence[Task]) -> WbcSolution:
         """Solve the QP at the state in ``data`` (its M, bias and kinematics current).
@@ -346,54 +332,36 @@ class WholeBodyQP:
         ``data`` must hold the results of ``mj_forward`` (or ``mj_step1``) for its qpos and
         qvel. Never raises on an infeasible tick: ``ok`` is then False and ``ctrl`` repeats
         the last good command.
+
+        Raises
+        ------
+        InvalidParameterError
+            If a task's matrix is not (k, m ≤ ``size``) with a target of k rows.
         """
-        model, nv, buf = self.model, self.nv, self._buf
-        _full_inertia(model, data, buf.mass)
-        bias = np.asarray(data.qfrc_bias) - np.asarray(data.qfrc_passive)
-        jac, jac_dot, local = self.contact_jacobians(data)
-        hessian = np.diag(self._regular)
-        linear = np.zeros(self.size)
-        for task in tasks:
-            weighted = task.weight * task.matrix
-            hessian += weighted.T @ task.matrix
-            linear -= weighted.T @ task.target
-        dynamics = np.hstack([buf.mass, -local.T])  # M q̈ − J_cᵀ w = −h (+ τ on actuated rows)
-        fixed = np.hstack([jac, np.zeros((jac.shape[0], jac.shape[0]))])
-        target = -jac_dot - self.contact_damping * (jac @ np.asarray(data.qvel))
-        for i in map(int, np.flatnonzero(~self.contacts)):  # swing: w_i = 0 replaces the fixed rows
-            fixed[6 * i : 6 * i + 6] = 0.0
-            fixed[6 * i : 6 * i + 6, nv + 6 * i : nv + 6 * i + 6] = np.eye(6)
-            target[6 * i : 6 * i + 6] = 0.0
-        blocks = [dynamics[self.unactuated], fixed]
-        upper = [-bias[self.unactuated], target]
-        lower = [-bias[self.unactuated], target]
-        for i, g in enumerate(self._foot_rows):
-            if not self.contacts[i]:
-                continue
-            block = np.zeros((g.shape[0], self.size))
-            block[:, nv + 6 * i : nv + 6 * i + 6] = g
-            blocks.append(block)
-            upper.append(np.zeros(g.shape[0]))
-            lower.append(np.full(g.shape[0], -_INF))
-        torque_rows = dynamics[self.actuated] / self.gear[:, None]  # (M_a q̈ + h_a − J_aᵀ w)/gear
-        offset = bias[self.actuated] / self.gear
-        blocks.append(torque_rows)
-        upper.append(np.minimum(self.ctrl_high - offset, _INF))
-        lower.append(np.maximum(self.ctrl_low - offset, -_INF))
-        rows = np.ascontiguousarray(np.vstack(blocks))
-        high, low = np.concatenate(upper), np.concatenate(lower)
-        start = time.perf_counter()  # the solve time includes DAQP's factorisation of H
-        if self._model is None:
-            self._setup(hessian, linear, rows, high, low)
-        else:
-            self._model.update(H=hessian, f=linear, A=rows, bupper=high, blower=low)
-        x, _, flag, info = self._model.solve()
-        elapsed, feet, steps = time.perf_counter() - start, len(self.feet), int(info["iterations"])
+        nv, buf, nu = self.nv, self._buf, int(self.model.nu)
+        count = self.assemble(data, tasks).rows.shape[0]
+        start = time.perf_counter()  # the solve time includes the factorisation of H
+        flag, feet, steps = -1, len(self.feet), 0
+        if least_distance(buf.hessian, buf.linear, buf.rows, buf.upper, buf.lower, count,
+                          buf.factor, buf.first, buf.shift, buf.ldp_rows, buf.ldp_upper,
+                          buf.ldp_lower):  # fmt: skip
+            rows, high, low = buf.ldp_rows[:count], buf.ldp_upper[:count], buf.ldp_lower[:count]
+            if self._model is None or self._model_rows != count:
+                self._setup(rows, high, low)
+                self._model_rows = count
+            else:
+                self._model.update(A=rows, bupper=high, blower=low)
+            u, _, flag, info = self._model.solve()
+            steps = int(info["iterations"])
         if flag <= 0:
+            elapsed = time.perf_counter() - start
             self._model = None  # the next tick starts cold
             last = self._last_ctrl.copy()
             return WbcSolution(np.zeros(nv), np.zeros((feet, 6)), last, False, elapsed, steps)
-        x = np.asarray(x, dtype=float)
-        ctrl = np.clip(torque_rows @ x + offset, self.ctrl_low, self.ctrl_high)
+        recover(buf.factor, buf.first, buf.shift, u, buf.x)
+        elapsed = time.perf_counter() - start
+        ctrl = np.dot(buf.rows[count - nu : count], buf.x) + buf.offset
+        np.clip(ctrl, self.ctrl_low, self.ctrl_high, out=ctrl)
         self._last_ctrl = ctrl
-        return WbcSolution(x[:nv].copy(), x[nv:].reshape(feet, 6), ctrl, True, elapsed, steps)
+        x = buf.x.copy()
+        return WbcSolution(x[:nv], x[nv:].reshape(feet, 6), ctrl, True, elapsed, steps)

@@ -53,6 +53,7 @@ from numpy.typing import NDArray
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import ankle_targets
 from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points
 from pushrecovery.sim.mujoco.humanoid3d.wbc import (
     FootContact,
@@ -63,7 +64,7 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc import (
 )
 from pushrecovery.sim.mujoco.humanoid3d.wbc_hip import UPRIGHT, HipLaw, momentum_rows
 from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings
-from pushrecovery.surfaces.plane import capture_point_xy
+from pushrecovery.surfaces.cop import capture_point
 
 FloatArray = NDArray[np.float64]
 
@@ -126,11 +127,11 @@ class WbcGains:
 
 def _rotation_vector(rot: FloatArray) -> FloatArray:
     """Return the rotation vector (axis × angle) of rotation matrix ``rot`` [rad]."""
-    angle = math.acos(max(-1.0, min(1.0, 0.5 * (float(np.trace(rot)) - 1.0))))
-    axial = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
-    if angle < 1e-9:
-        return axial
-    return axial * (angle / math.sin(angle))
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot.ravel().tolist()
+    angle = math.acos(max(-1.0, min(1.0, 0.5 * (r00 + r11 + r22 - 1.0))))
+    scale = 1.0 if angle < 1e-9 else angle / math.sin(angle)
+    return np.array([0.5 * (r21 - r12) * scale, 0.5 * (r02 - r20) * scale,
+                     0.5 * (r10 - r01) * scale])  # fmt: skip
 
 
 class WholeBodyController:
@@ -240,6 +241,15 @@ class WholeBodyController:
         self.last = None
         self._bodies = np.array([foot.body for foot in self.feet], dtype=np.intp)
         self._origins = np.array([foot.origin for foot in self.feet])
+        nv = int(model.nv)
+        self._dots = np.zeros((6, nv))  # the torso's J̇ (linear, angular), overwritten each tick
+        self._joints = np.zeros((nv - 6, self.qp.size))  # the posture task's constant matrix
+        self._joints[:, 6:nv] = np.eye(nv - 6)
+        self._joints.flags.writeable = False
+        g = self.gains  # k_R, d_R (set each tick), k_z, d_z, k_q, d_q of ankle_targets
+        self._gains = np.array([g.torso_stiffness, g.torso_damping, g.height_stiffness,
+                                g.height_damping, g.posture_stiffness,
+                                g.posture_damping])  # fmt: skip
         self.hip = None
         if self.hip_params is not None:
             weight = self.mass * float(np.linalg.norm(self.gravity))
@@ -256,7 +266,8 @@ class WholeBodyController:
             lateral = np.asarray(data.xpos)[self._bodies] - np.asarray(data.xpos[self.torso])
             left = int(np.argmax(lateral @ self.upright[:, 1]))
             self.stepper = Stepper(model, self.step_params, self.feet, left, floor,
-                                   com[2] - floor, self.step_settings)  # fmt: skip
+                                   com[2] - floor, self.step_settings,
+                                   hip=self.hip_params is not None)  # fmt: skip
             self.qp.contact_damping = self.stepper.settings.contact_damping
 
     def _set_support(self, data: Any, contacts: list[bool]) -> None:
@@ -300,17 +311,18 @@ class WholeBodyController:
         import mujoco
 
         mujoco.mj_subtreeVel(self.model, data)
-        com = np.asarray(data.subtree_com[0])
-        velocity = np.asarray(data.subtree_linvel[0])
-        xi_x, xi_y = capture_point_xy(com[0], com[1], velocity[0], velocity[1], self.omega)
-        xi = np.array([float(xi_x), float(xi_y)])
-        self.capture_point = xi
-        cop = xi + (self.gains.dcm / self.omega) * (xi - self.rest)
-        self.cmp_target = cop
+        com_x, com_y, _ = data.subtree_com[0].tolist()
+        vel_x, vel_y, _ = data.subtree_linvel[0].tolist()
+        omega = self.omega
+        xi_x, xi_y = capture_point(com_x, vel_x, omega), capture_point(com_y, vel_y, omega)
+        self.capture_point = np.array([xi_x, xi_y])
+        gain, (rest_x, rest_y) = self.gains.dcm / self.omega, self.rest.tolist()
+        cop_x, cop_y = xi_x + gain * (xi_x - rest_x), xi_y + gain * (xi_y - rest_y)
+        self.cmp_target = np.array([cop_x, cop_y])
         assert self.support is not None
-        if not bool(self.support.contains(cop[0], cop[1])):
-            cop = np.array(self.support.nearest_point(float(cop[0]), float(cop[1])))
-        return cop
+        if not self.support.point_signed_distance(cop_x, cop_y) > 0.0:  # not inside
+            cop_x, cop_y = self.support.nearest_point(cop_x, cop_y)
+        return np.array([cop_x, cop_y])
 
     def tasks(self, data: Any) -> list[Task]:
         """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.wbc_hip`)."""
@@ -337,52 +349,38 @@ class WholeBodyController:
             if hip_active:
                 self.desired_cop = self.hip.saturate(self.desired_cop)
             self.returning = self.returning or hip_active
-        # CoM: m c̈ = m g + Σ R_i F_i, rows x and y; c̈ = ω² (c − p_des − δ).
-        com_acc = self.omega**2 * (com[:2] - self.desired_cop - self.cmp_offset)
-        rots = np.asarray(data.xmat)[self._bodies].reshape(-1, 3, 3)
-        com_rows = np.zeros((2, size))
-        for i in range(len(self.feet)):
-            com_rows[:, nv + 6 * i : nv + 6 * i + 3] = rots[i, :2] / self.mass
-        tasks = [Task("com", com_rows, com_acc - self.gravity[:2], gains.com_weight)]
+        # Torso orientation and pelvis height: J q̈ + J̇ q̇ = a_des (matrices over q̈ only).
+        point = data.xpos[self.torso]
+        jacp, jacr, dots = np.zeros((3, nv)), np.zeros((3, nv)), self._dots
+        mujoco.mj_jac(model, data, jacp, jacr, point, self.torso)
+        mujoco.mj_jacDot(model, data, dots[:3], dots[3:], point, self.torso)
+        stiffness, damping = gains.torso_stiffness, gains.torso_damping
+        torso_weight = gains.hip_torso_weight if hip_active else gains.torso_weight
+        returning = self.returning and not hip_active  # gently back upright, then as usual
+        if returning:
+            stiffness, damping = gains.return_stiffness, gains.return_damping
+        self._gains[:2] = stiffness, damping
+        # All targets at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g + Σ R_i F_i, rows
+        # x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
+        com_rows, targets = np.zeros((2, size)), np.empty(nv)
+        upright = ankle_targets(
+            data.xmat, self._bodies, self.mass, com, self.desired_cop, self.cmp_offset,
+            self.omega**2, self.gravity, error, jacp, jacr, dots, data.qvel, data.qpos,
+            self.posture, self.height, float(point[2]), self._gains, UPRIGHT, com_rows, targets,
+        )  # fmt: skip
+        if returning and upright:
+            self.returning = False
+        tasks = [Task("com", com_rows, targets[:2], gains.com_weight)]
         if hip_active:  # L̇_x = −m g δ_y, L̇_y = m g δ_x
             rows = momentum_rows(data, self._bodies, size, nv, com, self._origins)[:2]
             weight = self.mass * float(np.linalg.norm(self.gravity))
             rate = weight * np.array([-self.cmp_offset[1], self.cmp_offset[0]])
             tasks.append(Task("momentum", rows, rate, gains.hip_weight))
-        # Torso orientation and pelvis height: J q̈ + J̇ q̇ = a_des.
-        point = np.array(data.xpos[self.torso], dtype=float)
-        jacp, jacr = np.zeros((3, nv)), np.zeros((3, nv))
-        dotp, dotr = np.zeros((3, nv)), np.zeros((3, nv))
-        mujoco.mj_jac(model, data, jacp, jacr, point, self.torso)
-        mujoco.mj_jacDot(model, data, dotp, dotr, point, self.torso)
-        qvel = np.asarray(data.qvel, dtype=float)
-        spin = jacr @ qvel
-        stiffness, damping = gains.torso_stiffness, gains.torso_damping
-        torso_weight = gains.torso_weight
-        if hip_active:
-            torso_weight = gains.hip_torso_weight
-        elif self.returning:  # gently back upright, then the usual gains
-            stiffness, damping = gains.return_stiffness, gains.return_damping
-            if np.linalg.norm(error) < UPRIGHT and np.linalg.norm(spin) < UPRIGHT:
-                self.returning = False
-        alpha = -stiffness * error - damping * spin - dotr @ qvel
-        tasks.append(Task("torso", np.hstack([jacr, np.zeros((3, size - nv))]), alpha,
-                          torso_weight))  # fmt: skip
-        rise = float(jacp[2] @ qvel)
-        climb = gains.height_stiffness * (self.height - point[2]) - gains.height_damping * rise
-        height_row = np.zeros((1, size))
-        height_row[0, :nv] = jacp[2]
-        tasks.append(Task("height", height_row, np.array([climb - dotp[2] @ qvel]),
-                          gains.height_weight))  # fmt: skip
-        # Posture of every joint dof (after the free joint's six).
-        joints = np.zeros((nv - 6, size))
-        joints[:, 6:nv] = np.eye(nv - 6)
-        angles = np.asarray(data.qpos[7:], dtype=float)
-        target = gains.posture_stiffness * (self.posture - angles)
-        target -= gains.posture_damping * qvel[6:]
-        tasks.append(Task("posture", joints, target, gains.posture_weight))
-        if self.stepper is not None and self.stepper.swing is not None:
-            tasks.append(self.stepper.task(data, size, nv))
+        tasks.append(Task("torso", jacr, targets[2:5], torso_weight))
+        tasks.append(Task("height", jacp[2:], targets[5:6], gains.height_weight))
+        tasks.append(Task("posture", self._joints, targets[6:], gains.posture_weight))
+        if self.stepper is not None:  # the swing foot (while it swings), the knee guard
+            tasks.extend(self.stepper.tasks(data, size, nv))
         return tasks
 
     def compute(self, t: float, state: Any) -> FloatArray:

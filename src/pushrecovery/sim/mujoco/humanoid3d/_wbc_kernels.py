@@ -1,0 +1,247 @@
+r"""Compiled (numba, cached on disk) assembly of the whole-body QP of :mod:`.wbc`, in place.
+
+One file on purpose: numba's disk cache is keyed by the file of each function. Every kernel
+writes into buffers the caller allocated once; none allocates more than an index vector.
+
+The QP min ½ xᵀ H x + fᵀ x s.t. l ≤ A x ≤ u is handed to DAQP in the form DAQP itself solves
+(its least-distance problem, Arnström, Bemporad & Axehill 2022): with H = Rᵀ R (R = Lᵀ, L the
+lower Cholesky factor), v = R⁻ᵀ f and u = R x + v,
+
+.. math:: \min_u \tfrac12 \lVert u \rVert^2 \quad\text{s.t.}\quad
+          l + M v \le M u \le u + M v, \qquad M = A R^{-1}, \qquad x = R^{-1} (u - v),
+
+the same problem (the cost differs by the constant ½‖v‖²), so the same solution. DAQP's own
+update of a dense H refactors it and recomputes A R⁻¹ in plain loops (~60 µs at the G1's 47
+unknowns); here H is factored on its *envelope*: row j of H is zero left of its first non-zero
+``first[j]``, a property the Cholesky factor keeps (no fill-in outside the envelope). The
+whole-body QP's H is diagonal outside the floating base, the waist and a swinging leg (the
+posture task), so the factorisation and M cost little more than reading A.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+#: Bounds at or beyond this magnitude are infinite for DAQP: never shifted.
+INF = 1e30
+#: Reassociation and contraction only (no assumption on NaN or infinities): the rounding
+#: differs from a strict loop at the 1e-16 level, the results are deterministic.
+_FAST = {"reassoc", "contract"}
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def add_task(hessian, linear, matrix, target, weight):  # type: ignore[no-untyped-def]
+    """Add W AᵀA to ``hessian`` and −W Aᵀb to ``linear``, skipping A's zero entries."""
+    index = np.empty(matrix.shape[1], dtype=np.int64)
+    for r in range(matrix.shape[0]):
+        count = 0
+        for j in range(matrix.shape[1]):
+            if matrix[r, j] != 0.0:
+                index[count] = j
+                count += 1
+        for a in range(count):
+            i = index[a]
+            scaled = weight * matrix[r, i]
+            linear[i] -= scaled * target[r]
+            for c in range(count):
+                j = index[c]
+                hessian[i, j] += scaled * matrix[r, j]
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def constraints(  # type: ignore[no-untyped-def]
+    mass, qfrc_bias, qfrc_passive, jac, jac_dot, local, qvel, contacts, unactuated, actuated,
+    gear, ctrl_low, ctrl_high, foot_rows, foot_start, damping, rows, upper, lower, offset,
+):  # fmt: skip
+    """Write the constraint rows of :class:`~.wbc.WholeBodyQP` into ``rows``; return their count.
+
+    Row order: the unactuated rows of the dynamics M q̈ − J_cᵀ w = −h; per foot, six rows
+    J_i q̈ = −J̇_i q̇ − k_c J_i q̇ (in contact) or w_i = 0 (swinging); the wrench rows G_i w_i ≤ 0
+    of each foot in contact; the motors' (M_a q̈ + h_a − J_aᵀ w)/gear within the ctrl range.
+    ``offset`` receives h_a/gear. ``foot_rows`` stacks every foot's G, foot i's rows from
+    ``foot_start[i]`` to ``foot_start[i + 1]``.
+    """
+    nv, size = mass.shape[0], rows.shape[1]
+    nf = size - nv
+    count = 0
+    for r in range(unactuated.shape[0]):
+        k = unactuated[r]
+        rows[count, :nv] = mass[k]
+        for j in range(nf):
+            rows[count, nv + j] = -local[j, k]
+        upper[count] = lower[count] = qfrc_passive[k] - qfrc_bias[k]
+        count += 1
+    for i in range(contacts.shape[0]):
+        for r in range(6 * i, 6 * i + 6):
+            rows[count] = 0.0
+            if contacts[i]:
+                rows[count, :nv] = jac[r]
+                drift = 0.0
+                for j in range(nv):
+                    drift += jac[r, j] * qvel[j]
+                upper[count] = lower[count] = -jac_dot[r] - damping * drift
+            else:
+                rows[count, nv + r] = 1.0
+                upper[count] = lower[count] = 0.0
+            count += 1
+    for i in range(contacts.shape[0]):
+        if not contacts[i]:
+            continue
+        for g in range(foot_start[i], foot_start[i + 1]):
+            rows[count] = 0.0
+            rows[count, nv + 6 * i : nv + 6 * i + 6] = foot_rows[g]
+            upper[count], lower[count] = 0.0, -INF
+            count += 1
+    for r in range(actuated.shape[0]):
+        k, scale = actuated[r], gear[r]
+        for j in range(nv):
+            rows[count, j] = mass[k, j] / scale
+        for j in range(nf):
+            rows[count, nv + j] = -local[j, k] / scale
+        offset[r] = (qfrc_bias[k] - qfrc_passive[k]) / scale
+        upper[count] = min(ctrl_high[r] - offset[r], INF)
+        lower[count] = max(ctrl_low[r] - offset[r], -INF)
+        count += 1
+    return count
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def least_distance(  # type: ignore[no-untyped-def]
+    hessian, linear, rows, upper, lower, count, factor, first, shift, out_rows, out_upper,
+    out_lower,
+):  # fmt: skip
+    """Factor H = L Lᵀ on its envelope; write M = A L⁻ᵀ, l + M v, u + M v (module docstring).
+
+    ``factor`` receives L, ``first`` each row's first non-zero column, ``shift`` v = L⁻¹ f.
+    Only the first ``count`` rows of ``rows`` are read. Returns False when H is not positive
+    definite (or not finite).
+    """
+    n = hessian.shape[0]
+    for j in range(n):
+        k = 0
+        while k < j and hessian[j, k] == 0.0:
+            k += 1
+        first[j] = k
+    for j in range(n):  # row-wise envelope Cholesky: L_jk for first[j] ≤ k ≤ j
+        factor[j, : first[j]] = 0.0
+        for k in range(first[j], j + 1):
+            total = hessian[j, k]
+            for p in range(max(first[j], first[k]), k):
+                total -= factor[j, p] * factor[k, p]
+            if k < j:
+                factor[j, k] = total / factor[k, k]
+            elif total > 0.0 and math.isfinite(total):
+                factor[j, j] = math.sqrt(total)
+            else:
+                return False
+        factor[j, j + 1 :] = 0.0
+    _forward(factor, first, linear, shift)
+    for r in range(count):
+        _forward(factor, first, rows[r], out_rows[r])
+        moved = 0.0
+        for j in range(n):
+            moved += out_rows[r, j] * shift[j]
+        out_upper[r] = upper[r] + moved if upper[r] < INF else upper[r]
+        out_lower[r] = lower[r] + moved if lower[r] > -INF else lower[r]
+    return True
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def _forward(factor, first, rhs, out):  # type: ignore[no-untyped-def]
+    """Solve L y = rhs for y (into ``out``), L lower triangular on its envelope ``first``."""
+    for j in range(rhs.shape[0]):
+        total = rhs[j]
+        for k in range(first[j], j):
+            total -= factor[j, k] * out[k]
+        out[j] = total / factor[j, j]
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def recover(factor, first, shift, solution, x):  # type: ignore[no-untyped-def]
+    """Write x = L⁻ᵀ (u − v) for DAQP's ``solution`` u (module docstring)."""
+    n = x.shape[0]
+    for j in range(n):
+        x[j] = solution[j] - shift[j]
+    for j in range(n - 1, -1, -1):  # Lᵀ x = y, column j of Lᵀ is row j of L
+        x[j] /= factor[j, j]
+        for k in range(first[j], j):
+            x[k] -= factor[j, k] * x[j]
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def sole_origins(xpos, xmat, bodies, origins, out):  # type: ignore[no-untyped-def]
+    """Write each sole frame's origin x_b + R_b o_b [m] (world) into ``out`` (n, 3)."""
+    for i in range(bodies.shape[0]):
+        b = bodies[i]
+        for r in range(3):
+            out[i, r] = xpos[b, r] + (
+                xmat[b, 3 * r] * origins[i, 0]
+                + xmat[b, 3 * r + 1] * origins[i, 1]
+                + xmat[b, 3 * r + 2] * origins[i, 2]
+            )
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def sole_frames(xmat, bodies, jac, dots, qvel, jac_dot, local):  # type: ignore[no-untyped-def]
+    """Write J̇ q̇ (from ``dots`` = J̇) and the sole-frame Jacobian Rᵀ J of each foot."""
+    nv = jac.shape[1]
+    for r in range(jac.shape[0]):
+        total = 0.0
+        for j in range(nv):
+            total += dots[r, j] * qvel[j]
+        jac_dot[r] = total
+    for i in range(bodies.shape[0]):
+        b = bodies[i]
+        for block in (6 * i, 6 * i + 3):
+            for a in range(3):  # row a of Rᵀ J: Σ_c R[c, a] J[c]
+                for j in range(nv):
+                    local[block + a, j] = (
+                        xmat[b, a] * jac[block, j]
+                        + xmat[b, 3 + a] * jac[block + 1, j]
+                        + xmat[b, 6 + a] * jac[block + 2, j]
+                    )
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def ankle_targets(  # type: ignore[no-untyped-def]
+    xmat, bodies, mass, com, cop, offset, omega2, gravity, error, jacp, jacr, dots, qvel, qpos,
+    posture, height, torso_z, gains, upright, com_rows, targets,
+):  # fmt: skip
+    """Write the ankle controller's task rows and targets (:mod:`.wbc_control`).
+
+    ``com_rows`` (2, size, zeros) receives R_i[:2] / m on each foot's force columns;
+    ``targets`` receives, in order, the CoM's ω² (c − p − δ) − g_xy [m/s²] (2), the torso's
+    α = −k_R e − d_R ω − J̇_r q̇ [rad/s²] (3), the pelvis's k_z (z_0 − z) − d_z ż − J̇_z q̇
+    [m/s²] (1) and the posture's k_q (q_0 − q) − d_q q̇ [rad/s²] (nv − 6), with ``gains`` =
+    (k_R, d_R, k_z, d_z, k_q, d_q). ``jacp``, ``jacr`` and ``dots`` (6, nv: J̇_p, J̇_r) are
+    the torso's. Returns whether |e| [rad] and |ω| [rad/s] are both below ``upright``.
+    """
+    nv = qvel.shape[0]
+    nv_rows = com_rows.shape[1] - 6 * bodies.shape[0]
+    for i in range(bodies.shape[0]):
+        b = bodies[i]
+        for a in range(2):
+            for c in range(3):
+                com_rows[a, nv_rows + 6 * i + c] = xmat[b, 3 * a + c] / mass
+    for a in range(2):
+        targets[a] = omega2 * (com[a] - cop[a] - offset[a]) - gravity[a]
+    spin2, error2 = 0.0, 0.0
+    for a in range(3):
+        spin, drift = 0.0, 0.0
+        for j in range(nv):
+            spin += jacr[a, j] * qvel[j]
+            drift += dots[3 + a, j] * qvel[j]
+        targets[2 + a] = -gains[0] * error[a] - gains[1] * spin - drift
+        spin2 += spin * spin
+        error2 += error[a] * error[a]
+    rise, drift = 0.0, 0.0
+    for j in range(nv):
+        rise += jacp[2, j] * qvel[j]
+        drift += dots[2, j] * qvel[j]
+    targets[5] = gains[2] * (height - torso_z) - gains[3] * rise - drift
+    for j in range(nv - 6):
+        targets[6 + j] = gains[4] * (posture[j] - qpos[7 + j]) - gains[5] * qvel[6 + j]
+    return math.sqrt(error2) < upright and math.sqrt(spin2) < upright
