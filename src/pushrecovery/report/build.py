@@ -29,6 +29,7 @@ from pushrecovery.report.config import (
 )
 from pushrecovery.report.context import _body_grids, _Context
 from pushrecovery.report.data import FailedSection, Footer, Report, Section, Verdict
+from pushrecovery.report.humanoid3d import humanoid3d_section
 from pushrecovery.report.mujoco import _critical, _filmstrips
 from pushrecovery.report.sections import _bounds, _figures, _map, _plane, _steps
 from pushrecovery.surfaces.bounds import bounds_data
@@ -49,6 +50,7 @@ _BUILDERS: Mapping[str, Callable[[_Context], Section]] = {
     "biped": _biped,
     "critical": _critical,
     "filmstrips": _filmstrips,
+    "humanoid3d": humanoid3d_section,
 }
 
 

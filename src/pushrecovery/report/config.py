@@ -21,9 +21,10 @@ SECTIONS: Mapping[str, str] = {
     "biped": "Push campaign in MuJoCo: stepping",
     "critical": "Critical pushes in MuJoCo",
     "filmstrips": "Filmstrips",
+    "humanoid3d": "3-D humanoid",
 }
 #: The sections that need MuJoCo (left out with ``mujoco=False``).
-MUJOCO_SECTIONS = ("mujoco", "biped", "critical", "filmstrips")
+MUJOCO_SECTIONS = ("mujoco", "biped", "critical", "filmstrips", "humanoid3d")
 #: Order of computation: the campaigns first (the longest work, on the workers).
 _RUN_ORDER = (
     "sweep",
@@ -38,6 +39,7 @@ _RUN_ORDER = (
     "figures",
     "critical",
     "filmstrips",
+    "humanoid3d",
 )
 #: Filmstrips: strategy -> (model, controller, caption), as docs/validation.md; the push is the
 #: body's own (:func:`~pushrecovery.experiments.pushes.strategy_pushes`: 25, 40 and 80 N s for
@@ -47,6 +49,19 @@ FILMSTRIPS: Mapping[str, tuple[str, str, str]] = {
     "hip": ("torso", "mpc", "hip strategy: torso + MPC"),
     "step": ("biped", "recovery", "stepping: biped + recovery controller"),
 }
+#: The 3-D humanoid's filmstrips: key -> (model, azimuth [deg], push as a fraction of the 2-D
+#: CoP-region critical impulse at that azimuth, controller: "ankle" (ankles only) or "step"
+#: (ankles and steps, 0.2 s swing), caption, frame times [s]; the push at 0.1 s, the run
+#: ending 0.1 s after the last frame). An ankle recovery, a lateral capture step (the push of
+#: tests/test_wbc_stepping.py), a G1 push.
+HUMANOID3D_STRIPS: Mapping[str, tuple[str, float, float, str, str, tuple[float, ...]]] = {
+    "biped3d-ankle": ("biped3d", 0.0, 0.6, "ankle", "biped3d, forward push, ankles",
+                      (0.1, 0.2, 0.3, 0.45, 0.7, 1.2)),
+    "biped3d-step": ("biped3d", 90.0, 1.5, "step", "biped3d, push to the left, a side step",
+                     (0.1, 0.2, 0.3, 0.4, 0.6, 1.5)),
+    "g1-ankle": ("g1", 90.0, 0.5, "ankle", "Unitree G1, push to the left, ankles",
+                 (0.1, 0.2, 0.3, 0.45, 0.7, 1.2)),
+}  # fmt: skip
 #: Captions of the paper's figures, by file stem.
 FIGURE_CAPTIONS: Mapping[str, str] = {
     "fig3a": "Fig. 3(a): open-loop saturated ankle torque on the linear inverted pendulum, "
@@ -110,6 +125,12 @@ class ReportGrids:
         Bracket of the ankle and hip critical pushes [m/s].
     step_tolerance : float
         Bracket of the stepping critical pushes [m/s].
+    azimuths3d : tuple of float
+        Push azimuths of the 3-D validation's polar plots [deg].
+    tolerance3d : float
+        Its bisection's final width, as a fraction of the prediction.
+    duration3d : float
+        Its runs' time after the push [s] (a run not fallen by then stands).
     """
 
     analytic: PushGrid
@@ -119,6 +140,9 @@ class ReportGrids:
     critical_x0s: tuple[float, ...] = (0.0,)
     critical_tolerance: float = 2e-3
     step_tolerance: float = 1e-2
+    azimuths3d: tuple[float, ...] = (0.0, 60.0, 120.0, 180.0, 240.0, 300.0)
+    tolerance3d: float = 0.05
+    duration3d: float = 1.5
 
 
 #: Grid sizes: ``small`` keeps the whole report near a minute on two cores.
@@ -137,5 +161,8 @@ SIZES: Mapping[str, ReportGrids] = {
         critical_x0s=(-0.03, 0.0, 0.05, 0.1),
         critical_tolerance=1e-3,
         step_tolerance=5e-3,
+        azimuths3d=tuple(float(a) for a in range(0, 360, 30)),
+        tolerance3d=0.01,
+        duration3d=3.0,
     ),
 }

@@ -25,6 +25,7 @@ __all__ = [
     "Filmstrip",
     "FilmstripsSection",
     "Footer",
+    "Humanoid3DSection",
     "MapSection",
     "Picture",
     "PlaneSection",
@@ -268,6 +269,22 @@ class FilmstripsSection(Section):
     template: ClassVar[str] = "filmstrips.html.j2"
     strips: tuple[Filmstrip, ...]
     unavailable: str | None = None
+
+
+@dataclass(frozen=True)
+class Humanoid3DSection(Section):
+    """The 3-D humanoids: the validation's polar plots and tables, and filmstrips.
+
+    ``unavailable`` is the one line saying how to get the section (the ``robots`` extra) when
+    it could not be computed; ``rendering`` says why there are no filmstrips (no OpenGL).
+    """
+
+    template: ClassVar[str] = "humanoid3d.html.j2"
+    polar: tuple[Picture, ...] = ()
+    tables: tuple[Table, ...] = ()
+    strips: tuple[Filmstrip, ...] = ()
+    unavailable: str | None = None
+    rendering: str | None = None
 
 
 @dataclass(frozen=True)
