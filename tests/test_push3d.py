@@ -133,8 +133,8 @@ def test_simulate_biped3d_recovers_a_small_push_and_reports_the_new_keys(capsys)
         (("simulate", "--model", "biped3d"), "use --backend mujoco"),
         (("simulate", "--azimuth", "30"), "--azimuth needs a 3-D model"),
         (("campaign", "--backend", "mujoco", "--model", "biped3d", "--out", "x"),
-         "campaign does not run the 3-D models"),
-        (("validate", "--model", "g1", "--azimuth", "30"), "validate does not run the 3-D"),
+         "campaign needs one of --impulse, --fraction, --xdot"),
+        (("validate", "--model", "g1", "--azimuth", "400"), "--azimuth must be in [-360, 360]"),
     ],
 )  # fmt: skip
 def test_bad_3d_requests_are_one_line_and_exit_2(capsys, args, words):

@@ -29,6 +29,9 @@ it, and what the simulation did. Columns, SI units, positions relative to the st
                        diverged, the push took more than ``push_timeout`` of wall time, or
                        its worker process died or stopped answering; null otherwise
 =====================  ======================================================================
+
+The 3-D models (``biped3d``, ``g1``) add columns, null on the others, and read some of the
+above in 3-D (:mod:`.pushes3d`, whose docstring lists them).
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ from typing import Any
 
 from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.spec import CampaignSpec, Push
-from pushrecovery.control.base import controller_class, make_controller
+from pushrecovery.control.base import make_controller
 from pushrecovery.errors import SimulationDiverged, SimulationTimeout
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.batched import BATCHED, BatchedRuns
@@ -81,6 +84,18 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("time", "float64"),
     ("stop_impacts", "int64"),
     ("error", "string"),
+    # The 3-D models' (pushes3d); null on the others.
+    ("azimuth", "float64"),
+    ("fraction", "float64"),
+    ("ankle_critical", "float64"),
+    ("y0", "float64"),
+    ("capture_point_y", "float64"),
+    ("predicted_corrected", "string"),
+    ("lift_offs", "int64"),
+    ("peak_hip_motor_torque", "float64"),
+    ("max_torso_tilt", "float64"),
+    ("peak_torque_ratio", "float64"),
+    ("failed_ticks", "int64"),
 )
 
 
@@ -93,6 +108,10 @@ def run_push(
     compiles a model per plant).
     """
     cache = {} if cache is None else cache
+    if spec.is_3d:
+        from pushrecovery.campaign.pushes3d import run_push3d
+
+        return run_push3d(spec, push, cache)
     if push.params not in cache:
         cache[push.params] = (
             make_plant(spec.model, push.params, spec.backend),
@@ -199,7 +218,7 @@ def _row(
 def _inputs_and_prediction(spec: CampaignSpec, push: Push, found: _Prediction) -> dict[str, Any]:
     """Return the columns of a row that do not depend on the run: the push and its verdict."""
     # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
-    reach = STRATEGY_CODES.index(Strategy(controller_class(spec.controller).strategy))
+    reach = STRATEGY_CODES.index(Strategy(spec.strategy))
     row: dict[str, Any] = {
         f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
     }
@@ -306,6 +325,10 @@ def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
 
     The simulated columns are NaN (counts 0), ``used`` is ``error`` and ``error`` says why.
     """
+    if spec.is_3d:
+        from pushrecovery.campaign.pushes3d import error_row3d
+
+        return error_row3d(spec, push, reason)
     row = _inputs_and_prediction(spec, push, _predictions([push])[0])
     row.update(
         outcome="error",

@@ -6,6 +6,13 @@ swept body parameters. Push ``i`` is fully defined by the spec and ``i``: the gr
 parameters (outermost, in the order given), then x0, then the push; a random campaign
 (``samples``) draws push ``i`` from ``numpy.random.default_rng([seed, i])``, so that no result
 depends on how the pushes are split into batches or spread over workers.
+
+On the 3-D models (``biped3d``, ``g1``; :mod:`.spec3d`) the body stands in its own posture
+(x0 = 0 only), each push also has an azimuth (the grid: parameters, x0, azimuth, push; a
+random campaign draws it uniformly between the smallest and largest azimuth), the pushes may
+be fractions of the ankle's predicted critical impulse along it (``fraction``), and the
+controller is the whole-body controller with one strategy set (``wbc-ankle``, ``wbc-hip``,
+``wbc-step``).
 """
 
 from __future__ import annotations
@@ -20,6 +27,15 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.campaign.ranges import MAX_PUSHES, Range, value_range
+from pushrecovery.campaign.ranges import interval as _interval
+from pushrecovery.campaign.spec3d import (
+    MODELS_3D,
+    WBC_CONTROLLERS,
+    check_spec3d,
+    critical_impulse,
+    standing_origin,
+)
 from pushrecovery.control.base import controller_class
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
@@ -41,63 +57,29 @@ class CampaignError(PushRecoveryError):
 #: Backends a campaign runs on, with their models.
 BACKENDS: Mapping[str, tuple[str, ...]] = {
     "analytic": ("lipm", "pendulum", "flywheel", "stepping", "stepping-plane"),
-    "mujoco": ("foot", "torso", "biped"),
+    "mujoco": ("foot", "torso", "biped", *MODELS_3D),
 }
-#: Largest campaign accepted [pushes].
-MAX_PUSHES = 1_000_000
 #: Wall time a push may take by default, and at most [s].
 DEFAULT_PUSH_TIMEOUT = 120.0
 MAX_PUSH_TIMEOUT = 3600.0
 #: Pushes per batch when the spec does not say: about a second of work per batch.
 DEFAULT_BATCH = {"analytic": 100, "mujoco": 10}
 
-Range = tuple[float, float, float]
-
-
-def value_range(name: str, triple: Range, limit: int = MAX_PUSHES) -> np.ndarray:
-    """START, START + STEP, ... up to STOP inclusive; STEP > 0, START <= STOP, finite.
-
-    Raises
-    ------
-    InvalidParameterError
-        Naming ``name`` when the range is empty, not finite or longer than ``limit``.
-    """
-    if len(triple) != 3:
-        raise InvalidParameterError(f"{name} needs START STOP STEP, got {triple!r}")
-    start, stop, increment = (float(v) for v in triple)
-    if not all(math.isfinite(v) for v in (start, stop, increment)):
-        raise InvalidParameterError(f"{name} must be finite, got {start:g} {stop:g} {increment:g}")
-    if increment <= 0.0 or stop < start:
-        raise InvalidParameterError(
-            f"{name} needs START <= STOP and STEP > 0, got {start:g} {stop:g} {increment:g}"
-        )
-    count = int(np.floor((stop - start) / increment + 1e-9)) + 1
-    if count > limit:
-        raise InvalidParameterError(f"{name} gives {count} values; at most {limit}")
-    # Rounded to 12 digits: 0.1 * 3 is 0.3 in the results, not 0.30000000000000004; never
-    # beyond STOP.
-    return np.minimum(np.round(start + increment * np.arange(count), 12), stop)
-
-
-def _interval(name: str, triple: Range) -> tuple[float, float]:
-    """START and STOP of a range whose STEP is not used (random samples): finite, ordered."""
-    if len(triple) != 3:
-        raise InvalidParameterError(f"{name} needs START STOP STEP, got {triple!r}")
-    start, stop = float(triple[0]), float(triple[1])
-    if not (math.isfinite(start) and math.isfinite(stop)) or stop < start:
-        raise InvalidParameterError(f"{name} needs finite START <= STOP, got {start:g} {stop:g}")
-    return start, stop
-
 
 @dataclass(frozen=True, slots=True)
 class Push:
-    """One push of a campaign: its index, the body, the CoM start and the push."""
+    """One push of a campaign: its index, the body, the CoM start and the push.
+
+    3-D models: its ``azimuth`` [deg], ``xdot`` = J/m along it, ``fraction`` of J*_ankle.
+    """
 
     index: int
     params: BodyParams
     swept: tuple[float, ...]
     x0: float
     xdot: float
+    azimuth: float | None = None
+    fraction: float | None = None
 
     @property
     def impulse(self) -> float:
@@ -114,13 +96,17 @@ class CampaignSpec:
     backend : {"analytic", "mujoco"}
         Physics: velocity jumps on the analytic models, real forces at the CoM on MuJoCo.
     model, controller : str
-        Plant (``BACKENDS[backend]``) and controller registry names.
+        Plant (``BACKENDS[backend]``) and controller registry names; on the 3-D models
+        (``biped3d``, ``g1``) the controller is one of ``WBC_CONTROLLERS``.
     params : BodyParams
         The body; swept parameters replace their field.
     x0 : (start, stop, step)
-        CoM positions before the push, relative to the ankle [m], strictly on the foot.
-    xdot, impulse : (start, stop, step)
-        The pushes, as the CoM velocity they give [m/s] or as impulses [N s] (exactly one).
+        CoM positions before the push, relative to the ankle [m], strictly on the foot
+        (3-D models: 0 only, the standing posture).
+    xdot, impulse, fraction : (start, stop, step)
+        The pushes, as the CoM velocity they give [m/s], as impulses [N s] or (3-D models)
+        as fractions of the ankle's predicted critical impulse along each azimuth [-]
+        (exactly one).
     sweeps : mapping of str to (start, stop, step)
         Body parameters to sweep (``BodyParams`` field names), in SI units.
     samples : int or None
@@ -136,6 +122,9 @@ class CampaignSpec:
         Wall time one push may take [s], in (0, 3600] (default 120): a push that takes longer
         is an ``error`` row, and a worker that stops answering is stopped
         (:mod:`~pushrecovery.campaign.isolation`).
+    azimuths : tuple of float or None
+        3-D models only: the pushes' directions [deg], 0 forward, 90 left (default (0,));
+        1 to 360 angles in [−360, 360], distinct modulo 360.
     """
 
     backend: str
@@ -151,6 +140,8 @@ class CampaignSpec:
     duration: float = 6.0
     batch_size: int | None = None
     push_timeout: float = DEFAULT_PUSH_TIMEOUT
+    azimuths: tuple[float, ...] | None = None
+    fraction: Range | None = None
 
     def __post_init__(self) -> None:
         if self.backend not in BACKENDS:
@@ -162,8 +153,8 @@ class CampaignSpec:
                 f"model must be one of {list(BACKENDS[self.backend])} on the {self.backend} "
                 f"backend, got {self.model!r}"
             )
-        controller_class(self.controller)  # raises, naming the controllers
-        if (self.xdot is None) == (self.impulse is None):
+        object.__setattr__(self, "azimuths", check_spec3d(self))  # and the 2-D's controller
+        if sum(p is not None for p in (self.xdot, self.impulse, self.fraction)) != 1:
             raise InvalidParameterError("give exactly one of xdot and impulse (the pushes)")
         # Every number of the body can be swept; a polygon cannot.
         fields = {f.name for f in dataclasses.fields(BodyParams)} - {"foot_polygon"}
@@ -221,8 +212,23 @@ class CampaignSpec:
                     )
         self._check_setup()
 
+    @property
+    def is_3d(self) -> bool:
+        """Whether the model is a 3-D humanoid (the whole-body controller, azimuths)."""
+        return self.model in MODELS_3D
+
+    @property
+    def strategy(self) -> str:
+        """The highest strategy the controller has: ankle, hip or step."""
+        if self.is_3d:
+            return WBC_CONTROLLERS[self.controller]
+        return str(controller_class(self.controller).strategy)
+
     def _check_setup(self) -> None:
         """Check that the model, controller and duration work together (:func:`check_run`)."""
+        if self.is_3d:  # the plant builds (the G1's extra is there, its params its own)
+            standing_origin(self.model, self.push(0).params)
+            return
         from pushrecovery.control.base import make_controller
         from pushrecovery.sim.registry import make_plant
         from pushrecovery.sim.simulate import check_run
@@ -235,13 +241,16 @@ class CampaignSpec:
     # --- the pushes -----------------------------------------------------------------------
     @property
     def push_name(self) -> str:
-        """``xdot`` or ``impulse``: how the pushes are given."""
+        """``xdot``, ``impulse`` or ``fraction``: how the pushes are given."""
+        if self.fraction is not None:
+            return "fraction"
         return "xdot" if self.xdot is not None else "impulse"
 
     @property
     def push_range(self) -> Range:
         """The range of the pushes, in the unit of :attr:`push_name`."""
         push = self.xdot if self.xdot is not None else self.impulse
+        push = self.fraction if self.fraction is not None else push
         assert push is not None  # checked in __post_init__
         return push
 
@@ -254,6 +263,11 @@ class CampaignSpec:
             value_range(f"--{self.push_name}", self.push_range),
         )
 
+    @property
+    def _directions(self) -> tuple[float, ...]:
+        """The azimuths of a 3-D campaign (one axis of the grid); () on the 2-D models."""
+        return self.azimuths or ()
+
     @functools.cached_property
     def size(self) -> int:
         """Number of pushes."""
@@ -261,7 +275,8 @@ class CampaignSpec:
             return self.samples
         sweeps, x0s, pushes = self._axes
         # Python ints: no overflow however large the grid.
-        return math.prod(len(v) for v in sweeps) * len(x0s) * len(pushes)
+        turns = len(self._directions) if self.is_3d else 1
+        return math.prod(len(v) for v in sweeps) * len(x0s) * turns * len(pushes)
 
     @property
     def batch(self) -> int:
@@ -281,12 +296,27 @@ class CampaignSpec:
         except InvalidParameterError as exc:
             raise InvalidParameterError(f"--param sweep: {exc}") from None
 
-    def _push(self, index: int, swept: tuple[float, ...], x0: float, push: float) -> Push:
+    def _push(
+        self,
+        index: int,
+        swept: tuple[float, ...],
+        x0: float,
+        push: float,
+        azimuth: float | None = None,
+    ) -> Push:
         body = self.body(swept)
         if not body.heel < x0 < body.toe:  # a bug, not input: the spec checked the box
             raise InvalidParameterError(f"x0 = {x0:g} m is off the foot of push {index}")
+        values = tuple(float(v) for v in swept)
+        if self.fraction is not None and azimuth is not None:  # J = f J*_ankle(ψ)
+            impulse = float(push) * critical_impulse(
+                body, standing_origin(self.model, body), float(azimuth)
+            )
+            return Push(index, body, values, float(x0), impulse / body.mass, float(azimuth),
+                        float(push))  # fmt: skip
         xdot = push if self.xdot is not None else push / body.mass
-        return Push(index, body, tuple(float(v) for v in swept), float(x0), float(xdot))
+        angle = None if azimuth is None else float(azimuth)
+        return Push(index, body, values, float(x0), float(xdot), angle)
 
     def push(self, index: int) -> Push:
         """Push number ``index`` (0 <= index < size)."""
@@ -295,13 +325,20 @@ class CampaignSpec:
         if self.samples is not None:
             rng = np.random.default_rng([self.seed, index])
             ranges = [*self.sweeps.values(), self.x0, self.push_range]
+            if self.is_3d:  # drawn between the push's start and its size
+                turns = self._directions
+                ranges.insert(-1, (min(turns), max(turns), 0.0))
             draws = [rng.uniform(r[0], r[1]) if r[1] > r[0] else r[0] for r in ranges]
+            if self.is_3d:
+                return self._push(index, tuple(draws[:-3]), draws[-3], draws[-1], draws[-2])
             return self._push(index, tuple(draws[:-2]), draws[-2], draws[-1])
         sweeps, x0s, pushes = self._axes
-        shape = [len(v) for v in sweeps] + [len(x0s), len(pushes)]
+        turns = self._directions
+        shape = [len(v) for v in sweeps] + [len(x0s), len(turns) or 1, len(pushes)]
         position = np.unravel_index(index, shape)
-        swept = tuple(v[k] for v, k in zip(sweeps, position[:-2], strict=True))
-        return self._push(index, swept, x0s[position[-2]], pushes[position[-1]])
+        swept = tuple(v[k] for v, k in zip(sweeps, position[:-3], strict=True))
+        azimuth = turns[position[-2]] if self.is_3d else None
+        return self._push(index, swept, x0s[position[-3]], pushes[position[-1]], azimuth)
 
     def pushes(self, batch: int) -> list[Push]:
         """Return the pushes of batch number ``batch``."""
@@ -314,8 +351,13 @@ class CampaignSpec:
 
     # --- storage ---------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """JSON form (``from_dict`` reads it back)."""
-        return {
+        """JSON form (``from_dict`` reads it back); ``azimuths``, ``fraction``: 3-D only."""
+        extra = {
+            name: list(value)
+            for name, value in (("azimuths", self.azimuths), ("fraction", self.fraction))
+            if value is not None
+        }
+        return extra | {
             "backend": self.backend,
             "model": self.model,
             "controller": self.controller,
@@ -351,6 +393,8 @@ class CampaignSpec:
                 duration=data["duration"],
                 batch_size=data["batch_size"],
                 push_timeout=data.get("push_timeout", DEFAULT_PUSH_TIMEOUT),
+                azimuths=None if data.get("azimuths") is None else tuple(data["azimuths"]),
+                fraction=None if data.get("fraction") is None else tuple(data["fraction"]),
             )
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InvalidParameterError(f"malformed campaign spec: {exc}") from None

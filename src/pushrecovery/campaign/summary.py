@@ -9,7 +9,9 @@
   smaller one in that direction, the next push of the grid], next to the analytic critical
   push of the controller's surface (Eq. 4, corrected Eq. 15 or the single-step limit,
   :func:`~pushrecovery.sim.critical.predicted_critical_velocity`). ``monotone`` is false when a
-  push beyond the first failure recovers again.
+  push beyond the first failure recovers again. On the 3-D models the groups are the azimuths
+  (``direction`` "ψ deg", ``azimuth``), the pushes J/m along ψ, and the analytic value the
+  ground plane's m ω ρ_R(r₀, ψ)/m for ankle and hip (:mod:`.spec3d`; none for step).
 """
 
 from __future__ import annotations
@@ -21,7 +23,6 @@ from typing import Any
 import numpy as np
 
 from pushrecovery.campaign.spec import CampaignSpec
-from pushrecovery.control.base import controller_class
 from pushrecovery.sim.critical import predicted_critical_velocity
 from pushrecovery.sim.validation import LABELS as VALIDATION_LABELS
 
@@ -35,21 +36,33 @@ def _clean(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
+def _analytic3d(spec: CampaignSpec, params: Any, azimuth: float) -> float:
+    """Return the ground plane's critical push along ``azimuth`` [m/s] (NaN for step)."""
+    from pushrecovery.campaign.spec3d import critical_impulse, standing_origin
+
+    if spec.strategy not in ("ankle", "hip"):
+        return math.nan
+    origin = standing_origin(spec.model, params)
+    return critical_impulse(params, origin, azimuth, spec.strategy) / params.mass
+
+
 def boundary(spec: CampaignSpec, columns: dict[str, np.ndarray]) -> list[dict[str, Any]]:
     """Empirical critical pushes against the analytic ones (module docstring)."""
-    strategy = controller_class(spec.controller).strategy
+    strategy = spec.strategy
     names = [f"param_{name}" for name in spec.sweeps]
+    where = "azimuth" if spec.is_3d else "x0"
     groups: dict[tuple[float, ...], list[int]] = defaultdict(list)
     for i in range(len(columns["x0"])):
         if columns["outcome"][i] == "error":
             continue  # no outcome: neither a recovery nor a fall
-        key = (*(float(columns[n][i]) for n in names), float(columns["x0"][i]))
+        key = (*(float(columns[n][i]) for n in names), float(columns[where][i]))
         groups[key].append(i)
     rows = []
     for key, members in groups.items():
         swept, x0 = key[:-1], key[-1]
         params = spec.body(swept)
-        for direction, sign in (("forward", 1.0), ("backward", -1.0)):
+        ways = [(f"{x0:g} deg", 1.0)] if spec.is_3d else [("forward", 1.0), ("backward", -1.0)]
+        for direction, sign in ways:
             picked = [i for i in members if sign * columns["xdot"][i] > 0.0]
             if not picked:
                 continue
@@ -61,12 +74,16 @@ def boundary(spec: CampaignSpec, columns: dict[str, np.ndarray]) -> list[dict[st
             low = speeds[first_fail - 1] if first_fail > 0 else math.nan
             high = speeds[first_fail] if first_fail < len(picked) else math.nan
             empirical = 0.5 * (low + high) if 0 < first_fail < len(picked) else math.nan
-            analytic = predicted_critical_velocity(params, strategy, x0, direction)
+            analytic = (
+                _analytic3d(spec, params, x0)
+                if spec.is_3d
+                else predicted_critical_velocity(params, strategy, x0, direction)
+            )
             error = (abs(empirical) - abs(analytic)) / abs(analytic) if analytic else math.nan
             rows.append(
                 {
                     **{name: value for name, value in zip(spec.sweeps, swept, strict=True)},
-                    "x0": x0,
+                    where: x0,
                     "direction": direction,
                     "strategy": strategy,
                     "empirical": _clean(empirical),
@@ -106,6 +123,7 @@ class SummaryTally:
         self.stepping = self.exact = 0
         self.has_steps = True
         self.boundary_names = [f"param_{name}" for name in spec.sweeps] + ["x0", "xdot"]
+        self.boundary_names += ["azimuth"] if spec.is_3d else []
         self.boundary_parts: list[dict[str, np.ndarray]] = []
 
     def add(self, table: Any) -> None:

@@ -8,6 +8,7 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.campaign3d import OPTIONS_3D
 from pushrecovery.cli.options import body_options, echo_confusion, emit, params_from
 from pushrecovery.cli.progress import Progress
 
@@ -60,15 +61,24 @@ _scheduler = click.option(
 @click.option(
     "--model",
     default=None,
-    help="Plant (default: stepping on analytic, torso on mujoco).",
+    help="Plant (default: stepping on analytic, torso on mujoco; 3-D: biped3d, g1).",
 )
-@click.option("--controller", default=None, help="Controller (default: recovery / mpc).")
 @click.option(
-    "--azimuth", type=float, default=None, help="3-D models (biped3d, g1): not available yet."
+    "--controller",
+    default=None,
+    help="Controller (default: recovery / mpc; 3-D: wbc-ankle, wbc-hip, wbc-step).",
 )
-@click.option("--x0", "x0", **_triple, help="CoM positions before the push [m].")
+@click.option("--azimuth", type=float, default=None, help="3-D models: one push direction [deg].")
+@OPTIONS_3D[2]
+@OPTIONS_3D[0]
+@click.option(
+    "--x0", "x0", **_triple, help="CoM positions before the push [m] (3-D: 0, the default)."
+)
 @click.option("--xdot", **_triple, help="Pushes as CoM velocities [m/s].")
-@click.option("--impulse", **_triple, help="Pushes as impulses at the CoM [N s].")
+@click.option(
+    "--impulse", **_triple, help="Pushes as impulses at the CoM [N s] (3-D: at the torso)."
+)
+@OPTIONS_3D[1]
 @click.option(
     "--param",
     "sweep_pairs",
@@ -113,9 +123,12 @@ def campaign(
     model: str | None,
     controller: str | None,
     azimuth: float | None,
+    azimuths: str | None,
+    strategy: str | None,
     x0: tuple[float, float, float] | None,
     xdot: tuple[float, float, float] | None,
     impulse: tuple[float, float, float] | None,
+    fraction: tuple[float, float, float] | None,
     sweep_pairs: tuple[str, ...],
     samples: int | None,
     seed: int,
@@ -138,26 +151,44 @@ def campaign(
     one used) and the empirical critical pushes against the analytic ones. Every finished
     batch is kept in OUT/batches: an interrupted campaign continues with --resume. The
     result does not depend on the number of workers.
+
+    The 3-D models (--backend mujoco --model biped3d|g1) push the standing body at its torso
+    from each of --azimuths with each push (--impulse, or --fraction of the ankle's predicted
+    critical impulse along the azimuth) under the whole-body controller (--strategy); OUT
+    also gets the confusion matrix of predicted against used strategy (confusion3d.*).
     """
     from pushrecovery.campaign import CampaignSpec, read_spec, run_campaign
+    from pushrecovery.cli.campaign3d import azimuths_from, spec_3d
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.sim.registry import MUJOCO_3D_MODELS
 
-    if model in MUJOCO_3D_MODELS or azimuth is not None:
+    directions = azimuths_from(azimuth, azimuths)
+    three_d = model in MUJOCO_3D_MODELS
+    if not three_d and (directions is not None or strategy or fraction):
         raise InvalidParameterError(
-            "campaign does not run the 3-D models (biped3d, g1) yet: it needs an impulse x "
-            "azimuth grid in CampaignSpec and Parquet rows of the 3-D state; use simulate or "
-            "critical-push --azimuth"
+            "--azimuth(s), --strategy and --fraction need a 3-D model (--backend mujoco "
+            f"--model biped3d or g1), got --model {model}"
         )
-    params = params_from(kwargs)
     directory = Path(out)
-    if resume and x0 is None and xdot is None and impulse is None:
-        if sweep_pairs or samples is not None or model or controller:
+    pushes = (x0, xdot, impulse, fraction, directions)
+    if resume and all(value is None for value in pushes):
+        if sweep_pairs or samples is not None or model or controller or strategy:
             raise InvalidParameterError(
                 "--resume without --x0 runs the stored campaign: give its whole spec or none"
             )
         spec = read_spec(directory)  # the stored campaign, as it was asked for
+    elif three_d:
+        if xdot is None and impulse is None and fraction is None:
+            raise InvalidParameterError("campaign needs one of --impulse, --fraction, --xdot")
+        options = {
+            "backend": backend, "controller": controller, "strategy": strategy, "x0": x0,
+            "xdot": xdot, "impulse": impulse, "fraction": fraction, "directions": directions,
+            "sweeps": _sweeps(sweep_pairs), "samples": samples, "seed": seed,
+            "duration": duration, "batch_size": batch_size, "push_timeout": push_timeout,
+        }  # fmt: skip
+        spec = spec_3d(str(model), options, kwargs)
     else:
+        params = params_from(kwargs)
         if x0 is None or (xdot is None and impulse is None):
             raise InvalidParameterError("campaign needs --x0 and one of --xdot, --impulse")
         spec = CampaignSpec(
@@ -196,7 +227,13 @@ def campaign(
     bar.close()
     assert result is not None  # no max_batches
     files = {"pushes": str(result.pushes_file), "summary": str(directory / "summary.json")}
-    if plot:
+    confusion3d = None
+    if spec.is_3d:
+        from pushrecovery.cli.campaign3d import write_confusion
+
+        confusion3d, written = write_confusion(result.table, spec.model, directory, plot)
+        files.update(written)
+    elif plot:
         from pushrecovery.plots.campaign import plot_critical_vs_parameter, plot_outcome_map
 
         files["outcome_map"] = str(
@@ -223,6 +260,10 @@ def campaign(
     echo_confusion(
         "confusion (rows predicted, columns used):", confusion["labels"], confusion["counts"]
     )
+    if confusion3d is not None:
+        from pushrecovery.cli.campaign3d import echo_causes
+
+        echo_causes(confusion3d)
     for name, path in files.items():
         click.echo(f"{name:<22}{path}")
 

@@ -1,0 +1,180 @@
+"""The 3-D models of ``validate`` (biped3d, g1): the polar validation and the confusion matrix.
+
+``validate --model biped3d|g1``: each strategy's critical push per azimuth against the 2-D
+prediction (:mod:`pushrecovery.experiments.validation3d`: table and polar plot), then a 3-D
+campaign over azimuths × fractions of the ankle's predicted critical push under the
+whole-body controller with all its tasks, read as the confusion matrix of predicted against
+used strategy (:mod:`pushrecovery.experiments.confusion3d`). Everything is written under
+``--out``; the campaign (``OUT/confusion_<model>``) resumes if interrupted.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import click
+
+__all__ = ["QUICK", "Validate3DOptions", "validate_3d"]
+
+
+@dataclass(frozen=True)
+class Validate3DOptions:
+    """What ``validate`` asks of a 3-D model (the command's options, parsed)."""
+
+    model: str
+    azimuths: tuple[float, ...]
+    strategies: tuple[str, ...]
+    rel_tolerance: float
+    duration: float
+    fractions: tuple[float, ...]
+    confusion_duration: float
+    confusion: bool
+    out: Path
+    workers: int | None
+
+
+#: ``--quick``: two azimuths, the ankle, a coarse bisection, two push sizes.
+QUICK = {
+    "azimuths": (0.0, 90.0),
+    "strategies": ("ankle",),
+    "rel_tolerance": 0.03,
+    "fractions": (0.5, 1.5),
+}
+
+
+def fraction_list(text: str | None, default: tuple[float, ...]) -> tuple[float, ...]:
+    """Parse ``--fractions A,B,...``: 1 to 50 distinct numbers in (0, 20], increasing."""
+    import math
+
+    from pushrecovery.errors import InvalidParameterError
+
+    if text is None:
+        return default
+    try:
+        values = tuple(float(part) for part in text.split(","))
+    except ValueError:
+        raise InvalidParameterError(f"--fractions needs a list A,B,... [-], got {text!r}") from None
+    if not (
+        1 <= len(values) <= 50
+        and all(math.isfinite(v) and 0.0 < v <= 20.0 for v in values)
+        and all(a < b for a, b in itertools.pairwise(values))
+    ):
+        raise InvalidParameterError(
+            f"--fractions must be 1 to 50 increasing numbers in (0, 20], got {text!r}"
+        )
+    return values
+
+
+def validate_3d(options: Validate3DOptions, params: Any) -> dict[str, Any]:
+    """Run the 3-D validation and confusion matrix; write them under ``options.out``; JSON."""
+    from pushrecovery.experiments.validation3d import run_validation3d
+    from pushrecovery.plots.common import save_figure
+    from pushrecovery.plots.validation3d import validation3d_figure
+
+    out = options.out
+    out.mkdir(parents=True, exist_ok=True)
+    data: dict[str, Any] = {"backend": "mujoco", "model": options.model}
+    result = None
+    if options.strategies:
+        result = run_validation3d(
+            options.model,
+            options.azimuths,
+            options.strategies,
+            params=params,
+            rel_tolerance=options.rel_tolerance,
+            duration=options.duration,
+        )
+        stem = out / f"validation3d_{options.model}"
+        stem.with_suffix(".md").write_text(result.to_table() + "\n")
+        _write_csv(result, stem.with_suffix(".csv"))
+        (figure,) = save_figure(validation3d_figure(result), stem, ["png"])
+        data["critical"] = [_row(row) for row in result.rows]
+        table, table_csv = stem.with_suffix(".md"), stem.with_suffix(".csv")
+        data["files"] = {"table": str(table), "csv": str(table_csv), "polar": str(figure)}
+    if options.confusion:
+        data["confusion"] = _confusion(options, params)
+    return data
+
+
+def _row(row: Any) -> dict[str, Any]:
+    return {
+        "azimuth": row.azimuth,
+        "strategy": row.strategy,
+        "predicted": row.predicted,
+        "corrected": row.corrected,
+        "measured": row.measured,
+        "bracket": list(row.bracket),
+        "relative_error": row.relative_error,
+        "corrected_error": row.corrected_error,
+        "strategy_used": row.strategy_used,
+    }
+
+
+def _write_csv(result: Any, path: Path) -> None:
+    rows = [_row(row) for row in result.rows]
+    with path.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=[k for k in rows[0] if k != "bracket"]
+                                + ["fell"])  # fmt: skip
+        writer.writeheader()
+        for row in rows:
+            fell = row.pop("bracket")[1]
+            writer.writerow({**row, "fell": fell})
+
+
+def _confusion(options: Validate3DOptions, params: Any) -> dict[str, Any]:
+    """Run the confusion campaigns (resumable) and write the matrix; return its JSON."""
+    from pushrecovery.campaign import CampaignSpec, run_campaign
+    from pushrecovery.cli.campaign3d import write_confusion
+    from pushrecovery.cli.progress import Progress
+
+    # One campaign per push size (the sizes need not be evenly spaced: a campaign's range is),
+    # each resumable in its own directory.
+    directory = options.out / f"confusion_{options.model}"
+    specs = [
+        CampaignSpec(
+            backend="mujoco",
+            model=options.model,
+            controller="wbc-step",
+            params=params,
+            x0=(0.0, 0.0, 1.0),
+            fraction=(fraction, fraction, 1.0),
+            azimuths=options.azimuths,
+            duration=options.confusion_duration,
+            batch_size=4,
+        )
+        for fraction in options.fractions
+    ]
+    tables = []
+    bar = Progress(sum(s.size for s in specs), "confusion", "push")
+    try:
+        for spec in specs:
+            fraction = spec.push_range[0]
+            result = run_campaign(
+                spec, directory / f"f{fraction:g}", workers=options.workers, resume=True,
+                progress=bar.update,
+            )  # fmt: skip
+            assert result is not None
+            tables.append(result.table)
+    finally:
+        bar.close()
+    import pyarrow as pa
+
+    table = pa.concat_tables(tables)
+    matrix, files = write_confusion(table, options.model, directory)
+    click.echo(f"confusion campaign in {directory}", err=True)
+    return {
+        "labels": ["ankle", "hip", "step", "fall"],
+        "rows": "predicted",
+        "columns": "used",
+        "counts": matrix.counts.tolist(),
+        "counts_corrected": matrix.counts_corrected.tolist(),
+        "accuracy": matrix.accuracy,
+        "accuracy_corrected": matrix.accuracy_corrected,
+        "causes": matrix.causes(),
+        "errors": matrix.errors,
+        "files": files,
+    }
