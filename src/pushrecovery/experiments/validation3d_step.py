@@ -25,7 +25,7 @@ with ``stepping=True``, ankles and steps, no hip task) by ``runs3d.bisect_critic
 ``duration``, or ends with ξ more than :data:`FALL_MARGIN` outside the support polygon of the
 feet it stands on then (the plant's fall set, ``plant3d``, is measured against the feet at
 reset, which a step leaves). Each stood run at the measured impulse reports its steps, their
-longest swing time and longest step (ankle displacement).
+longest swing time and its largest foothold distance from the stance ankle.
 
 **Cause** (:meth:`StepRow.cause`), where measured and predicted differ by more than 10 %:
 the simple model takes a touchdown Δt_s after the push and a step as long as
@@ -100,7 +100,10 @@ def predicted_step_critical(
 
 @dataclass(frozen=True)
 class SteppingRun:
-    """What one stepping run did: whether it stood, its steps, longest swing [s] and step [m]."""
+    """What one stepping run did: whether it stood, its steps, longest swing [s] and reach [m].
+
+    The reach is the largest distance of a landed ankle from the stance ankle [m].
+    """
 
     stood: bool
     steps: int
@@ -125,12 +128,22 @@ def _stepping_run(params: BodyParams, model: Any, impulse: float, azimuth: float
     stepper = controller.stepper
     assert stepper is not None
     landed = [s for s in stepper.steps if s.landed is not None]
+    # Each foothold's distance from the stance ankle (the reach R of (S1)); the feet start
+    # under the hips, ±stance_width/2 to the side of the ankles' midpoint.
+    where = {"left_foot": np.array([0.0, 0.5 * params.stance_width]),
+             "right_foot": np.array([0.0, -0.5 * params.stance_width])}  # fmt: skip
+    reaches = []
+    for step in landed:
+        other = "right_foot" if step.foot == "left_foot" else "left_foot"
+        assert step.landed is not None
+        reaches.append(float(np.linalg.norm(step.landed - where[other])))
+        where[step.foot] = step.landed
     swings = [s.touchdown - s.liftoff for s in landed if s.touchdown is not None]
     return SteppingRun(
         stood=not down and outside <= FALL_MARGIN,
         steps=len(stepper.steps),
         swing_time=max(swings, default=0.0),
-        step_length=max((s.length for s in landed), default=0.0),
+        step_length=max(reaches, default=0.0),
     )
 
 
@@ -153,7 +166,8 @@ class StepRow:
     steps : int
         Steps taken in the run at ``measured``.
     swing_time, step_length : float
-        That run's longest swing [s] and longest step [m].
+        That run's longest swing (lift-off to touchdown) [s] and its largest distance from a
+        landed ankle to the stance ankle [m] (the reach of (S1)).
     refit : float
         The corrected prediction with that swing as Δt_s and that step as the reach [N s]
         (nan when no step landed): the simple model given the biped's own step.
