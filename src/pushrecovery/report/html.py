@@ -21,7 +21,10 @@ Sections, in the page's order (key: content):
 - ``mujoco``: a campaign on the MuJoCo ``torso`` with ``mpc``;
 - ``biped``: a campaign on the MuJoCo ``biped`` with ``recovery``;
 - ``critical``: the MuJoCo critical-push table;
-- ``filmstrips``: one rendered MuJoCo run per strategy.
+- ``filmstrips``: one rendered MuJoCo run per strategy;
+- ``humanoid3d``: the 3-D humanoids (with MuJoCo and the ``robots`` extra; one line saying how
+  to get it otherwise): the 3-D validation's polar plots and tables and filmstrips
+  (:mod:`pushrecovery.report.humanoid3d`).
 
 The grids come in two sizes: ``small`` (the default, about a minute on two cores) and ``full``;
 any grid can be replaced (:class:`PushGrid`), any section left out (``skip``).
@@ -96,7 +99,8 @@ def write_report(
     analytic_grid, sweep_grid, mujoco_grid, biped_grid : PushGrid, optional
         Replace the grid of that campaign (``sweep_grid`` must sweep one parameter).
     mujoco : bool
-        Include the MuJoCo sections (``mujoco``, ``biped``, ``critical``, ``filmstrips``).
+        Include the MuJoCo sections (``mujoco``, ``biped``, ``critical``, ``filmstrips``,
+        ``humanoid3d``).
     skip : collection of str
         Section keys to leave out (:data:`SECTIONS`).
     workers : int, optional
