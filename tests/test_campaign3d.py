@@ -158,3 +158,16 @@ def test_cli_validate_on_the_biped3d(capsys, tmp_path):
 def test_bad_3d_requests_are_one_line_and_exit_2(capsys, args, words):
     code, _, err = run_cli(capsys, *args)
     assert code == 2 and err.count("\n") == 1 and words in err and "Traceback" not in err
+
+
+def test_validate_refuses_another_grid_in_the_same_out_in_one_line(capsys, tmp_path, params):
+    # A confusion campaign of another grid already in OUT: refused before any simulation.
+    spec = CampaignSpec("mujoco", "biped3d", "wbc-step", params, x0=(0.0, 0.0, 1.0),
+                        fraction=(0.5, 0.5, 1.0), azimuths=(30.0,), duration=5.0,
+                        batch_size=4)  # fmt: skip
+    stored = tmp_path / "confusion_biped3d" / "f0.5"
+    stored.mkdir(parents=True)
+    (stored / "spec.json").write_text(json.dumps(spec.to_dict()))
+    args = ("--model", "biped3d", "--no-critical", "--azimuths", "90", "--fractions", "0.5")
+    code, _, err = run_cli(capsys, "validate", *args, "--out", str(tmp_path))
+    assert code == 2 and err.count("\n") == 1 and "give another --out" in err

@@ -17,6 +17,7 @@ from pushrecovery.campaign.spec3d import critical_impulse, predict_push
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.experiments.confusion3d import (
     CAUSES,
+    FAILED_TICKS,
     LABELS,
     ConfusionPush,
     classify_cause,
@@ -69,24 +70,25 @@ def test_rows_to_matrix_causes_and_accuracy():
         row("step", "fall", outcome="fell", lift_offs=1),  # stepped, fell
         row("step", "fall", outcome="fell"),  # never lifted a foot
         row("ankle", "ankle", outcome="undecided"),  # still moving: used = fall
-        row("hip", "fall", outcome="fell", ratio=1.0, failed=3),  # saturated
+        row("hip", "fall", outcome="fell", ratio=1.0, failed=FAILED_TICKS),  # saturated
+        row("step", "fall", outcome="fell", lift_offs=1, ratio=1.0, failed=FAILED_TICKS - 1),
         row("ankle", "ankle", outcome="error"),  # no outcome: left out
     ]
     result = confusion_from_rows(rows, "biped3d")
-    assert len(result.pushes) == 8 and result.errors == 1
+    assert len(result.pushes) == 9 and result.errors == 1
     assert [p.cause for p in result.pushes] == [
         "agree", "torso lever", "lesser sufficed", "hip shortfall", "step failed", "no step",
-        "undecided", "saturation",
+        "undecided", "saturation", "step failed",
     ]  # fmt: skip
     assert result.pushes[6].used == "fall"
     counts = result.counts
     assert counts[LABELS.index("ankle"), LABELS.index("fall")] == 1
-    assert counts[LABELS.index("step"), LABELS.index("fall")] == 2
-    assert result.accuracy == pytest.approx(1 / 8)
+    assert counts[LABELS.index("step"), LABELS.index("fall")] == 3
+    assert result.accuracy == pytest.approx(1 / 9)
     # against the corrected verdict the second row agrees as well
-    assert result.accuracy_corrected == pytest.approx(2 / 8)
+    assert result.accuracy_corrected == pytest.approx(2 / 9)
     causes = result.causes()
-    assert set(causes) == set(CAUSES) and sum(causes.values()) == 8 and causes["agree"] == 1
+    assert set(causes) == set(CAUSES) and sum(causes.values()) == 9 and causes["agree"] == 1
 
 
 def test_write_tables(tmp_path):

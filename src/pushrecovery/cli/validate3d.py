@@ -127,7 +127,7 @@ def _write_csv(result: Any, path: Path) -> None:
 
 def _confusion(options: Validate3DOptions, params: Any) -> dict[str, Any]:
     """Run the confusion campaigns (resumable) and write the matrix; return its JSON."""
-    from pushrecovery.campaign import CampaignSpec, run_campaign
+    from pushrecovery.campaign import CampaignError, CampaignSpec, run_campaign
     from pushrecovery.cli.campaign3d import write_confusion
     from pushrecovery.cli.progress import Progress
 
@@ -159,6 +159,13 @@ def _confusion(options: Validate3DOptions, params: Any) -> dict[str, Any]:
             )  # fmt: skip
             assert result is not None
             tables.append(result.table)
+    except CampaignError as exc:
+        if "differs" not in str(exc):
+            raise
+        raise CampaignError(
+            f"{exc}: validate completes the confusion campaigns it finds in {directory}; "
+            "give another --out for another grid"
+        ) from None
     finally:
         bar.close()
     import pyarrow as pa

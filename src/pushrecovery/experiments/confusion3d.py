@@ -37,6 +37,7 @@ __all__ = [
     "CAUSES",
     "DEFAULT_AZIMUTHS",
     "DEFAULT_FRACTIONS",
+    "FAILED_TICKS",
     "LABELS",
     "SATURATED",
     "Confusion3D",
@@ -53,6 +54,10 @@ DEFAULT_AZIMUTHS: tuple[float, ...] = tuple(float(a) for a in range(0, 360, 30))
 DEFAULT_FRACTIONS: tuple[float, ...] = (0.5, 0.9, 1.1, 1.5, 2.0)
 #: A motor command at this fraction of its limit or more is saturated [-].
 SATURATED = 0.999
+#: Ticks DAQP must fail in a run (20 ms at 500 Hz) for the QP's failure to count as a cause:
+#: the hip motors reach their limits in nearly every hip run (bang-bang by design), and a
+#: single failed tick (the last command held 2 ms) does not decide a fall.
+FAILED_TICKS = 10
 #: Why a push's used strategy differs from the predicted one (:func:`classify_cause`).
 CAUSES: Mapping[str, str] = {
     "agree": "used = predicted",
@@ -65,8 +70,8 @@ CAUSES: Mapping[str, str] = {
     "stepped or fell (the hip law's band is narrower than the CMP region)",
     "step failed": "predicted step, a step was begun but the body did not come to rest",
     "no step": "predicted step, the controller never lifted a foot and fell",
-    "saturation": "the controller saturated (a motor at its limit and DAQP failed ticks) and "
-    "the body did not come to rest",
+    "saturation": "the controller saturated (a motor at its limit and DAQP failed for at least "
+    "FAILED_TICKS ticks) and the body fell",
     "other": "none of the above",
 }
 
@@ -135,7 +140,8 @@ def classify_cause(push: ConfusionPush) -> str:
     2. ``lesser sufficed``: it recovered with a strategy below the predicted one.
     3. ``torso lever``: used = the corrected verdict.
     4. ``undecided``: the run neither came to rest nor fell.
-    5. ``saturation``: it fell, a motor at :data:`SATURATED` of its limit and DAQP failed.
+    5. ``saturation``: it fell, a motor at :data:`SATURATED` of its limit and DAQP failed on
+       at least :data:`FAILED_TICKS` ticks.
     6. ``hip shortfall``: the plain or corrected verdict is hip, the run stepped or fell.
     7. ``step failed`` / ``no step``: the verdict is step and the body fell, with or without
        a step begun.
@@ -150,7 +156,8 @@ def classify_cause(push: ConfusionPush) -> str:
         return "torso lever"
     if push.outcome == "undecided":
         return "undecided"
-    if used == "fall" and push.peak_torque_ratio >= SATURATED and push.failed_ticks > 0:
+    saturated = push.peak_torque_ratio >= SATURATED and push.failed_ticks >= FAILED_TICKS
+    if used == "fall" and saturated:
         return "saturation"
     if "hip" in (predicted, corrected) and _rank(used) > _rank("hip"):
         return "hip shortfall"
