@@ -43,12 +43,12 @@ def eq17_cost(x0, inputs, settings):
     return total
 
 
-def sparse_solution(x0, settings=SETTINGS):
+def sparse_solution(x0, settings=SETTINGS, solver="quadprog"):
     """Independent exact solution of Eq. (17), constraints included: the sparse QP.
 
     States and inputs are both variables, linked by equality constraints x_{i+1} = A x_i +
-    B u_i; solved by quadprog (Goldfarb-Idnani, dense): another formulation and another code
-    than the controller's condensed, pre-stabilised QP in DAQP. Returns the inputs, (N, 2).
+    B u_i; solved by quadprog (Goldfarb-Idnani, dense; or ``solver``): another formulation and
+    another code than the controller's. Returns the inputs, (N, 2).
     """
     a, b = flywheel_discrete(P, settings.dt)
     n, g = settings.horizon, settings.gamma
@@ -75,7 +75,12 @@ def sparse_solution(x0, settings=SETTINGS):
         np.diag(2.0 * weights * scale**2), np.zeros(size), A=equality * scale, b=rhs,
         lb=lower / scale, ub=upper / scale,
     )  # fmt: skip
-    solution = solve_problem(problem, solver="quadprog")
+    options = (
+        {"tol_gap_abs": 1e-12, "tol_gap_rel": 1e-12, "tol_feas": 1e-12}
+        if solver == "clarabel"
+        else {}
+    )
+    solution = solve_problem(problem, solver=solver, **options)
     assert solution.found
     return (solution.x * scale).reshape(n, 6)[:, :2]
 

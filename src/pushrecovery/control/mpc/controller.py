@@ -9,7 +9,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command, Controller, register
-from pushrecovery.control.mpc.feasibility import FlywheelFeasibility
+from pushrecovery.control.mpc.feasibility import BAND, FlywheelFeasibility
+from pushrecovery.control.mpc.interior import InteriorPointSolver
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.qp import CondensedQP, shared_qp
@@ -20,6 +21,12 @@ from pushrecovery.models.flywheel import FLYWHEEL_STATE
 from pushrecovery.params import BodyParams
 
 __all__ = ["MPCController"]
+
+#: Riccati passes allowed to verify an interior-point iterate's active set.
+POLISH_PASSES = 3
+#: The interior point is not asked within this relative margin of S_N's boundary: there the
+#: feasible set has (almost) no interior and its iterates stall (DAQP decides, as before).
+INTERIOR_MARGIN = 1e-6
 
 
 @register
@@ -76,6 +83,11 @@ class MPCController(Controller):
             if settings.solver == "daqp" and RiccatiSolver.applies(params)
             else None
         )
+        # The ticks the passes do not verify: an interior point with Riccati steps, as fast
+        # and as well conditioned at any horizon (DAQP on the condensed QP is the last resort).
+        self.interior: InteriorPointSolver | None = (
+            InteriorPointSolver(params, settings) if self.riccati is not None else None
+        )
         self._qp: CondensedQP | None = None
         self._workspace: DaqpWorkspace | None = None
         self._use_workspace = settings.solver == "daqp"
@@ -110,6 +122,7 @@ class MPCController(Controller):
         self._use_workspace = value is not None
         if value is None:
             self.riccati = None
+            self.interior = None
 
     @classmethod
     def option_names(cls) -> tuple[str, ...]:
@@ -136,7 +149,8 @@ class MPCController(Controller):
             inputs = riccati.inputs
             return Plan(inputs[0], True, inputs, riccati.states)
         x0 = state.copy()  # the plan's own: the caller may reuse its array
-        if self._use_workspace and self._provably_infeasible(x0):
+        gauge = self._gauge(x0)
+        if self._use_workspace and gauge > 1.0 + BAND:
             # DAQP would fail, warm and then cold (up to ~1000 iterations): leave both solvers
             # as that failure would (cold next tick) without asking it.
             if self._workspace is not None:
@@ -144,6 +158,22 @@ class MPCController(Controller):
             if riccati is not None:
                 riccati.reset()
             return self._fallback_plan(x0)
+        interior = self.interior
+        if interior is not None and riccati is not None and gauge < 1.0 - INTERIOR_MARGIN:
+            # The passes did not verify this tick (a new active set, a degenerate stage): the
+            # interior point, whose iterates' active sets the passes are offered to verify.
+            def verify(active: NDArray[np.int8]) -> bool:
+                riccati.seed(active)
+                return riccati.solve(x0, shift=False, max_passes=POLISH_PASSES)
+
+            if interior.solve(x0, verify):
+                if interior.verified:
+                    inputs = riccati.inputs
+                    return Plan(inputs[0], True, inputs, riccati.states)
+                riccati.seed(interior.active_set())  # the next tick's start
+                inputs = interior.inputs
+                return Plan(inputs[0], True, inputs, interior.states)
+            riccati.reset()
         # Only the solvers' own failures mean "infeasible"; any other exception is a bug.
         workspace = self.workspace
         if workspace is not None:
@@ -171,14 +201,17 @@ class MPCController(Controller):
             lambda: qp.predict(x0, scaled),
         )
 
-    def _provably_infeasible(self, x0: NDArray[np.float64]) -> bool:
-        """Tell whether (θ, θ̇) of x0 is outside S_N beyond the solvers' tolerances."""
+    def _gauge(self, x0: NDArray[np.float64]) -> float:
+        """Return the gauge of (θ, θ̇) of x0 in S_N (:class:`FlywheelFeasibility`).
+
+        0 where the test does not apply (no interior): the solvers decide.
+        """
         feasibility = self._feasibility
         if feasibility is None:
             if not FlywheelFeasibility.applies(self.params):
-                return False
+                return 0.0
             feasibility = self._feasibility = FlywheelFeasibility(self.params, self.settings)
-        return feasibility.infeasible(x0)
+        return feasibility.gauge(x0)
 
     def _fallback_plan(self, x0: NDArray[np.float64]) -> Plan:
         """Return the infeasible tick's plan: the fallback over the horizon, states on demand."""

@@ -108,9 +108,12 @@ class RiccatiSolver:
         # The kernel's arguments, bound once (a tick makes one call).
         self._args = (
             self.active, self._guess, self.a, self.b, self.wx, self.wu, self.bounds, self.tols,
-            DUAL_TOL, MAX_PASSES,
+            DUAL_TOL,
         )  # fmt: skip
         self._scratch = (self._gains, self._offsets, self._curvature, self.multipliers)
+        # Load the compiled kernel now (from numba's disk cache), not on a control tick.
+        self.solve(np.zeros(4), max_passes=0)
+        self.verified = False
 
     @staticmethod
     def applies(params: BodyParams) -> bool:
@@ -127,11 +130,12 @@ class RiccatiSolver:
         self.active[...] = active
         self.verified = False
 
-    def solve(self, x0: FloatArray, shift: bool = True) -> bool:
+    def solve(self, x0: FloatArray, shift: bool = True, max_passes: int = MAX_PASSES) -> bool:
         """Solve from ``x0`` = [x, θ, ẋ, θ̇]; True if the KKT conditions were verified.
 
         The passes start from the last active set shifted by one stage (``shift``), the
-        receding horizon's guess; the last stage keeps its rows. On failure the attributes
+        receding horizon's guess; the last stage keeps its rows. At most ``max_passes``.
+        On failure the attributes
         hold no solution, ``active`` is left as it was (the caller may hand it to DAQP) and
         the next solve starts from it again unless :meth:`seed` or :meth:`reset` is called.
         """
@@ -139,7 +143,9 @@ class RiccatiSolver:
         # Fresh output arrays each solve: a verified solution is the caller's to keep (the
         # controller's plan holds them without copying).
         inputs, states = np.empty((n, 2)), np.empty((n + 1, 4))
-        self.passes = passes = solve_from(x0, shift, *self._args, inputs, states, *self._scratch)
+        self.passes = passes = solve_from(
+            x0, shift, *self._args, max_passes, inputs, states, *self._scratch
+        )
         if passes < 0:
             self.verified = False
             return False

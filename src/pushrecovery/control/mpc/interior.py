@@ -1,0 +1,166 @@
+r"""Eq. (17) with the states kept, solved by a primal-dual interior point with Riccati steps.
+
+The sparse form of :mod:`~pushrecovery.control.mpc.riccati` (inputs u_i and states x_{i+1},
+dynamics as equalities, three bounded components per stage: δ_i, τ_i, θ_{i+1}), solved by
+Mehrotra's predictor-corrector method (Nocedal & Wright 2006, Alg. 16.4) from a cold start.
+Every bound is a bound on one variable, so eliminating the slacks and the bounds' multipliers
+leaves, at each Newton step, an equality-constrained LQ problem with diagonal weights
+2W + Σ (Σ = z/s on the bounded components): a Riccati recursion solves it in O(N) with 4 × 4
+and 2 × 2 algebra (Rao, Wright & Rawlings 1998), and the corrector reuses the predictor's
+factors. A pure state bound (θ_{i+1} at its limit while τ_i is at its own), which the
+active-set passes cannot represent, is for it a diagonal weight like any other.
+
+Its place in the controller: the passes of :class:`~.riccati.RiccatiSolver` solve most ticks in
+a few µs from the previous tick's active set; a tick they do not verify (a push's first tick,
+an active set far from the last, a degenerate stage) goes here, 10-25 iterations of a few µs
+each at N = 50 whatever the start, no Hessian ever formed (its conditioning does not grow with
+N, as the condensed QP's does). The solution's active set (a bound whose multiplier exceeds
+its slack in the units below) then seeds the passes, which verify the KKT conditions exactly;
+if they cannot (a degenerate stage), the interior point's own solution stands, converged to
+:data:`TOL` of every scale.
+
+Scales. A bound's multiplier z is measured against H_jj × range_j, the multiplier that would
+move an unconstrained input by its whole range (H = 2 W^u_i + B^T S_{i+1} B, S the
+unconstrained problem's cost-to-go); the θ bound's against the torque's divided by |B_θτ|
+(θ moves by B_θτ τ), and a state's stationarity row against the inputs' scales divided by the
+entries of B that carry it. Convergence: every bound's residual and complementarity product below
+:data:`TOL` of its scale (× the range for products), every stationarity row below
+:data:`DUAL_TOL` of its own. Measured against DAQP on the condensed QP
+(``tests/test_mpc_interior.py``): first inputs equal to better than 1e-7 of their ranges.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.control.mpc._ipm_kernels import solve_interior
+from pushrecovery.control.mpc._ipm_scales import dual_scales
+from pushrecovery.control.mpc.problem import MPCSettings
+from pushrecovery.models.flywheel import flywheel_discrete
+from pushrecovery.params import BodyParams
+
+__all__ = ["DUAL_TOL", "MAX_ITERATIONS", "TOL", "InteriorPointSolver"]
+
+FloatArray = NDArray[np.float64]
+
+#: Convergence tolerance of the bounds and complementarity, relative to their scales.
+TOL = 1e-10
+#: Convergence tolerance of the stationarity rows, relative to their scales: their rounding
+#: floor is a few 1e-10 (the costates grow backward along the horizon as e^{ω t}).
+DUAL_TOL = 1e-8
+#: Iterations before giving up (an infeasible problem; well-posed ones take 10-30).
+MAX_ITERATIONS = 60
+#: Iterations before the first offer of the active set to a verifier, and between offers.
+FIRST_CHECK, CHECK_EVERY = 6, 2
+
+
+class InteriorPointSolver:
+    """The sparse Eq. (17) of one body and settings, solved by an interior point each call.
+
+    Parameters
+    ----------
+    params : BodyParams
+        Body parameters (bounds δ⁻ = heel, δ⁺ = toe, τmax, θmax; all with a range).
+    settings : MPCSettings
+        dt, N, Q, R and γ.
+
+    Attributes
+    ----------
+    inputs : ndarray, shape (N, 2)
+        (δ [m], τ [N m]) of the last converged solve (fresh arrays each solve).
+    states : ndarray, shape (N + 1, 4)
+        Its predicted states X_0..X_N.
+    iterations : int
+        Iterations of the last solve (−1: did not converge in :data:`MAX_ITERATIONS`).
+    verified : bool
+        Whether the last solve ended with the verifier's acceptance (see :meth:`solve`).
+    """
+
+    def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
+        n = settings.horizon
+        self.a, self.b = flywheel_discrete(params, settings.dt)
+        stage = settings.gamma ** (n - 1 - np.arange(n))  # γ^(N−i), i = 1..N
+        self.wx = np.ascontiguousarray(stage[:, None] * np.asarray(settings.state_weights))
+        self.wu = np.ascontiguousarray(stage[:, None] * np.asarray(settings.input_weights))
+        theta_max = params.flywheel_angle_max
+        self.bounds = np.array(
+            [[params.heel, params.toe], [-params.torque_max, params.torque_max],
+             [-theta_max, theta_max]]
+        )  # fmt: skip
+        self.scales, self.feedback = np.empty((n, 7)), np.empty((n, 2, 4))
+        dual_scales(self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback)
+        self.inputs = np.zeros((n, 2))
+        self.states = np.zeros((n + 1, 4))
+        self.iterations = 0
+        self.verified = False
+        self._u, self._x = np.zeros((n, 2)), np.zeros((n + 1, 4))  # the iterate
+        # Iterates and scratch, allocated once.
+        self._multipliers = np.zeros((n, 4))
+        self._slacks = (np.zeros((n, 3)), np.zeros((n, 3)))
+        self._bound_multipliers = (np.zeros((n, 3)), np.zeros((n, 3)))
+        self._work = np.zeros((17, n + 1, 4))
+        self._factors = (np.zeros((n + 1, 4, 4)), np.zeros((n, 2, 4)), np.zeros((n, 2, 2)),
+                         np.zeros((n + 1, 4)))  # fmt: skip
+        # Load the compiled kernel now (from numba's disk cache), not on a control tick.
+        self._iterate(np.zeros(4), 0, True)
+
+    def _iterate(self, x0: FloatArray, iterations: int, cold: bool) -> int:
+        """Run at most ``iterations`` of the kernel (``cold``: from its start); its status."""
+        status: int = solve_interior(
+            x0, self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback,
+            TOL, DUAL_TOL, iterations, cold, self._u, self._x, self._multipliers,
+            *self._slacks, *self._bound_multipliers, self._work, *self._factors,
+        )  # fmt: skip
+        return status
+
+    def solve(
+        self, x0: FloatArray, verify: Callable[[NDArray[np.int8]], bool] | None = None
+    ) -> bool:
+        """Solve from ``x0`` = [x, θ, ẋ, θ̇]; True if solved (see the attributes).
+
+        ``verify``, if given, is offered the iterate's active set (:meth:`active_set`) after
+        :data:`FIRST_CHECK` iterations and every :data:`CHECK_EVERY` after: if it returns
+        True (e.g. Riccati passes from that set verified the KKT conditions exactly), the
+        solve stops there, ``verified`` is True and the solution is the verifier's; the
+        attributes ``inputs`` and ``states`` are then not updated.
+        """
+        done = 0
+        chunk = FIRST_CHECK if verify is not None else MAX_ITERATIONS
+        self.verified = False
+        while True:
+            status = self._iterate(x0, min(chunk, MAX_ITERATIONS - done), done == 0)
+            if status == -1:
+                break
+            done += chunk if status == -2 else status
+            if verify is not None and verify(self.active_set()):
+                self.iterations, self.verified = done, True
+                return True
+            if status >= 0:
+                self.iterations = done
+                self.inputs, self.states = self._u.copy(), self._x.copy()
+                return True
+            if done >= MAX_ITERATIONS:
+                break
+            chunk = CHECK_EVERY
+        self.iterations = -1
+        return False
+
+    def active_set(self) -> NDArray[np.int8]:
+        """Return the last solve's active set, (N, 3) rows (δ_i, τ_i, θ_{i+1}), ±1 at a bound.
+
+        A bound is active when its multiplier, in units of its dual scale, exceeds its slack
+        in units of its range: at the interior point's solution the two are 1e-10 apart.
+        """
+        span = self.bounds[:, 1] - self.bounds[:, 0]
+        scale = self.scales[:, :3]
+        (lower, upper), (z_lower, z_upper) = self._slacks, self._bound_multipliers
+        active = np.zeros(lower.shape, dtype=np.int8)
+        # z / scale > s / range, without the quotients (z reaches 1e11 × its scale; a
+        # diverging iterate's overflow to inf compares as well).
+        with np.errstate(over="ignore", invalid="ignore"):
+            active[z_lower * span > lower * scale] = -1
+            active[z_upper * span > upper * scale] = 1
+        return active
