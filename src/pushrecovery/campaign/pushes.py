@@ -97,6 +97,8 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("peak_torque_ratio", "float64"),
     ("failed_ticks", "int64"),
 )
+#: The columns of the 3-D models only: null (None) in the other models' rows.
+COLUMNS_3D = tuple(name for name, _ in COLUMNS[[n for n, _ in COLUMNS].index("azimuth") :])
 
 
 def run_push(
@@ -235,6 +237,7 @@ def _inputs_and_prediction(spec: CampaignSpec, push: Push, found: _Prediction) -
         predicted_steps=-1 if found.steps is None else found.steps,
         predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
     )
+    row.update(dict.fromkeys(COLUMNS_3D))  # every row has every column
     return row
 
 
