@@ -159,3 +159,49 @@ def test_bad_iterate_reports_failure_not_nan():
     solver = InteriorPointSolver(P, MPCSettings())
     assert not solver.solve(np.array([0.0, 0.9, 0.0, 30.0]))
     assert solver.iterations == -1
+
+
+def test_forced_braking_on_the_boundary_of_the_viable_set():
+    # On S_N's boundary (γ = 1) full braking for k stages brings θ to its bound exactly
+    # (simulated here from the flywheel's own double integrator); inside it nothing is forced.
+    settings = MPCSettings()
+    feasibility = FlywheelFeasibility(P, settings)
+    top = np.array([0.0, 0.996, 0.0, 0.3])  # full braking from here just touches θmax
+    assert feasibility.gauge(top) == pytest.approx(1.0, abs=1e-14)
+    stages, side = feasibility.forced_braking(top)
+    assert side == -1 and stages > 0
+    dt, inertia = settings.dt, P.flywheel_inertia
+    theta, rate = top[1], top[3]
+    for _ in range(stages):
+        theta += dt * rate - 0.5 * dt * dt / inertia * P.torque_max
+        rate -= dt / inertia * P.torque_max
+    assert theta == pytest.approx(P.flywheel_angle_max, abs=1e-12)
+    assert feasibility.forced_braking(0.5 * top) == (0, 0)
+    assert feasibility.forced_braking(np.zeros(4)) == (0, 0)
+
+
+def test_boundary_ticks_solved_with_forced_braking_equal_daqp():
+    # Ticks of a pushed run on S_N's boundary: the passes with the braking held, started from
+    # DAQP's active set, verify and give DAQP's first input (another method on the condensed
+    # QP) to 1e-6 of the ranges.
+    from pushrecovery.control.mpc.riccati import RiccatiSolver
+
+    settings = MPCSettings()
+    feasibility = FlywheelFeasibility(P, settings)
+    plant = make_plant("flywheel", P)
+    run = simulate(plant, MPCController(P), plant.reset(0.0, 0.65))
+    controller, solver = MPCController(P, settings), RiccatiSolver(P, settings)
+    compared = 0
+    for state in run.states[:-1]:
+        if feasibility.gauge(state) < 1.0 - 1e-9:
+            continue
+        controller.workspace.reset()
+        scaled = controller.workspace.solve(state)
+        assert scaled is not None
+        daqp = controller.qp.first_input(state, scaled)
+        solver.seed(controller.workspace.active_set())
+        if not solver.solve(state, shift=False, forced=feasibility.forced_braking(state)):
+            continue
+        np.testing.assert_allclose(solver.inputs[0] / SCALE, daqp / SCALE, atol=1e-6)
+        compared += 1
+    assert compared >= 3

@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command, Controller, register
-from pushrecovery.control.mpc.feasibility import BAND, FlywheelFeasibility
+from pushrecovery.control.mpc.feasibility import BAND, BOUNDARY, FlywheelFeasibility
 from pushrecovery.control.mpc.interior import InteriorPointSolver
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.problem import MPCSettings
@@ -158,6 +158,13 @@ class MPCController(Controller):
             if riccati is not None:
                 riccati.reset()
             return self._fallback_plan(x0)
+        if riccati is not None and gauge >= 1.0 - BOUNDARY and self._feasibility is not None:
+            # On S_N's boundary: the torques brake at full until the flywheel stops, and the
+            # passes solve the rest (the θ rows of those stages would be degenerate).
+            forced = self._feasibility.forced_braking(x0)
+            if forced[0] and riccati.solve(x0, forced=forced):
+                inputs = riccati.inputs
+                return Plan(inputs[0], True, inputs, riccati.states)
         interior = self.interior
         if interior is not None and riccati is not None and gauge < 1.0 - INTERIOR_MARGIN:
             # The passes did not verify this tick (a new active set, a degenerate stage): the

@@ -44,12 +44,15 @@ from numpy.typing import NDArray
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.params import BodyParams
 
-__all__ = ["BAND", "FlywheelFeasibility", "viable_facets"]
+__all__ = ["BAND", "BOUNDARY", "FlywheelFeasibility", "viable_facets"]
 
 FloatArray = NDArray[np.float64]
 
 #: Relative margin beyond the exact boundary (γ > 1 + BAND) from which DAQP is not asked.
 BAND = 1e-4
+#: Relative margin inside the boundary within which a state is on it (γ ≥ 1 − BOUNDARY):
+#: the feasible torques are then full braking to within rounding (forced_braking).
+BOUNDARY = 1e-9
 
 
 def _add_segment(poly: FloatArray, w: FloatArray) -> FloatArray:
@@ -137,13 +140,45 @@ class FlywheelFeasibility:
         dt and N.
     """
 
-    __slots__ = ("facets",)
+    __slots__ = ("_braking", "facets")
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
         self.facets = viable_facets(
             params.flywheel_inertia, params.torque_max, params.flywheel_angle_max,
             settings.dt, settings.horizon,
         )  # fmt: skip
+        dt, inertia = settings.dt, params.flywheel_inertia
+        self._braking = (
+            0.5 * dt * dt / inertia, dt / inertia, dt, params.torque_max,
+            params.flywheel_angle_max, settings.horizon,
+        )  # fmt: skip
+
+    def forced_braking(self, state: FloatArray) -> tuple[int, int]:
+        """Return (k, side): full braking forced on the first k stages (k = 0: none).
+
+        On the boundary of S_N (γ = 1) the only plans that keep |θ| ≤ θmax brake at full
+        torque until the flywheel stops: from s_0, τ_i = side τmax with side = −sign θ̇_0
+        brings θ to its peak θ_k, which is the bound ±θmax itself; any less braking at any of
+        the first k stages would carry θ_k beyond it (θ_k increases with every τ_i, i < k,
+        by h + (k − 1 − i) dt g > 0 per unit). k is that peak's stage if it lies within
+        1e-9 of θmax (or beyond, by up to BAND), else 0.
+        """
+        h, g, dt, torque, limit, horizon = self._braking
+        theta, rate = float(state[1]), float(state[3])
+        if rate == 0.0:
+            return 0, 0
+        side = -1 if rate > 0.0 else 1
+        direction = -side  # the sign of the threatened bound
+        peak, peak_stage = -math.inf, 0
+        for k in range(1, horizon + 1):
+            theta, rate = theta + dt * rate + h * side * torque, rate + g * side * torque
+            if direction * theta > peak:
+                peak, peak_stage = direction * theta, k
+            if direction * rate <= 0.0:
+                break
+        if limit * (1.0 - BOUNDARY) <= peak <= limit * (1.0 + BAND):
+            return peak_stage, side
+        return 0, 0
 
     @staticmethod
     def applies(params: BodyParams) -> bool:

@@ -28,11 +28,16 @@ shifted by a stage, which is where the passes start (two or three passes per tic
 run). There is no Hessian to condition: the Riccati recursion is the numerically stable way to
 solve an LQ problem at any horizon, and its cost grows linearly with N.
 
-When the passes do not verify an optimum (a stage where τ_i and θ_{i+1} are both at a bound,
-which makes the row a pure state constraint; cycling; an infeasible QP), the caller solves the
-condensed QP with DAQP instead and may :meth:`RiccatiSolver.seed` the next tick with its active
-set. Everything here depends on the body (through A, B, the bounds) and the settings only, and
-costs about 0.1 ms to set up.
+A stage where τ_i and θ_{i+1} are both at a bound makes the θ row a pure state constraint:
+it is carried back through the stages whose torques are held to the latest one whose torque is
+free (helper's derivation in the kernel's docstring). On the boundary of the flywheel's viable
+set the caller may hold the first stages' torques at full braking (``forced``, the only plans
+there) instead. When the passes do not verify an optimum (cycling, an infeasible QP, too many
+passes) the caller solves the tick by the interior point
+(:mod:`~pushrecovery.control.mpc.interior`), whose active set the passes then verify, or near
+the viable set's boundary by DAQP on the condensed QP, and may :meth:`RiccatiSolver.seed` the
+next tick with its active set. Everything here depends on the body (through A, B, the bounds)
+and the settings only, and costs about 0.1 ms to set up.
 """
 
 from __future__ import annotations
@@ -130,11 +135,20 @@ class RiccatiSolver:
         self.active[...] = active
         self.verified = False
 
-    def solve(self, x0: FloatArray, shift: bool = True, max_passes: int = MAX_PASSES) -> bool:
+    def solve(
+        self,
+        x0: FloatArray,
+        shift: bool = True,
+        max_passes: int = MAX_PASSES,
+        forced: tuple[int, int] = (0, 0),
+    ) -> bool:
         """Solve from ``x0`` = [x, θ, ẋ, θ̇]; True if the KKT conditions were verified.
 
         The passes start from the last active set shifted by one stage (``shift``), the
         receding horizon's guess; the last stage keeps its rows. At most ``max_passes``.
+        ``forced`` = (k, side): the torques of the first k stages are held at the bound of
+        sign ``side`` and their θ rows left out (the flywheel on the edge of its viable set,
+        :meth:`~.feasibility.FlywheelFeasibility.forced_braking`).
         On failure the attributes
         hold no solution, ``active`` is left as it was (the caller may hand it to DAQP) and
         the next solve starts from it again unless :meth:`seed` or :meth:`reset` is called.
@@ -144,7 +158,7 @@ class RiccatiSolver:
         # controller's plan holds them without copying).
         inputs, states = np.empty((n, 2)), np.empty((n + 1, 4))
         self.passes = passes = solve_from(
-            x0, shift, *self._args, max_passes, inputs, states, *self._scratch
+            x0, shift, *self._args, max_passes, *forced, inputs, states, *self._scratch
         )
         if passes < 0:
             self.verified = False
