@@ -135,7 +135,8 @@ def test_a_backward_push_is_planned_at_long_horizons():
 
 def test_closed_loop_runs_need_daqp_only_at_the_boundary():
     # Pushed runs at N = 50: every tick is solved by the passes or the interior point except
-    # those within INTERIOR_MARGIN of S_N's boundary (no interior there), which DAQP solves.
+    # those within INTERIOR_MARGIN of S_N's boundary (no interior there): full braking held, then
+    # DAQP.
     from pushrecovery.control.mpc.controller import INTERIOR_MARGIN
 
     plant = make_plant("flywheel", P)

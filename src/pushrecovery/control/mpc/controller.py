@@ -24,9 +24,10 @@ __all__ = ["MPCController"]
 
 #: Riccati passes allowed to verify an interior-point iterate's active set.
 POLISH_PASSES = 3
-#: The interior point is not asked within this relative margin of S_N's boundary: there the
-#: feasible set has (almost) no interior and its iterates stall (DAQP decides, as before).
-INTERIOR_MARGIN = 1e-6
+#: The interior point is not asked within this relative margin of S_N's boundary (the
+#: boundary's own margin, BOUNDARY): there the feasible set has no interior and its iterates
+#: stall; the passes with full braking held decide, then DAQP.
+INTERIOR_MARGIN = BOUNDARY
 
 
 @register

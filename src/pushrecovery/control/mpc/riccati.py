@@ -30,7 +30,7 @@ solve an LQ problem at any horizon, and its cost grows linearly with N.
 
 A stage where τ_i and θ_{i+1} are both at a bound makes the θ row a pure state constraint:
 it is carried back through the stages whose torques are held to the latest one whose torque is
-free (helper's derivation in the kernel's docstring). On the boundary of the flywheel's viable
+free (the derivation is in the kernel's docstring). On the boundary of the flywheel's viable
 set the caller may hold the first stages' torques at full braking (``forced``, the only plans
 there) instead. When the passes do not verify an optimum (cycling, an infeasible QP, too many
 passes) the caller solves the tick by the interior point
