@@ -9,6 +9,12 @@ with conic optimization", ICRA 2013):
 
 .. math:: \min_{x = (\ddot q, w)} \sum_k W_k \lVert A_k x - b_k \rVert^2
           + \epsilon_a \lVert \ddot q \rVert^2 + \epsilon_f \lVert w \rVert^2
+          + \epsilon_z \textstyle\sum_i T_{z,i}^2
+
+(ε_z on the feet's yaw moments: in double support the split of the yaw moment between the
+feet, one foot +T the other −T, is free in the tasks; left to ε_f it wandered to the yaw
+friction bound, MuJoCo's soft friction let the feet creep under it, the legs twisted and the
+hip yaw motors saturated: docs/humanoid3d.md, "Controller")
 
 subject to
 
@@ -181,12 +187,14 @@ class WholeBodyQP:
     acc_regularisation, wrench_regularisation : float
         ε_a [(s²)² weight per (m/s²)²] and ε_f [per N²] of the module docstring, > 0: keep the
         Hessian positive definite.
+    yaw_regularisation : float
+        ε_z [per (N m)²] on each foot's yaw moment T_z (module docstring), ≥ ε_f.
 
     Raises
     ------
     InvalidParameterError
         If the model has no free joint first, an actuator is not on a joint, ``feet`` is
-        empty, or a regularisation is not in (0, 1].
+        empty, or a regularisation is not in (0, 1] (ε_z in [ε_f, 1]).
     """
 
     def __init__(
@@ -195,6 +203,7 @@ class WholeBodyQP:
         feet: Sequence[FootContact],
         acc_regularisation: float = 1e-6,
         wrench_regularisation: float = 1e-8,
+        yaw_regularisation: float = 1e-3,
     ) -> None:
         import mujoco
 
@@ -208,6 +217,12 @@ class WholeBodyQP:
                             ("wrench_regularisation", wrench_regularisation)):  # fmt: skip
             if not (isinstance(value, int | float) and 0.0 < value <= 1.0):
                 raise InvalidParameterError(f"{name} must be in (0, 1], got {value!r}")
+        if not (isinstance(yaw_regularisation, int | float)
+                and wrench_regularisation <= yaw_regularisation <= 1.0):  # fmt: skip
+            raise InvalidParameterError(
+                f"yaw_regularisation must be in [wrench_regularisation, 1], "
+                f"got {yaw_regularisation!r}"
+            )
         self.model = model
         self.feet = tuple(feet)
         nv, nf = int(model.nv), 6 * len(self.feet)
@@ -223,6 +238,7 @@ class WholeBodyQP:
         self._regular = np.concatenate(
             [np.full(nv, acc_regularisation), np.full(nf, wrench_regularisation)]
         )
+        self._regular[nv + 5 :: 6] = yaw_regularisation  # each T_z
         foot_rows = [foot.constraint_rows() for foot in self.feet]
         self._foot_rows = np.ascontiguousarray(np.vstack(foot_rows))
         self._foot_start = np.cumsum([0] + [g.shape[0] for g in foot_rows], dtype=np.int64)

@@ -26,8 +26,11 @@ the torso stays upright and the posture fills the null space.
 * **Hip, CMP balancing** (``hip=params``, :mod:`.wbc_hip`): when the capture point leaves the
   CoP region, the bang-bang law of Stephens Sec. III commands a CMP offset δ beyond the foot:
   a momentum task L̇_xy = m g (−δ_y, δ_x) (weight 10), the CoM task c̈ = ω² (c − p_des − δ)
-  with p_des on the edge, the torso task relaxed (weight 1e-3) while it acts; afterwards the
-  torso returns upright under k_R = 4, d_R = 4 until within 0.01 rad.
+  with p_des on the edge, the torso task's pitch and roll relaxed (weight 1e-3; its yaw keeps
+  its gains and weight) while it acts; afterwards the torso returns upright under k_R = 4,
+  d_R = 4, paced by the CoP's room (``HipLaw.paced_return``), until within 0.01 rad.
+* **Joint guard** (:mod:`.wbc_limits`, without stepping; the stepper guards its knees): the
+  knees kept 0.1 rad off their stops.
 
 * **Stepping** (``stepping=True``, :mod:`.wbc_step`): when ξ is beyond the ankles' (and the
   hip's) region, the foot on ξ's side leaves the contacts and a swing-foot task carries it to
@@ -44,7 +47,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -62,76 +64,16 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc import (
     WholeBodyQP,
     foot_contact,
 )
+from pushrecovery.sim.mujoco.humanoid3d.wbc_gains import WbcGains
 from pushrecovery.sim.mujoco.humanoid3d.wbc_hip import UPRIGHT, HipLaw, momentum_rows
+from pushrecovery.sim.mujoco.humanoid3d.wbc_limits import GuardSettings, JointGuard
 from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import rotation_vector
 from pushrecovery.surfaces.cop import capture_point
 
 FloatArray = NDArray[np.float64]
 
 __all__ = ["WbcGains", "WholeBodyController"]
-
-
-@dataclass(frozen=True)
-class WbcGains:
-    """Gains [1/s, 1/s²] and weights [-] of the tasks (module docstring); all finite, ≥ 0.
-
-    Attributes
-    ----------
-    dcm : float
-        k_ξ, the capture point's return rate [1/s].
-    torso_stiffness, torso_damping : float
-        k_R [1/s²], d_R [1/s].
-    height_stiffness, height_damping : float
-        k_z [1/s²], d_z [1/s].
-    posture_stiffness, posture_damping : float
-        k_q [1/s²], d_q [1/s].
-    com_weight, torso_weight, height_weight, posture_weight : float
-        W of each task (> 0).
-    hip_weight : float
-        W of the centroidal momentum task L̇_{x,y} while the hip acts (> 0, :mod:`.wbc_hip`).
-    hip_torso_weight : float
-        The torso task's W while the hip acts (> 0): relaxed, the torso turns.
-    return_stiffness, return_damping : float
-        k_R [1/s²] and d_R [1/s] of the torso's return to upright after the hip acted.
-    """
-
-    dcm: float = 2.0
-    torso_stiffness: float = 100.0
-    torso_damping: float = 20.0
-    height_stiffness: float = 100.0
-    height_damping: float = 20.0
-    posture_stiffness: float = 25.0
-    posture_damping: float = 10.0
-    com_weight: float = 10.0
-    torso_weight: float = 1.0
-    height_weight: float = 1.0
-    posture_weight: float = 0.01
-    hip_weight: float = 10.0
-    hip_torso_weight: float = 1e-3
-    return_stiffness: float = 4.0
-    return_damping: float = 4.0
-
-    def __post_init__(self) -> None:
-        for item in fields(self):
-            value = getattr(self, item.name)
-            positive = item.name.endswith("weight")
-            if not (
-                isinstance(value, int | float)
-                and math.isfinite(value)
-                and (value > 0.0 if positive else value >= 0.0)
-                and value <= 1e6
-            ):
-                bound = "(0, 1e6]" if positive else "[0, 1e6]"
-                raise InvalidParameterError(f"{item.name} must be in {bound}, got {value!r}")
-
-
-def _rotation_vector(rot: FloatArray) -> FloatArray:
-    """Return the rotation vector (axis × angle) of rotation matrix ``rot`` [rad]."""
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot.ravel().tolist()
-    angle = math.acos(max(-1.0, min(1.0, 0.5 * (r00 + r11 + r22 - 1.0))))
-    scale = 1.0 if angle < 1e-9 else angle / math.sin(angle)
-    return np.array([0.5 * (r21 - r12) * scale, 0.5 * (r02 - r20) * scale,
-                     0.5 * (r10 - r01) * scale])  # fmt: skip
 
 
 class WholeBodyController:
@@ -156,6 +98,8 @@ class WholeBodyController:
         The body the step plans are for (default ``hip``); required with ``stepping``.
     step_settings : StepSettings, optional
         The stepping task's settings.
+    guard : GuardSettings, optional
+        The joint-range guard's settings (:mod:`.wbc_limits`).
 
     Raises
     ------
@@ -179,6 +123,7 @@ class WholeBodyController:
         stepping: bool = False,
         params: BodyParams | None = None,
         step_settings: StepSettings | None = None,
+        guard: GuardSettings | None = None,
     ) -> None:
         if isinstance(feet, str) or not feet or len(set(feet)) != len(feet):
             raise InvalidParameterError(f"feet must be distinct body names, got {feet!r}")
@@ -220,6 +165,7 @@ class WholeBodyController:
             raise InvalidParameterError(f"step_settings must be StepSettings: {step_settings!r}")
         self.stepping, self.step_params, self.step_settings = stepping, params, step_settings
         self.stepper: Stepper | None = None
+        self.guard = JointGuard(model, guard)  # with stepping, the stepper guards the knees
 
     def reset(self, state: Any) -> None:
         """Take the reference posture, feet and balance point from ``state`` (an MjData).
@@ -237,6 +183,7 @@ class WholeBodyController:
         self.omega = math.sqrt(float(np.linalg.norm(self.gravity)) / (com[2] - floor))
         self.posture = np.array(data.qpos[7:], dtype=float)
         self.height = float(data.xpos[self.torso][2])
+        self.guard.set_posture(data.qpos)
         self.upright = np.array(data.xmat[self.torso], dtype=float).reshape(3, 3)
         self.last = None
         self._bodies = np.array([foot.body for foot in self.feet], dtype=np.intp)
@@ -332,33 +279,38 @@ class WholeBodyController:
         model, gains, nv, size = self.model, self.gains, self.qp.nv, self.qp.size
         # Torso orientation error and the hip law's CMP offset δ (zero with the ankles only).
         rot = np.asarray(data.xmat[self.torso]).reshape(3, 3)
-        error = _rotation_vector(rot @ self.upright.T)
+        error = rotation_vector(rot @ self.upright.T)
         com = np.asarray(data.subtree_com[0])
         self.desired_cop = self.cop_target(data)  # also the capture point, mj_subtreeVel
         if self.stepper is not None and self._step(data):
             self.desired_cop = self.cop_target(data)  # the new support polygon
-        hip_active = False
-        if self.hip is not None:
-            momentum = np.asarray(data.subtree_angmom[0])
-            self.cmp_offset = self.hip.update(
-                self.capture_point,
-                np.array([momentum[1], -momentum[0]]),
-                np.array([error[1], -error[0]]),
-            )
-            hip_active = self.hip.active
-            if hip_active:
-                self.desired_cop = self.hip.saturate(self.desired_cop)
-            self.returning = self.returning or hip_active
         # Torso orientation and pelvis height: J q̈ + J̇ q̇ = a_des (matrices over q̈ only).
         point = data.xpos[self.torso]
         jacp, jacr, dots = np.zeros((3, nv)), np.zeros((3, nv)), self._dots
         mujoco.mj_jac(model, data, jacp, jacr, point, self.torso)
         mujoco.mj_jacDot(model, data, dots[:3], dots[3:], point, self.torso)
+        spin = jacr @ data.qvel  # the torso's angular velocity [rad/s], world
+        hip_active = False
+        if self.hip is not None:
+            momentum = np.asarray(data.subtree_angmom[0])
+            self.cmp_offset = self.hip.update(
+                self.capture_point, np.array([momentum[1], -momentum[0]]),
+                np.array([error[1], -error[0]]), np.array([spin[1], -spin[0]]),
+            )  # fmt: skip
+            hip_active = self.hip.active
+            if hip_active:
+                self.desired_cop = self.hip.saturate(self.desired_cop)
+            self.returning = self.returning or hip_active
         stiffness, damping = gains.torso_stiffness, gains.torso_damping
         torso_weight = gains.hip_torso_weight if hip_active else gains.torso_weight
         returning = self.returning and not hip_active  # gently back upright, then as usual
+        paced = np.zeros(2)  # the paced return's change of the torso's α_x, α_y (wbc_hip)
         if returning:
+            assert self.hip is not None
             stiffness, damping = gains.return_stiffness, gains.return_damping
+            accel = -stiffness * error[:2] - damping * spin[:2]
+            self.cmp_offset, self.desired_cop, paced = self.hip.paced_return(self.cmp_target, accel)
+            paced -= accel
         self._gains[:2] = stiffness, damping
         # All targets at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g + Σ R_i F_i, rows
         # x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
@@ -368,6 +320,13 @@ class WholeBodyController:
             self.omega**2, self.gravity, error, jacp, jacr, dots, data.qvel, data.qpos,
             self.posture, self.height, float(point[2]), self._gains, UPRIGHT, com_rows, targets,
         )  # fmt: skip
+        targets[2:4] += paced
+        if hip_active or returning:  # yaw keeps the usual gains and weight (legs untwisted)
+            targets[4] -= (gains.torso_stiffness - stiffness) * error[2] + (
+                gains.torso_damping - damping) * spin[2]  # fmt: skip
+            scale = math.sqrt(gains.torso_weight / torso_weight)
+            jacr[2] *= scale
+            targets[4] *= scale
         if returning and upright:
             self.returning = False
         tasks = [Task("com", com_rows, targets[:2], gains.com_weight)]
@@ -381,6 +340,10 @@ class WholeBodyController:
         tasks.append(Task("posture", self._joints, targets[6:], gains.posture_weight))
         if self.stepper is not None:  # the swing foot (while it swings), the knee guard
             tasks.extend(self.stepper.tasks(data, size, nv))
+        else:  # the joints near their stops (wbc_limits)
+            guard = self.guard.task_rows(data.qpos, data.qvel, nv)
+            if guard[1].size:
+                tasks.append(Task("joint guard", *guard, self.guard.settings.weight))
         return tasks
 
     def compute(self, t: float, state: Any) -> FloatArray:

@@ -37,15 +37,25 @@ reset), I the flywheel's inertia and θmax its angle limit:
   bring ξ back to μ_ξ inside the edge, s(ξ_k − δ⁺) ≤ −a_k (1 − e^{−ω T_b}) − μ_ξ (from
   ξ̇ = ω(ξ − δ⁺ − δ), integrated over T_b; the margin μ_ξ = 2 cm absorbs the model's errors:
   F_z ≠ m g while the torso turns, the CoM's height drop, and leaves the ankles room to bring
-  the torso back), or when the flywheel would not stop before its limit,
-  θ + h²/(2 I τmax) ≥ θmax;
+  the torso back), or when the flywheel would not stop before its limit, θ + Δθ ≥ θmax with
+  Δθ = max(h²/(2 I τmax), θ̇ T_b / 2): the flywheel's stopping angle, and the measured spin
+  θ̇ of the upper body over the braking time (the legs turn against the torso, so the torso
+  turns faster than h/I: on the biped3d it overran θmax by 0.06 rad with the first alone);
 * *brake → idle* when h ≤ 0; the brake's torque is min(τmax, h/Δt) so it ends at rest.
 
 While an axis acts, the torso-upright task is relaxed (its weight × ``torso_relaxed``) and the
 momentum task L̇_{x,y} = m g (−δ_y, δ_x) and the CoM task c̈ = ω²(c − p_des − δ) drive the QP;
-afterwards the torso comes back upright under the gentle ``torso_return`` gains (a slow return
-costs the ankles little CoP), and the usual gains once it is within :data:`UPRIGHT` of
-upright.
+afterwards the torso comes back upright under the gentle return gains, and the usual gains
+once it is within :data:`UPRIGHT` of upright.
+
+**The paced return** (:meth:`HipLaw.paced_return`): the torso's return is itself a CMP offset,
+δ = (I α_y, −I_roll α_x)/(m g) for the return law's angular acceleration α, and the DCM law
+needs the CMP at r = ξ + (k_ξ/ω)(ξ − ξ₀): the CoP must be r − δ, inside the support's box
+shrunk by μ_p. So δ is clipped to [r − (high − μ_p), r − (low + μ_p)] and toward zero (never
+past the return law's δ, never against it: a torso that cannot return yet is held), α
+follows δ, and the CoP target is r − δ. Without it the return (k_R = 4 from θ ≈ 1 rad asks
+δ ≈ 0.06 m) needed the CoP beyond the toe while ξ sat 2 cm inside it: ξ left P again, the
+hip pushed a second time from near θmax, and the feet unloaded.
 """
 
 from __future__ import annotations
@@ -69,6 +79,8 @@ __all__ = ["BRAKE", "IDLE", "PUSH", "UPRIGHT", "HipLaw", "momentum_rows"]
 IDLE, PUSH, BRAKE = 0, 1, 2
 #: Torso tilt [rad] (and spin [rad/s]) under which the return gains hand back to the usual.
 UPRIGHT = 0.01
+#: How far short of θmax the brake aims the flywheel's stop [rad] (the stop's estimate errs).
+ANGLE_MARGIN = 0.03
 
 
 def momentum_rows(
@@ -188,7 +200,9 @@ class HipLaw:
                 out[k] = self.high[k] if self.side[k] > 0 else self.low[k]
         return out
 
-    def update(self, xi: FloatArray, momentum: FloatArray, tilt: FloatArray) -> FloatArray:
+    def update(
+        self, xi: FloatArray, momentum: FloatArray, tilt: FloatArray, spin: FloatArray | None = None
+    ) -> FloatArray:
         """Advance each axis's phase and return the CMP offset δ = (δ_x, δ_y) [m].
 
         Parameters
@@ -200,9 +214,11 @@ class HipLaw:
             along x, then y [N m s].
         tilt : float array, shape (2,)
             The upper body's pitch and −roll since reset [rad] (the same signs).
+        spin : float array, shape (2,), optional
+            The upper body's (ω_y, −ω_x) [rad/s]; None: the flywheel's h/I alone.
         """
         self.decision = self.decide(xi)
-        offset = np.zeros(2)
+        rate, offset = spin, np.zeros(2)
         for k in range(2):
             if self.phase[k] == IDLE and self.decision != "ankle":
                 if xi[k] > self.high[k]:
@@ -212,16 +228,19 @@ class HipLaw:
             if self.phase[k] == IDLE:
                 continue
             side = self.side[k]
-            spin = side * float(momentum[k])
+            spin = side * float(momentum[k])  # h
             torque, reach = float(self.torque[k]), float(self.reach[k])
             if self.phase[k] == PUSH:
                 edge = self.high[k] if side > 0 else self.low[k]
                 inside = side * (float(xi[k]) - edge)
                 braking = max(spin, 0.0) / torque
                 stop = side * float(tilt[k])
-                stop += max(spin, 0.0) ** 2 / (2.0 * self.inertia[k] * torque)
+                turn = max(spin, 0.0) ** 2 / (2.0 * self.inertia[k] * torque)
+                if rate is not None:  # the measured spin over the braking time
+                    turn = max(turn, max(side * float(rate[k]), 0.0) * 0.5 * braking)
+                stop += turn
                 aim = -reach * (1.0 - math.exp(-self.omega * braking)) - self.margin
-                if inside <= aim or stop >= self.angle_max[k]:
+                if inside <= aim or stop >= self.angle_max[k] - ANGLE_MARGIN:
                     self.phase[k] = BRAKE
                 else:
                     offset[k] = side * reach
@@ -231,3 +250,34 @@ class HipLaw:
                 else:
                     offset[k] = -side * min(torque, spin / self.period) / self.weight
         return offset
+
+    def paced_return(
+        self, target: FloatArray, accel: FloatArray, margin: float = 0.01
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Return the return's CMP offset δ, CoP target and torso α (module docstring).
+
+        Parameters
+        ----------
+        target : float array, shape (2,)
+            r, the DCM law's CMP (the unclipped p_des) [m], world xy.
+        accel : float array, shape (2,)
+            The return law's torso angular acceleration (α_x, α_y) [rad/s²], world.
+        margin : float
+            μ_p, how far inside the support's box the CoP stays [m].
+
+        Returns
+        -------
+        offset, cop, accel : float arrays, shape (2,)
+            δ [m], the CoP r − δ on the support polygon [m], and (α_x, α_y) after the clip.
+        """
+        inertia_x, inertia_y = float(self.inertia[0]), float(self.inertia[1])
+        wanted = np.array([inertia_x * accel[1], -inertia_y * accel[0]]) / self.weight
+        low = target - (self.high - margin)
+        high = target - (self.low + margin)
+        offset = np.clip(wanted, low, high)
+        offset = np.clip(offset, np.minimum(wanted, 0.0), np.maximum(wanted, 0.0))
+        cop_x, cop_y = (target - offset).tolist()
+        if not self.support.point_signed_distance(cop_x, cop_y) > 0.0:
+            cop_x, cop_y = self.support.nearest_point(cop_x, cop_y)
+        paced = self.weight * np.array([-offset[1] / inertia_y, offset[0] / inertia_x])
+        return offset, np.array([cop_x, cop_y]), paced

@@ -1,0 +1,157 @@
+r"""The joint-range guard of the whole-body controller: keep every joint off its stops.
+
+The QP (:mod:`.wbc`) models the motors, the contacts and the rigid-body dynamics, but not a
+joint's range: the constraint force of a joint on its stop (MuJoCo's limit constraint) is
+missing from its dynamics rows, so a task that drives a joint onto its stop gets a wrong
+answer from the QP, and a leg on the knee's stop is also straight, a kinematic singularity
+of the contact Jacobian (the QP becomes ill-conditioned). Measured on the biped3d's hip
+push (docs/humanoid3d.md, "Controller"): the torso pitched 0.95 rad forward while the CoM
+task held the CoM over the feet and the pelvis task held the hips at their height; the
+hips moved back 0.11 m, the knees straightened onto their stop (0 rad), and during the
+torso's return the hip yaw motors saturated, the ankles rolled and the feet left the floor.
+
+**The guard** (:class:`JointGuard`): for each guarded joint (by default the knees,
+:class:`GuardSettings`), a limited hinge or slide with range
+[q_lo, q_hi] and a margin μ_q, while its predicted position q̂ = q + T min(q̇, 0) (T the
+look-ahead) is within the margin, q̂ < q_lo + μ_q, the task
+
+.. math:: \ddot q = k \max(q_{lo} + \mu_q - q, 0) - d \min(\dot q, 0)
+
+of weight W (and the mirror image at q_hi; an edge inside which the reference posture lies
+moves to the posture, :meth:`JointGuard.set_posture`): a damper on the approach and a spring back to
+the margin's edge, never a pull towards the stop (at the switch, q̂ = q_lo + μ_q, its target
+is the damper's alone, small when the joint is slow). A soft task, not a hard bound: a hard
+bound can conflict with the contact rows and the torque limits and leave the QP infeasible.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pushrecovery.errors import InvalidParameterError
+
+FloatArray = NDArray[np.float64]
+
+__all__ = ["GuardSettings", "JointGuard"]
+
+
+@dataclass(frozen=True)
+class GuardSettings:
+    """The joint-range guard's settings (module docstring); all finite.
+
+    Attributes
+    ----------
+    joints : tuple of str
+        The guarded joints: each limited hinge or slide joint whose name contains one of
+        these (default the knees: a straight knee is the leg's singularity; guarding every
+        joint also held the swing ankle's roll inside its margin against the stepping task's
+        foot orientation, and the biped's lateral step fell).
+    margin : float
+        μ_q, the distance kept from each stop [rad or m], in [0, 1].
+    horizon : float
+        T, the look-ahead [s], in [0, 1].
+    stiffness, damping : float
+        k [1/s²] and d [1/s], in [0, 1e6].
+    weight : float
+        W of the guard's task, in (0, 1e6].
+    """
+
+    joints: tuple[str, ...] = ("knee",)
+    margin: float = 0.1
+    horizon: float = 0.05
+    stiffness: float = 400.0
+    damping: float = 40.0
+    weight: float = 10.0
+
+    def __post_init__(self) -> None:
+        bounds = {"margin": (0.0, 1.0), "horizon": (0.0, 1.0), "stiffness": (0.0, 1e6),
+                  "damping": (0.0, 1e6), "weight": (0.0, 1e6)}  # fmt: skip
+        if not (isinstance(self.joints, tuple) and all(isinstance(j, str) for j in self.joints)):
+            raise InvalidParameterError(f"joints must be a tuple of str, got {self.joints!r}")
+        for item in fields(self)[1:]:
+            value = getattr(self, item.name)
+            low, high = bounds[item.name]
+            positive = item.name == "weight"
+            if not (
+                isinstance(value, int | float)
+                and math.isfinite(value)
+                and (low < value if positive else low <= value)
+                and value <= high
+            ):
+                left = "(" if positive else "["
+                raise InvalidParameterError(
+                    f"{item.name} must be in {left}{low:g}, {high:g}], got {value!r}"
+                )
+
+
+class JointGuard:
+    """Tasks that keep each limited joint of a model inside its range (module docstring).
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The humanoid; its limited hinge and slide joints are guarded.
+    settings : GuardSettings, optional
+        Margin, look-ahead, gains and weight.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``settings`` is not a :class:`GuardSettings`.
+    """
+
+    def __init__(self, model: Any, settings: GuardSettings | None = None) -> None:
+        import mujoco
+
+        settings = GuardSettings() if settings is None else settings
+        if not isinstance(settings, GuardSettings):
+            raise InvalidParameterError(
+                f"guard must be a GuardSettings, got {type(settings).__name__}"
+            )
+        self.settings = settings
+        kinds = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+        joints = [j for j in range(int(model.njnt))
+                  if int(model.jnt_type[j]) in kinds and bool(model.jnt_limited[j])
+                  and any(part in model.joint(j).name for part in settings.joints)]  # fmt: skip
+        self.qpos = np.array([int(model.jnt_qposadr[j]) for j in joints], dtype=np.intp)
+        self.dofs = np.array([int(model.jnt_dofadr[j]) for j in joints], dtype=np.intp)
+        ranges = np.asarray(model.jnt_range, dtype=float)[joints].reshape(-1, 2)
+        # The margin, but never past the range's middle.
+        inset = np.minimum(settings.margin, 0.25 * (ranges[:, 1] - ranges[:, 0]))
+        self.edges = np.column_stack([ranges[:, 0] + inset, ranges[:, 1] - inset])
+        self.low, self.high = self.edges[:, 0].copy(), self.edges[:, 1].copy()
+
+    def set_posture(self, qpos: FloatArray) -> None:
+        """Move each margin's edge to the posture ``qpos`` [rad or m] where it lies inside.
+
+        The guard never drives a joint away from the posture it balances in.
+        """
+        q = np.asarray(qpos, dtype=float)[self.qpos]
+        self.low = np.minimum(self.edges[:, 0], q)
+        self.high = np.maximum(self.edges[:, 1], q)
+
+    def task_rows(
+        self, qpos: FloatArray, qvel: FloatArray, nv: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """Return the guard's task (A over q̈, b [rad/s² or m/s²]) now (module docstring).
+
+        No rows when no joint's predicted position is within its margin.
+        """
+        s = self.settings
+        q, v = qpos[self.qpos], qvel[self.dofs]
+        below = q + s.horizon * np.minimum(v, 0.0) < self.low
+        above = q + s.horizon * np.maximum(v, 0.0) > self.high
+        active = below | above
+        lower, q, v = below[active], q[active], v[active]
+        push = np.where(lower, np.maximum(self.low[active] - q, 0.0),
+                        np.minimum(self.high[active] - q, 0.0))  # fmt: skip
+        speed = np.where(lower, np.minimum(v, 0.0), np.maximum(v, 0.0))  # towards the stop
+        target = s.stiffness * push - s.damping * speed
+        rows = np.zeros((target.size, nv))
+        rows[np.arange(target.size), self.dofs[active]] = 1.0
+        return rows, target
