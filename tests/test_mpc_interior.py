@@ -60,8 +60,9 @@ def test_a_full_newton_step_solves_the_linearised_kkt_system():
     steps += [np.zeros((n, 3)) for _ in range(4)]
     kernels._newton(solver.a, solver.b, solver.wx, solver.wu, sl, su, zl, zu, rdu, rdx, rl, ru,
                     target_l, target_u, True, np.zeros((n + 1, 4, 4)), np.zeros((n, 2, 4)),
-                    np.zeros((n, 2, 2)), np.zeros((n + 1, 4)), np.zeros((n, 2)),
-                    np.zeros((n, 2)), *steps)  # fmt: skip
+                    np.zeros((n, 2, 2)), np.zeros((n + 1, 4)), np.zeros((n, 4, 2)),
+                    np.zeros((n, 4, 4)), np.zeros((n, 2)), np.zeros((n, 2)),
+                    *steps)  # fmt: skip
     du, dx, dnu, dsl, dsu, dzl, dzu = steps
     after = kkt_residuals(solver, u + du, x + dx, nu + dnu, sl + dsl, su + dsu, zl + dzl,
                           zu + dzu)  # fmt: skip

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -24,6 +25,9 @@ __all__ = ["MPCController"]
 
 #: Riccati passes allowed to verify an interior-point iterate's active set.
 POLISH_PASSES = 3
+#: Relative widening of θmax for the interior point on the viable set's boundary: enough for
+#: an interior, small enough that its active set is the problem's (with full braking held).
+RELAXED = 1e-3
 #: The interior point is not asked within this relative margin of S_N's boundary (the
 #: boundary's own margin, BOUNDARY): there the feasible set has no interior and its iterates
 #: stall; the passes with full braking held decide, then DAQP.
@@ -86,9 +90,15 @@ class MPCController(Controller):
         )
         # The ticks the passes do not verify: an interior point with Riccati steps, as fast
         # and as well conditioned at any horizon (DAQP on the condensed QP is the last resort).
-        self.interior: InteriorPointSolver | None = (
-            InteriorPointSolver(params, settings) if self.riccati is not None else None
-        )
+        self.interior: InteriorPointSolver | None = None
+        # On the flywheel's viable-set boundary, the same on θmax 0.1 % larger (see plan()).
+        self._relaxed: InteriorPointSolver | None = None
+        if self.riccati is not None:
+            self.interior = InteriorPointSolver(params, settings)
+            wider = params.flywheel_angle_max * (1.0 + RELAXED)
+            self._relaxed = InteriorPointSolver(
+                dataclasses.replace(params, flywheel_angle_max=wider), settings
+            )
         self._qp: CondensedQP | None = None
         self._workspace: DaqpWorkspace | None = None
         self._use_workspace = settings.solver == "daqp"
@@ -123,7 +133,7 @@ class MPCController(Controller):
         self._use_workspace = value is not None
         if value is None:
             self.riccati = None
-            self.interior = None
+            self.interior = self._relaxed = None
 
     @classmethod
     def option_names(cls) -> tuple[str, ...]:
@@ -159,29 +169,10 @@ class MPCController(Controller):
             if riccati is not None:
                 riccati.reset()
             return self._fallback_plan(x0)
-        if riccati is not None and gauge >= 1.0 - BOUNDARY and self._feasibility is not None:
-            # On S_N's boundary: the torques brake at full until the flywheel stops, and the
-            # passes solve the rest (the θ rows of those stages would be degenerate).
-            forced = self._feasibility.forced_braking(x0)
-            if forced[0] and riccati.solve(x0, forced=forced):
-                inputs = riccati.inputs
-                return Plan(inputs[0], True, inputs, riccati.states)
-        interior = self.interior
-        if interior is not None and riccati is not None and gauge < 1.0 - INTERIOR_MARGIN:
-            # The passes did not verify this tick (a new active set, a degenerate stage): the
-            # interior point, whose iterates' active sets the passes are offered to verify.
-            def verify(active: NDArray[np.int8]) -> bool:
-                riccati.seed(active)
-                return riccati.solve(x0, shift=False, max_passes=POLISH_PASSES)
-
-            if interior.solve(x0, verify):
-                if interior.verified:
-                    inputs = riccati.inputs
-                    return Plan(inputs[0], True, inputs, riccati.states)
-                riccati.seed(interior.active_set())  # the next tick's start
-                inputs = interior.inputs
-                return Plan(inputs[0], True, inputs, interior.states)
-            riccati.reset()
+        if riccati is not None:
+            plan = self._sparse_plan(riccati, x0, gauge)
+            if plan is not None:
+                return plan
         # Only the solvers' own failures mean "infeasible"; any other exception is a bug.
         workspace = self.workspace
         if workspace is not None:
@@ -208,6 +199,49 @@ class MPCController(Controller):
             lambda: qp.inputs(x0, scaled),
             lambda: qp.predict(x0, scaled),
         )
+
+    def _sparse_plan(
+        self, riccati: RiccatiSolver, x0: NDArray[np.float64], gauge: float
+    ) -> Plan | None:
+        """Solve a tick the passes did not verify from their warm start, on the sparse QP.
+
+        Inside S_N: the interior point, whose iterates' active sets the passes are offered to
+        verify (its own solution if none verifies, e.g. the cycling late-horizon torques). On
+        its boundary (γ ≥ 1 − BOUNDARY), where the feasible set has no interior: full braking
+        held (:meth:`FlywheelFeasibility.forced_braking`), the passes from the last set, then
+        from the active sets of the interior point on the problem with θmax 0.1 % larger
+        (:data:`RELAXED`), which has an interior. None: DAQP decides.
+        """
+        interior = self.interior
+        if gauge < 1.0 - INTERIOR_MARGIN:
+            if interior is None:
+                return None
+            forced = (0, 0)
+        else:
+            if self._feasibility is None or self._relaxed is None:
+                return None
+            forced = self._feasibility.forced_braking(x0)
+            if not forced[0]:
+                return None
+            if riccati.solve(x0, max_passes=POLISH_PASSES, forced=forced):
+                return Plan(riccati.inputs[0], True, riccati.inputs, riccati.states)
+            interior = self._relaxed
+
+        def verify(active: NDArray[np.int8]) -> bool:
+            riccati.seed(active)
+            return riccati.solve(x0, shift=False, max_passes=POLISH_PASSES, forced=forced)
+
+        # Warm from the last tick's plan (its inputs computed if they were left lazy).
+        last = self.last_plan
+        warm = last.inputs if last is not None and last.feasible else None
+        if interior.solve(x0, verify, warm):
+            if interior.verified:
+                return Plan(riccati.inputs[0], True, riccati.inputs, riccati.states)
+            if interior is self.interior:
+                riccati.seed(interior.active_set())  # the next tick's start
+                return Plan(interior.inputs[0], True, interior.inputs, interior.states)
+        riccati.reset()
+        return None
 
     def _gauge(self, x0: NDArray[np.float64]) -> float:
         """Return the gauge of (θ, θ̇) of x0 in S_N (:class:`FlywheelFeasibility`).

@@ -36,13 +36,13 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.mpc._ipm_kernels import solve_interior
+from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, identify_active, solve_interior
 from pushrecovery.control.mpc._ipm_scales import dual_scales
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 
-__all__ = ["DUAL_TOL", "MAX_ITERATIONS", "TOL", "InteriorPointSolver"]
+__all__ = ["DUAL_TOL", "IDENTIFY_TOL", "MAX_ITERATIONS", "TOL", "InteriorPointSolver"]
 
 FloatArray = NDArray[np.float64]
 
@@ -52,9 +52,9 @@ TOL = 1e-10
 #: floor is a few 1e-10 (the costates grow backward along the horizon as e^{ω t}).
 DUAL_TOL = 1e-8
 #: Iterations before giving up (an infeasible problem; well-posed ones take 10-30).
-MAX_ITERATIONS = 60
-#: Iterations before the first offer of the active set to a verifier, and between offers.
-FIRST_CHECK, CHECK_EVERY = 6, 2
+MAX_ITERATIONS = 100
+#: Looser tolerance at which a verifier is first offered the active set (see solve()).
+IDENTIFY_TOL = 1e-6
 
 
 class InteriorPointSolver:
@@ -102,65 +102,80 @@ class InteriorPointSolver:
         self._slacks = (np.zeros((n, 3)), np.zeros((n, 3)))
         self._bound_multipliers = (np.zeros((n, 3)), np.zeros((n, 3)))
         self._work = np.zeros((17, n + 1, 4))
-        self._factors = (np.zeros((n + 1, 4, 4)), np.zeros((n, 2, 4)), np.zeros((n, 2, 2)),
-                         np.zeros((n + 1, 4)))  # fmt: skip
+        # The Newton steps' factors: S, K, H⁻¹, s, S B and A_K per stage.
+        self._factors = (
+            np.zeros((n + 1, 4, 4)), np.zeros((n, 2, 4)), np.zeros((n, 2, 2)),
+            np.zeros((n + 1, 4)), np.zeros((n, 4, 2)), np.zeros((n, 4, 4)),
+        )  # fmt: skip
         # Load the compiled kernel now (from numba's disk cache), not on a control tick.
-        self._iterate(np.zeros(4), 0, True)
+        self._active = np.zeros((n, 3), dtype=np.int8)
+        self._iterate(np.zeros(4), 0, COLD)
+        identify_active(self.bounds, self.scales, *self._slacks, *self._bound_multipliers,
+                        self._active)  # fmt: skip
 
-    def _iterate(self, x0: FloatArray, iterations: int, cold: bool) -> int:
-        """Run at most ``iterations`` of the kernel (``cold``: from its start); its status."""
+    def _iterate(self, x0: FloatArray, iterations: int, start: int, loose: bool = False) -> int:
+        """Run at most ``iterations`` of the kernel (``start``: COLD, WARM or 0); its status.
+
+        ``loose``: converged at :data:`IDENTIFY_TOL` (enough to identify the active set).
+        """
+        tol, dual_tol = (IDENTIFY_TOL, IDENTIFY_TOL) if loose else (TOL, DUAL_TOL)
         status: int = solve_interior(
             x0, self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback,
-            TOL, DUAL_TOL, iterations, cold, self._u, self._x, self._multipliers,
+            tol, dual_tol, iterations, start, self._u, self._x, self._multipliers,
             *self._slacks, *self._bound_multipliers, self._work, *self._factors,
         )  # fmt: skip
         return status
 
     def solve(
-        self, x0: FloatArray, verify: Callable[[NDArray[np.int8]], bool] | None = None
+        self,
+        x0: FloatArray,
+        verify: Callable[[NDArray[np.int8]], bool] | None = None,
+        warm: FloatArray | None = None,
     ) -> bool:
         """Solve from ``x0`` = [x, θ, ẋ, θ̇]; True if solved (see the attributes).
 
-        ``verify``, if given, is offered the iterate's active set (:meth:`active_set`) after
-        :data:`FIRST_CHECK` iterations and every :data:`CHECK_EVERY` after: if it returns
-        True (e.g. Riccati passes from that set verified the KKT conditions exactly), the
-        solve stops there, ``verified`` is True and the solution is the verifier's; the
-        attributes ``inputs`` and ``states`` are then not updated.
+        ``warm``: the last tick's plan, inputs (N, 2), to start from shifted by one stage
+        (else the cold start). ``verify``, if given, is offered the iterate's active set
+        (:meth:`active_set`) once converged to :data:`IDENTIFY_TOL`: if it returns True
+        (e.g. Riccati passes from that set verified the KKT conditions exactly), the solve
+        stops there, ``verified`` is True and the solution is the verifier's; the attributes
+        ``inputs`` and ``states`` are then not updated. Else it goes on to :data:`TOL`.
         """
-        done = 0
-        chunk = FIRST_CHECK if verify is not None else MAX_ITERATIONS
+        start = COLD
+        if warm is not None:
+            self._u[:-1] = warm[1:]
+            self._u[-1] = warm[-1]
+            start = WARM
         self.verified = False
-        while True:
-            status = self._iterate(x0, min(chunk, MAX_ITERATIONS - done), done == 0)
+        done = 0
+        if verify is not None:
+            # Converged loosely: the active set is settled; verified, the solve ends there.
+            status = self._iterate(x0, MAX_ITERATIONS, start, loose=True)
+            start = 0
             if status == -1:
-                break
-            done += chunk if status == -2 else status
-            if verify is not None and verify(self.active_set()):
+                self.iterations = -1
+                return False
+            done = MAX_ITERATIONS if status == -2 else status
+            identify_active(self.bounds, self.scales, *self._slacks, *self._bound_multipliers,
+                            self._active)  # fmt: skip
+            if status >= 0 and verify(self._active):
                 self.iterations, self.verified = done, True
                 return True
-            if status >= 0:
-                self.iterations = done
-                self.inputs, self.states = self._u.copy(), self._x.copy()
-                return True
-            if done >= MAX_ITERATIONS:
-                break
-            chunk = CHECK_EVERY
+        status = -1 if done >= MAX_ITERATIONS else self._iterate(x0, MAX_ITERATIONS - done, start)
+        if status >= 0:
+            self.iterations = done + status
+            self.inputs, self.states = self._u.copy(), self._x.copy()
+            return True
         self.iterations = -1
         return False
 
     def active_set(self) -> NDArray[np.int8]:
-        """Return the last solve's active set, (N, 3) rows (δ_i, τ_i, θ_{i+1}), ±1 at a bound.
+        """Return the last iterate's active set, (N, 3) rows (δ_i, τ_i, θ_{i+1}), ±1 at a bound.
 
         A bound is active when its multiplier, in units of its dual scale, exceeds its slack
         in units of its range: at the interior point's solution the two are 1e-10 apart.
         """
-        span = self.bounds[:, 1] - self.bounds[:, 0]
-        scale = self.scales[:, :3]
-        (lower, upper), (z_lower, z_upper) = self._slacks, self._bound_multipliers
-        active = np.zeros(lower.shape, dtype=np.int8)
-        # z / scale > s / range, without the quotients (z reaches 1e11 × its scale; a
-        # diverging iterate's overflow to inf compares as well).
-        with np.errstate(over="ignore", invalid="ignore"):
-            active[z_lower * span > lower * scale] = -1
-            active[z_upper * span > upper * scale] = 1
+        active = np.zeros_like(self._active)
+        identify_active(self.bounds, self.scales, *self._slacks, *self._bound_multipliers,
+                        active)  # fmt: skip
         return active

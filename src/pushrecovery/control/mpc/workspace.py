@@ -28,19 +28,20 @@ from numpy.typing import NDArray
 
 from pushrecovery.control.mpc.qp import CondensedQP
 
-__all__ = ["ITER_LIMIT", "PRIMAL_TOL", "DaqpWorkspace"]
+__all__ = ["ITER_BUDGET", "PRIMAL_TOL", "DaqpWorkspace"]
 
 FloatArray = NDArray[np.float64]
 
 #: Largest constraint violation DAQP accepts (scaled units; its default is 1e-6).
 PRIMAL_TOL = 1e-9
-#: Active-set iterations before DAQP gives up (its default is 10,000). It is asked only for
-#: the ticks on the flywheel's viable-set boundary that the Riccati passes do not verify:
-#: there, in the benchmark's pushed runs, its solves took at most 109 iterations at N = 50,
-#: and at N = 100 and 200 it failed numerically after 280-950 (2 successes at N = 100, after
-#: 631 and 651), 40-60 ms a tick; capped, a failed tick costs a few ms and brakes with the
-#: fallback as before.
-ITER_LIMIT = 200
+#: Active-set iterations before DAQP gives up, times the horizon N (its default is 10,000
+#: iterations): 200 at N = 50, 50 at N = 200. It is asked only for the ticks on the
+#: flywheel's viable-set boundary that neither the Riccati passes nor the interior point
+#: solve: there, in the benchmark's pushed runs, its solves took at most 109 iterations at
+#: N = 50, and at N = 100 and 200 it failed numerically after 280-950 (2 successes at
+#: N = 100, after 631 and 651), 40-120 ms a tick; capped, a failed tick costs a few ms and
+#: brakes with the fallback as before.
+ITER_BUDGET = 10_000
 
 # DAQP's ``sense`` flags (daqp constants.h): bit 0 active, bit 1 at the lower bound. Indexed by
 # side + 1 of the active sets below: −1 (lower) → 3, 0 → 0, +1 (upper) → 1.
@@ -88,7 +89,8 @@ class DaqpWorkspace:
         )
         if flag < 0:
             raise RuntimeError(f"daqp could not set up the MPC problem (exit flag {flag})")
-        model.settings = {"primal_tol": PRIMAL_TOL, "iter_limit": ITER_LIMIT}
+        limit = max(1, ITER_BUDGET // qp.settings.horizon)
+        model.settings = {"primal_tol": PRIMAL_TOL, "iter_limit": limit}
         if model.settings.get("primal_tol") != PRIMAL_TOL:
             raise ImportError("this daqp Model ignores its primal_tol setting")
         self._model: Any = model
