@@ -4,7 +4,8 @@ For N = 50, 100 and 200 (dt = 0.02 s, the paper's weights), every tick of closed
 of ``flywheel`` + ``mpc`` after pushes of 0.55, -0.4, 0.3 and 0.65 m/s (torque and CoP limits
 active) is timed one by one, the solver warm-started between ticks as in a real loop, after a
 warm-up run on another push (0.6 m/s: compilation, DAQP's workspace). Also printed: the share
-of ticks verified by the Riccati passes (the rest are solved by DAQP), and the largest tick of
+of ticks verified by the Riccati passes (from the warm start, or from the interior point's
+active set) and the share that needed the interior point, and the largest tick of
 the recovery controller on the stepping model over 7 pushes (hip and step) after a warm-up
 push (target 2 ms). Baseline: one
 ``numpy.dot`` of a 100 x 100 matrix and a 100-vector, timed in the same loop. Targets: the tick
@@ -46,7 +47,7 @@ WARM_UP_PUSH, MEASURED_PUSHES = 0.6, (0.55, -0.4, 0.3, 0.65)
 
 
 def _ticks_us(horizon: int) -> tuple[np.ndarray, float, float, tuple[int, int]]:
-    """Every measured tick [µs], the build time [ms], the share verified by Riccati passes.
+    """Every measured tick [µs], the build time [ms], the shares verified and interior-point.
 
     And the fallback ticks: (exactly infeasible, exactly feasible but failed by DAQP), by the
     gauge of the flywheel's viable set (``FlywheelFeasibility``).
@@ -60,20 +61,24 @@ def _ticks_us(horizon: int) -> tuple[np.ndarray, float, float, tuple[int, int]]:
         simulate(plant, MPCController(params, horizon=horizon), plant.reset(0.0, v)).states[:-1]
         for v in (WARM_UP_PUSH, *MEASURED_PUSHES)
     ]
-    clock, times, verified = time.perf_counter_ns, [], 0
+    clock, times, verified, interior = time.perf_counter_ns, [], 0, 0
     exact, infeasible, failed = FlywheelFeasibility(params, MPCSettings(horizon=horizon)), 0, 0
     for run, states in enumerate(runs):
         controller.reset(states[0])
         for k, state in enumerate(states):
+            if controller.interior is not None:
+                controller.interior.iterations = 0
             begin = clock()
             controller.compute(0.02 * k, state)
             if run:
                 times.append(clock() - begin)
                 verified += controller.riccati is not None and controller.riccati.passes > 0
+                interior += controller.interior is not None and controller.interior.iterations != 0
                 if controller.last_plan is not None and not controller.last_plan.feasible:
                     outside = exact.gauge(state) > 1.0
                     infeasible, failed = infeasible + outside, failed + (not outside)
-    return np.array(times) / 1e3, build, verified / len(times), (infeasible, failed)
+    shares = (verified / len(times), interior / len(times))
+    return np.array(times) / 1e3, build, shares, (infeasible, failed)
 
 
 def _recovery_ticks_ms() -> tuple[float, int, int]:
@@ -106,7 +111,7 @@ def _recovery_ticks_ms() -> tuple[float, int, int]:
 def main() -> int:
     medians, failed = {}, False
     for horizon in HORIZONS:
-        ticks, build, verified, (infeasible, daqp_failed) = _ticks_us(horizon)
+        ticks, build, (verified, interior), (infeasible, daqp_failed) = _ticks_us(horizon)
         baseline = _matvec_us()
         median, p99 = float(np.median(ticks)), float(np.percentile(ticks, 99))
         medians[horizon] = median
@@ -114,7 +119,8 @@ def main() -> int:
             f"MPC tick, N = {horizon}: median {median:.0f} µs ({median / baseline:.0f}x a 100x100 "
             f"mat-vec of {baseline:.2f} µs), p99 {p99:.0f} µs ({p99 / median:.1f}x the median), "
             f"largest {ticks.max():.0f} µs; build {build:.1f} ms; {verified:.0%} of "
-            f"{ticks.size} ticks verified by the Riccati passes (the rest: DAQP); fallbacks: "
+            f"{ticks.size} ticks verified by the Riccati passes, {interior:.0%} through the "
+            f"interior point (the rest: DAQP); fallbacks: "
             f"{infeasible} infeasible QPs, {daqp_failed} feasible QPs DAQP failed"
         )
         if horizon == 50:
