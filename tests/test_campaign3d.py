@@ -150,7 +150,7 @@ def test_cli_validate_on_the_biped3d(capsys, tmp_path):
           "--controller", "wbc-hip", "--impulse", "5", "5", "1", "--out", "x"), "not both"),
         (("validate", "--model", "biped3d", "--azimuths", "0,360"), "repeats"),
         (("validate", "--model", "biped3d", "--fractions", "1,0.5"), "--fractions must be"),
-        (("validate", "--model", "biped3d", "--strategy", "step"), "no 3-D critical push"),
+        (("validate", "--model", "g1", "--strategy", "step"), "no critical push on the g1"),
         (("validate", "--backend", "analytic", "--model", "biped3d"), "use --backend mujoco"),
         (("validate", "--azimuths", "0,90"), "need a 3-D model"),
     ],
@@ -171,3 +171,18 @@ def test_validate_refuses_another_grid_in_the_same_out_in_one_line(capsys, tmp_p
     args = ("--model", "biped3d", "--no-critical", "--azimuths", "90", "--fractions", "0.5")
     code, _, err = run_cli(capsys, "validate", *args, "--out", str(tmp_path))
     assert code == 2 and err.count("\n") == 1 and "give another --out" in err
+
+
+def test_validate_measures_the_step_column_of_the_biped(capsys, tmp_path):
+    # --strategy step on the biped3d: the step critical push at one azimuth against the
+    # one-step capture region, in the JSON, a table and the polar plot.
+    args = ("--model", "biped3d", "--strategy", "step", "--azimuth", "90", "--no-confusion",
+            "--rel-tolerance", "0.2", "--duration", "2", "--out", str(tmp_path), "--json")  # fmt: skip
+    code, out, err = run_cli(capsys, "validate", *args)
+    assert code == 0, err
+    data = json.loads(out)
+    (row,) = data["step_critical"]
+    assert row["azimuth"] == 90.0 and 0.0 < row["measured"] < row["predicted"]
+    assert row["bracket"][0] == row["measured"] < row["bracket"][1]
+    assert (tmp_path / "validation3d_biped3d_step.md").exists()
+    assert (tmp_path / "validation3d_biped3d.png").exists()

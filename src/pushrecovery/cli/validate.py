@@ -276,14 +276,15 @@ def _validate_3d(
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
 
-    if "step" in strategies:
+    if "step" in strategies and model != "biped3d":
         raise InvalidParameterError(
-            "--strategy step has no 3-D critical push yet; the confusion matrix covers stepping"
+            f"--strategy step has no critical push on the {model} yet (its stepping does not "
+            "recover); use --model biped3d"
         )
     quick_values: dict[str, Any] = QUICK if quick else {}
     directions = azimuths_from(azimuth, azimuths) or quick_values.get("azimuths", DEFAULT_AZIMUTHS)
-    # The G1's hip is not validated yet (docs/validation.md): its ankle by default.
-    usual = ("ankle",) if model == "g1" else ("ankle", "hip")
+    # The G1's hip and step are not validated yet (docs/validation.md): its ankle by default.
+    usual = ("ankle",) if model == "g1" else ("ankle", "hip", "step")
     chosen = strategies or quick_values.get("strategies", usual)
     chosen = chosen if critical else ()
     options = Validate3DOptions(

@@ -1,7 +1,8 @@
 """The 3-D models of ``validate`` (biped3d, g1): the polar validation and the confusion matrix.
 
 ``validate --model biped3d|g1``: each strategy's critical push per azimuth against the 2-D
-prediction (:mod:`pushrecovery.experiments.validation3d`: table and polar plot), then a 3-D
+prediction (:mod:`pushrecovery.experiments.validation3d`, and for the biped3d's step
+:mod:`pushrecovery.experiments.validation3d_step`: tables and one polar plot), then a 3-D
 campaign over azimuths × fractions of the ankle's predicted critical push under the
 whole-body controller with all its tasks, read as the confusion matrix of predicted against
 used strategy (:mod:`pushrecovery.experiments.confusion3d`). Everything is written under
@@ -78,23 +79,39 @@ def validate_3d(options: Validate3DOptions, params: Any) -> dict[str, Any]:
     out = options.out
     out.mkdir(parents=True, exist_ok=True)
     data: dict[str, Any] = {"backend": "mujoco", "model": options.model}
-    result = None
-    if options.strategies:
+    result = step = None
+    stem = out / f"validation3d_{options.model}"
+    files: dict[str, str] = {}
+    balance = tuple(s for s in options.strategies if s != "step")
+    if balance:
         result = run_validation3d(
             options.model,
             options.azimuths,
-            options.strategies,
+            balance,
             params=params,
             rel_tolerance=options.rel_tolerance,
             duration=options.duration,
         )
-        stem = out / f"validation3d_{options.model}"
         stem.with_suffix(".md").write_text(result.to_table() + "\n")
         _write_csv(result, stem.with_suffix(".csv"))
-        (figure,) = save_figure(validation3d_figure(result), stem, ["png"])
         data["critical"] = [_row(row) for row in result.rows]
-        table, table_csv = stem.with_suffix(".md"), stem.with_suffix(".csv")
-        data["files"] = {"table": str(table), "csv": str(table_csv), "polar": str(figure)}
+        files |= {"table": str(stem.with_suffix(".md")), "csv": str(stem.with_suffix(".csv"))}
+    if "step" in options.strategies:
+        from pushrecovery.experiments.validation3d_step import run_step_validation
+
+        step = run_step_validation(
+            options.azimuths,
+            params=params,
+            rel_tolerance=max(options.rel_tolerance, 0.02),
+            duration=options.duration,
+        )
+        step_stem = out / f"validation3d_{options.model}_step"
+        step_stem.with_suffix(".md").write_text(step.to_table() + "\n")
+        data["step_critical"] = [_step_row(row, step) for row in step.rows]
+        files["step_table"] = str(step_stem.with_suffix(".md"))
+    if result is not None or step is not None:
+        (figure,) = save_figure(validation3d_figure(result, step), stem, ["png"])
+        data["files"] = files | {"polar": str(figure)}
     if options.confusion:
         data["confusion"] = _confusion(options, params)
     return data
@@ -111,6 +128,23 @@ def _row(row: Any) -> dict[str, Any]:
         "relative_error": row.relative_error,
         "corrected_error": row.corrected_error,
         "strategy_used": row.strategy_used,
+    }
+
+
+def _step_row(row: Any, step: Any) -> dict[str, Any]:
+    return {
+        "azimuth": row.azimuth,
+        "predicted": row.predicted,
+        "corrected": row.corrected,
+        "measured": row.measured,
+        "bracket": list(row.bracket),
+        "relative_error": row.relative_error,
+        "corrected_error": row.corrected_error,
+        "steps": row.steps,
+        "swing_time": row.swing_time,
+        "step_length": row.step_length,
+        "refit": row.refit,
+        "cause": row.cause(step.params),
     }
 
 

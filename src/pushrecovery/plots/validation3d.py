@@ -2,17 +2,18 @@
 
 Radius: the critical impulse [N s]; angle: the push's azimuth ψ (0 forward +x, 90 left +y,
 counter-clockwise, as seen from above). Per strategy (colour): the 2-D prediction m ω ρ_R
-(solid line), the prediction corrected for the push's height (dashed), and the measured
-critical impulses (markers, with a bar to the lowest impulse that fell). The lines close the
-circle only when the azimuths cover it.
+(solid line; for the step, the one-step capture region's), the prediction corrected for the
+push's height (dashed), and the measured critical impulses (markers, with a bar to the lowest
+impulse that fell). The lines close the circle only when the azimuths cover it.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from pushrecovery.experiments.validation3d import Validation3D
+from pushrecovery.experiments.validation3d_step import StepValidation
 from pushrecovery.plots.common import HIP_COLOUR, RECOVER_COLOUR
 
 if TYPE_CHECKING:
@@ -22,17 +23,30 @@ if TYPE_CHECKING:
 __all__ = ["STRATEGY_COLOURS", "validation3d_figure"]
 
 #: One colour per strategy.
-STRATEGY_COLOURS = {"ankle": RECOVER_COLOUR, "hip": HIP_COLOUR}
+STRATEGY_COLOURS = {"ankle": RECOVER_COLOUR, "hip": HIP_COLOUR, "step": "#1565c0"}
 
 
-def validation3d_figure(result: Validation3D) -> Figure:
-    """Return the polar plot of ``result`` (module docstring) as a matplotlib Figure."""
+def validation3d_figure(result: Validation3D | None, step: StepValidation | None = None) -> Figure:
+    """Return the polar plot of ``result`` and the step column ``step`` as a Figure.
+
+    Either may be None (not both); the step column is the biped3d's
+    (:func:`~pushrecovery.experiments.validation3d_step.run_step_validation`).
+    """
     from matplotlib.figure import Figure
 
+    from pushrecovery.errors import InvalidParameterError
+
+    if result is None and step is None:
+        raise InvalidParameterError("validation3d_figure needs a validation or a step column")
     fig = Figure(figsize=(6.4, 6.4))
     ax = cast("PolarAxes", fig.add_subplot(projection="polar"))
-    for strategy in result.strategies:
-        rows = sorted(result.rows_for(strategy), key=lambda row: row.azimuth % 360.0)
+    columns: list[tuple[str, list[Any]]] = []
+    if result is not None:
+        columns += [(s, list(result.rows_for(s))) for s in result.strategies]
+    if step is not None:
+        columns.append(("step", list(step.rows)))
+    for strategy, unsorted in columns:
+        rows = sorted(unsorted, key=lambda row: row.azimuth % 360.0)
         if not rows:
             continue
         colour = STRATEGY_COLOURS.get(strategy, "0.3")
@@ -54,7 +68,8 @@ def validation3d_figure(result: Validation3D) -> Figure:
     ax.set_theta_zero_location("E")
     ax.set_theta_direction(1)
     ax.set_rlabel_position(112.5)
-    ax.set_title(f"{result.model}: critical push [N s] by azimuth (0° forward, 90° left)", pad=18)
+    model = result.model if result is not None else "biped3d"
+    ax.set_title(f"{model}: critical push [N s] by azimuth (0° forward, 90° left)", pad=18)
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.28), ncol=2, fontsize="small")
     fig.subplots_adjust(bottom=0.22)
     return fig
