@@ -181,6 +181,10 @@ def _polar(ctx: _Context, result: Any) -> Picture:
     return Picture(path, caption, "experiments.validation3d.run_validation3d")
 
 
+#: Simulated time of a filmstrip's run [s] (its frames may end earlier).
+STRIP_DURATION = 3.0
+
+
 def _strip_run(ctx: _Context, spec: Strip) -> tuple[Any, float, str]:
     """Simulate one filmstrip's push (recorded): the recording, impulse [N s] and outcome."""
     from pushrecovery.experiments.validation3d import predicted_critical_impulses
@@ -208,7 +212,9 @@ def _strip_run(ctx: _Context, spec: Strip) -> tuple[Any, float, str]:
     else:
         wbc = wbc_for(plant, hip=controller == "hip")
     push = Push3D(impulse, azimuth)
-    run = simulate_push3d(plant, wbc, push, duration=times[-1], push_time=0.1, record=True)
+    # Simulated past the last frame so that the caption's outcome is decided.
+    duration = max(times[-1], STRIP_DURATION)
+    run = simulate_push3d(plant, wbc, push, duration=duration, push_time=0.1, record=True)
     outcome = run.outcome.value + (f", {run.steps} step(s)" if run.steps else "")
     return Recording3D.of_plant_run(plant, run), impulse, outcome
 
@@ -223,7 +229,7 @@ def _strip(ctx: _Context, key: str, spec: Strip) -> Filmstrip:
     folder = ctx.out / "humanoid3d"
     png, stamp = folder / f"{key}.png", folder / f"{key}.json"
     settings = _settings(ctx, model, azimuth=azimuth, fraction=fraction, controller=controller,
-                         times=list(times))  # fmt: skip
+                         times=list(times), duration=STRIP_DURATION)  # fmt: skip
     cached = _read(stamp, settings)
     if cached is not None and png.is_file():
         impulse, outcome = float(cached["impulse"]), str(cached["outcome"])
