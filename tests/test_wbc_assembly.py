@@ -30,14 +30,11 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc_step import StepSettings
 #: of 1e-16 per term over sums of ~50 terms [-].
 MATRIX_RTOL = 1e-9
 #: Relative agreement of the solutions x = (q̈, w) and the commands, both DAQP warm-started
-#: tick to tick: one optimum, reached from two forms of the QP whose rounding differs. The
-#: least-distance form goes through H's Cholesky factor, cond(H) up to 4e9 on these runs
-#: (ε_f = 1e-8 against task weights ~10): its rounding bound cond(H) ε_mach ≈ 1e-6; measured
-#: 5e-9 on the biped's step run with ε_z (1.3e-9 without it), while the reference solved
-#: cold differs from itself warm by 2e-13 there [-].
-SOLUTION_RTOL = 1e-8
-#: WholeBodyQP's default regularisations ε_a, ε_f and ε_z (its docstring).
-ACC_REG, WRENCH_REG, YAW_REG = 1e-6, 1e-8, 1e-3
+#: tick to tick: one optimum, reached from two forms of the QP whose rounding differs (the
+#: reference solved cold instead differs from itself warm by up to 5e-9 on these runs) [-].
+SOLUTION_RTOL = 1e-9
+#: WholeBodyQP's default regularisations ε_a and ε_f (its docstring).
+ACC_REG, WRENCH_REG = 1e-6, 1e-8
 #: DAQP's flag of an equality row.
 EQUALITY = 5
 
@@ -70,8 +67,7 @@ def reference_qp(qp, data, tasks):
         drift.append(np.concatenate([dp @ qvel, dr @ qvel]))
         local.append(np.vstack([rot.T @ jp, rot.T @ jr]))
     jac, drift, local = np.vstack(jac), np.concatenate(drift), np.vstack(local)
-    wrench_reg = np.tile([WRENCH_REG] * 5 + [YAW_REG], len(feet))  # (F, T_x, T_y), T_z
-    hessian = np.diag(np.r_[np.full(nv, ACC_REG), wrench_reg])
+    hessian = np.diag(np.r_[np.full(nv, ACC_REG), np.full(size - nv, WRENCH_REG)])
     linear = np.zeros(size)
     for task in tasks:
         matrix = np.zeros((task.matrix.shape[0], size))

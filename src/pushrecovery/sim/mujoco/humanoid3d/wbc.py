@@ -9,12 +9,6 @@ with conic optimization", ICRA 2013):
 
 .. math:: \min_{x = (\ddot q, w)} \sum_k W_k \lVert A_k x - b_k \rVert^2
           + \epsilon_a \lVert \ddot q \rVert^2 + \epsilon_f \lVert w \rVert^2
-          + \epsilon_z \textstyle\sum_i T_{z,i}^2
-
-(ε_z on the feet's yaw moments: in double support the split of the yaw moment between the
-feet, one foot +T the other −T, is free in the tasks; left to ε_f it wandered to the yaw
-friction bound, MuJoCo's soft friction let the feet creep under it, the legs twisted and the
-hip yaw motors saturated: docs/humanoid3d.md, "Controller")
 
 subject to
 
@@ -24,7 +18,12 @@ subject to
   M_u q̈ + h_u = J_{c,u}^T w (the actuated rows give the torques τ = M_a q̈ + h_a − J_{c,a}^T w);
 * each foot fixed on the floor: J_i q̈ + J̇_i q̇ = −k_c J_i q̇ with J_i the 6 × nv world Jacobian
   of the sole frame (``mj_jac``), J̇_i q̇ its bias acceleration (``mj_jacDot``) [m/s², rad/s²]
-  and k_c ≥ 0 (``contact_damping``, 0 by default) a damping of a drifting foot [1/s];
+  and k_c ≥ 0 (``contact_damping``, :data:`CONTACT_DAMPING` = 20 /s by default) a damping of
+  a drifting foot [1/s]. With k_c = 0 nothing in the QP sees a foot that moves: MuJoCo's soft
+  contact lets a loaded foot creep and a foot whose CoP sits on its sole's edge tip, and the
+  error grew unchecked (the G1 pushed forward: the heels rose 0.06 rad and the feet slid 7 cm
+  before the QP's wrenches no longer held it; the biped's hip push: the feet twisted apart
+  0.8 rad in yaw, docs/humanoid3d.md, "Controller");
   a foot off the floor (:meth:`WholeBodyQP.set_contacts`, a swing) has w_i = 0 instead and no
   wrench inequalities (its motion is a task, :mod:`.wbc_step`);
 * unilateral contact F_z ≥ 0 and a linearised friction pyramid |F_x|, |F_y| ≤ μ' F_z with
@@ -70,12 +69,22 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc_feet import FootContact, foot_contac
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["FootContact", "Task", "WbcProblem", "WbcSolution", "WholeBodyQP", "foot_contact"]
+__all__ = [
+    "CONTACT_DAMPING",
+    "FootContact",
+    "Task",
+    "WbcProblem",
+    "WbcSolution",
+    "WholeBodyQP",
+    "foot_contact",
+]
 
 #: Bounds DAQP treats as infinite.
 _INF = 1e30
 #: DAQP's sense flags: an active, immutable row (an equality).
 _EQUALITY = 5
+#: The default k_c, the damping of a foot's drift in its fixed-foot rows [1/s].
+CONTACT_DAMPING = 20.0
 
 
 def _full_inertia(model: Any, data: Any, out: FloatArray) -> None:
@@ -187,14 +196,12 @@ class WholeBodyQP:
     acc_regularisation, wrench_regularisation : float
         ε_a [(s²)² weight per (m/s²)²] and ε_f [per N²] of the module docstring, > 0: keep the
         Hessian positive definite.
-    yaw_regularisation : float
-        ε_z [per (N m)²] on each foot's yaw moment T_z (module docstring), ≥ ε_f.
 
     Raises
     ------
     InvalidParameterError
         If the model has no free joint first, an actuator is not on a joint, ``feet`` is
-        empty, or a regularisation is not in (0, 1] (ε_z in [ε_f, 1]).
+        empty, or a regularisation is not in (0, 1].
     """
 
     def __init__(
@@ -203,7 +210,6 @@ class WholeBodyQP:
         feet: Sequence[FootContact],
         acc_regularisation: float = 1e-6,
         wrench_regularisation: float = 1e-8,
-        yaw_regularisation: float = 1e-3,
     ) -> None:
         import mujoco
 
@@ -217,12 +223,6 @@ class WholeBodyQP:
                             ("wrench_regularisation", wrench_regularisation)):  # fmt: skip
             if not (isinstance(value, int | float) and 0.0 < value <= 1.0):
                 raise InvalidParameterError(f"{name} must be in (0, 1], got {value!r}")
-        if not (isinstance(yaw_regularisation, int | float)
-                and wrench_regularisation <= yaw_regularisation <= 1.0):  # fmt: skip
-            raise InvalidParameterError(
-                f"yaw_regularisation must be in [wrench_regularisation, 1], "
-                f"got {yaw_regularisation!r}"
-            )
         self.model = model
         self.feet = tuple(feet)
         nv, nf = int(model.nv), 6 * len(self.feet)
@@ -238,7 +238,6 @@ class WholeBodyQP:
         self._regular = np.concatenate(
             [np.full(nv, acc_regularisation), np.full(nf, wrench_regularisation)]
         )
-        self._regular[nv + 5 :: 6] = yaw_regularisation  # each T_z
         foot_rows = [foot.constraint_rows() for foot in self.feet]
         self._foot_rows = np.ascontiguousarray(np.vstack(foot_rows))
         self._foot_start = np.cumsum([0] + [g.shape[0] for g in foot_rows], dtype=np.int64)
@@ -253,7 +252,7 @@ class WholeBodyQP:
         self._identity, self._zeros = np.eye(self.size), np.zeros(self.size)
         self._model: Any = None
         self._last_ctrl = np.zeros(model.nu)
-        self.contact_damping = 0.0  # k_c [1/s]: J q̈ + J̇ q̇ = −k_c J q̇ holds a foot still
+        self.contact_damping = CONTACT_DAMPING  # k_c [1/s]: J q̈ + J̇ q̇ = −k_c J q̇
 
     def _setup(self, rows: FloatArray, upper: FloatArray, lower: FloatArray) -> None:
         """Set DAQP up afresh on the least-distance rows (H = I, f = 0; :mod:`._wbc_kernels`)."""

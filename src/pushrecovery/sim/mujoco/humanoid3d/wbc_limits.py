@@ -7,8 +7,8 @@ answer from the QP, and a leg on the knee's stop is also straight, a kinematic s
 of the contact Jacobian (the QP becomes ill-conditioned). Measured on the biped3d's hip
 push (docs/humanoid3d.md, "Controller"): the torso pitched 0.95 rad forward while the CoM
 task held the CoM over the feet and the pelvis task held the hips at their height; the
-hips moved back 0.11 m, the knees straightened onto their stop (0 rad), and during the
-torso's return the hip yaw motors saturated, the ankles rolled and the feet left the floor.
+hips moved back 0.11 m and the knees straightened onto their stop (0 rad; −0.01 to −0.015
+rad, pressed into it, with the feet's drift damped); with the guard they stay at 0.098 rad.
 
 **The guard** (:class:`JointGuard`): for each guarded joint (by default the knees,
 :class:`GuardSettings`), a limited hinge or slide with range
