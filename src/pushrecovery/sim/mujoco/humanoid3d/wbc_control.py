@@ -68,12 +68,19 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc_gains import WbcGains
 from pushrecovery.sim.mujoco.humanoid3d.wbc_hip import UPRIGHT, HipLaw, momentum_rows
 from pushrecovery.sim.mujoco.humanoid3d.wbc_limits import GuardSettings, JointGuard
 from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import rotation_vector
 from pushrecovery.surfaces.cop import capture_point
 
 FloatArray = NDArray[np.float64]
 
 __all__ = ["WbcGains", "WholeBodyController"]
+
+
+def _rotation_vector(rot: FloatArray) -> FloatArray:
+    """Return the rotation vector (axis × angle) of rotation matrix ``rot`` [rad]."""
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot.ravel().tolist()
+    angle = math.acos(max(-1.0, min(1.0, 0.5 * (r00 + r11 + r22 - 1.0))))
+    scale = 0.5 if angle < 1e-9 else 0.5 * angle / math.sin(angle)
+    return np.array([(r21 - r12) * scale, (r02 - r20) * scale, (r10 - r01) * scale])
 
 
 class WholeBodyController:
@@ -279,7 +286,7 @@ class WholeBodyController:
         model, gains, nv, size = self.model, self.gains, self.qp.nv, self.qp.size
         # Torso orientation error and the hip law's CMP offset δ (zero with the ankles only).
         rot = np.asarray(data.xmat[self.torso]).reshape(3, 3)
-        error = rotation_vector(rot @ self.upright.T)
+        error = _rotation_vector(rot @ self.upright.T)
         com = np.asarray(data.subtree_com[0])
         self.desired_cop = self.cop_target(data)  # also the capture point, mj_subtreeVel
         if self.stepper is not None and self._step(data):

@@ -182,9 +182,10 @@ class HipLaw:
         P ⊕ box(a'_x, a'_y) (corrected Eq. 15, :func:`~pushrecovery.surfaces.plane.cmp_polygon`);
         "step": beyond both.
         """
-        if bool(self.support.contains(xi[0], xi[1])):
+        x, y = float(xi[0]), float(xi[1])  # the scalar signed distance: strictly inside
+        if self.support.point_signed_distance(x, y) > 0.0:
             return "ankle"
-        if bool(self.cmp_region.contains(xi[0], xi[1])):
+        if self.cmp_region.point_signed_distance(x, y) > 0.0:
             return "hip"
         return "step"
 

@@ -124,7 +124,7 @@ class JointGuard:
         # The margin, but never past the range's middle.
         inset = np.minimum(settings.margin, 0.25 * (ranges[:, 1] - ranges[:, 0]))
         self.edges = np.column_stack([ranges[:, 0] + inset, ranges[:, 1] - inset])
-        self.low, self.high = self.edges[:, 0].copy(), self.edges[:, 1].copy()
+        self.set_posture(np.full(int(model.nq), np.nan))
 
     def set_posture(self, qpos: FloatArray) -> None:
         """Move each margin's edge to the posture ``qpos`` [rad or m] where it lies inside.
@@ -132,8 +132,10 @@ class JointGuard:
         The guard never drives a joint away from the posture it balances in.
         """
         q = np.asarray(qpos, dtype=float)[self.qpos]
-        self.low = np.minimum(self.edges[:, 0], q)
-        self.high = np.maximum(self.edges[:, 1], q)
+        self.low = np.fmin(self.edges[:, 0], q)  # NaN (no posture): the margin's edge
+        self.high = np.fmax(self.edges[:, 1], q)
+        self._joints = list(zip(self.qpos.tolist(), self.dofs.tolist(), self.low.tolist(),
+                                self.high.tolist(), strict=True))  # fmt: skip
 
     def task_rows(
         self, qpos: FloatArray, qvel: FloatArray, nv: int
@@ -143,15 +145,14 @@ class JointGuard:
         No rows when no joint's predicted position is within its margin.
         """
         s = self.settings
-        q, v = qpos[self.qpos], qvel[self.dofs]
-        below = q + s.horizon * np.minimum(v, 0.0) < self.low
-        above = q + s.horizon * np.maximum(v, 0.0) > self.high
-        active = below | above
-        lower, q, v = below[active], q[active], v[active]
-        push = np.where(lower, np.maximum(self.low[active] - q, 0.0),
-                        np.minimum(self.high[active] - q, 0.0))  # fmt: skip
-        speed = np.where(lower, np.minimum(v, 0.0), np.maximum(v, 0.0))  # towards the stop
-        target = s.stiffness * push - s.damping * speed
-        rows = np.zeros((target.size, nv))
-        rows[np.arange(target.size), self.dofs[active]] = 1.0
-        return rows, target
+        rows: list[tuple[int, float]] = []  # (dof, target): a plain loop over a few joints
+        for adr, dof, low, high in self._joints:
+            q, v = float(qpos[adr]), float(qvel[dof])
+            if q + s.horizon * min(v, 0.0) < low:
+                rows.append((dof, s.stiffness * max(low - q, 0.0) - s.damping * min(v, 0.0)))
+            elif q + s.horizon * max(v, 0.0) > high:
+                rows.append((dof, s.stiffness * min(high - q, 0.0) - s.damping * max(v, 0.0)))
+        matrix = np.zeros((len(rows), nv))
+        for k, (dof, _) in enumerate(rows):
+            matrix[k, dof] = 1.0
+        return matrix, np.array([target for _, target in rows])
