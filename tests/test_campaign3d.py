@@ -177,7 +177,8 @@ def test_validate_measures_the_step_column_of_the_biped(capsys, tmp_path):
     # --strategy step on the biped3d: the step critical push at one azimuth against the
     # one-step capture region, in the JSON, a table and the polar plot.
     args = ("--model", "biped3d", "--strategy", "step", "--azimuth", "90", "--no-confusion",
-            "--rel-tolerance", "0.2", "--duration", "2", "--out", str(tmp_path), "--json")  # fmt: skip
+            "--rel-tolerance", "0.2", "--duration", "2", "--out", str(tmp_path),
+            "--json")  # fmt: skip
     code, out, err = run_cli(capsys, "validate", *args)
     assert code == 0, err
     data = json.loads(out)
