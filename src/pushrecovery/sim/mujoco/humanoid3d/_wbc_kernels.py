@@ -139,14 +139,24 @@ def least_distance(  # type: ignore[no-untyped-def]
                 return False
         factor[j, j + 1 :] = 0.0
     _forward(factor, first, linear, shift)
-    for r in range(count):
+    transform_rows(factor, first, shift, rows, upper, lower, 0, count, out_rows, out_upper,
+                   out_lower)  # fmt: skip
+    return True
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def transform_rows(  # type: ignore[no-untyped-def]
+    factor, first, shift, rows, upper, lower, start, stop, out_rows, out_upper, out_lower
+):
+    """Write rows ``start`` to ``stop`` of M = A L⁻ᵀ, l + M v, u + M v (after the factor)."""
+    n = factor.shape[0]
+    for r in range(start, stop):
         _forward(factor, first, rows[r], out_rows[r])
         moved = 0.0
         for j in range(n):
             moved += out_rows[r, j] * shift[j]
         out_upper[r] = upper[r] + moved if upper[r] < INF else upper[r]
         out_lower[r] = lower[r] + moved if lower[r] > -INF else lower[r]
-    return True
 
 
 @numba.njit(cache=True, nogil=True, fastmath=_FAST)

@@ -18,12 +18,9 @@ subject to
   M_u q̈ + h_u = J_{c,u}^T w (the actuated rows give the torques τ = M_a q̈ + h_a − J_{c,a}^T w);
 * each foot fixed on the floor: J_i q̈ + J̇_i q̇ = −k_c J_i q̇ with J_i the 6 × nv world Jacobian
   of the sole frame (``mj_jac``), J̇_i q̇ its bias acceleration (``mj_jacDot``) [m/s², rad/s²]
-  and k_c ≥ 0 (``contact_damping``, :data:`CONTACT_DAMPING` = 20 /s by default) a damping of
-  a drifting foot [1/s]. With k_c = 0 nothing in the QP sees a foot that moves: MuJoCo's soft
-  contact lets a loaded foot creep and a foot whose CoP sits on its sole's edge tip, and the
-  error grew unchecked (the G1 pushed forward: the heels rose 0.06 rad and the feet slid 7 cm
-  before the QP's wrenches no longer held it; the biped's hip push: the feet twisted apart
-  0.8 rad in yaw, docs/humanoid3d.md, "Controller");
+  and k_c ≥ 0 (``contact_damping``, :data:`CONTACT_DAMPING` = 20 /s) a damping of a drifting
+  foot [1/s] (with k_c = 0 the feet crept and tipped under MuJoCo's soft contact unseen:
+  docs/humanoid3d.md, "The whole-body controller");
   a foot off the floor (:meth:`WholeBodyQP.set_contacts`, a swing) has w_i = 0 instead and no
   wrench inequalities (its motion is a task, :mod:`.wbc_step`);
 * unilateral contact F_z ≥ 0 and a linearised friction pyramid |F_x|, |F_y| ≤ μ' F_z with
@@ -64,6 +61,7 @@ from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
     recover,
     sole_frames,
     sole_origins,
+    transform_rows,
 )
 from pushrecovery.sim.mujoco.humanoid3d.wbc_feet import FootContact, foot_contact
 
@@ -248,26 +246,34 @@ class WholeBodyQP:
         rows = self._n_equal + self._foot_rows.shape[0] + int(model.nu)
         self._buf = _Buffers(nv, nf, rows, int(model.nu))
         self._regular_matrix = np.diag(self._regular)
-        self._model_rows = 0
         self._identity, self._zeros = np.eye(self.size), np.zeros(self.size)
-        self._model: Any = None
+        self._models: dict[int, Any] = {}  # DAQP, by rows handed over: without/with the motors'
+        self._motor_rows = False  # whether the last tick needed the motor rows
         self._last_ctrl = np.zeros(model.nu)
         self.contact_damping = CONTACT_DAMPING  # k_c [1/s]: J q̈ + J̇ q̇ = −k_c J q̇
 
-    def _setup(self, rows: FloatArray, upper: FloatArray, lower: FloatArray) -> None:
-        """Set DAQP up afresh on the least-distance rows (H = I, f = 0; :mod:`._wbc_kernels`)."""
+    def _daqp(self, count: int) -> tuple[Any, int, int]:
+        """Return DAQP's (u, flag, iterations) on the first ``count`` least-distance rows."""
         import daqp
 
-        sense = np.zeros(rows.shape[0], dtype=np.intc)
-        sense[: self._n_equal] = _EQUALITY
-        self._model = daqp.Model()
-        flag, _ = self._model.setup(self._identity, self._zeros, rows, upper, lower, sense)
-        if flag < 0:
-            raise RuntimeError(f"daqp could not set up the whole-body QP (exit flag {flag})")
+        buf = self._buf
+        rows, high, low = buf.ldp_rows[:count], buf.ldp_upper[:count], buf.ldp_lower[:count]
+        model = self._models.get(count)
+        if model is None:
+            sense = np.where(np.arange(count) < self._n_equal, _EQUALITY, 0).astype(np.intc)
+            model = daqp.Model()
+            flag, _ = model.setup(self._identity, self._zeros, rows, high, low, sense)
+            if flag < 0:
+                raise RuntimeError(f"daqp could not set up the whole-body QP (exit flag {flag})")
+            self._models[count] = model
+        else:
+            model.update(A=rows, bupper=high, blower=low)
+        u, _, flag, info = model.solve()
+        return u, int(flag), int(info["iterations"])
 
     def reset(self) -> None:
         """Forget the warm start (the next solve sets DAQP up afresh); every foot in contact."""
-        self._model = None
+        self._models.clear()
         self._last_ctrl = np.zeros(self.model.nu)
         self.contacts[:] = True
 
@@ -286,7 +292,7 @@ class WholeBodyQP:
             raise InvalidParameterError(f"contacts must be one bool per foot, got {contacts!r}")
         if not np.array_equal(mask, self.contacts):
             self.contacts = mask.copy()
-            self._model = None  # other rows: no warm start
+            self._models.clear()  # other rows: no warm start
 
     def contact_jacobians(self, data: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Return each foot's world Jacobian J (6 n × nv), J̇ q̇ (6 n) and sole-frame Jacobian.
@@ -356,26 +362,37 @@ class WholeBodyQP:
         nv, buf, nu = self.nv, self._buf, int(self.model.nu)
         count = self.assemble(data, tasks).rows.shape[0]
         start = time.perf_counter()  # the solve time includes the factorisation of H
-        flag, feet, steps = -1, len(self.feet), 0
-        if least_distance(buf.hessian, buf.linear, buf.rows, buf.upper, buf.lower, count,
+        flag, feet, steps, reduced = -1, len(self.feet), 0, count - nu
+        ctrl = buf.offset  # (overwritten)
+        if least_distance(buf.hessian, buf.linear, buf.rows, buf.upper, buf.lower, reduced,
                           buf.factor, buf.first, buf.shift, buf.ldp_rows, buf.ldp_upper,
                           buf.ldp_lower):  # fmt: skip
-            rows, high, low = buf.ldp_rows[:count], buf.ldp_upper[:count], buf.ldp_lower[:count]
-            if self._model is None or self._model_rows != count:
-                self._setup(rows, high, low)
-                self._model_rows = count
-            else:
-                self._model.update(A=rows, bupper=high, blower=low)
-            u, _, flag, info = self._model.solve()
-            steps = int(info["iterations"])
+            # Without the (rarely active) motor rows first: a convex QP's optimum stays optimal
+            # under constraints it satisfies; else again with them, and next tick at once.
+            for rows in (count,) if self._motor_rows else (reduced, count):
+                if rows == count:  # the motor rows, transformed only when needed
+                    transform_rows(buf.factor, buf.first, buf.shift, buf.rows, buf.upper,
+                                   buf.lower, reduced, count, buf.ldp_rows, buf.ldp_upper,
+                                   buf.ldp_lower)  # fmt: skip
+                u, flag, iterations = self._daqp(rows)
+                steps += iterations
+                if flag <= 0:
+                    break
+                recover(buf.factor, buf.first, buf.shift, u, buf.x)
+                ctrl = np.dot(buf.rows[reduced:count], buf.x) + buf.offset
+                inside = bool(np.all(ctrl > self.ctrl_low) and np.all(ctrl < self.ctrl_high))
+                if rows == count:
+                    self._motor_rows = not inside  # a motor on its limit: keep the rows
+                    break
+                if inside:
+                    break
         if flag <= 0:
             elapsed = time.perf_counter() - start
-            self._model = None  # the next tick starts cold
+            self._models.clear()  # the next tick starts cold
+            self._motor_rows = False
             last = self._last_ctrl.copy()
             return WbcSolution(np.zeros(nv), np.zeros((feet, 6)), last, False, elapsed, steps)
-        recover(buf.factor, buf.first, buf.shift, u, buf.x)
         elapsed = time.perf_counter() - start
-        ctrl = np.dot(buf.rows[count - nu : count], buf.x) + buf.offset
         np.clip(ctrl, self.ctrl_low, self.ctrl_high, out=ctrl)
         self._last_ctrl = ctrl
         x = buf.x.copy()
