@@ -170,7 +170,7 @@ class MPCController(Controller):
                 riccati.reset()
             return self._fallback_plan(x0)
         if riccati is not None:
-            plan = self._sparse_plan(riccati, x0, gauge)
+            plan = self._sparse_plan(riccati, x0, gauge, previous_verified)
             if plan is not None:
                 return plan
         # Only the solvers' own failures mean "infeasible"; any other exception is a bug.
@@ -201,7 +201,11 @@ class MPCController(Controller):
         )
 
     def _sparse_plan(
-        self, riccati: RiccatiSolver, x0: NDArray[np.float64], gauge: float
+        self,
+        riccati: RiccatiSolver,
+        x0: NDArray[np.float64],
+        gauge: float,
+        previous_verified: bool,
     ) -> Plan | None:
         """Solve a tick the passes did not verify from their warm start, on the sparse QP.
 
@@ -231,10 +235,12 @@ class MPCController(Controller):
             riccati.seed(active)
             return riccati.solve(x0, shift=False, max_passes=POLISH_PASSES, forced=forced)
 
-        # Warm from the last tick's plan (its inputs computed if they were left lazy).
+        # Warm from the last tick's plan (its inputs computed if they were left lazy) and, if
+        # the passes verified it, its active set (the failed warm passes leave it in place).
         last = self.last_plan
         warm = last.inputs if last is not None and last.feasible else None
-        if interior.solve(x0, verify, warm):
+        guide = riccati.active.copy() if warm is not None and previous_verified else None
+        if interior.solve(x0, verify, warm, guide):
             if interior.verified:
                 return Plan(riccati.inputs[0], True, riccati.inputs, riccati.states)
             if interior is self.interior:

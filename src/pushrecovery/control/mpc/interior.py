@@ -109,6 +109,7 @@ class InteriorPointSolver:
         )  # fmt: skip
         # Load the compiled kernel now (from numba's disk cache), not on a control tick.
         self._active = np.zeros((n, 3), dtype=np.int8)
+        self._guide = np.zeros((n, 3), dtype=np.int8)
         self._iterate(np.zeros(4), 0, COLD)
         identify_active(self.bounds, self.scales, *self._slacks, *self._bound_multipliers,
                         self._active)  # fmt: skip
@@ -121,7 +122,7 @@ class InteriorPointSolver:
         tol, dual_tol = (IDENTIFY_TOL, IDENTIFY_TOL) if loose else (TOL, DUAL_TOL)
         status: int = solve_interior(
             x0, self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback,
-            tol, dual_tol, iterations, start, self._u, self._x, self._multipliers,
+            tol, dual_tol, iterations, start, self._guide, self._u, self._x, self._multipliers,
             *self._slacks, *self._bound_multipliers, self._work, *self._factors,
         )  # fmt: skip
         return status
@@ -131,12 +132,14 @@ class InteriorPointSolver:
         x0: FloatArray,
         verify: Callable[[NDArray[np.int8]], bool] | None = None,
         warm: FloatArray | None = None,
+        guide: NDArray[np.int8] | None = None,
     ) -> bool:
         """Solve from ``x0`` = [x, θ, ẋ, θ̇]; True if solved (see the attributes).
 
         ``warm``: the last tick's plan, inputs (N, 2), to start from shifted by one stage
-        (else the cold start). ``verify``, if given, is offered the iterate's active set
-        (:meth:`active_set`) once converged to :data:`IDENTIFY_TOL`: if it returns True
+        (else the cold start), and ``guide`` (N, 3) the last verified active set (unshifted),
+        whose rows it starts near their bounds. ``verify``, if given, is offered the iterate's
+        active set (:meth:`active_set`) once converged to :data:`IDENTIFY_TOL`: if it returns True
         (e.g. Riccati passes from that set verified the KKT conditions exactly), the solve
         stops there, ``verified`` is True and the solution is the verifier's; the attributes
         ``inputs`` and ``states`` are then not updated. Else it goes on to :data:`TOL`.
@@ -146,6 +149,10 @@ class InteriorPointSolver:
             self._u[:-1] = warm[1:]
             self._u[-1] = warm[-1]
             start = WARM
+        if guide is not None:
+            self._guide[...] = guide
+        else:
+            self._guide.fill(0)
         self.verified = False
         done = 0
         if verify is not None:

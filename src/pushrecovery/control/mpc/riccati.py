@@ -60,10 +60,11 @@ PRIMAL_TOL = 1e-9
 DUAL_TOL = 1e-9
 #: Passes from the warm start before giving up on a tick (the caller then solves it by the
 #: interior point). A pass costs 15-20 µs at N = 50 and a verified warm start takes one or
-#: two; past ten the passes mostly cycle on the late horizon's flat torques. Measured on the
-#: MuJoCo torso's 3 s run (150 ticks): 3 passes, 35 interior-point ticks and 11.7 ms of MPC;
-#: 10 passes, 12 ticks and 9.7 ms; 20 passes, 9 ticks and 10.0 ms.
-MAX_PASSES = 10
+#: two; more mostly cycle on the late horizon's flat torques. Measured on the MuJoCo torso's
+#: 3 s run (150 ticks): 3 passes, 35 interior-point ticks and 11.7 ms of MPC; 10 passes, 12
+#: ticks and 9.7 ms; 20 passes, 9 ticks and 10.0 ms. 6 keeps the benchmark's worst ticks
+#: (a failed warm start, then the interior point) shortest.
+MAX_PASSES = 6
 
 
 class RiccatiSolver:
