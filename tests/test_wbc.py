@@ -393,3 +393,22 @@ def test_the_hip_brakes_for_the_measured_spin_of_the_torso(params, model):
     law.reset()
     # The torso spins at 4 rad/s: θ̇ T_b / 2 = 0.1 rad, 1.0 ≥ 0.97: brake.
     assert law.update(xi, momentum, tilt, np.array([4.0, 0.0]))[0] < 0.0
+
+
+@needs_robots
+def test_the_g1_recovers_a_forward_push_at_80_percent_of_its_corrected_ankle_limit(g1):
+    """J*/(1 + d/z₀) (docs/validation.md: the push at torso_link, d above the CoM); with the
+    feet's drift undamped (k_c = 0) the feet tipped on their toes and slid, and it fell.
+    """
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import G1_TORSO, g1_ankle_impulse, push_g1
+
+    data = mujoco.MjData(g1.model)
+    data.qpos[:] = g1.qpos
+    mujoco.mj_forward(g1.model, data)
+    height = float(data.subtree_com[0][2])  # the soles at z = 0
+    lever = float(data.xipos[g1.model.body(G1_TORSO).id][2]) - height
+    run = push_g1(0.8 * g1_ankle_impulse(g1) / (1.0 + lever / height), duration=2.0, robot=g1)
+    assert run.ok.all()
+    assert run.sole_lift.max() < LIFT
+    assert run.com[:, 2].min() > 0.95 * run.com[0, 2]
+    assert np.linalg.norm(run.com_velocity[-1]) < 0.02
