@@ -38,18 +38,21 @@ INTERIOR_MARGIN = BOUNDARY
 class MPCController(Controller):
     """Receding-horizon CMP balancing (Eqs. 16-17), the paper's settings by default.
 
-    Each tick solves the condensed QP (:class:`CondensedQP`) from the measured state
-    ``[x, θ, ẋ, θ̇]`` and returns its first input. If the QP is infeasible (the flywheel cannot
-    avoid its joint limit) the command is a saturated fallback, ``saturated=True``, and
-    ``last_plan.feasible`` is False: CoP at the capture point clipped to the foot, full torque
-    braking the flywheel. It never raises inside the loop. On the default route a tick whose
-    (θ, θ̇) is outside the flywheel's exact N-step viable set by more than every solver's
-    tolerance (:class:`FlywheelFeasibility`) gets the fallback without asking DAQP.
+    Each tick solves Eq. (17) exactly from the measured state ``[x, θ, ẋ, θ̇]`` and returns its
+    first input. If the QP is infeasible (the flywheel cannot avoid its joint limit) the
+    command is a saturated fallback, ``saturated=True``, and ``last_plan.feasible`` is False:
+    CoP at the capture point clipped to the foot, full torque braking the flywheel. It never
+    raises inside the loop.
 
-    With the default ``daqp`` solver the QP lives in a DAQP workspace (:class:`DaqpWorkspace`,
-    the attribute ``workspace``), set up once and warm-started from the previous tick's active
-    set: the same solution up to rounding, roughly ten times faster than through qpsolvers.
-    Other solvers, or ``workspace = None``, go through ``qpsolvers.solve_qp``.
+    The default route (``solver="daqp"``), each step only if the previous did not verify:
+    Riccati passes on the sparse QP from the last tick's active set (:class:`RiccatiSolver`);
+    the exact feasibility test (:class:`FlywheelFeasibility`: beyond every solver's tolerance,
+    the fallback); inside the flywheel's viable set, the interior point
+    (:class:`InteriorPointSolver`) whose active set the passes verify; on its boundary, the
+    passes with full braking held; last, the condensed QP (:class:`CondensedQP`, built on
+    first need) in a warm-started DAQP workspace (the attribute ``workspace``). docs/mpc.md
+    has the measurements. Other solvers, or ``workspace = None``, go through
+    ``qpsolvers.solve_qp`` on the condensed QP.
 
     Parameters
     ----------
