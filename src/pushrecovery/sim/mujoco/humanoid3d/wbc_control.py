@@ -322,10 +322,12 @@ class WholeBodyController:
         # All targets at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g + Σ R_i F_i, rows
         # x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
         com_rows, targets = np.zeros((2, size)), np.empty(nv)
+        stepper, height = self.stepper, self.height  # the stepper lowers it for long steps
+        height = height if stepper is None else stepper.pelvis_height(data, height)
         upright = ankle_targets(
             data.xmat, self._bodies, self.mass, com, self.desired_cop, self.cmp_offset,
             self.omega**2, self.gravity, error, jacp, jacr, dots, data.qvel, data.qpos,
-            self.posture, self.height, float(point[2]), self._gains, UPRIGHT, com_rows, targets,
+            self.posture, height, float(point[2]), self._gains, UPRIGHT, com_rows, targets,
         )  # fmt: skip
         targets[2:4] += paced
         if hip_active or returning:  # yaw keeps the usual gains and weight (legs untwisted)

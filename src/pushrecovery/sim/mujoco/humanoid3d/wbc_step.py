@@ -40,7 +40,7 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -52,120 +52,29 @@ from pushrecovery.ground.support import FootPose, Stance
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.humanoid3d.measure import sole_points
 from pushrecovery.sim.mujoco.humanoid3d.wbc import FootContact, Task
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_height import (
+    leg_span,
+    pelvis_limit,
+    segment_lengths,
+)
 from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import (
     StepRecord,
+    choose_step,
     evaluate,
     leg_joints,
     leg_swing_time,
+    lipm_com,
     plan_foothold,
+    planning_params,
     quintic,
     rotation_vector,
     yaw_of,
 )
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_settings import StepSettings
 
 FloatArray = NDArray[np.float64]
 
 __all__ = ["StepRecord", "StepSettings", "Stepper", "quintic"]
-
-
-@dataclass(frozen=True)
-class StepSettings:
-    """The stepping task's settings (module docstring); all finite.
-
-    Attributes
-    ----------
-    swing_time : float or None
-        t_s, lift-off to touchdown [s] in [0.05, 2]; None: the body's ``min_step_time``
-        (at least 0.05 s).
-    lift : float
-        h, the swing's apex above the straight line [m], in [0, 0.5].
-    sink, sink_speed : float
-        How far below the floor the reference ends [m] and its speed after t_1 [m/s], ≥ 0.
-    contact_damping : float
-        k_c of the feet in contact [1/s] (:class:`~.wbc.WholeBodyQP`): a foot unloaded beside
-        the stance foot stays down.
-    contact : float
-        Touchdown when the lowest sole point is this close to the floor [m], > 0.
-    margin : float
-        Step when ξ is this far outside the recoverable region [m], ≥ 0.
-    stiffness, damping : float
-        k_p [1/s²] and d_p [1/s] of the foot's position, ≥ 0.
-    turn_stiffness, turn_damping : float
-        k_R [1/s²] and d_R [1/s] of its orientation, ≥ 0.
-    weight : float
-        The foot task's W, > 0.
-    replan_period : float
-        Re-plan period during the swing [s], > 0.
-    replan_fraction : float
-        Re-plan only in this first fraction of the swing, in [0, 1].
-    torque_share : float or None
-        κ in [0.001, 1]: the share of the swing hip's motor limit the swing may take; the
-        swing lasts at least what that torque needs (:func:`~.wbc_step_plan.leg_swing_time`),
-        up to ``max_swing_time``. None: always ``swing_time``.
-    max_swing_time : float
-        The longest swing [s], in [0.05, 2], ≥ ``swing_time``.
-    knee_min : float
-        The knee guard [rad] in [0, 1]: a knee below it (or reaching it within 50 ms) is
-        pulled back, q̈ = k_p (q_min − q) − d_p q̇ (the QP does not model the joint stop).
-    knee_weight : float
-        The knee guard's W, > 0.
-    lift_weight : float
-        The swing foot's vertical row weighs this times W, in [0.001, 1000]: a foot that
-        does not leave the floor cannot step.
-    """
-
-    swing_time: float | None = 0.3
-    lift: float = 0.05
-    sink: float = 0.01
-    sink_speed: float = 0.2
-    contact: float = 2e-3
-    contact_damping: float = 20.0
-    margin: float = 0.01
-    stiffness: float = 900.0
-    damping: float = 60.0
-    turn_stiffness: float = 400.0
-    turn_damping: float = 40.0
-    weight: float = 10.0
-    replan_period: float = 0.02
-    replan_fraction: float = 0.6
-    torque_share: float | None = 1.0
-    max_swing_time: float = 0.6
-    knee_min: float = 0.1
-    knee_weight: float = 10.0
-    lift_weight: float = 30.0
-
-    def __post_init__(self) -> None:
-        for item in fields(self):
-            value = getattr(self, item.name)
-            if value is None and item.name in ("swing_time", "torque_share"):
-                continue
-            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0.0):
-                raise InvalidParameterError(f"{item.name} must be finite and ≥ 0, got {value!r}")
-        bounds = {
-            "lift": (0.0, 0.5),
-            "replan_fraction": (0.0, 1.0),
-            "contact": (1e-6, 0.1),
-            "weight": (1e-9, 1e6),
-            "replan_period": (1e-4, 10.0),
-            "stiffness": (0.0, 1e6),
-            "max_swing_time": (0.05, 2.0),
-            "knee_min": (0.0, 1.0),
-            "knee_weight": (1e-9, 1e6),
-            "lift_weight": (1e-3, 1e3),
-        }
-        if self.torque_share is not None:
-            bounds["torque_share"] = (1e-3, 1.0)
-        if self.swing_time is not None:
-            bounds["swing_time"] = (0.05, 2.0)
-        for name, (low, high) in bounds.items():  # fmt: skip
-            value = getattr(self, name)
-            if not low <= value <= high:
-                raise InvalidParameterError(f"{name} must be in [{low:g}, {high:g}], got {value!r}")
-        if self.swing_time is not None and self.swing_time > self.max_swing_time:
-            raise InvalidParameterError(
-                f"swing_time must be ≤ max_swing_time {self.max_swing_time:g} s, "
-                f"got {self.swing_time!r}"
-            )
 
 
 class Stepper:
@@ -207,17 +116,21 @@ class Stepper:
             raise InvalidParameterError(f"hip must be a bool, got {hip!r}")
         self._model = model
         self.params = replace(params, com_height=com_height)
+        self.plan_params = planning_params(self.params, settings.clearance)
         self.feet, self.left, self.floor, self.settings = feet, left, floor, settings
         self.hip = hip
         self.legs = tuple(leg_joints(model, foot.body) for foot in feet)
         self.swing_time = max(0.05, params.min_step_time if settings.swing_time is None
                               else settings.swing_time)  # fmt: skip
         self.swing: int | None = None
+        self._landed: int | None = None  # the foot that landed last, until ξ is captured
         self.steps: list[StepRecord] = []
         self._coeffs = np.zeros((6, 2))
         self._start = self._end = self._planned = 0.0
         self._z = np.zeros(2)
         self._rot = np.eye(3)
+        self._spans: tuple[float, ...] | None = None  # ℓ(knee_reach) of each leg [m]
+        self._pelvis = 0
 
     def _side(self, index: int) -> Stance:
         return Stance.LEFT if index == self.left else Stance.RIGHT
@@ -228,24 +141,26 @@ class Stepper:
         x, y = np.asarray(data.xpos[body])[:2]
         return FootPose(float(x), float(y), yaw_of(rot))
 
+    def _state(self, data: Any) -> tuple[float, float, float, float]:
+        com, vel = np.asarray(data.subtree_com[0]), np.asarray(data.subtree_linvel[0])
+        return float(com[0]), float(com[1]), float(vel[0]), float(vel[1])
+
     def _foothold(self, data: Any, swing: int, t: float) -> tuple[FloatArray, int]:
         """Plan the foothold of foot ``swing`` for a touchdown after t [s] (wbc_step_plan)."""
-        com, vel = np.asarray(data.subtree_com[0]), np.asarray(data.subtree_linvel[0])
-        state = (float(com[0]), float(com[1]), float(vel[0]), float(vel[1]))
         stance = (self._side(1 - swing), self._pose(data, 1 - swing))
-        return plan_foothold(self.params, state, stance, self._pose(data, swing), t, hip=self.hip)
+        return plan_foothold(self.plan_params, self._state(data), stance,
+                             self._pose(data, swing), t, hip=self.hip)  # fmt: skip
 
-    def _swing_foot(self, data: Any) -> int:
-        """Return the foot on the capture point's side of the ankles' midpoint (library rule)."""
-        com, vel = np.asarray(data.subtree_com[0]), np.asarray(data.subtree_linvel[0])
-        xi = com[:2] + vel[:2] / self.params.omega
-        poses = [self._pose(data, i) for i in range(2)]
-        middle = 0.5 * np.array([poses[0].x + poses[1].x, poses[0].y + poses[1].y])
-        left = poses[self.left].yaw
-        right = poses[1 - self.left].yaw
-        yaw = math.atan2(math.sin(left) + math.sin(right), math.cos(left) + math.cos(right))
-        lateral = -math.sin(yaw) * (xi[0] - middle[0]) + math.cos(yaw) * (xi[1] - middle[1])
-        return self.left if lateral >= 0.0 else 1 - self.left
+    def _choose(self, data: Any, t: float) -> tuple[int, FloatArray, int]:
+        """Choose the swing foot and plan its foothold (:func:`~.wbc_step_plan.choose_step`)."""
+        poses = (self._pose(data, self.left), self._pose(data, 1 - self.left))
+        landed = None
+        if self._landed is not None and self.steps[-1].touchdown is not None:
+            if float(data.time) - self.steps[-1].touchdown <= self.settings.follow_time:
+                landed = self._side(self._landed)
+        side, foothold, count = choose_step(self.plan_params, self._state(data), poses, t,
+                                            hip=self.hip, landed=landed)  # fmt: skip
+        return (self.left if side is Stance.LEFT else 1 - self.left), foothold, count
 
     def decide(self, xi: FloatArray, region: ConvexPolygon) -> bool:
         """Whether ξ [m] is more than ``margin`` outside ``region`` (P or the CMP region)."""
@@ -266,10 +181,9 @@ class Stepper:
         foothold re-planned for it, until the two agree within 10 ms or ``max_swing_time``.
         """
         t0, s = float(data.time), self.settings
-        index = self._swing_foot(data)
-        cop = np.asarray(data.xpos[self.feet[1 - index].body][:2], dtype=float)
         span = self.swing_time
-        foothold, _ = self._foothold(data, index, span)
+        index, foothold, count = self._choose(data, span)
+        cop = np.asarray(data.xpos[self.feet[1 - index].body][:2], dtype=float)
         for _ in range(8 if s.torque_share is not None else 0):
             assert s.torque_share is not None
             need = leg_swing_time(self._model, data, self.legs[index], foothold, cop,
@@ -277,14 +191,14 @@ class Stepper:
             if need <= span + 0.01 or span >= s.max_swing_time:
                 break
             span = min(s.max_swing_time, need)
-            foothold, _ = self._foothold(data, index, span)
+            foothold, count = self._foothold(data, index, span)
         point, self._rot = self.sole(data, index)
         self.swing, self._start = index, t0
         self._end = t0 + span
         self._planned = t0
         self._z = np.array([point[2], self.floor - s.sink])
         self._coeffs = quintic(point[:2], np.zeros(2), np.zeros(2), foothold, span)
-        record = StepRecord(self.feet[index].name, t0, self._end)
+        record = StepRecord(self.feet[index].name, t0, self._end, count=count)
         record.origin = np.array(data.xpos[self.feet[index].body][:2], dtype=float)
         record.plans.append((t0, float(foothold[0]), float(foothold[1])))
         self.steps.append(record)
@@ -370,6 +284,35 @@ class Stepper:
             return []
         return [Task("knee guard", np.array(rows), np.array(targets), s.knee_weight)]
 
+    def pelvis_height(self, data: Any, height: float) -> float:
+        """Return the pelvis height task's target [m]: ``height`` lowered for the legs' reach.
+
+        min(height, :func:`~.wbc_step_height.pelvis_limit`) with every knee bent by at least
+        ``knee_reach`` (the swinging leg at its foothold, its hip moved with the LIPM's CoM on
+        the stance ankle to touchdown), and at least ``height − max_drop``; ``height`` when
+        ``knee_reach`` is None or a leg lacks a hip pitch or knee joint.
+        """
+        s = self.settings
+        if s.knee_reach is None or any(leg.knee < 0 or leg.hip_pitch < 0 for leg in self.legs):
+            return height
+        if self._spans is None:
+            lengths = [segment_lengths(data, leg) for leg in self.legs]
+            self._spans = tuple(leg_span(*pair, s.knee_reach) for pair in lengths)
+            self._pelvis = int(
+                self._model.body_parentid[self._model.jnt_bodyid[self.legs[0].hip_pitch]]
+            )
+        foothold = shift = None
+        if self.swing is not None:
+            foothold = self.steps[-1].foothold
+            com = np.asarray(data.subtree_com[0][:2], dtype=float)
+            vel = np.asarray(data.subtree_linvel[0][:2], dtype=float)
+            cop = np.asarray(data.xpos[self.feet[1 - self.swing].body][:2], dtype=float)
+            remaining = max(self._end - float(data.time), 0.0)
+            shift = lipm_com(com, vel, cop, self.params.omega, remaining) - com
+        limit = pelvis_limit(data, self.legs, self._spans, self._pelvis, swing=self.swing,
+                             foothold=foothold, shift=shift)  # fmt: skip
+        return max(height - s.max_drop, min(height, limit))
+
     def tasks(self, data: Any, size: int, nv: int) -> list[Task]:
         """Return the stepping tasks now: the swing foot's (while it swings), the knee guard."""
         tasks = self.knee_guard(data, size, nv)
@@ -391,5 +334,5 @@ class Stepper:
         record = self.steps[-1]
         record.touchdown = t
         record.landed = np.array(data.xpos[foot.body][:2], dtype=float)
-        self.swing = None
+        self._landed, self.swing = self.swing, None
         return True

@@ -26,7 +26,7 @@ World frame, x forward, y left, z up, SI units. Used by :class:`~.wbc_step.Stepp
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -43,11 +43,13 @@ __all__ = [
     "Leg",
     "StepRecord",
     "axis_inertia",
+    "choose_step",
     "evaluate",
     "leg_joints",
     "leg_swing_time",
     "lipm_com",
     "plan_foothold",
+    "planning_params",
     "quintic",
     "rotation_vector",
     "yaw_of",
@@ -63,7 +65,8 @@ class StepRecord:
 
     ``plans`` lists (time, foothold x, foothold y) of the first plan and every re-plan;
     ``origin`` is the ankle's ground point at lift-off, ``landed`` at touchdown (None while
-    in the air).
+    in the air); ``count`` the steps of the capture plan at lift-off (1 or 2; 0: the clipped
+    fallback, no plan captured).
     """
 
     foot: str
@@ -73,6 +76,7 @@ class StepRecord:
     touchdown: float | None = None
     landed: FloatArray | None = None
     origin: FloatArray | None = None
+    count: int = 1
 
     @property
     def length(self) -> float:
@@ -200,6 +204,26 @@ def lipm_com(com: FloatArray, vel: FloatArray, cop: FloatArray, omega: float,
     return cop + (com - cop) * math.cosh(omega * t) + vel / omega * math.sinh(omega * t)
 
 
+def planning_params(params: BodyParams, clearance: float | None) -> BodyParams:
+    """Return ``params`` with ``min_step_width`` at least ``foot_width`` + ``clearance`` [m].
+
+    The library's reach cut (:func:`~pushrecovery.surfaces.n_step.reach_polygon`) then keeps
+    each landing ankle that far out on its own side of the stance ankle: the swing foot, on a
+    straight path between two points of that half-plane, never crosses the stance foot. None:
+    ``params`` unchanged (crossing footholds allowed).
+    """
+    if clearance is None:
+        return params
+    width = params.foot_width + clearance
+    if params.min_step_width is not None:
+        width = max(width, params.min_step_width)
+    return replace(params, min_step_width=width)
+
+
+def _other(side: Stance) -> Stance:
+    return Stance.RIGHT if side is Stance.LEFT else Stance.LEFT
+
+
 def plan_foothold(
     params: BodyParams,
     state: tuple[float, float, float, float],
@@ -214,20 +238,76 @@ def plan_foothold(
     ``state`` is (x, y, ẋ, ẏ) of the CoM [m, m/s], ``stance`` the stance side and its pose,
     ``swing_pose`` the swing foot's pose now, ``t`` the time to touchdown [s]; ``hip``: the
     controller's hip task helps (the region's box H). Step count 1 or 2, 0 for the clipped
-    fallback (module docstring).
+    fallback (module docstring), which is also moved out to ``min_step_width`` on the landing
+    foot's side when the body has one.
     """
     side, pose = stance
     poses = {"left": pose, "right": swing_pose} if side is Stance.LEFT else {
         "left": swing_pose, "right": pose}  # fmt: skip
     support = Support.from_params(params, side, **poses)
-    for steps in (1, 2):
-        region = capture_region(*state, params, support, t, steps=steps, hip=hip)
+    for count in (1, 2):
+        region = capture_region(*state, params, support, t, steps=count, hip=hip)
         if region.foothold is not None:
-            return np.asarray(region.foothold, dtype=float), steps
+            return np.asarray(region.foothold, dtype=float), count
     xi = np.array(state[:2]) + np.array(state[2:]) / params.omega
     offset = xi - np.array([pose.x, pose.y])
     offset *= min(1.0, params.max_step_length / max(float(np.linalg.norm(offset)), 1e-9))
+    if params.min_step_width is not None:
+        outward = -1.0 if side is Stance.LEFT else 1.0  # the landing foot's side
+        lateral = np.array([-math.sin(pose.yaw), math.cos(pose.yaw)]) * outward
+        short = params.min_step_width - float(offset @ lateral)
+        offset += max(short, 0.0) * lateral
     return np.array([pose.x, pose.y]) + offset, 0
+
+
+def choose_step(
+    params: BodyParams,
+    state: tuple[float, float, float, float],
+    poses: tuple[FootPose, FootPose],
+    t: float,
+    *,
+    hip: bool,
+    landed: Stance | None = None,
+) -> tuple[Stance, FloatArray, int]:
+    """Return the swing foot, its foothold [m] and the plan's step count, from double support.
+
+    ``poses`` are the (left, right) feet's poses, ``landed`` the foot that has just landed
+    (None for a first step). **First step**: the foot on the capture point's side of the
+    ankles' midpoint (the library's rule, :func:`capture_region`), its foothold from
+    :func:`plan_foothold`. **After a touchdown**, when the other foot is the trailing one (its
+    ankle behind the landed one along ξ's offset from the ankles' midpoint), each foot's plan
+    counts the steps its capture takes (one, two, or none: the clipped fallback); the trailing
+    foot swings unless the landed foot's plan captures in fewer steps (the plan says so: e.g.
+    a diagonal push whose capture point runs past the landed foot's outer side, which the
+    trailing foot could only reach by crossing). Otherwise the library's rule.
+    """
+    xi = np.array(state[:2]) + np.array(state[2:]) / params.omega
+    left, right = poses
+    middle = 0.5 * np.array([left.x + right.x, left.y + right.y])
+    yaw = math.atan2(math.sin(left.yaw) + math.sin(right.yaw),
+                     math.cos(left.yaw) + math.cos(right.yaw))  # fmt: skip
+    lateral = -math.sin(yaw) * (xi[0] - middle[0]) + math.cos(yaw) * (xi[1] - middle[1])
+    order = [Stance.LEFT if lateral >= 0.0 else Stance.RIGHT]
+    if landed is not None:
+        ankle = {
+            Stance.LEFT: np.array([left.x, left.y]),
+            Stance.RIGHT: np.array([right.x, right.y]),
+        }
+        ahead = xi - middle
+        if float((ankle[_other(landed)] - ankle[landed]) @ ahead) < 0.0:  # the other trails
+            order = [_other(landed), landed]
+
+    def plan(swing: Stance) -> tuple[FloatArray, int]:
+        stance = _other(swing)
+        own, free = (left, right) if stance is Stance.LEFT else (right, left)
+        return plan_foothold(params, state, (stance, own), free, t, hip=hip)
+
+    foothold, count = plan(order[0])
+    if len(order) == 2 and count != 1:  # the landed foot only on a plan of fewer steps
+        again, more = plan(order[1])
+        if 0 < more < (count or 3):
+            return order[1], again, more
+    return order[0], foothold, count
 
 
 def leg_swing_time(
