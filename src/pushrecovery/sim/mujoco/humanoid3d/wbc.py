@@ -35,12 +35,10 @@ subject to
 The tasks A_k x = b_k are handed in by the controller (:mod:`.wbc_control`): the CoM's
 acceleration, exact from Newton's law on the wrenches, m c̈ = m g + Σ_i R_i F_i; the torso's
 angular acceleration J_r q̈ + J̇_r q̇; the pelvis height z̈ = J_z q̈ + J̇_z q̇; and the posture
-q̈_j. Solved with DAQP (a dense dual active-set solver) in one ``daqp.Model`` kept between
-ticks: the equality rows are flagged immutable, and the active set of the last tick is its
-warm start. Each tick is assembled in place by the compiled kernels of :mod:`._wbc_kernels`,
-which also hand DAQP the problem in its own least-distance form (H factored on its envelope:
-the same QP, a fifth of DAQP's update time). MuJoCo's types appear as ``Any``: its bindings
-ship no type information.
+q̈_j. Solved with DAQP (a dense dual active-set solver), its models kept between ticks (the
+equality rows immutable, the last active set the warm start), first without the motor rows.
+The compiled kernels of :mod:`._wbc_kernels` assemble each tick in place and hand DAQP its
+least-distance form (H factored on its envelope). MuJoCo's types appear as ``Any``.
 """
 
 from __future__ import annotations
@@ -54,6 +52,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.mujoco.humanoid3d._wbc_buffers import Buffers, full_inertia
 from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
     add_task,
     constraints,
@@ -83,16 +82,6 @@ _INF = 1e30
 _EQUALITY = 5
 #: The default k_c, the damping of a foot's drift in its fixed-foot rows [1/s].
 CONTACT_DAMPING = 20.0
-
-
-def _full_inertia(model: Any, data: Any, out: FloatArray) -> None:
-    """Write the dense joint-space inertia M into ``out`` (MuJoCo 4's and 3's ``mj_fullM``)."""
-    import mujoco
-
-    if hasattr(data, "qM"):  # MuJoCo 3: mj_fullM(m, dst, qM)
-        mujoco.mj_fullM(model, out, data.qM)
-    else:  # MuJoCo 4: mj_fullM(m, d, dst)
-        mujoco.mj_fullM(model, data, out)
 
 
 @dataclass(frozen=True)
@@ -164,23 +153,6 @@ class WbcSolution:
     iterations: int
 
 
-class _Buffers:
-    """Every array of a tick, allocated once (``rows`` for all feet in contact)."""
-
-    def __init__(self, nv: int, nf: int, rows: int, nu: int) -> None:
-        size = nv + nf
-        self.offset = np.zeros(nu)
-        self.mass, self.jac, self.local = np.zeros((nv, nv)), np.zeros((nf, nv)), np.zeros((nf, nv))
-        self.jac_dot, self.dots = np.zeros(nf), np.zeros((nf, nv))
-        self.points = np.zeros((nf // 6, 3))
-        self.hessian, self.linear, self.x = np.zeros((size, size)), np.zeros(size), np.zeros(size)
-        self.factor, self.shift = np.zeros((size, size)), np.zeros(size)
-        self.first = np.zeros(size, np.int64)
-        self.rows, self.upper, self.lower = np.zeros((rows, size)), np.zeros(rows), np.zeros(rows)
-        self.ldp_rows, self.ldp_upper = np.zeros((rows, size)), np.zeros(rows)
-        self.ldp_lower = np.zeros(rows)
-
-
 class WholeBodyQP:
     """The dynamics, contact and limit constraints of one model, and a DAQP workspace.
 
@@ -244,7 +216,10 @@ class WholeBodyQP:
         self._n_equal = self.unactuated.size + nf
         self.contacts = np.ones(len(self.feet), dtype=bool)
         rows = self._n_equal + self._foot_rows.shape[0] + int(model.nu)
-        self._buf = _Buffers(nv, nf, rows, int(model.nu))
+        self._buf = buf = Buffers(nv, nf, rows, int(model.nu))
+        self._views = [(buf.points[i], buf.jac[6 * i : 6 * i + 3], buf.jac[6 * i + 3 : 6 * i + 6],
+                        buf.dots[6 * i : 6 * i + 3], buf.dots[6 * i + 3 : 6 * i + 6], int(body))
+                       for i, body in enumerate(self._bodies)]  # fmt: skip
         self._regular_matrix = np.diag(self._regular)
         self._identity, self._zeros = np.eye(self.size), np.zeros(self.size)
         self._models: dict[int, Any] = {}  # DAQP, by rows handed over: without/with the motors'
@@ -304,14 +279,12 @@ class WholeBodyQP:
         import mujoco
 
         buf, model = self._buf, self.model
-        xmat, qvel = data.xmat, data.qvel
+        xmat = data.xmat
         sole_origins(data.xpos, xmat, self._bodies, self._origins, buf.points)
-        for i, body in enumerate(self._bodies):
-            point, rows = buf.points[i], slice(6 * i, 6 * i + 3)
-            spin = slice(6 * i + 3, 6 * i + 6)
-            mujoco.mj_jac(model, data, buf.jac[rows], buf.jac[spin], point, body)
-            mujoco.mj_jacDot(model, data, buf.dots[rows], buf.dots[spin], point, body)
-        sole_frames(xmat, self._bodies, buf.jac, buf.dots, qvel, buf.jac_dot, buf.local)
+        for point, lin, ang, lin_dot, ang_dot, body in self._views:  # rows of buf, per foot
+            mujoco.mj_jac(model, data, lin, ang, point, body)
+            mujoco.mj_jacDot(model, data, lin_dot, ang_dot, point, body)
+        sole_frames(xmat, self._bodies, buf.jac, buf.dots, data.qvel, buf.jac_dot, buf.local)
         return buf.jac, buf.jac_dot, buf.local
 
     def assemble(self, data: Any, tasks: Sequence[Task]) -> WbcProblem:
@@ -324,8 +297,15 @@ class WholeBodyQP:
         InvalidParameterError
             If a task's matrix is not (k, m ≤ ``size``) with a target of k rows.
         """
+        count = self._assemble(data, tasks)
         buf = self._buf
-        _full_inertia(self.model, data, buf.mass)
+        return WbcProblem(buf.hessian, buf.linear, buf.rows[:count], buf.upper[:count],
+                          buf.lower[:count], self._n_equal)  # fmt: skip
+
+    def _assemble(self, data: Any, tasks: Sequence[Task]) -> int:
+        """Write the QP into the buffers (:meth:`assemble`); return its number of rows."""
+        buf = self._buf
+        full_inertia(self.model, data, buf.mass)
         self.contact_jacobians(data)
         np.copyto(buf.hessian, self._regular_matrix)
         buf.linear.fill(0.0)
@@ -344,8 +324,7 @@ class WholeBodyQP:
             self.ctrl_high, self._foot_rows, self._foot_start, float(self.contact_damping),
             buf.rows, buf.upper, buf.lower, buf.offset,
         )  # fmt: skip
-        return WbcProblem(buf.hessian, buf.linear, buf.rows[:count], buf.upper[:count],
-                          buf.lower[:count], self._n_equal)  # fmt: skip
+        return int(count)
 
     def solve(self, data: Any, tasks: Sequence[Task]) -> WbcSolution:
         """Solve the QP at the state in ``data`` (its M, bias and kinematics current).
@@ -360,7 +339,7 @@ class WholeBodyQP:
             If a task's matrix is not (k, m ≤ ``size``) with a target of k rows.
         """
         nv, buf, nu = self.nv, self._buf, int(self.model.nu)
-        count = self.assemble(data, tasks).rows.shape[0]
+        count = self._assemble(data, tasks)
         start = time.perf_counter()  # the solve time includes the factorisation of H
         flag, feet, steps, reduced = -1, len(self.feet), 0, count - nu
         ctrl = buf.offset  # (overwritten)
@@ -380,7 +359,7 @@ class WholeBodyQP:
                     break
                 recover(buf.factor, buf.first, buf.shift, u, buf.x)
                 ctrl = np.dot(buf.rows[reduced:count], buf.x) + buf.offset
-                inside = bool(np.all(ctrl > self.ctrl_low) and np.all(ctrl < self.ctrl_high))
+                inside = bool(((ctrl > self.ctrl_low) & (ctrl < self.ctrl_high)).all())
                 if rows == count:
                     self._motor_rows = not inside  # a motor on its limit: keep the rows
                     break
