@@ -412,3 +412,17 @@ def test_the_g1_recovers_a_forward_push_at_80_percent_of_its_corrected_ankle_lim
     assert run.sole_lift.max() < LIFT
     assert run.com[:, 2].min() > 0.95 * run.com[0, 2]
     assert np.linalg.norm(run.com_velocity[-1]) < 0.02
+
+
+def test_the_torso_error_is_the_rotation_vector_of_r_r0_transposed():
+    from scipy.spatial.transform import Rotation
+
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_control import _rotation_vector
+
+    rng = np.random.default_rng(42)
+    for _ in range(20):
+        rot, ref = (Rotation.random(random_state=rng).as_matrix() for _ in range(2))
+        expected = Rotation.from_matrix(rot @ ref.T).as_rotvec()
+        if np.linalg.norm(expected) < 3.0:  # away from π, where the axis is ill-defined
+            got = _rotation_vector(rot.ravel().tolist(), ref.ravel().tolist())
+            assert got == pytest.approx(expected, abs=1e-9)

@@ -372,7 +372,7 @@ class WholeBodyQP:
             last = self._last_ctrl.copy()
             return WbcSolution(np.zeros(nv), np.zeros((feet, 6)), last, False, elapsed, steps)
         elapsed = time.perf_counter() - start
-        np.clip(ctrl, self.ctrl_low, self.ctrl_high, out=ctrl)
+        np.minimum(np.maximum(ctrl, self.ctrl_low, out=ctrl), self.ctrl_high, out=ctrl)
         self._last_ctrl = ctrl
         x = buf.x.copy()
         return WbcSolution(x[:nv], x[nv:].reshape(feet, 6), ctrl, True, elapsed, steps)

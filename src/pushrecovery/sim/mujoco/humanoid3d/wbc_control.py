@@ -75,12 +75,17 @@ FloatArray = NDArray[np.float64]
 __all__ = ["WbcGains", "WholeBodyController"]
 
 
-def _rotation_vector(rot: FloatArray) -> FloatArray:
-    """Return the rotation vector (axis × angle) of rotation matrix ``rot`` [rad]."""
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot.ravel().tolist()
-    angle = math.acos(max(-1.0, min(1.0, 0.5 * (r00 + r11 + r22 - 1.0))))
+def _rotation_vector(rot: Sequence[float], ref: Sequence[float]) -> FloatArray:
+    """Return the rotation vector (axis × angle) [rad] of R R₀ᵀ, both row-major (9 floats)."""
+    r0, r1, r2, r3, r4, r5, r6, r7, r8 = rot
+    u0, u1, u2, u3, u4, u5, u6, u7, u8 = ref
+    trace = r0 * u0 + r1 * u1 + r2 * u2 + r3 * u3 + r4 * u4 + r5 * u5 + r6 * u6 + r7 * u7 + r8 * u8
+    angle = math.acos(max(-1.0, min(1.0, 0.5 * (trace - 1.0))))
     scale = 0.5 if angle < 1e-9 else 0.5 * angle / math.sin(angle)
-    return np.array([(r21 - r12) * scale, (r02 - r20) * scale, (r10 - r01) * scale])
+    x = r6 * u3 + r7 * u4 + r8 * u5 - (r3 * u6 + r4 * u7 + r5 * u8)  # (R R₀ᵀ)_21 − (R R₀ᵀ)_12
+    y = r0 * u6 + r1 * u7 + r2 * u8 - (r6 * u0 + r7 * u1 + r8 * u2)  # (R R₀ᵀ)_02 − (R R₀ᵀ)_20
+    z = r3 * u0 + r4 * u1 + r5 * u2 - (r0 * u3 + r1 * u4 + r2 * u5)  # (R R₀ᵀ)_10 − (R R₀ᵀ)_01
+    return np.array([x * scale, y * scale, z * scale])
 
 
 class WholeBodyController:
@@ -192,6 +197,7 @@ class WholeBodyController:
         self.height = float(data.xpos[self.torso][2])
         self.guard.set_posture(data.qpos)
         self.upright = np.array(data.xmat[self.torso], dtype=float).reshape(3, 3)
+        self._upright = self.upright.ravel().tolist()
         self.last = None
         self._bodies = np.array([foot.body for foot in self.feet], dtype=np.intp)
         self._origins = np.array([foot.origin for foot in self.feet])
@@ -285,8 +291,7 @@ class WholeBodyController:
         assert self.qp is not None
         model, gains, nv, size = self.model, self.gains, self.qp.nv, self.qp.size
         # Torso orientation error and the hip law's CMP offset δ (zero with the ankles only).
-        rot = np.asarray(data.xmat[self.torso]).reshape(3, 3)
-        error = _rotation_vector(rot @ self.upright.T)
+        error = _rotation_vector(data.xmat[self.torso].tolist(), self._upright)
         com = np.asarray(data.subtree_com[0])
         self.desired_cop = self.cop_target(data)  # also the capture point, mj_subtreeVel
         if self.stepper is not None and self._step(data):
