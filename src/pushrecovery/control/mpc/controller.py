@@ -15,7 +15,7 @@ from pushrecovery.control.mpc.interior import InteriorPointSolver
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.qp import CondensedQP, shared_qp
-from pushrecovery.control.mpc.riccati import RiccatiSolver
+from pushrecovery.control.mpc.riccati import MAX_PASSES, RiccatiSolver
 from pushrecovery.control.mpc.workspace import PRIMAL_TOL, DaqpWorkspace
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import FLYWHEEL_STATE
@@ -108,6 +108,7 @@ class MPCController(Controller):
         # The exact feasibility test, built (cached per flywheel, dt and N) on first need.
         self._feasibility: FlywheelFeasibility | None = None
         self.last_plan: Plan | None = None
+        self._passes_failed = False  # whether the last tick's warm passes failed
 
     @property
     def qp(self) -> CondensedQP:
@@ -147,6 +148,7 @@ class MPCController(Controller):
         """Forget the last plan and the solver's warm start; the MPC is otherwise stateless."""
         self._check(state)
         self.last_plan = None
+        self._passes_failed = False
         if self._workspace is not None:
             self._workspace.reset()
         if self.riccati is not None:
@@ -158,7 +160,13 @@ class MPCController(Controller):
         # Whether the previous tick was verified by the passes: DAQP did not solve it, and
         # riccati.active holds its optimal set (kept by a failed solve) to start DAQP from.
         previous_verified = riccati is not None and riccati.verified
-        if riccati is not None and riccati.solve(state):
+        # After a tick the warm passes failed, the next one's fail too 88 % of the time (the
+        # benchmark's runs): two passes, then the interior point (one: the benchmark's p99
+        # 19-21x the median, MuJoCo torso + MPC 0.41-0.43x MuJoCo alone; two: 19-24x, 0.51-
+        # 0.55x; six: 19-26x, 0.49x; interleaved on a loaded machine).
+        passes = 2 if self._passes_failed else MAX_PASSES
+        self._passes_failed = riccati is not None and not riccati.solve(state, max_passes=passes)
+        if riccati is not None and not self._passes_failed:
             # Fresh arrays each verified solve: the plan keeps them as they are.
             inputs = riccati.inputs
             return Plan(inputs[0], True, inputs, riccati.states)
