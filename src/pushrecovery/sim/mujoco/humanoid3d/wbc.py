@@ -142,7 +142,8 @@ class WbcSolution:
     ok : bool
         False when DAQP found no solution (``ctrl`` is then the last good one).
     solve_time, iterations : float, int
-        Wall time of DAQP's update (its factorisation) and solve [s], and its iterations.
+        Wall time of the factorisation, DAQP's update and solve (twice when a command left
+        its range without the motor rows) [s], and DAQP's iterations.
     """
 
     qacc: FloatArray
