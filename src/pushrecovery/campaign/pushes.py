@@ -323,6 +323,14 @@ def _rows_of_runs(
     return rows
 
 
+#: The outcome columns of a push that raised (the 3-D rows add their own).
+ERROR_OUTCOME: dict[str, Any] = {
+    "outcome": "error", "used": "error", "steps": 0, "peak_hip_torque": math.nan,
+    "peak_ankle_torque": math.nan, "cop_min": math.nan, "cop_max": math.nan, "time": math.nan,
+    "stop_impacts": 0,
+}  # fmt: skip
+
+
 def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
     """Return the row of a push without an outcome: the prediction, ``outcome`` = error.
 
@@ -333,18 +341,7 @@ def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
 
         return error_row3d(spec, push, reason)
     row = _inputs_and_prediction(spec, push, _predictions([push])[0])
-    row.update(
-        outcome="error",
-        used="error",
-        steps=0,
-        peak_hip_torque=math.nan,
-        peak_ankle_torque=math.nan,
-        cop_min=math.nan,
-        cop_max=math.nan,
-        time=math.nan,
-        stop_impacts=0,
-        error=reason,
-    )
+    row.update(ERROR_OUTCOME, error=reason)
     return row
 
 

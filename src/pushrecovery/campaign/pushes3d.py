@@ -153,17 +153,11 @@ def _torque_ratio(ctrl: Any, ranges: Any) -> float:
 
 def error_row3d(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
     """Return the row of a 3-D push without an outcome: the prediction, ``outcome`` = error."""
+    from pushrecovery.campaign.pushes import ERROR_OUTCOME
+
     row = predict3d(spec, push)
     row.update(
-        outcome="error",
-        used="error",
-        steps=0,
-        peak_hip_torque=math.nan,
-        peak_ankle_torque=math.nan,
-        cop_min=math.nan,
-        cop_max=math.nan,
-        time=math.nan,
-        stop_impacts=0,
+        ERROR_OUTCOME,
         error=reason,
         lift_offs=0,
         peak_hip_motor_torque=math.nan,
