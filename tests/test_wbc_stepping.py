@@ -234,3 +234,145 @@ def test_stepper_refuses_a_non_bool_hip(model, params):
     feet = tuple(foot_contact(model, data, n) for n in ("left_foot", "right_foot"))
     with pytest.raises(InvalidParameterError, match="hip"):
         Stepper(model, params, feet, 0, 0.0, 1.0, hip="yes")
+
+
+# --- Follow-up steps: the trailing foot, no crossing, the pelvis lowered (issue 19 item 3) ---
+
+#: A forward push of 2 × the ankle's critical impulse: one step does not capture it.
+TWICE = 2.0
+
+
+@pytest.fixture(scope="module")
+def forward_twice(params, model):
+    polygon = Support.from_params(params).polygon
+    impulse = TWICE * params.mass * params.omega * polygon.ray_distance(0.0, 0.0, 0.0)
+    return push_biped3d(params, impulse, 0.0, duration=3.0, model=model, stepping=True,
+                        step_settings=StepSettings(swing_time=0.2))  # fmt: skip
+
+
+def test_forward_push_of_twice_recovers_with_the_other_foot_second(forward_twice):
+    run = forward_twice
+    height = run.com[0, 2]
+    assert run.com[:, 2].min() > 0.8 * height and run.torso_tilt.max() < 1.0
+    assert np.linalg.norm(run.com_velocity[-1, :2]) < 0.1  # at rest at 3 s
+    steps = run.controller.stepper.steps
+    assert len(steps) >= 2 and all(step.landed is not None for step in steps)
+    assert steps[1].foot != steps[0].foot  # the trailing foot, not the one that just landed
+    assert steps[1].liftoff >= steps[0].touchdown
+    # The second step passes the first: its foot lands ahead of the first landing.
+    assert steps[1].landed[0] > steps[0].landed[0] + 0.1
+
+
+def test_forward_push_of_twice_wrenches_at_every_tick(forward_twice):
+    run = forward_twice
+    for foot, rows in enumerate(f.constraint_rows() for f in run.controller.feet):
+        assert np.all(run.wrenches[:, foot] @ rows.T <= FORCE_TOL)
+    names = [f.name for f in run.controller.feet]
+    for step in run.controller.stepper.steps:
+        end = math.inf if step.touchdown is None else step.touchdown
+        swing = (run.time > step.liftoff + 1e-9) & (run.time < end - 1e-9)
+        assert swing.any()
+        assert np.allclose(run.wrenches[swing, names.index(step.foot)], 0.0, atol=FORCE_TOL)
+
+
+def test_the_trailing_foot_steps_after_a_forward_step(params):
+    """Left foot landed 0.4 m ahead, ξ further ahead on the midline: the right foot swings."""
+    from pushrecovery.ground.support import FootPose, Stance
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import choose_step
+
+    poses = (FootPose(0.4, 0.1), FootPose(0.0, -0.1))
+    state = (0.3, 0.0, 1.0, 0.0)  # ξ = (0.3 + 1/ω, 0): ahead of both feet, between them
+    first, _, _ = choose_step(params, state, poses, 0.2, hip=False)
+    assert first is Stance.LEFT  # no landing yet: the library's rule (ξ on the left, y >= 0)
+    swing, foothold, count = choose_step(params, state, poses, 0.2, hip=False,
+                                         landed=Stance.LEFT)  # fmt: skip
+    assert swing is Stance.RIGHT and count in (1, 2)
+    assert foothold[0] > 0.4  # ahead of the landed foot
+
+
+def test_no_crossing_foothold(params):
+    """ξ beyond the left foot's outer side: the right foot lands at least w + 2 cm right of it
+    (the library's region, cut to that half-plane, when the uncut one would cross)."""
+    from pushrecovery.ground.support import FootPose, Stance
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import plan_foothold, planning_params
+
+    cut = planning_params(params, 0.02)
+    assert cut.min_step_width == pytest.approx(params.foot_width + 0.02)
+    assert planning_params(params, None) is params
+    left, right = FootPose(0.0, 0.4), FootPose(0.0, -0.1)
+    for vy in (0.5, 1.0, 2.0):  # ξ from 0.16 to 0.64 m left of the left ankle
+        state = (0.0, 0.4, 0.0, vy)
+        crossing, _ = plan_foothold(params, state, (Stance.LEFT, left), right, 0.2, hip=False)
+        assert crossing[1] > left.y - cut.min_step_width  # uncut: across the stance foot
+        foothold, _ = plan_foothold(params, state, (Stance.LEFT, left), right, 0.2, hip=False,
+                                    cut=cut)  # fmt: skip
+        assert foothold[1] <= left.y - cut.min_step_width + 1e-6
+
+
+def test_swing_path_collision_with_the_stance_sole(params):
+    """Soles of length L = toe − heel and width w overlap when the ankles are closer than
+    (L, w) in x and y: paths through, beside and behind the stance foot."""
+    from pushrecovery.ground.support import FootPose
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import collides
+
+    stance = FootPose(1.0, 2.0)
+    length = params.toe - params.heel
+    through = collides(params, stance, np.array([1.0, 1.7]), np.array([1.0, 2.3]), 0.0)
+    beside = collides(params, stance, np.array([0.5, 1.85]), np.array([1.5, 1.85]), 0.0)
+    behind = collides(params, stance, np.array([1.0 - length - 0.01, 1.7]),
+                      np.array([1.0 - length - 0.01, 2.3]), 0.0)  # fmt: skip
+    near = collides(params, stance, np.array([0.5, 1.89]), np.array([1.5, 1.89]), 0.02)
+    assert through and not beside and not behind and near
+    turned = FootPose(1.0, 2.0, math.pi / 2)  # the box turns with the stance foot
+    assert not collides(params, turned, np.array([0.85, 1.5]), np.array([0.85, 2.5]), 0.0)
+
+
+def test_leg_span_and_pelvis_limit_match_the_standing_posture(model):
+    """ℓ(κ) by the law of cosines against MuJoCo's hip-ankle distance; standing, the limit for
+    the stance's own knee bend (feet under the hips) is the pelvis' height."""
+    import mujoco
+
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import KNEE_BEND
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_height import (
+        leg_span,
+        pelvis_limit,
+        segment_lengths,
+    )
+
+    data = mujoco.MjData(model)
+    data.qpos[:] = bent_knee_qpos(model)
+    mujoco.mj_forward(model, data)
+    legs = tuple(leg_joints(model, model.body(n).id) for n in ("left_foot", "right_foot"))
+    thigh, shank = segment_lengths(data, legs[0])
+    for leg in legs:
+        hip, ankle = data.xanchor[leg.hip_pitch], data.xpos[leg.foot]
+        distance = float(np.linalg.norm(hip - ankle))
+        assert leg_span(thigh, shank, KNEE_BEND) == pytest.approx(distance, abs=1e-9)
+    pelvis = int(model.body_parentid[model.jnt_bodyid[legs[0].hip_pitch]])
+    spans = (leg_span(thigh, shank, KNEE_BEND),) * 2
+    limit = pelvis_limit(data, legs, spans, pelvis)
+    assert limit == pytest.approx(float(data.xpos[pelvis][2]), abs=1e-6)
+    # A foothold 0.4 m ahead of the left hip: the hip must be lower, by the right triangle.
+    foothold = data.xanchor[legs[0].hip_pitch][:2] + np.array([0.4, 0.0])
+    lower = pelvis_limit(data, legs, spans, pelvis, swing=0, foothold=foothold)
+    drop = float(data.xanchor[legs[0].hip_pitch][2] - data.xpos[legs[1].foot][2])
+    assert limit - lower == pytest.approx(drop - math.sqrt(spans[0] ** 2 - 0.4**2), abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"clearance": -0.01}, "clearance"),
+        ({"clearance": 0.6}, "clearance"),
+        ({"clearance": math.nan}, "clearance"),
+        ({"follow_time": -0.1}, "follow_time"),
+        ({"follow_time": 11.0}, "follow_time"),
+        ({"knee_reach": -0.1}, "knee_reach"),
+        ({"knee_reach": 2.0}, "knee_reach"),
+        ({"max_drop": 0.6}, "max_drop"),
+        ({"max_drop": -0.1}, "max_drop"),
+    ],
+)
+def test_bad_follow_up_settings(kwargs, name):
+    with pytest.raises(InvalidParameterError, match=name):
+        StepSettings(**kwargs)

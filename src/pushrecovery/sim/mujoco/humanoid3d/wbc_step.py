@@ -116,7 +116,8 @@ class Stepper:
             raise InvalidParameterError(f"hip must be a bool, got {hip!r}")
         self._model = model
         self.params = replace(params, com_height=com_height)
-        self.plan_params = planning_params(self.params, settings.clearance)
+        clearance = settings.clearance  # the no-crossing plan (wbc_step_plan.planning_params)
+        self.cut = None if clearance is None else planning_params(self.params, clearance)
         self.feet, self.left, self.floor, self.settings = feet, left, floor, settings
         self.hip = hip
         self.legs = tuple(leg_joints(model, foot.body) for foot in feet)
@@ -148,8 +149,8 @@ class Stepper:
     def _foothold(self, data: Any, swing: int, t: float) -> tuple[FloatArray, int]:
         """Plan the foothold of foot ``swing`` for a touchdown after t [s] (wbc_step_plan)."""
         stance = (self._side(1 - swing), self._pose(data, 1 - swing))
-        return plan_foothold(self.plan_params, self._state(data), stance,
-                             self._pose(data, swing), t, hip=self.hip)  # fmt: skip
+        return plan_foothold(self.params, self._state(data), stance,
+                             self._pose(data, swing), t, hip=self.hip, cut=self.cut)  # fmt: skip
 
     def _choose(self, data: Any, t: float) -> tuple[int, FloatArray, int]:
         """Choose the swing foot and plan its foothold (:func:`~.wbc_step_plan.choose_step`)."""
@@ -158,7 +159,7 @@ class Stepper:
         if self._landed is not None and self.steps[-1].touchdown is not None:
             if float(data.time) - self.steps[-1].touchdown <= self.settings.follow_time:
                 landed = self._side(self._landed)
-        side, foothold, count = choose_step(self.plan_params, self._state(data), poses, t,
+        side, foothold, count = choose_step(self.params, self._state(data), poses, t, cut=self.cut,
                                             hip=self.hip, landed=landed)  # fmt: skip
         return (self.left if side is Stance.LEFT else 1 - self.left), foothold, count
 
