@@ -6,13 +6,17 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
 * **Decision** (double support): step when the capture point ξ = c + ċ/ω is beyond what the
   ankles (and the hip, if enabled) recover: its signed distance to the CoP region P (or the
   CMP region P ⊕ box(a'_x, a'_y), :class:`~.wbc_hip.HipLaw`) below −``margin``.
-* **Plan** (:mod:`.wbc_step_plan`): the foot on ξ's side of the ankles' midpoint swings; the
-  library's one-step capture region of the state now, the stance foot's measured pose, a
+* **Plan** (:mod:`.wbc_step_plan`): the foot on ξ's side of the ankles' midpoint swings
+  (within ``follow_time`` of a touchdown, the trailing foot unless the landed foot's plan
+  captures in fewer steps, :func:`~.wbc_step_plan.choose_step`); the library's one-step
+  (else two-step) capture region of the state now, the stance foot's measured pose, a
   touchdown after t_s, and (when the controller has its hip task) the hip's box; its
-  recommended ``foothold`` (the region's Chebyshev centre) is the landing ankle's target.
-  t_s starts at ``swing_time`` (default the body's ``min_step_time``) and grows to what a
-  share ``torque_share`` of the swing hip's motor limit needs for that foothold (the plan
-  redone for the longer time), up to ``max_swing_time``.
+  recommended ``foothold`` (the region's Chebyshev centre) is the landing ankle's target;
+  when the straight swing to it would meet the stance sole, the region cut to the half-plane
+  ``foot_width`` + ``clearance`` out on the landing side (no crossing steps). t_s starts at
+  ``swing_time`` (default the body's ``min_step_time``) and grows to what a share
+  ``torque_share`` of the swing hip's motor limit needs for that foothold (the plan redone
+  for the longer time), up to ``max_swing_time``.
 * **Swing**: the foot is dropped from the QP's contacts (:meth:`~.wbc.WholeBodyQP.set_contacts`)
   and its sole frame tracks a reference: in x, y a quintic from the reference's position,
   velocity and acceleration to the foothold with zero velocity and acceleration at the
@@ -28,13 +32,16 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
 * **Knee guard** (always, with stepping): a knee below ``knee_min`` or reaching it within
   50 ms gets the task q̈ = k_p (q_min − q) − d_p q̇: the QP does not model the joint stop, and
   a stance knee driven onto it made the QP infeasible (torque limits with the contact rows).
+* **Pelvis height** (:meth:`Stepper.pelvis_height`, :mod:`.wbc_step_height`): the pelvis
+  task's target lowered so that every knee stays bent by ``knee_reach`` (the swinging leg at
+  its foothold), by at most ``max_drop``.
 * **Re-plan**: every ``replan_period`` until ``replan_fraction`` of the swing, the foothold
   is recomputed from the current state in single support with the remaining swing time, and
   the x, y quintic restarts from the reference's current state.
 * **Touchdown**: after half the swing, when the foot's lowest sole point is within ``contact``
   of the floor; the foot rejoins the contacts, the support polygon and the balance point (the
   ankles' midpoint) are re-measured, and the ankles balance: a second step follows if ξ is
-  still beyond the new region.
+  still beyond the new region (by the trailing foot, above).
 """
 
 from __future__ import annotations

@@ -9,6 +9,11 @@ World frame, x forward, y left, z up, SI units. Used by :class:`~.wbc_step.Stepp
   valid double support; the swing foot is named instead); its recommended ``foothold`` (the
   region's Chebyshev centre). An empty region falls back to the first foothold of a two-step
   plan, then to the stance ankle plus the capture point's offset clipped to the step length.
+  **No crossing**: when the straight swing to that foothold meets the stance sole
+  (:func:`collides`), the region cut to the half-plane ``min_step_width`` out on the landing
+  foot's side (:func:`planning_params`).
+* **Which foot** (:func:`choose_step`): the library's side rule; after a touchdown the
+  trailing foot, unless the landed foot's plan captures in fewer steps.
 * **Swing time** (:func:`leg_swing_time`): the step time of the plan is what the swing hip
   can drive. The swing foot's quintic (rest to rest, distance d in time T) peaks at
   a = (10/√3) d / T²; the leg swings about the hip, so with Δθ = d/ℓ (ℓ the hip's height
