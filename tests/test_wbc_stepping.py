@@ -376,3 +376,15 @@ def test_leg_span_and_pelvis_limit_match_the_standing_posture(model):
 def test_bad_follow_up_settings(kwargs, name):
     with pytest.raises(InvalidParameterError, match=name):
         StepSettings(**kwargs)
+
+
+def test_segment_lengths_need_a_hip_pitch_and_a_knee(model):
+    import mujoco
+
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_height import segment_lengths
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import Leg
+
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    with pytest.raises(InvalidParameterError, match="hip_pitch and a knee"):
+        segment_lengths(data, Leg(model.body("left_foot").id))
