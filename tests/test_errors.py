@@ -46,6 +46,10 @@ def test_a_bug_in_the_mpc_is_not_reported_as_infeasible(monkeypatch, solver):
 
     monkeypatch.setattr(controller.qp, "vectors", broken)
     monkeypatch.setattr(controller.qp, "vectors_into", broken)
+    # The default route's sparse solvers too (they come before the condensed QP).
+    for solver in (controller.riccati, controller.interior):
+        if solver is not None:
+            monkeypatch.setattr(solver, "solve", broken)
     with pytest.raises(TypeError, match="a bug"):
         controller.plan(state)
 
