@@ -386,25 +386,3 @@ def solve_interior(  # type: ignore[no-untyped-def]
                 zl[i, j] += dual * dzl[i, j]
                 zu[i, j] += dual * dzu[i, j]
     return -2
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def identify_active(bounds, scale, sl, su, zl, zu, active):  # type: ignore[no-untyped-def]
-    """Write the iterate's active set into ``active`` (N, 3); the number of rows that changed.
-
-    A bound is active when its multiplier, in units of its dual scale, exceeds its slack in
-    units of its range (z / scale > s / range, compared without the quotients).
-    """
-    changed = 0
-    for i in range(sl.shape[0]):
-        for j in range(3):
-            span = bounds[j, 1] - bounds[j, 0]
-            side = 0
-            if zl[i, j] * span > sl[i, j] * scale[i, j]:
-                side = -1
-            elif zu[i, j] * span > su[i, j] * scale[i, j]:
-                side = 1
-            if active[i, j] != side:
-                active[i, j] = side
-                changed += 1
-    return changed

@@ -36,8 +36,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, identify_active, solve_interior
-from pushrecovery.control.mpc._ipm_scales import dual_scales
+from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, solve_interior
+from pushrecovery.control.mpc._ipm_scales import dual_scales, identify_active
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
