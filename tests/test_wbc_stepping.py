@@ -13,7 +13,8 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc import WholeBodyQP, foot_contact
 from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos, push_biped3d
 from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings, quintic
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import axis_inertia, leg_joints, lipm_com
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_leg import axis_inertia, leg_joints
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import lipm_com
 
 #: The push, in CoP-region critical impulses (docs/plane.md): well outside the ankle region.
 OUTSIDE = 1.5
@@ -382,7 +383,7 @@ def test_segment_lengths_need_a_hip_pitch_and_a_knee(model):
     import mujoco
 
     from pushrecovery.sim.mujoco.humanoid3d.wbc_step_height import segment_lengths
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import Leg
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_leg import Leg
 
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)

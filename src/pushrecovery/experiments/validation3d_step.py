@@ -30,7 +30,7 @@ longest swing time and its largest foothold distance from the stance ankle.
 **Cause** (:meth:`StepRow.cause`), where measured and predicted differ by more than 10 %:
 the simple model takes a touchdown Δt_s after the push and a step as long as
 ``max_step_length``; the biped's swing lasts what its hip motors drive
-(``wbc_step_plan.leg_swing_time``), and its leg, standing with the hip ~0.99 ℓ above the
+(``wbc_step_leg.leg_swing_time``), and its leg, standing with the hip ~0.99 ℓ above the
 ankle, reaches far less than ℓ: the stepper lowers the pelvis for a long step
 (``StepSettings.knee_reach``, ``max_drop`` 0.2 m), which still leaves it short of ℓ. After a
 touchdown the trailing foot steps (``wbc_step_plan.choose_step``): several steps count.

@@ -64,12 +64,11 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc_step_height import (
     pelvis_limit,
     segment_lengths,
 )
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_leg import leg_joints, leg_swing_time
 from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import (
     StepRecord,
     choose_step,
     evaluate,
-    leg_joints,
-    leg_swing_time,
     lipm_com,
     plan_foothold,
     planning_params,
@@ -185,7 +184,7 @@ class Stepper:
         """Plan a step from double support and start its swing; return the swing foot's index.
 
         The swing time starts at ``swing_time`` and grows to what the swing hip needs for the
-        planned foothold (:func:`~.wbc_step_plan.leg_swing_time`, ``torque_share``), the
+        planned foothold (:func:`~.wbc_step_leg.leg_swing_time`, ``torque_share``), the
         foothold re-planned for it, until the two agree within 10 ms or ``max_swing_time``.
         """
         t0, s = float(data.time), self.settings

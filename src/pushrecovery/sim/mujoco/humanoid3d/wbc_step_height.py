@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import Leg
+from pushrecovery.sim.mujoco.humanoid3d.wbc_step_leg import Leg
 
 FloatArray = NDArray[np.float64]
 
@@ -40,7 +40,7 @@ def segment_lengths(data: Any, leg: Leg) -> tuple[float, float]:
     Raises
     ------
     InvalidParameterError
-        If the leg has no hip pitch or knee joint (:func:`~.wbc_step_plan.leg_joints`).
+        If the leg has no hip pitch or knee joint (:func:`~.wbc_step_leg.leg_joints`).
     """
     if leg.hip_pitch < 0 or leg.knee < 0:
         raise InvalidParameterError("the leg needs a hip_pitch and a knee joint to measure")

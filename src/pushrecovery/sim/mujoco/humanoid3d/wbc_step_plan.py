@@ -14,8 +14,8 @@ World frame, x forward, y left, z up, SI units. Used by :class:`~.wbc_step.Stepp
   foot's side (:func:`planning_params`).
 * **Which foot** (:func:`choose_step`): the library's side rule; after a touchdown the
   trailing foot, unless the landed foot's plan captures in fewer steps.
-* **Swing time** (:func:`leg_swing_time`): the step time of the plan is what the swing hip
-  can drive. The swing foot's quintic (rest to rest, distance d in time T) peaks at
+* **Swing time** (:func:`~.wbc_step_leg.leg_swing_time`): the step time of the plan is what
+  the swing hip can drive. The swing foot's quintic (rest to rest, distance d in time T) peaks at
   a = (10/√3) d / T²; the leg swings about the hip, so with Δθ = d/ℓ (ℓ the hip's height
   above the floor), I the leg's inertia about the hip axis and a share κ of the hip motor's
   limit τ,
@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,14 +44,10 @@ from pushrecovery.surfaces.capture_region import capture_region
 FloatArray = NDArray[np.float64]
 
 __all__ = [
-    "Leg",
     "StepRecord",
-    "axis_inertia",
     "choose_step",
     "collides",
     "evaluate",
-    "leg_joints",
-    "leg_swing_time",
     "lipm_com",
     "plan_foothold",
     "planning_params",
@@ -144,64 +139,6 @@ def rotation_vector(rot: FloatArray) -> FloatArray:
     angle = math.acos(max(-1.0, min(1.0, 0.5 * (float(np.trace(rot)) - 1.0))))
     axial = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
     return axial if angle < 1e-9 else axial * (angle / math.sin(angle))
-
-
-@dataclass(frozen=True)
-class Leg:
-    """The hinge joints of one leg that the swing time and the knee guard need (ids or −1).
-
-    Found by name on the bodies from the foot up to the root: ``hip_pitch``, ``hip_roll``,
-    ``knee`` (the biped3d's ``left_hip_pitch``, the G1's ``left_hip_pitch_joint``).
-    """
-
-    foot: int
-    hip_pitch: int = -1
-    hip_roll: int = -1
-    knee: int = -1
-
-
-def leg_joints(model: Any, foot: int) -> Leg:
-    """Return the :class:`Leg` of foot body ``foot`` in ``model``."""
-    import mujoco
-
-    found: dict[str, int] = {}
-    body = foot
-    while body > 0:
-        for joint in range(int(model.njnt)):
-            if int(model.jnt_bodyid[joint]) != body:
-                continue
-            if int(model.jnt_type[joint]) != mujoco.mjtJoint.mjJNT_HINGE:
-                continue
-            name = model.joint(joint).name
-            for key in ("hip_pitch", "hip_roll", "knee"):
-                if key in name and key not in found:
-                    found[key] = joint
-        body = int(model.body_parentid[body])
-    return Leg(foot, **found)
-
-
-def axis_inertia(model: Any, data: Any, joint: int) -> float:
-    """Return the inertia of ``joint``'s subtree about its axis [kg m²], armature included.
-
-    I = Σ_b m_b |a × (c_b − o)|² + aᵀ R_b I_b R_bᵀ a over the bodies b below the joint (a its
-    unit axis, o its anchor, after ``mj_kinematics``).
-    """
-    axis = np.asarray(data.xaxis[joint], dtype=float)
-    anchor = np.asarray(data.xanchor[joint], dtype=float)
-    first = int(model.jnt_bodyid[joint])
-    total = float(model.dof_armature[int(model.jnt_dofadr[joint])])
-    for body in range(first, int(model.nbody)):
-        parent = body
-        while parent > first:
-            parent = int(model.body_parentid[parent])
-        if parent != first:
-            continue
-        lever = np.cross(axis, np.asarray(data.xipos[body]) - anchor)
-        rot = np.asarray(data.ximat[body], dtype=float).reshape(3, 3)
-        local = rot.T @ axis
-        total += float(model.body_mass[body]) * float(lever @ lever)
-        total += float(local @ (np.asarray(model.body_inertia[body]) * local))
-    return total
 
 
 def lipm_com(com: FloatArray, vel: FloatArray, cop: FloatArray, omega: float,
@@ -356,54 +293,3 @@ def choose_step(
         if 0 < more < (count or 3):
             return order[1], again, more
     return order[0], foothold, count
-
-
-def leg_swing_time(
-    model: Any,
-    data: Any,
-    leg: Leg,
-    foothold: FloatArray,
-    cop: FloatArray,
-    omega: float,
-    t: float,
-    torque_share: float,
-) -> float:
-    """Return the shortest swing T [s] the hip of ``leg`` drives to ``foothold`` (module doc).
-
-    ``cop`` is the stance ankle the LIPM turns about [m], ``t`` the swing time the foothold
-    was planned for [s] (the hip's displacement is taken over it), ``torque_share`` κ in
-    (0, 1]. 0 when the leg has no hip joints named as :func:`leg_joints` finds them.
-    """
-    import mujoco
-
-    if leg.hip_pitch < 0 and leg.hip_roll < 0:
-        return 0.0
-    mujoco.mj_subtreeVel(model, data)
-    com = np.asarray(data.subtree_com[0][:2], dtype=float)
-    vel = np.asarray(data.subtree_linvel[0][:2], dtype=float)
-    hip_joint = leg.hip_pitch if leg.hip_pitch >= 0 else leg.hip_roll
-    hip = np.asarray(data.xanchor[hip_joint], dtype=float)
-    foot = np.asarray(data.xpos[leg.foot][:2], dtype=float)
-    moved = lipm_com(com, vel, cop, omega, t) - com
-    change = (foothold - (hip[:2] + moved)) - (foot - hip[:2])
-    height = max(float(hip[2]) - float(data.xpos[leg.foot][2]), 0.1)
-    # The pelvis' heading: the hip pitch axis is its lateral (y) direction.
-    lateral = np.asarray(data.xaxis[hip_joint][:2], dtype=float)
-    if leg.hip_pitch < 0 or float(np.linalg.norm(lateral)) < 1e-9:
-        lateral = np.array([0.0, 1.0])
-    lateral = lateral / float(np.linalg.norm(lateral))
-    forward = np.array([lateral[1], -lateral[0]])
-    need = 0.0
-    for joint, part in ((leg.hip_pitch, forward @ change), (leg.hip_roll, lateral @ change)):
-        if joint < 0:
-            continue
-        actuators = np.flatnonzero(np.asarray(model.actuator_trnid[:, 0]) == joint)
-        if actuators.size == 0:
-            continue
-        limit = float(np.abs(model.actuator_ctrlrange[actuators[0]]).min())
-        limit *= abs(float(model.actuator_gear[actuators[0], 0])) * torque_share
-        if limit <= 0.0:
-            continue
-        angle = abs(float(part)) / height
-        need = max(need, math.sqrt(QUINTIC_PEAK * angle * axis_inertia(model, data, joint) / limit))
-    return need
