@@ -56,6 +56,7 @@ from typing import Any
 from pushrecovery._validate import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.experiments.validation3d_predict import (
+    CriticalErrors,
     critical_impulse_along,
     predicted_critical_impulses,
     push_lever,
@@ -170,7 +171,7 @@ def measure_critical_impulse(
 
 
 @dataclass(frozen=True)
-class ValidationRow:
+class ValidationRow(CriticalErrors):
     """One azimuth and strategy of the validation.
 
     Attributes
@@ -201,16 +202,6 @@ class ValidationRow:
     bracket: tuple[float, float]
     runs: int
     strategy_used: str
-
-    @property
-    def relative_error(self) -> float:
-        """(measured − predicted)/predicted [-]."""
-        return (self.measured - self.predicted) / self.predicted
-
-    @property
-    def corrected_error(self) -> float:
-        """(measured − corrected)/corrected [-]."""
-        return (self.measured - self.corrected) / self.corrected
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,34 @@ from pushrecovery.ground.support import Support
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.plane import cmp_polygon
 
-__all__ = ["critical_impulse_along", "predicted_critical_impulses", "push_lever"]
+__all__ = [
+    "CriticalErrors",
+    "critical_impulse_along",
+    "predicted_critical_impulses",
+    "push_lever",
+]
+
+
+class CriticalErrors:
+    """The errors of a measured critical impulse against its predictions (a row's mixin).
+
+    The row (a frozen dataclass) has the fields ``measured``, ``predicted`` and ``corrected``
+    [N s].
+    """
+
+    measured: float
+    predicted: float
+    corrected: float
+
+    @property
+    def relative_error(self) -> float:
+        """(measured − predicted)/predicted [-]."""
+        return (self.measured - self.predicted) / self.predicted
+
+    @property
+    def corrected_error(self) -> float:
+        """(measured − corrected)/corrected [-]."""
+        return (self.measured - self.corrected) / self.corrected
 
 
 def critical_impulse_along(

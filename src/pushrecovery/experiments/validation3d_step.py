@@ -48,7 +48,7 @@ import numpy as np
 from pushrecovery._validate import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.experiments.validation3d import DEFAULT_AZIMUTHS
-from pushrecovery.experiments.validation3d_predict import critical_impulse_along
+from pushrecovery.experiments.validation3d_predict import CriticalErrors, critical_impulse_along
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.n_step import step_options, viable_region
@@ -150,7 +150,7 @@ def _stepping_run(params: BodyParams, model: Any, impulse: float, azimuth: float
 
 
 @dataclass(frozen=True)
-class StepRow:
+class StepRow(CriticalErrors):
     """One azimuth of the step column.
 
     Attributes
@@ -185,16 +185,6 @@ class StepRow:
     swing_time: float
     step_length: float
     refit: float = math.nan
-
-    @property
-    def relative_error(self) -> float:
-        """(measured − predicted)/predicted [-]."""
-        return (self.measured - self.predicted) / self.predicted
-
-    @property
-    def corrected_error(self) -> float:
-        """(measured − corrected)/corrected [-]."""
-        return (self.measured - self.corrected) / self.corrected
 
     def cause(self, params: BodyParams) -> str:
         """Name the simple model's assumptions the run broke (module docstring), or ``""``."""

@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, solve_interior
 from pushrecovery.control.mpc._ipm_scales import dual_scales, identify_active
 from pushrecovery.control.mpc.problem import MPCSettings
-from pushrecovery.models.flywheel import flywheel_discrete
+from pushrecovery.control.mpc.riccati import sparse_stages
 from pushrecovery.params import BodyParams
 
 __all__ = ["DUAL_TOL", "IDENTIFY_TOL", "MAX_ITERATIONS", "TOL", "InteriorPointSolver"]
@@ -81,15 +81,7 @@ class InteriorPointSolver:
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
         n = settings.horizon
-        self.a, self.b = flywheel_discrete(params, settings.dt)
-        stage = settings.gamma ** (n - 1 - np.arange(n))  # γ^(N−i), i = 1..N
-        self.wx = np.ascontiguousarray(stage[:, None] * np.asarray(settings.state_weights))
-        self.wu = np.ascontiguousarray(stage[:, None] * np.asarray(settings.input_weights))
-        theta_max = params.flywheel_angle_max
-        self.bounds = np.array(
-            [[params.heel, params.toe], [-params.torque_max, params.torque_max],
-             [-theta_max, theta_max]]
-        )  # fmt: skip
+        self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)
         self.scales, self.feedback = np.empty((n, 7)), np.empty((n, 2, 4))
         dual_scales(self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback)
         self.inputs = np.zeros((n, 2))

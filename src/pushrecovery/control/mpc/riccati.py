@@ -50,7 +50,7 @@ from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 
-__all__ = ["DUAL_TOL", "MAX_PASSES", "PRIMAL_TOL", "RiccatiSolver"]
+__all__ = ["DUAL_TOL", "MAX_PASSES", "PRIMAL_TOL", "RiccatiSolver", "sparse_stages"]
 
 FloatArray = NDArray[np.float64]
 
@@ -65,6 +65,29 @@ DUAL_TOL = 1e-9
 #: ticks and 9.7 ms; 20 passes, 9 ticks and 10.0 ms. 6 keeps the benchmark's worst ticks
 #: (a failed warm start, then the interior point) shortest.
 MAX_PASSES = 6
+
+
+def sparse_stages(
+    params: BodyParams, settings: MPCSettings
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Return the sparse Eq. (17)'s stages: A, B, the weights and the bounds.
+
+    A, B of x_{i+1} = A x_i + B u_i (:func:`~pushrecovery.models.flywheel.flywheel_discrete`);
+    ``wx``, ``wu`` (N, 4) and (N, 2), stage i's weights γ^(N−1−i) Q of x_{i+1} and
+    γ^(N−1−i) R of u_i; ``bounds`` (3, 2), the (lower, upper) bounds of δ [m], τ [N m] and
+    θ [rad].
+    """
+    n = settings.horizon
+    a, b = flywheel_discrete(params, settings.dt)
+    stage = settings.gamma ** (n - 1 - np.arange(n))  # γ^(N−i) of x_i and u_{i−1}, i = 1..N
+    wx = np.ascontiguousarray(stage[:, None] * np.asarray(settings.state_weights))
+    wu = np.ascontiguousarray(stage[:, None] * np.asarray(settings.input_weights))
+    theta_max = params.flywheel_angle_max
+    bounds = np.array(
+        [[params.heel, params.toe], [-params.torque_max, params.torque_max],
+         [-theta_max, theta_max]]
+    )  # fmt: skip
+    return a, b, wx, wu, bounds
 
 
 class RiccatiSolver:
@@ -95,15 +118,7 @@ class RiccatiSolver:
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
         n = settings.horizon
-        self.a, self.b = flywheel_discrete(params, settings.dt)
-        stage = settings.gamma ** (n - 1 - np.arange(n))  # γ^(N−i) of x_i and u_{i−1}, i = 1..N
-        self.wx = np.ascontiguousarray(stage[:, None] * np.asarray(settings.state_weights))
-        self.wu = np.ascontiguousarray(stage[:, None] * np.asarray(settings.input_weights))
-        theta_max = params.flywheel_angle_max
-        self.bounds = np.array(
-            [[params.heel, params.toe], [-params.torque_max, params.torque_max],
-             [-theta_max, theta_max]]
-        )  # fmt: skip
+        self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)
         self.tols = PRIMAL_TOL * (self.bounds[:, 1] - self.bounds[:, 0])
         self.active = np.zeros((n, 3), dtype=np.int8)
         self._guess = np.zeros((n, 3), dtype=np.int8)
