@@ -125,6 +125,22 @@ def test_simulate_biped3d_recovers_a_small_push_and_reports_the_new_keys(capsys)
     assert {"peak_hip_torque", "max_torso_tilt", "after_push", "predicted"} <= set(data)
 
 
+def test_simulate_with_stepping_steps_where_the_balance_strategies_fall(capsys):
+    # 50 N s to the left (1.5 x the ankle's 2-D limit): the whole-body controller falls
+    # without stepping and recovers with one step when --stepping lets it.
+    args = ("--backend", "mujoco", "--model", "biped3d", "--azimuth", "90", "--push", "50",
+            "--duration", "6", "--json")  # fmt: skip
+    code, out, err = run_cli(capsys, "simulate", *args)
+    assert code == 0, err
+    still = json.loads(out)
+    assert still["outcome"] == "fell" and still["steps"] == 0 and still["stepping"] is False
+    code, out, err = run_cli(capsys, "simulate", *args, "--stepping")
+    assert code == 0, err
+    stepped = json.loads(out)
+    assert stepped["recovered"] is True and stepped["steps"] >= 1
+    assert stepped["strategy"] == "step" and stepped["stepping"] is True
+
+
 @pytest.mark.parametrize(
     ("args", "words"),
     [
@@ -135,6 +151,7 @@ def test_simulate_biped3d_recovers_a_small_push_and_reports_the_new_keys(capsys)
         (("campaign", "--backend", "mujoco", "--model", "biped3d", "--out", "x"),
          "campaign needs one of --impulse, --fraction, --xdot"),
         (("validate", "--model", "g1", "--azimuth", "400"), "--azimuth must be in [-360, 360]"),
+        (("simulate", "--model", "foot", "--stepping"), "--stepping applies to the 3-D models"),
     ],
 )  # fmt: skip
 def test_bad_3d_requests_are_one_line_and_exit_2(capsys, args, words):

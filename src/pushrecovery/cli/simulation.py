@@ -95,6 +95,12 @@ __all__ = ["critical_push", "simulate"]
     "beside it (CoM, capture point and CoP drawn; on the 3-D models also the support polygon, "
     "from a tracking camera: --view-azimuth, --view-elevation, --frame-times).",
 )
+@click.option(
+    "--stepping",
+    is_flag=True,
+    default=False,
+    help="3-D models: the whole-body controller may step (docs/humanoid3d.md, Stepping).",
+)
 @_with(*_views)
 @body_options
 def simulate(
@@ -114,6 +120,7 @@ def simulate(
     control_period: float | None,
     plot: str | None,
     render: str | None,
+    stepping: bool,
     view_azimuth: float | None,
     view_elevation: float | None,
     frame_times: str | None,
@@ -127,7 +134,7 @@ def simulate(
     (controller recovery-plane) the body stands on both feet of the ground plane and --y,
     --ydot add the sideways part (--impulse pushes along x). The 3-D models (--backend
     mujoco --model biped3d or g1) take --impulse/--push at the torso at --azimuth and run
-    the whole-body controller (docs/humanoid3d.md).
+    the whole-body controller (docs/humanoid3d.md), with --stepping allowed to step.
     """
     from pushrecovery.control.base import make_controller
     from pushrecovery.sim.backend import Measuring, Recording
@@ -157,8 +164,18 @@ def simulate(
             from pushrecovery.sim.mujoco.render import require_offscreen_gl
 
             require_offscreen_gl()  # fail before the run, not after it
-        emit(_simulate_3d(model, body, impulse, azimuth, duration, render, pictures), as_json)
+        emit(
+            _simulate_3d(model, body, impulse, azimuth, duration, render, pictures, stepping),
+            as_json,
+        )
         return
+    if stepping:
+        from pushrecovery.errors import InvalidParameterError
+
+        raise InvalidParameterError(
+            "--stepping applies to the 3-D models (--backend mujoco --model biped3d or g1); "
+            "the stepping models step with --model stepping or stepping-plane"
+        )
     _check_views(view_azimuth, view_elevation, frame_times)
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)

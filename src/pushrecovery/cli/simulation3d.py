@@ -145,8 +145,11 @@ def _simulate_3d(
     duration: float,
     render: str | None = None,
     render_options: dict[str, Any] | None = None,
+    stepping: bool = False,
 ) -> dict[str, Any]:
     """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON).
+
+    ``stepping``: the controller may step (``wbc_for(plant, stepping=True)``).
 
     With ``render`` (``--render FILE``) the run is recorded and its filmstrip PNG and GIF
     written (``render_options``: :func:`_render_options`).
@@ -163,7 +166,8 @@ def _simulate_3d(
     dvx, dvy = push.delta_velocity(params.mass)
     predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
     plant: Any = make_plant(model, params, "mujoco")
-    run = simulate_push3d(plant, wbc_for(plant), push, duration=duration, record=bool(render))
+    wbc = wbc_for(plant, stepping=stepping)
+    run = simulate_push3d(plant, wbc, push, duration=duration, record=bool(render))
     states, before, after = run.states, run.before_push, run.after_push
     return {
         "recovered": run.recovered,
@@ -194,6 +198,7 @@ def _simulate_3d(
             "measured": [float(after[3] - before[3]), float(after[4] - before[4])],
         },
         "steps": run.steps,
+        "stepping": stepping,
         "strategy": run.strategy_used(),
         "peak_hip_torque": run.peak_hip_torque,
         "peak_hip_motor_torque": run.peak_hip_motor_torque,
