@@ -28,6 +28,7 @@ from pushrecovery import load_params
 from pushrecovery.analysis.base_polygon import FootModel, base_from_params
 from pushrecovery.analysis.c3d import write_c3d
 from pushrecovery.analysis.recording import fixed_feet
+from pushrecovery.control.mpc import MPCSettings
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.ground import Support, rectangle
 from pushrecovery.ground.minkowski import minkowski_sum, regular_polygon
@@ -68,7 +69,8 @@ def _trial_c3d() -> str:
 TRIAL = _trial_csv()
 VALID: dict[str, Any] = {
     "params": P, "support": Support.from_params(P), "x": 0.01, "xdot": 0.1, "y": 0.0,
-    "ydot": 0.0, "omega": P.omega, "dt": 0.01, "t": 0.1, "x0": 0.01, "xdot0": 0.1, "cop": 0.0,
+    "settings": MPCSettings(), "ydot": 0.0, "omega": P.omega, "dt": 0.01, "t": 0.1, "x0": 0.01,
+    "xdot0": 0.1, "cop": 0.0,
     "theta": 0.05, "theta_rate": 0.1, "mass": 72.0, "length": 1.0, "gravity": 9.81,
     "heel": -0.05, "toe": 0.15, "direction": 1.0, "v0": 1.0, "capture": np.array([0.05]),
     "velocity": 0.1, "duration": 0.5, "steps": 1, "swing_time": 0.2, "tolerance": 1e-3,

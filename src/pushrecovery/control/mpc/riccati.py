@@ -45,6 +45,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import require_type
 from pushrecovery.control.mpc._riccati_kernels import solve_from
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
@@ -76,7 +77,14 @@ def sparse_stages(
     ``wx``, ``wu`` (N, 4) and (N, 2), stage i's weights γ^(N−1−i) Q of x_{i+1} and
     γ^(N−1−i) R of u_i; ``bounds`` (3, 2), the (lower, upper) bounds of δ [m], τ [N m] and
     θ [rad].
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``params`` is not a BodyParams or ``settings`` not an MPCSettings.
     """
+    require_type("params", params, BodyParams)
+    require_type("settings", settings, MPCSettings)
     n = settings.horizon
     a, b = flywheel_discrete(params, settings.dt)
     stage = settings.gamma ** (n - 1 - np.arange(n))  # γ^(N−i) of x_i and u_{i−1}, i = 1..N
