@@ -60,8 +60,9 @@ PRIMAL_TOL = 1e-9
 #: Largest wrong-sign multiplier, as the displacement it stands for over the input's range.
 DUAL_TOL = 1e-9
 #: Passes from the warm start before giving up on a tick (the caller then solves it by the
-#: interior point). A pass costs 15-20 µs at N = 50 and a verified warm start takes one or
-#: two; more mostly cycle on the late horizon's flat torques. Measured on the MuJoCo torso's
+#: interior point). A pass costs 10-20 µs at N = 50 and a verified warm start takes one or
+#: two; the others mostly need many more (a median of 25: one wrong-sign row released per
+#: pass), a few cycle. Measured on the MuJoCo torso's
 #: 3 s run (150 ticks): 3 passes, 35 interior-point ticks and 11.7 ms of MPC; 10 passes, 12
 #: ticks and 9.7 ms; 20 passes, 9 ticks and 10.0 ms. 6 keeps the benchmark's worst ticks
 #: (a failed warm start, then the interior point) shortest.
