@@ -6,6 +6,7 @@ import pytest
 from pushrecovery.control.mpc import FlywheelFeasibility, MPCController, MPCSettings
 from pushrecovery.control.mpc import _ipm_kernels as kernels
 from pushrecovery.control.mpc.interior import InteriorPointSolver
+from pushrecovery.errors import ParameterTypeError
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from test_mpc import P, sparse_solution
@@ -207,3 +208,25 @@ def test_boundary_ticks_solved_with_forced_braking_equal_daqp():
         np.testing.assert_allclose(solver.inputs[0] / SCALE, daqp / SCALE, atol=1e-6)
         compared += 1
     assert compared >= 3
+
+
+def test_the_cold_start_is_the_unconstrained_optimum():
+    # The interior point's cold start (its feedback gains, _ipm_scales.dual_scales) is the
+    # unconstrained Eq. (17)'s solution: its first input equals an independent backward
+    # recursion's (test_mpc.riccati_first_input) where no bound binds.
+    from test_mpc import riccati_first_input
+
+    solver = InteriorPointSolver(P, MPCSettings())
+    for x0 in ([0.0, 0.0, 0.05, 0.0], [0.01, 0.02, -0.03, 0.1]):
+        x0 = np.array(x0)
+        np.testing.assert_allclose(solver.feedback[0] @ x0, riccati_first_input(x0), rtol=1e-9)
+
+
+def test_the_sparse_solvers_refuse_what_is_not_a_body_or_settings():
+    from pushrecovery.control.mpc.riccati import RiccatiSolver
+
+    for solver in (InteriorPointSolver, RiccatiSolver):
+        with pytest.raises(ParameterTypeError, match="params"):
+            solver("paper", MPCSettings())
+        with pytest.raises(ParameterTypeError, match="settings"):
+            solver(P, {"horizon": 50})

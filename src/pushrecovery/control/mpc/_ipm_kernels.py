@@ -49,6 +49,16 @@ def _value(u, x, i, j):  # type: ignore[no-untyped-def]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
+def _advance(a, b, x, u, i):  # type: ignore[no-untyped-def]
+    """Write x[i + 1] = A x[i] + B u[i] (the dynamics, Eq. 16 discretised)."""
+    for r in range(4):
+        acc = b[r, 0] * u[i, 0] + b[r, 1] * u[i, 1]
+        for c in range(4):
+            acc += a[r, c] * x[i, c]
+        x[i + 1, r] = acc
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _residuals(  # type: ignore[no-untyped-def]
     a, b, wx, wu, bounds, u, x, nu, sl, su, zl, zu, rdu, rdx, rl, ru, mdu, mdx
 ):
@@ -220,11 +230,7 @@ def _newton(  # type: ignore[no-untyped-def]
             for c in range(4):
                 acc += gain[i, r, c] * dx[i, c]
             du[i, r] = acc
-        for r in range(4):
-            acc = b[r, 0] * du[i, 0] + b[r, 1] * du[i, 1]
-            for c in range(4):
-                acc += a[r, c] * dx[i, c]
-            dx[i + 1, r] = acc
+        _advance(a, b, dx, du, i)
         for r in range(4):
             acc = vec_s[i + 1, r]
             for c in range(4):
@@ -273,11 +279,7 @@ def _start(x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, g
                 for c in range(4):
                     acc += feedback[i, r, c] * x[i, c]
                 u[i, r] = acc
-        for r in range(4):
-            acc = b[r, 0] * u[i, 0] + b[r, 1] * u[i, 1]
-            for c in range(4):
-                acc += a[r, c] * x[i, c]
-            x[i + 1, r] = acc
+        _advance(a, b, x, u, i)
         for r in range(4):
             nu[i, r] = 0.0
         for j in range(3):

@@ -82,8 +82,8 @@ class InteriorPointSolver:
     """
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
+        self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)  # checked
         n = settings.horizon
-        self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)
         self.scales, self.feedback = np.empty((n, 7)), np.empty((n, 2, 4))
         dual_scales(self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback)
         self.inputs = np.zeros((n, 2))

@@ -126,8 +126,8 @@ class RiccatiSolver:
     """
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
+        self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)  # checked
         n = settings.horizon
-        self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)
         self.tols = PRIMAL_TOL * (self.bounds[:, 1] - self.bounds[:, 0])
         self.active = np.zeros((n, 3), dtype=np.int8)
         self._guess = np.zeros((n, 3), dtype=np.int8)
