@@ -44,6 +44,34 @@ def test_grid_order_and_size():
     assert swept.push(5).params.torque_max == 150.0 and swept.push(5).xdot == pytest.approx(0.6)
 
 
+def test_default_batches_are_about_a_second_of_work():
+    from pushrecovery.campaign.spec import COMPILED_BATCH
+    from pushrecovery.sim.batched import BATCHED
+
+    # Every pair the batch runner compiles has its larger default, and no other pair.
+    assert set(COMPILED_BATCH) == set(BATCHED)
+
+    def default(model, controller, samples, backend="analytic"):
+        spec = CampaignSpec(backend, model, controller, P, x0=(0.0, 0.0, 1.0),
+                            xdot=(0.0, 0.5, 1.0), samples=samples)  # fmt: skip
+        return spec.batch, spec.batches
+
+    # Small campaigns keep 100 per batch; from 1,600 pushes the batch grows to keep 16
+    # batches, up to 10,000 (pendulum) or 1,000 (stepping + recovery).
+    assert default("pendulum", "ankle-pd", 1_000) == (100, 10)
+    assert default("pendulum", "ankle-pd", 16_000) == (1_000, 16)
+    assert default("pendulum", "ankle-pd", 16_001) == (1_001, 16)
+    assert default("pendulum", "ankle-pd", 10**6) == (10_000, 100)
+    assert default("lipm", "ankle-pd", 10**6) == (10_000, 100)
+    assert default("stepping", "recovery", 10**5) == (1_000, 100)
+    assert default("stepping", "recovery", 8_000) == (500, 16)
+    # The one-push loop's pairs keep theirs whatever the size.
+    assert default("flywheel", "mpc", 10**6) == (100, 10_000)
+    assert default("pendulum", "ankle-saturated", 10**6)[0] == 100
+    assert default("foot", "ankle-pd", 10**5, backend="mujoco")[0] == 10
+    assert tiny(samples=10**6, batch_size=7).batch == 7  # the spec's own wins
+
+
 def test_impulses_and_random_samples_depend_on_the_seed_only():
     spec = tiny(xdot=None, impulse=(-30.0, 60.0, 7.2))
     assert spec.push(1).xdot == pytest.approx((-30.0 + 7.2) / P.mass)

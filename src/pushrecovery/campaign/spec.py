@@ -62,8 +62,19 @@ BACKENDS: Mapping[str, tuple[str, ...]] = {
 #: Wall time a push may take by default, and at most [s].
 DEFAULT_PUSH_TIMEOUT = 120.0
 MAX_PUSH_TIMEOUT = 3600.0
-#: Pushes per batch when the spec does not say: about a second of work per batch.
+#: Pushes per batch when the spec does not say: about a second of work per batch through the
+#: one-push loop (0.5-2 s on the reference machine, docs/campaigns.md).
 DEFAULT_BATCH = {"analytic": 100, "mujoco": 10}
+#: Largest default batch of the analytic pairs whose batch runs as one compiled loop
+#: (``sim.batched.BATCHED``): about a second of work too (~120 µs per pendulum push, ~30 µs
+#: per LIPM push, ~1 ms per stepping + recovery push). A Dask task costs a few ms of
+#: scheduling and one Parquet file: at 100 such pushes per batch (12 ms of work) that would be
+#: most of a campaign's time.
+COMPILED_BATCH = {("pendulum", "ankle-pd"): 10_000, ("lipm", "ankle-pd"): 10_000,
+                  ("stepping", "recovery"): 1_000}  # fmt: skip
+#: A default batch of a compiled pair grows past ``DEFAULT_BATCH`` only while the campaign
+#: keeps at least this many batches: enough to share among the workers and to resume from.
+MIN_BATCHES = 16
 
 
 @dataclass(frozen=True, slots=True)
@@ -117,7 +128,10 @@ class CampaignSpec:
     duration : float
         Longest simulated time per push [s], > 0.
     batch_size : int or None
-        Pushes per task sent to a worker; ``None``: 100 analytic, 10 MuJoCo.
+        Pushes per task sent to a worker; ``None``: 100 analytic, 10 MuJoCo, and for the
+        pairs run as one compiled loop (``COMPILED_BATCH``) up to 10,000 (``pendulum``,
+        ``lipm`` + ``ankle-pd``) or 1,000 (``stepping`` + ``recovery``) while the campaign
+        keeps 16 batches (:attr:`batch`).
     push_timeout : float
         Wall time one push may take [s], in (0, 3600] (default 120): a push that takes longer
         is an ``error`` row, and a worker that stops answering is stopped
@@ -280,8 +294,19 @@ class CampaignSpec:
 
     @property
     def batch(self) -> int:
-        """Pushes per batch."""
-        return self.batch_size or DEFAULT_BATCH[self.backend]
+        """Pushes per batch: ``batch_size``, else about a second of work (``DEFAULT_BATCH``).
+
+        A compiled pair's default, min(largest, max(100, ⌈size / 16⌉)), keeps scheduling
+        under 1 % of the work at scale (10⁶ pendulum pushes: 100 tasks of ~1.2 s, not 10,000
+        of 12 ms) and a small campaign's batches as they were.
+        """
+        if self.batch_size:
+            return self.batch_size
+        usual = DEFAULT_BATCH[self.backend]
+        largest = COMPILED_BATCH.get((self.model, self.controller), usual)
+        if self.backend != "analytic" or largest == usual:
+            return usual
+        return min(largest, max(usual, -(-self.size // MIN_BATCHES)))
 
     @property
     def batches(self) -> int:

@@ -97,7 +97,11 @@ _scheduler = click.option(
     "--duration", type=float, default=6.0, show_default=True, help="Longest time per push [s]."
 )
 @click.option(
-    "--batch-size", type=int, default=None, help="Pushes per task (default 100 / 10 MuJoCo)."
+    "--batch-size",
+    type=int,
+    default=None,
+    help="Pushes per task (default about a second of work: 100 / 10 MuJoCo; up to 10,000 / "
+    "1,000 for the compiled pendulum, lipm / stepping + recovery pairs).",
 )
 @click.option(
     "--push-timeout",
