@@ -49,7 +49,7 @@ def tiny(monkeypatch) -> None:
 
 
 def test_with_the_extra_the_section_has_polar_plots_tables_and_filmstrips(
-    tiny: None, tmp_path: Path
+    tiny: None, tmp_path: Path, monkeypatch
 ) -> None:
     pytest.importorskip("mujoco")
     try:
@@ -82,6 +82,19 @@ def test_with_the_extra_the_section_has_polar_plots_tables_and_filmstrips(
     other = _Context(load_params(), tmp_path, replace(grids, duration3d=1.4), 1, None)
     section3d.humanoid3d_section(other)
     assert "humanoid3d" not in other.notes
+    # So does other code (a development tree after a controller change): the cache is keyed by
+    # a digest of the package's sources.
+    monkeypatch.setattr(section3d, "_code_fingerprint", lambda: "another")
+    changed = _Context(load_params(), tmp_path, grids, workers=1, scheduler=None)
+    section3d.humanoid3d_section(changed)
+    assert "humanoid3d" not in changed.notes
+
+
+def test_the_code_fingerprint_is_a_digest_of_the_sources() -> None:
+    digest = section3d._code_fingerprint()
+    assert len(digest) == 16 and int(digest, 16) >= 0
+    section3d._code_fingerprint.cache_clear()
+    assert section3d._code_fingerprint() == digest  # the same sources, the same digest
 
 
 def test_the_page_shows_the_section(tiny: None, tmp_path: Path, monkeypatch) -> None:

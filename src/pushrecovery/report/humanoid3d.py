@@ -9,11 +9,13 @@ the report's worker processes); then the filmstrips of :data:`~.config.HUMANOID3
 (:mod:`pushrecovery.sim.mujoco.humanoid3d.render3d`).
 
 Both are kept under ``OUT/humanoid3d`` with the settings they were computed with
-(``*.json``): a rerun with the same settings and body reuses them, as the campaigns do.
+(``*.json``): a rerun with the same settings, body and code (a digest of the package's
+sources) reuses them.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 from dataclasses import asdict, replace
@@ -78,13 +80,32 @@ def _write(path: Path, settings: dict[str, Any], result: dict[str, Any]) -> None
         raise PushRecoveryError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
+@functools.cache
+def _code_fingerprint() -> str:
+    """Return a digest of the package's source files: any change to the code recomputes.
+
+    A development tree would otherwise show a cache computed before a controller change
+    (the version number does not move between commits). About 10 ms, once per process.
+    """
+    import hashlib
+
+    import pushrecovery
+
+    root = Path(pushrecovery.__file__).parent
+    digest = hashlib.sha256()
+    for source in sorted(root.rglob("*.py")):
+        digest.update(source.relative_to(root).as_posix().encode())
+        digest.update(source.read_bytes())
+    return digest.hexdigest()[:16]
+
+
 def _settings(ctx: _Context, model: str, **extra: Any) -> dict[str, Any]:
-    """Return the settings a cached file must match: the body, the grid and ``extra``."""
+    """Return the settings a cached file must match: the body, the grid, ``extra``, the code."""
     from pushrecovery import __version__
 
     body = ctx.params.to_dict() if model == "biped3d" else "robot"
-    return {"cache": _CACHE_VERSION, "version": __version__, "model": model, "body": body,
-            **extra}  # fmt: skip
+    return {"cache": _CACHE_VERSION, "version": __version__, "code": _code_fingerprint(),
+            "model": model, "body": body, **extra}  # fmt: skip
 
 
 def _validate_one(model: str, azimuth: float, strategies: tuple[str, ...], params: Any,
