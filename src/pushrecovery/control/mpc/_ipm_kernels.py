@@ -17,6 +17,10 @@ x_{i+1} − A x_i − B u_i = 0. The Lagrangian's gradient (the dual residual r_
 
 with ν_N = 0. The iterate satisfies the dynamics exactly (it starts from a simulation and
 every Newton step does), so there is no primal residual of the equalities.
+
+A and B have the flywheel's structure (:func:`check_structure`): the CoM (x, ẋ) and the
+flywheel (θ, θ̇) evolve apart, A block-diagonal in that split, and the CoP moves the CoM only
+(B's δ column zero on θ, θ̇). The products skip those zeros, term by term the same sums.
 """
 
 from __future__ import annotations
@@ -40,6 +44,17 @@ _CENTRE = (0.0, 1.0, 0.01)
 _GUIDE_FLOOR, _GUIDE_CENTRE = 0.003, 3.0
 
 
+def check_structure(a: np.ndarray, b: np.ndarray) -> None:
+    """Raise ValueError unless A, B have the zeros the kernels skip (see the module)."""
+    com, wheel = np.ix_([0, 2], [1, 3]), np.ix_([1, 3], [0, 2])
+    if np.any(a[com]) or np.any(a[wheel]) or np.any(b[[1, 3], 0]):
+        raise ValueError(
+            "the interior point's kernels need A block-diagonal in (x, xdot), (theta, "
+            "theta_dot) and B's CoP column zero on theta, theta_dot (the flywheel model's "
+            f"discretisation); got A = {a.tolist()}, B = {b.tolist()}"
+        )
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _value(u, x, i, j):  # type: ignore[no-untyped-def]
     """Return the bounded component j of stage i: δ_i, τ_i or θ_{i+1}."""
@@ -50,10 +65,10 @@ def _value(u, x, i, j):  # type: ignore[no-untyped-def]
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _advance(a, b, x, u, i):  # type: ignore[no-untyped-def]
-    """Write x[i + 1] = A x[i] + B u[i] (the dynamics, Eq. 16 discretised)."""
+    """Write x[i + 1] = A x[i] + B u[i] (the dynamics, Eq. 16 discretised; zeros skipped)."""
     for r in range(4):
-        acc = b[r, 0] * u[i, 0] + b[r, 1] * u[i, 1]
-        for c in range(4):
+        acc = b[r, 0] * u[i, 0] + b[r, 1] * u[i, 1] if r & 1 == 0 else b[r, 1] * u[i, 1]
+        for c in range(r & 1, 4, 2):
             acc += a[r, c] * x[i, c]
         x[i + 1, r] = acc
 
@@ -74,7 +89,7 @@ def _residuals(  # type: ignore[no-untyped-def]
             term = 2.0 * wu[i, c] * u[i, c]
             acc = term - zl[i, c] + zu[i, c]
             size = abs(term) + zl[i, c] + zu[i, c]
-            for r in range(4):
+            for r in range(0, 4, 2 - c):  # B's δ column is zero on rows 1, 3
                 acc -= b[r, c] * nu[i, r]
                 size += abs(b[r, c] * nu[i, r])
             rdu[i, c] = acc
@@ -84,7 +99,7 @@ def _residuals(  # type: ignore[no-untyped-def]
             acc = term + nu[i, c]
             size = abs(term) + abs(nu[i, c])
             if i + 1 < n:
-                for r in range(4):
+                for r in range(c & 1, 4, 2):  # A's column c: the rows of c's block
                     acc -= a[r, c] * nu[i + 1, r]
                     size += abs(a[r, c] * nu[i + 1, r])
             rdx[i, c] = acc
@@ -113,14 +128,12 @@ def _newton(  # type: ignore[no-untyped-def]
     multipliers change by Δν_i = −(S_{i+1} Δx_{i+1} + s_{i+1}). With ``factor`` False the
     matrices (S, K, H⁻¹, S B, A_K) of the last call are reused: only the right-hand side
     changed (Mehrotra's corrector).
+
+    The products skip A and B's zeros (see the module). Returns the largest steps
+    α ≤ 1 that keep the slacks, and the multipliers, nonnegative (Mehrotra's step lengths).
     """
     n = du.shape[0]
-    sa = np.empty((4, 4))
-    h = np.empty((2, 2))
-    g = np.empty((2, 4))
-    gu = np.empty(2)
-    lin_u = np.empty(2)
-    sbk = np.empty(4)
+    sa, sbk = big_s[0], vec_s[0]  # scratch: S_0 and s_0 are never needed (x_0 is given)
     # Cost-to-go of x_N: its own stage cost only.
     i = n - 1
     for r in range(4):
@@ -138,50 +151,48 @@ def _newton(  # type: ignore[no-untyped-def]
         s = big_s[i + 1]
         sb = sbs[i]
         closed = closeds[i]
+        k = gain[i]
         if factor:
+            # S B, S A (A's column c has its nonzeros in rows p, p + 2; B's δ column in 0, 2).
             for r in range(4):
-                for c in range(2):
-                    acc = 0.0
-                    for q in range(4):
-                        acc += s[r, q] * b[q, c]
-                    sb[r, c] = acc
+                sb[r, 0] = s[r, 0] * b[0, 0] + s[r, 2] * b[2, 0]
+                sb[r, 1] = (
+                    s[r, 0] * b[0, 1] + s[r, 1] * b[1, 1] + s[r, 2] * b[2, 1] + s[r, 3] * b[3, 1]
+                )
                 for c in range(4):
-                    acc = 0.0
-                    for q in range(4):
-                        acc += s[r, q] * a[q, c]
-                    sa[r, c] = acc
-            for r in range(2):
-                for c in range(2):
-                    acc = 0.0
-                    for q in range(4):
-                        acc += b[q, r] * sb[q, c]
-                    h[r, c] = acc
-                rdiag[i, r] = 2.0 * wu[i, r] + zl[i, r] / sl[i, r] + zu[i, r] / su[i, r]
-                h[r, r] += rdiag[i, r]
-                for c in range(4):
-                    acc = 0.0
-                    for q in range(4):
-                        acc += b[q, r] * sa[q, c]
-                    g[r, c] = acc
-            det = h[0, 0] * h[1, 1] - h[0, 1] * h[1, 0]
-            hinv[i, 0, 0], hinv[i, 1, 1] = h[1, 1] / det, h[0, 0] / det
-            hinv[i, 0, 1] = hinv[i, 1, 0] = -h[0, 1] / det
-            for r in range(2):
-                for c in range(4):
-                    gain[i, r, c] = -(hinv[i, r, 0] * g[0, c] + hinv[i, r, 1] * g[1, c])
+                    p = c & 1
+                    sa[r, c] = s[r, p] * a[p, c] + s[r, p + 2] * a[p + 2, c]
+            # H = B^T S B + R̃ (its two off-diagonal sums kept apart, as computed), G = B^T S A.
+            d0 = 2.0 * wu[i, 0] + zl[i, 0] / sl[i, 0] + zu[i, 0] / su[i, 0]
+            d1 = 2.0 * wu[i, 1] + zl[i, 1] / sl[i, 1] + zu[i, 1] / su[i, 1]
+            rdiag[i, 0], rdiag[i, 1] = d0, d1
+            h00 = b[0, 0] * sb[0, 0] + b[2, 0] * sb[2, 0] + d0
+            h01 = b[0, 0] * sb[0, 1] + b[2, 0] * sb[2, 1]
+            h10 = b[0, 1] * sb[0, 0] + b[1, 1] * sb[1, 0] + b[2, 1] * sb[2, 0] + b[3, 1] * sb[3, 0]
+            h11 = b[0, 1] * sb[0, 1] + b[1, 1] * sb[1, 1] + b[2, 1] * sb[2, 1] + b[3, 1] * sb[3, 1]
+            h11 += d1
+            det = h00 * h11 - h01 * h10
+            i00, i11, i01 = h11 / det, h00 / det, -h01 / det
+            hinv[i, 0, 0], hinv[i, 1, 1], hinv[i, 0, 1], hinv[i, 1, 0] = i00, i11, i01, i01
+            for c in range(4):
+                g0 = b[0, 0] * sa[0, c] + b[2, 0] * sa[2, c]
+                g1 = b[0, 1] * sa[0, c] + b[1, 1] * sa[1, c] + b[2, 1] * sa[2, c]
+                g1 += b[3, 1] * sa[3, c]
+                k[0, c] = -(i00 * g0 + i01 * g1)
+                k[1, c] = -(i01 * g0 + i11 * g1)
         # The linear term of u_i (without B^T s), the feed-forward k_i.
-        for r in range(2):
-            lin_u[r] = (
-                rdu[i, r]
-                - (cl[i, r] - zl[i, r] * rl[i, r]) / sl[i, r]
-                + (cu[i, r] - zu[i, r] * ru[i, r]) / su[i, r]
-            )
-            acc = lin_u[r]
-            for q in range(4):
-                acc += b[q, r] * vec_s[i + 1, q]
-            gu[r] = acc
-        for r in range(2):
-            off[i, r] = -(hinv[i, r, 0] * gu[0] + hinv[i, r, 1] * gu[1])
+        d0, d1 = rdiag[i, 0], rdiag[i, 1]
+        lin0 = rdu[i, 0] - (cl[i, 0] - zl[i, 0] * rl[i, 0]) / sl[i, 0]
+        lin0 += (cu[i, 0] - zu[i, 0] * ru[i, 0]) / su[i, 0]
+        lin1 = rdu[i, 1] - (cl[i, 1] - zl[i, 1] * rl[i, 1]) / sl[i, 1]
+        lin1 += (cu[i, 1] - zu[i, 1] * ru[i, 1]) / su[i, 1]
+        v = vec_s[i + 1]
+        gu0 = lin0 + b[0, 0] * v[0] + b[2, 0] * v[2]
+        gu1 = lin1 + b[0, 1] * v[0] + b[1, 1] * v[1] + b[2, 1] * v[2] + b[3, 1] * v[3]
+        hi = hinv[i]
+        k0 = -(hi[0, 0] * gu0 + hi[0, 1] * gu1)
+        k1 = -(hi[1, 0] * gu0 + hi[1, 1] * gu1)
+        off[i, 0], off[i, 1] = k0, k1
         if i == 0:
             break
         # x_i's cost-to-go under u = K x + k, in Joseph's form (a sum of positive semidefinite
@@ -189,71 +200,69 @@ def _newton(  # type: ignore[no-untyped-def]
         # S_i = Q̃_{i−1} + A_K^T S A_K + K^T R̃ K, s_i = g_{x,i−1} + A_K^T (S B k + s) +
         # K^T (R̃ k + g_u), A_K = A + B K.
         if factor:
-            for r in range(4):
-                for c in range(4):
-                    closed[r, c] = a[r, c] + b[r, 0] * gain[i, 0, c] + b[r, 1] * gain[i, 1, c]
+            for c in range(4):
+                for r in range(0, 4, 2):  # B's δ column is zero on rows 1, 3
+                    closed[r, c] = a[r, c] + b[r, 0] * k[0, c] + b[r, 1] * k[1, c]
+                    closed[r + 1, c] = a[r + 1, c] + b[r + 1, 1] * k[1, c]
         for r in range(4):
-            sbk[r] = vec_s[i + 1, r] + sb[r, 0] * off[i, 0] + sb[r, 1] * off[i, 1]
-        rk0 = rdiag[i, 0] * off[i, 0] + lin_u[0]
-        rk1 = rdiag[i, 1] * off[i, 1] + lin_u[1]
+            sbk[r] = v[r] + sb[r, 0] * k0 + sb[r, 1] * k1
+        rk0 = d0 * k0 + lin0
+        rk1 = d1 * k1 + lin1
         for r in range(4):
-            acc = gain[i, 0, r] * rk0 + gain[i, 1, r] * rk1 + rdx[i - 1, r]
-            for q in range(4):
-                acc += closed[q, r] * sbk[q]
-            vec_s[i, r] = acc
+            vec_s[i, r] = (
+                k[0, r] * rk0 + k[1, r] * rk1 + rdx[i - 1, r] + closed[0, r] * sbk[0]
+                + closed[1, r] * sbk[1] + closed[2, r] * sbk[2] + closed[3, r] * sbk[3]
+            )  # fmt: skip
         vec_s[i, 1] -= (cl[i - 1, 2] - zl[i - 1, 2] * rl[i - 1, 2]) / sl[i - 1, 2] - (
             cu[i - 1, 2] - zu[i - 1, 2] * ru[i - 1, 2]
         ) / su[i - 1, 2]
         if factor:
             for r in range(4):
                 for c in range(4):
-                    sa[r, c] += sb[r, 0] * gain[i, 0, c] + sb[r, 1] * gain[i, 1, c]  # S A_K
+                    sa[r, c] += sb[r, 0] * k[0, c] + sb[r, 1] * k[1, c]  # S A_K
             nxt = big_s[i]
             for r in range(4):
                 for c in range(r, 4):
-                    acc = (
-                        rdiag[i, 0] * gain[i, 0, r] * gain[i, 0, c]
-                        + rdiag[i, 1] * gain[i, 1, r] * gain[i, 1, c]
-                    )
+                    acc = d0 * k[0, r] * k[0, c] + d1 * k[1, r] * k[1, c]
                     for q in range(4):
                         acc += closed[q, r] * sa[q, c]
                     nxt[r, c] = acc
                     nxt[c, r] = acc
                 nxt[r, r] += 2.0 * wx[i - 1, r]
             nxt[1, 1] += zl[i - 1, 2] / sl[i - 1, 2] + zu[i - 1, 2] / su[i - 1, 2]
-    # Forward: Δx_0 = 0.
+    # Forward: Δx_0 = 0; the step lengths on the way.
     for c in range(4):
         dx[0, c] = 0.0
+    primal = dual = 1.0
     for i in range(n):
+        k = gain[i]
         for r in range(2):
             acc = off[i, r]
             for c in range(4):
-                acc += gain[i, r, c] * dx[i, c]
+                acc += k[r, c] * dx[i, c]
             du[i, r] = acc
         _advance(a, b, dx, du, i)
+        s = big_s[i + 1]
         for r in range(4):
-            acc = vec_s[i + 1, r]
-            for c in range(4):
-                acc += big_s[i + 1, r, c] * dx[i + 1, c]
-            dnu[i, r] = -acc
+            dnu[i, r] = -(
+                vec_s[i + 1, r] + s[r, 0] * dx[i + 1, 0] + s[r, 1] * dx[i + 1, 1]
+                + s[r, 2] * dx[i + 1, 2] + s[r, 3] * dx[i + 1, 3]
+            )  # fmt: skip
         for j in range(3):
             dv = du[i, j] if j < 2 else dx[i + 1, 1]
-            dsl[i, j] = dv + rl[i, j]
-            dsu[i, j] = -dv + ru[i, j]
-            dzl[i, j] = (cl[i, j] - zl[i, j] * dsl[i, j]) / sl[i, j]
-            dzu[i, j] = (cu[i, j] - zu[i, j] * dsu[i, j]) / su[i, j]
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def _max_step(values, steps):  # type: ignore[no-untyped-def]
-    """Largest α ≤ 1 with values + α steps ≥ 0 (values > 0)."""
-    alpha = 1.0
-    n, m = values.shape
-    for i in range(n):
-        for j in range(m):
-            if steps[i, j] < 0.0:
-                alpha = min(alpha, -values[i, j] / steps[i, j])
-    return alpha
+            dsl[i, j] = dl = dv + rl[i, j]
+            dsu[i, j] = dh = -dv + ru[i, j]
+            dzl[i, j] = el = (cl[i, j] - zl[i, j] * dl) / sl[i, j]
+            dzu[i, j] = eh = (cu[i, j] - zu[i, j] * dh) / su[i, j]
+            if dl < 0.0:
+                primal = min(primal, -sl[i, j] / dl)
+            if dh < 0.0:
+                primal = min(primal, -su[i, j] / dh)
+            if el < 0.0:
+                dual = min(dual, -zl[i, j] / el)
+            if eh < 0.0:
+                dual = min(dual, -zu[i, j] / eh)
+    return primal, dual
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -355,11 +364,10 @@ def solve_interior(  # type: ignore[no-untyped-def]
             for j in range(3):
                 cl[i, j] = -sl[i, j] * zl[i, j]
                 cu[i, j] = -su[i, j] * zu[i, j]
-        _newton(a, b, wx, wu, sl, su, zl, zu, rdu, rdx, rl, ru, cl, cu, True,
-                big_s, gain, hinv, vec_s, sbs, closeds, off, rdiag, du, dx, dnu, dsl, dsu, dzl,
-                dzu)  # fmt: skip
-        alpha = min(_max_step(sl, dsl), _max_step(su, dsu))
-        alpha = min(alpha, _max_step(zl, dzl), _max_step(zu, dzu))
+        primal, dual = _newton(a, b, wx, wu, sl, su, zl, zu, rdu, rdx, rl, ru, cl, cu, True,
+                               big_s, gain, hinv, vec_s, sbs, closeds, off, rdiag, du, dx, dnu,
+                               dsl, dsu, dzl, dzu)  # fmt: skip
+        alpha = min(primal, dual)
         mu_aff = 0.0
         for i in range(n):
             for j in range(3):
@@ -371,11 +379,11 @@ def solve_interior(  # type: ignore[no-untyped-def]
             for j in range(3):
                 cl[i, j] = sigma * mu - sl[i, j] * zl[i, j] - dsl[i, j] * dzl[i, j]
                 cu[i, j] = sigma * mu - su[i, j] * zu[i, j] - dsu[i, j] * dzu[i, j]
-        _newton(a, b, wx, wu, sl, su, zl, zu, rdu, rdx, rl, ru, cl, cu, False,
-                big_s, gain, hinv, vec_s, sbs, closeds, off, rdiag, du, dx, dnu, dsl, dsu, dzl,
-                dzu)  # fmt: skip
-        primal = min(1.0, _FRACTION * min(_max_step(sl, dsl), _max_step(su, dsu)))
-        dual = min(1.0, _FRACTION * min(_max_step(zl, dzl), _max_step(zu, dzu)))
+        primal, dual = _newton(a, b, wx, wu, sl, su, zl, zu, rdu, rdx, rl, ru, cl, cu, False,
+                               big_s, gain, hinv, vec_s, sbs, closeds, off, rdiag, du, dx, dnu,
+                               dsl, dsu, dzl, dzu)  # fmt: skip
+        primal = min(1.0, _FRACTION * primal)
+        dual = min(1.0, _FRACTION * dual)
         for i in range(n):
             for r in range(2):
                 u[i, r] += primal * du[i, r]

@@ -36,7 +36,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, solve_interior
+from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, check_structure, solve_interior
 from pushrecovery.control.mpc._ipm_scales import dual_scales, identify_active
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.riccati import sparse_stages
@@ -83,6 +83,7 @@ class InteriorPointSolver:
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
         self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)  # checked
+        check_structure(self.a, self.b)  # the zeros the kernels skip
         n = settings.horizon
         self.scales, self.feedback = np.empty((n, 7)), np.empty((n, 2, 4))
         dual_scales(self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback)
