@@ -129,11 +129,17 @@ def _newton(  # type: ignore[no-untyped-def]
     matrices (S, K, H⁻¹, S B, A_K) of the last call are reused: only the right-hand side
     changed (Mehrotra's corrector).
 
-    The products skip A and B's zeros (see the module). Returns the largest steps
-    α ≤ 1 that keep the slacks, and the multipliers, nonnegative (Mehrotra's step lengths).
+    The products skip A and B's zeros (see the module); the recursions keep a stage's
+    matrices and vectors in scalars. Returns the largest steps α ≤ 1 that keep the slacks,
+    and the multipliers, nonnegative (Mehrotra's step lengths).
     """
     n = du.shape[0]
-    sa, sbk = big_s[0], vec_s[0]  # scratch: S_0 and s_0 are never needed (x_0 is given)
+    # A, B's entries (the kernels' zeros skipped in the products below).
+    a00, a01, a02, a03 = a[0, 0], a[0, 1], a[0, 2], a[0, 3]
+    a10, a11, a12, a13 = a[1, 0], a[1, 1], a[1, 2], a[1, 3]
+    a20, a21, a22, a23 = a[2, 0], a[2, 1], a[2, 2], a[2, 3]
+    a30, a31, a32, a33 = a[3, 0], a[3, 1], a[3, 2], a[3, 3]
+    b00, b20, b01, b11, b21, b31 = b[0, 0], b[2, 0], b[0, 1], b[1, 1], b[2, 1], b[3, 1]
     # Cost-to-go of x_N: its own stage cost only.
     i = n - 1
     for r in range(4):
@@ -153,33 +159,104 @@ def _newton(  # type: ignore[no-untyped-def]
         closed = closeds[i]
         k = gain[i]
         if factor:
-            # S B, S A (A's column c has its nonzeros in rows p, p + 2; B's δ column in 0, 2).
-            for r in range(4):
-                sb[r, 0] = s[r, 0] * b[0, 0] + s[r, 2] * b[2, 0]
-                sb[r, 1] = (
-                    s[r, 0] * b[0, 1] + s[r, 1] * b[1, 1] + s[r, 2] * b[2, 1] + s[r, 3] * b[3, 1]
-                )
-                for c in range(4):
-                    p = c & 1
-                    sa[r, c] = s[r, p] * a[p, c] + s[r, p + 2] * a[p + 2, c]
-            # H = B^T S B + R̃ (its two off-diagonal sums kept apart, as computed), G = B^T S A.
+            # Stage i's factors in scalars: between array stores, numba's arrays (which may alias)
+            # would be reloaded. The same sums, in the same order, as the loops they unroll.
+            s00, s01, s02, s03 = s[0, 0], s[0, 1], s[0, 2], s[0, 3]
+            s10, s11, s12, s13 = s[1, 0], s[1, 1], s[1, 2], s[1, 3]
+            s20, s21, s22, s23 = s[2, 0], s[2, 1], s[2, 2], s[2, 3]
+            s30, s31, s32, s33 = s[3, 0], s[3, 1], s[3, 2], s[3, 3]
+            # S B, S A (A's column c: rows c & 1 and (c & 1) + 2; B's δ column: rows 0, 2).
+            q00, q01 = s00 * b00 + s02 * b20, s00 * b01 + s01 * b11 + s02 * b21 + s03 * b31
+            q10, q11 = s10 * b00 + s12 * b20, s10 * b01 + s11 * b11 + s12 * b21 + s13 * b31
+            q20, q21 = s20 * b00 + s22 * b20, s20 * b01 + s21 * b11 + s22 * b21 + s23 * b31
+            q30, q31 = s30 * b00 + s32 * b20, s30 * b01 + s31 * b11 + s32 * b21 + s33 * b31
+            t00, t01 = s00 * a00 + s02 * a20, s01 * a11 + s03 * a31
+            t02, t03 = s00 * a02 + s02 * a22, s01 * a13 + s03 * a33
+            t10, t11 = s10 * a00 + s12 * a20, s11 * a11 + s13 * a31
+            t12, t13 = s10 * a02 + s12 * a22, s11 * a13 + s13 * a33
+            t20, t21 = s20 * a00 + s22 * a20, s21 * a11 + s23 * a31
+            t22, t23 = s20 * a02 + s22 * a22, s21 * a13 + s23 * a33
+            t30, t31 = s30 * a00 + s32 * a20, s31 * a11 + s33 * a31
+            t32, t33 = s30 * a02 + s32 * a22, s31 * a13 + s33 * a33
+            # H = B^T S B + R̃ (its off-diagonal sums kept apart, as computed), K = −H⁻¹ B^T S A.
             d0 = 2.0 * wu[i, 0] + zl[i, 0] / sl[i, 0] + zu[i, 0] / su[i, 0]
             d1 = 2.0 * wu[i, 1] + zl[i, 1] / sl[i, 1] + zu[i, 1] / su[i, 1]
             rdiag[i, 0], rdiag[i, 1] = d0, d1
-            h00 = b[0, 0] * sb[0, 0] + b[2, 0] * sb[2, 0] + d0
-            h01 = b[0, 0] * sb[0, 1] + b[2, 0] * sb[2, 1]
-            h10 = b[0, 1] * sb[0, 0] + b[1, 1] * sb[1, 0] + b[2, 1] * sb[2, 0] + b[3, 1] * sb[3, 0]
-            h11 = b[0, 1] * sb[0, 1] + b[1, 1] * sb[1, 1] + b[2, 1] * sb[2, 1] + b[3, 1] * sb[3, 1]
-            h11 += d1
+            h00 = b00 * q00 + b20 * q20 + d0
+            h01 = b00 * q01 + b20 * q21
+            h10 = b01 * q00 + b11 * q10 + b21 * q20 + b31 * q30
+            h11 = b01 * q01 + b11 * q11 + b21 * q21 + b31 * q31 + d1
             det = h00 * h11 - h01 * h10
             i00, i11, i01 = h11 / det, h00 / det, -h01 / det
             hinv[i, 0, 0], hinv[i, 1, 1], hinv[i, 0, 1], hinv[i, 1, 0] = i00, i11, i01, i01
-            for c in range(4):
-                g0 = b[0, 0] * sa[0, c] + b[2, 0] * sa[2, c]
-                g1 = b[0, 1] * sa[0, c] + b[1, 1] * sa[1, c] + b[2, 1] * sa[2, c]
-                g1 += b[3, 1] * sa[3, c]
-                k[0, c] = -(i00 * g0 + i01 * g1)
-                k[1, c] = -(i01 * g0 + i11 * g1)
+            g0, g1 = b00 * t00 + b20 * t20, b01 * t00 + b11 * t10 + b21 * t20 + b31 * t30
+            e0, f0 = -(i00 * g0 + i01 * g1), -(i01 * g0 + i11 * g1)
+            g0, g1 = b00 * t01 + b20 * t21, b01 * t01 + b11 * t11 + b21 * t21 + b31 * t31
+            e1, f1 = -(i00 * g0 + i01 * g1), -(i01 * g0 + i11 * g1)
+            g0, g1 = b00 * t02 + b20 * t22, b01 * t02 + b11 * t12 + b21 * t22 + b31 * t32
+            e2, f2 = -(i00 * g0 + i01 * g1), -(i01 * g0 + i11 * g1)
+            g0, g1 = b00 * t03 + b20 * t23, b01 * t03 + b11 * t13 + b21 * t23 + b31 * t33
+            e3, f3 = -(i00 * g0 + i01 * g1), -(i01 * g0 + i11 * g1)
+            sb[0, 0], sb[0, 1] = q00, q01
+            sb[1, 0], sb[1, 1] = q10, q11
+            sb[2, 0], sb[2, 1] = q20, q21
+            sb[3, 0], sb[3, 1] = q30, q31
+            k[0, 0], k[0, 1], k[0, 2], k[0, 3] = e0, e1, e2, e3
+            k[1, 0], k[1, 1], k[1, 2], k[1, 3] = f0, f1, f2, f3
+            if i > 0:
+                # x_i's cost-to-go under u = K x + k, S_i in Joseph's form (a sum of positive
+                # semidefinite terms: the shortcut A^T S A + G^T K loses definiteness to
+                # rounding at N = 200): S_i = Q̃_{i−1} + A_K^T S A_K + K^T R̃ K, A_K = A + B K.
+                c00, c01 = a00 + b00 * e0 + b01 * f0, a01 + b00 * e1 + b01 * f1
+                c02, c03 = a02 + b00 * e2 + b01 * f2, a03 + b00 * e3 + b01 * f3
+                closed[0, 0], closed[0, 1], closed[0, 2], closed[0, 3] = c00, c01, c02, c03
+                c10, c11, c12, c13 = a10 + b11 * f0, a11 + b11 * f1, a12 + b11 * f2, a13 + b11 * f3
+                closed[1, 0], closed[1, 1], closed[1, 2], closed[1, 3] = c10, c11, c12, c13
+                c20, c21 = a20 + b20 * e0 + b21 * f0, a21 + b20 * e1 + b21 * f1
+                c22, c23 = a22 + b20 * e2 + b21 * f2, a23 + b20 * e3 + b21 * f3
+                closed[2, 0], closed[2, 1], closed[2, 2], closed[2, 3] = c20, c21, c22, c23
+                c30, c31, c32, c33 = a30 + b31 * f0, a31 + b31 * f1, a32 + b31 * f2, a33 + b31 * f3
+                closed[3, 0], closed[3, 1], closed[3, 2], closed[3, 3] = c30, c31, c32, c33
+                p00, p01 = t00 + (q00 * e0 + q01 * f0), t01 + (q00 * e1 + q01 * f1)
+                p02, p03 = t02 + (q00 * e2 + q01 * f2), t03 + (q00 * e3 + q01 * f3)
+                p10, p11 = t10 + (q10 * e0 + q11 * f0), t11 + (q10 * e1 + q11 * f1)
+                p12, p13 = t12 + (q10 * e2 + q11 * f2), t13 + (q10 * e3 + q11 * f3)
+                p20, p21 = t20 + (q20 * e0 + q21 * f0), t21 + (q20 * e1 + q21 * f1)
+                p22, p23 = t22 + (q20 * e2 + q21 * f2), t23 + (q20 * e3 + q21 * f3)
+                p30, p31 = t30 + (q30 * e0 + q31 * f0), t31 + (q30 * e1 + q31 * f1)
+                p32, p33 = t32 + (q30 * e2 + q31 * f2), t33 + (q30 * e3 + q31 * f3)
+                nxt = big_s[i]
+                m = d0 * e0 * e0 + d1 * f0 * f0 + c00 * p00 + c10 * p10 + c20 * p20
+                m += c30 * p30
+                nxt[0, 0] = m + 2.0 * wx[i - 1, 0]
+                m = d0 * e0 * e1 + d1 * f0 * f1 + c00 * p01 + c10 * p11 + c20 * p21
+                m += c30 * p31
+                nxt[0, 1] = nxt[1, 0] = m
+                m = d0 * e0 * e2 + d1 * f0 * f2 + c00 * p02 + c10 * p12 + c20 * p22
+                m += c30 * p32
+                nxt[0, 2] = nxt[2, 0] = m
+                m = d0 * e0 * e3 + d1 * f0 * f3 + c00 * p03 + c10 * p13 + c20 * p23
+                m += c30 * p33
+                nxt[0, 3] = nxt[3, 0] = m
+                m = d0 * e1 * e1 + d1 * f1 * f1 + c01 * p01 + c11 * p11 + c21 * p21
+                m += c31 * p31
+                nxt[1, 1] = m + 2.0 * wx[i - 1, 1]
+                m = d0 * e1 * e2 + d1 * f1 * f2 + c01 * p02 + c11 * p12 + c21 * p22
+                m += c31 * p32
+                nxt[1, 2] = nxt[2, 1] = m
+                m = d0 * e1 * e3 + d1 * f1 * f3 + c01 * p03 + c11 * p13 + c21 * p23
+                m += c31 * p33
+                nxt[1, 3] = nxt[3, 1] = m
+                m = d0 * e2 * e2 + d1 * f2 * f2 + c02 * p02 + c12 * p12 + c22 * p22
+                m += c32 * p32
+                nxt[2, 2] = m + 2.0 * wx[i - 1, 2]
+                m = d0 * e2 * e3 + d1 * f2 * f3 + c02 * p03 + c12 * p13 + c22 * p23
+                m += c32 * p33
+                nxt[2, 3] = nxt[3, 2] = m
+                m = d0 * e3 * e3 + d1 * f3 * f3 + c03 * p03 + c13 * p13 + c23 * p23
+                m += c33 * p33
+                nxt[3, 3] = m + 2.0 * wx[i - 1, 3]
+                nxt[1, 1] += zl[i - 1, 2] / sl[i - 1, 2] + zu[i - 1, 2] / su[i - 1, 2]
         # The linear term of u_i (without B^T s), the feed-forward k_i.
         d0, d1 = rdiag[i, 0], rdiag[i, 1]
         lin0 = rdu[i, 0] - (cl[i, 0] - zl[i, 0] * rl[i, 0]) / sl[i, 0]
@@ -195,61 +272,45 @@ def _newton(  # type: ignore[no-untyped-def]
         off[i, 0], off[i, 1] = k0, k1
         if i == 0:
             break
-        # x_i's cost-to-go under u = K x + k, in Joseph's form (a sum of positive semidefinite
-        # terms: the shortcut A^T S A + G^T K loses definiteness to rounding at N = 200):
-        # S_i = Q̃_{i−1} + A_K^T S A_K + K^T R̃ K, s_i = g_{x,i−1} + A_K^T (S B k + s) +
-        # K^T (R̃ k + g_u), A_K = A + B K.
-        if factor:
-            for c in range(4):
-                for r in range(0, 4, 2):  # B's δ column is zero on rows 1, 3
-                    closed[r, c] = a[r, c] + b[r, 0] * k[0, c] + b[r, 1] * k[1, c]
-                    closed[r + 1, c] = a[r + 1, c] + b[r + 1, 1] * k[1, c]
-        for r in range(4):
-            sbk[r] = v[r] + sb[r, 0] * k0 + sb[r, 1] * k1
+        # s_i = g_{x,i−1} + A_K^T (S B k + s) + K^T (R̃ k + g_u), Joseph's form as S_i's.
+        t0 = v[0] + sb[0, 0] * k0 + sb[0, 1] * k1
+        t1 = v[1] + sb[1, 0] * k0 + sb[1, 1] * k1
+        t2 = v[2] + sb[2, 0] * k0 + sb[2, 1] * k1
+        t3 = v[3] + sb[3, 0] * k0 + sb[3, 1] * k1
         rk0 = d0 * k0 + lin0
         rk1 = d1 * k1 + lin1
         for r in range(4):
             vec_s[i, r] = (
-                k[0, r] * rk0 + k[1, r] * rk1 + rdx[i - 1, r] + closed[0, r] * sbk[0]
-                + closed[1, r] * sbk[1] + closed[2, r] * sbk[2] + closed[3, r] * sbk[3]
+                k[0, r] * rk0 + k[1, r] * rk1 + rdx[i - 1, r] + closed[0, r] * t0
+                + closed[1, r] * t1 + closed[2, r] * t2 + closed[3, r] * t3
             )  # fmt: skip
         vec_s[i, 1] -= (cl[i - 1, 2] - zl[i - 1, 2] * rl[i - 1, 2]) / sl[i - 1, 2] - (
             cu[i - 1, 2] - zu[i - 1, 2] * ru[i - 1, 2]
         ) / su[i - 1, 2]
-        if factor:
-            for r in range(4):
-                for c in range(4):
-                    sa[r, c] += sb[r, 0] * k[0, c] + sb[r, 1] * k[1, c]  # S A_K
-            nxt = big_s[i]
-            for r in range(4):
-                for c in range(r, 4):
-                    acc = d0 * k[0, r] * k[0, c] + d1 * k[1, r] * k[1, c]
-                    for q in range(4):
-                        acc += closed[q, r] * sa[q, c]
-                    nxt[r, c] = acc
-                    nxt[c, r] = acc
-                nxt[r, r] += 2.0 * wx[i - 1, r]
-            nxt[1, 1] += zl[i - 1, 2] / sl[i - 1, 2] + zu[i - 1, 2] / su[i - 1, 2]
-    # Forward: Δx_0 = 0; the step lengths on the way.
+    # Forward: Δx_0 = 0, the step lengths on the way. Δx_i in scalars (not through memory).
+    x0 = x1 = x2 = x3 = 0.0
     for c in range(4):
         dx[0, c] = 0.0
     primal = dual = 1.0
     for i in range(n):
         k = gain[i]
-        for r in range(2):
-            acc = off[i, r]
-            for c in range(4):
-                acc += k[r, c] * dx[i, c]
-            du[i, r] = acc
-        _advance(a, b, dx, du, i)
+        u0 = off[i, 0] + k[0, 0] * x0 + k[0, 1] * x1 + k[0, 2] * x2 + k[0, 3] * x3
+        u1 = off[i, 1] + k[1, 0] * x0 + k[1, 1] * x1 + k[1, 2] * x2 + k[1, 3] * x3
+        # Δx_{i+1} = A Δx_i + B Δu_i, as in _advance.
+        y0 = b00 * u0 + b01 * u1 + a00 * x0 + a02 * x2
+        y1 = b11 * u1 + a11 * x1 + a13 * x3
+        y2 = b20 * u0 + b21 * u1 + a20 * x0 + a22 * x2
+        y3 = b31 * u1 + a31 * x1 + a33 * x3
+        x0, x1, x2, x3 = y0, y1, y2, y3
+        du[i, 0], du[i, 1] = u0, u1
+        dx[i + 1, 0], dx[i + 1, 1], dx[i + 1, 2], dx[i + 1, 3] = x0, x1, x2, x3
         s = big_s[i + 1]
         for r in range(4):
             dnu[i, r] = -(
-                vec_s[i + 1, r] + s[r, 0] * dx[i + 1, 0] + s[r, 1] * dx[i + 1, 1]
-                + s[r, 2] * dx[i + 1, 2] + s[r, 3] * dx[i + 1, 3]
-            )  # fmt: skip
+                vec_s[i + 1, r] + s[r, 0] * x0 + s[r, 1] * x1 + s[r, 2] * x2 + s[r, 3] * x3
+            )
         for j in range(3):
-            dv = du[i, j] if j < 2 else dx[i + 1, 1]
+            dv = u0 if j == 0 else (u1 if j == 1 else x1)
             dsl[i, j] = dl = dv + rl[i, j]
             dsu[i, j] = dh = -dv + ru[i, j]
             dzl[i, j] = el = (cl[i, j] - zl[i, j] * dl) / sl[i, j]
