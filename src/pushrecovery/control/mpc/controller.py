@@ -25,6 +25,8 @@ __all__ = ["MPCController"]
 
 #: Riccati passes allowed to verify an interior-point iterate's active set.
 POLISH_PASSES = 3
+#: Warm passes on the tick after one whose warm passes failed (see plan()).
+PASSES_AFTER_FAILURE = 2
 #: Relative widening of θmax for the interior point on the viable set's boundary: enough for
 #: an interior, small enough that its active set is the problem's (with full braking held).
 RELAXED = 1e-3
@@ -161,10 +163,11 @@ class MPCController(Controller):
         # riccati.active holds its optimal set (kept by a failed solve) to start DAQP from.
         previous_verified = riccati is not None and riccati.verified
         # After a tick the warm passes failed, the next one's fail too 88 % of the time (the
-        # benchmark's runs): two passes, then the interior point (one: the benchmark's p99
-        # 19-21x the median, MuJoCo torso + MPC 0.41-0.43x MuJoCo alone; two: 19-24x, 0.51-
-        # 0.55x; six: 19-26x, 0.49x; interleaved on a loaded machine).
-        passes = 2 if self._passes_failed else MAX_PASSES
+        # benchmark's runs): PASSES_AFTER_FAILURE passes, then the interior point. With 15
+        # passes otherwise (quiet machine): 1 gave 6.2 ms of MPC on the MuJoCo torso's 3 s
+        # run, 2 gave 4.8 ms, 4 4.9 ms, 8 4.7 ms but the benchmark's p99 at N = 50 18.8x the
+        # median (2: 14.1x), 15 4.9 ms and 20.6x.
+        passes = PASSES_AFTER_FAILURE if self._passes_failed else MAX_PASSES
         self._passes_failed = riccati is not None and not riccati.solve(state, max_passes=passes)
         if riccati is not None and not self._passes_failed:
             # Fresh arrays each verified solve: the plan keeps them as they are.

@@ -60,13 +60,14 @@ PRIMAL_TOL = 1e-9
 #: Largest wrong-sign multiplier, as the displacement it stands for over the input's range.
 DUAL_TOL = 1e-9
 #: Passes from the warm start before giving up on a tick (the caller then solves it by the
-#: interior point). A pass costs 10-20 µs at N = 50 and a verified warm start takes one or
-#: two; the others mostly need many more (a median of 25: one wrong-sign row released per
-#: pass), a few cycle. Measured on the MuJoCo torso's
-#: 3 s run (150 ticks): 3 passes, 35 interior-point ticks and 11.7 ms of MPC; 10 passes, 12
-#: ticks and 9.7 ms; 20 passes, 9 ticks and 10.0 ms. 6 keeps the benchmark's worst ticks
-#: (a failed warm start, then the interior point) shortest.
-MAX_PASSES = 6
+#: interior point). A pass costs 6-9 µs at N = 50 and a verified warm start takes one or two;
+#: the others mostly need many more (a median of 25: the violated rows added at once overshoot
+#: and the wrong-sign rows are released one per pass), a few cycle. Measured after the interior
+#: point's iteration fell to 8 µs (quiet machine, best of 7): on the MuJoCo torso's 3 s run
+#: (150 ticks) 6 passes gave 27 interior-point ticks and 5.7 ms of MPC, 10 gave 5.0 ms, 15
+#: gave 4.7 ms (11 ticks), 20 gave 4.9 ms and 30 gave 5.2 ms; the flywheel benchmark's median,
+#: p99 and largest tick at N = 50, 100 and 200 were the same within 5 % for 6 and 15.
+MAX_PASSES = 15
 
 
 def sparse_stages(
