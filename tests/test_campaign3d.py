@@ -150,7 +150,6 @@ def test_cli_validate_on_the_biped3d(capsys, tmp_path):
           "--controller", "wbc-hip", "--impulse", "5", "5", "1", "--out", "x"), "not both"),
         (("validate", "--model", "biped3d", "--azimuths", "0,360"), "repeats"),
         (("validate", "--model", "biped3d", "--fractions", "1,0.5"), "--fractions must be"),
-        (("validate", "--model", "g1", "--strategy", "step"), "no critical push on the g1"),
         (("validate", "--backend", "analytic", "--model", "biped3d"), "use --backend mujoco"),
         (("validate", "--azimuths", "0,90"), "need a 3-D model"),
     ],

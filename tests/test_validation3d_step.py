@@ -68,6 +68,56 @@ def test_row_errors_and_cause(params):
     assert close.cause(params) == ""
 
 
+@pytest.fixture(scope="module")
+def g1():
+    """The G1's validation plant; skipped without MuJoCo or the robots extra."""
+    pytest.importorskip("mujoco")
+    from pushrecovery.sim.mujoco.humanoid3d import robots
+
+    try:
+        robots.robot_path("g1")
+    except robots.RobotsExtraMissing:
+        pytest.skip("the robots extra is not installed")
+    from pushrecovery.experiments.validation3d import validation_plant
+
+    return validation_plant("g1")
+
+
+def test_the_g1_steps_beyond_its_ankles_and_short_of_the_one_step_prediction(g1):
+    """Forward: the G1 with stepping stands pushes its CoP region cannot hold.
+
+    The CoP region's plain limit m ω (toe − x₀) is above what the G1's ankles hold (10.3 N s
+    against 15.2, docs/validation.md): stepping must stand more than that, and less than the
+    one-step region's plain prediction.
+    """
+    p = g1.params
+    ankle = p.mass * p.omega * (p.toe - g1.reset()[0])
+    measured, bracket, runs, run = measure_step_critical(
+        p, 0.0, guess=30.0, rel_tolerance=0.2, duration=2.0, plant=g1
+    )
+    assert bracket[0] == measured < bracket[1] <= measured + 0.2 * 30.0 + 1e-9
+    assert ankle < measured < predicted_step_critical(p, 0.0, origin=tuple(g1.reset()[:2]))
+    assert run.stood and run.steps >= 1 and run.step_length > 0.1
+    assert runs <= 12
+
+
+def test_cli_validates_the_g1s_step_column(g1, tmp_path, capsys):
+    import json
+
+    from pushrecovery.cli import main
+
+    args = ["validate", "--model", "g1", "--strategy", "step", "--azimuth", "90",
+            "--rel-tolerance", "0.3", "--duration", "2", "--no-confusion", "--json",
+            "--out", str(tmp_path)]  # fmt: skip
+    with pytest.raises(SystemExit) as done:
+        main(args)
+    assert done.value.code in (0, None)
+    data = json.loads(capsys.readouterr().out)
+    (row,) = data["step_critical"]
+    assert row["azimuth"] == 90.0 and row["measured"] > 0.0 and row["steps"] >= 0
+    assert (tmp_path / "validation3d_g1_step.md").exists()
+
+
 @pytest.mark.parametrize(
     ("call", "name"),
     [
@@ -82,6 +132,8 @@ def test_row_errors_and_cause(params):
         (lambda p: run_step_validation("0"), "azimuths"),
         (lambda p: run_step_validation([0.0], params="body"), "params"),
         (lambda p: run_step_validation([0.0], rel_tolerance=0.0), "rel_tolerance"),
+        (lambda p: run_step_validation([0.0], model="h1"), "model"),
+        (lambda p: measure_step_critical(p, 0.0, guess=10.0, plant="biped"), "plant"),
     ],
 )
 def test_bad_inputs(params, call, name):

@@ -273,18 +273,12 @@ def _validate_3d(
     from pushrecovery.cli.campaign3d import azimuths_from
     from pushrecovery.cli.simulation3d import _params_3d
     from pushrecovery.cli.validate3d import QUICK, Validate3DOptions, fraction_list, validate_3d
-    from pushrecovery.errors import InvalidParameterError
     from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
 
-    if "step" in strategies and model != "biped3d":
-        raise InvalidParameterError(
-            f"--strategy step has no critical push on the {model} yet (its stepping does not "
-            "recover); use --model biped3d"
-        )
     quick_values: dict[str, Any] = QUICK if quick else {}
     directions = azimuths_from(azimuth, azimuths) or quick_values.get("azimuths", DEFAULT_AZIMUTHS)
-    # The G1's hip and step are not validated yet (docs/validation.md): its ankle by default.
-    usual = ("ankle",) if model == "g1" else ("ankle", "hip", "step")
+    # The G1's hip task recovers nothing (docs/validation.md): its ankle and step by default.
+    usual = ("ankle", "step") if model == "g1" else ("ankle", "hip", "step")
     chosen = strategies or quick_values.get("strategies", usual)
     chosen = chosen if critical else ()
     options = Validate3DOptions(

@@ -1,7 +1,7 @@
 """The 3-D models of ``validate`` (biped3d, g1): the polar validation and the confusion matrix.
 
 ``validate --model biped3d|g1``: each strategy's critical push per azimuth against the 2-D
-prediction (:mod:`pushrecovery.experiments.validation3d`, and for the biped3d's step
+prediction (:mod:`pushrecovery.experiments.validation3d`, and for the step
 :mod:`pushrecovery.experiments.validation3d_step`: tables and one polar plot), then a 3-D
 campaign over azimuths × fractions of the ankle's predicted critical push under the
 whole-body controller with all its tasks, read as the confusion matrix of predicted against
@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import csv
 import itertools
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -49,8 +50,6 @@ QUICK = {
 
 def fraction_list(text: str | None, default: tuple[float, ...]) -> tuple[float, ...]:
     """Parse ``--fractions A,B,...``: 1 to 50 distinct numbers in (0, 20], increasing."""
-    import math
-
     from pushrecovery.errors import InvalidParameterError
 
     if text is None:
@@ -101,6 +100,7 @@ def validate_3d(options: Validate3DOptions, params: Any) -> dict[str, Any]:
 
         step = run_step_validation(
             options.azimuths,
+            model=options.model,
             params=params,
             rel_tolerance=max(options.rel_tolerance, 0.02),
             duration=options.duration,
@@ -143,7 +143,7 @@ def _step_row(row: Any, step: Any) -> dict[str, Any]:
         "steps": row.steps,
         "swing_time": row.swing_time,
         "step_length": row.step_length,
-        "refit": row.refit,
+        "refit": None if math.isnan(row.refit) else row.refit,  # no step landed: JSON null
         "cause": row.cause(step.params),
     }
 

@@ -75,6 +75,7 @@ __all__ = [
     "predicted_critical_impulses",
     "push_lever",
     "run_validation3d",
+    "validation_plant",
 ]
 
 #: Push azimuths of the validation [deg]: every 30°.
@@ -267,9 +268,29 @@ class Validation3D:
         return "\n".join(lines)
 
 
-def _plant(model: str, params: BodyParams | None) -> Any:
+def validation_plant(model: str, params: BodyParams | None = None) -> Any:
+    """Return the 3-D plant that ``model`` is validated on.
+
+    Parameters
+    ----------
+    model : str
+        ``biped3d`` (its body ``params``, default the ``paper`` preset) or ``g1`` (``params``
+        None or the robot's own; needs the ``robots`` extra).
+    params : BodyParams, optional
+        The body.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``model`` is not one of :data:`MODELS`, or ``params`` is not a BodyParams (or not
+        the G1's own).
+    """
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, G1Plant
 
+    if model not in MODELS:
+        raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
+    if params is not None:
+        require_type("params", params, BodyParams)
     if model == "biped3d":
         if params is None:
             from pushrecovery.presets import load_params
@@ -330,7 +351,7 @@ def run_validation3d(
     duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
     if params is not None:
         require_type("params", params, BodyParams)
-    plant = _plant(model, params)
+    plant = validation_plant(model, params)
     body = plant.params
     state = plant.reset()
     origin = (float(state[0]), float(state[1]))

@@ -1,8 +1,8 @@
 r"""The step column of the 3-D validation: the critical push with stepping, from every direction.
 
 Issue 19 item 5 (the step column beside :mod:`~pushrecovery.experiments.validation3d`'s ankle
-and hip columns). For the generated biped (``biped3d``) and each push azimuth ψ (0 forward +x,
-90 left +y, degrees):
+and hip columns). For a 3-D model (the generated ``biped3d``, or the ``g1`` with the ``robots``
+extra) and each push azimuth ψ (0 forward +x, 90 left +y, degrees):
 
 **Predicted** (the library's one-step capturability, :mod:`pushrecovery.surfaces.n_step`). A push
 J at ψ puts the capture point of the standing body (CoM ground point r₀) at
@@ -19,8 +19,9 @@ along ψ. Beside the +y edge of C₁ for a left step of a rectangle foot, ρ = w
 (w the foot's width, s the stance width, l the reach).
 **Corrected** (the push's height, as the ankle and hip columns): J*/(1 + d/z₀).
 
-**Measured.** The largest impulse at ψ the biped stands (:func:`~.wbc_push.push_biped3d`
-with ``stepping=True``, ankles and steps, no hip task) by ``runs3d.bisect_critical``: a run
+**Measured.** The largest impulse at ψ the body stands (:func:`~.wbc_push.push_humanoid` at
+the plant's pushed body, its whole-body controller with ``stepping=True``: ankles and steps,
+no hip task) by ``runs3d.bisect_critical``: a run
 *falls* when the CoM drops below 0.7 z₀ or the torso tilts more than 1 rad within
 ``duration``, or ends with ξ more than :data:`FALL_MARGIN` outside the support polygon of the
 feet it stands on then (the plant's fall set, ``plant3d``, is measured against the feet at
@@ -113,15 +114,48 @@ class SteppingRun:
     step_length: float
 
 
-def _stepping_run(params: BodyParams, model: Any, impulse: float, azimuth: float,
-                  duration: float, swing_time: float | None) -> SteppingRun:  # fmt: skip
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import push_biped3d
+@dataclass(frozen=True)
+class _Body:
+    """What a stepping run needs of a 3-D body: its model, standing pose and named bodies."""
+
+    params: BodyParams
+    model: Any
+    qpos: Any
+    feet: tuple[str, ...]
+    torso: str  # the pushed body
+    upright: str  # the body the controller holds upright
+
+
+def _body(params: BodyParams, model: Any = None, plant: Any = None) -> _Body:
+    """Return the ``plant``'s body (a Humanoid3DPlant), else the biped3d of ``params``."""
+    if plant is not None:
+        from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
+
+        require_type("plant", plant, Humanoid3DPlant)
+        if plant.params != params:
+            raise InvalidParameterError("plant must be of the body params (plant.params)")
+        return _Body(params, plant.model, plant.qpos, plant.feet, plant.torso, plant.upright)
+    from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos
+
+    model = biped3d_model(params) if model is None else model
+    feet = tuple(f"{side}_foot" for side in SIDES)
+    return _Body(params, model, bent_knee_qpos(model), feet, "torso", "torso")
+
+
+def _stepping_run(body: _Body, impulse: float, azimuth: float, duration: float,
+                  swing_time: float | None) -> SteppingRun:  # fmt: skip
+    import mujoco
+
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import push_humanoid
     from pushrecovery.sim.mujoco.humanoid3d.wbc_step import StepSettings
 
-    settings = StepSettings(swing_time=swing_time)
-    run = push_biped3d(params, impulse, math.radians(azimuth), duration=duration, model=model,
-                       stepping=True, step_settings=settings)  # fmt: skip
-    controller = run.controller
+    controller = WholeBodyController(body.model, body.feet, body.upright, stepping=True,
+                                     params=body.params,
+                                     step_settings=StepSettings(swing_time=swing_time))  # fmt: skip
+    run = push_humanoid(body.model, body.qpos, controller, body.feet, body.torso, impulse,
+                        math.radians(azimuth), duration=duration)  # fmt: skip
     height = float(run.com[0, 2])
     down = bool(np.any(run.com[:, 2] < 0.7 * height)) or float(run.torso_tilt.max()) > 1.0
     xi = run.com[-1, :2] + run.com_velocity[-1, :2] / controller.omega
@@ -130,13 +164,15 @@ def _stepping_run(params: BodyParams, model: Any, impulse: float, azimuth: float
     stepper = controller.stepper
     assert stepper is not None
     landed = [s for s in stepper.steps if s.landed is not None]
-    # Each foothold's distance from the stance ankle (the reach R of (S1)); the feet start
-    # under the hips, ±stance_width/2 to the side of the ankles' midpoint.
-    where = {"left_foot": np.array([0.0, 0.5 * params.stance_width]),
-             "right_foot": np.array([0.0, -0.5 * params.stance_width])}  # fmt: skip
+    # Each foothold's distance from the stance foot's (the reach R of (S1)), from where the
+    # feet stood (the foot bodies' origins, as ``StepRecord.landed``).
+    data = mujoco.MjData(body.model)
+    data.qpos[:] = body.qpos
+    mujoco.mj_kinematics(body.model, data)
+    where = {foot: np.array(data.xpos[body.model.body(foot).id][:2]) for foot in body.feet}
     reaches = []
     for step in landed:
-        other = "right_foot" if step.foot == "left_foot" else "left_foot"
+        (other,) = (foot for foot in body.feet if foot != step.foot)
         assert step.landed is not None
         reaches.append(float(np.linalg.norm(step.landed - where[other])))
         where[step.foot] = step.landed
@@ -194,7 +230,7 @@ class StepRow(CriticalErrors):
         if self.swing_time > params.min_step_time + 0.02:
             causes.append(f"swing {self.swing_time:.2f} s > Δt_s {params.min_step_time:g} s")
         if self.step_length < 0.8 * params.max_step_length:
-            causes.append(f"step {self.step_length:.2f} m < reach {params.max_step_length:g} m")
+            causes.append(f"step {self.step_length:.2f} m < reach {params.max_step_length:.3g} m")
         if self.steps > 1:
             causes.append(f"{self.steps} steps")
         return "; ".join(causes)
@@ -253,17 +289,19 @@ def measure_step_critical(
     duration: float = 3.0,
     model: Any = None,
     swing_time: float | None = None,
+    plant: Any = None,
 ) -> tuple[float, tuple[float, float], int, SteppingRun]:
-    """Bisect the largest impulse at ``azimuth`` [deg] the biped stands with stepping.
+    """Bisect the largest impulse at ``azimuth`` [deg] the body stands with stepping.
 
     The bracket starts at 0.5 and 1.0 × ``guess`` [N s] (> 0), widens (×0.7 down, ×1.3 up)
     until it holds a stand and a fall, then halves to ``rel_tolerance`` × guess (in [1e-3,
     0.5]); ``duration`` [s] in (0, 60] after a push at 0.1 s (module docstring); the
     controller's shortest swing ``swing_time`` [s] (``StepSettings``; None: the body's
-    ``min_step_time``). Returns the measured impulse, the bracket, the runs made and the run
-    at the measured impulse.
+    ``min_step_time``). The body: ``plant``'s (a 3-D plant, ``Biped3DPlant`` or ``G1Plant``,
+    of ``params``), else the biped3d of ``params`` (``model``: its compiled
+    ``biped3d_model(params)`` to reuse). Returns the measured impulse, the bracket, the runs
+    made and the run at the measured impulse.
     """
-    from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical
     from pushrecovery.sim.push import IMPULSE_MAX, Push3D
 
@@ -272,7 +310,7 @@ def measure_step_critical(
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-3, 0.5)
     duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
     Push3D(0.0, azimuth)  # checks the azimuth
-    model = biped3d_model(params) if model is None else model
+    body = _body(params, model, plant)
     done: dict[float, SteppingRun] = {}
 
     def stands(impulse: float) -> tuple[bool, str]:
@@ -280,7 +318,7 @@ def measure_step_critical(
             raise InvalidParameterError(
                 f"guess {guess:g} N s: no stand/fall bracket within {MAX_RUNS} runs"
             )
-        done[impulse] = _stepping_run(params, model, impulse, azimuth, duration, swing_time)
+        done[impulse] = _stepping_run(body, impulse, azimuth, duration, swing_time)
         return done[impulse].stood, "step" if done[impulse].steps else "ankle"
 
     low, bracket, _ = bisect_critical(stands, 0.5 * guess, guess, rel_tolerance * guess,
@@ -291,19 +329,22 @@ def measure_step_critical(
 def run_step_validation(
     azimuths: Sequence[float] = DEFAULT_AZIMUTHS,
     *,
+    model: str = "biped3d",
     params: BodyParams | None = None,
     rel_tolerance: float = 0.02,
     duration: float = 3.0,
     swing_time: float | None = None,
 ) -> StepValidation:
-    """Predict and measure the step critical impulse of the biped3d at each azimuth.
+    """Predict and measure the step critical impulse of a 3-D model at each azimuth.
 
     Parameters
     ----------
     azimuths : sequence of float
         ψ [deg], each in [−360, 360]; 1 to 72 of them.
+    model : str
+        ``biped3d`` or ``g1`` (needs the ``robots`` extra: ``RobotsExtraMissing`` otherwise).
     params : BodyParams, optional
-        The body (default the ``paper`` preset).
+        The biped3d's body (default the ``paper`` preset); the G1's must be its own.
     rel_tolerance : float
         The bisection's width as a fraction of the corrected prediction, in [1e-3, 0.5].
     duration : float
@@ -317,22 +358,22 @@ def run_step_validation(
     InvalidParameterError
         Naming the bad argument.
     """
+    from pushrecovery.experiments.validation3d import MODELS, validation_plant
     from pushrecovery.experiments.validation3d_predict import push_lever
-    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant
 
+    if model not in MODELS:
+        raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
     if isinstance(azimuths, str) or not isinstance(azimuths, Sequence):
         raise InvalidParameterError("azimuths must be a sequence of angles [deg]")
     if not 1 <= len(azimuths) <= 72:
         raise InvalidParameterError(f"azimuths must hold 1 to 72 angles, got {len(azimuths)}")
     angles = [bounded_float("azimuths", a, -360.0, 360.0, "deg") for a in azimuths]
-    if params is None:
-        from pushrecovery.presets import load_params
-
-        params = load_params()
-    require_type("params", params, BodyParams)
+    if params is not None:
+        require_type("params", params, BodyParams)
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-3, 0.5)
     duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
-    plant = Biped3DPlant(params)
+    plant = validation_plant(model, params)
+    params = plant.params
     state = plant.reset()
     origin = (float(state[0]), float(state[1]))
     lever, height = push_lever(plant)
@@ -342,7 +383,7 @@ def run_step_validation(
         predicted = predicted_step_critical(params, angle, origin=origin)
         measured, bracket, runs, run = measure_step_critical(
             params, angle, guess=factor * predicted, rel_tolerance=rel_tolerance,
-            duration=duration, model=plant.model, swing_time=swing_time,
+            duration=duration, swing_time=swing_time, plant=plant,
         )  # fmt: skip
         refit = math.nan
         if run.step_length > 0.0:

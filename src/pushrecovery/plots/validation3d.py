@@ -29,7 +29,7 @@ STRATEGY_COLOURS = {"ankle": RECOVER_COLOUR, "hip": HIP_COLOUR, "step": "#1565c0
 def validation3d_figure(result: Validation3D | None, step: StepValidation | None = None) -> Figure:
     """Return the polar plot of ``result`` and the step column ``step`` as a Figure.
 
-    Either may be None (not both); the step column is the biped3d's
+    Either may be None (not both); the step column is a model's
     (:func:`~pushrecovery.experiments.validation3d_step.run_step_validation`).
     """
     from matplotlib.figure import Figure
