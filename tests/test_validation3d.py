@@ -117,6 +117,18 @@ def test_polar_figure_draws_a_synthetic_result():
     fig = validation3d_figure(result)
     assert fig.axes[0].name == "polar"
     assert len(fig.axes[0].get_lines()) >= 2
+    assert fig.axes[0].get_title().startswith("biped3d:")
+
+
+def test_polar_figure_of_a_step_column_alone_is_titled_by_its_model():
+    from pushrecovery.experiments.validation3d_step import StepRow, StepValidation
+    from pushrecovery.plots.validation3d import validation3d_figure
+
+    rows = tuple(StepRow(a, 40.0, 30.0, 25.0, (25.0, 25.5), 6, 1, 0.2, 0.4)
+                 for a in (0.0, 90.0, 180.0, 270.0))  # fmt: skip
+    step = StepValidation(load_params(), rows, (0.0, 0.0), 0.3, 0.7, 0.02, 3.0, "g1")
+    fig = validation3d_figure(None, step)
+    assert fig.axes[0].get_title().startswith("g1:")
 
 
 def test_biped3d_ankle_critical_push_forward_and_left():

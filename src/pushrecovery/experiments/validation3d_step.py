@@ -243,7 +243,7 @@ class StepValidation:
     Attributes
     ----------
     params : BodyParams
-        The biped's body.
+        The body.
     rows : tuple of StepRow
         By azimuth.
     origin : (float, float)
@@ -252,6 +252,8 @@ class StepValidation:
         d and z₀ of the correction [m].
     rel_tolerance, duration : float
         The bisection's width (fraction of the corrected prediction) and each run's time [s].
+    model : str
+        The 3-D model measured (``biped3d`` or ``g1``).
     """
 
     params: BodyParams
@@ -261,6 +263,7 @@ class StepValidation:
     standing_height: float
     rel_tolerance: float
     duration: float
+    model: str = "biped3d"
 
     def to_table(self) -> str:
         """Return the rows as a markdown table (impulses [N s], errors in %)."""
@@ -392,4 +395,5 @@ def run_step_validation(
                                                      step_time=run.swing_time)  # fmt: skip
         rows.append(StepRow(angle, predicted, factor * predicted, measured, bracket, runs,
                             run.steps, run.swing_time, run.step_length, refit))  # fmt: skip
-    return StepValidation(params, tuple(rows), origin, lever, height, rel_tolerance, duration)
+    return StepValidation(params, tuple(rows), origin, lever, height, rel_tolerance, duration,
+                          model)  # fmt: skip

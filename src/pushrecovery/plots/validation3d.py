@@ -68,7 +68,7 @@ def validation3d_figure(result: Validation3D | None, step: StepValidation | None
     ax.set_theta_zero_location("E")
     ax.set_theta_direction(1)
     ax.set_rlabel_position(112.5)
-    model = result.model if result is not None else "biped3d"
+    model = result.model if result is not None else step.model if step is not None else ""
     ax.set_title(f"{model}: critical push [N s] by azimuth (0° forward, 90° left)", pad=18)
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.28), ncol=2, fontsize="small")
     fig.subplots_adjust(bottom=0.22)
