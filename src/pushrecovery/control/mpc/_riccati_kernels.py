@@ -23,6 +23,14 @@ rows they are reduced against u_i: at most two independent ones fix u_i's part i
 to stage i − 1 (τ_i and θ_{i+1} both at a bound: a row on θ_i, θ̇_i). Rows carried to x_0, which
 is given, make the active set infeasible. The multipliers are the dual of this: the unknown ones
 are carried back in λ (λ = l + L w) until a stage's stationarity fixes them.
+
+Speed. A and B have the flywheel's structure (:func:`check_structure`): A block-diagonal in
+(x, ẋ) and (θ, θ̇), B's CoP column zero on θ, θ̇. The products skip those zeros, and a
+stage's matrices stay in scalars (numba reloads arrays, which may alias, after every store):
+term by term the same sums in the same order as plain loops, so the same results (a skipped
+term is ±0, which leaves a nonzero sum as it is; a sum the loops started from 0.0 keeps that
+start, ``0.0 + …``, so that an all-zero one stays +0). A solve's scratch is allocated once
+(:func:`_scratch`), not per pass.
 """
 
 from __future__ import annotations
@@ -36,336 +44,392 @@ OPTIMAL, CHANGED, DEGENERATE = 0, 1, -1
 CARRIED = 5
 #: Relative size under which a row is dependent on the pivots, or a pivot is missing.
 RANK_TOL = 1e-10
+# Unknown multipliers carried back in λ at once (_multipliers' columns).
+_WIDTH = CARRIED + 1
+# The scratch's float rows (see _scratch): _backward's rows (c^T x_i + d^T u_i = e as
+# c0..c3, d0, d1, e; a stage's candidates, then from _PENDING the rows carried to the stage
+# before), then _multipliers' L (λ's columns), the Jacobian and right-hand side of a stage's
+# inactive inputs' equations, and from _EX one row per multiplier (3 i + j): its recorded
+# expression's coefficients, constant (_CONST) and value (_VALUE).
+_PENDING = CARRIED + 2
+_ROWS = _PENDING + CARRIED
+_LC = _ROWS
+_JAC = _LC + 4
+_RHS = _JAC + 2
+_EX = _RHS + 1
+_CONST, _VALUE = _WIDTH, _WIDTH + 1
+# The int rows: one per multiplier (its expression's unknowns' ids, their count (_COUNT), and
+# in column _ORDER the order the expressions were recorded in); then the live unknowns' ids and
+# flags.
+_COUNT, _ORDER = _WIDTH, _WIDTH + 1
+
+
+def check_structure(a: np.ndarray, b: np.ndarray) -> None:
+    """Raise ValueError unless A, B have the zeros the kernels skip (see the module)."""
+    com, wheel = np.ix_([0, 2], [1, 3]), np.ix_([1, 3], [0, 2])
+    if np.any(a[com]) or np.any(a[wheel]) or np.any(b[[1, 3], 0]):
+        raise ValueError(
+            "the Riccati passes' kernels need A block-diagonal in (x, xdot), (theta, "
+            "theta_dot) and B's CoP column zero on theta, theta_dot (the flywheel model's "
+            f"discretisation); got A = {a.tolist()}, B = {b.tolist()}"
+        )
 
 
 @numba.njit(cache=True, nogil=True)
-def _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature):  # type: ignore[no-untyped-def]
+def _scratch(n):  # type: ignore[no-untyped-def]
+    """Return the passes' scratch at horizon ``n``: floats, ints and the rows' origins.
+
+    Three arrays rather than one per purpose, indexed as the constants above say: an
+    allocation, or a view, costs tens of ns, a pass a few µs. Nothing is read before it is
+    written in the same pass, so the contents need no initialisation.
+    """
+    total = 3 * n
+    floats = np.empty((_EX + total, _WIDTH + 2))
+    ints = np.empty((total + 2, _WIDTH + 2), dtype=np.int64)
+    origins = np.empty(_ROWS, dtype=np.int64)  # the stage of the θ row a carried row comes from
+    return floats, ints, origins
+
+
+@numba.njit(cache=True, nogil=True)
+def _entry(ata, g0r, g1r, er, fr, kh0r, kh1r, g0c, g1c, ec, fc):  # type: ignore[no-untyped-def]
+    """P_i[r, c] = (A^T S A)[r, c] + (G^T K)[r, c] + (K^T G)[r, c] + (K^T H K)[r, c], as summed."""
+    acc = ata + (g0r * ec + g1r * fc)
+    acc += er * g0c + fr * g1c
+    acc += kh0r * ec + kh1r * fc
+    return acc
+
+
+@numba.njit(cache=True, nogil=True)
+def _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, rows, origins):  # type: ignore[no-untyped-def]
     """Riccati recursion with the active rows as equalities; the number of rows left on x_0.
 
     −i − 2: the rows of stage i are over-determined (a carried row reduced to 0 = e).
 
     Writes u_i = gains[i] x_i + offsets[i] and the diagonal of the stage's input Hessian
     H = diag(wu_i) + B^T S_{i+1} B (the scale of its multipliers) into ``curvature[i]``; the
-    rows carried to x_0 into ``rows_c`` (CARRIED, 4), ``rows_e``. Per stage, with
+    rows in ``rows`` (the scratch's floats) and ``origins`` (:func:`_scratch`). Per stage, with
     S = P_{i+1} + diag(wx_i), s = p_{i+1} (cost-to-go x^T P x + 2 p^T x): u = T z + F x + f (the
     pivot rows fix F, f; T spans the free directions), z minimises T^T [H u + B^T S A x + B^T s]
     = 0, and P_i = A^T S A + G^T K + K^T G + K^T H K, p_i = A^T (S B k + s) + K^T (H k + B^T s)
-    with G = B^T S A and u = K x + k.
+    with G = B^T S A and u = K x + k. P (symmetric: its upper triangle), p and the stage's
+    matrices are scalars; A's and B's zeros are skipped (see the module).
     """
     n = wx.shape[0]
-    cost = np.zeros((4, 4))
-    lin = np.zeros(4)
-    s = np.empty((4, 4))
-    sb = np.empty((4, 2))
-    sa = np.empty((4, 4))
-    h = np.empty((2, 2))
-    g = np.empty((2, 4))
-    hs = np.empty(2)
-    feed = np.empty((2, 4))
-    ff = np.empty(2)
-    t = np.empty(2)
-    rc = np.empty((CARRIED + 2, 4))  # candidate rows c^T x_i + d^T u_i = e
-    rd = np.empty((CARRIED + 2, 2))
-    re = np.empty(CARRIED + 2)
-    pc = np.empty((2, 4))
-    pd = np.empty((2, 2))
-    pe = np.empty(2)
-    pend_c = np.empty((CARRIED, 4))  # rows on x_{i+1}
-    pend_e = np.empty(CARRIED)
-    pend_o = np.empty(CARRIED, dtype=np.int64)  # the stage of the θ row a carried row comes from
-    ro = np.empty(CARRIED + 2, dtype=np.int64)
-    po = np.empty(2, dtype=np.int64)
+    a00, a02, a20, a22 = a[0, 0], a[0, 2], a[2, 0], a[2, 2]  # A's (x, ẋ) block
+    a11, a13, a31, a33 = a[1, 1], a[1, 3], a[3, 1], a[3, 3]  # its (θ, θ̇) block
+    b00, b20, b01, b11, b21, b31 = b[0, 0], b[2, 0], b[0, 1], b[1, 1], b[2, 1], b[3, 1]
+    # x_N's cost-to-go: none beyond its stage's weight.
+    p00 = p01 = p02 = p03 = p11 = p12 = p13 = p22 = p23 = p33 = 0.0
+    l0 = l1 = l2 = l3 = 0.0
     npend = 0
     for i in range(n - 1, -1, -1):
-        for r in range(4):
-            for c in range(4):
-                s[r, c] = cost[r, c]
-            s[r, r] += wx[i, r]
-        for r in range(4):
-            for c in range(2):
-                acc = 0.0
-                for q in range(4):
-                    acc += s[r, q] * b[q, c]
-                sb[r, c] = acc
-            for c in range(4):
-                acc = 0.0
-                for q in range(4):
-                    acc += s[r, q] * a[q, c]
-                sa[r, c] = acc
-        for r in range(2):
-            for c in range(2):
-                acc = 0.0
-                for q in range(4):
-                    acc += b[q, r] * sb[q, c]
-                h[r, c] = acc
-            h[r, r] += wu[i, r]
-            for c in range(4):
-                acc = 0.0
-                for q in range(4):
-                    acc += b[q, r] * sa[q, c]
-                g[r, c] = acc
-            acc = 0.0
-            for q in range(4):
-                acc += b[q, r] * lin[q]
-            hs[r] = acc
-        curvature[i, 0], curvature[i, 1] = h[0, 0], h[1, 1]
+        # S = P + diag(wx_i) (off the diagonal, P's own entries).
+        s00, s11, s22, s33 = p00 + wx[i, 0], p11 + wx[i, 1], p22 + wx[i, 2], p33 + wx[i, 3]
+        # S B (B's CoP column: rows 0, 2) and S A (A's column c: rows c & 1, (c & 1) + 2).
+        q00 = 0.0 + s00 * b00 + p02 * b20
+        q01 = 0.0 + s00 * b01 + p01 * b11 + p02 * b21 + p03 * b31
+        q10 = 0.0 + p01 * b00 + p12 * b20
+        q11 = 0.0 + p01 * b01 + s11 * b11 + p12 * b21 + p13 * b31
+        q20 = 0.0 + p02 * b00 + s22 * b20
+        q21 = 0.0 + p02 * b01 + p12 * b11 + s22 * b21 + p23 * b31
+        q30 = 0.0 + p03 * b00 + p23 * b20
+        q31 = 0.0 + p03 * b01 + p13 * b11 + p23 * b21 + s33 * b31
+        t00, t01 = 0.0 + s00 * a00 + p02 * a20, 0.0 + p01 * a11 + p03 * a31
+        t02, t03 = 0.0 + s00 * a02 + p02 * a22, 0.0 + p01 * a13 + p03 * a33
+        t10, t11 = 0.0 + p01 * a00 + p12 * a20, 0.0 + s11 * a11 + p13 * a31
+        t12, t13 = 0.0 + p01 * a02 + p12 * a22, 0.0 + s11 * a13 + p13 * a33
+        t20, t21 = 0.0 + p02 * a00 + s22 * a20, 0.0 + p12 * a11 + p23 * a31
+        t22, t23 = 0.0 + p02 * a02 + s22 * a22, 0.0 + p12 * a13 + p23 * a33
+        t30, t31 = 0.0 + p03 * a00 + p23 * a20, 0.0 + p13 * a11 + s33 * a31
+        t32, t33 = 0.0 + p03 * a02 + p23 * a22, 0.0 + p13 * a13 + s33 * a33
+        # H = B^T S B + diag(wu_i) (both off-diagonal sums, as computed), G = B^T S A, B^T s.
+        h00 = 0.0 + b00 * q00 + b20 * q20 + wu[i, 0]
+        h01 = 0.0 + b00 * q01 + b20 * q21
+        h10 = 0.0 + b01 * q00 + b11 * q10 + b21 * q20 + b31 * q30
+        h11 = 0.0 + b01 * q01 + b11 * q11 + b21 * q21 + b31 * q31 + wu[i, 1]
+        g00 = 0.0 + b00 * t00 + b20 * t20
+        g01 = 0.0 + b00 * t01 + b20 * t21
+        g02 = 0.0 + b00 * t02 + b20 * t22
+        g03 = 0.0 + b00 * t03 + b20 * t23
+        g10 = 0.0 + b01 * t00 + b11 * t10 + b21 * t20 + b31 * t30
+        g11 = 0.0 + b01 * t01 + b11 * t11 + b21 * t21 + b31 * t31
+        g12 = 0.0 + b01 * t02 + b11 * t12 + b21 * t22 + b31 * t32
+        g13 = 0.0 + b01 * t03 + b11 * t13 + b21 * t23 + b31 * t33
+        hs0 = 0.0 + b00 * l0 + b20 * l2
+        hs1 = 0.0 + b01 * l0 + b11 * l1 + b21 * l2 + b31 * l3
+        curvature[i, 0], curvature[i, 1] = h00, h11
         # The stage's rows: inputs first, then those on x_{i+1} through the dynamics.
         m = 0
         for j in range(2):
             side = active[i, j]
             if side != 0:
-                rc[m, :] = 0.0
-                rd[m, 0], rd[m, 1] = (1.0, 0.0) if j == 0 else (0.0, 1.0)
-                re[m] = bounds[j, 1] if side > 0 else bounds[j, 0]
-                ro[m] = -1
+                rows[m, 0] = rows[m, 1] = rows[m, 2] = rows[m, 3] = 0.0
+                rows[m, 4], rows[m, 5] = (1.0, 0.0) if j == 0 else (0.0, 1.0)
+                rows[m, 6] = bounds[j, 1] if side > 0 else bounds[j, 0]
+                origins[m] = -1
                 m += 1
         if active[i, 2] != 0:
             if npend == CARRIED:
                 return -i - 2
-            pend_o[npend] = i
-            pend_c[npend, :] = 0.0
-            pend_c[npend, 1] = 1.0
-            pend_e[npend] = bounds[2, 1] if active[i, 2] > 0 else bounds[2, 0]
+            o = _PENDING + npend
+            rows[o, 0], rows[o, 1], rows[o, 2], rows[o, 3] = 0.0, 1.0, 0.0, 0.0
+            rows[o, 6] = bounds[2, 1] if active[i, 2] > 0 else bounds[2, 0]
+            origins[o] = i
             npend += 1
-        for q in range(npend):
-            for c in range(4):
-                acc = 0.0
-                for r in range(4):
-                    acc += pend_c[q, r] * a[r, c]
-                rc[m, c] = acc
-            for c in range(2):
-                acc = 0.0
-                for r in range(4):
-                    acc += pend_c[q, r] * b[r, c]
-                rd[m, c] = acc
-            re[m] = pend_e[q]
-            ro[m] = pend_o[q]
+        for q in range(_PENDING, _PENDING + npend):
+            c0, c1, c2, c3 = rows[q, 0], rows[q, 1], rows[q, 2], rows[q, 3]
+            rows[m, 0], rows[m, 1] = 0.0 + c0 * a00 + c2 * a20, 0.0 + c1 * a11 + c3 * a31
+            rows[m, 2], rows[m, 3] = 0.0 + c0 * a02 + c2 * a22, 0.0 + c1 * a13 + c3 * a33
+            rows[m, 4] = 0.0 + c0 * b00 + c2 * b20
+            rows[m, 5] = 0.0 + c0 * b01 + c1 * b11 + c2 * b21 + c3 * b31
+            rows[m, 6] = rows[q, 6]
+            origins[m] = origins[q]
             m += 1
         # Pivots (at most two independent d's); the others reduced to rows on x_i.
         rank = 0
         npend = 0
+        pc00 = pc01 = pc02 = pc03 = pd00 = pd01 = pe0 = 0.0
+        pc10 = pc11 = pc12 = pc13 = pd10 = pd11 = pe1 = 0.0
+        po0 = po1 = -1
         for q in range(m):
-            size = abs(rd[q, 0]) + abs(rd[q, 1])
+            rd0, rd1 = rows[q, 4], rows[q, 5]
+            size = abs(rd0) + abs(rd1)
             if rank == 0:
                 residual = size
             elif rank == 1:
-                residual = abs(pd[0, 0] * rd[q, 1] - pd[0, 1] * rd[q, 0]) / (
-                    abs(pd[0, 0]) + abs(pd[0, 1])
-                )
+                residual = abs(pd00 * rd1 - pd01 * rd0) / (abs(pd00) + abs(pd01))
             else:
                 residual = 0.0
             if residual > RANK_TOL * size:
-                pc[rank, :] = rc[q, :]
-                pd[rank, :] = rd[q, :]
-                pe[rank] = re[q]
-                po[rank] = ro[q]
+                if rank == 0:
+                    pc00, pc01, pc02, pc03 = rows[q, 0], rows[q, 1], rows[q, 2], rows[q, 3]
+                    pd00, pd01, pe0, po0 = rd0, rd1, rows[q, 6], origins[q]
+                else:
+                    pc10, pc11, pc12, pc13 = rows[q, 0], rows[q, 1], rows[q, 2], rows[q, 3]
+                    pd10, pd11, pe1, po1 = rd0, rd1, rows[q, 6], origins[q]
                 rank += 1
                 continue
             al0, al1 = 0.0, 0.0  # d_q = al0 d_p0 + al1 d_p1
             if rank == 1:
-                al0 = (pd[0, 0] * rd[q, 0] + pd[0, 1] * rd[q, 1]) / (
-                    pd[0, 0] * pd[0, 0] + pd[0, 1] * pd[0, 1]
-                )
+                al0 = (pd00 * rd0 + pd01 * rd1) / (pd00 * pd00 + pd01 * pd01)
             elif rank == 2:
-                det = pd[0, 0] * pd[1, 1] - pd[0, 1] * pd[1, 0]
-                al0 = (rd[q, 0] * pd[1, 1] - rd[q, 1] * pd[1, 0]) / det
-                al1 = (pd[0, 0] * rd[q, 1] - pd[0, 1] * rd[q, 0]) / det
-            origin = max(ro[q], po[0] if al0 != 0.0 else -1, po[1] if al1 != 0.0 else -1)
+                det = pd00 * pd11 - pd01 * pd10
+                al0 = (rd0 * pd11 - rd1 * pd10) / det
+                al1 = (pd00 * rd1 - pd01 * rd0) / det
+            origin = max(origins[q], po0 if al0 != 0.0 else -1, po1 if al1 != 0.0 else -1)
             if npend == CARRIED:
                 return -origin - 2
-            big, scale = 0.0, 0.0
-            for c in range(4):
-                v = rc[q, c] - al0 * pc[0, c] - al1 * pc[1, c]
-                pend_c[npend, c] = v
-                big = max(big, abs(v))
-                scale = max(scale, abs(rc[q, c]))
+            o = _PENDING + npend
+            rc0, rc1, rc2, rc3 = rows[q, 0], rows[q, 1], rows[q, 2], rows[q, 3]
+            v0, v1 = rc0 - al0 * pc00 - al1 * pc10, rc1 - al0 * pc01 - al1 * pc11
+            v2, v3 = rc2 - al0 * pc02 - al1 * pc12, rc3 - al0 * pc03 - al1 * pc13
+            big = max(max(max(max(0.0, abs(v0)), abs(v1)), abs(v2)), abs(v3))
+            scale = max(max(max(max(0.0, abs(rc0)), abs(rc1)), abs(rc2)), abs(rc3))
             if big <= RANK_TOL * scale:
                 return -origin - 2  # a row implied by (or at odds with) the others
-            pend_e[npend] = re[q] - al0 * pe[0] - al1 * pe[1]
-            pend_o[npend] = origin
+            rows[o, 0], rows[o, 1], rows[o, 2], rows[o, 3] = v0, v1, v2, v3
+            rows[o, 6] = rows[q, 6] - al0 * pe0 - al1 * pe1
+            origins[o] = origin
             npend += 1
-        feed[:, :] = 0.0
-        ff[:] = 0.0
+        # u = K x + k: the rows' F, f (K rows e, f; k = (k0, k1)) and the free part's optimum.
         if rank == 0:
-            det = h[0, 0] * h[1, 1] - h[0, 1] * h[1, 0]
-            for c in range(4):
-                gains[i, 0, c] = -(h[1, 1] * g[0, c] - h[0, 1] * g[1, c]) / det
-                gains[i, 1, c] = -(h[0, 0] * g[1, c] - h[1, 0] * g[0, c]) / det
-            offsets[i, 0] = -(h[1, 1] * hs[0] - h[0, 1] * hs[1]) / det
-            offsets[i, 1] = -(h[0, 0] * hs[1] - h[1, 0] * hs[0]) / det
+            det = h00 * h11 - h01 * h10
+            e0, f0 = -(h11 * g00 - h01 * g10) / det, -(h00 * g10 - h10 * g00) / det
+            e1, f1 = -(h11 * g01 - h01 * g11) / det, -(h00 * g11 - h10 * g01) / det
+            e2, f2 = -(h11 * g02 - h01 * g12) / det, -(h00 * g12 - h10 * g02) / det
+            e3, f3 = -(h11 * g03 - h01 * g13) / det, -(h00 * g13 - h10 * g03) / det
+            k0 = -(h11 * hs0 - h01 * hs1) / det
+            k1 = -(h00 * hs1 - h10 * hs0) / det
         elif rank == 1:
-            norm2 = pd[0, 0] * pd[0, 0] + pd[0, 1] * pd[0, 1]
-            for r in range(2):
-                ff[r] = pd[0, r] * pe[0] / norm2
-                for c in range(4):
-                    feed[r, c] = -pd[0, r] * pc[0, c] / norm2
-            t[0], t[1] = -pd[0, 1], pd[0, 0]
-            th0 = h[0, 0] * t[0] + h[0, 1] * t[1]
-            th1 = h[1, 0] * t[0] + h[1, 1] * t[1]
-            hz = t[0] * th0 + t[1] * th1
-            hv = th0 * ff[0] + th1 * ff[1] + t[0] * hs[0] + t[1] * hs[1]
-            for c in range(4):
-                gz = th0 * feed[0, c] + th1 * feed[1, c] + t[0] * g[0, c] + t[1] * g[1, c]
-                for r in range(2):
-                    gains[i, r, c] = feed[r, c] - t[r] * gz / hz
-            for r in range(2):
-                offsets[i, r] = ff[r] - t[r] * hv / hz
+            norm2 = pd00 * pd00 + pd01 * pd01
+            ff0, ff1 = pd00 * pe0 / norm2, pd01 * pe0 / norm2
+            t0, t1 = -pd01, pd00
+            th0 = h00 * t0 + h01 * t1
+            th1 = h10 * t0 + h11 * t1
+            hz = t0 * th0 + t1 * th1
+            hv = th0 * ff0 + th1 * ff1 + t0 * hs0 + t1 * hs1
+            e0, f0 = _free(pd00, pd01, pc00, norm2, th0, th1, t0, t1, hz, g00, g10)
+            e1, f1 = _free(pd00, pd01, pc01, norm2, th0, th1, t0, t1, hz, g01, g11)
+            e2, f2 = _free(pd00, pd01, pc02, norm2, th0, th1, t0, t1, hz, g02, g12)
+            e3, f3 = _free(pd00, pd01, pc03, norm2, th0, th1, t0, t1, hz, g03, g13)
+            k0, k1 = ff0 - t0 * hv / hz, ff1 - t1 * hv / hz
         else:  # u = D^{-1} (e − C x)
-            det = pd[0, 0] * pd[1, 1] - pd[0, 1] * pd[1, 0]
-            for r in range(2):
-                c0 = (pd[1, 1] if r == 0 else -pd[1, 0]) / det  # D^{-1}[r, 0]
-                c1 = (-pd[0, 1] if r == 0 else pd[0, 0]) / det  # D^{-1}[r, 1]
-                offsets[i, r] = c0 * pe[0] + c1 * pe[1]
-                for c in range(4):
-                    gains[i, r, c] = -(c0 * pc[0, c] + c1 * pc[1, c])
+            det = pd00 * pd11 - pd01 * pd10
+            c0, c1 = pd11 / det, -pd01 / det  # D^{-1}'s first row
+            k0 = c0 * pe0 + c1 * pe1
+            e0, e1 = -(c0 * pc00 + c1 * pc10), -(c0 * pc01 + c1 * pc11)
+            e2, e3 = -(c0 * pc02 + c1 * pc12), -(c0 * pc03 + c1 * pc13)
+            c0, c1 = -pd10 / det, pd00 / det  # its second
+            k1 = c0 * pe0 + c1 * pe1
+            f0, f1 = -(c0 * pc00 + c1 * pc10), -(c0 * pc01 + c1 * pc11)
+            f2, f3 = -(c0 * pc02 + c1 * pc12), -(c0 * pc03 + c1 * pc13)
+        gains[i, 0, 0], gains[i, 0, 1], gains[i, 0, 2], gains[i, 0, 3] = e0, e1, e2, e3
+        gains[i, 1, 0], gains[i, 1, 1], gains[i, 1, 2], gains[i, 1, 3] = f0, f1, f2, f3
+        offsets[i, 0], offsets[i, 1] = k0, k1
         # P_i and p_i of u = K x + k.
-        k0, k1 = offsets[i, 0], offsets[i, 1]
-        hk0 = h[0, 0] * k0 + h[0, 1] * k1 + hs[0]
-        hk1 = h[1, 0] * k0 + h[1, 1] * k1 + hs[1]
-        for r in range(4):
-            sb[r, 0] = sb[r, 0] * k0 + sb[r, 1] * k1 + lin[r]  # S B k + s (sb done with)
-        for r in range(4):
-            acc = gains[i, 0, r] * hk0 + gains[i, 1, r] * hk1
-            for q in range(4):
-                acc += a[q, r] * sb[q, 0]
-            lin[r] = acc
-        for r in range(4):
-            kh0 = gains[i, 0, r] * h[0, 0] + gains[i, 1, r] * h[1, 0]
-            kh1 = gains[i, 0, r] * h[0, 1] + gains[i, 1, r] * h[1, 1]
-            for c in range(r, 4):
-                acc = 0.0
-                for q in range(4):
-                    acc += a[q, r] * sa[q, c]
-                acc += g[0, r] * gains[i, 0, c] + g[1, r] * gains[i, 1, c]
-                acc += gains[i, 0, r] * g[0, c] + gains[i, 1, r] * g[1, c]
-                acc += kh0 * gains[i, 0, c] + kh1 * gains[i, 1, c]
-                cost[r, c] = acc
-                cost[c, r] = acc
+        hk0 = h00 * k0 + h01 * k1 + hs0
+        hk1 = h10 * k0 + h11 * k1 + hs1
+        v0 = q00 * k0 + q01 * k1 + l0  # S B k + s
+        v1 = q10 * k0 + q11 * k1 + l1
+        v2 = q20 * k0 + q21 * k1 + l2
+        v3 = q30 * k0 + q31 * k1 + l3
+        l0 = e0 * hk0 + f0 * hk1 + a00 * v0 + a20 * v2
+        l1 = e1 * hk0 + f1 * hk1 + a11 * v1 + a31 * v3
+        l2 = e2 * hk0 + f2 * hk1 + a02 * v0 + a22 * v2
+        l3 = e3 * hk0 + f3 * hk1 + a13 * v1 + a33 * v3
+        x0, y0 = e0 * h00 + f0 * h10, e0 * h01 + f0 * h11  # (K^T H)[r], r = 0..3
+        x1, y1 = e1 * h00 + f1 * h10, e1 * h01 + f1 * h11
+        x2, y2 = e2 * h00 + f2 * h10, e2 * h01 + f2 * h11
+        x3, y3 = e3 * h00 + f3 * h10, e3 * h01 + f3 * h11
+        p00 = _entry(0.0 + a00 * t00 + a20 * t20, g00, g10, e0, f0, x0, y0, g00, g10, e0, f0)
+        p01 = _entry(0.0 + a00 * t01 + a20 * t21, g00, g10, e0, f0, x0, y0, g01, g11, e1, f1)
+        p02 = _entry(0.0 + a00 * t02 + a20 * t22, g00, g10, e0, f0, x0, y0, g02, g12, e2, f2)
+        p03 = _entry(0.0 + a00 * t03 + a20 * t23, g00, g10, e0, f0, x0, y0, g03, g13, e3, f3)
+        p11 = _entry(0.0 + a11 * t11 + a31 * t31, g01, g11, e1, f1, x1, y1, g01, g11, e1, f1)
+        p12 = _entry(0.0 + a11 * t12 + a31 * t32, g01, g11, e1, f1, x1, y1, g02, g12, e2, f2)
+        p13 = _entry(0.0 + a11 * t13 + a31 * t33, g01, g11, e1, f1, x1, y1, g03, g13, e3, f3)
+        p22 = _entry(0.0 + a02 * t02 + a22 * t22, g02, g12, e2, f2, x2, y2, g02, g12, e2, f2)
+        p23 = _entry(0.0 + a02 * t03 + a22 * t23, g02, g12, e2, f2, x2, y2, g03, g13, e3, f3)
+        p33 = _entry(0.0 + a13 * t13 + a33 * t33, g03, g13, e3, f3, x3, y3, g03, g13, e3, f3)
     if npend:
         origin = 0
-        for q in range(npend):
-            origin = max(origin, pend_o[q])
+        for q in range(_PENDING, _PENDING + npend):
+            origin = max(origin, origins[q])
         return -origin - 2
     return 0
 
 
 @numba.njit(cache=True, nogil=True)
-def _eliminate(p, e, jac, rhs, ids, live, k, ex_const, ex_ids, ex_coef, ex_n):  # type: ignore[no-untyped-def]
-    """Record unknown ``p`` from equation ``e``: w_p = (rhs_e − Σ_{c ≠ p} jac_ec w_c) / jac_ep."""
-    idx = ids[p]
-    pivot = jac[e, p]
-    ex_const[idx] = rhs[e] / pivot
+def _free(pd0, pd1, pc, norm2, th0, th1, t0, t1, hz, g0, g1):  # type: ignore[no-untyped-def]
+    """Column of K with one pivot row d^T u + c^T x = e: the row's part, then the free one's.
+
+    F = −d c^T / |d|², moved along T = (−d_1, d_0) to the free optimum: K = F − T g_z / h_z
+    with g_z = T^T (H F + G) (``th`` = H T, ``hz`` = T^T H T); one column of x.
+    """
+    fd0, fd1 = -pd0 * pc / norm2, -pd1 * pc / norm2
+    gz = th0 * fd0 + th1 * fd1 + t0 * g0 + t1 * g1
+    return fd0 - t0 * gz / hz, fd1 - t1 * gz / hz
+
+
+@numba.njit(cache=True, nogil=True)
+def _eliminate(p, e, k, floats, ints, top):  # type: ignore[no-untyped-def]
+    """Record unknown ``p`` from equation ``e``: w_p = (rhs_e − Σ_{c ≠ p} jac_ec w_c) / jac_ep.
+
+    ``top``: the ints' row of the live unknowns' ids (their flags in the next).
+    """
+    idx = ints[top, p]
+    row = _EX + idx
+    pivot = floats[_JAC + e, p]
+    floats[row, _CONST] = floats[_RHS, e] / pivot
     m = 0
     for c in range(k):
-        if live[c] and c != p:
-            ex_ids[idx, m] = c  # a column for now; turned into an id by the caller
-            ex_coef[idx, m] = -jac[e, c] / pivot
+        if ints[top + 1, c] and c != p:
+            ints[idx, m] = c  # a column for now; turned into an id by the caller
+            floats[row, m] = -floats[_JAC + e, c] / pivot
             m += 1
-    ex_n[idx] = m
+    ints[idx, _COUNT] = m
     return idx
 
 
 @numba.njit(cache=True, nogil=True)
-def _multipliers(a, b, wx, wu, active, inputs, states, mult):  # type: ignore[no-untyped-def]
+def _multipliers(a, b, wx, wu, active, inputs, states, mult, floats, ints):  # type: ignore[no-untyped-def]
     """Multipliers of the active rows into ``mult`` (N, 3); False if they are not unique.
 
     Backward, λ_{i+1} = l + L w with w the θ rows' multipliers not fixed yet; stage i's
     stationarity 2 W^u u_i + B^T λ_{i+1} + μ_i = 0 fixes the active inputs' μ_i (their equation)
     and, by the other equations, up to two of w. The values follow forward by substitution.
+    ``floats``, ``ints``: scratch (:func:`_scratch`). l is kept in scalars; A's and B's zeros
+    are skipped (see the module).
     """
     n = wx.shape[0]
-    width = CARRIED + 1
-    after = np.zeros(4)
-    lam = np.empty(4)
-    lc = np.zeros((4, width))
-    tmp = np.empty(4)
-    ids = np.empty(width, dtype=np.int64)
-    live = np.empty(width, dtype=np.bool_)
-    total = 3 * n
-    ex_const = np.zeros(total)
-    ex_ids = np.empty((total, width), dtype=np.int64)
-    ex_coef = np.empty((total, width))
-    ex_n = np.zeros(total, dtype=np.int64)
-    order = np.empty(total, dtype=np.int64)
+    width = _WIDTH
+    top = 3 * n  # ints' rows of the live unknowns' ids and flags
+    a00, a02, a20, a22 = a[0, 0], a[0, 2], a[2, 0], a[2, 2]
+    a11, a13, a31, a33 = a[1, 1], a[1, 3], a[3, 1], a[3, 3]
+    b00, b20, b01, b11, b21, b31 = b[0, 0], b[2, 0], b[0, 1], b[1, 1], b[2, 1], b[3, 1]
+    f0 = f1 = f2 = f3 = 0.0  # l of λ_{i+2}
     nord = 0
-    jac = np.empty((2, width))
-    rhs = np.empty(2)
     k = 0
     for i in range(n - 1, -1, -1):
-        for r in range(4):
-            acc = 2.0 * wx[i, r] * states[i + 1, r]
-            for q in range(4):
-                acc += a[q, r] * after[q]
-            lam[r] = acc
-        for col in range(k):
-            for r in range(4):
-                acc = 0.0
-                for q in range(4):
-                    acc += a[q, r] * lc[q, col]
-                tmp[r] = acc
-            lc[:, col] = tmp
+        m0 = 2.0 * wx[i, 0] * states[i + 1, 0] + a00 * f0 + a20 * f2
+        m1 = 2.0 * wx[i, 1] * states[i + 1, 1] + a11 * f1 + a31 * f3
+        m2 = 2.0 * wx[i, 2] * states[i + 1, 2] + a02 * f0 + a22 * f2
+        m3 = 2.0 * wx[i, 3] * states[i + 1, 3] + a13 * f1 + a33 * f3
+        for col in range(k):  # L ← A^T L
+            c0, c1 = floats[_LC, col], floats[_LC + 1, col]
+            c2, c3 = floats[_LC + 2, col], floats[_LC + 3, col]
+            floats[_LC, col] = 0.0 + a00 * c0 + a20 * c2
+            floats[_LC + 1, col] = 0.0 + a11 * c1 + a31 * c3
+            floats[_LC + 2, col] = 0.0 + a02 * c0 + a22 * c2
+            floats[_LC + 3, col] = 0.0 + a13 * c1 + a33 * c3
         if active[i, 2] != 0:
             if k == width:
                 return False
-            ids[k] = 3 * i + 2
-            lc[:, k] = 0.0
-            lc[1, k] = 1.0
+            ints[top, k] = 3 * i + 2
+            floats[_LC, k], floats[_LC + 1, k] = 0.0, 1.0
+            floats[_LC + 2, k], floats[_LC + 3, k] = 0.0, 0.0
             k += 1
         scale = 0.0
-        for e in range(2):
-            acc = -2.0 * wu[i, e] * inputs[i, e]
-            for q in range(4):
-                acc -= b[q, e] * lam[q]
-            rhs[e] = acc
-            for col in range(k):
-                acc = 0.0
-                for q in range(4):
-                    acc += b[q, e] * lc[q, col]
-                jac[e, col] = acc
-                if active[i, e] == 0:
-                    scale = max(scale, abs(acc))
-            live[e] = False
+        free0, free1 = active[i, 0] == 0, active[i, 1] == 0
+        floats[_RHS, 0] = -2.0 * wu[i, 0] * inputs[i, 0] - b00 * m0 - b20 * m2
+        floats[_RHS, 1] = -2.0 * wu[i, 1] * inputs[i, 1] - b01 * m0 - b11 * m1 - b21 * m2 - b31 * m3
         for col in range(k):
-            live[col] = True
+            acc = 0.0 + b00 * floats[_LC, col] + b20 * floats[_LC + 2, col]
+            floats[_JAC, col] = acc
+            if free0:
+                scale = max(scale, abs(acc))
+        for col in range(k):
+            acc = 0.0 + b01 * floats[_LC, col] + b11 * floats[_LC + 1, col]
+            acc += b21 * floats[_LC + 2, col]
+            acc += b31 * floats[_LC + 3, col]
+            floats[_JAC + 1, col] = acc
+            if free1:
+                scale = max(scale, abs(acc))
+        for col in range(k):
+            ints[top + 1, col] = True
         # The active inputs' μ = rhs_e − jac_e w: recorded first, so computed last.
         for e in range(2):
             if active[i, e] != 0:
                 idx = 3 * i + e
-                ex_const[idx] = rhs[e]
+                floats[_EX + idx, _CONST] = floats[_RHS, e]
                 for col in range(k):
-                    ex_ids[idx, col] = ids[col]
-                    ex_coef[idx, col] = -jac[e, col]
-                ex_n[idx] = k
-                order[nord] = idx
+                    ints[idx, col] = ints[top, col]
+                    floats[_EX + idx, col] = -floats[_JAC + e, col]
+                ints[idx, _COUNT] = k
+                ints[nord, _ORDER] = idx
                 nord += 1
         # The inactive inputs' equations fix up to two carried unknowns (full pivoting).
-        used0, used1 = active[i, 0] != 0, active[i, 1] != 0
+        used0, used1 = not free0, not free1
         for _ in range(2):
             best, pe, pp = RANK_TOL * scale, -1, -1
             for e in range(2):
                 if used0 if e == 0 else used1:
                     continue
                 for col in range(k):
-                    if live[col] and abs(jac[e, col]) > best:
-                        best, pe, pp = abs(jac[e, col]), e, col
+                    if ints[top + 1, col] and abs(floats[_JAC + e, col]) > best:
+                        best, pe, pp = abs(floats[_JAC + e, col]), e, col
             if pe < 0:
                 break
-            idx = _eliminate(pp, pe, jac, rhs, ids, live, k, ex_const, ex_ids, ex_coef, ex_n)
-            for m in range(ex_n[idx]):  # columns into ids; λ's dependence substituted
-                col = ex_ids[idx, m]
-                for r in range(4):
-                    lc[r, col] += lc[r, pp] * ex_coef[idx, m]
-                ex_ids[idx, m] = ids[col]
-            for r in range(4):
-                lam[r] += lc[r, pp] * ex_const[idx]
+            idx = _eliminate(pp, pe, k, floats, ints, top)
+            for m in range(ints[idx, _COUNT]):  # columns into ids; λ's dependence substituted
+                col = ints[idx, m]
+                coef = floats[_EX + idx, m]
+                for r in range(_LC, _LC + 4):
+                    floats[r, col] += floats[r, pp] * coef
+                ints[idx, m] = ints[top, col]
+            w = floats[_EX + idx, _CONST]
+            m0 += floats[_LC, pp] * w
+            m1 += floats[_LC + 1, pp] * w
+            m2 += floats[_LC + 2, pp] * w
+            m3 += floats[_LC + 3, pp] * w
             other = 1 - pe
             if not (used0 if other == 0 else used1):
-                ratio = jac[other, pp] / jac[pe, pp]
+                ratio = floats[_JAC + other, pp] / floats[_JAC + pe, pp]
                 for col in range(k):
-                    jac[other, col] -= ratio * jac[pe, col]
-                rhs[other] -= ratio * rhs[pe]
-            live[pp] = False
-            order[nord] = idx
+                    floats[_JAC + other, col] -= ratio * floats[_JAC + pe, col]
+                floats[_RHS, other] -= ratio * floats[_RHS, pe]
+            ints[top + 1, pp] = False
+            ints[nord, _ORDER] = idx
             nord += 1
             if pe == 0:
                 used0 = True
@@ -373,26 +437,111 @@ def _multipliers(a, b, wx, wu, active, inputs, states, mult):  # type: ignore[no
                 used1 = True
         kept = 0
         for col in range(k):
-            if live[col]:
-                ids[kept] = ids[col]
-                lc[:, kept] = lc[:, col]
+            if ints[top + 1, col]:
+                ints[top, kept] = ints[top, col]
+                for r in range(_LC, _LC + 4):
+                    floats[r, kept] = floats[r, col]
                 kept += 1
         k = kept
-        for r in range(4):
-            after[r] = lam[r]
+        f0, f1, f2, f3 = m0, m1, m2, m3
     if k:
         return False
-    value = np.zeros(total)
     for m in range(nord - 1, -1, -1):
-        idx = order[m]
-        acc = ex_const[idx]
-        for q in range(ex_n[idx]):
-            acc += ex_coef[idx, q] * value[ex_ids[idx, q]]
-        value[idx] = acc
+        idx = ints[m, _ORDER]
+        acc = floats[_EX + idx, _CONST]
+        for q in range(ints[idx, _COUNT]):
+            acc += floats[_EX + idx, q] * floats[_EX + ints[idx, q], _VALUE]
+        floats[_EX + idx, _VALUE] = acc
     for i in range(n):
         for j in range(3):
-            mult[i, j] = value[3 * i + j] if active[i, j] != 0 else 0.0
+            mult[i, j] = floats[_EX + 3 * i + j, _VALUE] if active[i, j] != 0 else 0.0
     return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _pass_in(  # type: ignore[no-untyped-def]
+    x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains, offsets, curvature,
+    mult, forced, work,
+):  # fmt: skip
+    """:func:`_pass` on the scratch ``work`` of :func:`_scratch`."""
+    n = wx.shape[0]
+    left = _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, work[0], work[2])
+    if left != 0:
+        # Too many rows: a θ row carried through saturated torques to a state that cannot meet
+        # it. Release the chain's first torque row (else the θ row); the passes go on from there.
+        origin = -left - 2
+        for i in range(forced, origin + 1):
+            if active[i, 1] != 0:
+                active[i, 1] = 0
+                return CHANGED
+        if active[origin, 2] == 0:
+            return DEGENERATE
+        active[origin, 2] = 0
+        return CHANGED
+    # The rollout (the state in scalars; A's and B's zeros skipped), the inactive rows checked
+    # on the way: the violated ones are added, no θ row after the first nor in the forced stages.
+    a00, a02, a20, a22 = a[0, 0], a[0, 2], a[2, 0], a[2, 2]
+    a11, a13, a31, a33 = a[1, 1], a[1, 3], a[3, 1], a[3, 3]
+    b00, b20, b01, b11, b21, b31 = b[0, 0], b[2, 0], b[0, 1], b[1, 1], b[2, 1], b[3, 1]
+    lo0, hi0 = bounds[0, 0] - tols[0], bounds[0, 1] + tols[0]
+    lo1, hi1 = bounds[1, 0] - tols[1], bounds[1, 1] + tols[1]
+    lo2, hi2 = bounds[2, 0] - tols[2], bounds[2, 1] + tols[2]
+    s0, s1, s2, s3 = x0[0], x0[1], x0[2], x0[3]
+    states[0, 0], states[0, 1], states[0, 2], states[0, 3] = s0, s1, s2, s3
+    added, angle = False, False
+    for i in range(n):
+        u0 = offsets[i, 0] + gains[i, 0, 0] * s0 + gains[i, 0, 1] * s1 + gains[i, 0, 2] * s2
+        u0 += gains[i, 0, 3] * s3
+        u1 = offsets[i, 1] + gains[i, 1, 0] * s0 + gains[i, 1, 1] * s1 + gains[i, 1, 2] * s2
+        u1 += gains[i, 1, 3] * s3
+        s0, s1, s2, s3 = (
+            a00 * s0 + a02 * s2 + b00 * u0 + b01 * u1, a11 * s1 + a13 * s3 + b11 * u1,
+            a20 * s0 + a22 * s2 + b20 * u0 + b21 * u1, a31 * s1 + a33 * s3 + b31 * u1,
+        )  # fmt: skip
+        inputs[i, 0], inputs[i, 1] = u0, u1
+        states[i + 1, 0], states[i + 1, 1], states[i + 1, 2], states[i + 1, 3] = s0, s1, s2, s3
+        if active[i, 0] == 0:
+            if u0 > hi0:
+                active[i, 0] = 1
+                added = True
+            elif u0 < lo0:
+                active[i, 0] = -1
+                added = True
+        if active[i, 1] == 0:
+            if u1 > hi1:
+                active[i, 1] = 1
+                added = True
+            elif u1 < lo1:
+                active[i, 1] = -1
+                added = True
+        if active[i, 2] == 0 and not (angle or i < forced):
+            if s1 > hi2:
+                active[i, 2] = 1
+                added = angle = True
+            elif s1 < lo2:
+                active[i, 2] = -1
+                added = angle = True
+    if added:
+        return CHANGED
+    if not _multipliers(a, b, wx, wu, active, inputs, states, mult, work[0], work[1]):
+        return DEGENERATE
+    worst, worst_i, worst_j = 0.0, -1, -1
+    for i in range(n):
+        for j in range(3):
+            side = active[i, j]
+            if side == 0 or (j == 1 and i < forced):
+                continue
+            if j < 2:
+                scale = curvature[i, j] * (bounds[j, 1] - bounds[j, 0])
+            else:
+                scale = curvature[i, 1] * (bounds[1, 1] - bounds[1, 0]) / abs(b11)
+            wrong = -mult[i, j] * side / scale
+            if wrong > dual_tol and wrong > worst:
+                worst, worst_i, worst_j = wrong, i, j
+    if worst_i < 0:
+        return OPTIMAL
+    active[worst_i, worst_j] = 0  # one at a time: releasing a whole block overshoots
+    return CHANGED
 
 
 @numba.njit(cache=True, nogil=True)
@@ -421,69 +570,12 @@ def _pass(  # type: ignore[no-untyped-def]
     guess adds the violated rows; only when none is violated does it release the row whose
     multiplier has the most wrong sign. The torques of the first ``forced`` stages are
     equalities (held, whatever their multipliers' signs) and those stages' θ rows are not
-    checked: see :func:`solve_from`.
+    checked: see :func:`solve_from`. Allocates its scratch (the passes of
+    :func:`solve_active_set` share one).
     """
-    n = wx.shape[0]
-    left = _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature)
-    if left != 0:
-        # Too many rows: a θ row carried through saturated torques to a state that cannot meet
-        # it. Release the chain's first torque row (else the θ row); the passes go on from there.
-        origin = -left - 2
-        for i in range(forced, origin + 1):
-            if active[i, 1] != 0:
-                active[i, 1] = 0
-                return CHANGED
-        if active[origin, 2] == 0:
-            return DEGENERATE
-        active[origin, 2] = 0
-        return CHANGED
-    for c in range(4):
-        states[0, c] = x0[c]
-    for i in range(n):
-        for r in range(2):
-            acc = offsets[i, r]
-            for c in range(4):
-                acc += gains[i, r, c] * states[i, c]
-            inputs[i, r] = acc
-        for r in range(4):
-            states[i + 1, r] = (
-                a[r, 0] * states[i, 0] + a[r, 1] * states[i, 1] + a[r, 2] * states[i, 2]
-                + a[r, 3] * states[i, 3] + b[r, 0] * inputs[i, 0] + b[r, 1] * inputs[i, 1]
-            )  # fmt: skip
-    added, angle = False, False
-    for i in range(n):
-        values = (inputs[i, 0], inputs[i, 1], states[i + 1, 1])
-        for j in range(3):
-            if active[i, j] == 0 and not (j == 2 and (angle or i < forced)):
-                if values[j] > bounds[j, 1] + tols[j]:
-                    active[i, j] = 1
-                    added = True
-                    angle |= j == 2
-                elif values[j] < bounds[j, 0] - tols[j]:
-                    active[i, j] = -1
-                    added = True
-                    angle |= j == 2
-    if added:
-        return CHANGED
-    if not _multipliers(a, b, wx, wu, active, inputs, states, mult):
-        return DEGENERATE
-    worst, worst_i, worst_j = 0.0, -1, -1
-    for i in range(n):
-        for j in range(3):
-            side = active[i, j]
-            if side == 0 or (j == 1 and i < forced):
-                continue
-            if j < 2:
-                scale = curvature[i, j] * (bounds[j, 1] - bounds[j, 0])
-            else:
-                scale = curvature[i, 1] * (bounds[1, 1] - bounds[1, 0]) / abs(b[1, 1])
-            wrong = -mult[i, j] * side / scale
-            if wrong > dual_tol and wrong > worst:
-                worst, worst_i, worst_j = wrong, i, j
-    if worst_i < 0:
-        return OPTIMAL
-    active[worst_i, worst_j] = 0  # one at a time: releasing a whole block overshoots
-    return CHANGED
+    work = _scratch(wx.shape[0])
+    return _pass_in(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains,
+                    offsets, curvature, mult, forced, work)  # fmt: skip
 
 
 @numba.njit(cache=True, nogil=True)
@@ -512,9 +604,10 @@ def solve_active_set(  # type: ignore[no-untyped-def]
     and ``active`` its active set. −1: degenerate, or no verified optimum within
     ``max_passes`` (cycling, or an infeasible problem).
     """
+    work = _scratch(wx.shape[0])
     for k in range(max_passes):
-        outcome = _pass(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains,
-                        offsets, curvature, mult, forced)  # fmt: skip
+        outcome = _pass_in(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states,
+                           gains, offsets, curvature, mult, forced, work)  # fmt: skip
         if outcome == OPTIMAL:
             return k + 1
         if outcome == DEGENERATE:

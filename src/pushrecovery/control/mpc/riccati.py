@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery._validate import require_type
-from pushrecovery.control.mpc._riccati_kernels import solve_from
+from pushrecovery.control.mpc._riccati_kernels import check_structure, solve_from
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
@@ -110,6 +110,12 @@ class RiccatiSolver:
     settings : MPCSettings
         dt, N, Q, R and γ.
 
+    Raises
+    ------
+    ValueError
+        If A, B lack the flywheel's zeros the kernels skip
+        (:func:`~pushrecovery.control.mpc._riccati_kernels.check_structure`).
+
     Attributes
     ----------
     inputs : ndarray, shape (N, 2)
@@ -128,6 +134,7 @@ class RiccatiSolver:
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
         self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)  # checked
+        check_structure(self.a, self.b)  # the zeros the kernels skip
         n = settings.horizon
         self.tols = PRIMAL_TOL * (self.bounds[:, 1] - self.bounds[:, 0])
         self.active = np.zeros((n, 3), dtype=np.int8)
