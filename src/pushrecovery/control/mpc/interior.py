@@ -12,7 +12,7 @@ active-set passes cannot represent, is for it a diagonal weight like any other.
 
 Its place in the controller: the passes of :class:`~.riccati.RiccatiSolver` solve most ticks in
 a few µs from the previous tick's active set; a tick they do not verify (a push's first tick,
-an active set far from the last, a degenerate stage) goes here, 10-25 iterations of a few µs
+an active set far from the last, a degenerate stage) goes here, 10-25 iterations of 8 µs
 each at N = 50 whatever the start, no Hessian ever formed (its conditioning does not grow with
 N, as the condensed QP's does). The solution's active set (a bound whose multiplier exceeds
 its slack in the units below) then seeds the passes, which verify the KKT conditions exactly;
