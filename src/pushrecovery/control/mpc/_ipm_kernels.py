@@ -18,9 +18,9 @@ x_{i+1} − A x_i − B u_i = 0. The Lagrangian's gradient (the dual residual r_
 with ν_N = 0. The iterate satisfies the dynamics exactly (it starts from a simulation and
 every Newton step does), so there is no primal residual of the equalities.
 
-A and B have the flywheel's structure (:func:`check_structure`): the CoM (x, ẋ) and the
-flywheel (θ, θ̇) evolve apart, A block-diagonal in that split, and the CoP moves the CoM only
-(B's δ column zero on θ, θ̇). The products skip those zeros, term by term the same sums.
+A and B have the flywheel's structure (:func:`~.riccati.check_structure`): the CoM (x, ẋ) and
+the flywheel (θ, θ̇) evolve apart, A block-diagonal in that split, and the CoP moves the CoM
+only (B's δ column zero on θ, θ̇). The products skip those zeros, term by term the same sums.
 """
 
 from __future__ import annotations
@@ -42,17 +42,6 @@ _CENTRE = (0.0, 1.0, 0.01)
 # interior-point ticks: 15.5 iterations on average and 22 at most to a verified set without,
 # 12.4 and 15 with).
 _GUIDE_FLOOR, _GUIDE_CENTRE = 0.003, 3.0
-
-
-def check_structure(a: np.ndarray, b: np.ndarray) -> None:
-    """Raise ValueError unless A, B have the zeros the kernels skip (see the module)."""
-    com, wheel = np.ix_([0, 2], [1, 3]), np.ix_([1, 3], [0, 2])
-    if np.any(a[com]) or np.any(a[wheel]) or np.any(b[[1, 3], 0]):
-        raise ValueError(
-            "the interior point's kernels need A block-diagonal in (x, xdot), (theta, "
-            "theta_dot) and B's CoP column zero on theta, theta_dot (the flywheel model's "
-            f"discretisation); got A = {a.tolist()}, B = {b.tolist()}"
-        )
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

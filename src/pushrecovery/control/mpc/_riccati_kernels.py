@@ -24,13 +24,13 @@ to stage i − 1 (τ_i and θ_{i+1} both at a bound: a row on θ_i, θ̇_i). Row
 is given, make the active set infeasible. The multipliers are the dual of this: the unknown ones
 are carried back in λ (λ = l + L w) until a stage's stationarity fixes them.
 
-Speed. A and B have the flywheel's structure (:func:`check_structure`): A block-diagonal in
-(x, ẋ) and (θ, θ̇), B's CoP column zero on θ, θ̇. The products skip those zeros, and a
-stage's matrices stay in scalars (numba reloads arrays, which may alias, after every store):
-term by term the same sums in the same order as plain loops, so the same results (a skipped
-term is ±0, which leaves a nonzero sum as it is; a sum the loops started from 0.0 keeps that
-start, ``0.0 + …``, so that an all-zero one stays +0). A solve's scratch is allocated once
-(:func:`_scratch`), not per pass.
+Speed. A and B have the flywheel's structure (:func:`~.riccati.check_structure`): A
+block-diagonal in (x, ẋ) and (θ, θ̇), B's CoP column zero on θ, θ̇. The products skip those
+zeros, and a stage's matrices stay in scalars (numba reloads arrays, which may alias, after
+every store): term by term the same sums in the same order as plain loops, so the same results
+(a skipped term is ±0, which leaves a nonzero sum as it is; a sum the loops started from 0.0
+keeps that start, ``0.0 + …``, so that an all-zero one stays +0). A solve's scratch is allocated
+once (:func:`_scratch`), not per pass.
 """
 
 from __future__ import annotations
@@ -62,17 +62,6 @@ _CONST, _VALUE = _WIDTH, _WIDTH + 1
 # in column _ORDER the order the expressions were recorded in); then the live unknowns' ids and
 # flags.
 _COUNT, _ORDER = _WIDTH, _WIDTH + 1
-
-
-def check_structure(a: np.ndarray, b: np.ndarray) -> None:
-    """Raise ValueError unless A, B have the zeros the kernels skip (see the module)."""
-    com, wheel = np.ix_([0, 2], [1, 3]), np.ix_([1, 3], [0, 2])
-    if np.any(a[com]) or np.any(a[wheel]) or np.any(b[[1, 3], 0]):
-        raise ValueError(
-            "the Riccati passes' kernels need A block-diagonal in (x, xdot), (theta, "
-            "theta_dot) and B's CoP column zero on theta, theta_dot (the flywheel model's "
-            f"discretisation); got A = {a.tolist()}, B = {b.tolist()}"
-        )
 
 
 @numba.njit(cache=True, nogil=True)

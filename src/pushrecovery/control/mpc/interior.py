@@ -36,10 +36,10 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, check_structure, solve_interior
+from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, solve_interior
 from pushrecovery.control.mpc._ipm_scales import dual_scales, identify_active
 from pushrecovery.control.mpc.problem import MPCSettings
-from pushrecovery.control.mpc.riccati import sparse_stages
+from pushrecovery.control.mpc.riccati import check_structure, sparse_stages
 from pushrecovery.params import BodyParams
 
 __all__ = ["DUAL_TOL", "IDENTIFY_TOL", "MAX_ITERATIONS", "TOL", "InteriorPointSolver"]

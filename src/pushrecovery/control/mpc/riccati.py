@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery._validate import require_type
-from pushrecovery.control.mpc._riccati_kernels import check_structure, solve_from
+from pushrecovery.control.mpc._riccati_kernels import solve_from
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
@@ -100,6 +100,22 @@ def sparse_stages(
     return a, b, wx, wu, bounds
 
 
+def check_structure(a: FloatArray, b: FloatArray) -> None:
+    """Raise ValueError unless A, B have the zeros the sparse solvers' kernels skip.
+
+    The flywheel's exact discretisation leaves (x, ẋ) and (θ, θ̇) decoupled in A and the CoP's
+    column of B zero on θ, θ̇; the kernels (``_riccati_kernels``, ``_ipm_kernels``) leave
+    those products out. A model without these zeros is a bug here, not a user's input.
+    """
+    com, wheel = np.ix_([0, 2], [1, 3]), np.ix_([1, 3], [0, 2])
+    if np.any(a[com]) or np.any(a[wheel]) or np.any(b[[1, 3], 0]):
+        raise ValueError(
+            "the sparse MPC solvers' kernels need A block-diagonal in (x, xdot), (theta, "
+            "theta_dot) and B's CoP column zero on theta, theta_dot (the flywheel model's "
+            f"discretisation); got A = {a.tolist()}, B = {b.tolist()}"
+        )
+
+
 class RiccatiSolver:
     """The sparse Eq. (17) of one body and settings, solved from a state each tick.
 
@@ -114,7 +130,7 @@ class RiccatiSolver:
     ------
     ValueError
         If A, B lack the flywheel's zeros the kernels skip
-        (:func:`~pushrecovery.control.mpc._riccati_kernels.check_structure`).
+        (:func:`check_structure`).
 
     Attributes
     ----------
