@@ -162,6 +162,11 @@ def simulate(
     observing = type(controller).observe is not Controller.observe
     per_tick = round(dt / h) if abs(dt / h - round(dt / h)) < 1e-9 else 0  # 0: round per tick
     pushing = push is not None
+    # Bound once per run: a tick's attribute lookups are a visible share of its Python.
+    compute, step_plant, falling, plant_at_rest = (
+        controller.compute, plant.step, plant.falling, plant.at_rest,
+    )  # fmt: skip
+    speed, undecided = rest.speed, Outcome.UNDECIDED
     while k < end:
         if pushing and push is not None:
             if k == start:
@@ -180,11 +185,11 @@ def simulate(
                     f"the run took more than its wall-time limit of {wall_limit:g} s "
                     f"(simulated {k * h:g} of {duration:g} s)"
                 )
-            command = controller.compute(tick * dt, state)
+            command = compute(tick * dt, state)
             tick += 1
             next_tick = k + per_tick if per_tick else origin + round(tick * dt / h)
         try:
-            step = plant.step(command, h)
+            step = step_plant(command, h)
         except SimulationDiverged:
             if outcome is not Outcome.FELL:
                 raise
@@ -198,10 +203,10 @@ def simulate(
                 observer.on_step(k, step, command)
         k += 1
         states[k] = state
-        if k != next_tick or outcome is not Outcome.UNDECIDED:
+        if k != next_tick or outcome is not undecided:
             continue  # the criteria are judged at the end of a control tick
         try:
-            fell = plant.falling(state)
+            fell = falling(state)
         except InvalidParameterError:
             if np.isfinite(state).all():
                 raise
@@ -213,7 +218,7 @@ def simulate(
             outcome, decided = Outcome.FELL, k
             end = min(end, k + _steps_after(keep_running[1], h))
             continue
-        resting = settled and not command.saturated and plant.at_rest(state, rest.speed)
+        resting = settled and not command.saturated and plant_at_rest(state, speed)
         at_rest = at_rest + 1 if resting else 0
         if at_rest >= rest_ticks:
             outcome, decided = Outcome.RECOVERED, k

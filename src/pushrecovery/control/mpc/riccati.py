@@ -169,6 +169,7 @@ class RiccatiSolver:
             DUAL_TOL,
         )  # fmt: skip
         self._scratch = (self._gains, self._offsets, self._curvature, self.multipliers)
+        self._shapes = (self.inputs.shape, self.states.shape)
         # Load the compiled kernel now (from numba's disk cache), not on a control tick.
         self.solve(np.zeros(4), max_passes=0)
         self.verified = False
@@ -206,10 +207,10 @@ class RiccatiSolver:
         hold no solution, ``active`` is left as it was (the caller may hand it to DAQP) and
         the next solve starts from it again unless :meth:`seed` or :meth:`reset` is called.
         """
-        n = self.active.shape[0]
         # Fresh output arrays each solve: a verified solution is the caller's to keep (the
         # controller's plan holds them without copying).
-        inputs, states = np.empty((n, 2)), np.empty((n + 1, 4))
+        inputs_shape, states_shape = self._shapes
+        inputs, states = np.empty(inputs_shape), np.empty(states_shape)
         self.passes = passes = solve_from(
             x0, shift, *self._args, max_passes, *forced, inputs, states, *self._scratch
         )
