@@ -35,6 +35,12 @@ _FAST = {"reassoc", "contract"}
 @numba.njit(cache=True, nogil=True, fastmath=_FAST)
 def add_task(hessian, linear, matrix, target, weight):  # type: ignore[no-untyped-def]
     """Add W AᵀA to ``hessian`` and −W Aᵀb to ``linear``, skipping A's zero entries."""
+    add_rows(hessian, linear, matrix, target, np.full(matrix.shape[0], weight))
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def add_rows(hessian, linear, matrix, target, weights):  # type: ignore[no-untyped-def]
+    """:func:`add_task` of row r weighted by ``weights[r]``: stacked tasks in one call."""
     index = np.empty(matrix.shape[1], dtype=np.int64)
     for r in range(matrix.shape[0]):
         count = 0
@@ -44,7 +50,7 @@ def add_task(hessian, linear, matrix, target, weight):  # type: ignore[no-untype
                 count += 1
         for a in range(count):
             i = index[a]
-            scaled = weight * matrix[r, i]
+            scaled = weights[r] * matrix[r, i]
             linear[i] -= scaled * target[r]
             for c in range(count):
                 j = index[c]
@@ -218,24 +224,28 @@ def sole_frames(xmat, bodies, jac, dots, qvel, jac_dot, local):  # type: ignore[
 @numba.njit(cache=True, nogil=True, fastmath=_FAST)
 def ankle_targets(  # type: ignore[no-untyped-def]
     xmat, bodies, mass, com, cop, offset, omega2, gravity, error, jacp, jacr, dots, qvel, qpos,
-    posture, height, torso_z, gains, upright, com_rows, targets,
+    posture, height, torso_z, gains, upright, stack, targets,
 ):  # fmt: skip
     """Write the ankle controller's task rows and targets (:mod:`.wbc_control`).
 
-    ``com_rows`` (2, size, zeros) receives R_i[:2] / m on each foot's force columns;
-    ``targets`` receives, in order, the CoM's ω² (c − p − δ) − g_xy [m/s²] (2), the torso's
-    α = −k_R e − d_R ω − J̇_r q̇ [rad/s²] (3), the pelvis's k_z (z_0 − z) − d_z ż − J̇_z q̇
-    [m/s²] (1) and the posture's k_q (q_0 − q) − d_q q̇ [rad/s²] (nv − 6), with ``gains`` =
-    (k_R, d_R, k_z, d_z, k_q, d_q). ``jacp``, ``jacr`` and ``dots`` (6, nv: J̇_p, J̇_r) are
-    the torso's. Returns whether |e| [rad] and |ω| [rad/s] are both below ``upright``.
+    ``stack`` (≥ nv rows of the QP's size, zeros beyond what is written here) receives the
+    tasks' rows in the order of the targets: the CoM's R_i[:2] / m on each foot's force
+    columns (2), the torso's J_r (3) and the pelvis's J_z (1) on the q̈ columns (the posture's
+    identity rows below are the caller's, constant); ``targets`` receives, in order, the
+    CoM's ω² (c − p − δ) − g_xy [m/s²] (2), the torso's α = −k_R e − d_R ω − J̇_r q̇
+    [rad/s²] (3), the pelvis's k_z (z_0 − z) − d_z ż − J̇_z q̇ [m/s²] (1) and the posture's
+    k_q (q_0 − q) − d_q q̇ [rad/s²] (nv − 6), with ``gains`` = (k_R, d_R, k_z, d_z, k_q, d_q).
+    ``jacp``, ``jacr`` and ``dots`` (6, nv: J̇_p, J̇_r) are the torso's. Returns whether |e|
+    [rad] and |ω| [rad/s] are both below ``upright``.
     """
     nv = qvel.shape[0]
-    nv_rows = com_rows.shape[1] - 6 * bodies.shape[0]
     for i in range(bodies.shape[0]):
         b = bodies[i]
         for a in range(2):
             for c in range(3):
-                com_rows[a, nv_rows + 6 * i + c] = xmat[b, 3 * a + c] / mass
+                stack[a, nv + 6 * i + c] = xmat[b, 3 * a + c] / mass
+    stack[2:5, :nv] = jacr
+    stack[5, :nv] = jacp[2]
     for a in range(2):
         targets[a] = omega2 * (com[a] - cop[a] - offset[a]) - gravity[a]
     spin2, error2 = 0.0, 0.0

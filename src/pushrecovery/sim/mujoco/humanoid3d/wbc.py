@@ -54,6 +54,7 @@ from numpy.typing import NDArray
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.mujoco.humanoid3d._wbc_buffers import Buffers, full_inertia
 from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
+    add_rows,
     add_task,
     constraints,
     least_distance,
@@ -305,11 +306,7 @@ class WholeBodyQP:
 
     def _assemble(self, data: Any, tasks: Sequence[Task]) -> int:
         """Write the QP into the buffers (:meth:`assemble`); return its number of rows."""
-        buf = self._buf
-        full_inertia(self.model, data, buf.mass)
-        self.contact_jacobians(data)
-        np.copyto(buf.hessian, self._regular_matrix)
-        buf.linear.fill(0.0)
+        checked = []  # every task checked before the buffers change
         for task in tasks:
             matrix = np.ascontiguousarray(task.matrix, dtype=np.float64)
             target = np.ascontiguousarray(task.target, dtype=np.float64)
@@ -318,7 +315,38 @@ class WholeBodyQP:
                     f"task {task.name!r}: matrix must be (k, m ≤ {self.size}) and target (k,), "
                     f"got {matrix.shape} and {target.shape}"
                 )
-            add_task(buf.hessian, buf.linear, matrix, target, float(task.weight))
+            checked.append((matrix, target, float(task.weight)))
+        buf = self._buf
+        self._clear(data)
+        for matrix, target, weight in checked:
+            add_task(buf.hessian, buf.linear, matrix, target, weight)
+        return self._constrain(data)
+
+    def _assemble_rows(
+        self, data: Any, matrix: FloatArray, target: FloatArray, weights: FloatArray
+    ) -> int:
+        """:meth:`_assemble` of stacked tasks, row r of weight ``weights[r]``, unchecked.
+
+        The controller's fast path: ``matrix`` (k, size), ``target`` and ``weights`` (k,),
+        all C-contiguous float64, its tasks' rows in their order; one compiled call instead
+        of a check and a call per task (the same sums: the same QP to the last bit).
+        """
+        buf = self._buf
+        self._clear(data)
+        add_rows(buf.hessian, buf.linear, matrix, target, weights)
+        return self._constrain(data)
+
+    def _clear(self, data: Any) -> None:
+        """Start a tick: M and the contact Jacobians of ``data``, H = diag(ε), f = 0."""
+        buf = self._buf
+        full_inertia(self.model, data, buf.mass)
+        self.contact_jacobians(data)
+        np.copyto(buf.hessian, self._regular_matrix)
+        buf.linear.fill(0.0)
+
+    def _constrain(self, data: Any) -> int:
+        """Write the constraint rows (after the tasks); return the QP's number of rows."""
+        buf = self._buf
         count = constraints(
             buf.mass, data.qfrc_bias, data.qfrc_passive, buf.jac, buf.jac_dot, buf.local,
             data.qvel, self.contacts, self.unactuated, self.actuated, self.gear, self.ctrl_low,
@@ -339,8 +367,17 @@ class WholeBodyQP:
         InvalidParameterError
             If a task's matrix is not (k, m ≤ ``size``) with a target of k rows.
         """
-        nv, buf, nu = self.nv, self._buf, int(self.model.nu)
-        count = self._assemble(data, tasks)
+        return self._solve_assembled(self._assemble(data, tasks))
+
+    def _solve_rows(
+        self, data: Any, matrix: FloatArray, target: FloatArray, weights: FloatArray
+    ) -> WbcSolution:
+        """:meth:`solve` of stacked, unchecked tasks (:meth:`_assemble_rows`)."""
+        return self._solve_assembled(self._assemble_rows(data, matrix, target, weights))
+
+    def _solve_assembled(self, count: int) -> WbcSolution:
+        """Solve the QP of ``count`` rows in the buffers (:meth:`solve`)."""
+        nv, buf, nu = self.nv, self._buf, self._buf.offset.shape[0]
         start = time.perf_counter()  # the solve time includes the factorisation of H
         flag, feet, steps, reduced = -1, len(self.feet), 0, count - nu
         ctrl = buf.offset  # (overwritten)

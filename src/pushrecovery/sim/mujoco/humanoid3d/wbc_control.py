@@ -201,11 +201,21 @@ class WholeBodyController:
         self.last = None
         self._bodies = np.array([foot.body for foot in self.feet], dtype=np.intp)
         self._origins = np.array([foot.origin for foot in self.feet])
-        nv = int(model.nv)
+        nv, size = int(model.nv), self.qp.size
         self._dots = np.zeros((6, nv))  # the torso's J̇ (linear, angular), overwritten each tick
-        self._joints = np.zeros((nv - 6, self.qp.size))  # the posture task's constant matrix
+        self._jacp, self._jacr = np.zeros((3, nv)), np.zeros((3, nv))  # its J (each tick)
+        self._joints = np.zeros((nv - 6, size))  # the posture task's constant matrix
         self._joints[:, 6:nv] = np.eye(nv - 6)
         self._joints.flags.writeable = False
+        # The tasks stacked for the QP's one compiled call (_rows), row by row: the CoM (2),
+        # torso (3), height (1) and posture (nv − 6) rows (ankle_targets), then the tick's
+        # others (the hip's momentum, the stepper's, the joint guard's), grown on demand.
+        self._stack, self._targets = np.zeros((nv + 8, size)), np.zeros(nv + 8)
+        self._stack[6:nv] = self._joints
+        self._weights = np.concatenate([[self.gains.com_weight] * 2, [0.0] * 3,
+                                        [self.gains.height_weight],
+                                        [self.gains.posture_weight] * (nv - 6),
+                                        np.zeros(8)])  # fmt: skip
         g = self.gains  # k_R, d_R (set each tick), k_z, d_z, k_q, d_q of ankle_targets
         self._gains = np.array([g.torso_stiffness, g.torso_damping, g.height_stiffness,
                                 g.height_damping, g.posture_stiffness,
@@ -286,6 +296,50 @@ class WholeBodyController:
 
     def tasks(self, data: Any) -> list[Task]:
         """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.wbc_hip`)."""
+        momentum, others = self._update(data)
+        assert self.qp is not None
+        nv, gains, stack, targets = self.qp.nv, self.gains, self._stack, self._targets
+        tasks = [Task("com", stack[:2].copy(), targets[:2].copy(), gains.com_weight)]
+        if momentum is not None:
+            tasks.append(momentum)
+        tasks.append(Task("torso", stack[2:5, :nv].copy(), targets[2:5].copy(),
+                          float(self._weights[2])))  # fmt: skip
+        tasks.append(Task("height", stack[5:6, :nv].copy(), targets[5:6].copy(),
+                          gains.height_weight))  # fmt: skip
+        tasks.append(Task("posture", self._joints, targets[6:nv].copy(), gains.posture_weight))
+        return tasks + others
+
+    def _rows(self, data: Any) -> int:
+        """Stack the tasks of :meth:`tasks` in ``_stack``, ``_targets``, ``_weights``; their rows.
+
+        The hip's momentum task acts on the wrenches alone, the torso's, pelvis's and posture's
+        on q̈ alone: after them instead of between the CoM's and the torso's, each sum of H and
+        f still takes its terms in the same order.
+        """
+        momentum, others = self._update(data)
+        assert self.qp is not None
+        count = self.qp.nv  # the rows ankle_targets wrote
+        for task in others if momentum is None else [momentum, *others]:
+            rows = task.matrix.shape[0]
+            if count + rows > self._stack.shape[0]:  # more rows than ever: grow the buffers
+                grow = count + rows - self._stack.shape[0]
+                self._stack = np.vstack([self._stack, np.zeros((grow, self._stack.shape[1]))])
+                self._targets = np.concatenate([self._targets, np.zeros(grow)])
+                self._weights = np.concatenate([self._weights, np.zeros(grow)])
+            block = self._stack[count : count + rows]
+            block[:, : task.matrix.shape[1]] = task.matrix
+            block[:, task.matrix.shape[1] :] = 0.0
+            self._targets[count : count + rows] = task.target
+            self._weights[count : count + rows] = task.weight
+            count += rows
+        return count
+
+    def _update(self, data: Any) -> tuple[Task | None, list[Task]]:
+        """Run the tick's laws; write the CoM, torso, pelvis and posture rows (:meth:`_rows`).
+
+        Returns the hip's momentum task (None when the hip is idle) and the tasks that follow
+        the posture's (the stepper's or the joint guard's).
+        """
         import mujoco
 
         assert self.qp is not None
@@ -298,7 +352,7 @@ class WholeBodyController:
             self.desired_cop = self.cop_target(data)  # the new support polygon
         # Torso orientation and pelvis height: J q̈ + J̇ q̇ = a_des (matrices over q̈ only).
         point = data.xpos[self.torso]
-        jacp, jacr, dots = np.zeros((3, nv)), np.zeros((3, nv)), self._dots
+        jacp, jacr, dots = self._jacp, self._jacr, self._dots
         mujoco.mj_jac(model, data, jacp, jacr, point, self.torso)
         mujoco.mj_jacDot(model, data, dots[:3], dots[3:], point, self.torso)
         spin = jacr @ data.qvel  # the torso's angular velocity [rad/s], world
@@ -330,41 +384,40 @@ class WholeBodyController:
             self.cmp_offset, self.desired_cop, paced = self.hip.paced_return(self.cmp_target, accel)
             paced -= accel
         self._gains[:2] = stiffness, damping
-        # All targets at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g + Σ R_i F_i, rows
-        # x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
-        com_rows, targets = np.zeros((2, size)), np.empty(nv)
+        # All targets and rows at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g +
+        # Σ R_i F_i, rows x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
+        stack, targets = self._stack, self._targets
         stepper, height = self.stepper, self.height  # the stepper lowers it for long steps
         height = height if stepper is None else stepper.pelvis_height(data, height)
         upright = ankle_targets(
             data.xmat, self._bodies, self.mass, com, self.desired_cop, self.cmp_offset,
             self.omega**2, self.gravity, error, jacp, jacr, dots, data.qvel, data.qpos,
-            self.posture, height, float(point[2]), self._gains, UPRIGHT, com_rows, targets,
+            self.posture, height, float(point[2]), self._gains, UPRIGHT, stack, targets,
         )  # fmt: skip
         targets[2:4] += paced
         if hip_active or returning:  # yaw keeps the usual gains and weight (legs untwisted)
             targets[4] -= (gains.torso_stiffness - stiffness) * error[2] + (
                 gains.torso_damping - damping) * spin[2]  # fmt: skip
             scale = math.sqrt(gains.torso_weight / torso_weight)
-            jacr[2] *= scale
+            stack[4, :nv] *= scale
             targets[4] *= scale
         if returning and upright:
             self.returning = False
-        tasks = [Task("com", com_rows, targets[:2], gains.com_weight)]
+        self._weights[2:5] = torso_weight
+        momentum_task = None
         if hip_active:  # L̇_x = −m g δ_y, L̇_y = m g δ_x
             rows = momentum_rows(data, self._bodies, size, nv, com, self._origins)[:2]
             weight = self.mass * float(np.linalg.norm(self.gravity))
             rate = weight * np.array([-self.cmp_offset[1], self.cmp_offset[0]])
-            tasks.append(Task("momentum", rows, rate, gains.hip_weight))
-        tasks.append(Task("torso", jacr, targets[2:5], torso_weight))
-        tasks.append(Task("height", jacp[2:], targets[5:6], gains.height_weight))
-        tasks.append(Task("posture", self._joints, targets[6:], gains.posture_weight))
+            momentum_task = Task("momentum", rows, rate, gains.hip_weight)
+        others: list[Task] = []
         if self.stepper is not None:  # the swing foot (while it swings), the knee guard
-            tasks.extend(self.stepper.tasks(data, size, nv))
+            others = self.stepper.tasks(data, size, nv)
         else:  # the joints near their stops (wbc_limits)
             guard = self.guard.task_rows(data.qpos, data.qvel, nv)
             if guard[1].size:
-                tasks.append(Task("joint guard", *guard, self.guard.settings.weight))
-        return tasks
+                others.append(Task("joint guard", *guard, self.guard.settings.weight))
+        return momentum_task, others
 
     def compute(self, t: float, state: Any) -> FloatArray:
         """Return the motor commands ``ctrl`` [N m] for the state in ``state`` (an MjData).
@@ -374,5 +427,7 @@ class WholeBodyController:
         """
         if self.qp is None:
             raise InvalidParameterError("call reset(state) before compute(t, state)")
-        self.last = self.qp.solve(state, self.tasks(state))
+        count = self._rows(state)  # the tasks() as stacked rows: the QP's fast path
+        self.last = self.qp._solve_rows(state, self._stack[:count], self._targets[:count],
+                                        self._weights[:count])  # fmt: skip
         return self.last.ctrl

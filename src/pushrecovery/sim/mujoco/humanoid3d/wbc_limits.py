@@ -145,13 +145,17 @@ class JointGuard:
         No rows when no joint's predicted position is within its margin.
         """
         s = self.settings
-        rows: list[tuple[int, float]] = []  # (dof, target): a plain loop over a few joints
+        horizon, stiffness, damping = s.horizon, s.stiffness, s.damping
+        # A plain loop over a few joints; memoryviews read Python floats (numpy scalars' sums
+        # cost twice as much), a call's share of the controller's tick.
+        positions, velocities = np.asarray(qpos).data, np.asarray(qvel).data  # memoryviews
+        rows: list[tuple[int, float]] = []  # (dof, target)
         for adr, dof, low, high in self._joints:
-            q, v = float(qpos[adr]), float(qvel[dof])
-            if q + s.horizon * min(v, 0.0) < low:
-                rows.append((dof, s.stiffness * max(low - q, 0.0) - s.damping * min(v, 0.0)))
-            elif q + s.horizon * max(v, 0.0) > high:
-                rows.append((dof, s.stiffness * min(high - q, 0.0) - s.damping * max(v, 0.0)))
+            q, v = positions[adr], velocities[dof]
+            if q + horizon * min(v, 0.0) < low:
+                rows.append((dof, stiffness * max(low - q, 0.0) - damping * min(v, 0.0)))
+            elif q + horizon * max(v, 0.0) > high:
+                rows.append((dof, stiffness * min(high - q, 0.0) - damping * max(v, 0.0)))
         matrix = np.zeros((len(rows), nv))
         for k, (dof, _) in enumerate(rows):
             matrix[k, dof] = 1.0
