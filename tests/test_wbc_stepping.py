@@ -389,3 +389,21 @@ def test_segment_lengths_need_a_hip_pitch_and_a_knee(model):
     mujoco.mj_forward(model, data)
     with pytest.raises(InvalidParameterError, match="hip_pitch and a knee"):
         segment_lengths(data, Leg(model.body("left_foot").id))
+
+
+def test_hip_and_stepping_hand_over_at_lift_off(params, model):
+    """A push of 1.5 × the ankle's limit at 30° with the hip and stepping tasks both on.
+
+    The hip acts first (ξ leaves P before the CMP region); once a foot swings the step owns the
+    recovery. With the hip law running through the swing this push fell after 9 steps.
+    """
+    polygon = Support.from_params(params).polygon
+    azimuth = math.radians(30.0)
+    impulse = OUTSIDE * params.mass * params.omega * polygon.ray_distance(0.0, 0.0, azimuth)
+    run = push_biped3d(params, impulse, azimuth, duration=4.0, model=model, hip=True,
+                       stepping=True)  # fmt: skip
+    assert np.abs(run.cmp_offset).max() > 0.01  # the hip acted
+    assert run.com[:, 2].min() > 0.7 * run.com[0, 2] and run.torso_tilt.max() < 1.0
+    xi = run.com[-1, :2] + run.com_velocity[-1, :2] / run.controller.omega
+    assert run.controller.support.point_signed_distance(*map(float, xi)) > -0.05
+    assert 1 <= len(run.controller.stepper.steps) <= 2
