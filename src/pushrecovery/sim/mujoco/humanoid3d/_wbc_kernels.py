@@ -35,14 +35,18 @@ _FAST = {"reassoc", "contract"}
 @numba.njit(cache=True, nogil=True, fastmath=_FAST)
 def add_task(hessian, linear, matrix, target, weight):  # type: ignore[no-untyped-def]
     """Add W AᵀA to ``hessian`` and −W Aᵀb to ``linear``, skipping A's zero entries."""
-    add_rows(hessian, linear, matrix, target, np.full(matrix.shape[0], weight))
+    add_rows(hessian, linear, matrix, target, np.full(matrix.shape[0], weight), matrix.shape[0])
 
 
 @numba.njit(cache=True, nogil=True, fastmath=_FAST)
-def add_rows(hessian, linear, matrix, target, weights):  # type: ignore[no-untyped-def]
-    """:func:`add_task` of row r weighted by ``weights[r]``: stacked tasks in one call."""
+def add_rows(hessian, linear, matrix, target, weights, count):  # type: ignore[no-untyped-def]
+    """:func:`add_task` of the first ``count`` rows, row r weighted by ``weights[r]``.
+
+    Stacked tasks in one call (each entry of H and f takes its terms in row order, one sum per
+    entry: no reduction the compiler could reorder).
+    """
     index = np.empty(matrix.shape[1], dtype=np.int64)
-    for r in range(matrix.shape[0]):
+    for r in range(count):
         count = 0
         for j in range(matrix.shape[1]):
             if matrix[r, j] != 0.0:
@@ -112,6 +116,52 @@ def constraints(  # type: ignore[no-untyped-def]
         lower[count] = max(ctrl_low[r] - offset[r], -INF)
         count += 1
     return count
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+def assemble_rows(  # type: ignore[no-untyped-def]
+    matrix, target, weights, tasks, damping, xmat, bodies, dots, qvel, regular, mass, qfrc_bias,
+    qfrc_passive, contacts, unactuated, actuated, gear, ctrl_low, ctrl_high, foot_rows,
+    foot_start, jac, jac_dot, local, hessian, linear, rows, upper, lower, offset,
+):  # fmt: skip
+    """Write the whole tick's QP after MuJoCo's calls in one call; return its rows' count.
+
+    :func:`sole_frames`, H = diag(``regular``) and f = 0, :func:`add_rows` of the first
+    ``tasks`` rows of the stacked tasks, :func:`constraints`: the kernels the QP otherwise
+    calls one by one, in the same order on the same arrays (the same sums, bit for bit),
+    without a Python call and its argument checks between them.
+    """
+    sole_frames(xmat, bodies, jac, dots, qvel, jac_dot, local)
+    hessian[:] = 0.0
+    for j in range(regular.shape[0]):
+        hessian[j, j] = regular[j]
+    linear[:] = 0.0
+    add_rows(hessian, linear, matrix, target, weights, tasks)
+    return constraints(
+        mass, qfrc_bias, qfrc_passive, jac, jac_dot, local, qvel, contacts, unactuated,
+        actuated, gear, ctrl_low, ctrl_high, foot_rows, foot_start, damping, rows, upper, lower,
+        offset,
+    )  # fmt: skip
+
+
+@numba.njit(cache=True, nogil=True)
+def commands(product, offset, low, high, ctrl):  # type: ignore[no-untyped-def]
+    """Write the motor commands A_a x + h_a/gear, clipped to [low, high], into ``ctrl``.
+
+    ``product`` is A_a x (NumPy's dot: BLAS's sums, kept). Returns whether every command was
+    strictly inside (low, high) before the clip (False for a NaN). No fast-math: one add and
+    two comparisons per motor, as NumPy's ``+``, ``maximum`` and ``minimum`` round them.
+    """
+    inside = True
+    for r in range(ctrl.shape[0]):
+        value = product[r] + offset[r]
+        inside = inside and low[r] < value < high[r]
+        if value < low[r]:  # np.maximum(value, low): value unless below (NaN kept)
+            value = low[r]
+        if value > high[r]:  # np.minimum(value, high)
+            value = high[r]
+        ctrl[r] = value
+    return inside
 
 
 @numba.njit(cache=True, nogil=True, fastmath=_FAST)

@@ -43,7 +43,6 @@ least-distance form (H factored on its envelope). MuJoCo's types appear as ``Any
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -54,16 +53,14 @@ from numpy.typing import NDArray
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.mujoco.humanoid3d._wbc_buffers import Buffers, full_inertia
 from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
-    add_rows,
     add_task,
+    assemble_rows,
     constraints,
-    least_distance,
-    recover,
     sole_frames,
     sole_origins,
-    transform_rows,
 )
 from pushrecovery.sim.mujoco.humanoid3d.wbc_feet import FootContact, foot_contact
+from pushrecovery.sim.mujoco.humanoid3d.wbc_ldp import LeastDistanceSolver
 
 FloatArray = NDArray[np.float64]
 
@@ -77,10 +74,6 @@ __all__ = [
     "foot_contact",
 ]
 
-#: Bounds DAQP treats as infinite.
-_INF = 1e30
-#: DAQP's sense flags: an active, immutable row (an equality).
-_EQUALITY = 5
 #: The default k_c, the damping of a foot's drift in its fixed-foot rows [1/s].
 CONTACT_DAMPING = 20.0
 
@@ -223,35 +216,17 @@ class WholeBodyQP:
                         buf.dots[6 * i : 6 * i + 3], buf.dots[6 * i + 3 : 6 * i + 6], int(body))
                        for i, body in enumerate(self._bodies)]  # fmt: skip
         self._regular_matrix = np.diag(self._regular)
-        self._identity, self._zeros = np.eye(self.size), np.zeros(self.size)
-        self._models: dict[int, Any] = {}  # DAQP, by rows handed over: without/with the motors'
-        self._motor_rows = False  # whether the last tick needed the motor rows
-        self._last_ctrl = np.zeros(model.nu)
+        self._solver = LeastDistanceSolver(buf, self._n_equal, self.ctrl_low, self.ctrl_high)
         self.contact_damping = CONTACT_DAMPING  # k_c [1/s]: J q̈ + J̇ q̇ = −k_c J q̇
-
-    def _daqp(self, count: int) -> tuple[Any, int, int]:
-        """Return DAQP's (u, flag, iterations) on the first ``count`` least-distance rows."""
-        import daqp
-
-        buf = self._buf
-        rows, high, low = buf.ldp_rows[:count], buf.ldp_upper[:count], buf.ldp_lower[:count]
-        model = self._models.get(count)
-        if model is None:
-            sense = np.where(np.arange(count) < self._n_equal, _EQUALITY, 0).astype(np.intc)
-            model = daqp.Model()
-            flag, _ = model.setup(self._identity, self._zeros, rows, high, low, sense)
-            if flag < 0:
-                raise RuntimeError(f"daqp could not set up the whole-body QP (exit flag {flag})")
-            self._models[count] = model
-        else:
-            model.update(A=rows, bupper=high, blower=low)
-        u, _, flag, info = model.solve()
-        return u, int(flag), int(info["iterations"])
+        # The fast path's arguments after the tasks' (_tick_arguments), for one MjData and
+        # contact set: MuJoCo's arrays are views of its fixed arena, read anew each tick.
+        self._data: Any = None
+        self._arguments: tuple[Any, ...] = ()
 
     def reset(self) -> None:
         """Forget the warm start (the next solve sets DAQP up afresh); every foot in contact."""
-        self._models.clear()
-        self._last_ctrl = np.zeros(self.model.nu)
+        self._solver.forget()
+        self._solver.last_ctrl = np.zeros(self.model.nu)
         self.contacts[:] = True
 
     def set_contacts(self, contacts: Sequence[bool]) -> None:
@@ -269,7 +244,8 @@ class WholeBodyQP:
             raise InvalidParameterError(f"contacts must be one bool per foot, got {contacts!r}")
         if not np.array_equal(mask, self.contacts):
             self.contacts = mask.copy()
-            self._models.clear()  # other rows: no warm start
+            self._data = None  # the fast path's arguments name the contacts
+            self._solver.forget()  # other rows: no warm start
 
     def contact_jacobians(self, data: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Return each foot's world Jacobian J (6 n × nv), J̇ q̇ (6 n) and sole-frame Jacobian.
@@ -278,16 +254,21 @@ class WholeBodyQP:
         foot's orientation: its transpose maps a sole-frame wrench to generalised forces.
         Written in place into the QP's buffers: valid until the next call.
         """
+        buf = self._buf
+        self._jacobians(data)
+        sole_frames(data.xmat, self._bodies, buf.jac, buf.dots, data.qvel, buf.jac_dot,
+                    buf.local)  # fmt: skip
+        return buf.jac, buf.jac_dot, buf.local
+
+    def _jacobians(self, data: Any) -> None:
+        """Write MuJoCo's J and J̇ of each sole frame into the buffers (``jac``, ``dots``)."""
         import mujoco
 
-        buf, model = self._buf, self.model
-        xmat = data.xmat
-        sole_origins(data.xpos, xmat, self._bodies, self._origins, buf.points)
+        model = self.model
+        sole_origins(data.xpos, data.xmat, self._bodies, self._origins, self._buf.points)
         for point, lin, ang, lin_dot, ang_dot, body in self._views:  # rows of buf, per foot
             mujoco.mj_jac(model, data, lin, ang, point, body)
             mujoco.mj_jacDot(model, data, lin_dot, ang_dot, point, body)
-        sole_frames(xmat, self._bodies, buf.jac, buf.dots, data.qvel, buf.jac_dot, buf.local)
-        return buf.jac, buf.jac_dot, buf.local
 
     def assemble(self, data: Any, tasks: Sequence[Task]) -> WbcProblem:
         """Build the QP of the module docstring at the state in ``data`` (:meth:`solve`).
@@ -323,18 +304,35 @@ class WholeBodyQP:
         return self._constrain(data)
 
     def _assemble_rows(
-        self, data: Any, matrix: FloatArray, target: FloatArray, weights: FloatArray
+        self, data: Any, matrix: FloatArray, target: FloatArray, weights: FloatArray, count: int
     ) -> int:
-        """:meth:`_assemble` of stacked tasks, row r of weight ``weights[r]``, unchecked.
+        """:meth:`_assemble` of the first ``count`` stacked task rows, unchecked.
 
-        The controller's fast path: ``matrix`` (k, size), ``target`` and ``weights`` (k,),
-        all C-contiguous float64, its tasks' rows in their order; one compiled call instead
-        of a check and a call per task (the same sums: the same QP to the last bit).
+        The controller's fast path: ``matrix`` (≥ count, size), ``target`` and ``weights``
+        (≥ count), all C-contiguous float64, row r of weight ``weights[r]``, its tasks' rows in
+        their order; after MuJoCo's calls one compiled call (:func:`._wbc_kernels.assemble_rows`)
+        instead of a check and a call per task and kernel (the same sums: the same QP to the
+        last bit).
         """
+        full_inertia(self.model, data, self._buf.mass)
+        self._jacobians(data)
+        if data is not self._data:
+            self._tick_arguments(data)
+        count = assemble_rows(matrix, target, weights, count, float(self.contact_damping),
+                              *self._arguments)  # fmt: skip
+        return int(count)
+
+    def _tick_arguments(self, data: Any) -> None:
+        """Gather :func:`._wbc_kernels.assemble_rows`' arrays after the tasks' and k_c."""
         buf = self._buf
-        self._clear(data)
-        add_rows(buf.hessian, buf.linear, matrix, target, weights)
-        return self._constrain(data)
+        self._data = data
+        self._arguments = (
+            data.xmat, self._bodies, buf.dots, data.qvel, self._regular, buf.mass,
+            data.qfrc_bias, data.qfrc_passive, self.contacts, self.unactuated, self.actuated,
+            self.gear, self.ctrl_low, self.ctrl_high, self._foot_rows, self._foot_start,
+            buf.jac, buf.jac_dot, buf.local, buf.hessian, buf.linear, buf.rows, buf.upper,
+            buf.lower, buf.offset,
+        )  # fmt: skip
 
     def _clear(self, data: Any) -> None:
         """Start a tick: M and the contact Jacobians of ``data``, H = diag(ε), f = 0."""
@@ -370,47 +368,16 @@ class WholeBodyQP:
         return self._solve_assembled(self._assemble(data, tasks))
 
     def _solve_rows(
-        self, data: Any, matrix: FloatArray, target: FloatArray, weights: FloatArray
+        self, data: Any, matrix: FloatArray, target: FloatArray, weights: FloatArray, count: int
     ) -> WbcSolution:
-        """:meth:`solve` of stacked, unchecked tasks (:meth:`_assemble_rows`)."""
-        return self._solve_assembled(self._assemble_rows(data, matrix, target, weights))
+        """:meth:`solve` of stacked, unchecked task rows (:meth:`_assemble_rows`)."""
+        return self._solve_assembled(self._assemble_rows(data, matrix, target, weights, count))
 
     def _solve_assembled(self, count: int) -> WbcSolution:
-        """Solve the QP of ``count`` rows in the buffers (:meth:`solve`)."""
-        nv, buf, nu = self.nv, self._buf, self._buf.offset.shape[0]
-        start = time.perf_counter()  # the solve time includes the factorisation of H
-        flag, feet, steps, reduced = -1, len(self.feet), 0, count - nu
-        ctrl = buf.offset  # (overwritten)
-        if least_distance(buf.hessian, buf.linear, buf.rows, buf.upper, buf.lower, reduced,
-                          buf.factor, buf.first, buf.shift, buf.ldp_rows, buf.ldp_upper,
-                          buf.ldp_lower):  # fmt: skip
-            # Without the (rarely active) motor rows first: a convex QP's optimum stays optimal
-            # under constraints it satisfies; else again with them, and next tick at once.
-            for rows in (count,) if self._motor_rows else (reduced, count):
-                if rows == count:  # the motor rows, transformed only when needed
-                    transform_rows(buf.factor, buf.first, buf.shift, buf.rows, buf.upper,
-                                   buf.lower, reduced, count, buf.ldp_rows, buf.ldp_upper,
-                                   buf.ldp_lower)  # fmt: skip
-                u, flag, iterations = self._daqp(rows)
-                steps += iterations
-                if flag <= 0:
-                    break
-                recover(buf.factor, buf.first, buf.shift, u, buf.x)
-                ctrl = np.dot(buf.rows[reduced:count], buf.x) + buf.offset
-                inside = bool(((ctrl > self.ctrl_low) & (ctrl < self.ctrl_high)).all())
-                if rows == count:
-                    self._motor_rows = not inside  # a motor on its limit: keep the rows
-                    break
-                if inside:
-                    break
-        if flag <= 0:
-            elapsed = time.perf_counter() - start
-            self._models.clear()  # the next tick starts cold
-            self._motor_rows = False
-            last = self._last_ctrl.copy()
-            return WbcSolution(np.zeros(nv), np.zeros((feet, 6)), last, False, elapsed, steps)
-        elapsed = time.perf_counter() - start
-        np.minimum(np.maximum(ctrl, self.ctrl_low, out=ctrl), self.ctrl_high, out=ctrl)
-        self._last_ctrl = ctrl
-        x = buf.x.copy()
-        return WbcSolution(x[:nv], x[nv:].reshape(feet, 6), ctrl, True, elapsed, steps)
+        """Solve the QP of ``count`` rows in the buffers (:meth:`solve`, :mod:`.wbc_ldp`)."""
+        x, ctrl, elapsed, steps = self._solver.solve(count)
+        if x is None:
+            feet = len(self.feet)
+            return WbcSolution(np.zeros(self.nv), np.zeros((feet, 6)), ctrl, False, elapsed, steps)
+        nv = self.nv
+        return WbcSolution(x[:nv], x[nv:].reshape(-1, 6), ctrl, True, elapsed, steps)

@@ -428,6 +428,5 @@ class WholeBodyController:
         if self.qp is None:
             raise InvalidParameterError("call reset(state) before compute(t, state)")
         count = self._rows(state)  # the tasks() as stacked rows: the QP's fast path
-        self.last = self.qp._solve_rows(state, self._stack[:count], self._targets[:count],
-                                        self._weights[:count])  # fmt: skip
+        self.last = self.qp._solve_rows(state, self._stack, self._targets, self._weights, count)
         return self.last.ctrl

@@ -124,6 +124,7 @@ class JointGuard:
         # The margin, but never past the range's middle.
         inset = np.minimum(settings.margin, 0.25 * (ranges[:, 1] - ranges[:, 0]))
         self.edges = np.column_stack([ranges[:, 0] + inset, ranges[:, 1] - inset])
+        self._empty: dict[int, tuple[FloatArray, FloatArray]] = {}  # task_rows' empty, by nv
         self.set_posture(np.full(int(model.nq), np.nan))
 
     def set_posture(self, qpos: FloatArray) -> None:
@@ -156,6 +157,12 @@ class JointGuard:
                 rows.append((dof, stiffness * max(low - q, 0.0) - damping * min(v, 0.0)))
             elif q + horizon * max(v, 0.0) > high:
                 rows.append((dof, stiffness * min(high - q, 0.0) - damping * max(v, 0.0)))
+        if not rows:  # the usual tick: one shared, read-only empty task (no allocation)
+            empty = self._empty.get(nv)
+            if empty is None:
+                empty = self._empty[nv] = (np.zeros((0, nv)), np.zeros(0))
+                empty[0].flags.writeable = empty[1].flags.writeable = False
+            return empty
         matrix = np.zeros((len(rows), nv))
         for k, (dof, _) in enumerate(rows):
             matrix[k, dof] = 1.0
