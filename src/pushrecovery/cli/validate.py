@@ -64,7 +64,7 @@ __all__ = ["validate"]
 @click.option(
     "--quick",
     is_flag=True,
-    help="3-D models: azimuths 0 and 90, the ankle, a 3 %% bracket, push sizes 0.5 and 1.5.",
+    help="3-D models: azimuths 0 and 90, the ankle, a 3 % bracket, push sizes 0.5 and 1.5.",
 )
 @click.option(
     "--out",
