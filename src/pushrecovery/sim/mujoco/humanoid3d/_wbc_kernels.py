@@ -271,6 +271,57 @@ def sole_frames(xmat, bodies, jac, dots, qvel, jac_dot, local):  # type: ignore[
                     )
 
 
+@numba.njit(cache=True, nogil=True)
+def rotation_vector(rot, ref, out):  # type: ignore[no-untyped-def]
+    """Write the rotation vector (axis × angle) [rad] of R R₀ᵀ (both row-major, 9) into ``out``.
+
+    No fast-math: the controller's Python formula before, operation for operation.
+    """
+    trace = (rot[0] * ref[0] + rot[1] * ref[1] + rot[2] * ref[2] + rot[3] * ref[3]
+             + rot[4] * ref[4] + rot[5] * ref[5] + rot[6] * ref[6] + rot[7] * ref[7]
+             + rot[8] * ref[8])  # fmt: skip
+    cosine = 0.5 * (trace - 1.0)
+    cosine = cosine if cosine < 1.0 else 1.0  # min(1.0, ·), NaN → 1
+    cosine = cosine if cosine > -1.0 else -1.0  # max(-1.0, ·)
+    angle = math.acos(cosine)
+    scale = 0.5 if angle < 1e-9 else 0.5 * angle / math.sin(angle)
+    # (R R₀ᵀ)_21 − (R R₀ᵀ)_12, (R R₀ᵀ)_02 − (R R₀ᵀ)_20, (R R₀ᵀ)_10 − (R R₀ᵀ)_01
+    x = rot[6] * ref[3] + rot[7] * ref[4] + rot[8] * ref[5] - (
+        rot[3] * ref[6] + rot[4] * ref[7] + rot[5] * ref[8])  # fmt: skip
+    y = rot[0] * ref[6] + rot[1] * ref[7] + rot[2] * ref[8] - (
+        rot[6] * ref[0] + rot[7] * ref[1] + rot[8] * ref[2])  # fmt: skip
+    z = rot[3] * ref[0] + rot[4] * ref[1] + rot[5] * ref[2] - (
+        rot[0] * ref[3] + rot[1] * ref[4] + rot[2] * ref[5])  # fmt: skip
+    out[0], out[1], out[2] = x * scale, y * scale, z * scale
+
+
+@numba.njit(cache=True, nogil=True)
+def balance_point(  # type: ignore[no-untyped-def]
+    xmat, torso, upright, com, vel, omega, gain, rest, normals, offsets, out
+):
+    """Write the torso's error, the capture point and the DCM law's CoP; return if inside.
+
+    ``out`` receives (e (3) of :func:`rotation_vector` of the torso's ``xmat`` row against
+    ``upright``, ξ = c + ċ/ω (2), p = ξ + gain (ξ − ``rest``) (2)) from the CoM ``com`` and
+    its velocity ``vel`` (world, rows of MuJoCo's subtree arrays: body 0). Returns whether p is
+    strictly inside the polygon n·p ≤ b (``normals``, ``offsets``), finite. No fast-math: the
+    rounding of the Python floats of ``capture_point`` and ``ConvexPolygon`` before.
+    """
+    rotation_vector(xmat[torso], upright, out)
+    inv = 1.0 / omega
+    xi_x, xi_y = com[0, 0] + vel[0, 0] * inv, com[0, 1] + vel[0, 1] * inv
+    cop_x, cop_y = xi_x + gain * (xi_x - rest[0]), xi_y + gain * (xi_y - rest[1])
+    out[3], out[4], out[5], out[6] = xi_x, xi_y, cop_x, cop_y
+    if not (math.isfinite(cop_x) and math.isfinite(cop_y)):
+        return False
+    excess = -math.inf
+    for e in range(offsets.shape[0]):
+        value = normals[e, 0] * cop_x + normals[e, 1] * cop_y - offsets[e]
+        if value > excess:
+            excess = value
+    return excess < 0.0
+
+
 @numba.njit(cache=True, nogil=True, fastmath=_FAST)
 def ankle_targets(  # type: ignore[no-untyped-def]
     xmat, bodies, mass, com, cop, offset, omega2, gravity, error, jacp, jacr, dots, qvel, qpos,

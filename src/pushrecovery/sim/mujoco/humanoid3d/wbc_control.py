@@ -55,7 +55,11 @@ from numpy.typing import NDArray
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import ankle_targets
+from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
+    ankle_targets,
+    balance_point,
+    rotation_vector,
+)
 from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points
 from pushrecovery.sim.mujoco.humanoid3d.wbc import (
     FootContact,
@@ -74,18 +78,19 @@ FloatArray = NDArray[np.float64]
 
 __all__ = ["WbcGains", "WholeBodyController"]
 
+#: The torso's spin where no hip law reads it (the ankles' kernel computes its own).
+_NO_SPIN = np.zeros(3)
+_NO_SPIN.flags.writeable = False
+
 
 def _rotation_vector(rot: Sequence[float], ref: Sequence[float]) -> FloatArray:
-    """Return the rotation vector (axis × angle) [rad] of R R₀ᵀ, both row-major (9 floats)."""
-    r0, r1, r2, r3, r4, r5, r6, r7, r8 = rot
-    u0, u1, u2, u3, u4, u5, u6, u7, u8 = ref
-    trace = r0 * u0 + r1 * u1 + r2 * u2 + r3 * u3 + r4 * u4 + r5 * u5 + r6 * u6 + r7 * u7 + r8 * u8
-    angle = math.acos(max(-1.0, min(1.0, 0.5 * (trace - 1.0))))
-    scale = 0.5 if angle < 1e-9 else 0.5 * angle / math.sin(angle)
-    x = r6 * u3 + r7 * u4 + r8 * u5 - (r3 * u6 + r4 * u7 + r5 * u8)  # (R R₀ᵀ)_21 − (R R₀ᵀ)_12
-    y = r0 * u6 + r1 * u7 + r2 * u8 - (r6 * u0 + r7 * u1 + r8 * u2)  # (R R₀ᵀ)_02 − (R R₀ᵀ)_20
-    z = r3 * u0 + r4 * u1 + r5 * u2 - (r0 * u3 + r1 * u4 + r2 * u5)  # (R R₀ᵀ)_10 − (R R₀ᵀ)_01
-    return np.array([x * scale, y * scale, z * scale])
+    """Return the rotation vector (axis × angle) [rad] of R R₀ᵀ, both row-major (9 floats).
+
+    The tick's own kernel (:func:`._wbc_kernels.rotation_vector`, inside ``balance_point``).
+    """
+    out = np.zeros(3)
+    rotation_vector(np.asarray(rot, dtype=float), np.asarray(ref, dtype=float), out)
+    return out
 
 
 class WholeBodyController:
@@ -197,7 +202,11 @@ class WholeBodyController:
         self.height = float(data.xpos[self.torso][2])
         self.guard.set_posture(data.qpos)
         self.upright = np.array(data.xmat[self.torso], dtype=float).reshape(3, 3)
-        self._upright = self.upright.ravel().tolist()
+        self._upright = self.upright.ravel()
+        capture_point(0.0, 0.0, self.omega)  # ω's range checked once (the tick's kernel cannot)
+        # balance_point's results, read through fixed views: e (3), ξ (2), the DCM CoP (2).
+        self._balance = np.zeros(7)
+        self._error = self._balance[:3]
         self.last = None
         self._bodies = np.array([foot.body for foot in self.feet], dtype=np.intp)
         self._origins = np.array([foot.origin for foot in self.feet])
@@ -281,18 +290,17 @@ class WholeBodyController:
         import mujoco
 
         mujoco.mj_subtreeVel(self.model, data)
-        com_x, com_y, _ = data.subtree_com[0].tolist()
-        vel_x, vel_y, _ = data.subtree_linvel[0].tolist()
-        omega = self.omega
-        xi_x, xi_y = capture_point(com_x, vel_x, omega), capture_point(com_y, vel_y, omega)
-        self.capture_point = np.array([xi_x, xi_y])
-        gain, (rest_x, rest_y) = self.gains.dcm / self.omega, self.rest.tolist()
-        cop_x, cop_y = xi_x + gain * (xi_x - rest_x), xi_y + gain * (xi_y - rest_y)
-        self.cmp_target = np.array([cop_x, cop_y])
-        assert self.support is not None
-        if not self.support.point_signed_distance(cop_x, cop_y) > 0.0:  # not inside
-            cop_x, cop_y = self.support.nearest_point(cop_x, cop_y)
-        return np.array([cop_x, cop_y])
+        support, out = self.support, self._balance
+        assert support is not None
+        # One kernel: the torso's error (kept for _update), ξ = c + ċ/ω and the DCM law's CoP.
+        inside = balance_point(data.xmat, self.torso, self._upright, data.subtree_com,
+                               data.subtree_linvel, self.omega, self.gains.dcm / self.omega,
+                               self.rest, support.normals, support.offsets, out)  # fmt: skip
+        self.capture_point = out[3:5].copy()
+        self.cmp_target = out[5:7].copy()
+        if inside:
+            return out[5:7].copy()
+        return np.array(support.nearest_point(float(out[5]), float(out[6])))
 
     def tasks(self, data: Any) -> list[Task]:
         """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.wbc_hip`)."""
@@ -344,18 +352,18 @@ class WholeBodyController:
 
         assert self.qp is not None
         model, gains, nv, size = self.model, self.gains, self.qp.nv, self.qp.size
-        # Torso orientation error and the hip law's CMP offset δ (zero with the ankles only).
-        error = _rotation_vector(data.xmat[self.torso].tolist(), self._upright)
-        com = np.asarray(data.subtree_com[0])
-        self.desired_cop = self.cop_target(data)  # also the capture point, mj_subtreeVel
+        # The DCM law's CoP (also ξ and the torso's orientation error, mj_subtreeVel).
+        self.desired_cop = self.cop_target(data)
         if self.stepper is not None and self._step(data):
             self.desired_cop = self.cop_target(data)  # the new support polygon
+        error, com = self._error, data.subtree_com[0]
         # Torso orientation and pelvis height: J q̈ + J̇ q̇ = a_des (matrices over q̈ only).
         point = data.xpos[self.torso]
         jacp, jacr, dots = self._jacp, self._jacr, self._dots
         mujoco.mj_jac(model, data, jacp, jacr, point, self.torso)
         mujoco.mj_jacDot(model, data, dots[:3], dots[3:], point, self.torso)
-        spin = jacr @ data.qvel  # the torso's angular velocity [rad/s], world
+        # The torso's angular velocity [rad/s], world: the hip law's (ankle_targets has its own).
+        spin = jacr @ data.qvel if self.hip is not None else _NO_SPIN
         hip_active = False
         # No hip task while a foot swings: the step owns the recovery (the confusion matrix's
         # steps that failed fell from 10 to 2 of 60 pushes, docs/validation.md); the torso's
@@ -376,14 +384,14 @@ class WholeBodyController:
         stiffness, damping = gains.torso_stiffness, gains.torso_damping
         torso_weight = gains.hip_torso_weight if hip_active else gains.torso_weight
         returning = self.returning and not hip_active  # gently back upright, then as usual
-        paced = np.zeros(2)  # the paced return's change of the torso's α_x, α_y (wbc_hip)
+        paced = None  # the paced return's change of the torso's α_x, α_y (wbc_hip)
         if returning:
             assert self.hip is not None
             stiffness, damping = gains.return_stiffness, gains.return_damping
             accel = -stiffness * error[:2] - damping * spin[:2]
             self.cmp_offset, self.desired_cop, paced = self.hip.paced_return(self.cmp_target, accel)
             paced -= accel
-        self._gains[:2] = stiffness, damping
+        self._gains[0], self._gains[1] = stiffness, damping
         # All targets and rows at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g +
         # Σ R_i F_i, rows x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
         stack, targets = self._stack, self._targets
@@ -394,7 +402,8 @@ class WholeBodyController:
             self.omega**2, self.gravity, error, jacp, jacr, dots, data.qvel, data.qpos,
             self.posture, height, float(point[2]), self._gains, UPRIGHT, stack, targets,
         )  # fmt: skip
-        targets[2:4] += paced
+        if paced is not None:
+            targets[2:4] += paced
         if hip_active or returning:  # yaw keeps the usual gains and weight (legs untwisted)
             targets[4] -= (gains.torso_stiffness - stiffness) * error[2] + (
                 gains.torso_damping - damping) * spin[2]  # fmt: skip
