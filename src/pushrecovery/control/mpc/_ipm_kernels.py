@@ -35,6 +35,8 @@ _FRACTION = 0.99
 # shifted, near the solution: closer to the boundary, less centred; 13 iterations to a
 # verified set instead of 20 in the benchmark's runs).
 COLD, WARM = 1, 2
+# solve_interior's outcomes.
+CONVERGED, SETTLED, DIVERGED, EXHAUSTED = 0, 1, -1, -2
 _FLOOR = (0.0, 0.1, 0.01)
 _CENTRE = (0.0, 1.0, 0.01)
 # A warm start's rows at a bound in the last verified active set (shifted): slack at most this
@@ -42,6 +44,28 @@ _CENTRE = (0.0, 1.0, 0.01)
 # interior-point ticks: 15.5 iterations on average and 22 at most to a verified set without,
 # 12.4 and 15 with).
 _GUIDE_FLOOR, _GUIDE_CENTRE = 0.003, 3.0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def identify_active(bounds, scale, sl, su, zl, zu, active):  # type: ignore[no-untyped-def]
+    """Write the iterate's active set into ``active`` (N, 3); the number of rows that changed.
+
+    A bound is active when its multiplier, in units of its dual scale, exceeds its slack in
+    units of its range (z / scale > s / range, compared without the quotients).
+    """
+    changed = 0
+    for i in range(sl.shape[0]):
+        for j in range(3):
+            span = bounds[j, 1] - bounds[j, 0]
+            side = 0
+            if zl[i, j] * span > sl[i, j] * scale[i, j]:
+                side = -1
+            elif zu[i, j] * span > su[i, j] * scale[i, j]:
+                side = 1
+            if active[i, j] != side:
+                active[i, j] = side
+                changed += 1
+    return changed
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -361,15 +385,21 @@ def _start(x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, g
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def solve_interior(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, bounds, scale, feedback, tol, dual_tol, max_iter, start, guide,
-    u, x, nu, sl, su, zl, zu, work, big_s, gain, hinv, vec_s, sbs, closeds,
+    u, x, nu, sl, su, zl, zu, work, big_s, gain, hinv, vec_s, sbs, closeds, active,
+    settle_tol, settle_rows,
 ):  # fmt: skip
-    """Mehrotra predictor-corrector iterations; their number if converged, else −1 or −2.
+    """Mehrotra predictor-corrector iterations: (status, their number).
 
     ``feedback`` (N, 2, 4) is the unconstrained problem's time-varying gain (:func:`dual_scales`).
     ``start``: COLD or WARM from :func:`_start`'s point, 0: continue from the iterate in the arrays
-    (u, x, ν, slacks and multipliers of a previous call). −2: not converged in ``max_iter``
-    (the iterate is left to continue from); −1: the iterate is no longer finite (an
-    infeasible problem diverges).
+    (u, x, ν, slacks and multipliers of a previous call). Status CONVERGED: ``active`` (N, 3)
+    holds the converged iterate's active set (:func:`identify_active`); EXHAUSTED: not
+    converged in ``max_iter`` (the iterate is left to continue from); DIVERGED: the iterate
+    is no longer finite (an infeasible problem diverges). SETTLED (only if ``settle_rows``
+    >= 0): after an iteration of this call, the iterate's active set, in ``active``, differs
+    from the previous iterate's in at most ``settle_rows`` rows and every complementarity
+    product is within ``settle_tol`` of scale × range: a set worth verifying before the
+    iterations converge (continue with ``start`` 0).
 
     ``scale`` (N, 7) holds each stage's dual scales: columns 0-2 those of the bounded
     components (the multiplier that would move it by its whole range, see the wrapper),
@@ -390,24 +420,32 @@ def solve_interior(  # type: ignore[no-untyped-def]
     for it in range(max_iter):
         _residuals(a, b, wx, wu, bounds, u, x, nu, sl, su, zl, zu, rdu, rdx, rl, ru, mdu, mdx)
         mu = 0.0
-        done = True
+        done = near = True
         for i in range(n):
             for j in range(3):
                 span = bounds[j, 1] - bounds[j, 0]
                 mu += sl[i, j] * zl[i, j] + su[i, j] * zu[i, j]
                 if max(abs(rl[i, j]), abs(ru[i, j])) > tol * span:
                     done = False
-                if max(sl[i, j] * zl[i, j], su[i, j] * zu[i, j]) > tol * scale[i, j] * span:
+                product = max(sl[i, j] * zl[i, j], su[i, j] * zu[i, j])
+                if product > tol * scale[i, j] * span:
                     done = False
+                if product > settle_tol * scale[i, j] * span:
+                    near = False
                 if j < 2 and abs(rdu[i, j]) > dual_tol * max(scale[i, j], mdu[i, j]):
                     done = False
             for c in range(4):
                 if abs(rdx[i, c]) > dual_tol * max(scale[i, 3 + c], mdx[i, c]):
                     done = False
         if not np.isfinite(mu):
-            return -1
+            return DIVERGED, it
         if done:
-            return it
+            identify_active(bounds, scale, sl, su, zl, zu, active)
+            return CONVERGED, it
+        if settle_rows >= 0:
+            changed = identify_active(bounds, scale, sl, su, zl, zu, active)
+            if it > 0 and near and changed <= settle_rows:
+                return SETTLED, it
         mu /= 6 * n
         # Predictor (affine scaling).
         for i in range(n):
@@ -445,4 +483,4 @@ def solve_interior(  # type: ignore[no-untyped-def]
                 su[i, j] += primal * dsu[i, j]
                 zl[i, j] += dual * dzl[i, j]
                 zu[i, j] += dual * dzu[i, j]
-    return -2
+    return EXHAUSTED, max_iter

@@ -1,9 +1,9 @@
-"""Compiled (numba, cached on disk) dual scales of the interior point, and what they measure.
+"""Compiled (numba, cached on disk) dual scales of the interior point.
 
-The scales and feedback of its start (:func:`dual_scales`) and the active set of an iterate
-read in those scales (:func:`identify_active`). See :mod:`~pushrecovery.control.mpc.interior`.
-Apart from the iterations' kernels (:mod:`~pushrecovery.control.mpc._ipm_kernels`): it calls
-none of them.
+The scales and feedback of its start (:func:`dual_scales`); the active set of an iterate read
+in those scales is :func:`~pushrecovery.control.mpc._ipm_kernels.identify_active`, beside the
+iterations that call it. See :mod:`~pushrecovery.control.mpc.interior`. Apart from the
+iterations' kernels (:mod:`~pushrecovery.control.mpc._ipm_kernels`): it calls none of them.
 """
 
 from __future__ import annotations
@@ -83,25 +83,3 @@ def dual_scales(a, b, wx, wu, bounds, scales, feedback):  # type: ignore[no-unty
                     acc += closed[q, r] * sk[q, c]
                 s[r, c] = acc
             s[r, r] += 2.0 * wx[i - 1, r]
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def identify_active(bounds, scale, sl, su, zl, zu, active):  # type: ignore[no-untyped-def]
-    """Write the iterate's active set into ``active`` (N, 3); the number of rows that changed.
-
-    A bound is active when its multiplier, in units of its dual scale, exceeds its slack in
-    units of its range (z / scale > s / range, compared without the quotients).
-    """
-    changed = 0
-    for i in range(sl.shape[0]):
-        for j in range(3):
-            span = bounds[j, 1] - bounds[j, 0]
-            side = 0
-            if zl[i, j] * span > sl[i, j] * scale[i, j]:
-                side = -1
-            elif zu[i, j] * span > su[i, j] * scale[i, j]:
-                side = 1
-            if active[i, j] != side:
-                active[i, j] = side
-                changed += 1
-    return changed

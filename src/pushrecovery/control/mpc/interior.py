@@ -36,13 +36,29 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.mpc._ipm_kernels import COLD, WARM, solve_interior
-from pushrecovery.control.mpc._ipm_scales import dual_scales, identify_active
+from pushrecovery.control.mpc._ipm_kernels import (
+    COLD,
+    CONVERGED,
+    DIVERGED,
+    EXHAUSTED,
+    WARM,
+    identify_active,
+    solve_interior,
+)
+from pushrecovery.control.mpc._ipm_scales import dual_scales
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.riccati import check_structure, sparse_stages
 from pushrecovery.params import BodyParams
 
-__all__ = ["DUAL_TOL", "IDENTIFY_TOL", "MAX_ITERATIONS", "TOL", "InteriorPointSolver"]
+__all__ = [
+    "DUAL_TOL",
+    "IDENTIFY_TOL",
+    "MAX_ITERATIONS",
+    "SETTLE_ROWS",
+    "SETTLE_TOL",
+    "TOL",
+    "InteriorPointSolver",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -57,6 +73,17 @@ MAX_ITERATIONS = 100
 #: benchmark's interior-point ticks took 12.3 iterations on average and 16 at most at 1e-6,
 #: 11.2 and 15 at 1e-4; at 1e-3 some sets failed to verify and the worst took 20.
 IDENTIFY_TOL = 1e-4
+#: Before that, the set is offered once as soon as it has settled: within SETTLE_ROWS rows of
+#: the previous iterate's, every complementarity product within SETTLE_TOL of its scale ×
+#: range (a failed offer costs up to POLISH_PASSES passes, ~1.5 iterations). Iterations of the
+#: interior-point ticks of the torso's 3 s run (MuJoCo, N = 50) and of the flywheel
+#: benchmark's five pushes (N = 50 | N = 200), and the Riccati solves (offers included): only
+#: at IDENTIFY_TOL 152, 1380 | 4439 (solves 765 at N = 50); 0 rows and 1e-2 141, 1309 | 4357;
+#: 2 and 1e-2 139, 1266 | 4340; 2 and 1e-1 135, 1243 | 4314 (solves 778); 8 and 1e-1 133,
+#: 1237 | 4302 (785); 4 and 1 135, 1235 | 4316 (793). The verified sets are the same: the
+#: plans are bit for bit those verified at IDENTIFY_TOL.
+SETTLE_ROWS = 2
+SETTLE_TOL = 1e-1
 
 
 class InteriorPointSolver:
@@ -109,18 +136,23 @@ class InteriorPointSolver:
         identify_active(self.bounds, self.scales, *self._slacks, *self._bound_multipliers,
                         self._active)  # fmt: skip
 
-    def _iterate(self, x0: FloatArray, iterations: int, start: int, loose: bool = False) -> int:
-        """Run at most ``iterations`` of the kernel (``start``: COLD, WARM or 0); its status.
+    def _iterate(
+        self, x0: FloatArray, iterations: int, start: int, loose: bool = False, settle: int = -1
+    ) -> tuple[int, int]:
+        """Run at most ``iterations`` of the kernel (``start``: COLD, WARM or 0).
 
-        ``loose``: converged at :data:`IDENTIFY_TOL` (enough to identify the active set).
+        Returns its status and the iterations run. ``loose``: converged at :data:`IDENTIFY_TOL`
+        (enough to identify the active set); ``settle`` >= 0: or stopped where the active set
+        has settled (within ``settle`` rows and :data:`SETTLE_TOL`).
         """
         tol, dual_tol = (IDENTIFY_TOL, IDENTIFY_TOL) if loose else (TOL, DUAL_TOL)
-        status: int = solve_interior(
+        status, count = solve_interior(
             x0, self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback,
             tol, dual_tol, iterations, start, self._guide, self._u, self._x, self._multipliers,
-            *self._slacks, *self._bound_multipliers, self._work, *self._factors,
+            *self._slacks, *self._bound_multipliers, self._work, *self._factors, self._active,
+            SETTLE_TOL, settle,
         )  # fmt: skip
-        return status
+        return int(status), int(count)
 
     def solve(
         self,
@@ -134,10 +166,11 @@ class InteriorPointSolver:
         ``warm``: the last tick's plan, inputs (N, 2), to start from shifted by one stage
         (else the cold start), and ``guide`` (N, 3) the last verified active set (unshifted),
         whose rows it starts near their bounds. ``verify``, if given, is offered the iterate's
-        active set (:meth:`active_set`) once converged to :data:`IDENTIFY_TOL`: if it returns True
-        (e.g. Riccati passes from that set verified the KKT conditions exactly), the solve
-        stops there, ``verified`` is True and the solution is the verifier's; the attributes
-        ``inputs`` and ``states`` are then not updated. Else it goes on to :data:`TOL`.
+        active set (:meth:`active_set`) once it has settled (:data:`SETTLE_ROWS`), and if that
+        one fails, once converged to :data:`IDENTIFY_TOL`: if it returns True (e.g. Riccati
+        passes from that set verified the KKT conditions exactly), the solve stops there,
+        ``verified`` is True and the solution is the verifier's; the attributes ``inputs`` and
+        ``states`` are then not updated. Else it goes on to :data:`TOL`.
         """
         start = COLD
         if warm is not None:
@@ -149,23 +182,32 @@ class InteriorPointSolver:
         else:
             self._guide.fill(0)
         self.verified = False
-        done = 0
-        if verify is not None:
-            # Converged loosely: the active set is settled; verified, the solve ends there.
-            status = self._iterate(x0, MAX_ITERATIONS, start, loose=True)
-            start = 0
-            if status == -1:
+        done, settle = 0, SETTLE_ROWS
+        while verify is not None and done < MAX_ITERATIONS:
+            # The settled set first (one offer), then the loosely converged one: verified, the
+            # solve ends there.
+            status, count = self._iterate(x0, MAX_ITERATIONS - done, start, True, settle)
+            start, done = 0, done + count
+            if status == DIVERGED:
                 self.iterations = -1
                 return False
-            done = MAX_ITERATIONS if status == -2 else status
-            identify_active(self.bounds, self.scales, *self._slacks, *self._bound_multipliers,
-                            self._active)  # fmt: skip
-            if status >= 0 and verify(self._active):
+            if status == EXHAUSTED:
+                break
+            # Converged without an iteration since a settled set failed: the same set.
+            repeated = status == CONVERGED and count == 0 and settle < 0
+            if not repeated and verify(self._active):
                 self.iterations, self.verified = done, True
                 return True
-        status = -1 if done >= MAX_ITERATIONS else self._iterate(x0, MAX_ITERATIONS - done, start)
-        if status >= 0:
-            self.iterations = done + status
+            if status == CONVERGED:
+                break
+            settle = -1  # settled, not verified: on to IDENTIFY_TOL
+        status, count = (
+            (EXHAUSTED, 0)
+            if done >= MAX_ITERATIONS
+            else self._iterate(x0, MAX_ITERATIONS - done, start)
+        )
+        if status == CONVERGED:
+            self.iterations = done + count
             self.inputs, self.states = self._u.copy(), self._x.copy()
             return True
         self.iterations = -1
