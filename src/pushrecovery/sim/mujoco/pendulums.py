@@ -65,6 +65,8 @@ class MujocoFootPlant(MujocoPlant):
         # ``ndarray.item``.
         self._q = memoryview(self.data.qpos)
         self._v = memoryview(self.data.qvel)
+        # The torque map's body constants, bound once: read at every torque refresh.
+        self._body = (params.mass, params.com_height, params.gravity)
 
     def lean(self) -> tuple[float, float]:
         """Absolute pitch φ of the body above the ankle and its rate [rad, rad/s]."""
@@ -141,17 +143,19 @@ class MujocoTorsoPlant(MujocoFootPlant):
         self._at_stop = False
         #: Hip angle from which the hip counts as at its stop [rad].
         self._stop_angle = params.flywheel_angle_max - 1e-3
+        self._torque_max = params.torque_max
 
     def read_state(self) -> FloatArray:
         """``[x, theta, xdot, theta_dot]`` [m, rad, m/s, rad/s]."""
-        lean, rate = self.lean()
-        length = self.params.com_height
+        q, v = self._q, self._v  # lean() inlined: read at every control tick
+        lean, rate = q[self._pitch] + q[self._ankle], v[self._pitch_v] + v[self._ankle_v]
+        length = self._body[1]
         return np.array(
             [
                 length * math.sin(lean),
-                lean + self._q[self._hip],
+                lean + q[self._hip],
                 length * math.cos(lean) * rate,
-                rate + self._v[self._hip_v],
+                rate + v[self._hip_v],
             ]
         )
 
@@ -166,10 +170,28 @@ class MujocoTorsoPlant(MujocoFootPlant):
         """Hip torque (clipped to τmax) and the ankle torque for the CoP under it."""
         if command.step_length is not None:
             raise InvalidParameterError("the mujoco torso model has no legs to step with")
-        torque = self.params.clip_hip_torque(command.flywheel_torque)
-        self._ctrl[0] = -self.ankle_torque(cop, torque)
-        self._ctrl[1] = torque
-        at_stop = abs(self._q[self._hip]) >= self._stop_angle
+        # clip_hip_torque, lean() and ankle_torque() inlined (the same operations): this runs
+        # twice per control tick, and each call cost ~0.15 µs of its ~1.1 µs.
+        limit = self._torque_max
+        torque = min(limit, max(-limit, command.flywheel_torque))
+        q, v = self._q, self._v
+        mass, length, gravity = self._body
+        ctrl = self._ctrl
+        ctrl[0] = -_ankle_torque_for_cop(
+            q[self._pitch] + q[self._ankle],
+            v[self._pitch_v] + v[self._ankle_v],
+            cop,
+            mass,
+            length,
+            gravity,
+            torque,
+            self.push_now,
+            ANKLE_HEIGHT,
+            FOOT_MASS,
+            self._foot_centre,
+        )
+        ctrl[1] = torque
+        at_stop = abs(q[self._hip]) >= self._stop_angle
         if at_stop and not self._at_stop:
             self.stop_impacts += 1
         self._at_stop = at_stop

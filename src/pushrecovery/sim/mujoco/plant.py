@@ -356,11 +356,12 @@ class MujocoPlant:
             self.push_now = self._xfrc[self._push_target, 0] = 0.0
             self._push_target = -1
         # The hot loop: the torques are refreshed every `torque_hold` steps (about 1 µs of
-        # Python each), MuJoCo steps in between without leaving C.
+        # Python each), MuJoCo steps in between without leaving C (nstep by position: the
+        # keyword cost 0.12 µs a call).
         hold = self._hold_steps
         while steps > 0:
             torque = actuate(cop, command)
-            mj_step(model, d, nstep=min(hold, steps))
+            mj_step(model, d, min(hold, steps))
             steps -= hold
         counts, (a, b, c) = self._warnings, self._unstable
         if counts[a] or counts[b] or counts[c]:
