@@ -72,6 +72,7 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc_gains import WbcGains
 from pushrecovery.sim.mujoco.humanoid3d.wbc_hip import UPRIGHT, HipLaw, momentum_rows
 from pushrecovery.sim.mujoco.humanoid3d.wbc_limits import GuardSettings, JointGuard
 from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings
+from pushrecovery.sim.mujoco.humanoid3d.wbc_task_stack import TaskStack
 from pushrecovery.surfaces.cop import capture_point
 
 FloatArray = NDArray[np.float64]
@@ -213,22 +214,7 @@ class WholeBodyController:
         nv, size = int(model.nv), self.qp.size
         self._dots = np.zeros((6, nv))  # the torso's J̇ (linear, angular), overwritten each tick
         self._jacp, self._jacr = np.zeros((3, nv)), np.zeros((3, nv))  # its J (each tick)
-        self._joints = np.zeros((nv - 6, size))  # the posture task's constant matrix
-        self._joints[:, 6:nv] = np.eye(nv - 6)
-        self._joints.flags.writeable = False
-        # The tasks stacked for the QP's one compiled call (_rows), row by row: the CoM (2),
-        # torso (3), height (1) and posture (nv − 6) rows (ankle_targets), then the tick's
-        # others (the hip's momentum, the stepper's, the joint guard's), grown on demand.
-        self._stack, self._targets = np.zeros((nv + 8, size)), np.zeros(nv + 8)
-        self._stack[6:nv] = self._joints
-        self._weights = np.concatenate([[self.gains.com_weight] * 2, [0.0] * 3,
-                                        [self.gains.height_weight],
-                                        [self.gains.posture_weight] * (nv - 6),
-                                        np.zeros(8)])  # fmt: skip
-        g = self.gains  # k_R, d_R (set each tick), k_z, d_z, k_q, d_q of ankle_targets
-        self._gains = np.array([g.torso_stiffness, g.torso_damping, g.height_stiffness,
-                                g.height_damping, g.posture_stiffness,
-                                g.posture_damping])  # fmt: skip
+        self._stack = TaskStack(nv, size, self.gains)  # the tasks as rows (wbc_task_stack)
         self.hip = None
         if self.hip_params is not None:
             weight = self.mass * float(np.linalg.norm(self.gravity))
@@ -305,42 +291,12 @@ class WholeBodyController:
     def tasks(self, data: Any) -> list[Task]:
         """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.wbc_hip`)."""
         momentum, others = self._update(data)
-        assert self.qp is not None
-        nv, gains, stack, targets = self.qp.nv, self.gains, self._stack, self._targets
-        tasks = [Task("com", stack[:2].copy(), targets[:2].copy(), gains.com_weight)]
-        if momentum is not None:
-            tasks.append(momentum)
-        tasks.append(Task("torso", stack[2:5, :nv].copy(), targets[2:5].copy(),
-                          float(self._weights[2])))  # fmt: skip
-        tasks.append(Task("height", stack[5:6, :nv].copy(), targets[5:6].copy(),
-                          gains.height_weight))  # fmt: skip
-        tasks.append(Task("posture", self._joints, targets[6:nv].copy(), gains.posture_weight))
-        return tasks + others
+        return self._stack.tasks(momentum, others)
 
     def _rows(self, data: Any) -> int:
-        """Stack the tasks of :meth:`tasks` in ``_stack``, ``_targets``, ``_weights``; their rows.
-
-        The hip's momentum task acts on the wrenches alone, the torso's, pelvis's and posture's
-        on q̈ alone: after them instead of between the CoM's and the torso's, each sum of H and
-        f still takes its terms in the same order.
-        """
+        """Stack the tasks of :meth:`tasks` as rows (:class:`.TaskStack`); their number."""
         momentum, others = self._update(data)
-        assert self.qp is not None
-        count = self.qp.nv  # the rows ankle_targets wrote
-        for task in others if momentum is None else [momentum, *others]:
-            rows = task.matrix.shape[0]
-            if count + rows > self._stack.shape[0]:  # more rows than ever: grow the buffers
-                grow = count + rows - self._stack.shape[0]
-                self._stack = np.vstack([self._stack, np.zeros((grow, self._stack.shape[1]))])
-                self._targets = np.concatenate([self._targets, np.zeros(grow)])
-                self._weights = np.concatenate([self._weights, np.zeros(grow)])
-            block = self._stack[count : count + rows]
-            block[:, : task.matrix.shape[1]] = task.matrix
-            block[:, task.matrix.shape[1] :] = 0.0
-            self._targets[count : count + rows] = task.target
-            self._weights[count : count + rows] = task.weight
-            count += rows
-        return count
+        return self._stack.extend(others if momentum is None else [momentum, *others])
 
     def _update(self, data: Any) -> tuple[Task | None, list[Task]]:
         """Run the tick's laws; write the CoM, torso, pelvis and posture rows (:meth:`_rows`).
@@ -391,16 +347,16 @@ class WholeBodyController:
             accel = -stiffness * error[:2] - damping * spin[:2]
             self.cmp_offset, self.desired_cop, paced = self.hip.paced_return(self.cmp_target, accel)
             paced -= accel
-        self._gains[0], self._gains[1] = stiffness, damping
+        self._stack.pd_gains[0], self._stack.pd_gains[1] = stiffness, damping
         # All targets and rows at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g +
         # Σ R_i F_i, rows x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
-        stack, targets = self._stack, self._targets
+        stack, targets = self._stack.matrix, self._stack.targets
         stepper, height = self.stepper, self.height  # the stepper lowers it for long steps
         height = height if stepper is None else stepper.pelvis_height(data, height)
         upright = ankle_targets(
             data.xmat, self._bodies, self.mass, com, self.desired_cop, self.cmp_offset,
             self.omega**2, self.gravity, error, jacp, jacr, dots, data.qvel, data.qpos,
-            self.posture, height, float(point[2]), self._gains, UPRIGHT, stack, targets,
+            self.posture, height, float(point[2]), self._stack.pd_gains, UPRIGHT, stack, targets,
         )  # fmt: skip
         if paced is not None:
             targets[2:4] += paced
@@ -412,7 +368,7 @@ class WholeBodyController:
             targets[4] *= scale
         if returning and upright:
             self.returning = False
-        self._weights[2:5] = torso_weight
+        self._stack.weights[2:5] = torso_weight
         momentum_task = None
         if hip_active:  # L̇_x = −m g δ_y, L̇_y = m g δ_x
             rows = momentum_rows(data, self._bodies, size, nv, com, self._origins)[:2]
@@ -437,5 +393,6 @@ class WholeBodyController:
         if self.qp is None:
             raise InvalidParameterError("call reset(state) before compute(t, state)")
         count = self._rows(state)  # the tasks() as stacked rows: the QP's fast path
-        self.last = self.qp._solve_rows(state, self._stack, self._targets, self._weights, count)
+        stack = self._stack
+        self.last = self.qp._solve_rows(state, stack.matrix, stack.targets, stack.weights, count)
         return self.last.ctrl
