@@ -124,7 +124,7 @@ class JointGuard:
         # The margin, but never past the range's middle.
         inset = np.minimum(settings.margin, 0.25 * (ranges[:, 1] - ranges[:, 0]))
         self.edges = np.column_stack([ranges[:, 0] + inset, ranges[:, 1] - inset])
-        self._empty: dict[int, tuple[FloatArray, FloatArray]] = {}  # task_rows' empty, by nv
+        self._matrices: dict[tuple[int, ...], FloatArray] = {}  # task_rows' A, by nv and dofs
         self.set_posture(np.full(int(model.nq), np.nan))
 
     def set_posture(self, qpos: FloatArray) -> None:
@@ -143,7 +143,8 @@ class JointGuard:
     ) -> tuple[FloatArray, FloatArray]:
         """Return the guard's task (A over q̈, b [rad/s² or m/s²]) now (module docstring).
 
-        No rows when no joint's predicted position is within its margin.
+        No rows when no joint's predicted position is within its margin. A is shared between
+        calls (read-only).
         """
         s = self.settings
         horizon, stiffness, damping = s.horizon, s.stiffness, s.damping
@@ -157,13 +158,13 @@ class JointGuard:
                 rows.append((dof, stiffness * max(low - q, 0.0) - damping * min(v, 0.0)))
             elif q + horizon * max(v, 0.0) > high:
                 rows.append((dof, stiffness * min(high - q, 0.0) - damping * max(v, 0.0)))
-        if not rows:  # the usual tick: one shared, read-only empty task (no allocation)
-            empty = self._empty.get(nv)
-            if empty is None:
-                empty = self._empty[nv] = (np.zeros((0, nv)), np.zeros(0))
-                empty[0].flags.writeable = empty[1].flags.writeable = False
-            return empty
-        matrix = np.zeros((len(rows), nv))
-        for k, (dof, _) in enumerate(rows):
-            matrix[k, dof] = 1.0
+        # The rows q̈_dof of a set of dofs are constant: one shared, read-only matrix per set
+        # (the G1's knees sit within their margins at its keyframe: rows at every tick).
+        key = (nv, *(dof for dof, _ in rows))
+        matrix = self._matrices.get(key)
+        if matrix is None:
+            matrix = self._matrices[key] = np.zeros((len(rows), nv))
+            for k, (dof, _) in enumerate(rows):
+                matrix[k, dof] = 1.0
+            matrix.flags.writeable = False
         return matrix, np.array([target for _, target in rows])
