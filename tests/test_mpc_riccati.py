@@ -108,3 +108,83 @@ def test_daqp_seeded_with_the_verified_set_ends_on_it():
     np.testing.assert_array_equal(workspace.active_set(), solver.active)
     first = controller.qp.first_input(x0, scaled)
     np.testing.assert_allclose(first / SCALE, solver.inputs[0] / SCALE, atol=1e-6)
+
+
+@pytest.mark.parametrize("horizon", [50, 200])
+def test_a_resumed_recursion_equals_a_whole_one(horizon):
+    # The passes keep the Riccati recursion of the last active set and, when the next set
+    # differs only up to stage k, resume it from what entered stage k (P, p and the θ rows
+    # carried back), or skip it (the same set). Every resumption must give the numbers of a
+    # whole recursion on a fresh solver, bit for bit: the same verified inputs, states and
+    # multipliers. States with the flywheel near its limit: θ rows carried back.
+    settings = MPCSettings(horizon=horizon)
+    controller = MPCController(P, settings)
+    assert controller.workspace is not None
+    theta = 0.9 * P.flywheel_angle_max
+    rng = np.random.default_rng(7 + horizon)
+    resumed = RiccatiSolver(P, settings)  # one solver through every state: it resumes
+    compared = 0
+    for _ in range(60):
+        if compared >= 12:
+            break
+        x0 = rng.uniform([-0.03, -theta, -0.5, -2.0], [0.1, theta, 0.6, 2.0])
+        if controller.workspace.solve(x0) is None:
+            continue
+        active = controller.workspace.active_set()
+        for stage in (None, 0, 2, 5, 10, 20):  # the set, then with one stage's rows cleared
+            start = active.copy()
+            if stage is not None:
+                start[stage] = 0
+            fresh = RiccatiSolver(P, settings)
+            resumed.seed(start)
+            fresh.seed(start)
+            ok = resumed.solve(x0, shift=False)
+            assert ok == fresh.solve(x0, shift=False)
+            assert resumed.passes == fresh.passes
+            if ok:
+                compared += 1
+                np.testing.assert_array_equal(resumed.inputs, fresh.inputs)
+                np.testing.assert_array_equal(resumed.states, fresh.states)
+                np.testing.assert_array_equal(resumed.multipliers, fresh.multipliers)
+                np.testing.assert_array_equal(resumed.active, fresh.active)
+    assert compared >= 12
+
+
+@pytest.mark.parametrize("horizon", [50, 200])
+def test_the_recursion_resumed_inside_a_carried_chain_equals_a_whole_one(horizon):
+    # The kernel itself: a recursion on set S1, then one resumed at stage k on S2 (S1 with
+    # stage k's rows changed), against a whole recursion on S2: the same gains, offsets and
+    # curvature bit for bit. S1 holds the torque at its bound over stages 3..12 with θ_13 at
+    # its bound (a θ row carried back through the chain: the rows entering stages 4..12), and
+    # k lies inside the chain.
+    from pushrecovery.control.mpc._riccati_kernels import _backward, _scratch
+
+    solver = RiccatiSolver(P, MPCSettings(horizon=horizon))
+    n = horizon
+
+    def recursion(active, start, work, arrays):
+        gains, offsets, curvature = arrays
+        return _backward(solver.a, solver.b, solver.wx, solver.wu, active, solver.bounds,
+                         gains, offsets, curvature, work[0], work[2], start, work[3])  # fmt: skip
+
+    def fresh_arrays():
+        return np.zeros((n, 2, 4)), np.zeros((n, 2)), np.zeros((n, 2))
+
+    first = np.zeros((n, 3), dtype=np.int8)
+    first[3:13, 1] = 1
+    first[12, 2] = 1
+    first[n - 5 :, 0] = -1  # and the CoP at the heel late in the horizon
+    resumed_with = 0
+    for stage, column, side in ((8, 0, 1), (5, 0, -1), (12, 0, 1), (10, 1, 0), (2, 2, 1)):
+        second = first.copy()
+        second[stage, column] = side
+        work, arrays = _scratch(n), fresh_arrays()
+        assert recursion(first, n - 1, work, arrays) == 0
+        left = recursion(second, stage, work, arrays)  # resumed at the changed stage
+        reference = fresh_arrays()
+        assert left == recursion(second, n - 1, _scratch(n), reference)
+        if left == 0:
+            resumed_with += 1
+            for got, want in zip(arrays, reference, strict=True):
+                np.testing.assert_array_equal(got, want)
+    assert resumed_with >= 3

@@ -58,6 +58,9 @@ _JAC = _LC + 4
 _RHS = _JAC + 2
 _EX = _RHS + 1
 _CONST, _VALUE = _WIDTH, _WIDTH + 1
+#: Columns of _backward's record of what enters a stage: P's upper triangle (10), p (4), the
+#: number of rows carried, then per carried row its c0..c3, e and origin.
+_SAVED = 15 + 6 * CARRIED
 # The int rows: one per multiplier (its expression's unknowns' ids, their count (_COUNT), and
 # in column _ORDER the order the expressions were recorded in); then the live unknowns' ids and
 # flags.
@@ -66,7 +69,7 @@ _COUNT, _ORDER = _WIDTH, _WIDTH + 1
 
 @numba.njit(cache=True, nogil=True)
 def _scratch(n):  # type: ignore[no-untyped-def]
-    """Return the passes' scratch at horizon ``n``: floats, ints and the rows' origins.
+    """Return the passes' scratch at horizon ``n``: floats, ints, the rows' origins, the record.
 
     Three arrays rather than one per purpose, indexed as the constants above say: an
     allocation, or a view, costs tens of ns, a pass a few µs. Nothing is read before it is
@@ -76,7 +79,8 @@ def _scratch(n):  # type: ignore[no-untyped-def]
     floats = np.empty((_EX + total, _WIDTH + 2))
     ints = np.empty((total + 2, _WIDTH + 2), dtype=np.int64)
     origins = np.empty(_ROWS, dtype=np.int64)  # the stage of the θ row a carried row comes from
-    return floats, ints, origins
+    saved = np.empty((n, _SAVED))  # what enters each stage of the recursion (_backward)
+    return floats, ints, origins, saved
 
 
 @numba.njit(cache=True, nogil=True)
@@ -89,10 +93,17 @@ def _entry(ata, g0r, g1r, er, fr, kh0r, kh1r, g0c, g1c, ec, fc):  # type: ignore
 
 
 @numba.njit(cache=True, nogil=True)
-def _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, rows, origins):  # type: ignore[no-untyped-def]
+def _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, rows, origins, start, saved):  # type: ignore[no-untyped-def]
     """Riccati recursion with the active rows as equalities; the number of rows left on x_0.
 
     −i − 2: the rows of stage i are over-determined (a carried row reduced to 0 = e).
+
+    From stage ``start`` down (N − 1: all of it): what the recursion carries into each stage
+    (P, p and the rows carried back, :data:`_SAVED` columns) is saved in ``saved[i]`` as it
+    enters stage i, and a recursion from ``start`` < N − 1 resumes from ``saved[start]``: the
+    stages after ``start`` must have the rows they had when it was saved (their gains,
+    offsets and curvature are then still in place), and it gives the same numbers as a whole
+    recursion.
 
     Writes u_i = gains[i] x_i + offsets[i] and the diagonal of the stage's input Hessian
     H = diag(wu_i) + B^T S_{i+1} B (the scale of its multipliers) into ``curvature[i]``; the
@@ -111,7 +122,25 @@ def _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, rows, ori
     p00 = p01 = p02 = p03 = p11 = p12 = p13 = p22 = p23 = p33 = 0.0
     l0 = l1 = l2 = l3 = 0.0
     npend = 0
-    for i in range(n - 1, -1, -1):
+    if start < n - 1:  # resume: what entered stage `start` last time
+        c = saved[start]
+        p00, p01, p02, p03, p11 = c[0], c[1], c[2], c[3], c[4]
+        p12, p13, p22, p23, p33 = c[5], c[6], c[7], c[8], c[9]
+        l0, l1, l2, l3 = c[10], c[11], c[12], c[13]
+        npend = int(c[14])
+        for q in range(npend):
+            o, k = _PENDING + q, 15 + 6 * q
+            rows[o, 0], rows[o, 1], rows[o, 2], rows[o, 3] = c[k], c[k + 1], c[k + 2], c[k + 3]
+            rows[o, 6], origins[o] = c[k + 4], int(c[k + 5])
+    for i in range(start, -1, -1):
+        c = saved[i]  # what enters stage i, for a later resumption
+        c[0], c[1], c[2], c[3], c[4] = p00, p01, p02, p03, p11
+        c[5], c[6], c[7], c[8], c[9] = p12, p13, p22, p23, p33
+        c[10], c[11], c[12], c[13], c[14] = l0, l1, l2, l3, npend
+        for q in range(npend):
+            o, k = _PENDING + q, 15 + 6 * q
+            c[k], c[k + 1], c[k + 2], c[k + 3] = rows[o, 0], rows[o, 1], rows[o, 2], rows[o, 3]
+            c[k + 4], c[k + 5] = rows[o, 6], origins[o]
         # S = P + diag(wx_i) (off the diagonal, P's own entries).
         s00, s11, s22, s33 = p00 + wx[i, 0], p11 + wx[i, 1], p22 + wx[i, 2], p33 + wx[i, 3]
         # S B (B's CoP column: rows 0, 2) and S A (A's column c: rows c & 1, (c & 1) + 2).
@@ -450,11 +479,34 @@ def _multipliers(a, b, wx, wu, active, inputs, states, mult, floats, ints):  # t
 @numba.njit(cache=True, nogil=True)
 def _pass_in(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains, offsets, curvature,
-    mult, forced, work,
+    mult, forced, work, swept,
 ):  # fmt: skip
-    """:func:`_pass` on the scratch ``work`` of :func:`_scratch`."""
+    """:func:`_pass` on the scratch ``work`` of :func:`_scratch` and the sweep's record ``swept``.
+
+    ``swept`` (N + 1, 3): rows 0..N−1 the active set whose recursion ``gains``, ``offsets`` and
+    ``curvature`` hold, ``swept[N, 0]`` 1 if they hold one. The recursion depends on the set
+    alone (A, B, the weights and bounds are the solver's own), so a pass on that set again (a
+    steady state's empty set, tick after tick) skips it: the same numbers.
+    """
     n = wx.shape[0]
-    left = _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, work[0], work[2])
+    left = 0
+    # The last stage whose rows differ from the recorded recursion's (all of it: none on record).
+    start = n - 1 if swept[n, 0] != 1 else -1
+    i = n - 1
+    while start < 0 and i >= 0:
+        if active[i, 0] != swept[i, 0] or active[i, 1] != swept[i, 1] or active[i, 2] != swept[
+                i, 2]:  # fmt: skip
+            start = i
+        i -= 1
+    if start >= 0:
+        swept[n, 0] = 0  # the recursion below overwrites the arrays
+        left = _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, work[0],
+                         work[2], start, work[3])  # fmt: skip
+        if left == 0:
+            for i in range(start + 1):
+                for j in range(3):
+                    swept[i, j] = active[i, j]
+            swept[n, 0] = 1
     if left != 0:
         # Too many rows: a θ row carried through saturated torques to a state that cannot meet
         # it. Release the chain's first torque row (else the θ row); the passes go on from there.
@@ -512,6 +564,16 @@ def _pass_in(  # type: ignore[no-untyped-def]
                 added = angle = True
     if added:
         return CHANGED
+    empty = True
+    for i in range(n):
+        for j in range(3):
+            if active[i, j] != 0:
+                empty = False
+    if empty:  # no multiplier to find or check: the unconstrained optimum
+        for i in range(n):
+            for j in range(3):
+                mult[i, j] = 0.0
+        return OPTIMAL
     if not _multipliers(a, b, wx, wu, active, inputs, states, mult, work[0], work[1]):
         return DEGENERATE
     worst, worst_i, worst_j = 0.0, -1, -1
@@ -563,8 +625,9 @@ def _pass(  # type: ignore[no-untyped-def]
     :func:`solve_active_set` share one).
     """
     work = _scratch(wx.shape[0])
+    swept = np.zeros((wx.shape[0] + 1, 3), dtype=np.int8)  # no recursion on record
     return _pass_in(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains,
-                    offsets, curvature, mult, forced, work)  # fmt: skip
+                    offsets, curvature, mult, forced, work, swept)  # fmt: skip
 
 
 @numba.njit(cache=True, nogil=True)
@@ -586,17 +649,20 @@ def solve_active_set(  # type: ignore[no-untyped-def]
     offsets,
     curvature,
     mult,
+    work,
+    swept,
 ):
     """Primal-dual active-set iterations from ``active``; the number of passes, or −1.
 
     On success ``inputs`` (N, 2), ``states`` (N + 1, 4) and ``mult`` (N, 3) are the KKT point
     and ``active`` its active set. −1: degenerate, or no verified optimum within
-    ``max_passes`` (cycling, or an infeasible problem).
+    ``max_passes`` (cycling, or an infeasible problem). ``work``: the scratch of
+    :func:`_scratch`, the caller's (kept from solve to solve: an allocation per tick cost
+    ~1 µs); ``swept``: the record of the last recursion (:func:`_pass_in`).
     """
-    work = _scratch(wx.shape[0])
     for k in range(max_passes):
         outcome = _pass_in(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states,
-                           gains, offsets, curvature, mult, forced, work)  # fmt: skip
+                           gains, offsets, curvature, mult, forced, work, swept)  # fmt: skip
         if outcome == OPTIMAL:
             return k + 1
         if outcome == DEGENERATE:
@@ -626,13 +692,20 @@ def solve_from(  # type: ignore[no-untyped-def]
     offsets,
     curvature,
     mult,
+    floats,
+    ints,
+    origins,
+    saved,
+    swept,
 ):
     """:func:`solve_active_set` started from ``active`` (shifted one stage if ``shift``).
 
     The passes work on ``guess`` (the start is copied there: ``active[i + 1]`` to stage i,
     the last stage keeping its rows); on success the verified set is copied back into
     ``active``, on failure ``active`` is left as it was. One call per tick, so the Python
-    side does no array work.
+    side does no array work. ``floats``, ``ints``, ``origins``, ``saved``: the scratch of
+    :func:`_scratch`, and ``swept`` the recursion's record (:func:`_pass_in`); both the
+    caller's, kept from solve to solve.
 
     The first ``forced`` stages' torques are held at the bound of sign ``forced_side`` and
     their θ rows left out: the flywheel on the edge of its viable set, where braking at full
@@ -648,8 +721,8 @@ def solve_from(  # type: ignore[no-untyped-def]
             guess[i, 1] = forced_side
             guess[i, 2] = 0
     passes = solve_active_set(x0, a, b, wx, wu, guess, bounds, tols, dual_tol, max_passes,
-                              forced, inputs, states, gains, offsets, curvature,
-                              mult)  # fmt: skip
+                              forced, inputs, states, gains, offsets, curvature, mult,
+                              (floats, ints, origins, saved), swept)  # fmt: skip
     if passes > 0:
         for i in range(n):
             for j in range(3):

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery._validate import require_type
-from pushrecovery.control.mpc._riccati_kernels import solve_from
+from pushrecovery.control.mpc._riccati_kernels import _scratch, solve_from
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
@@ -168,7 +168,12 @@ class RiccatiSolver:
             self.active, self._guess, self.a, self.b, self.wx, self.wu, self.bounds, self.tols,
             DUAL_TOL,
         )  # fmt: skip
-        self._scratch = (self._gains, self._offsets, self._curvature, self.multipliers)
+        # The recursion's arrays, the passes' scratch and the record of which active set the
+        # recursion was last run on (its numbers are reused while the set stays: a steady
+        # state's empty set), kept from solve to solve.
+        self._swept = np.zeros((n + 1, 3), dtype=np.int8)
+        self._scratch = (self._gains, self._offsets, self._curvature, self.multipliers,
+                         *_scratch(n), self._swept)  # fmt: skip
         self._shapes = (self.inputs.shape, self.states.shape)
         # Load the compiled kernel now (from numba's disk cache), not on a control tick.
         self.solve(np.zeros(4), max_passes=0)
