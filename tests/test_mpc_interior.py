@@ -1,12 +1,14 @@
 """The MPC's interior-point route against the sparse QP and the KKT equations."""
 
+import math
+
 import numpy as np
 import pytest
 
 from pushrecovery.control.mpc import FlywheelFeasibility, MPCController, MPCSettings
 from pushrecovery.control.mpc import _ipm_kernels as kernels
 from pushrecovery.control.mpc.interior import InteriorPointSolver
-from pushrecovery.errors import ParameterTypeError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from test_mpc import P, sparse_solution
@@ -230,3 +232,13 @@ def test_the_sparse_solvers_refuse_what_is_not_a_body_or_settings():
             solver("paper", MPCSettings())
         with pytest.raises(ParameterTypeError, match="settings"):
             solver(P, {"horizon": 50})
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [("guide_floor", 0.0), ("guide_floor", 1.5), ("guide_floor", math.nan),
+     ("guide_centre", 0.0), ("guide_centre", -1.0), ("guide_centre", math.inf)],
+)  # fmt: skip
+def test_bad_warm_start_settings_are_refused(name, value):
+    with pytest.raises(InvalidParameterError, match=name):
+        InteriorPointSolver(P, MPCSettings(horizon=8), **{name: value})

@@ -42,8 +42,8 @@ _CENTRE = (0.0, 1.0, 0.01)
 # A warm start's rows at a bound in the last verified active set (shifted): slack at most this
 # fraction of the range, product s z this fraction of dual scale × range (the benchmark's
 # interior-point ticks: 15.5 iterations on average and 22 at most to a verified set without,
-# 12.4 and 15 with).
-_GUIDE_FLOOR, _GUIDE_CENTRE = 0.003, 3.0
+# 12.4 and 15 with). The defaults of solve_interior's ``guide_floor`` and ``guide_centre``.
+GUIDE_FLOOR, GUIDE_CENTRE = 0.003, 3.0
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -340,7 +340,10 @@ def _newton(  # type: ignore[no-untyped-def]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _start(x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, guide):  # type: ignore[no-untyped-def]
+def _start(  # type: ignore[no-untyped-def]
+    x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, guide, guide_floor,
+    guide_centre,
+):  # fmt: skip
     """Write a start from x0: ``start`` COLD or WARM (the inputs already in ``u``).
 
     COLD: the unconstrained problem's solution, whatever its bounds (inputs by its feedback,
@@ -349,7 +352,7 @@ def _start(x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, g
     at least a fraction of their range (an infeasible start), products s z a fraction of the
     bound's dual scale × range (``_FLOOR``, ``_CENTRE``). WARM also takes ``guide`` (N, 3),
     the last verified active set (unshifted; zeros: none): its rows start near their bounds
-    with larger multipliers (``_GUIDE_FLOOR``, ``_GUIDE_CENTRE``).
+    with larger multipliers (``guide_floor``, ``guide_centre``: as ``_FLOOR``, ``_CENTRE``).
     """
     floor, centre = _FLOOR[start], _CENTRE[start]
     n = u.shape[0]
@@ -375,18 +378,18 @@ def _start(x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, g
             if start == WARM:
                 side = guide[i + 1, j] if i + 1 < n else guide[i, j]  # shifted by a stage
                 if side < 0:
-                    sl[i, j] = min(sl[i, j], _GUIDE_FLOOR * span)
-                    zl[i, j] = _GUIDE_CENTRE * scale[i, j] / sl[i, j] * span
+                    sl[i, j] = min(sl[i, j], guide_floor * span)
+                    zl[i, j] = guide_centre * scale[i, j] / sl[i, j] * span
                 elif side > 0:
-                    su[i, j] = min(su[i, j], _GUIDE_FLOOR * span)
-                    zu[i, j] = _GUIDE_CENTRE * scale[i, j] / su[i, j] * span
+                    su[i, j] = min(su[i, j], guide_floor * span)
+                    zu[i, j] = guide_centre * scale[i, j] / su[i, j] * span
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def solve_interior(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, bounds, scale, feedback, tol, dual_tol, max_iter, start, guide,
     u, x, nu, sl, su, zl, zu, work, big_s, gain, hinv, vec_s, sbs, closeds, active,
-    settle_tol, settle_rows,
+    settle_tol, settle_rows, guide_floor, guide_centre,
 ):  # fmt: skip
     """Mehrotra predictor-corrector iterations: (status, their number).
 
@@ -416,7 +419,8 @@ def solve_interior(  # type: ignore[no-untyped-def]
     off, rdiag = work[13, :n, :2], work[14, :n, :2]
     mdu, mdx = work[15, :n, :2], work[16, :n]
     if start:
-        _start(x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, guide)
+        _start(x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, guide,
+               guide_floor, guide_centre)  # fmt: skip
     for it in range(max_iter):
         _residuals(a, b, wx, wu, bounds, u, x, nu, sl, su, zl, zu, rdu, rdx, rl, ru, mdu, mdx)
         mu = 0.0

@@ -30,6 +30,11 @@ PASSES_AFTER_FAILURE = 2
 #: Relative widening of θmax for the interior point on the viable set's boundary: enough for
 #: an interior, small enough that its active set is the problem's (with full braking held).
 RELAXED = 1e-3
+#: The relaxed interior point's warm start: the last verified set's rows start with s z at
+#: this × dual scale × range (the other's 3.0, GUIDE_CENTRE). On the flywheel benchmark's 26
+#: boundary ticks at N = 50: 390 iterations, 20 at most, with 3.0; 369 and 16 with 10 (and
+#: with 100); 380 and 17 with 30. Those ticks set the benchmark's p99.
+RELAXED_GUIDE_CENTRE = 10.0
 #: The interior point is not asked within this relative margin of S_N's boundary (the
 #: boundary's own margin, BOUNDARY): there the feasible set has no interior and its iterates
 #: stall; the passes with full braking held decide, then DAQP.
@@ -102,8 +107,9 @@ class MPCController(Controller):
             self.interior = InteriorPointSolver(params, settings)
             wider = params.flywheel_angle_max * (1.0 + RELAXED)
             self._relaxed = InteriorPointSolver(
-                dataclasses.replace(params, flywheel_angle_max=wider), settings
-            )
+                dataclasses.replace(params, flywheel_angle_max=wider), settings,
+                guide_centre=RELAXED_GUIDE_CENTRE,
+            )  # fmt: skip
         self._qp: CondensedQP | None = None
         self._workspace: DaqpWorkspace | None = None
         self._use_workspace = settings.solver == "daqp"
@@ -111,6 +117,7 @@ class MPCController(Controller):
         self._feasibility: FlywheelFeasibility | None = None
         self.last_plan: Plan | None = None
         self._passes_failed = False  # whether the last tick's warm passes failed
+        self._boundary = False  # whether the last tick was solved on S_N's boundary
 
     @property
     def qp(self) -> CondensedQP:
@@ -150,7 +157,7 @@ class MPCController(Controller):
         """Forget the last plan and the solver's warm start; the MPC is otherwise stateless."""
         self._check(state)
         self.last_plan = None
-        self._passes_failed = False
+        self._passes_failed = self._boundary = False
         if self._workspace is not None:
             self._workspace.reset()
         if self.riccati is not None:
@@ -168,13 +175,26 @@ class MPCController(Controller):
         # run, 2 gave 4.8 ms, 4 4.9 ms, 8 4.7 ms but the benchmark's p99 at N = 50 18.8x the
         # median (2: 14.1x), 15 4.9 ms and 20.6x.
         passes = PASSES_AFTER_FAILURE if self._passes_failed else MAX_PASSES
-        self._passes_failed = riccati is not None and not riccati.solve(state, max_passes=passes)
+        gauge = -1.0
+        if self._boundary:
+            # The last tick was on S_N's boundary, where the passes without full braking held
+            # verified 1 of 25 ticks after a boundary tick (0 of 32 at N = 200; the benchmark's
+            # runs): when this one is too, its boundary route at once.
+            gauge = self._gauge(state)
+            if gauge >= 1.0 - INTERIOR_MARGIN:
+                passes = 0
+        self._passes_failed = riccati is not None and (
+            passes == 0 or not riccati.solve(state, max_passes=passes)
+        )
         if riccati is not None and not self._passes_failed:
             # Fresh arrays each verified solve: the plan keeps them as they are.
+            self._boundary = False
             inputs = riccati.inputs
             return Plan(inputs[0], True, inputs, riccati.states)
         x0 = state.copy()  # the plan's own: the caller may reuse its array
-        gauge = self._gauge(x0)
+        if gauge < 0.0:
+            gauge = self._gauge(x0)
+        self._boundary = gauge >= 1.0 - INTERIOR_MARGIN
         if self._use_workspace and gauge > 1.0 + BAND:
             # DAQP would fail, warm and then cold (up to ~1000 iterations): leave both solvers
             # as that failure would (cold next tick) without asking it.
@@ -226,9 +246,9 @@ class MPCController(Controller):
         Inside S_N: the interior point, whose iterates' active sets the passes are offered to
         verify (its own solution if none verifies, e.g. the cycling late-horizon torques). On
         its boundary (γ ≥ 1 − BOUNDARY), where the feasible set has no interior: full braking
-        held (:meth:`FlywheelFeasibility.forced_braking`), the passes from the last set, then
-        from the active sets of the interior point on the problem with θmax 0.1 % larger
-        (:data:`RELAXED`), which has an interior. None: DAQP decides.
+        held (:meth:`FlywheelFeasibility.forced_braking`), the passes from the active sets of
+        the interior point on the problem with θmax 0.1 % larger (:data:`RELAXED`), which has
+        an interior. None: DAQP decides.
         """
         interior = self.interior
         if gauge < 1.0 - INTERIOR_MARGIN:
@@ -241,8 +261,9 @@ class MPCController(Controller):
             forced = self._feasibility.forced_braking(x0)
             if not forced[0]:
                 return None
-            if riccati.solve(x0, max_passes=POLISH_PASSES, forced=forced):
-                return Plan(riccati.inputs[0], True, riccati.inputs, riccati.states)
+            # No passes from the last set first: with full braking held they verified 1 of 69
+            # boundary ticks (MuJoCo torso pushes of ±20-50 N s, flywheel pushes of −0.5 to
+            # 0.7 m/s; 0 of 26-32 in the N = 50-200 benchmark) and cost ~12 µs on each.
             interior = self._relaxed
 
         def verify(active: NDArray[np.int8]) -> bool:

@@ -36,11 +36,14 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery._validate import positive_float
 from pushrecovery.control.mpc._ipm_kernels import (
     COLD,
     CONVERGED,
     DIVERGED,
     EXHAUSTED,
+    GUIDE_CENTRE,
+    GUIDE_FLOOR,
     WARM,
     identify_active,
     solve_interior,
@@ -48,6 +51,7 @@ from pushrecovery.control.mpc._ipm_kernels import (
 from pushrecovery.control.mpc._ipm_scales import dual_scales
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.riccati import check_structure, sparse_stages
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
 __all__ = [
@@ -95,6 +99,15 @@ class InteriorPointSolver:
         Body parameters (bounds δ⁻ = heel, δ⁺ = toe, τmax, θmax; all with a range).
     settings : MPCSettings
         dt, N, Q, R and γ.
+    guide_floor, guide_centre : float
+        A warm start's rows in the last verified set (see :meth:`solve`) start with their slack
+        at most ``guide_floor`` × the range, in (0, 1], and the product s z at
+        ``guide_centre`` × dual scale × range, > 0.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``guide_floor`` or ``guide_centre`` is out of its range.
 
     Attributes
     ----------
@@ -108,8 +121,19 @@ class InteriorPointSolver:
         Whether the last solve ended with the verifier's acceptance (see :meth:`solve`).
     """
 
-    def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
+    def __init__(
+        self,
+        params: BodyParams,
+        settings: MPCSettings,
+        *,
+        guide_floor: float = GUIDE_FLOOR,
+        guide_centre: float = GUIDE_CENTRE,
+    ) -> None:
         self.a, self.b, self.wx, self.wu, self.bounds = sparse_stages(params, settings)  # checked
+        self.guide_floor = positive_float("guide_floor", guide_floor)
+        if self.guide_floor > 1.0:
+            raise InvalidParameterError(f"guide_floor must be in (0, 1], got {guide_floor!r}")
+        self.guide_centre = positive_float("guide_centre", guide_centre)
         check_structure(self.a, self.b)  # the zeros the kernels skip
         n = settings.horizon
         self.scales, self.feedback = np.empty((n, 7)), np.empty((n, 2, 4))
@@ -150,7 +174,7 @@ class InteriorPointSolver:
             x0, self.a, self.b, self.wx, self.wu, self.bounds, self.scales, self.feedback,
             tol, dual_tol, iterations, start, self._guide, self._u, self._x, self._multipliers,
             *self._slacks, *self._bound_multipliers, self._work, *self._factors, self._active,
-            SETTLE_TOL, settle,
+            SETTLE_TOL, settle, self.guide_floor, self.guide_centre,
         )  # fmt: skip
         return int(status), int(count)
 
