@@ -683,6 +683,7 @@ def solve_from(  # type: ignore[no-untyped-def]
     bounds,
     tols,
     dual_tol,
+    empty_passes,
     max_passes,
     forced,
     forced_side,
@@ -707,19 +708,26 @@ def solve_from(  # type: ignore[no-untyped-def]
     :func:`_scratch`, and ``swept`` the recursion's record (:func:`_pass_in`); both the
     caller's, kept from solve to solve.
 
+    From the empty set at most ``empty_passes`` passes (:data:`~.riccati.EMPTY_PASSES`).
+
     The first ``forced`` stages' torques are held at the bound of sign ``forced_side`` and
     their θ rows left out: the flywheel on the edge of its viable set, where braking at full
     torque is the only way to keep θ within its bound (the caller's judgement), and those θ
     rows would be carried back to x_0, which cannot meet them otherwise.
     """
     n = active.shape[0]
+    rows = False
     for i in range(n):
         src = i + 1 if shift and i < n - 1 else i
         for j in range(3):
             guess[i, j] = active[src, j]
+            rows = rows or guess[i, j] != 0
         if i < forced:
             guess[i, 1] = forced_side
             guess[i, 2] = 0
+            rows = True
+    if not rows:
+        max_passes = min(max_passes, empty_passes)
     passes = solve_active_set(x0, a, b, wx, wu, guess, bounds, tols, dual_tol, max_passes,
                               forced, inputs, states, gains, offsets, curvature, mult,
                               (floats, ints, origins, saved), swept)  # fmt: skip
