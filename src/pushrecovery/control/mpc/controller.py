@@ -248,7 +248,7 @@ class MPCController(Controller):
         its boundary (γ ≥ 1 − BOUNDARY), where the feasible set has no interior: full braking
         held (:meth:`FlywheelFeasibility.forced_braking`), the passes from the active sets of
         the interior point on the problem with θmax 0.1 % larger (:data:`RELAXED`), which has
-        an interior. None: DAQP decides.
+        an interior, then from the last tick's set. None: DAQP decides.
         """
         interior = self.interior
         if gauge < 1.0 - INTERIOR_MARGIN:
@@ -261,9 +261,11 @@ class MPCController(Controller):
             forced = self._feasibility.forced_braking(x0)
             if not forced[0]:
                 return None
-            # No passes from the last set first: with full braking held they verified 1 of 69
-            # boundary ticks (MuJoCo torso pushes of ±20-50 N s, flywheel pushes of −0.5 to
-            # 0.7 m/s; 0 of 26-32 in the N = 50-200 benchmark) and cost ~12 µs on each.
+            # The passes from the last set come after the relaxed interior point, not before:
+            # with full braking held they verified 1 of 69 boundary ticks first (MuJoCo torso
+            # pushes of ±20-50 N s, flywheel pushes of −0.5 to 0.7 m/s; 0 of 26-32 in the
+            # N = 50-200 benchmark), ~12 µs on each; that one (θ just past θmax) the interior
+            # point did not verify.
             interior = self._relaxed
 
         def verify(active: NDArray[np.int8]) -> bool:
@@ -274,13 +276,18 @@ class MPCController(Controller):
         # the passes verified it, its active set (the failed warm passes leave it in place).
         last = self.last_plan
         warm = last.inputs if last is not None and last.feasible else None
-        guide = riccati.active.copy() if warm is not None and previous_verified else None
+        start = riccati.active.copy()  # the last tick's set (the failed passes keep it)
+        guide = start if warm is not None and previous_verified else None
         if interior.solve(x0, verify, warm, guide):
             if interior.verified:
                 return Plan(riccati.inputs[0], True, riccati.inputs, riccati.states)
             if interior is self.interior:
                 riccati.seed(interior.active_set())  # the next tick's start
                 return Plan(interior.inputs[0], True, interior.inputs, interior.states)
+        if forced[0]:  # on the boundary: the passes from the last tick's set, braking held
+            riccati.seed(start)
+            if riccati.solve(x0, max_passes=POLISH_PASSES, forced=forced):
+                return Plan(riccati.inputs[0], True, riccati.inputs, riccati.states)
         riccati.reset()
         return None
 
