@@ -173,7 +173,9 @@ class MPCController(Controller):
         # benchmark's runs): PASSES_AFTER_FAILURE passes, then the interior point. With 15
         # passes otherwise (quiet machine): 1 gave 6.2 ms of MPC on the MuJoCo torso's 3 s
         # run, 2 gave 4.8 ms, 4 4.9 ms, 8 4.7 ms but the benchmark's p99 at N = 50 18.8x the
-        # median (2: 14.1x), 15 4.9 ms and 20.6x.
+        # median (2: 14.1x), 15 4.9 ms and 20.6x. Re-measured with the kept recursion
+        # (2026-12-02): 2 gave 3.29-3.38 ms and a p99 of 18.0x (best of 10 per tick), 6 2.90 ms
+        # and 19.3x, 10 2.91 ms and 20.2x.
         passes = PASSES_AFTER_FAILURE if self._passes_failed else MAX_PASSES
         gauge = -1.0
         if self._boundary:
