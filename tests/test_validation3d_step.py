@@ -139,3 +139,18 @@ def test_cli_validates_the_g1s_step_column(g1, tmp_path, capsys):
 def test_bad_inputs(params, call, name):
     with pytest.raises((InvalidParameterError, PushRecoveryError), match=name):
         call(params)
+
+
+def test_the_g1s_controller_has_no_hip_task_unless_asked_and_the_biped3ds_has(g1):
+    # Measured: on the G1 the hip task lowers the critical push at every azimuth
+    # (docs/validation.md), so its default WBC balances without it; the biped3d keeps it.
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, wbc_for
+
+    assert wbc_for(g1).hip_params is None
+    assert wbc_for(g1, hip=True).hip_params is g1.params
+    biped = Biped3DPlant(load_params())
+    assert wbc_for(biped).hip_params is biped.params
+    assert wbc_for(biped, hip=False).hip_params is None
+    for bad in ("yes", 1, 1.0):
+        with pytest.raises(InvalidParameterError, match="hip must be a bool or None"):
+            wbc_for(biped, hip=bad)

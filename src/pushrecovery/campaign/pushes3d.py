@@ -106,7 +106,10 @@ def run_push3d(
         cache[push.params] = make_plant(spec.model, push.params, "mujoco")
     plant = cache[push.params]
     strategy = spec.strategy
-    controller = wbc_for(plant, hip=strategy != "ankle", stepping=strategy == "step")
+    # wbc-hip: the hip task; wbc-step: the plant's own controller (its default hip task,
+    # off on the G1, whose pushes it lowers) with stepping; wbc-ankle: the ankles only.
+    hip = {"ankle": False, "hip": True}.get(strategy)
+    controller = wbc_for(plant, hip=hip, stepping=strategy == "step")
     azimuth = 0.0 if push.azimuth is None else push.azimuth
     try:
         run = simulate_push3d(

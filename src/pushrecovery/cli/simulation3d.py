@@ -204,6 +204,7 @@ def _simulate_3d(
         "peak_hip_motor_torque": run.peak_hip_motor_torque,
         "max_torso_tilt": run.max_torso_tilt,
         "failed_ticks": run.failed_ticks,
+        "hip_task": plant.hip_task,
     } | (_render_3d(plant, run, render, render_options or {}) if render else {})
 
 
@@ -233,4 +234,5 @@ def _critical_3d(
         "azimuth": 0.0 if azimuth is None else azimuth,
         "backend": "mujoco",
         "strategy": found.strategy,
+        "hip_task": plant.hip_task,
     }

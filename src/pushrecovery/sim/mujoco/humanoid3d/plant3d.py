@@ -93,6 +93,8 @@ class Humanoid3DPlant:
 
     name: ClassVar[str] = "humanoid3d"
     state_labels: ClassVar[tuple[str, ...]] = STATE_LABELS
+    #: Whether :func:`wbc_for` gives its controller the hip (CMP) task unless told.
+    hip_task: ClassVar[bool] = True
 
     def __init__(
         self,
@@ -327,6 +329,10 @@ class G1Plant(Humanoid3DPlant):
     """
 
     name: ClassVar[str] = "g1"
+    #: The hip task lowers the G1's critical push at every azimuth (docs/validation.md, its
+    #: hip column: 9.3 N s forward against the ankles' 10.3; with stepping it falls at 11-15
+    #: N s where stepping alone stands): off unless asked for.
+    hip_task: ClassVar[bool] = False
 
     def __init__(self, params: BodyParams) -> None:
         from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
@@ -343,16 +349,26 @@ class G1Plant(Humanoid3DPlant):
 
 
 def wbc_for(
-    plant: Humanoid3DPlant, *, hip: bool = True, stepping: bool = False
+    plant: Humanoid3DPlant, *, hip: bool | None = None, stepping: bool = False
 ) -> WholeBodyController:
     """Return the whole-body controller of ``plant``'s model, feet and upright body.
 
-    With ``hip`` (the default) its hip (CMP) task uses the flywheel limits of
-    ``plant.params`` (:mod:`.wbc_hip`); without, it balances with the ankles only. With
+    With ``hip`` its hip (CMP) task uses the flywheel limits of ``plant.params``
+    (:mod:`.wbc_hip`); without, it balances with the ankles only; None (the default): the
+    plant's own default, ``plant.hip_task`` (the biped3d's on, the G1's off). With
     ``stepping`` it steps, planned for ``plant.params`` (:mod:`.wbc_step`), when neither
     recovers.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``hip`` is neither a bool nor None.
     """
     require_type("plant", plant, Humanoid3DPlant)
+    if hip is None:
+        hip = plant.hip_task
+    elif not isinstance(hip, bool):
+        raise InvalidParameterError(f"hip must be a bool or None, got {hip!r}")
     return WholeBodyController(
         plant.model, feet=plant.feet, torso=plant.upright, hip=plant.params if hip else None,
         stepping=stepping, params=plant.params,

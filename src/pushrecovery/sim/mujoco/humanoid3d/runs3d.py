@@ -275,8 +275,9 @@ def critical_push3d(
 
     The upper end starts at m · 0.25 m/s and doubles while the body recovers (up to the
     push's largest impulse); then the bracket halves until it is at most ``tolerance`` [N s]
-    wide (in (0, 1e3]). Each run is :func:`simulate_push3d` with the WBC and its hip task,
-    ``duration`` [s] after the push; a run that has not fallen by then (recovered or still
+    wide (in (0, 1e3]). Each run is :func:`simulate_push3d` with the plant's own WBC
+    (:func:`~.plant3d.wbc_for`: the hip task on the biped3d, not on the G1, whose critical
+    pushes it lowers), ``duration`` [s] after the push; a run that has not fallen by then (recovered or still
     undecided) counts as standing: falls are decided within a second, rest takes seconds.
     """
     require_type("plant", plant, Humanoid3DPlant)
