@@ -277,8 +277,9 @@ def critical_push3d(
     push's largest impulse); then the bracket halves until it is at most ``tolerance`` [N s]
     wide (in (0, 1e3]). Each run is :func:`simulate_push3d` with the plant's own WBC
     (:func:`~.plant3d.wbc_for`: the hip task on the biped3d, not on the G1, whose critical
-    pushes it lowers), ``duration`` [s] after the push; a run that has not fallen by then (recovered or still
-    undecided) counts as standing: falls are decided within a second, rest takes seconds.
+    pushes it lowers), ``duration`` [s] after the push; a run that has not fallen by then
+    (recovered or still undecided) counts as standing: falls are decided within a second,
+    rest takes seconds.
     """
     require_type("plant", plant, Humanoid3DPlant)
     tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
