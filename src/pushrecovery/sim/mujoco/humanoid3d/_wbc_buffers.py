@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -9,17 +11,25 @@ from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["Buffers", "full_inertia"]
+__all__ = ["Buffers", "full_inertia", "inertia_writer"]
 
 
 def full_inertia(model: Any, data: Any, out: FloatArray) -> None:
     """Write the dense joint-space inertia M into ``out`` (MuJoCo 4's and 3's ``mj_fullM``)."""
+    inertia_writer(model, data, out)()
+
+
+def inertia_writer(model: Any, data: Any, out: FloatArray) -> Callable[[], None]:
+    """Return a call that writes :func:`full_inertia` of ``data`` into ``out``, bound once.
+
+    MuJoCo's arrays are views of ``data``'s fixed arena: a tick's call skips the version test
+    and the lookups.
+    """
     import mujoco
 
     if hasattr(data, "qM"):  # MuJoCo 3: mj_fullM(m, dst, qM)
-        mujoco.mj_fullM(model, out, data.qM)
-    else:  # MuJoCo 4: mj_fullM(m, d, dst)
-        mujoco.mj_fullM(model, data, out)
+        return partial(mujoco.mj_fullM, model, out, data.qM)
+    return partial(mujoco.mj_fullM, model, data, out)  # MuJoCo 4: mj_fullM(m, d, dst)
 
 
 class Buffers:

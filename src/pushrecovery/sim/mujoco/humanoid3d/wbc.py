@@ -51,7 +51,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.sim.mujoco.humanoid3d._wbc_buffers import Buffers, full_inertia
+from pushrecovery.sim.mujoco.humanoid3d._wbc_buffers import Buffers, full_inertia, inertia_writer
 from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
     add_task,
     assemble_rows,
@@ -264,8 +264,10 @@ class WholeBodyQP:
         """Write MuJoCo's J and J̇ of each sole frame into the buffers (``jac``, ``dots``)."""
         import mujoco
 
+        if data is not self._data:
+            self._tick_arguments(data)
         model = self.model
-        sole_origins(data.xpos, data.xmat, self._bodies, self._origins, self._buf.points)
+        sole_origins(*self._origin_arguments)
         for point, lin, ang, lin_dot, ang_dot, body in self._views:  # rows of buf, per foot
             mujoco.mj_jac(model, data, lin, ang, point, body)
             mujoco.mj_jacDot(model, data, lin_dot, ang_dot, point, body)
@@ -314,18 +316,23 @@ class WholeBodyQP:
         instead of a check and a call per task and kernel (the same sums: the same QP to the
         last bit).
         """
-        full_inertia(self.model, data, self._buf.mass)
-        self._jacobians(data)
         if data is not self._data:
             self._tick_arguments(data)
+        self._inertia()  # full_inertia
+        self._jacobians(data)
         count = assemble_rows(matrix, target, weights, count, float(self.contact_damping),
                               *self._arguments)  # fmt: skip
         return int(count)
 
     def _tick_arguments(self, data: Any) -> None:
-        """Gather :func:`._wbc_kernels.assemble_rows`' arrays after the tasks' and k_c."""
+        """Gather :func:`._wbc_kernels.assemble_rows`' arrays after the tasks' and k_c.
+
+        Also ``sole_origins``' arguments and the bound ``mj_fullM`` of ``data``.
+        """
         buf = self._buf
         self._data = data
+        self._inertia = inertia_writer(self.model, data, buf.mass)
+        self._origin_arguments = (data.xpos, data.xmat, self._bodies, self._origins, buf.points)
         self._arguments = (
             data.xmat, self._bodies, buf.dots, data.qvel, self._regular, buf.mass,
             data.qfrc_bias, data.qfrc_passive, self.contacts, self.unactuated, self.actuated,

@@ -161,19 +161,17 @@ class WholeBodyController:
         self.foot_names, self.torso = tuple(feet), body_id(model, torso)
         self.mass = float(model.body_subtreemass[0])
         self.gravity = np.array(model.opt.gravity, dtype=float)
+        self._weight = self.mass * float(np.linalg.norm(self.gravity))  # m g [N]
         self.qp: WholeBodyQP | None = None
         self.feet: tuple[FootContact, ...] = ()
         self.support: ConvexPolygon | None = None
         self.last: WbcSolution | None = None
-        self.desired_cop = np.zeros(2)
-        self.cmp_offset = np.zeros(2)
-        self.capture_point = np.zeros(2)
+        self.desired_cop, self.cmp_offset = np.zeros(2), np.zeros(2)
         if hip is not None and not isinstance(hip, BodyParams):
             raise InvalidParameterError(f"hip must be a BodyParams, got {type(hip).__name__}")
         self.hip_params = hip
         self.hip: HipLaw | None = None
-        self.cmp_target = np.zeros(2)
-        self.returning = False
+        self.capture_point, self.cmp_target, self.returning = np.zeros(2), np.zeros(2), False
         if not isinstance(stepping, bool):
             raise InvalidParameterError(f"stepping must be a bool, got {stepping!r}")
         params = hip if params is None else params
@@ -184,6 +182,7 @@ class WholeBodyController:
         self.stepping, self.step_params, self.step_settings = stepping, params, step_settings
         self.stepper: Stepper | None = None
         self.guard = JointGuard(model, guard)  # with stepping, the stepper guards the knees
+        self._data: Any = None  # the MjData whose array views cop_target keeps
 
     def reset(self, state: Any) -> None:
         """Take the reference posture, feet and balance point from ``state`` (an MjData).
@@ -207,21 +206,23 @@ class WholeBodyController:
         capture_point(0.0, 0.0, self.omega)  # ω's range checked once (the tick's kernel cannot)
         # balance_point's results, read through fixed views: e (3), ξ (2), the DCM CoP (2).
         self._balance = np.zeros(7)
-        self._error = self._balance[:3]
+        self._error, self._xi, self._cop = self._balance[:3], self._balance[3:5], self._balance[5:7]
+        self._omega2 = self.omega**2
+        self._torso_weight = math.nan  # the stack's torso weights are to be written
         self.last = None
         self._bodies = np.array([foot.body for foot in self.feet], dtype=np.intp)
         self._origins = np.array([foot.origin for foot in self.feet])
         nv, size = int(model.nv), self.qp.size
         self._dots = np.zeros((6, nv))  # the torso's J̇ (linear, angular), overwritten each tick
+        self._dots_p, self._dots_r = self._dots[:3], self._dots[3:]
         self._jacp, self._jacr = np.zeros((3, nv)), np.zeros((3, nv))  # its J (each tick)
         self._stack = TaskStack(nv, size, self.gains)  # the tasks as rows (wbc_task_stack)
+        self._stack.reserve(nv + 2 + self.guard.qpos.size)  # the hip's 2 rows, the guard's
         self.hip = None
         if self.hip_params is not None:
-            weight = self.mass * float(np.linalg.norm(self.gravity))
-            self.hip = HipLaw(self.hip_params, self.support, weight, self.omega,
+            self.hip = HipLaw(self.hip_params, self.support, self._weight, self.omega,
                               self.control_period)  # fmt: skip
-        self.returning = False
-        self.stepper = None
+        self.returning, self.stepper = False, None
         self._soles = {  # each sole's points in its foot's frame, for the supports of steps
             f.body: (sole_points(model, data, f.body) - np.asarray(data.xpos[f.body]))
             @ np.asarray(data.xmat[f.body]).reshape(3, 3) for f in self.feet
@@ -244,8 +245,7 @@ class WholeBodyController:
                  @ np.asarray(data.xmat[f.body]).reshape(3, 3).T for f in on]  # fmt: skip
         self.support = convex_hull(np.vstack(soles)[:, :2])
         if self.hip_params is not None:
-            weight = self.mass * float(np.linalg.norm(self.gravity))
-            self.hip = HipLaw(self.hip_params, self.support, weight, self.omega,
+            self.hip = HipLaw(self.hip_params, self.support, self._weight, self.omega,
                               self.control_period)  # fmt: skip
 
     def _step(self, data: Any) -> bool:
@@ -275,88 +275,90 @@ class WholeBodyController:
         """
         import mujoco
 
+        if data is not self._data:  # views of the arrays a tick reads, once (a fixed arena)
+            self._data, self._views = data, (
+                data.xmat, data.subtree_com, data.subtree_linvel, data.subtree_com[0],
+                data.xpos[self.torso], data.qvel, data.qpos)  # fmt: skip
         mujoco.mj_subtreeVel(self.model, data)
-        support, out = self.support, self._balance
+        support, out, views = self.support, self._balance, self._views
         assert support is not None
         # One kernel: the torso's error (kept for _update), ξ = c + ċ/ω and the DCM law's CoP.
-        inside = balance_point(data.xmat, self.torso, self._upright, data.subtree_com,
-                               data.subtree_linvel, self.omega, self.gains.dcm / self.omega,
-                               self.rest, support.normals, support.offsets, out)  # fmt: skip
-        self.capture_point = out[3:5].copy()
-        self.cmp_target = out[5:7].copy()
+        inside = balance_point(views[0], self.torso, self._upright, views[1], views[2],
+                               self.omega, self.gains.dcm / self.omega, self.rest,
+                               support.normals, support.offsets, out)  # fmt: skip
+        self.capture_point = self._xi.copy()
+        self.cmp_target = self._cop.copy()
         if inside:
-            return out[5:7].copy()
+            return self._cop.copy()
         return np.array(support.nearest_point(float(out[5]), float(out[6])))
 
     def tasks(self, data: Any) -> list[Task]:
         """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.wbc_hip`)."""
-        momentum, others = self._update(data)
-        return self._stack.tasks(momentum, others)
+        momentum = self._update(data)
+        assert self.qp is not None
+        if self.stepper is not None:  # the swing foot (while it swings), the knee guard
+            return self._stack.tasks(momentum, self.stepper.tasks(data, self.qp.size, self.qp.nv))
+        return self._stack.tasks(momentum, self.guard.tasks(data.qpos, data.qvel, self.qp.nv))
 
-    def _rows(self, data: Any) -> int:
-        """Stack the tasks of :meth:`tasks` as rows (:class:`.TaskStack`); their number."""
-        momentum, others = self._update(data)
-        return self._stack.extend(others if momentum is None else [momentum, *others])
+    def _update(self, data: Any) -> Task | None:
+        """Run the tick's laws; write the CoM, torso, pelvis and posture rows (:meth:`compute`).
 
-    def _update(self, data: Any) -> tuple[Task | None, list[Task]]:
-        """Run the tick's laws; write the CoM, torso, pelvis and posture rows (:meth:`_rows`).
-
-        Returns the hip's momentum task (None when the hip is idle) and the tasks that follow
-        the posture's (the stepper's or the joint guard's).
+        Returns the hip's momentum task (None when the hip is idle).
         """
         import mujoco
 
         assert self.qp is not None
         model, gains, nv, size = self.model, self.gains, self.qp.nv, self.qp.size
-        # The DCM law's CoP (also ξ and the torso's orientation error, mj_subtreeVel).
+        # The DCM law's CoP (also ξ, the torso's orientation error, mj_subtreeVel, the views).
         self.desired_cop = self.cop_target(data)
-        if self.stepper is not None and self._step(data):
+        stepper = self.stepper
+        if stepper is not None and self._step(data):
             self.desired_cop = self.cop_target(data)  # the new support polygon
-        error, com = self._error, data.subtree_com[0]
+        xmat, _, _, com, point, qvel, qpos = self._views
+        error, hip, torso = self._error, self.hip, self.torso  # the hip law after _step's
         # Torso orientation and pelvis height: J q̈ + J̇ q̇ = a_des (matrices over q̈ only).
-        point = data.xpos[self.torso]
-        jacp, jacr, dots = self._jacp, self._jacr, self._dots
-        mujoco.mj_jac(model, data, jacp, jacr, point, self.torso)
-        mujoco.mj_jacDot(model, data, dots[:3], dots[3:], point, self.torso)
+        jacp, jacr = self._jacp, self._jacr
+        mujoco.mj_jac(model, data, jacp, jacr, point, torso)
+        mujoco.mj_jacDot(model, data, self._dots_p, self._dots_r, point, torso)
         # The torso's angular velocity [rad/s], world: the hip law's (ankle_targets has its own).
-        spin = jacr @ data.qvel if self.hip is not None else _NO_SPIN
+        spin = jacr @ qvel if hip is not None else _NO_SPIN
         hip_active = False
         # No hip task while a foot swings: the step owns the recovery (the confusion matrix's
         # steps that failed fell from 10 to 2 of 60 pushes, docs/validation.md); the torso's
         # paced return goes on.
-        swinging = self.stepper is not None and self.stepper.swing is not None
-        if swinging:
+        if stepper is not None and stepper.swing is not None:
             self.cmp_offset = np.zeros(2)
-        elif self.hip is not None:
+        elif hip is not None:
             momentum = np.asarray(data.subtree_angmom[0])
-            self.cmp_offset = self.hip.update(
+            self.cmp_offset = hip.update(
                 self.capture_point, np.array([momentum[1], -momentum[0]]),
                 np.array([error[1], -error[0]]), np.array([spin[1], -spin[0]]),
             )  # fmt: skip
-            hip_active = self.hip.active
+            hip_active = hip.active
             if hip_active:
-                self.desired_cop = self.hip.saturate(self.desired_cop)
+                self.desired_cop = hip.saturate(self.desired_cop)
             self.returning = self.returning or hip_active
         stiffness, damping = gains.torso_stiffness, gains.torso_damping
         torso_weight = gains.hip_torso_weight if hip_active else gains.torso_weight
         returning = self.returning and not hip_active  # gently back upright, then as usual
         paced = None  # the paced return's change of the torso's α_x, α_y (wbc_hip)
         if returning:
-            assert self.hip is not None
+            assert hip is not None
             stiffness, damping = gains.return_stiffness, gains.return_damping
             accel = -stiffness * error[:2] - damping * spin[:2]
-            self.cmp_offset, self.desired_cop, paced = self.hip.paced_return(self.cmp_target, accel)
+            self.cmp_offset, self.desired_cop, paced = hip.paced_return(self.cmp_target, accel)
             paced -= accel
-        self._stack.pd_gains[0], self._stack.pd_gains[1] = stiffness, damping
+        rows = self._stack
+        rows.pd_gains[0], rows.pd_gains[1] = stiffness, damping
         # All targets and rows at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g +
         # Σ R_i F_i, rows x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
-        stack, targets = self._stack.matrix, self._stack.targets
-        stepper, height = self.stepper, self.height  # the stepper lowers it for long steps
+        stack, targets = rows.matrix, rows.targets
+        height = self.height  # the stepper lowers it for long steps
         height = height if stepper is None else stepper.pelvis_height(data, height)
         upright = ankle_targets(
-            data.xmat, self._bodies, self.mass, com, self.desired_cop, self.cmp_offset,
-            self.omega**2, self.gravity, error, jacp, jacr, dots, data.qvel, data.qpos,
-            self.posture, height, float(point[2]), self._stack.pd_gains, UPRIGHT, stack, targets,
+            xmat, self._bodies, self.mass, com, self.desired_cop, self.cmp_offset, self._omega2,
+            self.gravity, error, jacp, jacr, self._dots, qvel, qpos, self.posture, height,
+            float(point[2]), rows.pd_gains, UPRIGHT, stack, targets,
         )  # fmt: skip
         if paced is not None:
             targets[2:4] += paced
@@ -368,21 +370,14 @@ class WholeBodyController:
             targets[4] *= scale
         if returning and upright:
             self.returning = False
-        self._stack.weights[2:5] = torso_weight
-        momentum_task = None
-        if hip_active:  # L̇_x = −m g δ_y, L̇_y = m g δ_x
-            rows = momentum_rows(data, self._bodies, size, nv, com, self._origins)[:2]
-            weight = self.mass * float(np.linalg.norm(self.gravity))
-            rate = weight * np.array([-self.cmp_offset[1], self.cmp_offset[0]])
-            momentum_task = Task("momentum", rows, rate, gains.hip_weight)
-        others: list[Task] = []
-        if self.stepper is not None:  # the swing foot (while it swings), the knee guard
-            others = self.stepper.tasks(data, size, nv)
-        else:  # the joints near their stops (wbc_limits)
-            guard = self.guard.task_rows(data.qpos, data.qvel, nv)
-            if guard[1].size:
-                others.append(Task("joint guard", *guard, self.guard.settings.weight))
-        return momentum_task, others
+        if torso_weight != self._torso_weight:  # the weights stay in the stack between ticks
+            rows.weights[2:5] = self._torso_weight = torso_weight
+        if not hip_active:
+            return None
+        # L̇_x = −m g δ_y, L̇_y = m g δ_x
+        matrix = momentum_rows(data, self._bodies, size, nv, com, self._origins)[:2]
+        rate = self._weight * np.array([-self.cmp_offset[1], self.cmp_offset[0]])
+        return Task("momentum", matrix, rate, gains.hip_weight)
 
     def compute(self, t: float, state: Any) -> FloatArray:
         """Return the motor commands ``ctrl`` [N m] for the state in ``state`` (an MjData).
@@ -392,7 +387,13 @@ class WholeBodyController:
         """
         if self.qp is None:
             raise InvalidParameterError("call reset(state) before compute(t, state)")
-        count = self._rows(state)  # the tasks() as stacked rows: the QP's fast path
-        stack = self._stack
-        self.last = self.qp._solve_rows(state, stack.matrix, stack.targets, stack.weights, count)
+        # The tasks() as stacked rows (TaskStack), the QP's fast path.
+        momentum, stack, qp = self._update(state), self._stack, self.qp
+        count = stack.nv if momentum is None else stack.extend([momentum])
+        if self.stepper is not None:
+            count = stack.extend(self.stepper.tasks(state, qp.size, qp.nv), count)
+        else:  # the guard's rows, no Task (the G1's knees are within their margins at each tick)
+            count = self.guard.stack_rows(state.qpos, state.qvel, stack.matrix, stack.targets,
+                                          stack.weights, count)  # fmt: skip
+        self.last = qp._solve_rows(state, stack.matrix, stack.targets, stack.weights, count)
         return self.last.ctrl

@@ -78,11 +78,11 @@ class LeastDistanceSolver:
 
     def _daqp(self, count: int) -> tuple[Any, int, int]:
         """Return DAQP's (u, flag, iterations) on the first ``count`` least-distance rows."""
-        import daqp
-
         rows, high, low, _ = self._rows(count)
         model = self._models.get(count)
         if model is None:
+            import daqp  # here: an import statement costs a tick ~60 ns
+
             sense = np.where(np.arange(count) < self.equalities, _EQUALITY, 0).astype(np.intc)
             model = daqp.Model()
             flag, _ = model.setup(self._identity, self._zeros, rows, high, low, sense)
@@ -102,7 +102,7 @@ class LeastDistanceSolver:
         ones), the wall time of the factorisation and DAQP's update and solve [s], and DAQP's
         iterations.
         """
-        buf, nu = self.buf, self.buf.offset.shape[0]
+        buf, nu = self.buf, self._product.shape[0]
         start = time.perf_counter()  # the solve time includes the factorisation of H
         flag, steps, reduced = -1, 0, count - nu
         ctrl = np.empty(nu)

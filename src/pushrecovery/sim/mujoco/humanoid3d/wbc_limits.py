@@ -30,14 +30,45 @@ import math
 from dataclasses import dataclass, fields
 from typing import Any
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.mujoco.humanoid3d.wbc import Task
 
 FloatArray = NDArray[np.float64]
 
 __all__ = ["GuardSettings", "JointGuard"]
+
+
+@numba.njit(cache=True, nogil=True)
+def guard_rows(qpos, qvel, joints, edges, settings, stack, targets, weights, start):  # type: ignore[no-untyped-def]
+    """Write the joint guard's rows (:meth:`JointGuard.task_rows`) from row ``start``.
+
+    ``joints`` (n, 2): each joint's qpos and dof address; ``edges`` (n, 2) its (low, high);
+    ``settings`` (T, k, d, W). A row: q̈_dof (zeros, 1 at the dof), its target, W. Returns the
+    rows' end. No fast-math: ``task_rows``' Python floats, operation for operation (``min(v,
+    0.0)`` is v unless 0.0 < v, ``max`` likewise).
+    """
+    horizon, stiffness, damping, weight = settings[0], settings[1], settings[2], settings[3]
+    count = start
+    for i in range(joints.shape[0]):
+        q, v = qpos[joints[i, 0]], qvel[joints[i, 1]]
+        slow, fast = 0.0 if 0.0 < v else v, 0.0 if 0.0 > v else v  # min(v, 0), max(v, 0)
+        if q + horizon * slow < edges[i, 0]:
+            gap = edges[i, 0] - q
+            target = stiffness * (0.0 if 0.0 > gap else gap) - damping * slow
+        elif q + horizon * fast > edges[i, 1]:
+            gap = edges[i, 1] - q
+            target = stiffness * (0.0 if 0.0 < gap else gap) - damping * fast
+        else:
+            continue
+        stack[count] = 0.0
+        stack[count, joints[i, 1]] = 1.0
+        targets[count], weights[count] = target, weight
+        count += 1
+    return count
 
 
 @dataclass(frozen=True)
@@ -125,6 +156,10 @@ class JointGuard:
         inset = np.minimum(settings.margin, 0.25 * (ranges[:, 1] - ranges[:, 0]))
         self.edges = np.column_stack([ranges[:, 0] + inset, ranges[:, 1] - inset])
         self._matrices: dict[tuple[int, ...], FloatArray] = {}  # task_rows' A, by nv and dofs
+        # stack_rows' arrays: each joint's (qpos, dof) addresses; T, k, d, W as floats.
+        self._addresses = np.column_stack([self.qpos, self.dofs]).astype(np.int64)
+        self._settings = np.array([settings.horizon, settings.stiffness, settings.damping,
+                                   settings.weight], dtype=float)  # fmt: skip
         self.set_posture(np.full(int(model.nq), np.nan))
 
     def set_posture(self, qpos: FloatArray) -> None:
@@ -137,6 +172,7 @@ class JointGuard:
         self.high = np.fmax(self.edges[:, 1], q)
         self._joints = list(zip(self.qpos.tolist(), self.dofs.tolist(), self.low.tolist(),
                                 self.high.tolist(), strict=True))  # fmt: skip
+        self._bounds = np.column_stack([self.low, self.high])
 
     def task_rows(
         self, qpos: FloatArray, qvel: FloatArray, nv: int
@@ -168,3 +204,23 @@ class JointGuard:
                 matrix[k, dof] = 1.0
             matrix.flags.writeable = False
         return matrix, np.array([target for _, target in rows])
+
+    def tasks(self, qpos: FloatArray, qvel: FloatArray, nv: int) -> list[Task]:
+        """Return :meth:`task_rows` as a :class:`~.wbc.Task` (none without rows)."""
+        matrix, target = self.task_rows(qpos, qvel, nv)
+        return [Task("joint guard", matrix, target, self.settings.weight)] if target.size else []
+
+    def stack_rows(
+        self, qpos: FloatArray, qvel: FloatArray, stack: FloatArray, targets: FloatArray,
+        weights: FloatArray, start: int,
+    ) -> int:  # fmt: skip
+        """Write :meth:`task_rows`' task as stacked rows from row ``start``; return their end.
+
+        The controller's fast path (:class:`~.wbc_task_stack.TaskStack`): row r of ``stack``
+        (over all the QP's unknowns, zeros beyond q̈) with ``targets[r]`` and weight
+        ``weights[r]`` = W, in one compiled call instead of a task's arrays, a
+        :class:`~.wbc.Task` and its copy into the stack. ``stack`` must have a row for each
+        guarded joint after ``start``.
+        """
+        return int(guard_rows(qpos, qvel, self._addresses, self._bounds, self._settings, stack,
+                              targets, weights, start))  # fmt: skip

@@ -63,21 +63,26 @@ class TaskStack:
                                   gains.height_stiffness, gains.height_damping,
                                   gains.posture_stiffness, gains.posture_damping])  # fmt: skip
 
-    def extend(self, tasks: Sequence[Task]) -> int:
-        """Stack ``tasks`` after the ankle controller's nv rows; return the number of rows.
+    def reserve(self, rows: int) -> None:
+        """Grow the buffers to at least ``rows`` rows (kept: the rows already written)."""
+        grow = rows - self.matrix.shape[0]
+        if grow > 0:
+            self.matrix = np.vstack([self.matrix, np.zeros((grow, self.matrix.shape[1]))])
+            self.targets = np.concatenate([self.targets, np.zeros(grow)])
+            self.weights = np.concatenate([self.weights, np.zeros(grow)])
 
-        The hip's momentum task acts on the wrenches alone, the torso's, pelvis's and posture's
-        on q̈ alone: after them instead of between the CoM's and the torso's (the order of
-        :meth:`tasks`), each sum of H and f still takes its terms in the same order.
+    def extend(self, tasks: Sequence[Task], start: int | None = None) -> int:
+        """Stack ``tasks`` from row ``start`` (default nv); return the number of rows.
+
+        The first nv rows are the ankle controller's. The hip's momentum task acts on the
+        wrenches alone, the torso's, pelvis's and posture's on q̈ alone: after them instead of
+        between the CoM's and the torso's (the order of :meth:`tasks`), each sum of H and f
+        still takes its terms in the same order.
         """
-        count = self.nv  # the rows ankle_targets wrote
+        count = self.nv if start is None else start  # nv: the rows ankle_targets wrote
         for task in tasks:
             rows, columns = task.matrix.shape
-            if count + rows > self.matrix.shape[0]:  # more rows than ever: grow the buffers
-                grow = count + rows - self.matrix.shape[0]
-                self.matrix = np.vstack([self.matrix, np.zeros((grow, self.matrix.shape[1]))])
-                self.targets = np.concatenate([self.targets, np.zeros(grow)])
-                self.weights = np.concatenate([self.weights, np.zeros(grow)])
+            self.reserve(count + rows)  # more rows than ever: grow the buffers
             block = self.matrix[count : count + rows]
             block[:, :columns] = task.matrix
             block[:, columns:] = 0.0
