@@ -336,7 +336,17 @@ def test_the_joint_guard_pushes_a_knee_off_its_stop_and_never_towards_it(model):
     left = int(knees[0].qposadr[0]), int(knees[0].dofadr[0])
     qpos[left[0]] = 0.05  # inside the margin: a spring back out, k (0.1 − 0.05) > 0
     rows, target = guard.task_rows(qpos, qvel, model.nv)
-    assert rows.shape[0] == 1 and rows[0, left[1]] == 1.0 and target[0] > 0.0
+    assert rows.shape[0] == 1 and rows[0, left[1]] == 1.0 and rows.sum() == 1.0
+    assert target[0] == pytest.approx(GuardSettings().stiffness * (0.1 - 0.05), rel=1e-12)
+    # The controller's fast path writes the same row into its stack, after the rows before it,
+    # and refuses a stack without room for every guarded joint.
+    stack, targets, weights = np.full((4, model.nv), 9.0), np.zeros(4), np.zeros(4)
+    assert guard._stack_rows(qpos, qvel, stack, targets, weights, 2) == 3
+    np.testing.assert_array_equal(stack[2], rows[0])
+    assert (targets[2], weights[2]) == (target[0], GuardSettings().weight)
+    assert (stack[:2] == 9.0).all() and (stack[3] == 9.0).all()
+    with pytest.raises(ValueError, match="no room"):
+        guard._stack_rows(qpos, qvel, stack, targets, weights, 3)
     qpos[left[0]], qvel[left[1]] = 0.3, -5.0  # 0.3 − 0.05 × 5 < 0.1: damp the approach only
     rows, target = guard.task_rows(qpos, qvel, model.nv)
     assert target[0] == pytest.approx(GuardSettings().damping * 5.0)

@@ -393,7 +393,7 @@ class WholeBodyController:
         if self.stepper is not None:
             count = stack.extend(self.stepper.tasks(state, qp.size, qp.nv), count)
         else:  # the guard's rows, no Task (the G1's knees are within their margins at each tick)
-            count = self.guard.stack_rows(state.qpos, state.qvel, stack.matrix, stack.targets,
-                                          stack.weights, count)  # fmt: skip
+            count = self.guard._stack_rows(state.qpos, state.qvel, stack.matrix, stack.targets,
+                                           stack.weights, count)  # fmt: skip
         self.last = qp._solve_rows(state, stack.matrix, stack.targets, stack.weights, count)
         return self.last.ctrl

@@ -156,7 +156,7 @@ class JointGuard:
         inset = np.minimum(settings.margin, 0.25 * (ranges[:, 1] - ranges[:, 0]))
         self.edges = np.column_stack([ranges[:, 0] + inset, ranges[:, 1] - inset])
         self._matrices: dict[tuple[int, ...], FloatArray] = {}  # task_rows' A, by nv and dofs
-        # stack_rows' arrays: each joint's (qpos, dof) addresses; T, k, d, W as floats.
+        # guard_rows' arrays: each joint's (qpos, dof) addresses; T, k, d, W as floats.
         self._addresses = np.column_stack([self.qpos, self.dofs]).astype(np.int64)
         self._settings = np.array([settings.horizon, settings.stiffness, settings.damping,
                                    settings.weight], dtype=float)  # fmt: skip
@@ -170,8 +170,6 @@ class JointGuard:
         q = np.asarray(qpos, dtype=float)[self.qpos]
         self.low = np.fmin(self.edges[:, 0], q)  # NaN (no posture): the margin's edge
         self.high = np.fmax(self.edges[:, 1], q)
-        self._joints = list(zip(self.qpos.tolist(), self.dofs.tolist(), self.low.tolist(),
-                                self.high.tolist(), strict=True))  # fmt: skip
         self._bounds = np.column_stack([self.low, self.high])
 
     def task_rows(
@@ -182,35 +180,27 @@ class JointGuard:
         No rows when no joint's predicted position is within its margin. A is shared between
         calls (read-only).
         """
-        s = self.settings
-        horizon, stiffness, damping = s.horizon, s.stiffness, s.damping
-        # A plain loop over a few joints; memoryviews read Python floats (numpy scalars' sums
-        # cost twice as much), a call's share of the controller's tick.
-        positions, velocities = np.asarray(qpos).data, np.asarray(qvel).data  # memoryviews
-        rows: list[tuple[int, float]] = []  # (dof, target)
-        for adr, dof, low, high in self._joints:
-            q, v = positions[adr], velocities[dof]
-            if q + horizon * min(v, 0.0) < low:
-                rows.append((dof, stiffness * max(low - q, 0.0) - damping * min(v, 0.0)))
-            elif q + horizon * max(v, 0.0) > high:
-                rows.append((dof, stiffness * min(high - q, 0.0) - damping * max(v, 0.0)))
+        n = self.qpos.size
+        stack, targets = np.zeros((n, nv)), np.empty(n)
+        count = guard_rows(np.asarray(qpos, dtype=float), np.asarray(qvel, dtype=float),
+                           self._addresses, self._bounds, self._settings, stack, targets,
+                           np.empty(n), 0)  # fmt: skip
         # The rows q̈_dof of a set of dofs are constant: one shared, read-only matrix per set
         # (the G1's knees sit within their margins at its keyframe: rows at every tick).
-        key = (nv, *(dof for dof, _ in rows))
+        dofs = [int(np.argmax(row)) for row in stack[:count]]
+        key = (nv, *dofs)
         matrix = self._matrices.get(key)
         if matrix is None:
-            matrix = self._matrices[key] = np.zeros((len(rows), nv))
-            for k, (dof, _) in enumerate(rows):
-                matrix[k, dof] = 1.0
+            matrix = self._matrices[key] = stack[:count].copy()
             matrix.flags.writeable = False
-        return matrix, np.array([target for _, target in rows])
+        return matrix, targets[:count].copy()
 
     def tasks(self, qpos: FloatArray, qvel: FloatArray, nv: int) -> list[Task]:
         """Return :meth:`task_rows` as a :class:`~.wbc.Task` (none without rows)."""
         matrix, target = self.task_rows(qpos, qvel, nv)
         return [Task("joint guard", matrix, target, self.settings.weight)] if target.size else []
 
-    def stack_rows(
+    def _stack_rows(
         self, qpos: FloatArray, qvel: FloatArray, stack: FloatArray, targets: FloatArray,
         weights: FloatArray, start: int,
     ) -> int:  # fmt: skip
@@ -219,8 +209,10 @@ class JointGuard:
         The controller's fast path (:class:`~.wbc_task_stack.TaskStack`): row r of ``stack``
         (over all the QP's unknowns, zeros beyond q̈) with ``targets[r]`` and weight
         ``weights[r]`` = W, in one compiled call instead of a task's arrays, a
-        :class:`~.wbc.Task` and its copy into the stack. ``stack`` must have a row for each
-        guarded joint after ``start``.
+        :class:`~.wbc.Task` and its copy into the stack. The caller reserves a row for each
+        guarded joint after ``start`` (the kernel does not check its writes).
         """
+        if start + self.qpos.size > min(stack.shape[0], targets.shape[0], weights.shape[0]):
+            raise ValueError(f"the task stack has no room for the guard's rows after {start}")
         return int(guard_rows(qpos, qvel, self._addresses, self._bounds, self._settings, stack,
                               targets, weights, start))  # fmt: skip
