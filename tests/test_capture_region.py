@@ -405,7 +405,7 @@ def test_the_compiled_decomposition_and_sum_equal_numpys():
     # The plan's compiled twins (ground._kernels) against ground.minkowski on random sums.
     from pushrecovery.ground import convex_hull
     from pushrecovery.ground._kernels import decompose_loop, minkowski_loop
-    from pushrecovery.ground.minkowski import _stacked_shapes, decompose
+    from pushrecovery.ground.minkowski import decompose, stacked_shapes
 
     rng = np.random.default_rng(5)
     for _ in range(100):
@@ -415,7 +415,7 @@ def test_the_compiled_decomposition_and_sum_equal_numpys():
         terms.append((float(rng.uniform(0.1, 2.0)), np.array([[0.3, -0.2]])))
         offset = rng.normal(size=2)
         total = minkowski_sum(terms, offset)
-        stacked, counts, weights = _stacked_shapes(terms)
+        stacked, counts, weights = stacked_shapes(terms)
         loop = minkowski_loop(stacked, counts, weights, offset)
         np.testing.assert_allclose(loop, total.vertices, atol=1e-12)
         point = total.centroid + rng.uniform(-1.0, 1.0, 2) * 0.5

@@ -22,9 +22,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_float, positive_float, require_type, sample_array
 from pushrecovery.analysis.recording import LOADED
 from pushrecovery.analysis.signals import _find_gaps, _times
+from pushrecovery.arguments import finite_float, positive_float, require_type, sample_array
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, float_array, require_type, sample_array
+from pushrecovery.arguments import bounded_float, float_array, require_type, sample_array
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy

@@ -36,8 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import bounded_float, require_type, sample_array
 from pushrecovery.analysis.base_polygon import BasePolygons, edges
+from pushrecovery.arguments import bounded_float, require_type, sample_array
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams

@@ -20,16 +20,16 @@ FRAME_FILES = ("frames.parquet", "frames.csv")
 SUMMARY_FILE = "summary.json"
 
 
-def _json_safe(value: Any) -> Any:
+def json_safe(value: Any) -> Any:
     """Plain Python values, non-finite floats as None (JSON has no NaN or infinity)."""
     if isinstance(value, np.generic):
         value = value.item()
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, dict):
-        return {key: _json_safe(item) for key, item in value.items()}
+        return {key: json_safe(item) for key, item in value.items()}
     if isinstance(value, list | tuple):
-        return [_json_safe(item) for item in value]
+        return [json_safe(item) for item in value]
     return value
 
 
@@ -58,7 +58,7 @@ def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Pa
     }
     _atomic(paths["frames_parquet"], lambda p: pq.write_table(table, p))
     _atomic(paths["frames_csv"], lambda p: pacsv.write_csv(table, p))
-    text = json.dumps(_json_safe(analysis.summary), indent=2, allow_nan=False)
+    text = json.dumps(json_safe(analysis.summary), indent=2, allow_nan=False)
     _atomic(paths["summary"], lambda p: p.write_text(text + "\n"))
     return paths
 

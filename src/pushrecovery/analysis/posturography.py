@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import detrend, welch
 
-from pushrecovery._validate import bounded_float, float_array, positive_float
 from pushrecovery.analysis.recording import LOADED
+from pushrecovery.arguments import bounded_float, float_array, positive_float
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [

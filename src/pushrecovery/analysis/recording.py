@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, positive_float, require_type, whole_number
+from pushrecovery.arguments import finite_float, positive_float, require_type, whole_number
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = ["AXES", "LOADED", "Foot", "Recording", "Support", "fixed_feet", "support_from_feet"]

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, sosfiltfilt
 
-from pushrecovery._validate import (
+from pushrecovery.arguments import (
     finite_float,
     positive_float,
     require_type,

@@ -44,7 +44,6 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_float, positive_float, require_type
 from pushrecovery.analysis.events import (
     MIN_DURATION,
     _non_negative,
@@ -54,6 +53,7 @@ from pushrecovery.analysis.events import (
 )
 from pushrecovery.analysis.recording import LOADED, Foot, _check_feet
 from pushrecovery.analysis.signals import _find_gaps, _times, smooth_and_differentiate
+from pushrecovery.arguments import finite_float, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [

@@ -27,8 +27,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import cumulative_trapezoid
 
-from pushrecovery._validate import bounded_float, finite_float, sample_array
 from pushrecovery.analysis.signals import _times
+from pushrecovery.arguments import bounded_float, finite_float, sample_array
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import LIMITS
 

@@ -232,7 +232,7 @@ def predict_push(
     (Classification, str)
         The verdict (strategy, capture point, margins, steps) and the corrected strategy.
     """
-    from pushrecovery._validate import bounded_float
+    from pushrecovery.arguments import bounded_float
     from pushrecovery.sim.push import Push3D
     from pushrecovery.surfaces.classify import classify
 

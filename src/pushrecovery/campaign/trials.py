@@ -176,7 +176,7 @@ class TrialsResult:
 
 def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict[str, Any]:
     """Analyse one trial into ``out / trials / job.name``; return and store its rows."""
-    from pushrecovery.analysis.output import _json_safe, write_analysis
+    from pushrecovery.analysis.output import json_safe, write_analysis
     from pushrecovery.analysis.readers import read_recording
     from pushrecovery.analysis.trial import analyze, body_for
     from pushrecovery.presets import load_params
@@ -205,7 +205,7 @@ def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict
         files = {name: str(path) for name, path in write_analysis(analysis, directory).items()}
         if after is not None:
             files.update(after(analysis, directory))
-        summary = _json_safe(analysis.summary)
+        summary = json_safe(analysis.summary)
         record = {
             "trials": trial_rows(job, summary, params, sources),
             "events": trial_events(job, summary),

@@ -193,7 +193,7 @@ def _single(
     **kwargs: Any,
 ) -> None:
     """One trial, its outputs straight into ``out`` (the first releases' contract)."""
-    from pushrecovery.analysis.output import _json_safe, write_analysis
+    from pushrecovery.analysis.output import json_safe, write_analysis
     from pushrecovery.analysis.readers import read_recording
     from pushrecovery.analysis.trial import analyze as analyze_trial
     from pushrecovery.analysis.trial import body_for
@@ -214,7 +214,7 @@ def _single(
     files = {name: str(path) for name, path in write_analysis(result, out).items()}
     if plot:
         files.update(plot_trial(result, out))
-    summary = _json_safe(result.summary)
+    summary = json_safe(result.summary)
     if as_json:
         emit({**summary, "files": files}, True)
         return

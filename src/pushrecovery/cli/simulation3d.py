@@ -212,7 +212,7 @@ def _critical_3d(
     model: str, params: Any, azimuth: float | None, tolerance: float, duration: float
 ) -> dict[str, Any]:
     """Bisect the impulse at ``azimuth`` on a 3-D model (the JSON)."""
-    from pushrecovery._validate import positive_float
+    from pushrecovery.arguments import positive_float
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d
     from pushrecovery.sim.registry import make_plant
 

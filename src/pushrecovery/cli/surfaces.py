@@ -109,7 +109,7 @@ def step(
     **kwargs: Any,
 ) -> None:
     """Optimal step (Eq. 21) and the range of recovering steps for initial CoM velocities."""
-    from pushrecovery._validate import finite_array
+    from pushrecovery.arguments import finite_array
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.models.stepping import step_solution
 

@@ -149,7 +149,7 @@ def validate(
 
     import numpy as np
 
-    from pushrecovery._validate import finite_array
+    from pushrecovery.arguments import finite_array
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.sim.validation import (
         available_strategies,

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, require_type
+from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams

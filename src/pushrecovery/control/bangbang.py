@@ -7,7 +7,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import positive_float
+from pushrecovery.arguments import positive_float
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import FLYWHEEL_STATE, bang_bang_switch_time, max_spin_up_time

@@ -34,7 +34,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, finite_float, require_type
+from pushrecovery.arguments import finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.lipm import ANKLE_STATE
 from pushrecovery.params import BodyParams

@@ -37,10 +37,10 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, finite_float, positive_float
+from pushrecovery.arguments import bounded_float, finite_float, positive_float
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.minkowski import Shape, _decompose, _minkowski_sum
+from pushrecovery.ground.minkowski import Shape, decompose_unchecked, minkowski_sum_unchecked
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, roll_axis
@@ -188,7 +188,7 @@ class PlaneRecoveryController(Controller):
             raise InvalidParameterError("no hip torque: the CMP region is the support")
         terms: list[tuple[float, Shape]] = [(1.0, box), (1.0, self.support.polygon)]
         origin = np.zeros(2)
-        points, _ = _decompose(xi, terms, origin, _minkowski_sum(terms, origin))
+        points, _ = decompose_unchecked(xi, terms, origin, minkowski_sum_unchecked(terms, origin))
         self._begin_hip(t, points[0])
         self.mode = "hip"
         pitch, roll = self._hip_torques(t)

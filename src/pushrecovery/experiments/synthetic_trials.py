@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from pushrecovery._validate import bounded_float, finite_float, require_type, whole_number
+from pushrecovery.arguments import bounded_float, finite_float, require_type, whole_number
 from pushrecovery.params import BodyParams
 
 __all__ = ["lipm_trial_csv"]

@@ -53,7 +53,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from pushrecovery._validate import bounded_float, require_type
+from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.experiments.validation3d_predict import (
     CriticalErrors,

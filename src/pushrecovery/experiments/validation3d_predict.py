@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from pushrecovery._validate import bounded_float, finite_float, finite_vector, require_type
+from pushrecovery.arguments import bounded_float, finite_float, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support

@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery._validate import bounded_float, require_type
+from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.experiments.validation3d import DEFAULT_AZIMUTHS
 from pushrecovery.experiments.validation3d_predict import CriticalErrors, critical_impulse_along

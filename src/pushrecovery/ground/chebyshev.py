@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import require_type
+from pushrecovery.arguments import require_type
 from pushrecovery.ground.polygon import ConvexPolygon
 
 __all__ = ["chebyshev_centre"]
@@ -31,10 +31,10 @@ def chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
         If ``polygon`` is not a :class:`~pushrecovery.ground.polygon.ConvexPolygon`.
     """
     require_type("polygon", polygon, ConvexPolygon)
-    return _chebyshev_centre(polygon)
+    return chebyshev_centre_unchecked(polygon)
 
 
-def _chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
+def chebyshev_centre_unchecked(polygon: ConvexPolygon) -> FloatArray:
     """:func:`chebyshev_centre` of a polygon."""
     from pushrecovery.ground._kernels import chebyshev_centre as solve
 

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import (
+from pushrecovery.arguments import (
     finite_array,
     finite_float,
     finite_vector,
@@ -107,10 +107,12 @@ def minkowski_sum(
         an ``offset`` that is not a finite (x, y), no term of non-zero weight, or a sum of
         zero area.
     """
-    return _minkowski_sum(_checked_terms(terms), finite_vector("offset", offset, 2, unit="m"))
+    return minkowski_sum_unchecked(
+        _checked_terms(terms), finite_vector("offset", offset, 2, unit="m")
+    )
 
 
-def _minkowski_sum(
+def minkowski_sum_unchecked(
     terms: Sequence[tuple[float, Shape]], offset: tuple[float, float] | FloatArray = (0.0, 0.0)
 ) -> ConvexPolygon:
     """:func:`minkowski_sum` of checked terms (the library's own calls)."""
@@ -142,7 +144,7 @@ def _minkowski_sum(
     return _cleaned(vertices)
 
 
-def _stacked_shapes(
+def stacked_shapes(
     terms: Sequence[tuple[float, Shape]],
 ) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
     """Return the terms as the compiled kernels take them: (shapes (K, M, 2), counts, weights)."""
@@ -157,13 +159,13 @@ def _stacked_shapes(
     return stacked, counts, weights
 
 
-def _sum_loop(
+def minkowski_sum_loop(
     terms: Sequence[tuple[float, Shape]], offset: tuple[float, float] | FloatArray = (0.0, 0.0)
 ) -> FloatArray:
     """Return the vertex loop of :func:`minkowski_sum`, compiled, without building a polygon."""
     from pushrecovery.ground._kernels import minkowski_loop
 
-    stacked, counts, weights = _stacked_shapes(terms)
+    stacked, counts, weights = stacked_shapes(terms)
     return np.asarray(
         minkowski_loop(stacked, counts, weights, np.asarray(offset, dtype=np.float64))
     )
@@ -203,10 +205,10 @@ def clip(polygon: ConvexPolygon, window: ConvexPolygon) -> ConvexPolygon | None:
     """
     require_type("polygon", polygon, ConvexPolygon)
     require_type("window", window, ConvexPolygon)
-    return _clip_halfplanes(polygon, window.normals, window.offsets)
+    return clip_halfplanes(polygon, window.normals, window.offsets)
 
 
-def _clip_halfplanes(
+def clip_halfplanes(
     polygon: ConvexPolygon, normals: FloatArray, offsets: FloatArray
 ) -> ConvexPolygon | None:
     """``polygon`` ∩ {p : n_i · p <= b_i for all i}, or None when it has no area [m].
@@ -302,10 +304,10 @@ def decompose(
     terms = _checked_terms(terms, non_negative=True)
     offset = finite_vector("offset", offset, 2, unit="m")
     require_type("total", total, ConvexPolygon)
-    return _decompose(point, terms, offset, total)
+    return decompose_unchecked(point, terms, offset, total)
 
 
-def _decompose(
+def decompose_unchecked(
     point: FloatArray,
     terms: Sequence[tuple[float, Shape]],
     offset: FloatArray,

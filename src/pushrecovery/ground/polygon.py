@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import bounded_float, finite_array
+from pushrecovery.arguments import bounded_float, finite_array
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = ["ConvexPolygon", "convex_hull", "rectangle"]

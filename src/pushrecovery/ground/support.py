@@ -22,7 +22,7 @@ from enum import StrEnum
 
 import numpy as np
 
-from pushrecovery._validate import finite_float, require_type
+from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull, rectangle
 from pushrecovery.ground.user_polygon import convex_polygon

@@ -25,7 +25,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_float, require_type
+from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.models.flywheel import _propagated, flywheel_discrete
 from pushrecovery.params import BodyParams
 

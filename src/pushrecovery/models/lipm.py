@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, finite_float
+from pushrecovery.arguments import finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN
 

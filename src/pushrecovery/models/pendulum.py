@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 
-from pushrecovery._validate import bounded_float, finite_float
+from pushrecovery.arguments import bounded_float, finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import LIMITS
 
@@ -113,10 +113,10 @@ def ankle_torque_for_cop(
             ("foot_centre", foot_centre),
         )
     }
-    return _ankle_torque_for_cop(theta, theta_rate, cop, mass, length, gravity, **extras)
+    return ankle_torque_for_cop_unchecked(theta, theta_rate, cop, mass, length, gravity, **extras)
 
 
-def _ankle_torque_for_cop(
+def ankle_torque_for_cop_unchecked(
     theta: float,
     theta_rate: float,
     cop: float,
@@ -178,7 +178,7 @@ def _pendulum_acceleration(
     theta: float, theta_rate: float, cop: float, mass: float, length: float, gravity: float
 ) -> float:
     """:func:`pendulum_acceleration` unchecked: the kernel of :func:`pendulum_step`'s RK4."""
-    torque = _ankle_torque_for_cop(theta, theta_rate, cop, mass, length, gravity)
+    torque = ankle_torque_for_cop_unchecked(theta, theta_rate, cop, mass, length, gravity)
     return gravity * math.sin(theta) / length - torque / (mass * length * length)
 
 
@@ -194,10 +194,10 @@ def lean_from_com(x: float, xdot: float, length: float) -> tuple[float, float]:
     length = bounded_float("length", length, *LIMITS["com_height"])
     if not abs(x) < length:
         raise InvalidParameterError(f"x must satisfy |x| < length = {length:g} m, got {x:g}")
-    return _lean_from_com(x, xdot, length)
+    return lean_from_com_unchecked(x, xdot, length)
 
 
-def _lean_from_com(x: float, xdot: float, length: float) -> tuple[float, float]:
+def lean_from_com_unchecked(x: float, xdot: float, length: float) -> tuple[float, float]:
     """:func:`lean_from_com` unchecked (a plant's every step)."""
     theta = math.asin(x / length)
     return theta, xdot / (length * math.cos(theta))
@@ -214,10 +214,10 @@ def com_from_lean(theta: float, theta_rate: float, length: float) -> tuple[float
     theta = finite_float("theta", theta, "rad")
     theta_rate = finite_float("theta_rate", theta_rate, "rad/s")
     length = bounded_float("length", length, *LIMITS["com_height"])
-    return _com_from_lean(theta, theta_rate, length)
+    return com_from_lean_unchecked(theta, theta_rate, length)
 
 
-def _com_from_lean(theta: float, theta_rate: float, length: float) -> tuple[float, float]:
+def com_from_lean_unchecked(theta: float, theta_rate: float, length: float) -> tuple[float, float]:
     """:func:`com_from_lean` unchecked (a plant's every step)."""
     return length * math.sin(theta), length * math.cos(theta) * theta_rate
 
@@ -266,10 +266,10 @@ def pendulum_step(
         raise InvalidParameterError(
             f"substeps must be a whole number in [1, 1000], got {substeps!r}"
         )
-    return _pendulum_step(theta, theta_rate, cop, dt, mass, length, gravity, substeps)
+    return pendulum_step_unchecked(theta, theta_rate, cop, dt, mass, length, gravity, substeps)
 
 
-def _pendulum_step(
+def pendulum_step_unchecked(
     theta: float,
     theta_rate: float,
     cop: float,

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import bounded_float, finite_array, finite_float
+from pushrecovery.arguments import bounded_float, finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models._step_scalar import MAX_STEP_ANGLE as MAX_STEP_ANGLE
 from pushrecovery.models._step_scalar import step_angle

@@ -209,7 +209,7 @@ def _swing_acceleration(theta: float, length: float, gravity: float) -> float:
 
 @numba.njit(cache=True)
 def _rk4(theta: float, rate: float, h: float, length: float, gravity: float) -> tuple[float, float]:
-    """models.pendulum._pendulum_step, one substep."""
+    """models.pendulum.pendulum_step_unchecked, one substep."""
     k1a = _swing_acceleration(theta, length, gravity)
     k2q = rate + 0.5 * h * k1a
     k2a = _swing_acceleration(theta + 0.5 * h * rate, length, gravity)

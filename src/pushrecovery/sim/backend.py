@@ -37,7 +37,7 @@ from typing import ClassVar, NamedTuple, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, float_array, require_type
+from pushrecovery.arguments import finite_float, float_array, require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, require_type, sample_array
+from pushrecovery.arguments import bounded_float, require_type, sample_array
 from pushrecovery.control.ankle import default_pd_gains
 from pushrecovery.control.recovery import RecoveryController, plan_step_now
 from pushrecovery.errors import InvalidParameterError

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, positive_float, require_type
+from pushrecovery.arguments import finite_float, positive_float, require_type
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams

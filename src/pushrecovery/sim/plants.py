@@ -19,7 +19,11 @@ from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import FLYWHEEL_STATE, flywheel_discrete
 from pushrecovery.models.lipm import ANKLE_STATE
-from pushrecovery.models.pendulum import _com_from_lean, _lean_from_com, _pendulum_step
+from pushrecovery.models.pendulum import (
+    com_from_lean_unchecked,
+    lean_from_com_unchecked,
+    pendulum_step_unchecked,
+)
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import Backend, PlantBase, check_com_state, over_foot_at_rest
 from pushrecovery.sim.result import is_falling
@@ -106,15 +110,15 @@ class PendulumPlant(_AnklePlant):
         """Advance by dt with RK4 (substeps <= ``max_substep``)."""
         cop = self.applied_cop(command)
         p, state = self.params, self.state
-        theta, rate = _lean_from_com(float(state[0]), float(state[1]), p.com_height)
+        theta, rate = lean_from_com_unchecked(float(state[0]), float(state[1]), p.com_height)
         substeps = max(1, math.ceil(dt / self.max_substep - 1e-9))
-        theta, rate = _pendulum_step(
+        theta, rate = pendulum_step_unchecked(
             theta, rate, cop, dt, p.mass, p.com_height, p.gravity, substeps=substeps
         )
         if abs(theta) >= 0.5 * math.pi:
             # Lying on the floor: x = ±L, at rest. (x, ẋ) cannot describe θ past horizontal.
             theta, rate = math.copysign(0.5 * math.pi, theta), 0.0
-        return np.array(_com_from_lean(theta, rate, p.com_height)), (cop, 0.0)
+        return np.array(com_from_lean_unchecked(theta, rate, p.com_height)), (cop, 0.0)
 
 
 class FlywheelPlant(PlantBase):

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pushrecovery._validate import bounded_float, finite_float, positive_float
+from pushrecovery.arguments import bounded_float, finite_float, positive_float
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [

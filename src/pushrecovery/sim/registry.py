@@ -67,7 +67,9 @@ def available_models(backend: str) -> tuple[str, ...]:
     InvalidParameterError
         If it names no backend.
     """
-    if not isinstance(backend, str):  # checked here: _validate would load numpy (--help)
+    if not isinstance(
+        backend, str
+    ):  # checked here: pushrecovery.arguments would load numpy (--help)
         raise ParameterTypeError(f"backend must be a str, got {type(backend).__name__}")
     if backend not in PLANTS:
         raise InvalidParameterError(f"backend must be one of {list(PLANTS)}, got {backend!r}")
@@ -80,7 +82,7 @@ def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plan
     The MuJoCo backend also builds the 3-D models of :data:`PLANTS_3D` (the G1's ``params``
     must be ``robot_params("g1")``).
     """
-    from pushrecovery._validate import require_type
+    from pushrecovery.arguments import require_type
     from pushrecovery.params import BodyParams as Body  # a runtime check, not an annotation
 
     require_type("name", name, str)

@@ -9,7 +9,7 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float
+from pushrecovery.arguments import finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.surfaces.classify import Strategy
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pushrecovery._validate import finite_array, positive_float
+from pushrecovery.arguments import finite_array, positive_float
 from pushrecovery.control.base import Command, Controller, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged, SimulationTimeout
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS

@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.models.pendulum import _pendulum_step
+from pushrecovery.models.pendulum import pendulum_step_unchecked
 from pushrecovery.models.stepping import STEPPING_STATE
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import PlantBase, check_com_state, over_foot_at_rest
@@ -131,7 +131,7 @@ class SteppingPlant(PlantBase):
         left = dt
         while left > 1e-15:
             h = min(self.substep, left)
-            new_lean, new_rate = _pendulum_step(lean, rate, 0.0, h, 1.0, length, g)
+            new_lean, new_rate = pendulum_step_unchecked(lean, rate, 0.0, h, 1.0, length, g)
             if sign * new_lean >= landing:
                 # Land exactly at the landing lean; its rate follows from energy.
                 impact = sign * landing

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import positive_float, require_type
+from pushrecovery.arguments import positive_float, require_type
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams

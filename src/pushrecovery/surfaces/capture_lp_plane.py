@@ -55,7 +55,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, positive_float
+from pushrecovery.arguments import finite_float, positive_float
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.models.flywheel_plane import plane_discrete

@@ -12,14 +12,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, finite_float, finite_vector, require_type
+from pushrecovery.arguments import bounded_float, finite_float, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
-    _decompose,
-    _minkowski_sum,
-    _stacked_shapes,
-    _sum_loop,
+    decompose_unchecked,
+    minkowski_sum_loop,
+    minkowski_sum_unchecked,
+    stacked_shapes,
 )
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance
@@ -231,7 +231,7 @@ def _viable_loop(
     stance = np.frombuffer(stance_key, dtype=np.float64).reshape(-1, 2)
     option = StepOption(swing, ConvexPolygon._from_ccw(stance), ORIGIN, yaw)
     terms, offset, _ = _sum_terms(params, option, touchdowns, hip)
-    loop = _sum_loop(terms, offset)
+    loop = minkowski_sum_loop(terms, offset)
     loop.flags.writeable = False
     return loop
 
@@ -266,7 +266,7 @@ def _split(
     """Decompose ``target`` in the sum of ``split`` (compiled: a plan does it at every step)."""
     from pushrecovery.ground._kernels import decompose_loop, minkowski_loop
 
-    stacked, counts, weights = _stacked_shapes(split)
+    stacked, counts, weights = stacked_shapes(split)
     origin = np.zeros(2)
     total = minkowski_loop(stacked, counts, weights, origin)
     points, _ = decompose_loop(target, stacked, counts, weights, origin, total)
@@ -284,8 +284,8 @@ def _decomposed(
 ) -> CapturePlan:
     """Return the plan of (S1)'s decomposition (every term equally deep), for ξ0 outside C_N."""
     terms, offset, sides = _sum_terms(params, option, times, hip)
-    total = _minkowski_sum(terms, offset)
-    points, _ = _decompose(xi, terms, offset, total)
+    total = minkowski_sum_unchecked(terms, offset)
+    points, _ = decompose_unchecked(xi, terms, offset, total)
     reach = np.cumsum(np.array(points[2 + steps :]), axis=0) + option.ankle
     feet = np.array(points[2 : 2 + steps]) + reach
     cops = np.vstack([points[1], feet])

@@ -26,15 +26,15 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, finite_float, finite_vector, require_type
+from pushrecovery.arguments import bounded_float, finite_float, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.chebyshev import _chebyshev_centre, chebyshev_centre
+from pushrecovery.ground.chebyshev import chebyshev_centre, chebyshev_centre_unchecked
 from pushrecovery.ground.minkowski import (
     Shape,
-    _clip_halfplanes,
-    _minkowski_sum,
-    _stacked_shapes,
     clip,
+    clip_halfplanes,
+    minkowski_sum_unchecked,
+    stacked_shapes,
 )
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
@@ -169,7 +169,7 @@ def capture_region(
         polygon, foothold = _foothold_and_centre(xi, params, option, t, steps, hip)
         return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
     polygon = _foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
-    foothold = None if polygon is None else _chebyshev_centre(polygon)
+    foothold = None if polygon is None else chebyshev_centre_unchecked(polygon)
     return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
 
 
@@ -228,8 +228,8 @@ def step_terms(
         (scale - 1.0, stance),
         (1.0, landing),
     ]
-    foot_shapes, foot_counts, foot_weights = _stacked_shapes(foot)
-    split_shapes, split_counts, split_weights = _stacked_shapes(split)
+    foot_shapes, foot_counts, foot_weights = stacked_shapes(foot)
+    split_shapes, split_counts, split_weights = stacked_shapes(split)
     window = reach_polygon(params, swing, yaw)
     return StepTerms(
         scale,
@@ -277,7 +277,7 @@ def _foothold_and_centre(
     )
     if not ok:  # pragma: no cover - the compiled simplex found no start: the numpy path
         region = _foothold_region(xi, params, option, t, steps, hip=hip)
-        return region, None if region is None else _chebyshev_centre(region)
+        return region, None if region is None else chebyshev_centre_unchecked(region)
     if len(vertices) < 3:
         return None, None
     region = ConvexPolygon._from_ccw(vertices + ankle) if polygon else None
@@ -339,7 +339,7 @@ def _foothold_region(
     boxes: list[tuple[float, Shape]] = [] if box is None else [(1.0, box)]
     window = _window(params, option.swing, option.yaw, *(float(v) for v in option.ankle))
     scale = math.exp(params.omega * touchdown)
-    at = _minkowski_sum(
+    at = minkowski_sum_unchecked(
         [(-scale * w, b) for w, b in boxes] + [(1.0 - scale, option.stance), (-1.0, landing)],
         scale * xi,
     )
@@ -378,7 +378,7 @@ def _after(
     window: ConvexPolygon,
 ) -> ConvexPolygon | None:
     """(Q_{T0} ⊕ cone(A)) ∩ window, A = ξ0 ⊕ (−H) ⊕ (−S) (module docstring)."""
-    growth = _minkowski_sum([(-w, b) for w, b in boxes] + [(-1.0, stance)], xi)
+    growth = minkowski_sum_unchecked([(-w, b) for w, b in boxes] + [(-1.0, stance)], xi)
     if float(growth.signed_distance(0.0, 0.0)) > 0.0:
         return window  # already captured without a step: any later foothold
     # The cone's edges: the extreme directions of A's vertices seen from the origin.
@@ -395,4 +395,4 @@ def _after(
     sides = np.where((np.sum(sides * rays[::-1], axis=1) > 0.0)[:, None], -sides, sides)
     normals = np.vstack([at.normals[keep], sides])
     offsets = np.concatenate([at.offsets[keep], (at.vertices @ sides.T).max(axis=0)])
-    return _clip_halfplanes(window, normals, offsets)
+    return clip_halfplanes(window, normals, offsets)

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery._validate import finite_float, require_type
+from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams

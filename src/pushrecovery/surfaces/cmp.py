@@ -25,7 +25,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import bounded_float, require_type
+from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.params import LIMITS, OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.cop import CaptureInterval, capture_margin

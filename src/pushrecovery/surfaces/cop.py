@@ -22,7 +22,7 @@ from typing import overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, float_array, positive_float, require_type
+from pushrecovery.arguments import finite_array, float_array, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pushrecovery._validate import require_type
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support

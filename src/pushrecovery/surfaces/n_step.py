@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import (
+from pushrecovery.arguments import (
     bounded_float,
     finite_float,
     float_array,
@@ -49,8 +49,8 @@ from pushrecovery._validate import (
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     Shape,
-    _clip_halfplanes,
-    _minkowski_sum,
+    clip_halfplanes,
+    minkowski_sum_unchecked,
     regular_polygon,
 )
 from pushrecovery.ground.polygon import ConvexPolygon, following
@@ -204,7 +204,7 @@ def reach_polygon(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon
         return disc
     outward = 1.0 if side is Stance.LEFT else -1.0
     normal = -outward * np.array([[-math.sin(yaw), math.cos(yaw)]])  # −(lateral, outward)
-    cut = _clip_halfplanes(disc, normal, np.array([-params.min_step_width]))
+    cut = clip_halfplanes(disc, normal, np.array([-params.min_step_width]))
     if cut is None:  # pragma: no cover - min_step_width < max_step_length is validated
         raise InvalidParameterError("min_step_width leaves no foothold within the reach")
     return cut
@@ -346,7 +346,7 @@ def viable_region(
     touchdowns = tuple(float(t) for t in times)
     _check_touchdowns(params, touchdowns)
     terms, offset, _ = _sum_terms(params, option, touchdowns, bool(hip))
-    return _minkowski_sum(terms, offset)
+    return minkowski_sum_unchecked(terms, offset)
 
 
 def _ray_distances(

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import (
+from pushrecovery.arguments import (
     bounded_float,
     finite_array,
     finite_float,

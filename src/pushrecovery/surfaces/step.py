@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, finite_float, require_type
+from pushrecovery.arguments import finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models._step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
 from pushrecovery.models._step_scalar import decide, feasible

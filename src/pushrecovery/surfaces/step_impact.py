@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import finite_float, finite_vector, require_type
+from pushrecovery.arguments import finite_float, finite_vector, require_type
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED

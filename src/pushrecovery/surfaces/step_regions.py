@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import finite_array, require_type
+from pushrecovery.arguments import finite_array, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support

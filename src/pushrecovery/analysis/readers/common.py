@@ -9,8 +9,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import require_type
 from pushrecovery.analysis.recording import Recording
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InputFileError, InvalidParameterError
 
 if TYPE_CHECKING:

@@ -36,7 +36,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import positive_float
+from pushrecovery.arguments import positive_float
 from pushrecovery.control.mpc._ipm_kernels import (
     COLD,
     CONVERGED,

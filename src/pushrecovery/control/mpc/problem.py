@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pushrecovery._validate import finite_float, positive_float
+from pushrecovery.arguments import finite_float, positive_float
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = ["MPCSettings"]

@@ -45,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import require_type
+from pushrecovery.arguments import require_type
 from pushrecovery.control.mpc._riccati_kernels import _scratch, solve_from
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete

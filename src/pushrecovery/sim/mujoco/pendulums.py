@@ -16,7 +16,7 @@ from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import FLYWHEEL_STATE
 from pushrecovery.models.lipm import ANKLE_STATE
-from pushrecovery.models.pendulum import _ankle_torque_for_cop
+from pushrecovery.models.pendulum import ankle_torque_for_cop_unchecked
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, FOOT_MASS
 from pushrecovery.sim.mujoco.plant import (
@@ -98,7 +98,7 @@ class MujocoFootPlant(MujocoPlant):
         """Ankle torque (paper's sign) that puts the CoP at ``cop`` now [N m] (errata E3)."""
         p = self.params
         lean, rate = self.lean()
-        return _ankle_torque_for_cop(  # by position: called at every torque refresh
+        return ankle_torque_for_cop_unchecked(  # by position: called at every torque refresh
             lean,
             rate,
             cop,
@@ -177,7 +177,7 @@ class MujocoTorsoPlant(MujocoFootPlant):
         q, v = self._q, self._v
         mass, length, gravity = self._body
         ctrl = self._ctrl
-        ctrl[0] = -_ankle_torque_for_cop(
+        ctrl[0] = -ankle_torque_for_cop_unchecked(
             q[self._pitch] + q[self._ankle],
             v[self._pitch_v] + v[self._ankle_v],
             cop,

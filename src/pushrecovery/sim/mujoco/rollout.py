@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, require_type, sample_array
+from pushrecovery.arguments import bounded_float, require_type, sample_array
 from pushrecovery.control.ankle import default_pd_gains
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -203,8 +203,8 @@ class _Lockstep:
 
         As ``AnklePD.compute`` (θ = asin(x/L), τ = k_p θ + k_d θ̇, δ = τ/(m g) clipped to
         [heel, toe]) then the plant: δ clipped to the margins and turned into the ankle torque
-        that puts the CoP there (``models.pendulum._ankle_torque_for_cop``, ankle height and
-        foot mass included, no push, no hip), sent as −τ (MuJoCo's hinge sign).
+        that puts the CoP there (``models.pendulum.ankle_torque_for_cop_unchecked``, ankle
+        height and foot mass included, no push, no hip), sent as −τ (MuJoCo's hinge sign).
         """
         p = self.plant.params
         length, mass, gravity = p.com_height, p.mass, p.gravity

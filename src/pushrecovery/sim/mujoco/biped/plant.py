@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.models.pendulum import _ankle_torque_for_cop
+from pushrecovery.models.pendulum import ankle_torque_for_cop_unchecked
 from pushrecovery.models.stepping import STEPPING_STATE
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import check_com_state
@@ -344,7 +344,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         elif not self.gait.lipm:
             cx, cz, cvx, cvz = self._com(q, v, stance[0])
             reach = math.hypot(cx, cz)
-            torque = _ankle_torque_for_cop(
+            torque = ankle_torque_for_cop_unchecked(
                 math.atan2(cx, cz),
                 (cvx * cz - cvz * cx) / (reach * reach),
                 cop,

@@ -39,7 +39,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, finite_float, require_type
+from pushrecovery.arguments import bounded_float, finite_float, require_type
 from pushrecovery.control.base import StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, positive_float, require_type
+from pushrecovery.arguments import bounded_float, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import convex_hull
 from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points, subtree

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery._validate import bounded_float, require_type
+from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
     FALL_HEIGHT,

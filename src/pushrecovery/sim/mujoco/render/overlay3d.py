@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import bounded_float
+from pushrecovery.arguments import bounded_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.mujoco.render.scene import CAPTURE_POINT_RGBA, COM_RGBA, COP_RGBA
 

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery._validate import bounded_float
+from pushrecovery.arguments import bounded_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.mujoco.render.frames import _checked_times, select_indices
 from pushrecovery.sim.mujoco.render.overlay3d import Frame3D, Marker, overlay_markers
