@@ -352,24 +352,22 @@ def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]
     and with one worker per core, more threads per worker only compete for the cores (we saw
     a push whose 102 step queries take 0.04 s take 0.8 s on a busy machine).
     """
-    import numba
+    from pushrecovery.kernels.threads import one_thread
 
-    threads = numba.get_num_threads()
-    numba.set_num_threads(1)
-    try:
-        pushes = spec.pushes(batch)
-        if spec.backend == "analytic" and (spec.model, spec.controller) in BATCHED:
-            return batch, _batched_rows(spec, pushes)
-        if spec.backend == "mujoco" and (spec.model, spec.controller) in ROLLOUT:
-            # The whole batch at once: the pushes' time limits add up.
-            watchdog.arm(spec.push_timeout * len(pushes))
-            return batch, _rollout_rows(spec, pushes)
-        cache: dict[BodyParams, Any] = {}
-        rows = []
-        for push in pushes:
-            watchdog.arm(spec.push_timeout)
-            rows.append(run_push(spec, push, cache))
-        return batch, rows
-    finally:
-        watchdog.disarm()
-        numba.set_num_threads(threads)
+    with one_thread():
+        try:
+            pushes = spec.pushes(batch)
+            if spec.backend == "analytic" and (spec.model, spec.controller) in BATCHED:
+                return batch, _batched_rows(spec, pushes)
+            if spec.backend == "mujoco" and (spec.model, spec.controller) in ROLLOUT:
+                # The whole batch at once: the pushes' time limits add up.
+                watchdog.arm(spec.push_timeout * len(pushes))
+                return batch, _rollout_rows(spec, pushes)
+            cache: dict[BodyParams, Any] = {}
+            rows = []
+            for push in pushes:
+                watchdog.arm(spec.push_timeout)
+                rows.append(run_push(spec, push, cache))
+            return batch, rows
+        finally:
+            watchdog.disarm()

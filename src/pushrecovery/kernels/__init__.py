@@ -1,0 +1,30 @@
+"""Compiled kernels: plain array functions, and the only package that imports numba.
+
+Every kernel is a module-level ``@numba.njit(cache=True)`` function: numba keys its on-disk
+cache by the function's file, so a new process loads machine code instead of compiling (nothing
+compiles on a call path after the first run on a machine). A module here imports nothing of
+the project, only numpy, numba and math; the floors above call these kernels with checked
+arguments (the checks and the units live with the models that own the equations).
+
+Importing this package imports no numba: each module is loaded where it is first needed,
+because importing numba alone costs about 0.4 s.
+
+Modules
+-------
+polygons
+    convex polygon clipping, Minkowski sums, Chebyshev centres, foothold regions.
+plane_codes
+    fused planar margins and strategy codes over many states.
+capture_point
+    the fused capture-point margin of Eq. (4) over many states.
+step_scalar, stepping
+    the step model's scalar functions (plain Python) and their numba builds.
+batched_ankle, batched_stepping
+    many pushes of the analytic models in one compiled loop.
+mpc_riccati, mpc_interior, mpc_scales
+    the MPC's Riccati active-set passes and interior point.
+hull
+    the convex hull of every frame's points.
+threads
+    numba's thread count, held at one while a worker runs pushes.
+"""
