@@ -36,7 +36,8 @@ from pushrecovery.campaign.isolation import (
     quarantine,
     quiet_worker_start,
 )
-from pushrecovery.campaign.pushes import COLUMNS, run_batch
+from pushrecovery.campaign.pushes import run_batch
+from pushrecovery.campaign.rows import row_schema
 from pushrecovery.campaign.spec import CampaignError, CampaignSpec
 from pushrecovery.errors import InvalidParameterError
 
@@ -76,20 +77,8 @@ class CampaignResult:
 
 
 def schema(spec: CampaignSpec) -> Any:
-    """Arrow schema of the pushes of ``spec``."""
-    import pyarrow as pa
-
-    types = {
-        "float64": pa.float64(),
-        "int64": pa.int64(),
-        "string": pa.string(),
-        "bool": pa.bool_(),
-    }
-    return pa.schema(
-        [("index", pa.int64())]
-        + [(f"param_{name}", pa.float64()) for name in spec.sweeps]
-        + [(name, types[kind]) for name, kind in COLUMNS]
-    )
+    """Arrow schema of the pushes of ``spec``: its family's (:func:`~.rows.row_schema`)."""
+    return row_schema("3d" if spec.is_3d else "planar", tuple(spec.sweeps))
 
 
 def read_spec(directory: Path) -> CampaignSpec:

@@ -1,37 +1,14 @@
 """Simulate the pushes of one batch and record each as one row (runs on the workers).
 
 Every row records the push's inputs, what the paper's surfaces predict for the state just after
-it, and what the simulation did. Columns, SI units, positions relative to the stance ankle:
+it, and what the simulation did: a ``dict`` from column name to value, the columns of
+:mod:`.rows` (whose :func:`~.rows.row_schema` gives each one's unit and description; positions
+relative to the stance ankle). A push without an outcome (its physics diverged, it was too
+slow, its worker died) is an error row (:func:`error_row`): ``outcome`` = ``used`` = error, the
+simulated columns NaN (counts 0), ``error`` saying why.
 
-=====================  ======================================================================
-``index``              push number in the campaign
-``param_<name>``       each swept body parameter
-``x0``                 CoM position before the push [m]
-``xdot``               CoM velocity the push gives, J/m [m/s]
-``impulse``            the push, J [N s]
-``predicted``          strategy the surfaces give for (x0, ẋ): ankle, hip, step or fall
-``capture_point``      x0 + ẋ/ω [m]
-``cop_margin``         signed distance of the capture point inside the CoP region, Eq. (4) [m]
-``cmp_margin``         the same for the CMP region, corrected Eq. (15) [m]
-``step_margin``        signed distance of the capture point to the N-step regions [m]; > 0:
-                       at most ``max_steps`` steps capture the state
-``predicted_steps``    steps the surfaces predict: 0 for ankle and hip, N for step, −1 fall
-``predicted_recovers`` the predicted strategy is within the controller's (ankle < hip < step)
-``outcome``            recovered, fell or undecided
-``used``               strategy the run used: ankle (CoP only), hip (hip torque), step, or fall
-``steps``              steps taken
-``peak_hip_torque``    largest |hip torque| applied [N m]
-``peak_ankle_torque``  m g max|δ|: the ankle torque of the largest CoP offset (LIPM, Eq. 1) [N m]
-``cop_min, cop_max``   CoP excursion commanded over the run [m]
-``time``               simulated time to the outcome [s]
-``stop_impacts``       times the upper body hit its joint stop
-``error``              why the push has no outcome (``outcome`` = ``error``): the physics
-                       diverged, the push took more than ``push_timeout`` of wall time, or
-                       its worker process died or stopped answering; null otherwise
-=====================  ======================================================================
-
-The 3-D models (``biped3d``, ``g1``) add columns, null on the others, and read some of the
-above in 3-D (:mod:`.pushes3d`, whose docstring lists them).
+The 3-D models (``biped3d``, ``g1``) add columns, null on the others, and read some of them in
+3-D (:mod:`.pushes3d`).
 """
 
 from __future__ import annotations
@@ -41,6 +18,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from pushrecovery.campaign import watchdog
+from pushrecovery.campaign.pushes3d import error_row3d, run_push3d
+from pushrecovery.campaign.rows import COLUMNS, COLUMNS_3D, ERROR_OUTCOME
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import SimulationDiverged, SimulationTimeout
@@ -56,49 +35,10 @@ from pushrecovery.surfaces.classify import (
     sagittal_verdicts,
 )
 
-__all__ = ["COLUMNS", "ROLLOUT", "error_row", "run_batch", "run_push"]
+__all__ = ["COLUMNS", "ERROR_OUTCOME", "ROLLOUT", "error_row", "run_batch", "run_push"]
 
 #: (model, controller) pairs of the MuJoCo backend simulated in lockstep with mujoco.rollout.
 ROLLOUT = frozenset({("foot", "ankle-pd")})
-
-
-#: Fixed columns after the ``param_<name>`` ones, with their Arrow type names.
-COLUMNS: tuple[tuple[str, str], ...] = (
-    ("x0", "float64"),
-    ("xdot", "float64"),
-    ("impulse", "float64"),
-    ("predicted", "string"),
-    ("capture_point", "float64"),
-    ("cop_margin", "float64"),
-    ("cmp_margin", "float64"),
-    ("step_margin", "float64"),
-    ("predicted_steps", "int64"),
-    ("predicted_recovers", "bool"),
-    ("outcome", "string"),
-    ("used", "string"),
-    ("steps", "int64"),
-    ("peak_hip_torque", "float64"),
-    ("peak_ankle_torque", "float64"),
-    ("cop_min", "float64"),
-    ("cop_max", "float64"),
-    ("time", "float64"),
-    ("stop_impacts", "int64"),
-    ("error", "string"),
-    # The 3-D models' (pushes3d); null on the others.
-    ("azimuth", "float64"),
-    ("fraction", "float64"),
-    ("ankle_critical", "float64"),
-    ("y0", "float64"),
-    ("capture_point_y", "float64"),
-    ("predicted_corrected", "string"),
-    ("lift_offs", "int64"),
-    ("peak_hip_motor_torque", "float64"),
-    ("max_torso_tilt", "float64"),
-    ("peak_torque_ratio", "float64"),
-    ("failed_ticks", "int64"),
-)
-#: The columns of the 3-D models only: null (None) in the other models' rows.
-COLUMNS_3D = tuple(name for name, _ in COLUMNS[[n for n, _ in COLUMNS].index("azimuth") :])
 
 
 def run_push(
@@ -111,8 +51,6 @@ def run_push(
     """
     cache = {} if cache is None else cache
     if spec.is_3d:
-        from pushrecovery.campaign.pushes3d import run_push3d
-
         return run_push3d(spec, push, cache)
     if push.params not in cache:
         cache[push.params] = (
@@ -323,22 +261,12 @@ def _rows_of_runs(
     return rows
 
 
-#: The outcome columns of a push that raised (the 3-D rows add their own).
-ERROR_OUTCOME: dict[str, Any] = {
-    "outcome": "error", "used": "error", "steps": 0, "peak_hip_torque": math.nan,
-    "peak_ankle_torque": math.nan, "cop_min": math.nan, "cop_max": math.nan, "time": math.nan,
-    "stop_impacts": 0,
-}  # fmt: skip
-
-
 def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
     """Return the row of a push without an outcome: the prediction, ``outcome`` = error.
 
     The simulated columns are NaN (counts 0), ``used`` is ``error`` and ``error`` says why.
     """
     if spec.is_3d:
-        from pushrecovery.campaign.pushes3d import error_row3d
-
         return error_row3d(spec, push, reason)
     row = _inputs_and_prediction(spec, push, _predictions([push])[0])
     row.update(ERROR_OUTCOME, error=reason)

@@ -34,6 +34,9 @@ controller runs with the tasks of the campaign's controller (``wbc-ankle``: ankl
 ``peak_torque_ratio``      largest |motor command| / its limit over the run [-] (1: saturated)
 ``failed_ticks``           ticks DAQP did not solve (the last command held)
 =========================  ==================================================================
+
+The written file carries these readings as its fields' metadata (:func:`.rows.row_schema`,
+family ``"3d"``).
 """
 
 from __future__ import annotations
@@ -43,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.campaign.rows import ERROR_OUTCOME, ERROR_OUTCOME_3D
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.campaign.spec3d import critical_impulse, predict_push, push_geometry
 from pushrecovery.errors import SimulationDiverged
@@ -156,16 +160,7 @@ def _torque_ratio(ctrl: Any, ranges: Any) -> float:
 
 def error_row3d(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
     """Return the row of a 3-D push without an outcome: the prediction, ``outcome`` = error."""
-    from pushrecovery.campaign.pushes import ERROR_OUTCOME
-
     row = predict3d(spec, push)
-    row.update(
-        ERROR_OUTCOME,
-        error=reason,
-        lift_offs=0,
-        peak_hip_motor_torque=math.nan,
-        max_torso_tilt=math.nan,
-        peak_torque_ratio=math.nan,
-        failed_ticks=0,
-    )
+    row.update(ERROR_OUTCOME, error=reason)
+    row.update(ERROR_OUTCOME_3D)
     return row
