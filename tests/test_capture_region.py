@@ -380,7 +380,7 @@ def test_minkowski_sums_with_a_point_term_keep_every_vertex():
 def test_the_compiled_chebyshev_centre_equals_highs():
     # The dual simplex behind the recommended foothold against scipy's HiGHS on random hulls.
     from pushrecovery.ground import convex_hull
-    from pushrecovery.ground._kernels import chebyshev_centre
+    from pushrecovery.kernels.polygons import chebyshev_centre
 
     rng = np.random.default_rng(7)
     solved = 0
@@ -402,10 +402,10 @@ def test_the_compiled_chebyshev_centre_equals_highs():
 
 
 def test_the_compiled_decomposition_and_sum_equal_numpys():
-    # The plan's compiled twins (ground._kernels) against ground.minkowski on random sums.
+    # The plan's compiled twins (kernels.polygons) against ground.minkowski on random sums.
     from pushrecovery.ground import convex_hull
-    from pushrecovery.ground._kernels import decompose_loop, minkowski_loop
     from pushrecovery.ground.minkowski import decompose, stacked_shapes
+    from pushrecovery.kernels.polygons import decompose_loop, minkowski_loop
 
     rng = np.random.default_rng(5)
     for _ in range(100):

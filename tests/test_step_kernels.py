@@ -1,4 +1,4 @@
-"""The step decision: one pure-Python function (models/_step_scalar.py), run interpreted or
+"""The step decision: one pure-Python function (models/step_scalar.py), run interpreted or
 compiled by numba; the compiled loops load from numba's disk cache in a new process; the
 bounds path loads neither numba nor scipy."""
 
@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pushrecovery import InvalidParameterError, load_params
-from pushrecovery.models import _stepping_kernels as kernels
+from pushrecovery.kernels import stepping as kernels
 from pushrecovery.surfaces.step import (
     StepDecision,
     compiled_plan_step,
@@ -237,7 +237,7 @@ def test_small_arrays_stay_off_the_thread_pool():
 CACHE_SCRIPT = """
 import numpy as np
 from pushrecovery import load_params
-from pushrecovery.models._stepping_kernels import PARALLEL_MIN_SIZE
+from pushrecovery.kernels.stepping import PARALLEL_MIN_SIZE
 from pushrecovery.models.stepping import solve_step_angle
 from pushrecovery.surfaces.cop import cop_margin
 from pushrecovery.surfaces.step import compiled_plan_step, plan_steps
@@ -268,21 +268,21 @@ from pushrecovery.surfaces.n_step import step_options
 capture_plan(np.array([0.9, 0.2]), P, step_options(P, Support.from_params(P, "left"))[0], 2)
 """
 KERNELS = {
-    "_step_scalar.decide",
-    "_step_scalar.decide_serial",
-    "_step_scalar.decide_parallel",
-    "_step_scalar.solve_serial",
-    "_step_scalar.solve_parallel",
-    "cop._fused_margin_kernel.locals.kernel",
-    "_kernels.locate_steps",
-    "_kernels.mark_regions",
-    "_kernels.sagittal_codes",
-    "_kernels._codes_4",
-    "_kernels._margins_4",
-    "_kernels.foothold_kernel",
-    "_kernels.decompose_loop",
-    "_kernels.minkowski_loop",
-    "_kernels.loop_signed_distance",
+    "step_scalar.decide",
+    "step_scalar.decide_serial",
+    "step_scalar.decide_parallel",
+    "step_scalar.solve_serial",
+    "step_scalar.solve_parallel",
+    "capture_point.capture_margins",
+    "plane_codes.locate_steps",
+    "plane_codes.mark_regions",
+    "plane_codes.sagittal_codes",
+    "plane_codes._codes_4",
+    "plane_codes._margins_4",
+    "polygons.foothold_kernel",
+    "polygons.decompose_loop",
+    "polygons.minkowski_loop",
+    "polygons.loop_signed_distance",
 }
 
 
@@ -305,14 +305,14 @@ def test_kernels_load_from_the_disk_cache_in_a_new_process(tmp_path):
 
 
 def test_pure_loops_run_uncompiled():
-    # The loops of _step_scalar are plain Python too (prange is range there).
-    from pushrecovery.models import _step_scalar
+    # The loops of step_scalar are plain Python too (prange is range there).
+    from pushrecovery.kernels import step_scalar
 
     x = np.linspace(-0.4, 0.4, 7)
     heel, toe = np.full(7, P.heel), np.full(7, P.toe)
     values, flags = np.empty((6, 7)), np.empty((2, 7), dtype=bool)
     args = (P.com_height, P.gravity, P.max_step_length)
-    _step_scalar.decide_parallel(x, 5 * x, heel, toe, *args, values, flags)
+    step_scalar.decide_parallel(x, 5 * x, heel, toe, *args, values, flags)
     compiled = kernels.plan(x, 5 * x, heel, toe, *args)
     np.testing.assert_allclose(values, compiled[0], rtol=0, atol=SAME_CODE)
     np.testing.assert_array_equal(flags, compiled[1])
@@ -324,7 +324,7 @@ def test_feasibility_without_angles_equals_the_plan():
     # its three Newton solves, on states spanning every branch (backward, slow falls, beyond
     # reach, stance leg pulling). They may differ only where ξ⁺ at
     # the limiting angle is within the solver's 1e-15 of the toe: none in this sample.
-    from pushrecovery.models import _step_scalar
+    from pushrecovery.kernels import step_scalar
 
     rng = np.random.default_rng(11)
     for body in (P, load_params(overrides={"max_step_length": 0.4, "toe": 0.25})):
@@ -333,4 +333,4 @@ def test_feasibility_without_angles_equals_the_plan():
         full = plan_steps(x, xdot, body).feasible
         assert 0.05 < full.mean() < 0.8  # both answers are common
         for i in range(0, 200_000, 37):
-            assert _step_scalar.feasible(x[i], xdot[i], *args) == full[i]
+            assert step_scalar.feasible(x[i], xdot[i], *args) == full[i]

@@ -28,12 +28,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.analysis._hull_kernel import hull_kernel
 from pushrecovery.analysis.recording import MAX_FRAMES, Foot, support_from_feet
 from pushrecovery.arguments import bounded_float, require_type, sample_array, whole_number
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import MIN_EDGE, ConvexPolygon, convex_hull
 from pushrecovery.ground.support import FootPose, Support
+from pushrecovery.kernels.hull import hull_kernel
 from pushrecovery.params import BodyParams
 
 __all__ = [

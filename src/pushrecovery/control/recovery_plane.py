@@ -216,7 +216,7 @@ class PlaneRecoveryController(Controller):
 
     def _locate(self, regions: StepRegions, px: float, py: float) -> tuple[int, float]:
         """:meth:`StepRegions.locate`, compiled (as the monitor's; tens of µs saved a call)."""
-        from pushrecovery.surfaces._kernels import locate_steps
+        from pushrecovery.kernels.plane_codes import locate_steps
 
         entry = self._steps.get(id(regions))
         if entry is None or entry[0] is not regions:

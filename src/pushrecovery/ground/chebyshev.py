@@ -21,7 +21,7 @@ def chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
     """Return the centre of the largest disc in a convex polygon [m].
 
     The LP max r subject to n_i · q + r <= b_i, solved by a small compiled dual simplex
-    (``ground._kernels.chebyshev_centre``; scipy's HiGHS if it fails). When the largest disc
+    (``kernels.polygons.chebyshev_centre``; scipy's HiGHS if it fails). When the largest disc
     can slide (two parallel edges hold it) the centres form a segment and its midpoint is
     returned: unique, and mirrored with the polygon.
 
@@ -36,7 +36,7 @@ def chebyshev_centre(polygon: ConvexPolygon) -> FloatArray:
 
 def chebyshev_centre_unchecked(polygon: ConvexPolygon) -> FloatArray:
     """:func:`chebyshev_centre` of a polygon."""
-    from pushrecovery.ground._kernels import chebyshev_centre as solve
+    from pushrecovery.kernels.polygons import chebyshev_centre as solve
 
     normals, offsets = polygon.normals, polygon.offsets
     qx, qy, radius, ok = solve(normals, offsets)

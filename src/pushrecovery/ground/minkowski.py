@@ -163,7 +163,7 @@ def minkowski_sum_loop(
     terms: Sequence[tuple[float, Shape]], offset: tuple[float, float] | FloatArray = (0.0, 0.0)
 ) -> FloatArray:
     """Return the vertex loop of :func:`minkowski_sum`, compiled, without building a polygon."""
-    from pushrecovery.ground._kernels import minkowski_loop
+    from pushrecovery.kernels.polygons import minkowski_loop
 
     stacked, counts, weights = stacked_shapes(terms)
     return np.asarray(
@@ -221,7 +221,7 @@ def clip_halfplanes(
     cutting = np.any(vertices @ normals.T > offsets, axis=0)
     if not cutting.any():
         return polygon
-    from pushrecovery.ground._kernels import clip_loop  # compiled: hundreds of vertex visits
+    from pushrecovery.kernels.polygons import clip_loop  # compiled: hundreds of vertex visits
 
     points = clip_loop(
         np.ascontiguousarray(vertices),

@@ -28,8 +28,8 @@ which decreases monotonically from v0/ω at θ = 0 to −L/√2 at θ = π/4 (ch
 θ̇(θ)); any θ with δ⁻ < ξ⁺ < δ⁺ leaves the body recoverable by the new foot's ankle (Eq. 4).
 Every such condition is therefore a 1-D root of ξ⁺(θ) = target on (0, π/4), solved with a
 safeguarded Newton iteration written once, in pure Python
-(:func:`pushrecovery.models._step_scalar.step_angle`), and compiled by numba into cached,
-vectorised loops (:mod:`pushrecovery.models._stepping_kernels`) for arrays.
+(:func:`pushrecovery.kernels.step_scalar.step_angle`), and compiled by numba into cached,
+vectorised loops (:mod:`pushrecovery.kernels.stepping`) for arrays.
 """
 
 from __future__ import annotations
@@ -42,8 +42,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.arguments import bounded_float, finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.models._step_scalar import MAX_STEP_ANGLE as MAX_STEP_ANGLE
-from pushrecovery.models._step_scalar import step_angle
+from pushrecovery.kernels.step_scalar import MAX_STEP_ANGLE as MAX_STEP_ANGLE
+from pushrecovery.kernels.step_scalar import step_angle
 from pushrecovery.params import LIMITS
 
 __all__ = [
@@ -214,7 +214,7 @@ def solve_step_angle(
         angles = [step_angle(float(a), float(b), float(c), length, gravity) for a, b, c in rows]
         out = np.array(angles, dtype=np.float64)
     else:
-        from pushrecovery.models._stepping_kernels import solve
+        from pushrecovery.kernels.stepping import solve
 
         out = solve(energy, lean, target, length, gravity)
     return out.reshape(energy.shape)

@@ -138,7 +138,7 @@ def capture_plan(
         margin = finite_float("margin", margin, "m")
     times = tuple(first + params.min_step_time * k for k in range(steps))
     _check_touchdowns(params, times)
-    from pushrecovery.ground._kernels import decompose_loop, foothold_kernel, loop_signed_distance
+    from pushrecovery.kernels.polygons import decompose_loop, foothold_kernel, loop_signed_distance
 
     # Everything relative to the stance ankle a: the shapes then repeat from call to call and
     # from step to step, so their stacked forms and sums are kept (_PlanTerms).
@@ -264,7 +264,7 @@ def _split(
     target: FloatArray, split: list[tuple[float, Shape]]
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Decompose ``target`` in the sum of ``split`` (compiled: a plan does it at every step)."""
-    from pushrecovery.ground._kernels import decompose_loop, minkowski_loop
+    from pushrecovery.kernels.polygons import decompose_loop, minkowski_loop
 
     stacked, counts, weights = stacked_shapes(split)
     origin = np.zeros(2)

@@ -214,7 +214,7 @@ def step_terms(
     Kept (the plans and the regions ask for the same few again and again): ``stance_key`` is
     the float64 bytes of the stance's vertices minus its ankle.
     """
-    from pushrecovery.ground._kernels import minkowski_loop
+    from pushrecovery.kernels.polygons import minkowski_loop
 
     stance = np.frombuffer(stance_key, dtype=np.float64).reshape(-1, 2)
     landing = landing_viable(params, swing, yaw, steps - 1)
@@ -262,7 +262,7 @@ def _foothold_and_centre(
     compiled simplex fails); (None, None) when no foothold captures. Without ``polygon`` the
     region is not built (None) and only the foothold is returned.
     """
-    from pushrecovery.ground._kernels import foothold_kernel
+    from pushrecovery.kernels.polygons import foothold_kernel
 
     ankle = np.asarray(option.ankle, dtype=np.float64)
     key = (option.stance.vertices - ankle).tobytes()

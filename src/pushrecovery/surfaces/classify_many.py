@@ -77,7 +77,7 @@ def classify_states(
     cop, hip = cop_region(params), cmp_region(params)
     step = sagittal_step_interval(params)
     if flat.size >= _CHUNK:
-        from pushrecovery.surfaces._kernels import sagittal_codes
+        from pushrecovery.kernels.plane_codes import sagittal_codes
 
         bad = sagittal_codes(
             flat_x,
@@ -156,7 +156,7 @@ def _plane_codes_compiled(
     hip_region: ConvexPolygon,
 ) -> None:
     """Large arrays: the compiled region test, then the compiled step test, chunk by chunk."""
-    from pushrecovery.surfaces._kernels import padded_edges, plane_codes
+    from pushrecovery.kernels.plane_codes import padded_edges, plane_codes
 
     inv = 1.0 / params.omega
     cop_edges = padded_edges(support.polygon.edge_table)
@@ -185,7 +185,7 @@ def _mark_plane_steps(
     regions: StepRegions,
 ) -> None:
     """Mark ``step`` where the N-step regions hold the states coded ``fall`` (compiled)."""
-    from pushrecovery.surfaces._kernels import mark_regions
+    from pushrecovery.kernels.plane_codes import mark_regions
 
     x, y, xdot, ydot = (np.ascontiguousarray(a) for a in (xs, ys, xds, yds))
     outer = regions.outer  # their union is that of all the regions

@@ -13,9 +13,7 @@ t → ∞, hence the strict inequalities.
 
 from __future__ import annotations
 
-import functools
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import overload
 
@@ -177,7 +175,9 @@ def capture_margin(
     centre, half = region.centre, region.half_width
     if _fusable(x, xdot, out):
         margin = np.empty_like(x) if out is None else out
-        bad = _fused_margin_kernel()(
+        from pushrecovery.kernels.capture_point import capture_margins
+
+        bad = capture_margins(
             x.reshape(-1), xdot.reshape(-1), inv_omega, centre, half, margin.reshape(-1)
         )
     else:
@@ -200,24 +200,6 @@ def _fusable(
         and all(a.shape == x.shape and a.flags.c_contiguous for a in arrays)
         and (out is None or out.dtype == np.float64)
     )
-
-
-@functools.cache
-def _fused_margin_kernel() -> Callable[..., int]:
-    """Compile (once, cached on disk) the fused margin loop; returns the non-finite count."""
-    import numba
-
-    @numba.njit(parallel=True, cache=True, nogil=True)
-    def kernel(x, xdot, inv_omega, centre, half, out):  # type: ignore[no-untyped-def]
-        bad = 0
-        for i in numba.prange(x.shape[0]):
-            margin = half - abs(x[i] + xdot[i] * inv_omega - centre)
-            out[i] = margin
-            if not math.isfinite(margin):
-                bad += 1
-        return bad
-
-    return kernel
 
 
 def _raise_non_finite(x: NDArray[np.float64], xdot: NDArray[np.float64]) -> None:

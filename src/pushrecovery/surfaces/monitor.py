@@ -4,7 +4,7 @@
 :meth:`BalanceMonitor.set_support` when a foot lands or lifts). Every query then runs on Python
 floats and tuples prepared at construction (no arrays allocated, no thread pool, no
 compilation) and one call of the compiled N-step region test
-(``surfaces._kernels.locate_steps`` over the regions of
+(``kernels.plane_codes.locate_steps`` over the regions of
 :class:`~pushrecovery.surfaces.step_regions.StepRegions`), loaded from numba's on-disk cache
 in the constructor, which calls every path once: the first query of a process pays nothing
 either.
@@ -127,7 +127,7 @@ class BalanceMonitor:
     __slots__ = ("_cmp", "_cop", "_locate", "_omega", "_regions", "params", "support")
 
     def __init__(self, params: BodyParams, support: Support | None = None) -> None:
-        from pushrecovery.surfaces._kernels import locate_steps
+        from pushrecovery.kernels.plane_codes import locate_steps
 
         require_type("params", params, BodyParams)
         if support is not None:

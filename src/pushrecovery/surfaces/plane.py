@@ -49,7 +49,7 @@ from pushrecovery.arguments import (
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.ground.support import Stance, Support
-from pushrecovery.models._step_scalar import step_line
+from pushrecovery.kernels.step_scalar import step_line
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import _fusable, capture_point
@@ -181,7 +181,7 @@ def capture_margin_xy(
         and _fusable(arrays[0], arrays[2], out)
         and all(a.flags.c_contiguous for a in arrays)
     ):
-        from pushrecovery.surfaces._kernels import padded_edges, polygon_margin
+        from pushrecovery.kernels.plane_codes import padded_edges, polygon_margin
 
         margin = np.empty(shape) if out is None else out
         xs, ys, xds, yds = (a.reshape(-1) for a in arrays)
@@ -261,7 +261,7 @@ def direction_thresholds(
 
 @dataclass(frozen=True, slots=True)
 class StepFrame:
-    """What the step line of a support needs (:func:`_step_scalar.step_line`), as floats.
+    """What the step line of a support needs (:func:`step_scalar.step_line`), as floats.
 
     Attributes
     ----------
@@ -300,7 +300,7 @@ class StepFrame:
     def line(
         self, x: float, y: float, xdot: float, ydot: float, inv_omega: float
     ) -> tuple[float, float, float, float, float, float]:
-        """(e_x, e_y, s, ṡ, heel, toe) of a state: :func:`_step_scalar.step_line`."""
+        """(e_x, e_y, s, ṡ, heel, toe) of a state: :func:`step_scalar.step_line`."""
         return step_line(
             x,
             y,
@@ -328,7 +328,7 @@ def plan_step_xy(
     · e, ṡ = ṙ · e, as the sagittal model measures x from the ankle, and the landing foot
     (the swing foot: the right one from left stance, the left from right stance, the one on
     the side of the step from double support) lands with the stance's yaw, its edges along e
-    its support function (``models._step_scalar.step_line``, the one implementation of the
+    its support function (``kernels.step_scalar.step_line``, the one implementation of the
     line). The planner then steps forward or backward along e exactly as on the sagittal line
     (:func:`~pushrecovery.surfaces.step.plan_step`). With y = ẏ = 0 and feet at yaw 0 this is
     the sagittal plan.

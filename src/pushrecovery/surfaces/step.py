@@ -11,7 +11,7 @@ leg is still in compression at the landing (l θ̇² ≤ g cos θ). The recommen
 θ*, moved into that feasible interval if needed. Backward steps are the mirror image (heel and
 toe swapped).
 
-One function decides a state: :func:`pushrecovery.models._step_scalar.decide`, plain Python
+One function decides a state: :func:`pushrecovery.kernels.step_scalar.decide`, plain Python
 (``math`` only). :func:`plan_step`, :func:`step_critical_velocity` and :func:`step_thresholds`
 run it as it is, with neither numba nor scipy imported; :func:`plan_steps` runs it as it is for
 a few states and compiled by numba (cached on disk, parallel for large arrays) for more;
@@ -30,8 +30,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.arguments import finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.models._step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
-from pushrecovery.models._step_scalar import decide, feasible
+from pushrecovery.kernels.step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
+from pushrecovery.kernels.step_scalar import decide, feasible
 from pushrecovery.params import BodyParams
 
 __all__ = [
@@ -182,7 +182,7 @@ def plan_steps(
         values = np.array([columns[k] for k in (0, 3, 4, 5, 6, 7)], dtype=np.float64)
         flags = np.array(columns[1:3], dtype=np.bool_)
     else:
-        from pushrecovery.models._stepping_kernels import plan
+        from pushrecovery.kernels.stepping import plan
 
         values, flags = plan(xs, xds, backs, fronts, height, gravity, reach)
     values = values.reshape((6, *shape))
@@ -234,7 +234,7 @@ def plan_step(
 def step_feasible(x: float, xdot: float, heel: float, toe: float, params: BodyParams) -> bool:
     """Whether a single step recovers one state: ``plan_step(...).feasible``, faster.
 
-    Pure Python, without solving for the step angle (``_step_scalar.feasible``: two
+    Pure Python, without solving for the step angle (``step_scalar.feasible``: two
     evaluations of the post-impact capture point instead of three Newton solves). Arguments
     as in :func:`plan_step`, the new foot's edges ``heel`` < ``toe`` [m] given.
     """
@@ -266,7 +266,7 @@ def compiled_plan_step() -> ScalarPlanner:
         step_length, shortest, longest, margin) of :class:`StepDecision`'s fields. It does not
         validate its arguments (heel < toe, finite values) and releases the GIL.
     """
-    from pushrecovery.models._stepping_kernels import scalar_decide
+    from pushrecovery.kernels.stepping import scalar_decide
 
     return scalar_decide()
 

@@ -333,7 +333,7 @@ class StepRegions:
         From double support the foot on the capture point's side of the other ankle steps
         when its regions capture ξ (a side step, not a crossover), else the other one.
         """
-        from pushrecovery.ground._kernels import loop_signed_distance  # compiled, as the plan
+        from pushrecovery.kernels.polygons import loop_signed_distance  # compiled, as the plan
 
         rows = [i for i, n in enumerate(self.steps) if n == steps]
         margins = {i: float(loop_signed_distance(self.polygons[i].vertices, px, py)) for i in rows}

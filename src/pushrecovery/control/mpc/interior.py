@@ -37,7 +37,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import positive_float
-from pushrecovery.control.mpc._ipm_kernels import (
+from pushrecovery.control.mpc.problem import MPCSettings
+from pushrecovery.control.mpc.riccati import check_structure, sparse_stages
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.kernels.mpc_interior import (
     COLD,
     CONVERGED,
     DIVERGED,
@@ -48,10 +51,7 @@ from pushrecovery.control.mpc._ipm_kernels import (
     identify_active,
     solve_interior,
 )
-from pushrecovery.control.mpc._ipm_scales import dual_scales
-from pushrecovery.control.mpc.problem import MPCSettings
-from pushrecovery.control.mpc.riccati import check_structure, sparse_stages
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.kernels.mpc_scales import dual_scales
 from pushrecovery.params import BodyParams
 
 __all__ = [

@@ -46,8 +46,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import require_type
-from pushrecovery.control.mpc._riccati_kernels import _scratch, solve_from
 from pushrecovery.control.mpc.problem import MPCSettings
+from pushrecovery.kernels.mpc_riccati import scratch, solve_from
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 
@@ -110,7 +110,7 @@ def check_structure(a: FloatArray, b: FloatArray) -> None:
     """Raise ValueError unless A, B have the zeros the sparse solvers' kernels skip.
 
     The flywheel's exact discretisation leaves (x, ẋ) and (θ, θ̇) decoupled in A and the CoP's
-    column of B zero on θ, θ̇; the kernels (``_riccati_kernels``, ``_ipm_kernels``) leave
+    column of B zero on θ, θ̇; the kernels (``kernels.mpc_riccati``, ``kernels.mpc_interior``) leave
     those products out. A model without these zeros is a bug here, not a user's input.
     """
     com, wheel = np.ix_([0, 2], [1, 3]), np.ix_([1, 3], [0, 2])
@@ -179,7 +179,7 @@ class RiccatiSolver:
         # state's empty set), kept from solve to solve.
         self._swept = np.zeros((n + 1, 3), dtype=np.int8)
         self._scratch = (self._gains, self._offsets, self._curvature, self.multipliers,
-                         *_scratch(n), self._swept)  # fmt: skip
+                         *scratch(n), self._swept)  # fmt: skip
         self._shapes = (self.inputs.shape, self.states.shape)
         # Load the compiled kernel now (from numba's disk cache), not on a control tick.
         self.solve(np.zeros(4), max_passes=0)

@@ -30,7 +30,7 @@ zeros, and a stage's matrices stay in scalars (numba reloads arrays, which may a
 every store): term by term the same sums in the same order as plain loops, so the same results
 (a skipped term is ±0, which leaves a nonzero sum as it is; a sum the loops started from 0.0
 keeps that start, ``0.0 + …``, so that an all-zero one stays +0). A solve's scratch is allocated
-once (:func:`_scratch`), not per pass.
+once (:func:`scratch`), not per pass.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ CARRIED = 5
 RANK_TOL = 1e-10
 # Unknown multipliers carried back in λ at once (_multipliers' columns).
 _WIDTH = CARRIED + 1
-# The scratch's float rows (see _scratch): _backward's rows (c^T x_i + d^T u_i = e as
+# The scratch's float rows (see scratch): _backward's rows (c^T x_i + d^T u_i = e as
 # c0..c3, d0, d1, e; a stage's candidates, then from _PENDING the rows carried to the stage
 # before), then _multipliers' L (λ's columns), the Jacobian and right-hand side of a stage's
 # inactive inputs' equations, and from _EX one row per multiplier (3 i + j): its recorded
@@ -68,7 +68,7 @@ _COUNT, _ORDER = _WIDTH, _WIDTH + 1
 
 
 @numba.njit(cache=True, nogil=True)
-def _scratch(n):  # type: ignore[no-untyped-def]
+def scratch(n):  # type: ignore[no-untyped-def]
     """Return the passes' scratch at horizon ``n``: floats, ints, the rows' origins, the record.
 
     Three arrays rather than one per purpose, indexed as the constants above say: an
@@ -107,7 +107,7 @@ def _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, rows, ori
 
     Writes u_i = gains[i] x_i + offsets[i] and the diagonal of the stage's input Hessian
     H = diag(wu_i) + B^T S_{i+1} B (the scale of its multipliers) into ``curvature[i]``; the
-    rows in ``rows`` (the scratch's floats) and ``origins`` (:func:`_scratch`). Per stage, with
+    rows in ``rows`` (the scratch's floats) and ``origins`` (:func:`scratch`). Per stage, with
     S = P_{i+1} + diag(wx_i), s = p_{i+1} (cost-to-go x^T P x + 2 p^T x): u = T z + F x + f (the
     pivot rows fix F, f; T spans the free directions), z minimises T^T [H u + B^T S A x + B^T s]
     = 0, and P_i = A^T S A + G^T K + K^T G + K^T H K, p_i = A^T (S B k + s) + K^T (H k + B^T s)
@@ -356,7 +356,7 @@ def _multipliers(a, b, wx, wu, active, inputs, states, mult, floats, ints):  # t
     Backward, λ_{i+1} = l + L w with w the θ rows' multipliers not fixed yet; stage i's
     stationarity 2 W^u u_i + B^T λ_{i+1} + μ_i = 0 fixes the active inputs' μ_i (their equation)
     and, by the other equations, up to two of w. The values follow forward by substitution.
-    ``floats``, ``ints``: scratch (:func:`_scratch`). l is kept in scalars; A's and B's zeros
+    ``floats``, ``ints``: scratch (:func:`scratch`). l is kept in scalars; A's and B's zeros
     are skipped (see the module).
     """
     n = wx.shape[0]
@@ -481,7 +481,7 @@ def _pass_in(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains, offsets, curvature,
     mult, forced, work, swept,
 ):  # fmt: skip
-    """:func:`_pass` on the scratch ``work`` of :func:`_scratch` and the sweep's record ``swept``.
+    """:func:`_pass` on the scratch ``work`` of :func:`scratch` and the sweep's record ``swept``.
 
     ``swept`` (N + 1, 3): rows 0..N−1 the active set whose recursion ``gains``, ``offsets`` and
     ``curvature`` hold, ``swept[N, 0]`` 1 if they hold one. The recursion depends on the set
@@ -624,7 +624,7 @@ def _pass(  # type: ignore[no-untyped-def]
     checked: see :func:`solve_from`. Allocates its scratch (the passes of
     :func:`solve_active_set` share one).
     """
-    work = _scratch(wx.shape[0])
+    work = scratch(wx.shape[0])
     swept = np.zeros((wx.shape[0] + 1, 3), dtype=np.int8)  # no recursion on record
     return _pass_in(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains,
                     offsets, curvature, mult, forced, work, swept)  # fmt: skip
@@ -657,7 +657,7 @@ def solve_active_set(  # type: ignore[no-untyped-def]
     On success ``inputs`` (N, 2), ``states`` (N + 1, 4) and ``mult`` (N, 3) are the KKT point
     and ``active`` its active set. −1: degenerate, or no verified optimum within
     ``max_passes`` (cycling, or an infeasible problem). ``work``: the scratch of
-    :func:`_scratch`, the caller's (kept from solve to solve: an allocation per tick cost
+    :func:`scratch`, the caller's (kept from solve to solve: an allocation per tick cost
     ~1 µs); ``swept``: the record of the last recursion (:func:`_pass_in`).
     """
     for k in range(max_passes):
@@ -705,7 +705,7 @@ def solve_from(  # type: ignore[no-untyped-def]
     the last stage keeping its rows); on success the verified set is copied back into
     ``active``, on failure ``active`` is left as it was. One call per tick, so the Python
     side does no array work. ``floats``, ``ints``, ``origins``, ``saved``: the scratch of
-    :func:`_scratch`, and ``swept`` the recursion's record (:func:`_pass_in`); both the
+    :func:`scratch`, and ``swept`` the recursion's record (:func:`_pass_in`); both the
     caller's, kept from solve to solve.
 
     From the empty set at most ``empty_passes`` passes (:data:`~.riccati.EMPTY_PASSES`).

@@ -1,17 +1,17 @@
-"""numba builds of :mod:`pushrecovery.models._step_scalar` (cached on disk, no closures).
+"""numba builds of :mod:`pushrecovery.kernels.step_scalar` (cached on disk, no closures).
 
 Imported lazily, only by the vectorised paths and by
 :func:`~pushrecovery.surfaces.step.compiled_plan_step`: importing numba alone costs about 0.4 s.
 
-Each pure-Python function of ``_step_scalar`` is compiled here as it is written there: the same
+Each pure-Python function of ``step_scalar`` is compiled here as it is written there: the same
 code object, run with a namespace in which the names of its callees refer to their compiled
 versions (and ``prange`` to ``numba.prange``). Nothing is captured in a closure, so numba's
 cache index key (signature, CPU, bytecode hash) is the same in every process and a new process
 loads the machine code from ``__pycache__`` instead of compiling it. As the code objects belong
-to ``_step_scalar.py``, the cache files are named after it and numba discards them whenever that
+to ``step_scalar.py``, the cache files are named after it and numba discards them whenever that
 file changes, including the callees linked into a kernel (numba tracks only the kernel's own
 source file). It does not track the options below: after changing them, delete
-``__pycache__/_step_scalar.*.nb[ic]``.
+``__pycache__/step_scalar.*.nb[ic]``.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.models import _step_scalar
+from pushrecovery.kernels import step_scalar
 
 __all__ = [
     "PARALLEL_MIN_SIZE",
@@ -44,15 +44,15 @@ DECIDE_SIGNATURE = numba.types.Tuple(
     (numba.float64, numba.boolean, numba.boolean) + (numba.float64,) * 5
 )(*(numba.float64,) * 7)
 
-_NAMESPACE: dict[str, Any] = dict(vars(_step_scalar), prange=numba.prange)
+_NAMESPACE: dict[str, Any] = dict(vars(step_scalar), prange=numba.prange)
 
 
 def _build(name: str, signature: Any = None, **options: Any) -> Any:
-    """Return a numba dispatcher of ``_step_scalar.<name>``, its callees compiled ones.
+    """Return a numba dispatcher of ``step_scalar.<name>``, its callees compiled ones.
 
     With a ``signature`` it is compiled (or loaded from the cache) now, and never again.
     """
-    function = getattr(_step_scalar, name)
+    function = getattr(step_scalar, name)
     rebound = types.FunctionType(function.__code__, _NAMESPACE, function.__name__)
     rebound.__doc__ = function.__doc__
     return numba.njit(signature, cache=True, nogil=True, **options)(rebound)
@@ -75,7 +75,7 @@ _solve_serial = _compile("solve_serial")
 _solve_parallel = _compile("solve_parallel", parallel=True)
 
 
-def scalar_decide() -> Callable[..., _step_scalar.Decision]:
+def scalar_decide() -> Callable[..., step_scalar.Decision]:
     """:func:`decide` with the float64 signature loaded (from the disk cache) and frozen.
 
     A new dispatcher of the same code with :data:`DECIDE_SIGNATURE` declared: it never compiles

@@ -3,7 +3,7 @@ r"""The per-state step decision in pure Python (``math`` only): the single sourc
 Every stepping answer of the package comes from the functions below, run either as plain
 Python (:func:`pushrecovery.surfaces.step.plan_step`, the thresholds of ``pushrecovery bounds``,
 small arrays) or compiled by numba from this very code
-(:mod:`pushrecovery.models._stepping_kernels`: the vectorised :func:`plan_steps
+(:mod:`pushrecovery.kernels.stepping`: the vectorised :func:`plan_steps
 <pushrecovery.surfaces.step.plan_steps>` and :func:`solve_step_angle
 <pushrecovery.models.stepping.solve_step_angle>`, and the real-time
 :func:`~pushrecovery.surfaces.step.compiled_plan_step`). Hence the rules for this module:
