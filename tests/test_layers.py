@@ -1,5 +1,6 @@
 """The floors of docs/architecture.md hold: import contracts, and plots that leave no trace."""
 
+import ast
 import shutil
 import subprocess
 import sys
@@ -51,3 +52,103 @@ def test_drawing_never_imports_pyplot():
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert run.stdout.strip() == "False"
+
+
+# The contracts import-linter cannot state, read from the source with ast (issue 31).
+SRC = ROOT / "src" / "pushrecovery"
+
+
+def _modules(root=SRC):
+    """(path, dotted parts, tree) of every module below ``root`` (a ``pushrecovery`` folder)."""
+    for path in sorted(root.rglob("*.py")):
+        parts = path.relative_to(root.parent).with_suffix("").parts
+        yield path.relative_to(root), parts, ast.parse(path.read_text(encoding="utf-8"))
+
+
+def _imports(tree):
+    """(module, imported names) of every absolute import statement, at any depth."""
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                yield alias.name, ()
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            yield node.module, tuple(alias.name for alias in node.names)
+
+
+def _private(name):
+    return name.startswith("_") and not name.startswith("__")
+
+
+def private_crossings(modules):
+    """Imports of another subpackage's ``_name`` (module or name); a top-level module owns none."""
+    found = []
+    for path, parts, tree in modules:
+        own = parts[1] if len(parts) > 2 else None
+        for module, names in _imports(tree):
+            words = module.split(".")
+            if words[0] != "pushrecovery" or (len(words) > 1 and words[1] == own):
+                continue
+            if any(map(_private, words[1:])) or any(map(_private, names)):
+                found.append(f"{path}: {module} {names}")
+    return found
+
+
+def numba_outside_kernels(modules):
+    return [
+        str(path)
+        for path, parts, tree in modules
+        if parts[1] != "kernels" and any(m.split(".")[0] == "numba" for m, _ in _imports(tree))
+    ]
+
+
+def kernels_importing_the_project(modules):
+    return [
+        f"{path}: {module}"
+        for path, parts, tree in modules
+        if parts[1] == "kernels"
+        for module, _ in _imports(tree)
+        if module.split(".")[0] == "pushrecovery" and module.split(".")[1:2] != ["kernels"]
+    ]
+
+
+def controllers_outside_control(modules):
+    def named(base):
+        return base.id if isinstance(base, ast.Name) else getattr(base, "attr", "")
+
+    return [
+        f"{path}: {node.name}"
+        for path, parts, tree in modules
+        if parts[1] != "control"
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ClassDef)
+        and any(named(base).endswith("Controller") for base in node.bases)
+    ]
+
+
+CHECKS = (
+    private_crossings,
+    numba_outside_kernels,
+    kernels_importing_the_project,
+    controllers_outside_control,
+)
+
+
+@pytest.mark.parametrize("check", CHECKS, ids=lambda c: c.__name__)
+def test_the_source_keeps_the_contract(check):
+    assert check(_modules()) == []
+
+
+@pytest.mark.parametrize("check", CHECKS, ids=lambda c: c.__name__)
+def test_each_contract_check_sees_its_violation(check, tmp_path):
+    root = tmp_path / "pushrecovery"
+    for folder in ("kernels", "sim", "control"):
+        (root / folder).mkdir(parents=True)
+    (root / "kernels" / "bad.py").write_text("from pushrecovery.models import stepping\n")
+    (root / "sim" / "bad.py").write_text(
+        "import numba\nfrom pushrecovery.control._x import y\n"
+        "class Mine(base.Controller):\n    pass\n"
+    )
+    (root / "control" / "fine.py").write_text(
+        "from pushrecovery.control._x import y\nclass Mine(Controller):\n    pass\n"
+    )
+    assert len(check(_modules(root))) == 1
