@@ -30,10 +30,10 @@ trial = read_c3d_recording(path)
 found, sources = body_for(trial, mass=None, com_height=None, gravity=params.gravity)
 result = analyze(trial, load_params(overrides=found), sources=sources)
 truth, summary = recording.truth, result.summary
-event = summary["step_events"][0]
+event = summary.step_events[0]
 print(f"wrote {path}: {len(trial.time)} marker frames, {len(recording.plates)} force plates")
 print(f"simulation used:   {truth['used']}, step {truth['step_lengths'][0]:.3f} m")
 print(
-    f"analysis needs:    {summary['strategy']['most_demanding']}, "
-    f"step {event['step_length']:.3f} m recommended from t = {event['time']:.2f} s"
+    f"analysis needs:    {summary.most_demanding}, "
+    f"step {event.step_length:.3f} m recommended from t = {event.time:.2f} s"
 )

@@ -295,12 +295,12 @@ def test_trial_summary_reports_what_a_biomechanist_needs(tmp_path):
     path = tmp_path / "trial.csv"
     _write_csv(path, t, states, cop)
     summary = analyze(read_csv_recording(path), PARAMS, FIXED).summary
-    assert summary["strategy"]["most_demanding"] == "ankle"
-    assert summary["directions"]["ap"]["time_in_strategy"]["ankle"] == pytest.approx(3.0)
+    assert summary.most_demanding == "ankle"
+    assert summary.directions["ap"].time_in_strategy["ankle"] == pytest.approx(3.0)
     true_capture = states[:, 0] + states[:, 1] / OMEGA
     low = np.min(PARAMS.toe - true_capture)
-    assert summary["directions"]["ap"]["min_margin"]["cop"]["value"] == pytest.approx(low, abs=3e-3)
-    assert summary["step_events"] == []
+    assert summary.directions["ap"].min_cop_margin.value == pytest.approx(low, abs=3e-3)
+    assert summary.step_events == ()
 
 
 def test_trial_needing_a_step_reports_the_step_event(tmp_path):
@@ -308,9 +308,9 @@ def test_trial_needing_a_step_reports_the_step_event(tmp_path):
     path = tmp_path / "trial.csv"
     _write_csv(path, t, states, cop)
     summary = analyze(read_csv_recording(path), PARAMS, FIXED).summary
-    events = summary["step_events"]
-    assert events and events[0]["axis"] == "ap"
-    assert PUSH_TIME < events[0]["time"] < PUSH_TIME + PUSH_DURATION + 0.05
+    events = summary.step_events
+    assert events and events[0].axis == "ap"
+    assert PUSH_TIME < events[0].time < PUSH_TIME + PUSH_DURATION + 0.05
     # Once the push is over, the recommended step is the classifier's for the true state.
     result = analyze(read_csv_recording(path), PARAMS, FIXED)
     checked = 0
@@ -352,15 +352,15 @@ def test_gaps_are_interpolated_or_excluded_and_reported(tmp_path):
     path = tmp_path / "gaps.csv"
     _write_csv(path, t, states, cop, gaps=[(30, 35), (150, 200)])
     result = analyze(read_csv_recording(path), PARAMS, FIXED)
-    gaps = result.summary["gaps"]
-    assert [(g["signal"], g["samples"], g["filled"]) for g in gaps] == [
+    gaps = result.summary.gaps
+    assert [(g.signal, g.samples, g.filled) for g in gaps] == [
         ("com", 5, True),
         ("com", 50, False),
     ]
     assert result.columns["interpolated"][30:35].all()
     assert not result.columns["valid"][150:200].any()
-    assert result.summary["excluded_frames"] == 50
-    assert result.summary["excluded"] == {"no CoM": 50}
+    assert result.summary.excluded_frames == 50
+    assert result.summary.excluded == {"no CoM": 50}
 
 
 def _table(header, row=lambda i: f"{i / 100:.2f},0,0", n=12, change=None):
@@ -448,12 +448,12 @@ def test_force_plate_only_csv_integrates_the_com(tmp_path):
     values, _sources = body_for(recording, mass=None, com_height=None, gravity=PARAMS.gravity)
     assert values["mass"] == pytest.approx(PARAMS.mass, rel=1e-4)
     result = analyze(recording, PARAMS, AnalysisSettings(ankle_ap=-0.05, ankle_ml=0.0))
-    assert result.summary["com_source"].startswith("zero-point")
+    assert result.summary.com_source.startswith("zero-point")
     com = result.columns["ap_com"]
     inside = np.isfinite(com)
     assert inside.mean() > 0.8
     assert np.abs(com[inside] - x[inside]).max() < 2e-3
-    assert result.summary["strategy"]["most_demanding"] == "ankle"
+    assert result.summary.most_demanding == "ankle"
 
 
 def test_a_foot_without_markers_leaves_the_base_unknown():

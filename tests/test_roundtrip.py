@@ -63,20 +63,20 @@ def test_the_analysis_needs_what_the_simulation_used(tmp_path, case):
     assert truth["predicted"]["strategy"] == case
     _, params, result = _analyse(_c3d(tmp_path, recording))
     summary = result.summary
-    assert summary["body"]["mass_source"] == "file"
-    assert summary["body"]["mass"] == pytest.approx(recording.mass, rel=1e-6)
-    assert summary["body"]["com_height_source"] == "file"
+    assert summary.mass_source == "file"
+    assert summary.params.mass == pytest.approx(recording.mass, rel=1e-6)
+    assert summary.com_height_source == "file"
     # The ankle marker sits at the hinge: the standing CoM above it is the model's L (the
     # biped's 1.6 kg legs put its whole-body CoM 1.5 cm lower).
     assert params.com_height == pytest.approx(PARAMS.com_height, abs=0.02)
-    assert summary["support_source"] == "foot markers"
-    assert summary["directions"]["ap"]["most_demanding"] == case
+    assert summary.support_source == "foot markers"
+    assert summary.directions["ap"].most_demanding == case
     if case != "step":
-        assert summary["directions"]["ml"]["most_demanding"] == "ankle"
+        assert summary.directions["ml"].most_demanding == "ankle"
     # else: the planar biped's feet are drawn 0.1 m either side of its CoM and its joints hold
     # it in the sagittal plane; in single support the markers rightly say that a free body
     # would need more than its ankle medio-laterally (the CoM 5.5 cm beyond the stance foot).
-    assert summary["excluded_frames"] == 0
+    assert summary.excluded_frames == 0
     # Before the push: quiet standing, ankle.
     time, strategy = result.columns["time"], result.columns["ap_strategy"]
     assert (strategy[time < truth["push_time"] - 0.1] == "ankle").all()
@@ -88,9 +88,9 @@ def test_the_predicted_step_is_the_step_taken(tmp_path):
     assert truth["steps"] == 1
     taken = truth["step_lengths"][0]
     _, _, result = _analyse(_c3d(tmp_path, recording))
-    events = result.summary["step_events"]
-    assert events and events[0]["axis"] == "ap"
-    assert abs(events[0]["time"] - truth["push_time"]) < 0.05
+    events = result.summary.step_events
+    assert events and events[0].axis == "ap"
+    assert abs(events[0].time - truth["push_time"]) < 0.05
     # From the end of the filter's transient to the landing the stance leg falls as a
     # pendulum, whose recommended step stays the one the controller took.
     time = result.columns["time"]
@@ -108,7 +108,7 @@ def test_the_predicted_step_is_the_step_taken(tmp_path):
     # holds the step taken (later frames ask for longer first steps, or for two steps).
     assert shortest[0] <= taken <= longest[0]
     assert np.nanmedian(lengths) == pytest.approx(taken, rel=0.1)
-    assert events[0]["step_length"] == pytest.approx(taken, rel=0.1)
+    assert events[0].step_length == pytest.approx(taken, rel=0.1)
 
 
 def test_force_plates_alone_give_the_same_strategy(tmp_path):
@@ -121,8 +121,8 @@ def test_force_plates_alone_give_the_same_strategy(tmp_path):
     recording = _recorded("ankle")
     _, _, result = _analyse(_c3d(tmp_path, recording, com=False))
     summary = result.summary
-    assert summary["com_source"].startswith("zero-point")
-    assert summary["directions"]["ap"]["most_demanding"] == "ankle"
+    assert summary.com_source.startswith("zero-point")
+    assert summary.directions["ap"].most_demanding == "ankle"
     time = result.columns["time"]
     marker_com = np.interp(time, recording.point_time, recording.markers["CentreOfMass"][:, 0])
     error = np.abs(result.columns["ap_com"] - marker_com)

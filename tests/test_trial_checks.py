@@ -35,16 +35,16 @@ def test_jumps_weigh_the_subject_standing_and_give_no_verdict_in_flight(name):
     assert "quiet windows" in sources["mass"]
     params = load_params(overrides=found)
     result = analyze(recording, params)
-    flights = result.summary["checks"]["flight_phases"]
+    flights = result.summary.checks.flights
     assert flights, "every jump has a flight"
     in_flight = result.columns["flight"]
     assert in_flight.any()
     assert not result.columns["valid"][in_flight].any()
     assert all(s is None for s in result.columns["strategy"][in_flight])
-    for start_end in flights:
-        frames = (result.time > start_end["start"] + 0.01) & (result.time < start_end["end"] - 0.01)
+    for start, end in flights:
+        frames = (result.time > start + 0.01) & (result.time < end - 0.01)
         assert in_flight[frames].all()
-    assert result.summary["posturography"] is None  # a jump is no quiet standing
+    assert result.summary.sway is None  # a jump is no quiet standing
 
 
 def _csv(path, shift_ml, frames_shifted):
@@ -70,34 +70,34 @@ def _csv(path, shift_ml, frames_shifted):
 def test_a_cop_beyond_the_base_withholds_those_verdicts(tmp_path):
     shift = 0.15 + COP_TOLERANCE + 0.03  # the base's ml edge 3 cm beyond the tolerance
     result = analyze(read_recording(_csv(tmp_path / "a.csv", shift, 60)), P)
-    checks = result.summary["checks"]
-    assert checks["cop_outside_base_frames"]["ml"] == 60 and not checks["base_rejected"]
+    checks = result.summary.checks
+    assert checks.cop_outside["ml"].sum() == 60 and not checks.base_rejected
     assert not result.columns["valid"][:60].any()
     assert result.columns["valid"][60:].all()
     assert result.columns["cop_outside_base"][:60].all()
-    reasons = result.summary["excluded"]
+    reasons = result.summary.excluded
     assert reasons["CoP beyond the computed base by more than 2 cm"] == 60
 
 
 def test_a_base_the_cop_contradicts_is_rejected_and_nothing_is_classified(tmp_path):
     result = analyze(read_recording(_csv(tmp_path / "b.csv", 0.2, 600)), P)
-    assert result.summary["checks"]["base_rejected"]
+    assert result.summary.checks.base_rejected
     assert not result.columns["valid"].any()
-    assert result.summary["strategy"]["most_demanding"] is None
-    assert any("no verdict is given" in note for note in result.summary["notes"])
+    assert result.summary.most_demanding is None
+    assert any("no verdict is given" in note for note in result.summary.notes)
     # Within the tolerance nothing is withheld.
     inside = analyze(read_recording(_csv(tmp_path / "c.csv", 0.15 + 0.01, 600)), P)
-    assert inside.columns["valid"].all() and not inside.summary["checks"]["base_rejected"]
+    assert inside.columns["valid"].all() and not inside.summary.checks.base_rejected
 
 
 def test_quiet_standing_gets_its_sway_measures(tmp_path):
     recording = read_recording(DATA / "kistler_COP.c3d")
     found, _ = body_for(recording, mass=None, com_height=None, gravity=9.81)
     result = analyze(recording, load_params(overrides=found))
-    sway = result.summary["posturography"]
-    assert sway is not None and sway["cop_cutoff"] == 10.0
+    sway = result.summary.to_dict()["posturography"]
+    assert result.summary.sway is not None and sway["cop_cutoff"] == 10.0
     # The 95 % prediction ellipse holds the CoP (order of magnitude of a standing subject).
-    assert 1e-5 < sway["ellipse_area"] < 1e-2
+    assert 1e-5 < result.summary.sway.ellipse.area < 1e-2
     json.dumps(sway, allow_nan=False)
 
 
@@ -144,7 +144,7 @@ def test_a_step_is_detected_measured_and_given_its_margins():
     import math
 
     result = analyze(_stepping_recording(), P)
-    events = result.summary["events"]
+    events = result.summary.events
     onset = events["onset"]["time"]
     # The push, from the CoM acceleration, low-passed at 6 Hz forward and backward: the zero-lag
     # filter spreads the push over about +-1/fc, and with little noise the threshold is crossed
@@ -187,11 +187,11 @@ def test_the_plane_margin_is_the_xcom_distance_to_the_base_polygon(tmp_path):
     result = analyze(read_recording(path), P)
     mos = result.columns["mos"]
     assert mos == pytest.approx(np.full(n, 0.07), abs=1e-9)
-    plane = result.summary["plane"]
-    assert plane["min_mos"]["value"] == pytest.approx(0.07, abs=1e-9)
-    assert plane["base_source"] == "base columns"
+    plane = result.summary.plane
+    assert plane.min_mos.value == pytest.approx(0.07, abs=1e-9)
+    assert plane.base_source == "base columns"
     # The 2-D verdicts classify against feet (a Support): a base given as columns has none.
-    assert plane["most_demanding"] is None
+    assert plane.most_demanding is None
     assert result.columns["base_area"] == pytest.approx(np.full(n, 0.2 * 0.3))
 
 
@@ -210,7 +210,7 @@ def test_a_base_polygon_from_vertex_columns(tmp_path):
     # / hypot(0.1, 0.2) (the line 0.1 x + 0.2 y = 0.015), and to the rear edge x = -0.05.
     expected = min(0.015 / np.hypot(0.1, 0.2), 0.05)
     assert result.columns["mos"] == pytest.approx(np.full(n, expected), abs=1e-9)
-    assert result.summary["support_source"] == "base polygon columns"
+    assert result.summary.support_source == "base polygon columns"
     assert result.columns["ap_base_min"] == pytest.approx(np.full(n, -0.05))
     path.write_text(
         "\n".join([head.replace(",base_ml3", ""), *(r.rsplit(",", 1)[0] for r in rows)])
@@ -257,15 +257,15 @@ def test_foot_events_from_each_plate_of_a_drop_jump():
     assert len(recording.plates) == 2
     found, _ = body_for(recording, mass=None, com_height=None, gravity=9.81)
     result = analyze(recording, load_params(overrides=found))
-    events = [(e["foot"], e["kind"], e["time"]) for e in result.summary["events"]["foot_events"]]
+    events = [(e["foot"], e["kind"], e["time"]) for e in result.summary.events["foot_events"]]
     assert [(foot, kind) for foot, kind, _ in events] == [
         ("plate 2", "foot-off"),
         ("plate 1", "foot-contact"),
         ("plate 1", "foot-off"),
         ("plate 1", "foot-contact"),
     ]
-    flights = result.summary["checks"]["flight_phases"]
-    edges = [flights[0]["start"], flights[0]["end"], flights[1]["start"], flights[1]["end"]]
+    flights = result.summary.checks.flights
+    edges = [*flights[0], *flights[1]]
     for (_, _, time), edge in zip(events, edges, strict=True):
         assert time == pytest.approx(edge, abs=0.02)
 
@@ -273,12 +273,12 @@ def test_foot_events_from_each_plate_of_a_drop_jump():
 def test_a_step_is_judged_against_the_capture_region_at_its_foot_off():
     # The landing 0.30 m ahead misses the one-step capture region of the state at foot-off
     # (the push was large); landing at the foothold the region recommends is inside it.
-    first = analyze(_stepping_recording(), P).summary["events"]["measured_steps"][0]
+    first = analyze(_stepping_recording(), P).summary.events["measured_steps"][0]
     region = first["capture_region"]
     assert region["landing_ankle"] == pytest.approx([0.30, -0.12], abs=1e-9)
     assert region["within"] is False and region["margin"] < 0.0
     foothold = region["recommended_foothold"]
     step = (foothold[0] - 0.0, foothold[1] - (-0.1))  # from the right ankle at (0, -0.1)
-    again = analyze(_stepping_recording(step), P).summary["events"]["measured_steps"][0]
+    again = analyze(_stepping_recording(step), P).summary.events["measured_steps"][0]
     assert again["capture_region"]["within"] is True
     assert again["capture_region"]["margin"] > 0.01

@@ -6,13 +6,14 @@ import json
 import math
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from pushrecovery.analysis.trial import TrialAnalysis
+if TYPE_CHECKING:  # the trial's summary serialises itself with json_safe
+    from pushrecovery.analysis.trial import TrialAnalysis
 
-__all__ = ["FRAME_FILES", "SUMMARY_FILE", "write_analysis"]
+__all__ = ["FRAME_FILES", "SUMMARY_FILE", "json_safe", "write_analysis"]
 
 #: Per-frame tables written into the output directory.
 FRAME_FILES = ("frames.parquet", "frames.csv")
@@ -58,7 +59,7 @@ def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Pa
     }
     _atomic(paths["frames_parquet"], lambda p: pq.write_table(table, p))
     _atomic(paths["frames_csv"], lambda p: pacsv.write_csv(table, p))
-    text = json.dumps(json_safe(analysis.summary), indent=2, allow_nan=False)
+    text = json.dumps(analysis.summary.to_dict(), indent=2, allow_nan=False)
     _atomic(paths["summary"], lambda p: p.write_text(text + "\n"))
     return paths
 

@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, fields, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pushrecovery.campaign.trial_rows import subject_name
+
+if TYPE_CHECKING:
+    from pushrecovery.analysis.trial import TrialSummary
 
 __all__ = ["EVENT_FIELDS", "EventRow", "trial_events"]
 
@@ -77,32 +80,35 @@ class EventRow:
 EVENT_FIELDS: tuple[tuple[str, str], ...] = tuple((f.name, str(f.type)) for f in fields(EventRow))
 
 
-def trial_events(job: Any, summary: dict[str, Any]) -> list[dict[str, Any]]:
-    """Return the events of an analysed trial, in time order (:class:`EventRow`)."""
+def trial_events(job: Any, summary: TrialSummary) -> list[dict[str, Any]]:
+    """Return the events of an analysed trial, in time order (:class:`EventRow`).
+
+    The values are the summary's own (NaN, not yet None: ``json_safe`` them for a JSON file).
+    """
     subject = subject_name(job)
     rows = [
         EventRow(
             trial=job.name,
             subject=subject,
-            axis=event["axis"],
+            axis=event.axis,
             kind="step needed",
-            time=event["time"],
-            end=event["end"],
-            step_length=event["step_length"],
-            step_length_min=event["step_length_range"][0],
-            step_length_max=event["step_length_range"][1],
-            capture_point=event["capture_point"],
+            time=event.time,
+            end=event.end,
+            step_length=event.step_length,
+            step_length_min=event.step_length_min,
+            step_length_max=event.step_length_max,
+            capture_point=event.capture_point,
         )
-        for event in summary["step_events"]
+        for event in summary.step_events
     ]
-    for flight in (summary.get("checks") or {}).get("flight_phases", []):
-        rows.append(EventRow(job.name, subject, "", "flight", flight["start"], flight["end"]))
-    events = summary.get("events") or {}
-    onset = events.get("onset") or {}
+    for start, end in summary.checks.flights:
+        rows.append(EventRow(job.name, subject, "", "flight", start, end))
+    events = summary.events
+    onset = events["onset"]
     for axis in ("ap", "ml"):
-        if onset.get("time") is not None:
+        if onset["time"] is not None:
             rows.append(_at(job.name, subject, axis, "onset", onset["time"], onset["margins"]))
-        for foot in events.get("foot_events", []):
+        for foot in events["foot_events"]:
             rows.append(
                 replace(
                     _at(job.name, subject, axis, foot["kind"], foot["time"], foot["margins"]),
@@ -110,7 +116,7 @@ def trial_events(job: Any, summary: dict[str, Any]) -> list[dict[str, Any]]:
                     source=foot["source"],
                 )
             )
-        for step in events.get("measured_steps", []):
+        for step in events["measured_steps"]:
             compared = step["against_recommended"][axis]
             row = _at(
                 job.name, subject, axis, "step", step["off_time"], step["margins_at_foot_off"]
@@ -128,8 +134,8 @@ def trial_events(job: Any, summary: dict[str, Any]) -> list[dict[str, Any]]:
                     latency=step["latency"],
                     duration=step["duration"],
                     within=compared["within"],
-                    capture_region_margin=(step.get("capture_region") or {}).get("margin"),
-                    in_capture_region=(step.get("capture_region") or {}).get("within"),
+                    capture_region_margin=(step["capture_region"] or {}).get("margin"),
+                    in_capture_region=(step["capture_region"] or {}).get("within"),
                 )
             )
     rows.sort(key=lambda r: (math.inf if r.time is None else r.time, r.kind, r.axis))

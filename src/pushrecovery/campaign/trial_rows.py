@@ -12,9 +12,13 @@ import math
 import statistics
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pushrecovery.params import BodyParams
+
+if TYPE_CHECKING:
+    from pushrecovery.analysis.posturography import SwayMeasures
+    from pushrecovery.analysis.trial import TrialSummary
 
 __all__ = [
     "TRIAL_FIELDS",
@@ -167,14 +171,18 @@ def subject_name(job: Any) -> str:
 
 
 def trial_rows(
-    job: Any, summary: dict[str, Any], params: BodyParams, sources: dict[str, str]
+    job: Any, summary: TrialSummary, params: BodyParams, sources: dict[str, str]
 ) -> list[dict[str, Any]]:
-    """Return the rows of an analysed trial, from its summary (``summary.json``)."""
-    body = summary["body"]
+    """Return the rows of an analysed trial, from its summary.
+
+    The values are the summary's own (NaN, not yet None: ``json_safe`` them for a JSON file).
+    """
+    checks, plane = summary.checks, summary.plane
+    onset, steps_taken = summary.events["onset"]["time"], len(summary.events["measured_steps"])
     rows = []
-    for axis, data in summary["directions"].items():
-        margin = data["min_margin"]["cop"]["value"]
-        times = data["time_in_strategy"]
+    for axis, data in summary.directions.items():
+        margin, mos = data.min_cop_margin.value, plane.min_mos.value
+        times = data.time_in_strategy
         row = TrialRow(
             trial=job.name,
             path=str(job.path),
@@ -182,39 +190,50 @@ def trial_rows(
             axis=axis,
             status="analysed",
             error=None,
-            frames=summary["frames"],
-            valid_frames=summary["valid_frames"],
-            excluded_frames=summary["excluded_frames"],
-            interpolated_frames=summary["interpolated_frames"],
-            rate=summary["rate"],
-            duration=summary["duration"],
-            mass=body["mass"],
-            mass_source=body["mass_source"],
-            com_height=body["com_height"],
-            com_height_source=body["com_height_source"],
+            frames=summary.frames,
+            valid_frames=summary.valid_frames,
+            excluded_frames=summary.excluded_frames,
+            interpolated_frames=summary.interpolated_frames,
+            rate=summary.rate,
+            duration=summary.duration,
+            mass=summary.params.mass,
+            mass_source=summary.mass_source,
+            com_height=summary.params.com_height,
+            com_height_source=summary.com_height_source,
             leg_length=params.leg_length,
             leg_length_source=sources.get("leg_length", "preset"),
-            com_source=summary["com_source"],
-            support_source=summary["support_source"],
-            heel=data["foot"]["heel"],
-            toe=data["foot"]["toe"],
-            most_demanding=data["most_demanding"],
+            com_source=summary.com_source,
+            support_source=summary.support_source,
+            heel=data.heel,
+            toe=data.toe,
+            most_demanding=data.most_demanding,
             time_ankle=times["ankle"],
             time_hip=times["hip"],
             time_step=times["step"],
             time_fall=times["fall"],
             min_cop_margin=margin,
-            min_cop_margin_time=data["min_margin"]["cop"]["time"],
+            min_cop_margin_time=data.min_cop_margin.time,
             min_cop_margin_normalised=None if margin is None else margin / params.leg_length,
-            min_cmp_margin=data["min_margin"]["cmp"]["value"],
-            min_cmp_margin_time=data["min_margin"]["cmp"]["time"],
-            min_time_to_leave_cop=data["min_time_to_leave"]["cop"]["value"],
-            capture_point_min=data["capture_point_range"][0],
-            capture_point_max=data["capture_point_range"][1],
-            step_events=sum(1 for e in summary["step_events"] if e["axis"] == axis),
-            **_checked(summary, axis),
-            **_planar(summary.get("plane"), axis, params.leg_length),
-            **_sway(summary.get("posturography"), axis),
+            min_cmp_margin=data.min_cmp_margin.value,
+            min_cmp_margin_time=data.min_cmp_margin.time,
+            min_time_to_leave_cop=data.min_time_to_leave_cop.value,
+            capture_point_min=data.capture_point_min,
+            capture_point_max=data.capture_point_max,
+            step_events=sum(1 for e in summary.step_events if e.axis == axis),
+            flight_frames=int(checks.flight.sum()),
+            cop_outside_base_frames=int(checks.cop_outside[axis].sum()),
+            cop_tolerance=checks.tolerance,
+            base_rejected=checks.base_rejected,
+            onset=onset,
+            steps_taken=steps_taken,
+            min_mos=mos,
+            min_mos_time=plane.min_mos.time,
+            min_mos_normalised=None if mos is None else mos / params.leg_length,
+            min_mos_axis=(plane.min_mos_ap if axis == "ap" else plane.min_mos_ml).value,
+            min_time_to_boundary_cop=plane.min_time_to_boundary_cop.value,
+            min_time_to_boundary_xcom=plane.min_time_to_boundary_xcom.value,
+            most_demanding_2d=plane.most_demanding,
+            **_sway(summary.sway, axis),
         )
         if row.base_rejected:
             row = replace(
@@ -224,51 +243,20 @@ def trial_rows(
     return rows
 
 
-def _checked(summary: dict[str, Any], axis: str) -> dict[str, Any]:
-    """Return the data checks and events of a trial row."""
-    checks, events = summary.get("checks"), summary.get("events")
-    found: dict[str, Any] = {}
-    if checks is not None:
-        found.update(
-            flight_frames=checks["flight_frames"],
-            cop_outside_base_frames=checks["cop_outside_base_frames"][axis],
-            cop_tolerance=checks["cop_tolerance"],
-            base_rejected=checks["base_rejected"],
-        )
-    if events is not None:
-        found.update(onset=events["onset"]["time"], steps_taken=len(events["measured_steps"]))
-    return found
-
-
-def _planar(plane: dict[str, Any] | None, axis: str, leg_length: float) -> dict[str, Any]:
-    """Return a trial row's measures against the base polygon."""
-    if plane is None:
-        return {}
-    mos = plane["min_mos"]["value"]
-    return {
-        "min_mos": mos,
-        "min_mos_normalised": None if mos is None else mos / leg_length,
-        "min_mos_time": plane["min_mos"]["time"],
-        "min_mos_axis": plane[f"min_mos_{axis}"]["value"],
-        "min_time_to_boundary_cop": plane["min_time_to_boundary_cop"]["value"],
-        "min_time_to_boundary_xcom": plane["min_time_to_boundary_xcom"]["value"],
-        "most_demanding_2d": plane["most_demanding"],
-    }
-
-
-def _sway(sway: dict[str, Any] | None, axis: str) -> dict[str, Any]:
+def _sway(sway: SwayMeasures | None, axis: str) -> dict[str, Any]:
     """Return a trial row's quiet-standing measures (none if the trial is no quiet standing)."""
     if sway is None:
         return {}
+    spectrum = sway.spectrum_ap if axis == "ap" else sway.spectrum_ml
     return {
-        "sway_path_length": sway[f"path_length_{axis}"],
-        "sway_mean_velocity": sway[f"mean_velocity_{axis}"],
-        "sway_rms_distance": sway[f"rms_distance_{axis}"],
-        "sway_range": sway[f"range_{axis}"],
-        "sway_f50": sway[f"{axis}_f50"],
-        "sway_f95": sway[f"{axis}_f95"],
-        "sway_ellipse_area": sway["ellipse_area"],
-        "sway_mean_velocity_total": sway["mean_velocity"],
+        "sway_path_length": getattr(sway.path_length, axis),
+        "sway_mean_velocity": getattr(sway.mean_velocity, axis),
+        "sway_rms_distance": getattr(sway.rms_distance, axis),
+        "sway_range": sway.range_ap if axis == "ap" else sway.range_ml,
+        "sway_f50": spectrum.f50,
+        "sway_f95": spectrum.f95,
+        "sway_ellipse_area": sway.ellipse.area,
+        "sway_mean_velocity_total": sway.mean_velocity.total,
     }
 
 

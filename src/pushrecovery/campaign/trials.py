@@ -205,10 +205,9 @@ def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict
         files = {name: str(path) for name, path in write_analysis(analysis, directory).items()}
         if after is not None:
             files.update(after(analysis, directory))
-        summary = json_safe(analysis.summary)
         record = {
-            "trials": trial_rows(job, summary, params, sources),
-            "events": trial_events(job, summary),
+            "trials": json_safe(trial_rows(job, analysis.summary, params, sources)),
+            "events": json_safe(trial_events(job, analysis.summary)),
             "files": files,
         }
     except PushRecoveryError as exc:

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from pushrecovery.cli.options import PARAM_FLAGS, body_options, emit
+
+if TYPE_CHECKING:
+    from pushrecovery.analysis.trial import TrialSummary
 
 __all__ = ["analyze"]
 
@@ -193,7 +196,7 @@ def _single(
     **kwargs: Any,
 ) -> None:
     """One trial, its outputs straight into ``out`` (the first releases' contract)."""
-    from pushrecovery.analysis.output import json_safe, write_analysis
+    from pushrecovery.analysis.output import write_analysis
     from pushrecovery.analysis.readers import read_recording
     from pushrecovery.analysis.trial import analyze as analyze_trial
     from pushrecovery.analysis.trial import body_for
@@ -214,11 +217,10 @@ def _single(
     files = {name: str(path) for name, path in write_analysis(result, out).items()}
     if plot:
         files.update(plot_trial(result, out))
-    summary = json_safe(result.summary)
     if as_json:
-        emit({**summary, "files": files}, True)
+        emit({**result.summary.to_dict(), "files": files}, True)
         return
-    emit(_brief(summary, files), False)
+    emit(_brief(result.summary, files), False)
 
 
 def plot_trial(result: Any, out: Path) -> dict[str, str]:
@@ -286,30 +288,26 @@ def _batch(
     )
 
 
-def _brief(summary: dict[str, Any], files: dict[str, str]) -> dict[str, Any]:
+def _brief(summary: TrialSummary, files: dict[str, str]) -> dict[str, Any]:
     """Pick the lines a person reads first; everything else is in summary.json."""
     brief: dict[str, Any] = {
-        "frames": f"{summary['valid_frames']} of {summary['frames']} analysed "
-        f"({summary['rate']:.6g} Hz, {summary['duration']:.6g} s)",
-        "mass": f"{summary['body']['mass']:.4g} kg ({summary['body']['mass_source']})",
-        "com_height": f"{summary['body']['com_height']:.4g} m "
-        f"({summary['body']['com_height_source']})",
-        "com": summary["com_source"],
-        "support": summary["support_source"],
-        "needs": summary["strategy"]["most_demanding"],
+        "frames": f"{summary.valid_frames} of {summary.frames} analysed "
+        f"({summary.rate:.6g} Hz, {summary.duration:.6g} s)",
+        "mass": f"{summary.params.mass:.4g} kg ({summary.mass_source})",
+        "com_height": f"{summary.params.com_height:.4g} m ({summary.com_height_source})",
+        "com": summary.com_source,
+        "support": summary.support_source,
+        "needs": summary.most_demanding,
     }
-    for axis, data in summary["directions"].items():
-        margin = data["min_margin"]["cop"]
+    for axis, data in summary.directions.items():
         brief[f"{axis}"] = {
-            "needs": data["most_demanding"],
-            "min_cop_margin": margin["value"],
-            "at": margin["time"],
-            "time_in_strategy": data["time_in_strategy"],
+            "needs": data.most_demanding,
+            "min_cop_margin": data.min_cop_margin.value,
+            "at": data.min_cop_margin.time,
+            "time_in_strategy": data.time_in_strategy,
         }
-    brief["step_events"] = len(summary["step_events"])
-    brief["gaps"] = (
-        f"{sum(g['filled'] for g in summary['gaps'])} interpolated, "
-        f"{sum(not g['filled'] for g in summary['gaps'])} excluded"
-    )
+    brief["step_events"] = len(summary.step_events)
+    filled = sum(gap.filled for gap in summary.gaps)
+    brief["gaps"] = f"{filled} interpolated, {len(summary.gaps) - filled} excluded"
     brief["files"] = files
     return brief

@@ -103,7 +103,7 @@ def withheld_frames(
     flight = none & columns["flight"].astype(bool)
     outside = none & columns["cop_outside_base"].astype(bool) & ~flight
     rest = none & ~flight & ~outside
-    rejected = bool(analysis.summary.get("checks", {}).get("base_rejected", False))
+    rejected = analysis.summary.checks.base_rejected
     empty = np.zeros_like(none)
     return {
         "flight": ("no verdict: flight (no ground contact)", flight),
@@ -115,13 +115,13 @@ def withheld_frames(
 
 def _events(analysis: TrialAnalysis) -> list[tuple[float, str, str]]:
     """Return the summary's events: (time [s], kind, legend text), in time order."""
-    events = analysis.summary.get("events") or {}
+    events = analysis.summary.events
     found: list[tuple[float, str, str]] = []
-    onset = events.get("onset") or {}
-    if onset.get("time") is not None:
+    onset = events["onset"]
+    if onset["time"] is not None:
         found.append((float(onset["time"]), "onset", "push onset"))
-    for event in events.get("foot_events") or []:
-        if event.get("time") is not None:
+    for event in events["foot_events"]:
+        if event["time"] is not None:
             found.append((float(event["time"]), event["kind"], f"{event['foot']} {event['kind']}"))
     return sorted(found)
 
@@ -205,7 +205,7 @@ def plot_phase_portrait(analysis: TrialAnalysis, path: Path) -> Path:
 
 def _title(analysis: TrialAnalysis, axis: str) -> str:
     """Return the axis and the most demanding strategy its frames need (or no verdict)."""
-    needs = analysis.summary["directions"][axis]["most_demanding"]
+    needs = analysis.summary.directions[axis].most_demanding
     return f"{_TITLES[axis]}: needs {needs}" if needs else f"{_TITLES[axis]}: no verdict"
 
 

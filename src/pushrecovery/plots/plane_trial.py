@@ -165,7 +165,7 @@ def plane_figure(analysis: TrialAnalysis, base: BasePolygons | None = None) -> F
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("ap position [m]   (forward +, to the right)")
     ax.set_ylabel("ml position [m]   (subject's left +, up)")
-    source = analysis.summary.get("plane", {}).get("base_source") or base.source
+    source = analysis.summary.plane.base_source or base.source
     if base.source.startswith("per-axis"):
         source = base.source
     ax.set_title(
@@ -187,7 +187,7 @@ def _xcom_paths(ax: Axes, analysis: TrialAnalysis, xcom: np.ndarray) -> str:
         ("XCoM, " + strategy_label(n), c, 1.8, strategy == n) for n, c in STRATEGY_COLOURS.items()
     ]
     for key, (text, mask) in withheld_frames(analysis, column).items():
-        if key == "missing" and column == "strategy_2d" and analysis.summary.get("plane"):
+        if key == "missing" and column == "strategy_2d":
             text = "no verdict: CoM or base missing, or no feet to classify against"
         marks.append((f"XCoM, {text}", WITHHELD_COLOURS[key], 1.2, mask))
     for label, colour, width, mask in marks:
@@ -215,12 +215,12 @@ def _mark(ax: Axes, analysis: TrialAnalysis, base: BasePolygons, xcom: np.ndarra
         ax.plot(*xcom[frame], _MARKERS.get(kind, "D"), ms=9 if kind == "onset" else 7,
                 mfc="white" if kind in ("start", "end") else "0.1", mec="0.1",
                 label=f"XCoM at {text} ({when:.2f} s)", ls="none")  # fmt: skip
-    smallest = analysis.summary.get("plane", {}).get("min_mos") or {}
-    if smallest.get("time") is not None:
-        frame = int(np.argmin(np.abs(time - smallest["time"])))
+    smallest = analysis.summary.plane.min_mos
+    if smallest.time is not None and smallest.value is not None:
+        frame = int(np.argmin(np.abs(time - smallest.time)))
         ax.plot(*xcom[frame], "X", ms=8, color="#d81b60", ls="none",
-                label=f"smallest margin of stability {smallest['value'] * 100:.1f} cm "
-                f"({smallest['time']:.2f} s)")  # fmt: skip
+                label=f"smallest margin of stability {smallest.value * 100:.1f} cm "
+                f"({smallest.time:.2f} s)")  # fmt: skip
 
 
 def _limits(ax: Axes, body: list[np.ndarray], xcom: np.ndarray) -> str:

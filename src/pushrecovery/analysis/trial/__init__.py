@@ -16,10 +16,12 @@ The pipeline (docs/analysis.md):
 
 from pushrecovery.analysis.trial.pipeline import analyze
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis, body_for
+from pushrecovery.analysis.trial.summary import TrialSummary
 
 __all__ = [
     "AnalysisSettings",
     "TrialAnalysis",
+    "TrialSummary",
     "analyze",
     "body_for",
 ]

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 from pushrecovery.analysis.base_polygon import BasePolygons
 from pushrecovery.analysis.margins import DirectionMargins, direction_margins
 from pushrecovery.analysis.margins_2d import Margins2D, margins_2d
-from pushrecovery.analysis.posturography import quiet_standing, sway_measures
+from pushrecovery.analysis.posturography import SwayMeasures, quiet_standing, sway_measures
 from pushrecovery.analysis.recording import (
     AXES,
     LOADED,
@@ -28,9 +28,7 @@ from pushrecovery.analysis.trial.events import trial_events
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
 from pushrecovery.analysis.trial.summary import (
     _exclusions,
-    _extreme,
     _interpolated,
-    _most_demanding,
     _names,
     _summary,
 )
@@ -206,6 +204,18 @@ def analyze(
     columns["flight"] = checks.flight
     columns["cop_outside_base"] = checks.contradicted
 
+    events = trial_events(
+        recording, time, velocity, per_axis, params.mass, com=com, plane=(base, params)
+    )
+    sway = _posturography(force_time, plate_cop, plate_force)
+    if sway is not None and events["onset"]["time"] is not None:
+        # Quiet standing has no perturbation: its sway crosses any threshold of a short baseline.
+        events["onset"] = {
+            "time": None,
+            "signal": events["onset"]["signal"],
+            "margins": None,
+            "note": "quiet standing: no perturbation",
+        }
     summary = _summary(
         recording,
         time,
@@ -224,23 +234,13 @@ def analyze(
             **_exclusions(com, velocity, support, invalid & ~checks.withheld),
             **checks.reasons(),
         },
+        checks=checks,
+        plane=plane,
+        events=events,
+        sway=sway,
     )
     if settings.normalise:
         columns.update(_normalised(columns, params))
-    summary["checks"] = checks.to_dict()
-    summary["plane"] = _plane_summary(plane, time, support_source)
-    summary["events"] = trial_events(
-        recording, time, velocity, per_axis, params.mass, com=com, plane=(base, params)
-    )
-    summary["posturography"] = _posturography(force_time, plate_cop, plate_force, settings)
-    if summary["posturography"] is not None and summary["events"]["onset"]["time"] is not None:
-        # Quiet standing has no perturbation: its sway crosses any threshold of a short baseline.
-        summary["events"]["onset"] = {
-            "time": None,
-            "signal": summary["events"]["onset"]["signal"],
-            "margins": None,
-            "note": "quiet standing: no perturbation",
-        }
     return TrialAnalysis(columns, summary, base)
 
 
@@ -284,20 +284,6 @@ def _plane(
     return plane
 
 
-def _plane_summary(plane: Margins2D, time: FloatArray, source: str) -> dict[str, Any]:
-    """Return the smallest 2-D margins and times to boundary, and the 2-D verdict."""
-    return {
-        "base_source": source,
-        "min_mos": _extreme(plane.mos, time),
-        "min_mos_ap": _extreme(plane.mos_ap, time),
-        "min_mos_ml": _extreme(plane.mos_ml, time),
-        "min_mos_cmp": _extreme(plane.mos_cmp, time),
-        "min_time_to_boundary_cop": _extreme(plane.ttb_cop, time),
-        "min_time_to_boundary_xcom": _extreme(plane.ttb_xcom, time),
-        "most_demanding": _most_demanding(plane.strategy),
-    }
-
-
 def _withhold(margins: DirectionMargins, frames: NDArray[np.bool_]) -> None:
     """Withhold the verdicts of ``frames``: margins against the base NaN, strategy invalid."""
     for name in ("cop", "cmp", "step", "time_to_leave_cop", "time_to_leave_cmp"):
@@ -312,9 +298,8 @@ def _posturography(
     force_time: FloatArray | None,
     cop: FloatArray | None,
     force: FloatArray | None,
-    settings: AnalysisSettings,
-) -> dict[str, Any] | None:
-    """Sway measures of a quiet-standing trial (docs/posturography.md), else None.
+) -> tuple[SwayMeasures, float] | None:
+    """Sway measures of a quiet-standing trial (docs/posturography.md) and the rate [Hz].
 
     The whole trial at the plates' rate, its CoP low-passed at ``force_cutoff``; None when
     the plates are missing or :func:`~pushrecovery.analysis.posturography.quiet_standing`
@@ -326,7 +311,6 @@ def _posturography(
     try:
         if not quiet_standing(cop, rate, force=force):
             return None
-        measures = sway_measures(cop, rate).to_dict()
+        return sway_measures(cop, rate), rate
     except InvalidParameterError:  # too short for the spectra, or a gap in the CoP
         return None
-    return {**measures, "cop_cutoff": settings.force_cutoff, "rate": rate}

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -15,6 +15,9 @@ from pushrecovery.analysis.recording import (
 )
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
+
+if TYPE_CHECKING:
+    from pushrecovery.analysis.trial.summary import TrialSummary
 
 __all__ = [
     "COP_AHEAD_OF_ANKLE",
@@ -98,16 +101,17 @@ class AnalysisSettings:
 
 @dataclass(frozen=True, slots=True)
 class TrialAnalysis:
-    """Result of :func:`analyze`: the per-frame table and the summary (``summary.json``).
+    """Result of :func:`analyze`: the per-frame table and the summary.
 
     ``columns`` are the per-frame columns of ``frames.parquet`` (docs/analysis.md: SI units,
-    NaN where unknown, strategies as text, None where withheld); ``summary`` the trial's;
-    ``base`` the base of support per frame in the plane (a
+    NaN where unknown, strategies as text, None where withheld); ``summary`` the trial's
+    (a :class:`~pushrecovery.analysis.trial.summary.TrialSummary`; its ``to_dict()`` is
+    ``summary.json``); ``base`` the base of support per frame in the plane (a
     :class:`~pushrecovery.analysis.base_polygon.BasePolygons`; None when not computed).
     """
 
     columns: dict[str, NDArray[Any]]
-    summary: dict[str, Any]
+    summary: TrialSummary
     base: Any = None
 
     @property
