@@ -31,9 +31,7 @@ PASSES_AFTER_FAILURE = 2
 #: an interior, small enough that its active set is the problem's (with full braking held).
 RELAXED = 1e-3
 #: The relaxed interior point's warm start: the last verified set's rows start with s z at
-#: this × dual scale × range (the other's 3.0, GUIDE_CENTRE). On the flywheel benchmark's 26
-#: boundary ticks at N = 50: 390 iterations, 20 at most, with 3.0; 369 and 16 with 10 (and
-#: with 100); 380 and 17 with 30. Those ticks set the benchmark's p99.
+#: this × dual scale × range (the other's 3.0, GUIDE_CENTRE); measured in docs/mpc.md.
 RELAXED_GUIDE_CENTRE = 10.0
 #: The interior point is not asked within this relative margin of S_N's boundary (the
 #: boundary's own margin, BOUNDARY): there the feasible set has no interior and its iterates
@@ -169,19 +167,13 @@ class MPCController(Controller):
         # Whether the previous tick was verified by the passes: DAQP did not solve it, and
         # riccati.active holds its optimal set (kept by a failed solve) to start DAQP from.
         previous_verified = riccati is not None and riccati.verified
-        # After a tick the warm passes failed, the next one's fail too 88 % of the time (the
-        # benchmark's runs): PASSES_AFTER_FAILURE passes, then the interior point. With 15
-        # passes otherwise (quiet machine): 1 gave 6.2 ms of MPC on the MuJoCo torso's 3 s
-        # run, 2 gave 4.8 ms, 4 4.9 ms, 8 4.7 ms but the benchmark's p99 at N = 50 18.8x the
-        # median (2: 14.1x), 15 4.9 ms and 20.6x. Re-measured with the kept recursion
-        # (2026-12-02): 2 gave 3.29-3.38 ms and a p99 of 18.0x (best of 10 per tick), 6 2.90 ms
-        # and 19.3x, 10 2.91 ms and 20.2x.
+        # After a tick the warm passes failed, the next one's usually fail too: a few passes,
+        # then the interior point (PASSES_AFTER_FAILURE, measured in docs/mpc.md).
         passes = PASSES_AFTER_FAILURE if self._passes_failed else MAX_PASSES
         gauge = -1.0
         if self._boundary:
             # The last tick was on S_N's boundary, where the passes without full braking held
-            # verified 1 of 25 ticks after a boundary tick (0 of 32 at N = 200; the benchmark's
-            # runs): when this one is too, its boundary route at once.
+            # rarely verify the next tick (docs/mpc.md): when this one is too, its route at once.
             gauge = self._gauge(state)
             if gauge >= 1.0 - INTERIOR_MARGIN:
                 passes = 0
@@ -264,10 +256,7 @@ class MPCController(Controller):
             if not forced[0]:
                 return None
             # The passes from the last set come after the relaxed interior point, not before:
-            # with full braking held they verified 1 of 69 boundary ticks first (MuJoCo torso
-            # pushes of ±20-50 N s, flywheel pushes of −0.5 to 0.7 m/s; 0 of 26-32 in the
-            # N = 50-200 benchmark), ~12 µs on each; that one (θ just past θmax) the interior
-            # point did not verify.
+            # tried first they rarely verify a boundary tick and cost time on each (docs/mpc.md).
             interior = self._relaxed
 
         def verify(active: NDArray[np.int8]) -> bool:
