@@ -107,12 +107,16 @@ class StepInfo:
     measured_cop : float or None
         CoP measured from the contact forces, relative to the stance ankle [m] (NaN while
         airborne); None when the plant does not measure it.
+    footholds_xy : tuple of (float, float)
+        World (x, y) of every stance ankle of the run so far on the ground plane [m]; empty
+        for a sagittal plant.
     """
 
     stance: bool = True
     footholds: tuple[float, ...] = (0.0,)
     stop_impacts: int = 0
     measured_cop: float | None = None
+    footholds_xy: tuple[tuple[float, float], ...] = ()
 
 
 class Controller(ABC):

@@ -25,12 +25,13 @@ et al. 2012's 3-D LIPM with a finite foot and a reaction mass), simulated:
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.base import Command
+from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, plane_discrete
@@ -90,6 +91,13 @@ class PlaneSteppingPlant(PlantBase):
     def _in_stance(self) -> bool:
         """Stance unless a foot swings toward its landing."""
         return self._swing is None
+
+    def info(self) -> StepInfo:
+        """:meth:`PlantBase.info` with the (x, y) footholds (kept while they stay the same)."""
+        info = super().info()
+        if len(info.footholds_xy) != len(self.footholds_xy):
+            info = self._info = replace(info, footholds_xy=tuple(self.footholds_xy))
+        return info
 
     def check_state(self, state: FloatArray) -> None:
         """Require a planar state within the model."""

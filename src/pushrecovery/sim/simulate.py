@@ -19,7 +19,6 @@ from pushrecovery.sim.events import (
     ScheduledPush,
     VelocityJumping,
 )
-from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.result import Outcome, SimulationResult
 
@@ -232,7 +231,7 @@ def simulate(
         controller=controller.name,
         stop_impacts=info.stop_impacts,
         footholds=info.footholds,
-        footholds_xy=(tuple(plant.footholds_xy) if isinstance(plant, PlaneSteppingPlant) else ()),
+        footholds_xy=info.footholds_xy,
         state_labels=plant.state_labels,
         decided_time=None if decided < 0 else decided * h,
     )
