@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id
+from pushrecovery.control.wbc.bodies import body_id
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION
 
 REPEAT = 5
@@ -64,9 +64,9 @@ def g1_case() -> Case | None:
 
 def biped_case() -> Case:
     from pushrecovery import load_params
+    from pushrecovery.control.wbc.controller import WholeBodyController
     from pushrecovery.ground.support import Support
     from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
     from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos
 
     params = load_params()

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from pushrecovery import load_params
+from pushrecovery.control.wbc.bodies import body_id, colliding_geoms
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.sim.mujoco.humanoid3d import robots
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, colliding_geoms
 from pushrecovery.sim.mujoco.humanoid3d.standing import hold_standing
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT
 

@@ -8,11 +8,14 @@ import numpy as np
 import pytest
 
 from pushrecovery import load_params
+from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.control.wbc.foot_contact import foot_contact
+from pushrecovery.control.wbc.gains import WbcGains
+from pushrecovery.control.wbc.qp import WholeBodyQP
+from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
-from pushrecovery.sim.mujoco.humanoid3d.wbc import Task, WholeBodyQP, foot_contact
-from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WbcGains, WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos, push_biped3d
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.plane import cmp_polygon
@@ -325,7 +328,7 @@ def test_hip_pushes_near_the_hip_test_recover_with_feet_flat(params, model, scal
 
 
 def test_the_joint_guard_pushes_a_knee_off_its_stop_and_never_towards_it(model):
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_limits import GuardSettings, JointGuard
+    from pushrecovery.control.wbc.limits.joint_guard import GuardSettings, JointGuard
 
     guard = JointGuard(model)  # the knees, range [0, 2.5], margin 0.1 rad
     knees = [model.joint(f"{side}_knee") for side in ("left", "right")]
@@ -387,7 +390,7 @@ def test_the_paced_return_keeps_the_cop_inside_and_never_turns_the_torso_forward
 
 
 def test_the_hip_brakes_for_the_measured_spin_of_the_torso(params, model):
-    """θ + max(h²/(2 I τ), θ̇ T_b / 2) ≥ θmax − μ_θ brakes (wbc_hip): with the torso turning
+    """θ + max(h²/(2 I τ), θ̇ T_b / 2) ≥ θmax − μ_θ brakes (control.wbc.hip): with the torso turning
     faster than h/I (the legs turn against it) the flywheel's estimate alone overran θmax.
     """
     data = mujoco.MjData(model)
@@ -427,7 +430,7 @@ def test_the_g1_recovers_a_forward_push_at_80_percent_of_its_corrected_ankle_lim
 def test_the_torso_error_is_the_rotation_vector_of_r_r0_transposed():
     from scipy.spatial.transform import Rotation
 
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_control import _rotation_vector
+    from pushrecovery.control.wbc.controller import _rotation_vector
 
     rng = np.random.default_rng(42)
     for _ in range(20):

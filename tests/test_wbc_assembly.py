@@ -1,11 +1,11 @@
 """The whole-body QP's compiled assembly against a slow, obviously-correct one (issue 19).
 
-:class:`~pushrecovery.sim.mujoco.humanoid3d.wbc.WholeBodyQP` builds its QP in place with numba
-kernels and hands DAQP the least-distance form of it (:mod:`.._wbc_kernels`). Here the QP of
-the module docstring of ``wbc.py`` is assembled again with plain NumPy, row block by row block,
-from MuJoCo's M, bias forces and Jacobians, and solved by DAQP from scratch in its ordinary
-form: over pushed runs (ankle, hip, a step with a foot off the floor) both the matrices and the
-solutions must agree.
+:class:`~pushrecovery.control.wbc.qp.WholeBodyQP` builds its QP in place with numba kernels
+(:mod:`pushrecovery.kernels.wbc`) and hands DAQP the least-distance form of it. Here the QP of
+the module docstring of ``control/wbc/qp.py`` is assembled again with plain NumPy, row block
+by row block, from MuJoCo's M, bias forces and Jacobians, and solved by DAQP from scratch in
+its ordinary form: over pushed runs (ankle, hip, a step with a foot off the floor) both the
+matrices and the solutions must agree.
 """
 
 import importlib.util
@@ -17,14 +17,14 @@ import numpy as np
 import pytest
 
 from pushrecovery import load_params
+from pushrecovery.control.wbc.bodies import body_id
+from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.control.wbc.stepper.settings import StepSettings
+from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id
-from pushrecovery.sim.mujoco.humanoid3d.wbc import Task
-from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step import StepSettings
 
 #: Relative agreement of the matrices: the same products summed in another order, rounding
 #: of 1e-16 per term over sums of ~50 terms [-].

@@ -6,15 +6,17 @@ import numpy as np
 import pytest
 
 from pushrecovery import load_params
+from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.control.wbc.foot_contact import foot_contact
+from pushrecovery.control.wbc.qp import WholeBodyQP
+from pushrecovery.control.wbc.stepper.leg import axis_inertia, leg_joints
+from pushrecovery.control.wbc.stepper.plan import lipm_com, quintic
+from pushrecovery.control.wbc.stepper.settings import StepSettings
+from pushrecovery.control.wbc.stepper.stepper import Stepper
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
-from pushrecovery.sim.mujoco.humanoid3d.wbc import WholeBodyQP, foot_contact
-from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos, push_biped3d
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings, quintic
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_leg import axis_inertia, leg_joints
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import lipm_com
 
 #: The push, in CoP-region critical impulses (docs/plane.md): well outside the ankle region.
 OUTSIDE = 1.5
@@ -278,8 +280,8 @@ def test_forward_push_of_twice_wrenches_at_every_tick(forward_twice):
 
 def test_the_trailing_foot_steps_after_a_forward_step(params):
     """Left foot landed 0.4 m ahead, ξ further ahead on the midline: the right foot swings."""
+    from pushrecovery.control.wbc.stepper.plan import choose_step
     from pushrecovery.ground.support import FootPose, Stance
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import choose_step
 
     poses = (FootPose(0.4, 0.1), FootPose(0.0, -0.1))
     state = (0.3, 0.0, 1.0, 0.0)  # ξ = (0.3 + 1/ω, 0): ahead of both feet, between them
@@ -294,8 +296,8 @@ def test_the_trailing_foot_steps_after_a_forward_step(params):
 def test_no_crossing_foothold(params):
     """ξ beyond the left foot's outer side: the right foot lands at least w + 2 cm right of it
     (the library's region, cut to that half-plane, when the uncut one would cross)."""
+    from pushrecovery.control.wbc.stepper.plan import plan_foothold, planning_params
     from pushrecovery.ground.support import FootPose, Stance
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import plan_foothold, planning_params
 
     cut = planning_params(params, 0.02)
     assert cut.min_step_width == pytest.approx(params.foot_width + 0.02)
@@ -313,8 +315,8 @@ def test_no_crossing_foothold(params):
 def test_swing_path_collision_with_the_stance_sole(params):
     """Soles of length L = toe − heel and width w overlap when the ankles are closer than
     (L, w) in x and y: paths through, beside and behind the stance foot."""
+    from pushrecovery.control.wbc.stepper.plan import collides
     from pushrecovery.ground.support import FootPose
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import collides
 
     stance = FootPose(1.0, 2.0)
     length = params.toe - params.heel
@@ -333,12 +335,8 @@ def test_leg_span_and_pelvis_limit_match_the_standing_posture(model):
     the stance's own knee bend (feet under the hips) is the pelvis' height."""
     import mujoco
 
+    from pushrecovery.control.wbc.stepper.height import leg_span, pelvis_limit, segment_lengths
     from pushrecovery.sim.mujoco.humanoid3d.wbc_push import KNEE_BEND
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_height import (
-        leg_span,
-        pelvis_limit,
-        segment_lengths,
-    )
 
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)
@@ -382,8 +380,8 @@ def test_bad_follow_up_settings(kwargs, name):
 def test_segment_lengths_need_a_hip_pitch_and_a_knee(model):
     import mujoco
 
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_height import segment_lengths
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step_leg import Leg
+    from pushrecovery.control.wbc.stepper.height import segment_lengths
+    from pushrecovery.control.wbc.stepper.leg import Leg
 
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)

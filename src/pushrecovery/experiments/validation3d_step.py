@@ -147,9 +147,9 @@ def _stepping_run(body: _Body, impulse: float, azimuth: float, duration: float,
                   swing_time: float | None) -> SteppingRun:  # fmt: skip
     import mujoco
 
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
+    from pushrecovery.control.wbc.controller import WholeBodyController
+    from pushrecovery.control.wbc.stepper.settings import StepSettings
     from pushrecovery.sim.mujoco.humanoid3d.wbc_push import push_humanoid
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step import StepSettings
 
     controller = WholeBodyController(body.model, body.feet, body.upright, stepping=True,
                                      params=body.params,

@@ -208,12 +208,12 @@ STRIP_DURATION = 3.0
 
 def _strip_run(ctx: _Context, spec: Strip) -> tuple[Any, float, str]:
     """Simulate one filmstrip's push (recorded): the recording, impulse [N s] and outcome."""
+    from pushrecovery.control.wbc.controller import WholeBodyController
+    from pushrecovery.control.wbc.stepper.settings import StepSettings
     from pushrecovery.experiments.validation3d import predicted_critical_impulses
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, G1Plant, wbc_for
     from pushrecovery.sim.mujoco.humanoid3d.render3d import Recording3D
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_step import StepSettings
     from pushrecovery.sim.push import Push3D
 
     model, azimuth, fraction, controller, _, times = spec

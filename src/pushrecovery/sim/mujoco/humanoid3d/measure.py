@@ -1,8 +1,10 @@
-"""Measurements of a compiled 3-D humanoid: standing pose, sole points, inertia about an axis.
+"""Measurements of a compiled 3-D humanoid: joints by name, subtrees, standing pose, inertia.
 
 Shared by the generated biped (:mod:`.biped3d`), the robots (:mod:`.robots`) and the standing
-controller (:mod:`.standing`). World frame: x forward, y left, z up, the floor at z = 0 [m].
-MuJoCo's types appear as ``Any``: its bindings ship no type information.
+controller (:mod:`.standing`); bodies by name and the soles' points are the whole-body
+controller's (:mod:`pushrecovery.control.wbc.bodies`). World frame: x forward, y left, z up,
+the floor at z = 0 [m]. MuJoCo's types appear as ``Any``: its bindings ship no type
+information.
 """
 
 from __future__ import annotations
@@ -12,31 +14,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.bodies import sole_points
+
 FloatArray = NDArray[np.float64]
 
-__all__ = [
-    "SOLE_TOLERANCE",
-    "body_id",
-    "colliding_geoms",
-    "inertia_about_axis",
-    "joint_id",
-    "sole_points",
-    "standing_qpos",
-    "subtree",
-]
-
-#: Points of a foot's colliding geoms within this height of its lowest one form its sole [m].
-SOLE_TOLERANCE = 1e-3
-
-
-def body_id(model: Any, name: str) -> int:
-    """Return the id of body ``name`` (a KeyError naming it if the model has none)."""
-    import mujoco
-
-    index = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name))
-    if index < 0:
-        raise KeyError(f"the model has no body {name!r}")
-    return index
+__all__ = ["inertia_about_axis", "joint_id", "standing_qpos", "subtree"]
 
 
 def joint_id(model: Any, name: str) -> int:
@@ -59,56 +41,6 @@ def subtree(model: Any, root: int) -> list[int]:
         if walk == root:
             inside.append(body)
     return inside
-
-
-def colliding_geoms(model: Any, body: int) -> list[int]:
-    """Return the geoms of ``body`` that take part in contacts (contype or conaffinity set)."""
-    return [
-        g
-        for g in range(model.ngeom)
-        if int(model.geom_bodyid[g]) == body
-        and (int(model.geom_contype[g]) or int(model.geom_conaffinity[g]))
-    ]
-
-
-def _geom_low_points(model: Any, data: Any, geom: int) -> FloatArray:
-    """Return the world points of ``geom`` that can touch a floor below it [m], shape (k, 3).
-
-    A sphere: its centre minus its radius in z; a capsule: both end centres minus the radius;
-    a box: its eight corners; a mesh: its vertices. The caller keeps the lowest.
-    """
-    import mujoco
-
-    kind = int(model.geom_type[geom])
-    centre = np.array(data.geom_xpos[geom], dtype=float)
-    rot = np.array(data.geom_xmat[geom], dtype=float).reshape(3, 3)
-    size = np.array(model.geom_size[geom], dtype=float)
-    down = np.array([0.0, 0.0, size[0]])
-    if kind == mujoco.mjtGeom.mjGEOM_SPHERE:
-        return (centre - down)[None, :]
-    if kind == mujoco.mjtGeom.mjGEOM_CAPSULE:
-        ends = np.array([[0.0, 0.0, -size[1]], [0.0, 0.0, size[1]]])
-        return centre + ends @ rot.T - down
-    if kind == mujoco.mjtGeom.mjGEOM_BOX:
-        signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-        return centre + (signs * size) @ rot.T
-    if kind == mujoco.mjtGeom.mjGEOM_MESH:
-        mesh = int(model.geom_dataid[geom])
-        start, count = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
-        vertices = np.array(model.mesh_vert[start : start + count], dtype=float)
-        return centre + vertices @ rot.T
-    raise ValueError(f"geom {geom} of type {kind} cannot be a sole (sphere, capsule, box, mesh)")
-
-
-def sole_points(model: Any, data: Any, foot: int) -> FloatArray:
-    """Return the world points of foot body ``foot``'s sole [m], shape (k, 3).
-
-    The points of its colliding geoms within :data:`SOLE_TOLERANCE` of the lowest (after
-    ``mj_kinematics``): the corners of a flat box, the bottoms of contact spheres, the ends of
-    capsules lying on the floor.
-    """
-    points = np.vstack([_geom_low_points(model, data, g) for g in colliding_geoms(model, foot)])
-    return np.asarray(points[points[:, 2] <= points[:, 2].min() + SOLE_TOLERANCE], dtype=float)
 
 
 def standing_qpos(model: Any, qpos: FloatArray, feet: list[int]) -> FloatArray:

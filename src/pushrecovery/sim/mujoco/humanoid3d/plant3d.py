@@ -17,9 +17,9 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   the pushed body's centre of mass (``xfrc_applied``), the motors holding their last ``ctrl``
   meanwhile: the whole body's momentum gains J, minus what the floor's friction takes.
 * **step(ctrl, dt)** holds the motor commands ``ctrl`` [N m] (the
-  :class:`~.wbc_control.WholeBodyController`'s output: not a ``Command``), clipped to the
-  motors' ranges, for dt (rounded to physics steps); ``applied`` is the clipped ``ctrl``
-  (``input_labels``: the motors' names).
+  :class:`~pushrecovery.control.wbc.controller.WholeBodyController`'s output: not a
+  ``Command``), clipped to the motors' ranges, for dt (rounded to physics steps);
+  ``applied`` is the clipped ``ctrl`` (``input_labels``: the motors' names).
 * **falling(state)**: the capture point ξ = c_xy + ċ_xy/ω (ω = sqrt(g/z₀), z₀ the CoM's
   standing height above the soles) farther than :meth:`~Humanoid3DPlant.fall_margin` =
   2 max(τmax, τmax_roll)/(m g) outside the support polygon P (the hull of both soles at
@@ -41,13 +41,13 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, finite_float, require_type
 from pushrecovery.control.base import StepInfo
+from pushrecovery.control.wbc.bodies import body_id, sole_points
+from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import Step
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points
-from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
 from pushrecovery.sim.push import Push, Push3D
 
@@ -354,10 +354,10 @@ def wbc_for(
     """Return the whole-body controller of ``plant``'s model, feet and upright body.
 
     With ``hip`` its hip (CMP) task uses the flywheel limits of ``plant.params``
-    (:mod:`.wbc_hip`); without, it balances with the ankles only; None (the default): the
-    plant's own default, ``plant.hip_task`` (the biped3d's on, the G1's off). With
-    ``stepping`` it steps, planned for ``plant.params`` (:mod:`.wbc_step`), when neither
-    recovers.
+    (:mod:`pushrecovery.control.wbc.hip`); without, it balances with the ankles only; None
+    (the default): the plant's own default, ``plant.hip_task`` (the biped3d's on, the G1's
+    off). With ``stepping`` it steps, planned for ``plant.params``
+    (:mod:`pushrecovery.control.wbc.stepper`), when neither recovers.
 
     Raises
     ------

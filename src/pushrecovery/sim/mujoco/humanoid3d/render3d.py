@@ -33,9 +33,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, positive_float, require_type
+from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import convex_hull
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points, subtree
+from pushrecovery.sim.mujoco.humanoid3d.measure import subtree
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 from pushrecovery.sim.mujoco.humanoid3d.runs3d import Push3DRun
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import WbcRun

@@ -23,13 +23,12 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.humanoid3d.measure import (
-    body_id,
     inertia_about_axis,
     joint_id,
-    sole_points,
     standing_qpos,
     subtree,
 )

@@ -17,13 +17,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, require_type
+from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
     FALL_HEIGHT,
     Humanoid3DPlant,
     wbc_for,
 )
-from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WholeBodyController
 from pushrecovery.sim.push import Push3D
 from pushrecovery.sim.result import Outcome, strategy_used
 

@@ -11,10 +11,11 @@ from __future__ import annotations
 
 from typing import Any
 
+from pushrecovery.control.wbc.bodies import sole_points
+from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.control.wbc.gains import WbcGains
 from pushrecovery.ground.polygon import convex_hull
-from pushrecovery.sim.mujoco.humanoid3d.measure import sole_points
 from pushrecovery.sim.mujoco.humanoid3d.robots import RobotDescription, describe_robot
-from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WbcGains, WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import WbcRun, push_humanoid
 
 __all__ = ["G1_FEET", "G1_TORSO", "g1_ankle_impulse", "g1_controller", "push_g1"]

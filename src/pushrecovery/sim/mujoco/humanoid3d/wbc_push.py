@@ -20,12 +20,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.bodies import body_id, sole_points
+from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.control.wbc.gains import WbcGains
+from pushrecovery.control.wbc.stepper.settings import StepSettings
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points, standing_qpos
-from pushrecovery.sim.mujoco.humanoid3d.wbc_control import WbcGains, WholeBodyController
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step import StepSettings
+from pushrecovery.sim.mujoco.humanoid3d.measure import standing_qpos
 
 FloatArray = NDArray[np.float64]
 
@@ -67,7 +69,7 @@ class WbcRun:
     desired_cop : float array, shape (n, 2)
         The DCM law's CoP [m] (world xy).
     cmp_offset : float array, shape (n, 2)
-        The hip law's CMP offset δ from the CoP [m] (0 with the ankles only, :mod:`.wbc_hip`).
+        The hip law's CMP offset δ from the CoP [m] (0 with the ankles only, :mod:`~.wbc.hip`).
     ok : bool array, shape (n,)
         Whether DAQP solved the tick.
     solve_time, control_time, physics_time : float arrays, shape (n,)
@@ -162,9 +164,9 @@ def push_biped3d(
     model : mujoco.MjModel, optional
         A compiled ``biped3d_model(params)`` to reuse.
     hip : bool
-        Enable the hip (CMP) task with ``params``' flywheel limits (:mod:`.wbc_hip`).
+        Enable the hip (CMP) task with ``params``' flywheel limits (:mod:`~.wbc.hip`).
     stepping : bool
-        Enable the stepping task, planned for ``params`` (:mod:`.wbc_step`).
+        Enable the stepping task, planned for ``params`` (:mod:`~.wbc.stepper`).
     step_settings : StepSettings, optional
         Its settings.
     """

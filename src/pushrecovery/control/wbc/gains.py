@@ -1,4 +1,4 @@
-"""The gains and weights of the whole-body controller's tasks (:mod:`.wbc_control`)."""
+"""The gains and weights of the whole-body controller's tasks (:mod:`.controller`)."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ class WbcGains:
     com_weight, torso_weight, height_weight, posture_weight : float
         W of each task (> 0).
     hip_weight : float
-        W of the centroidal momentum task L̇_{x,y} while the hip acts (> 0, :mod:`.wbc_hip`).
+        W of the centroidal momentum task L̇_{x,y} while the hip acts (> 0, :mod:`.hip`).
     hip_torso_weight : float
         The torso task's W while the hip acts (> 0): relaxed, the torso turns.
     return_stiffness, return_damping : float

@@ -1,9 +1,9 @@
-r"""The feet of the whole-body QP (:mod:`.wbc`): each sole frame and its wrench constraints.
+r"""The feet of the whole-body QP (:mod:`.qp`): each sole frame and its wrench constraints.
 
 A foot's wrench w = (F, T) is the force and moment the floor exerts on it at its *sole frame*
 (the foot body's axes, its origin on the sole plane under the ankle; F_z > 0 pushes the foot
 up). Its linear constraints G w ≤ 0: unilateral contact, the friction pyramid inscribed in
-Coulomb's cone, the CoP inside the sole polygon and the yaw friction (:mod:`.wbc`'s docstring).
+Coulomb's cone, the CoP inside the sole polygon and the yaw friction (:mod:`.qp`'s docstring).
 """
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.bodies import body_id, colliding_geoms, sole_points
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import convex_hull
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, colliding_geoms, sole_points
 
 FloatArray = NDArray[np.float64]
 
@@ -71,7 +71,7 @@ class FootContact:
 def foot_contact(model: Any, data: Any, name: str) -> FootContact:
     """Return the :class:`FootContact` of foot body ``name``, measured in ``data``'s pose.
 
-    The sole polygon is the convex hull of the sole points (:func:`~.measure.sole_points`,
+    The sole polygon is the convex hull of the sole points (:func:`~.bodies.sole_points`,
     after ``mj_kinematics``) in the foot body's frame; the sole frame's origin is the body
     origin moved along the body's z onto the sole plane. μ is the largest sliding friction of
     the foot's colliding geoms and every geom they can touch (the floor), as MuJoCo mixes two

@@ -1,11 +1,11 @@
-"""The whole-body controller's tasks as one stack of rows (:mod:`.wbc_control`, :mod:`.wbc`).
+"""The whole-body controller's tasks as one stack of rows (:mod:`.controller`, :mod:`.qp`).
 
 The QP's cost Σ_k W_k ‖A_k x − b_k‖² is a sum over rows: row r of weight W_r adds
 W_r a_rᵀ a_r to H and −W_r a_rᵀ b_r to f. :class:`TaskStack` keeps every task of a tick as
 rows of one matrix (with one target and one weight per row), so that the QP takes them in
-one compiled call (``WholeBodyQP._solve_rows``) instead of a :class:`~.wbc.Task`, a check and
+one compiled call (``WholeBodyQP._solve_rows``) instead of a :class:`~.task.Task`, a check and
 a call per task. Row order: the CoM (2), the torso (3), the pelvis height (1) and the posture
-(nv − 6), written in place by the ankle controller's kernel (``_wbc_kernels.ankle_targets``),
+(nv − 6), written in place by the ankle controller's kernel (``kernels.wbc.ankle_targets``),
 then the tick's other tasks (the hip's momentum, the stepper's, the joint guard's).
 """
 
@@ -16,8 +16,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.sim.mujoco.humanoid3d.wbc import Task
-from pushrecovery.sim.mujoco.humanoid3d.wbc_gains import WbcGains
+from pushrecovery.control.wbc.gains import WbcGains
+from pushrecovery.control.wbc.tasks.task import Task
 
 FloatArray = NDArray[np.float64]
 
@@ -92,7 +92,7 @@ class TaskStack:
         return count
 
     def tasks(self, momentum: Task | None, others: Sequence[Task]) -> list[Task]:
-        """Return the ankle controller's rows as :class:`~.wbc.Task` copies, then the others.
+        """Return the ankle controller's rows as :class:`~.task.Task` copies, then the others.
 
         Order: the CoM, the hip's ``momentum`` (if any), the torso, the pelvis height, the
         posture, then ``others``.

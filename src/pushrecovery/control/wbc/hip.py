@@ -7,9 +7,9 @@ angular momentum about its CoM c at the rate
 .. math:: \dot{\mathbf L} = \sum_i (\mathbf p_i - \mathbf c) \times R_i \mathbf F_i
           + R_i \mathbf T_i ,
 
-linear in w (:func:`momentum_rows`). With the total vertical force F_z ≈ m g and the CoM at a
-constant height, the horizontal CoM dynamics are those of the LIPM about the centroidal moment
-pivot (CMP; Popovic, Hofmann & Herr 2005, Hofmann et al. 2009):
+linear in w (:func:`~.momentum.momentum_rows`). With the total vertical force F_z ≈ m g and
+the CoM at a constant height, the horizontal CoM dynamics are those of the LIPM about the
+centroidal moment pivot (CMP; Popovic, Hofmann & Herr 2005, Hofmann et al. 2009):
 
 .. math:: \ddot c_x = \omega^2 (c_x - p_x - \delta_x), \quad
           \ddot c_y = \omega^2 (c_y - p_y - \delta_y), \qquad
@@ -61,7 +61,6 @@ hip pushed a second time from near θmax, and the feet unloaded.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -73,7 +72,7 @@ from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["BRAKE", "IDLE", "PUSH", "UPRIGHT", "HipLaw", "momentum_rows"]
+__all__ = ["BRAKE", "IDLE", "PUSH", "UPRIGHT", "HipLaw"]
 
 #: Phases of an axis.
 IDLE, PUSH, BRAKE = 0, 1, 2
@@ -81,36 +80,6 @@ IDLE, PUSH, BRAKE = 0, 1, 2
 UPRIGHT = 0.01
 #: How far short of θmax the brake aims the flywheel's stop [rad] (the stop's estimate errs).
 ANGLE_MARGIN = 0.03
-
-
-def momentum_rows(
-    data: Any, bodies: NDArray[np.intp], size: int, nv: int, com: FloatArray, origins: FloatArray
-) -> FloatArray:
-    """Return the 3 × size rows A with A x = L̇ (module docstring) [N m per unit of w].
-
-    Parameters
-    ----------
-    data : mujoco.MjData
-        After ``mj_kinematics``: the feet's orientations ``xmat`` and positions ``xpos``.
-    bodies : int array
-        The feet's body ids, in the QP's order.
-    size, nv : int
-        The QP's unknowns (nv accelerations then 6 per foot).
-    com : float array, shape (3,)
-        The CoM c [m].
-    origins : float array, shape (n, 3)
-        Each sole frame's origin in its body frame [m].
-    """
-    rows = np.zeros((3, size))
-    rot = np.asarray(data.xmat)[bodies].reshape(-1, 3, 3)
-    points = np.asarray(data.xpos)[bodies] + np.einsum("nij,nj->ni", rot, origins)
-    for i, (r, lever) in enumerate(zip(rot, points - com, strict=True)):
-        skew = np.array(
-            [[0.0, -lever[2], lever[1]], [lever[2], 0.0, -lever[0]], [-lever[1], lever[0], 0.0]]
-        )
-        rows[:, nv + 6 * i : nv + 6 * i + 3] = skew @ r
-        rows[:, nv + 6 * i + 3 : nv + 6 * i + 6] = r
-    return rows
 
 
 class HipLaw:

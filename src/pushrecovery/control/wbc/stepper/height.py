@@ -1,4 +1,4 @@
-r"""How high the pelvis may stand while the legs step: the leg's reach (:mod:`.wbc_step`).
+r"""How high the pelvis may stand while the legs step: the leg's reach (:mod:`.stepper.stepper`).
 
 World frame, x forward, y left, z up, SI units. A leg of thigh a and shank b (hip to knee,
 knee to ankle, the joints' anchors) with its knee bent by κ spans
@@ -24,8 +24,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.stepper.leg import Leg
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_leg import Leg
 
 FloatArray = NDArray[np.float64]
 
@@ -40,7 +40,7 @@ def segment_lengths(data: Any, leg: Leg) -> tuple[float, float]:
     Raises
     ------
     InvalidParameterError
-        If the leg has no hip pitch or knee joint (:func:`~.wbc_step_leg.leg_joints`).
+        If the leg has no hip pitch or knee joint (:func:`~.leg.leg_joints`).
     """
     if leg.hip_pitch < 0 or leg.knee < 0:
         raise InvalidParameterError("the leg needs a hip_pitch and a knee joint to measure")

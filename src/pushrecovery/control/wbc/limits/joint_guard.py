@@ -1,6 +1,6 @@
 r"""The joint-range guard of the whole-body controller: keep every joint off its stops.
 
-The QP (:mod:`.wbc`) models the motors, the contacts and the rigid-body dynamics, but not a
+The QP (:mod:`.qp`) models the motors, the contacts and the rigid-body dynamics, but not a
 joint's range: the constraint force of a joint on its stop (MuJoCo's limit constraint) is
 missing from its dynamics rows, so a task that drives a joint onto its stop gets a wrong
 answer from the QP, and a leg on the knee's stop is also straight, a kinematic singularity
@@ -30,45 +30,16 @@ import math
 from dataclasses import dataclass, fields
 from typing import Any
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.sim.mujoco.humanoid3d.wbc import Task
+from pushrecovery.kernels.wbc import guard_rows
 
 FloatArray = NDArray[np.float64]
 
 __all__ = ["GuardSettings", "JointGuard"]
-
-
-@numba.njit(cache=True, nogil=True)
-def guard_rows(qpos, qvel, joints, edges, settings, stack, targets, weights, start):  # type: ignore[no-untyped-def]
-    """Write the joint guard's rows (:meth:`JointGuard.task_rows`) from row ``start``.
-
-    ``joints`` (n, 2): each joint's qpos and dof address; ``edges`` (n, 2) its (low, high);
-    ``settings`` (T, k, d, W). A row: q̈_dof (zeros, 1 at the dof), its target, W. Returns the
-    rows' end. No fast-math: ``task_rows``' Python floats, operation for operation (``min(v,
-    0.0)`` is v unless 0.0 < v, ``max`` likewise).
-    """
-    horizon, stiffness, damping, weight = settings[0], settings[1], settings[2], settings[3]
-    count = start
-    for i in range(joints.shape[0]):
-        q, v = qpos[joints[i, 0]], qvel[joints[i, 1]]
-        slow, fast = 0.0 if 0.0 < v else v, 0.0 if 0.0 > v else v  # min(v, 0), max(v, 0)
-        if q + horizon * slow < edges[i, 0]:
-            gap = edges[i, 0] - q
-            target = stiffness * (0.0 if 0.0 > gap else gap) - damping * slow
-        elif q + horizon * fast > edges[i, 1]:
-            gap = edges[i, 1] - q
-            target = stiffness * (0.0 if 0.0 < gap else gap) - damping * fast
-        else:
-            continue
-        stack[count] = 0.0
-        stack[count, joints[i, 1]] = 1.0
-        targets[count], weights[count] = target, weight
-        count += 1
-    return count
 
 
 @dataclass(frozen=True)
@@ -196,7 +167,7 @@ class JointGuard:
         return matrix, targets[:count].copy()
 
     def tasks(self, qpos: FloatArray, qvel: FloatArray, nv: int) -> list[Task]:
-        """Return :meth:`task_rows` as a :class:`~.wbc.Task` (none without rows)."""
+        """Return :meth:`task_rows` as a :class:`~.task.Task` (none without rows)."""
         matrix, target = self.task_rows(qpos, qvel, nv)
         return [Task("joint guard", matrix, target, self.settings.weight)] if target.size else []
 
@@ -206,10 +177,10 @@ class JointGuard:
     ) -> int:  # fmt: skip
         """Write :meth:`task_rows`' task as stacked rows from row ``start``; return their end.
 
-        The controller's fast path (:class:`~.wbc_task_stack.TaskStack`): row r of ``stack``
+        The controller's fast path (:class:`~.stack.TaskStack`): row r of ``stack``
         (over all the QP's unknowns, zeros beyond q̈) with ``targets[r]`` and weight
         ``weights[r]`` = W, in one compiled call instead of a task's arrays, a
-        :class:`~.wbc.Task` and its copy into the stack. The caller reserves a row for each
+        :class:`~.task.Task` and its copy into the stack. The caller reserves a row for each
         guarded joint after ``start`` (the kernel does not check its writes).
         """
         if start + self.qpos.size > min(stack.shape[0], targets.shape[0], weights.shape[0]):

@@ -1,14 +1,14 @@
 r"""The stepping task of the whole-body controller: decide, plan, swing and land a foot.
 
 World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
-:class:`~.wbc_control.WholeBodyController` (``stepping=True``) at every control tick:
+:class:`~.controller.WholeBodyController` (``stepping=True``) at every control tick:
 
 * **Decision** (double support): step when the capture point ξ = c + ċ/ω is beyond what the
   ankles (and the hip, if enabled) recover: its signed distance to the CoP region P (or the
-  CMP region P ⊕ box(a'_x, a'_y), :class:`~.wbc_hip.HipLaw`) below −``margin``.
-* **Plan** (:mod:`.wbc_step_plan`): the foot on ξ's side of the ankles' midpoint swings
+  CMP region P ⊕ box(a'_x, a'_y), :class:`~.hip.HipLaw`) below −``margin``.
+* **Plan** (:mod:`.plan`): the foot on ξ's side of the ankles' midpoint swings
   (within ``follow_time`` of a touchdown, the trailing foot unless the landed foot's plan
-  captures in fewer steps, :func:`~.wbc_step_plan.choose_step`); the library's one-step
+  captures in fewer steps, :func:`~.plan.choose_step`); the library's one-step
   (else two-step) capture region of the state now, the stance foot's measured pose, a
   touchdown after t_s, and (when the controller has its hip task) the hip's box; its
   recommended ``foothold`` (the region's Chebyshev centre) is the landing ankle's target;
@@ -17,7 +17,7 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
   ``swing_time`` (default the body's ``min_step_time``) and grows to what a share
   ``torque_share`` of the swing hip's motor limit needs for that foothold (the plan redone
   for the longer time), up to ``max_swing_time``.
-* **Swing**: the foot is dropped from the QP's contacts (:meth:`~.wbc.WholeBodyQP.set_contacts`)
+* **Swing**: the foot is dropped from the QP's contacts (:meth:`~.qp.WholeBodyQP.set_contacts`)
   and its sole frame tracks a reference: in x, y a quintic from the reference's position,
   velocity and acceleration to the foothold with zero velocity and acceleration at the
   touchdown time t_1; in z, with s = (t − t_0)/(t_1 − t_0),
@@ -32,7 +32,7 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
 * **Knee guard** (always, with stepping): a knee below ``knee_min`` or reaching it within
   50 ms gets the task q̈ = k_p (q_min − q) − d_p q̇: the QP does not model the joint stop, and
   a stance knee driven onto it made the QP infeasible (torque limits with the contact rows).
-* **Pelvis height** (:meth:`Stepper.pelvis_height`, :mod:`.wbc_step_height`): the pelvis
+* **Pelvis height** (:meth:`Stepper.pelvis_height`, :mod:`.height`): the pelvis
   task's target lowered so that every knee stays bent by ``knee_reach`` (the swinging leg at
   its foothold), by at most ``max_drop``.
 * **Re-plan**: every ``replan_period`` until ``replan_fraction`` of the swing, the foothold
@@ -53,19 +53,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import FootPose, Stance
-from pushrecovery.params import BodyParams
-from pushrecovery.sim.mujoco.humanoid3d.measure import sole_points
-from pushrecovery.sim.mujoco.humanoid3d.wbc import FootContact, Task
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_height import (
-    leg_span,
-    pelvis_limit,
-    segment_lengths,
-)
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_leg import leg_joints, leg_swing_time
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import (
+from pushrecovery.control.wbc.bodies import sole_points
+from pushrecovery.control.wbc.foot_contact import FootContact
+from pushrecovery.control.wbc.stepper.height import leg_span, pelvis_limit, segment_lengths
+from pushrecovery.control.wbc.stepper.leg import leg_joints, leg_swing_time
+from pushrecovery.control.wbc.stepper.plan import (
     StepRecord,
     choose_step,
     evaluate,
@@ -76,11 +68,16 @@ from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import (
     rotation_vector,
     yaw_of,
 )
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_settings import StepSettings
+from pushrecovery.control.wbc.stepper.settings import StepSettings
+from pushrecovery.control.wbc.tasks.task import Task
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.support import FootPose, Stance
+from pushrecovery.params import BodyParams
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["StepRecord", "StepSettings", "Stepper", "quintic"]
+__all__ = ["Stepper"]
 
 
 class Stepper:
@@ -122,7 +119,7 @@ class Stepper:
             raise InvalidParameterError(f"hip must be a bool, got {hip!r}")
         self._model = model
         self.params = replace(params, com_height=com_height)
-        clearance = settings.clearance  # the no-crossing plan (wbc_step_plan.planning_params)
+        clearance = settings.clearance  # the no-crossing plan (plan.planning_params)
         self.cut = None if clearance is None else planning_params(self.params, clearance)
         self.feet, self.left, self.floor, self.settings = feet, left, floor, settings
         self.hip = hip
@@ -153,13 +150,13 @@ class Stepper:
         return float(com[0]), float(com[1]), float(vel[0]), float(vel[1])
 
     def _foothold(self, data: Any, swing: int, t: float) -> tuple[FloatArray, int]:
-        """Plan the foothold of foot ``swing`` for a touchdown after t [s] (wbc_step_plan)."""
+        """Plan the foothold of foot ``swing`` for a touchdown after t [s] (plan)."""
         stance = (self._side(1 - swing), self._pose(data, 1 - swing))
         return plan_foothold(self.params, self._state(data), stance,
                              self._pose(data, swing), t, hip=self.hip, cut=self.cut)  # fmt: skip
 
     def _choose(self, data: Any, t: float) -> tuple[int, FloatArray, int]:
-        """Choose the swing foot and plan its foothold (:func:`~.wbc_step_plan.choose_step`)."""
+        """Choose the swing foot and plan its foothold (:func:`~.plan.choose_step`)."""
         poses = (self._pose(data, self.left), self._pose(data, 1 - self.left))
         landed = None
         if self._landed is not None and self.steps[-1].touchdown is not None:
@@ -184,7 +181,7 @@ class Stepper:
         """Plan a step from double support and start its swing; return the swing foot's index.
 
         The swing time starts at ``swing_time`` and grows to what the swing hip needs for the
-        planned foothold (:func:`~.wbc_step_leg.leg_swing_time`, ``torque_share``), the
+        planned foothold (:func:`~.leg.leg_swing_time`, ``torque_share``), the
         foothold re-planned for it, until the two agree within 10 ms or ``max_swing_time``.
         """
         t0, s = float(data.time), self.settings
@@ -294,7 +291,7 @@ class Stepper:
     def pelvis_height(self, data: Any, height: float) -> float:
         """Return the pelvis height task's target [m]: ``height`` lowered for the legs' reach.
 
-        min(height, :func:`~.wbc_step_height.pelvis_limit`) with every knee bent by at least
+        min(height, :func:`~.height.pelvis_limit`) with every knee bent by at least
         ``knee_reach`` (the swinging leg at its foothold, its hip moved with the LIPM's CoM on
         the stance ankle to touchdown), and at least ``height − max_drop``; ``height`` when
         ``knee_reach`` is None or a leg lacks a hip pitch or knee joint.

@@ -22,7 +22,7 @@ subject to
   foot [1/s] (with k_c = 0 the feet crept and tipped under MuJoCo's soft contact unseen:
   docs/humanoid3d.md, "The whole-body controller");
   a foot off the floor (:meth:`WholeBodyQP.set_contacts`, a swing) has w_i = 0 instead and no
-  wrench inequalities (its motion is a task, :mod:`.wbc_step`);
+  wrench inequalities (its motion is a task, :mod:`.stepper.stepper`);
 * unilateral contact F_z ≥ 0 and a linearised friction pyramid |F_x|, |F_y| ≤ μ' F_z with
   μ' = μ/√2 (the square inscribed in Coulomb's cone of μ; μ the larger sliding friction of
   the sole's and the floor's geoms, MuJoCo's mixing rule);
@@ -32,12 +32,12 @@ subject to
   origin (a conservative bound of the torsional friction);
 * motor limits: the torque of each motor, τ_a / gear, within its ``actuator_ctrlrange``.
 
-The tasks A_k x = b_k are handed in by the controller (:mod:`.wbc_control`): the CoM's
+The tasks A_k x = b_k are handed in by the controller (:mod:`.controller`): the CoM's
 acceleration, exact from Newton's law on the wrenches, m c̈ = m g + Σ_i R_i F_i; the torso's
 angular acceleration J_r q̈ + J̇_r q̇; the pelvis height z̈ = J_z q̈ + J̇_z q̇; and the posture
 q̈_j. Solved with DAQP (a dense dual active-set solver), its models kept between ticks (the
 equality rows immutable, the last active set the warm start), first without the motor rows.
-The compiled kernels of :mod:`._wbc_kernels` assemble each tick in place and hand DAQP its
+The compiled kernels of :mod:`.kernels.wbc` assemble each tick in place and hand DAQP its
 least-distance form (H factored on its envelope). MuJoCo's types appear as ``Any``.
 """
 
@@ -50,53 +50,19 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.buffers import Buffers, full_inertia, inertia_writer
+from pushrecovery.control.wbc.foot_contact import FootContact
+from pushrecovery.control.wbc.least_distance import LeastDistanceSolver
+from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.sim.mujoco.humanoid3d._wbc_buffers import Buffers, full_inertia, inertia_writer
-from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
-    add_task,
-    assemble_rows,
-    constraints,
-    sole_frames,
-    sole_origins,
-)
-from pushrecovery.sim.mujoco.humanoid3d.wbc_feet import FootContact, foot_contact
-from pushrecovery.sim.mujoco.humanoid3d.wbc_ldp import LeastDistanceSolver
+from pushrecovery.kernels.wbc import add_task, assemble_rows, constraints, sole_frames, sole_origins
 
 FloatArray = NDArray[np.float64]
 
-__all__ = [
-    "CONTACT_DAMPING",
-    "FootContact",
-    "Task",
-    "WbcProblem",
-    "WbcSolution",
-    "WholeBodyQP",
-    "foot_contact",
-]
+__all__ = ["CONTACT_DAMPING", "WbcProblem", "WbcSolution", "WholeBodyQP"]
 
 #: The default k_c, the damping of a foot's drift in its fixed-foot rows [1/s].
 CONTACT_DAMPING = 20.0
-
-
-@dataclass(frozen=True)
-class Task:
-    """One weighted task A x = b of the QP (module docstring).
-
-    Attributes
-    ----------
-    name : str
-        For reports.
-    matrix, target : float arrays, shapes (k, m) and (k,)
-        A over the first m ≤ nv + 6 n_feet unknowns of x = (q̈, w_1, …) (m = nv: a task on
-        q̈ alone), and b [the task's units: m/s² or rad/s²].
-    weight : float
-        W > 0 [-].
-    """
-
-    name: str
-    matrix: FloatArray
-    target: FloatArray
-    weight: float
 
 
 @dataclass(frozen=True)
@@ -312,7 +278,7 @@ class WholeBodyQP:
 
         The controller's fast path: ``matrix`` (≥ count, size), ``target`` and ``weights``
         (≥ count), all C-contiguous float64, row r of weight ``weights[r]``, its tasks' rows in
-        their order; after MuJoCo's calls one compiled call (:func:`._wbc_kernels.assemble_rows`)
+        their order; after MuJoCo's calls one compiled call (:func:`.kernels.wbc.assemble_rows`)
         instead of a check and a call per task and kernel (the same sums: the same QP to the
         last bit).
         """
@@ -325,7 +291,7 @@ class WholeBodyQP:
         return int(count)
 
     def _tick_arguments(self, data: Any) -> None:
-        """Gather :func:`._wbc_kernels.assemble_rows`' arrays after the tasks' and k_c.
+        """Gather :func:`.kernels.wbc.assemble_rows`' arrays after the tasks' and k_c.
 
         Also ``sole_origins``' arguments and the bound ``mj_fullM`` of ``data``.
         """
@@ -381,7 +347,7 @@ class WholeBodyQP:
         return self._solve_assembled(self._assemble_rows(data, matrix, target, weights, count))
 
     def _solve_assembled(self, count: int) -> WbcSolution:
-        """Solve the QP of ``count`` rows in the buffers (:meth:`solve`, :mod:`.wbc_ldp`)."""
+        """Solve the QP of ``count`` rows in the buffers (:meth:`solve`, :mod:`.least_distance`)."""
         x, ctrl, elapsed, steps = self._solver.solve(count)
         if x is None:
             feet = len(self.feet)

@@ -1,9 +1,9 @@
-r"""The whole-body QP's solve (:mod:`.wbc`): DAQP on its least-distance form, motor rows last.
+r"""The whole-body QP's solve (:mod:`.qp`): DAQP on its least-distance form, motor rows last.
 
-:class:`~.wbc.WholeBodyQP` writes the QP min ½ xᵀ H x + fᵀ x s.t. l ≤ A x ≤ u into its
-buffers (:mod:`._wbc_buffers`): the equality rows first, the wrench rows, then one row per
+:class:`~.qp.WholeBodyQP` writes the QP min ½ xᵀ H x + fᵀ x s.t. l ≤ A x ≤ u into its
+buffers (:mod:`.buffers`): the equality rows first, the wrench rows, then one row per
 motor. :class:`LeastDistanceSolver` factors H on its envelope and hands DAQP the problem's
-least-distance form (:func:`._wbc_kernels.least_distance`: H = I, M = A R⁻¹, bounds shifted),
+least-distance form (:func:`.kernels.wbc.least_distance`: H = I, M = A R⁻¹, bounds shifted),
 first *without* the motor rows: a convex QP's optimum stays optimal under constraints it
 satisfies, so when every command lands strictly inside its range that is the answer; else it
 solves again with them, and keeps them while a motor stays on its limit. DAQP keeps one model
@@ -19,13 +19,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.sim.mujoco.humanoid3d._wbc_buffers import Buffers
-from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
-    commands,
-    least_distance,
-    recover,
-    transform_rows,
-)
+from pushrecovery.control.wbc.buffers import Buffers
+from pushrecovery.kernels.wbc import commands, least_distance, recover, transform_rows
 
 FloatArray = NDArray[np.float64]
 
@@ -41,7 +36,7 @@ class LeastDistanceSolver:
     Parameters
     ----------
     buf : Buffers
-        The QP's arrays (:class:`~._wbc_buffers.Buffers`).
+        The QP's arrays (:class:`~.buffers.Buffers`).
     equalities : int
         The number of equality rows at the top of ``buf.rows``.
     ctrl_low, ctrl_high : float arrays, shape (nu,)

@@ -1,7 +1,16 @@
-r"""Compiled (numba, cached on disk) assembly of the whole-body QP of :mod:`.wbc`, in place.
+r"""The whole-body controller's compiled kernels (numba, cached on disk): its QP, in place.
 
-One file on purpose: numba's disk cache is keyed by the file of each function. Every kernel
-writes into buffers the caller allocated once; none allocates more than an index vector.
+Plain array functions for :mod:`pushrecovery.control.wbc` (the QP's assembly and
+least-distance form, :mod:`~pushrecovery.control.wbc.qp` and
+:mod:`~pushrecovery.control.wbc.least_distance`; the ankle tasks' rows,
+:mod:`~pushrecovery.control.wbc.controller`; the joint guard's rows,
+:mod:`~pushrecovery.control.wbc.limits.joint_guard`). Every kernel writes into buffers the
+caller allocated once; none allocates more than an index vector.
+
+Over 400 lines on purpose: numba's disk cache is keyed by the file of each function, and the
+kernels call one another (``assemble_rows`` runs ``sole_frames``, ``add_rows`` and
+``constraints``; ``least_distance`` runs ``transform_rows``; ``balance_point`` runs
+``rotation_vector``): one group, one file.
 
 The QP min ½ xᵀ H x + fᵀ x s.t. l ≤ A x ≤ u is handed to DAQP in the form DAQP itself solves
 (its least-distance problem, Arnström, Bemporad & Axehill 2022): with H = Rᵀ R (R = Lᵀ, L the
@@ -66,7 +75,7 @@ def constraints(  # type: ignore[no-untyped-def]
     mass, qfrc_bias, qfrc_passive, jac, jac_dot, local, qvel, contacts, unactuated, actuated,
     gear, ctrl_low, ctrl_high, foot_rows, foot_start, damping, rows, upper, lower, offset,
 ):  # fmt: skip
-    """Write the constraint rows of :class:`~.wbc.WholeBodyQP` into ``rows``; return their count.
+    """Write the constraint rows of the QP (``WholeBodyQP``) into ``rows``; return their count.
 
     Row order: the unactuated rows of the dynamics M q̈ − J_cᵀ w = −h; per foot, six rows
     J_i q̈ = −J̇_i q̇ − k_c J_i q̇ (in contact) or w_i = 0 (swinging); the wrench rows G_i w_i ≤ 0
@@ -338,7 +347,7 @@ def ankle_targets(  # type: ignore[no-untyped-def]
     xmat, bodies, mass, com, cop, offset, omega2, gravity, error, jacp, jacr, dots, qvel, qpos,
     posture, height, torso_z, gains, upright, stack, targets,
 ):  # fmt: skip
-    """Write the ankle controller's task rows and targets (:mod:`.wbc_control`).
+    """Write the ankle controller's task rows and targets (``WholeBodyController``).
 
     ``stack`` (≥ nv rows of the QP's size, zeros beyond what is written here) receives the
     tasks' rows in the order of the targets: the CoM's R_i[:2] / m on each foot's force
@@ -377,3 +386,32 @@ def ankle_targets(  # type: ignore[no-untyped-def]
     for j in range(nv - 6):
         targets[6 + j] = gains[4] * (posture[j] - qpos[7 + j]) - gains[5] * qvel[6 + j]
     return math.sqrt(error2) < upright and math.sqrt(spin2) < upright
+
+
+@numba.njit(cache=True, nogil=True)
+def guard_rows(qpos, qvel, joints, edges, settings, stack, targets, weights, start):  # type: ignore[no-untyped-def]
+    """Write the joint guard's rows (``JointGuard.task_rows``) from row ``start``.
+
+    ``joints`` (n, 2): each joint's qpos and dof address; ``edges`` (n, 2) its (low, high);
+    ``settings`` (T, k, d, W). A row: q̈_dof (zeros, 1 at the dof), its target, W. Returns the
+    rows' end. No fast-math: ``task_rows``' Python floats, operation for operation (``min(v,
+    0.0)`` is v unless 0.0 < v, ``max`` likewise).
+    """
+    horizon, stiffness, damping, weight = settings[0], settings[1], settings[2], settings[3]
+    count = start
+    for i in range(joints.shape[0]):
+        q, v = qpos[joints[i, 0]], qvel[joints[i, 1]]
+        slow, fast = 0.0 if 0.0 < v else v, 0.0 if 0.0 > v else v  # min(v, 0), max(v, 0)
+        if q + horizon * slow < edges[i, 0]:
+            gap = edges[i, 0] - q
+            target = stiffness * (0.0 if 0.0 > gap else gap) - damping * slow
+        elif q + horizon * fast > edges[i, 1]:
+            gap = edges[i, 1] - q
+            target = stiffness * (0.0 if 0.0 < gap else gap) - damping * fast
+        else:
+            continue
+        stack[count] = 0.0
+        stack[count, joints[i, 1]] = 1.0
+        targets[count], weights[count] = target, weight
+        count += 1
+    return count

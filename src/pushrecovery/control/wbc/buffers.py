@@ -1,4 +1,4 @@
-"""The whole-body QP's per-tick arrays, allocated once, and MuJoCo's dense inertia (:mod:`.wbc`)."""
+"""The whole-body QP's per-tick arrays, allocated once, and MuJoCo's dense inertia (:mod:`.qp`)."""
 
 from __future__ import annotations
 

@@ -1,8 +1,8 @@
 """The swing leg of the whole-body controller's step: its joints, inertia and swing time.
 
 World frame, x forward, y left, z up, SI units. The swing-time bound is derived in
-:mod:`~.wbc_step_plan` (its module docstring); used by :class:`~.wbc_step.Stepper` and the knee
-and pelvis limits (:mod:`~.wbc_step_height`).
+:mod:`~.plan` (its module docstring); used by :class:`~.stepper.stepper.Stepper` and the knee
+and pelvis limits (:mod:`~.height`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step_plan import QUINTIC_PEAK, lipm_com
+from pushrecovery.control.wbc.stepper.plan import QUINTIC_PEAK, lipm_com
 
 FloatArray = NDArray[np.float64]
 

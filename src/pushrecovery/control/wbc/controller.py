@@ -1,4 +1,4 @@
-r"""The whole-body balance controller: the ankle strategy's tasks for :class:`~.wbc.WholeBodyQP`.
+r"""The whole-body balance controller: the ankle strategy's tasks for :class:`~.qp.WholeBodyQP`.
 
 Tasks, each an acceleration a PD law asks for (world frame, x forward, y left, z up, SI):
 
@@ -23,16 +23,16 @@ Tasks, each an acceleration a PD law asks for (world frame, x forward, y left, z
 Weights (:class:`WbcGains`): CoM 10, torso 1, pelvis 1, posture 0.01: the CoM law dominates,
 the torso stays upright and the posture fills the null space.
 
-* **Hip, CMP balancing** (``hip=params``, :mod:`.wbc_hip`): when the capture point leaves the
+* **Hip, CMP balancing** (``hip=params``, :mod:`.hip`): when the capture point leaves the
   CoP region, the bang-bang law of Stephens Sec. III commands a CMP offset δ beyond the foot:
   a momentum task L̇_xy = m g (−δ_y, δ_x) (weight 10), the CoM task c̈ = ω² (c − p_des − δ)
   with p_des on the edge, the torso task's pitch and roll relaxed (weight 1e-3; its yaw keeps
   its gains and weight) while it acts; afterwards the torso returns upright under k_R = 4,
   d_R = 4, paced by the CoP's room (``HipLaw.paced_return``), until within 0.01 rad.
-* **Joint guard** (:mod:`.wbc_limits`, without stepping; the stepper guards its knees): the
+* **Joint guard** (:mod:`.limits.joint_guard`, without stepping; the stepper guards its knees): the
   knees kept 0.1 rad off their stops.
 
-* **Stepping** (``stepping=True``, :mod:`.wbc_step`): when ξ is beyond the ankles' (and the
+* **Stepping** (``stepping=True``, :mod:`.stepper.stepper`): when ξ is beyond the ankles' (and the
   hip's) region, the foot on ξ's side leaves the contacts and a swing-foot task carries it to
   the capture region's recommended foothold, re-planned during the swing; at touchdown it
   rejoins the contacts and the ankles balance about the new feet's midpoint.
@@ -52,32 +52,26 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.bodies import body_id, sole_points
+from pushrecovery.control.wbc.foot_contact import FootContact, foot_contact
+from pushrecovery.control.wbc.gains import WbcGains
+from pushrecovery.control.wbc.hip import UPRIGHT, HipLaw
+from pushrecovery.control.wbc.limits.joint_guard import GuardSettings, JointGuard
+from pushrecovery.control.wbc.qp import WbcSolution, WholeBodyQP
+from pushrecovery.control.wbc.stepper.settings import StepSettings
+from pushrecovery.control.wbc.stepper.stepper import Stepper
+from pushrecovery.control.wbc.tasks.momentum import momentum_rows
+from pushrecovery.control.wbc.tasks.stack import TaskStack
+from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
+from pushrecovery.kernels.wbc import ankle_targets, balance_point, rotation_vector
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.mujoco.humanoid3d._wbc_kernels import (
-    ankle_targets,
-    balance_point,
-    rotation_vector,
-)
-from pushrecovery.sim.mujoco.humanoid3d.measure import body_id, sole_points
-from pushrecovery.sim.mujoco.humanoid3d.wbc import (
-    FootContact,
-    Task,
-    WbcSolution,
-    WholeBodyQP,
-    foot_contact,
-)
-from pushrecovery.sim.mujoco.humanoid3d.wbc_gains import WbcGains
-from pushrecovery.sim.mujoco.humanoid3d.wbc_hip import UPRIGHT, HipLaw, momentum_rows
-from pushrecovery.sim.mujoco.humanoid3d.wbc_limits import GuardSettings, JointGuard
-from pushrecovery.sim.mujoco.humanoid3d.wbc_step import Stepper, StepSettings
-from pushrecovery.sim.mujoco.humanoid3d.wbc_task_stack import TaskStack
 from pushrecovery.surfaces.cop import capture_point
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["WbcGains", "WholeBodyController"]
+__all__ = ["WholeBodyController"]
 
 #: The torso's spin where no hip law reads it (the ankles' kernel computes its own).
 _NO_SPIN = np.zeros(3)
@@ -87,7 +81,7 @@ _NO_SPIN.flags.writeable = False
 def _rotation_vector(rot: Sequence[float], ref: Sequence[float]) -> FloatArray:
     """Return the rotation vector (axis × angle) [rad] of R R₀ᵀ, both row-major (9 floats).
 
-    The tick's own kernel (:func:`._wbc_kernels.rotation_vector`, inside ``balance_point``).
+    The tick's own kernel (:func:`.kernels.wbc.rotation_vector`, inside ``balance_point``).
     """
     out = np.zeros(3)
     rotation_vector(np.asarray(rot, dtype=float), np.asarray(ref, dtype=float), out)
@@ -108,16 +102,16 @@ class WholeBodyController:
     gains : WbcGains, optional
         Task gains and weights.
     hip : BodyParams, optional
-        The flywheel limits (τmax, I, θmax per axis) of the hip (CMP) task, :mod:`.wbc_hip`;
+        The flywheel limits (τmax, I, θmax per axis) of the hip (CMP) task, :mod:`.hip`;
         None (the default) balances with the ankles only.
     stepping : bool
-        Step when the ankles (and hip) cannot recover (:mod:`.wbc_step`); needs two feet.
+        Step when the ankles (and hip) cannot recover (:mod:`.stepper.stepper`); needs two feet.
     params : BodyParams, optional
         The body the step plans are for (default ``hip``); required with ``stepping``.
     step_settings : StepSettings, optional
         The stepping task's settings.
     guard : GuardSettings, optional
-        The joint-range guard's settings (:mod:`.wbc_limits`).
+        The joint-range guard's settings (:mod:`.limits.joint_guard`).
 
     Raises
     ------
@@ -216,7 +210,7 @@ class WholeBodyController:
         self._dots = np.zeros((6, nv))  # the torso's J̇ (linear, angular), overwritten each tick
         self._dots_p, self._dots_r = self._dots[:3], self._dots[3:]
         self._jacp, self._jacr = np.zeros((3, nv)), np.zeros((3, nv))  # its J (each tick)
-        self._stack = TaskStack(nv, size, self.gains)  # the tasks as rows (wbc_task_stack)
+        self._stack = TaskStack(nv, size, self.gains)  # the tasks as rows (tasks.stack)
         self._stack.reserve(nv + 2 + self.guard.qpos.size)  # the hip's 2 rows, the guard's
         self.hip = None
         if self.hip_params is not None:
@@ -293,7 +287,7 @@ class WholeBodyController:
         return np.array(support.nearest_point(float(out[5]), float(out[6])))
 
     def tasks(self, data: Any) -> list[Task]:
-        """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.wbc_hip`)."""
+        """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.hip`)."""
         momentum = self._update(data)
         assert self.qp is not None
         if self.stepper is not None:  # the swing foot (while it swings), the knee guard
@@ -341,7 +335,7 @@ class WholeBodyController:
         stiffness, damping = gains.torso_stiffness, gains.torso_damping
         torso_weight = gains.hip_torso_weight if hip_active else gains.torso_weight
         returning = self.returning and not hip_active  # gently back upright, then as usual
-        paced = None  # the paced return's change of the torso's α_x, α_y (wbc_hip)
+        paced = None  # the paced return's change of the torso's α_x, α_y (hip)
         if returning:
             assert hip is not None
             stiffness, damping = gains.return_stiffness, gains.return_damping
@@ -350,7 +344,7 @@ class WholeBodyController:
             paced -= accel
         rows = self._stack
         rows.pd_gains[0], rows.pd_gains[1] = stiffness, damping
-        # All targets and rows at once (_wbc_kernels.ankle_targets): CoM (m c̈ = m g +
+        # All targets and rows at once (kernels.wbc.ankle_targets): CoM (m c̈ = m g +
         # Σ R_i F_i, rows x and y; c̈ = ω² (c − p_des − δ)), torso, pelvis height, posture.
         stack, targets = rows.matrix, rows.targets
         height = self.height  # the stepper lowers it for long steps

@@ -1,6 +1,6 @@
 r"""Planning a step of the whole-body controller: the swing leg, its foothold and swing time.
 
-World frame, x forward, y left, z up, SI units. Used by :class:`~.wbc_step.Stepper`.
+World frame, x forward, y left, z up, SI units. Used by :class:`~.stepper.stepper.Stepper`.
 
 * **Foothold** (:func:`plan_foothold`): the library's one-step capture region
   (:func:`~pushrecovery.surfaces.capture_region.capture_region`) of the CoM state for a
@@ -14,7 +14,7 @@ World frame, x forward, y left, z up, SI units. Used by :class:`~.wbc_step.Stepp
   foot's side (:func:`planning_params`).
 * **Which foot** (:func:`choose_step`): the library's side rule; after a touchdown the
   trailing foot, unless the landed foot's plan captures in fewer steps.
-* **Swing time** (:func:`~.wbc_step_leg.leg_swing_time`): the step time of the plan is what
+* **Swing time** (:func:`~.leg.leg_swing_time`): the step time of the plan is what
   the swing hip can drive. The swing foot's quintic (rest to rest, distance d in time T) peaks at
   a = (10/√3) d / T²; the leg swings about the hip, so with Δθ = d/ℓ (ℓ the hip's height
   above the floor), I the leg's inertia about the hip axis and a share κ of the hip motor's
@@ -25,7 +25,7 @@ World frame, x forward, y left, z up, SI units. Used by :class:`~.wbc_step.Stepp
   per axis (pitch for the forward part of d, roll for the lateral part, in the pelvis'
   heading), d the change of the foot's offset from the hip: the hip moves with the CoM,
   c(T) = p + (c − p) cosh ωT + (ċ/ω) sinh ωT (the LIPM on the stance ankle p).
-  :class:`~.wbc_step.Stepper` re-plans with the longer time until the two agree.
+  :class:`~.stepper.stepper.Stepper` re-plans with the longer time until the two agree.
 """
 
 from __future__ import annotations

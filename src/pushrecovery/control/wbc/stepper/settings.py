@@ -1,7 +1,7 @@
-"""The settings of the whole-body controller's stepping task (:mod:`.wbc_step`).
+"""The settings of the whole-body controller's stepping task (:mod:`.stepper.stepper`).
 
 SI units; every setting is validated once here (:class:`StepSettings`), the
-:class:`~.wbc_step.Stepper` reads them at every control tick.
+:class:`~.stepper.stepper.Stepper` reads them at every control tick.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ class StepSettings:
     sink, sink_speed : float
         How far below the floor the reference ends [m] and its speed after t_1 [m/s], ≥ 0.
     contact_damping : float
-        k_c of the feet in contact [1/s] (:class:`~.wbc.WholeBodyQP`): a foot unloaded beside
+        k_c of the feet in contact [1/s] (:class:`~.qp.WholeBodyQP`): a foot unloaded beside
         the stance foot stays down.
     contact : float
         Touchdown when the lowest sole point is this close to the floor [m], > 0.
@@ -46,7 +46,7 @@ class StepSettings:
         Re-plan only in this first fraction of the swing, in [0, 1].
     torque_share : float or None
         κ in [0.001, 1]: the share of the swing hip's motor limit the swing may take; the
-        swing lasts at least what that torque needs (:func:`~.wbc_step_leg.leg_swing_time`),
+        swing lasts at least what that torque needs (:func:`~.leg.leg_swing_time`),
         up to ``max_swing_time``. None: always ``swing_time``.
     max_swing_time : float
         The longest swing [s], in [0.05, 2], ≥ ``swing_time``.
@@ -68,11 +68,11 @@ class StepSettings:
     follow_time : float
         A step decided within this time [s] in [0, 10] of the last touchdown follows it: the
         foot that has just landed does not swing again while the other one trails
-        (:func:`~.wbc_step_plan.choose_step`); later, a step starts afresh (the library's rule).
+        (:func:`~.plan.choose_step`); later, a step starts afresh (the library's rule).
     knee_reach : float or None
         κ [rad] in [0, 1.5]: the pelvis height task's target is lowered so that every leg
         keeps its knee bent by at least κ, the swinging leg at its foothold
-        (:mod:`.wbc_step_height`), by at most ``max_drop``. None: the target is never lowered.
+        (:mod:`.height`), by at most ``max_drop``. None: the target is never lowered.
     max_drop : float
         The most the pelvis target is lowered [m], in [0, 0.5].
     """
