@@ -145,35 +145,36 @@ def test_a_step_is_detected_measured_and_given_its_margins():
 
     result = analyze(_stepping_recording(), P)
     events = result.summary.events
-    onset = events["onset"]["time"]
+    onset = events.onset.time
     # The push, from the CoM acceleration, low-passed at 6 Hz forward and backward: the zero-lag
     # filter spreads the push over about +-1/fc, and with little noise the threshold is crossed
     # early in that spread: up to 1/fc = 0.17 s before the push, never after it.
     assert 1.0 - 1.0 / 6.0 <= onset <= 1.0 + 0.01
-    kinds = [(e["foot"], e["kind"]) for e in events["foot_events"]]
+    kinds = [(e.event.foot, e.event.kind) for e in events.foot_events]
     assert kinds == [("right", "foot-off"), ("right", "foot-contact")]
-    off, contact = (e["time"] for e in events["foot_events"])
+    off, contact = (e.event.time for e in events.foot_events)
     # The markers method (docs/events.md): off once the foot is 3 cm up (0.08 sin(pi s / 0.4 s)
     # reaches 3 cm 49 ms after the lift), down when within 3 cm and slower than 0.1 m/s.
     lifted = 1.5 + 0.4 * math.asin(0.03 / 0.08) / math.pi
     assert off == pytest.approx(lifted, abs=0.011) and 1.85 <= contact <= 1.95
-    (step,) = events["measured_steps"]
-    assert step["length"] == pytest.approx(0.30, abs=1e-3)
-    assert step["width"] == pytest.approx(-0.02, abs=1e-3)
-    assert step["latency"] == pytest.approx(off - onset)
+    (taken,) = events.measured_steps
+    step = taken.step
+    assert step.length == pytest.approx(0.30, abs=1e-3)
+    assert step.width == pytest.approx(-0.02, abs=1e-3)
+    assert step.latency == pytest.approx(off - onset)
     # The margins at foot-off are the frame's own.
     frame = int(np.argmin(np.abs(result.time - off)))
-    at_off = step["margins_at_foot_off"]["ap"]
-    assert at_off["capture_point"] == pytest.approx(result.columns["ap_capture_point"][frame])
-    assert at_off["strategy"] == result.columns["ap_strategy"][frame]
-    compared = step["against_recommended"]["ap"]
-    assert compared["taken"] == step["length"]
+    at_off = taken.at_foot_off.axes["ap"]
+    assert at_off.capture_point == pytest.approx(result.columns["ap_capture_point"][frame])
+    assert at_off.strategy == result.columns["ap_strategy"][frame]
+    compared = taken.against_recommended["ap"]
+    assert compared.taken == step.length
     recommended = result.columns["ap_step_length"][frame]
     if np.isfinite(recommended):
-        assert compared["recommended"] == pytest.approx(recommended)
-        assert isinstance(compared["within"], bool)
+        assert compared.recommended == pytest.approx(recommended)
+        assert isinstance(compared.within, bool)
     else:
-        assert compared["within"] is None
+        assert compared.within is None
 
 
 def test_the_plane_margin_is_the_xcom_distance_to_the_base_polygon(tmp_path):
@@ -257,7 +258,7 @@ def test_foot_events_from_each_plate_of_a_drop_jump():
     assert len(recording.plates) == 2
     found, _ = body_for(recording, mass=None, com_height=None, gravity=9.81)
     result = analyze(recording, load_params(overrides=found))
-    events = [(e["foot"], e["kind"], e["time"]) for e in result.summary.events["foot_events"]]
+    events = [(e.event.foot, e.event.kind, e.event.time) for e in result.summary.events.foot_events]
     assert [(foot, kind) for foot, kind, _ in events] == [
         ("plate 2", "foot-off"),
         ("plate 1", "foot-contact"),
@@ -273,12 +274,12 @@ def test_foot_events_from_each_plate_of_a_drop_jump():
 def test_a_step_is_judged_against_the_capture_region_at_its_foot_off():
     # The landing 0.30 m ahead misses the one-step capture region of the state at foot-off
     # (the push was large); landing at the foothold the region recommends is inside it.
-    first = analyze(_stepping_recording(), P).summary.events["measured_steps"][0]
-    region = first["capture_region"]
-    assert region["landing_ankle"] == pytest.approx([0.30, -0.12], abs=1e-9)
-    assert region["within"] is False and region["margin"] < 0.0
-    foothold = region["recommended_foothold"]
+    first = analyze(_stepping_recording(), P).summary.events.measured_steps[0]
+    region = first.capture_region
+    assert region.landing_ankle == pytest.approx((0.30, -0.12), abs=1e-9)
+    assert region.within is False and region.margin < 0.0
+    foothold = region.recommended_foothold
     step = (foothold[0] - 0.0, foothold[1] - (-0.1))  # from the right ankle at (0, -0.1)
-    again = analyze(_stepping_recording(step), P).summary.events["measured_steps"][0]
-    assert again["capture_region"]["within"] is True
-    assert again["capture_region"]["margin"] > 0.01
+    again = analyze(_stepping_recording(step), P).summary.events.measured_steps[0]
+    assert again.capture_region.within is True
+    assert again.capture_region.margin > 0.01

@@ -14,6 +14,7 @@ from pushrecovery.campaign.trial_rows import subject_name
 
 if TYPE_CHECKING:
     from pushrecovery.analysis.trial import TrialSummary
+    from pushrecovery.analysis.trial.events import FrameMargins
 
 __all__ = ["EVENT_FIELDS", "EventRow", "trial_events"]
 
@@ -104,38 +105,37 @@ def trial_events(job: Any, summary: TrialSummary) -> list[dict[str, Any]]:
     for start, end in summary.checks.flights:
         rows.append(EventRow(job.name, subject, "", "flight", start, end))
     events = summary.events
-    onset = events["onset"]
+    onset = events.onset
     for axis in ("ap", "ml"):
-        if onset["time"] is not None:
-            rows.append(_at(job.name, subject, axis, "onset", onset["time"], onset["margins"]))
-        for foot in events["foot_events"]:
+        if onset.time is not None and onset.margins is not None:
+            rows.append(_at(job.name, subject, axis, "onset", onset.time, onset.margins))
+        for found in events.foot_events:
+            foot = found.event
             rows.append(
                 replace(
-                    _at(job.name, subject, axis, foot["kind"], foot["time"], foot["margins"]),
-                    foot=foot["foot"],
-                    source=foot["source"],
+                    _at(job.name, subject, axis, foot.kind, foot.time, found.margins),
+                    foot=foot.foot,
+                    source=foot.source,
                 )
             )
-        for step in events["measured_steps"]:
-            compared = step["against_recommended"][axis]
-            row = _at(
-                job.name, subject, axis, "step", step["off_time"], step["margins_at_foot_off"]
-            )
+        for taken in events.measured_steps:
+            step, compared = taken.step, taken.against_recommended[axis]
+            region = taken.capture_region
             rows.append(
                 replace(
-                    row,
-                    end=step["contact_time"],
-                    foot=step["foot"],
+                    _at(job.name, subject, axis, "step", step.off_time, taken.at_foot_off),
+                    end=step.contact_time,
+                    foot=step.foot,
                     source="markers",
-                    step_length=compared["recommended"],
-                    step_length_min=compared["capture_range"][0],
-                    step_length_max=compared["capture_range"][1],
-                    taken=compared["taken"],
-                    latency=step["latency"],
-                    duration=step["duration"],
-                    within=compared["within"],
-                    capture_region_margin=(step["capture_region"] or {}).get("margin"),
-                    in_capture_region=(step["capture_region"] or {}).get("within"),
+                    step_length=compared.recommended,
+                    step_length_min=compared.shortest,
+                    step_length_max=compared.longest,
+                    taken=compared.taken,
+                    latency=step.latency,
+                    duration=step.duration,
+                    within=compared.within,
+                    capture_region_margin=None if region is None else region.margin,
+                    in_capture_region=None if region is None else region.within,
                 )
             )
     rows.sort(key=lambda r: (math.inf if r.time is None else r.time, r.kind, r.axis))
@@ -143,17 +143,17 @@ def trial_events(job: Any, summary: TrialSummary) -> list[dict[str, Any]]:
 
 
 def _at(
-    trial: str, subject: str, axis: str, kind: str, time: float, margins: dict[str, Any] | None
+    trial: str, subject: str, axis: str, kind: str, time: float, margins: FrameMargins
 ) -> EventRow:
     """Return an event row with the axis' margins at the event's frame."""
-    here = (margins or {}).get(axis) or {}
+    here = margins.axes[axis]
     return EventRow(
         trial=trial,
         subject=subject,
         axis=axis,
         kind=kind,
         time=time,
-        capture_point=here.get("capture_point"),
-        cop_margin=here.get("cop_margin"),
-        strategy=here.get("strategy"),
+        capture_point=here.capture_point,
+        cop_margin=here.cop_margin,
+        strategy=here.strategy,
     )

@@ -178,7 +178,6 @@ def trial_rows(
     The values are the summary's own (NaN, not yet None: ``json_safe`` them for a JSON file).
     """
     checks, plane = summary.checks, summary.plane
-    onset, steps_taken = summary.events["onset"]["time"], len(summary.events["measured_steps"])
     rows = []
     for axis, data in summary.directions.items():
         margin, mos = data.min_cop_margin.value, plane.min_mos.value
@@ -224,8 +223,8 @@ def trial_rows(
             cop_outside_base_frames=int(checks.cop_outside[axis].sum()),
             cop_tolerance=checks.tolerance,
             base_rejected=checks.base_rejected,
-            onset=onset,
-            steps_taken=steps_taken,
+            onset=summary.events.onset.time,
+            steps_taken=len(summary.events.measured_steps),
             min_mos=mos,
             min_mos_time=plane.min_mos.time,
             min_mos_normalised=None if mos is None else mos / params.leg_length,

@@ -117,12 +117,10 @@ def _events(analysis: TrialAnalysis) -> list[tuple[float, str, str]]:
     """Return the summary's events: (time [s], kind, legend text), in time order."""
     events = analysis.summary.events
     found: list[tuple[float, str, str]] = []
-    onset = events["onset"]
-    if onset["time"] is not None:
-        found.append((float(onset["time"]), "onset", "push onset"))
-    for event in events["foot_events"]:
-        if event["time"] is not None:
-            found.append((float(event["time"]), event["kind"], f"{event['foot']} {event['kind']}"))
+    if events.onset.time is not None:
+        found.append((float(events.onset.time), "onset", "push onset"))
+    for event in (found_event.event for found_event in events.foot_events):
+        found.append((float(event.time), event.kind, f"{event.foot} {event.kind}"))
     return sorted(found)
 
 

@@ -29,6 +29,7 @@ given what a reader of the trial asks of them:
 from __future__ import annotations
 
 import math
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -50,12 +51,203 @@ from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_region import capture_region
 from pushrecovery.surfaces.classify import STRATEGY_CODES
 
-__all__: list[str] = []  # the pipeline's (pushrecovery.analysis.trial.pipeline)
+__all__ = [
+    "AxisMargins",
+    "CaptureRegionCheck",
+    "FrameMargins",
+    "Onset",
+    "StepComparison",
+    "StepTaken",
+    "TrialEvents",
+    "TriggeredFootEvent",
+]
 
 FloatArray = NDArray[np.float64]
 
 #: Baseline of the onset detection: the trial's first seconds [s].
 ONSET_BASELINE = 0.5
+
+
+@dataclass(frozen=True, slots=True)
+class AxisMargins:
+    """One axis' verdict at one frame.
+
+    Attributes
+    ----------
+    capture_point : float or None
+        Capture point (XCoM) [m], lab frame along the axis (ap forward +, ml left +).
+    cop_margin, cmp_margin : float or None
+        Its margin inside the CoP (CMP) region [m], + inside.
+    time_to_leave_cop : float or None
+        Time before the CoM would leave the CoP region at its motion [s].
+    strategy : str or None
+        The strategy the frame needs along the axis; None where withheld or unknown.
+    """
+
+    capture_point: float | None
+    cop_margin: float | None
+    cmp_margin: float | None
+    time_to_leave_cop: float | None
+    strategy: str | None
+
+
+@dataclass(frozen=True, slots=True)
+class FrameMargins:
+    """The verdicts of the frame nearest an event: its time [s] and per axis (ap, ml)."""
+
+    frame_time: float
+    axes: dict[str, AxisMargins]
+
+
+@dataclass(frozen=True, slots=True)
+class Onset:
+    """The perturbation onset.
+
+    Attributes
+    ----------
+    time : float or None
+        Onset [s]; None when none was found (or the trial is quiet standing).
+    signal : str
+        The signal it was detected on (module docstring).
+    margins : FrameMargins or None
+        The verdicts at the onset's frame.
+    note : str or None
+        Why no onset is given although the signal crossed its threshold.
+    """
+
+    time: float | None
+    signal: str
+    margins: FrameMargins | None
+    note: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class TriggeredFootEvent:
+    """A foot-off or foot-contact and the verdicts at its frame."""
+
+    event: FootEvent
+    margins: FrameMargins
+
+
+@dataclass(frozen=True, slots=True)
+class StepComparison:
+    """The step taken along one axis against the recommended one at foot-off.
+
+    Attributes
+    ----------
+    taken : float or None
+        The foot's displacement along the axis [m] (ap forward +, ml left +).
+    recommended : float or None
+        The step the surfaces recommend at the foot-off frame (Eq. 21) [m], signed.
+    shortest, longest : float or None
+        The range of first steps that capture the state there [m] (unsigned, in the direction
+        of ``recommended``).
+    within : bool or None
+        Whether ``taken`` lies in that range; None where the frame needed no step.
+    """
+
+    taken: float | None
+    recommended: float | None
+    shortest: float | None
+    longest: float | None
+    within: bool | None
+
+
+@dataclass(frozen=True, slots=True)
+class CaptureRegionCheck:
+    """A step's landing against the 2-D one-step capture region at its foot-off.
+
+    Attributes
+    ----------
+    landing_ankle : tuple of float
+        The stepping foot's ankle at its contact frame (ap, ml) [m].
+    swing_time : float
+        The swing time the region assumes [s].
+    margin : float or None
+        Signed distance of the landing to the region [m], + inside; None for an empty region.
+    within : bool or None
+        Whether the landing lies inside.
+    empty : bool
+        The region is empty: no single step captures the state.
+    recommended_foothold : tuple of float or None
+        The foothold the region recommends (ap, ml) [m].
+    """
+
+    landing_ankle: tuple[float, float]
+    swing_time: float
+    margin: float | None
+    within: bool | None
+    empty: bool
+    recommended_foothold: tuple[float, ...] | None
+
+
+@dataclass(frozen=True, slots=True)
+class StepTaken:
+    """A measured step, the verdicts at its foot-off and foot-contact, and its judgement.
+
+    ``against_recommended`` is per axis (ap, ml); ``capture_region`` None without a two-foot
+    base or where the surfaces refuse the state.
+    """
+
+    step: MeasuredStep
+    at_foot_off: FrameMargins
+    at_foot_contact: FrameMargins
+    against_recommended: dict[str, StepComparison]
+    capture_region: CaptureRegionCheck | None
+
+
+@dataclass(frozen=True, slots=True)
+class TrialEvents:
+    """The trial's onset, foot events and measured steps (``summary.json`` → ``events``)."""
+
+    onset: Onset
+    foot_events: tuple[TriggeredFootEvent, ...]
+    measured_steps: tuple[StepTaken, ...]
+
+
+def _events_dict(events: TrialEvents) -> dict[str, Any]:
+    """Return ``summary.json`` → ``events`` (docs/events.md)."""
+    onset = events.onset
+    return {
+        "onset": {
+            "time": onset.time,
+            "signal": onset.signal,
+            "margins": None if onset.margins is None else _margins_dict(onset.margins),
+            **({} if onset.note is None else {"note": onset.note}),
+        },
+        "foot_events": [
+            {**found.event.to_dict(), "margins": _margins_dict(found.margins)}
+            for found in events.foot_events
+        ],
+        "measured_steps": [
+            {
+                **taken.step.to_dict(),
+                "margins_at_foot_off": _margins_dict(taken.at_foot_off),
+                "margins_at_foot_contact": _margins_dict(taken.at_foot_contact),
+                "against_recommended": {
+                    axis: {
+                        "taken": c.taken,
+                        "recommended": c.recommended,
+                        "capture_range": [c.shortest, c.longest],
+                        "within": c.within,
+                    }
+                    for axis, c in taken.against_recommended.items()
+                },
+                "capture_region": None
+                if taken.capture_region is None
+                else asdict(taken.capture_region),
+            }
+            for taken in events.measured_steps
+        ],
+        "axes": list(AXES),
+    }
+
+
+def _margins_dict(margins: FrameMargins) -> dict[str, Any]:
+    return {
+        "frame_time": margins.frame_time,
+        **{axis: asdict(values) for axis, values in margins.axes.items()},
+    }
 
 
 def _value(array: NDArray[Any], frame: int) -> float | None:
@@ -65,20 +257,20 @@ def _value(array: NDArray[Any], frame: int) -> float | None:
 
 def _margins_at(
     time: FloatArray, when: float, per_axis: dict[str, DirectionMargins]
-) -> dict[str, Any]:
+) -> FrameMargins:
     """Return the margins of the frame nearest ``when`` [s], per axis."""
     frame = int(np.argmin(np.abs(time - when)))
-    found: dict[str, Any] = {"frame_time": float(time[frame])}
+    axes = {}
     for axis, margins in per_axis.items():
         code = int(margins.strategy[frame])
-        found[axis] = {
-            "capture_point": _value(margins.capture_point, frame),
-            "cop_margin": _value(margins.cop, frame),
-            "cmp_margin": _value(margins.cmp, frame),
-            "time_to_leave_cop": _value(margins.time_to_leave_cop, frame),
-            "strategy": STRATEGY_CODES[code].value if code >= 0 else None,
-        }
-    return found
+        axes[axis] = AxisMargins(
+            capture_point=_value(margins.capture_point, frame),
+            cop_margin=_value(margins.cop, frame),
+            cmp_margin=_value(margins.cmp, frame),
+            time_to_leave_cop=_value(margins.time_to_leave_cop, frame),
+            strategy=STRATEGY_CODES[code].value if code >= 0 else None,
+        )
+    return FrameMargins(float(time[frame]), axes)
 
 
 def _onset(
@@ -101,11 +293,14 @@ def _onset(
 
 
 def _compared(
-    step: dict[str, Any], time: FloatArray, per_axis: dict[str, DirectionMargins]
-) -> dict[str, Any]:
+    step: MeasuredStep, time: FloatArray, per_axis: dict[str, DirectionMargins]
+) -> dict[str, StepComparison]:
     """Compare the step taken with the recommended one and the capture range at foot-off."""
-    frame = int(np.argmin(np.abs(time - step["off_time"])))
-    taken = {"ap": step["length"], "ml": step["width"]}
+    frame = int(np.argmin(np.abs(time - step.off_time)))
+    taken = {
+        axis: None if math.isnan(moved) else moved
+        for axis, moved in (("ap", step.length), ("ml", step.width))
+    }
     result = {}
     for axis, margins in per_axis.items():
         recommended = _value(margins.step_length, frame)
@@ -117,12 +312,7 @@ def _compared(
             # The range is unsigned, in the direction of the recommended step.
             along = None if moved is None else math.copysign(1.0, recommended) * moved
             within = along is not None and shortest <= along <= longest
-        result[axis] = {
-            "taken": moved,
-            "recommended": recommended,
-            "capture_range": [shortest, longest],
-            "within": within,
-        }
+        result[axis] = StepComparison(moved, recommended, shortest, longest, within)
     return result
 
 
@@ -179,7 +369,7 @@ def _in_capture_region(
     com: FloatArray,
     velocity: FloatArray,
     plane: tuple[Any, BodyParams] | None,
-) -> dict[str, Any] | None:
+) -> CaptureRegionCheck | None:
     """Judge the step's landing against the one-step capture region at its foot-off.
 
     The region (:func:`~pushrecovery.surfaces.capture_region.capture_region`, issue 9: the
@@ -215,16 +405,16 @@ def _in_capture_region(
         if region.polygon is None
         else float(region.polygon.signed_distance(landing[0], landing[1]))
     )
-    return {
-        "landing_ankle": [float(landing[0]), float(landing[1])],
-        "swing_time": swing_time,
-        "margin": margin,
-        "within": None if margin is None else margin >= 0.0,
-        "empty": region.polygon is None,
-        "recommended_foothold": None
+    return CaptureRegionCheck(
+        landing_ankle=(float(landing[0]), float(landing[1])),
+        swing_time=swing_time,
+        margin=margin,
+        within=None if margin is None else margin >= 0.0,
+        empty=region.polygon is None,
+        recommended_foothold=None
         if region.foothold is None
-        else [float(v) for v in region.foothold],
-    }
+        else tuple(float(v) for v in region.foothold),
+    )
 
 
 def trial_events(
@@ -236,7 +426,7 @@ def trial_events(
     *,
     com: FloatArray | None = None,
     plane: tuple[Any, BodyParams] | None = None,
-) -> dict[str, Any]:
+) -> TrialEvents:
     """Return the trial's onset, foot events and steps with their margins (module docstring).
 
     ``time`` [s] and ``velocity`` (n, 2) [m/s] are the analysis' frames, ``per_axis`` their
@@ -251,27 +441,23 @@ def trial_events(
         if events and recording.feet
         else []
     )
-    return {
-        "onset": {
-            "time": onset,
-            "signal": onset_source,
-            "margins": None if onset is None else _margins_at(time, onset, per_axis),
-        },
-        "foot_events": [
-            {**event.to_dict(), "margins": _margins_at(time, event.time, per_axis)}
-            for event in events
-        ],
-        "measured_steps": [
-            {
-                **row,
-                "margins_at_foot_off": _margins_at(time, step.off_time, per_axis),
-                "margins_at_foot_contact": _margins_at(time, step.contact_time, per_axis),
-                "against_recommended": _compared(row, time, per_axis),
-                "capture_region": None
+    return TrialEvents(
+        onset=Onset(
+            onset, onset_source, None if onset is None else _margins_at(time, onset, per_axis)
+        ),
+        foot_events=tuple(
+            TriggeredFootEvent(event, _margins_at(time, event.time, per_axis)) for event in events
+        ),
+        measured_steps=tuple(
+            StepTaken(
+                step,
+                at_foot_off=_margins_at(time, step.off_time, per_axis),
+                at_foot_contact=_margins_at(time, step.contact_time, per_axis),
+                against_recommended=_compared(step, time, per_axis),
+                capture_region=None
                 if com is None
                 else _in_capture_region(step, time, com, velocity, plane),
-            }
-            for step, row in ((step, step.to_dict()) for step in steps)
-        ],
-        "axes": list(AXES),
-    }
+            )
+            for step in steps
+        ),
+    )

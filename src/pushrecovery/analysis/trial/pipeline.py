@@ -24,7 +24,7 @@ from pushrecovery.analysis.signals import (
     smooth_and_differentiate,
 )
 from pushrecovery.analysis.trial.checks import check_frames
-from pushrecovery.analysis.trial.events import trial_events
+from pushrecovery.analysis.trial.events import Onset, trial_events
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
 from pushrecovery.analysis.trial.summary import (
     _exclusions,
@@ -208,14 +208,10 @@ def analyze(
         recording, time, velocity, per_axis, params.mass, com=com, plane=(base, params)
     )
     sway = _posturography(force_time, plate_cop, plate_force)
-    if sway is not None and events["onset"]["time"] is not None:
+    if sway is not None and events.onset.time is not None:
         # Quiet standing has no perturbation: its sway crosses any threshold of a short baseline.
-        events["onset"] = {
-            "time": None,
-            "signal": events["onset"]["signal"],
-            "margins": None,
-            "note": "quiet standing: no perturbation",
-        }
+        quiet = Onset(None, events.onset.signal, None, "quiet standing: no perturbation")
+        events = replace(events, onset=quiet)
     summary = _summary(
         recording,
         time,

@@ -27,6 +27,7 @@ from pushrecovery.analysis.signals import (
     find_gaps,
 )
 from pushrecovery.analysis.trial.checks import DataChecks
+from pushrecovery.analysis.trial.events import TrialEvents, _events_dict
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy
 
@@ -195,9 +196,9 @@ class TrialSummary:
         The data checks: flights and a CoP beyond the base (docs/analysis.md).
     plane : PlaneSummary
         The 2-D margins against the base polygon.
-    events : dict
-        Perturbation onset, foot events and measured steps with their margins, JSON-shaped
-        (docs/events.md; times [s], lengths [m]).
+    events : TrialEvents
+        Perturbation onset, foot events and measured steps with the verdicts at their frames
+        (docs/events.md).
     sway : SwayMeasures or None
         The sway measures of a quiet-standing trial (docs/posturography.md), else None.
     sway_rate : float or None
@@ -226,7 +227,7 @@ class TrialSummary:
     notes: tuple[str, ...]
     checks: DataChecks
     plane: PlaneSummary
-    events: dict[str, Any]
+    events: TrialEvents
     sway: SwayMeasures | None = None
     sway_rate: float | None = None
 
@@ -280,7 +281,7 @@ class TrialSummary:
                 "notes": self.notes,
                 "checks": self.checks.to_dict(),
                 "plane": asdict(self.plane),
-                "events": self.events,
+                "events": _events_dict(self.events),
                 "posturography": None
                 if self.sway is None
                 else {
@@ -433,7 +434,7 @@ def _summary(
     notes: list[str],
     checks: DataChecks,
     plane: Margins2D,
-    events: dict[str, Any],
+    events: TrialEvents,
     sway: tuple[SwayMeasures, float] | None,
 ) -> TrialSummary:
     period = float(time[-1] - time[0]) / max(len(time) - 1, 1)
