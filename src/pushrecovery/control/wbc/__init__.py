@@ -28,10 +28,11 @@ bodies
     Bodies by name, the colliding geoms and each sole's points of a compiled humanoid.
 hip
     :class:`~.hip.HipLaw`: the hip (CMP balancing) law, Stephens' bang-bang as a feedback.
-tasks.task, tasks.stack, tasks.momentum
-    A task W ‖A x − b‖²; the tick's tasks as one stack of rows; the centroidal momentum rows.
-limits.joint_guard
-    :class:`~.limits.joint_guard.JointGuard`: keep the guarded joints off their stops.
+tasks.task, tasks.stack, tasks.momentum, tasks.swing_foot
+    A task W ‖A x − b‖²; the tick's tasks as one stack of rows; the centroidal momentum rows;
+    the swing foot's task.
+limits.joint_guard, limits.knee_guard
+    Soft limits: the guarded joints kept off their stops; the stepper's knee guard.
 stepper.stepper, stepper.plan, stepper.leg, stepper.height, stepper.settings
     The stepping task: decide, plan the foothold, swing and land a foot.
 """

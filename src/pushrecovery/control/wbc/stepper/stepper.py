@@ -25,13 +25,15 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
   .. math:: z(s) = z_0 + (z_1 - z_0)(10 s^3 - 15 s^4 + 6 s^5) + 64 h\, s^3 (1 - s)^3,
 
   h the lift [m], z_1 = z_0 − ``sink`` (aimed just below the floor so that the sole meets
-  it); after t_1 the reference keeps sinking at ``sink_speed``. The task is the sole frame's
-  acceleration J q̈ + J̇ q̇ = a_ref + k_p (p_ref − p) + k_d (v_ref − v) (linear) and
-  −k_R e − d_R ω (angular, e the rotation vector from the lift-off orientation); its vertical
-  row weighs ``lift_weight`` times more (a foot that stays on the floor cannot step).
-* **Knee guard** (always, with stepping): a knee below ``knee_min`` or reaching it within
-  50 ms gets the task q̈ = k_p (q_min − q) − d_p q̇: the QP does not model the joint stop, and
-  a stance knee driven onto it made the QP infeasible (torque limits with the contact rows).
+  it); after t_1 the reference keeps sinking at ``sink_speed``. The task
+  (:mod:`~.tasks.swing_foot`) is the sole frame's acceleration J q̈ + J̇ q̇ = a_ref + k_p
+  (p_ref − p) + k_d (v_ref − v) (linear) and −k_R e − d_R ω (angular, e the rotation vector
+  from the lift-off orientation); its vertical row weighs ``lift_weight`` times more (a foot
+  that stays on the floor cannot step).
+* **Knee guard** (always, with stepping, :mod:`~.limits.knee_guard`): a knee below
+  ``knee_min`` or reaching it within 50 ms gets the task q̈ = k_p (q_min − q) − d_p q̇: the QP
+  does not model the joint stop, and a stance knee driven onto it made the QP infeasible
+  (torque limits with the contact rows).
 * **Pelvis height** (:meth:`Stepper.pelvis_height`, :mod:`.height`): the pelvis
   task's target lowered so that every knee stays bent by ``knee_reach`` (the swinging leg at
   its foothold), by at most ``max_drop``.
@@ -46,7 +48,6 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 from typing import Any
 
@@ -55,6 +56,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.control.wbc.bodies import sole_points
 from pushrecovery.control.wbc.foot_contact import FootContact
+from pushrecovery.control.wbc.limits.knee_guard import knee_guard_tasks
 from pushrecovery.control.wbc.stepper.height import leg_span, pelvis_limit, segment_lengths
 from pushrecovery.control.wbc.stepper.leg import leg_joints, leg_swing_time
 from pushrecovery.control.wbc.stepper.plan import (
@@ -65,10 +67,10 @@ from pushrecovery.control.wbc.stepper.plan import (
     plan_foothold,
     planning_params,
     quintic,
-    rotation_vector,
     yaw_of,
 )
 from pushrecovery.control.wbc.stepper.settings import StepSettings
+from pushrecovery.control.wbc.tasks.swing_foot import swing_foot_task
 from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
@@ -244,49 +246,19 @@ class Stepper:
         record.plans.append((t, float(foothold[0]), float(foothold[1])))
 
     def task(self, data: Any, size: int, nv: int) -> Task:
-        """Return the swing foot's task: J q̈ = a_des − J̇ q̇ over 6 rows (linear, angular)."""
-        import mujoco
-
+        """Return the swing foot's task now (:func:`~.swing_foot.swing_foot_task`)."""
         assert self.swing is not None
-        s, model = self.settings, self._model
-        foot = self.feet[self.swing]
-        point, rot = self.sole(data, self.swing)
-        jacp, jacr = np.zeros((3, nv)), np.zeros((3, nv))
-        dotp, dotr = np.zeros((3, nv)), np.zeros((3, nv))
-        mujoco.mj_jac(model, data, jacp, jacr, point, foot.body)
-        mujoco.mj_jacDot(model, data, dotp, dotr, point, foot.body)
-        qvel = np.asarray(data.qvel, dtype=float)
-        p_ref, v_ref, a_ref = self.reference(float(data.time))
-        linear = a_ref + s.stiffness * (p_ref - point) + s.damping * (v_ref - jacp @ qvel)
-        error = rotation_vector(rot @ self._rot.T)
-        angular = -s.turn_stiffness * error - s.turn_damping * (jacr @ qvel)
-        matrix = np.zeros((6, size))
-        matrix[:3, :nv], matrix[3:, :nv] = jacp, jacr
-        target = np.concatenate([linear - dotp @ qvel, angular - dotr @ qvel])
-        scale = math.sqrt(s.lift_weight)  # the vertical row weighs lift_weight × W
-        matrix[2] *= scale
-        target[2] *= scale
-        return Task("swing", matrix, target, s.weight)
+        return swing_foot_task(self._model, data, self.feet[self.swing].body,
+                               self.sole(data, self.swing), self._rot,
+                               self.reference(float(data.time)), self.settings, size,
+                               nv)  # fmt: skip
 
     def knee_guard(self, data: Any, size: int, nv: int) -> list[Task]:
-        """Return a task per knee below ``knee_min`` or reaching it within 50 ms (settings)."""
-        s, model = self.settings, self._model
-        rows, targets = [], []
-        qvel = np.asarray(data.qvel, dtype=float)
-        for leg in self.legs:
-            if leg.knee < 0:
-                continue
-            angle = float(data.qpos[int(model.jnt_qposadr[leg.knee])])
-            dof = int(model.jnt_dofadr[leg.knee])
-            if angle + 0.05 * min(float(qvel[dof]), 0.0) >= s.knee_min:
-                continue
-            row = np.zeros(size)
-            row[dof] = 1.0
-            rows.append(row)
-            targets.append(s.stiffness * (s.knee_min - angle) - s.damping * float(qvel[dof]))
-        if not rows:
-            return []
-        return [Task("knee guard", np.array(rows), np.array(targets), s.knee_weight)]
+        """Return the knee guard's task (:func:`~.knee_guard.knee_guard_tasks`), if any."""
+        s = self.settings
+        return knee_guard_tasks(self._model, data, [leg.knee for leg in self.legs], size,
+                                knee_min=s.knee_min, stiffness=s.stiffness, damping=s.damping,
+                                weight=s.knee_weight)  # fmt: skip
 
     def pelvis_height(self, data: Any, height: float) -> float:
         """Return the pelvis height task's target [m]: ``height`` lowered for the legs' reach.
