@@ -19,7 +19,7 @@ from pushrecovery.campaign import CampaignSpec
 from pushrecovery.campaign.pushes import run_batch, run_push
 from pushrecovery.campaign.spec import Push
 from pushrecovery.errors import PushRecoveryError
-from pushrecovery.kernels import batched_stepping as kernel
+from pushrecovery.kernels.batched import stepping as kernel
 from pushrecovery.sim.batched import BATCHED, recovery_pushes
 
 P = load_params()

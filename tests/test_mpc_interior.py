@@ -8,7 +8,7 @@ import pytest
 from pushrecovery.control.mpc import FlywheelFeasibility, MPCController, MPCSettings
 from pushrecovery.control.mpc.interior import InteriorPointSolver
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
-from pushrecovery.kernels import mpc_interior as kernels
+from pushrecovery.kernels.mpc import interior as kernels
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from test_mpc import P, sparse_solution
@@ -213,7 +213,7 @@ def test_boundary_ticks_solved_with_forced_braking_equal_daqp():
 
 
 def test_the_cold_start_is_the_unconstrained_optimum():
-    # The interior point's cold start (its feedback gains, kernels.mpc_scales.dual_scales) is the
+    # The interior point's cold start (its feedback gains, kernels.mpc.scales.dual_scales) is the
     # unconstrained Eq. (17)'s solution: its first input equals an independent backward
     # recursion's (test_mpc.riccati_first_input) where no bound binds.
     from test_mpc import riccati_first_input

@@ -70,7 +70,7 @@ def test_a_wrong_active_set_is_not_accepted():
     assert not solver.solve(x0, max_passes=1)  # from the empty set in one pass
     solver.active[:, 1] = 1  # full torque forward over the whole horizon: wrong
     guess = solver.active.copy()
-    from pushrecovery.kernels.mpc_riccati import CHANGED, _pass
+    from pushrecovery.kernels.mpc.riccati import CHANGED, _pass
 
     outcome = _pass(
         x0, solver.a, solver.b, solver.wx, solver.wu, guess, solver.bounds, solver.tols,
@@ -157,7 +157,7 @@ def test_the_recursion_resumed_inside_a_carried_chain_equals_a_whole_one(horizon
     # curvature bit for bit. S1 holds the torque at its bound over stages 3..12 with θ_13 at
     # its bound (a θ row carried back through the chain: the rows entering stages 4..12), and
     # k lies inside the chain.
-    from pushrecovery.kernels.mpc_riccati import _backward, scratch
+    from pushrecovery.kernels.mpc.riccati import _backward, scratch
 
     solver = RiccatiSolver(P, MPCSettings(horizon=horizon))
     n = horizon

@@ -19,10 +19,12 @@ capture_point
     the fused capture-point margin of Eq. (4) over many states.
 step_scalar, stepping
     the step model's scalar functions (plain Python) and their numba builds.
-batched_ankle, batched_stepping
+batched.ankle, batched.stepping
     many pushes of the analytic models in one compiled loop.
-mpc_riccati, mpc_interior, mpc_scales
+mpc.riccati, mpc.interior, mpc.scales
     the MPC's Riccati active-set passes and interior point.
+wbc
+    the whole-body controller's QP assembly, least-distance form, ankle and joint-guard rows.
 hull
     the convex hull of every frame's points.
 threads

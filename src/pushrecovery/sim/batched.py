@@ -7,7 +7,7 @@ the same numbers (``tests/test_batched.py``), without a Python call per tick.
 :func:`recovery_pushes` does the same for ``RecoveryController`` on ``SteppingPlant``
 (``tests/test_batched_stepping.py``): the loop is compiled, and only the MPC's QPs, the step
 plans and the controller's body at a new stance height are asked of Python
-(:mod:`pushrecovery.kernels.batched_stepping`). Campaigns of these pairs use them
+(:mod:`pushrecovery.kernels.batched.stepping`). Campaigns of these pairs use them
 (:func:`~pushrecovery.campaign.pushes.run_batch`).
 """
 
@@ -104,7 +104,7 @@ def ankle_pd_pushes(
     ParameterTypeError
         ``bodies`` not a list or tuple of BodyParams.
     """
-    from pushrecovery.kernels.batched_ankle import ankle_pd_pushes as kernel
+    from pushrecovery.kernels.batched.ankle import ankle_pd_pushes as kernel
 
     if not (isinstance(model, str) and model in ("pendulum", "lipm")):
         raise InvalidParameterError(f"model must be 'pendulum' or 'lipm', got {model!r:.40}")
@@ -167,7 +167,7 @@ def recovery_pushes(
 
     What ``simulate(SteppingPlant(b), RecoveryController(b), [x0, 0, L, ẋ, 0, 0])`` gives with
     the default control period (1 ms) and rest criterion, push after push, the same numbers:
-    the loop runs compiled (:mod:`pushrecovery.kernels.batched_stepping`) and asks Python only
+    the loop runs compiled (:mod:`pushrecovery.kernels.batched.stepping`) and asks Python only
     for the MPC's QPs, the step plans and the controller's body at a new stance height, from
     one :class:`~pushrecovery.control.recovery.RecoveryController` per body, as a campaign
     batch of one-push runs shares one (its MPCs warm-start from the previous push's last QP).
@@ -196,7 +196,7 @@ def recovery_pushes(
     ParameterTypeError
         ``bodies`` not a list or tuple of BodyParams.
     """
-    from pushrecovery.kernels import batched_stepping as kernel
+    from pushrecovery.kernels.batched import stepping as kernel
 
     starts, speeds, ticks, rest_ticks = _checked_pushes(bodies, x0, xdot, duration)
     controllers = {} if controllers is None else controllers
@@ -247,7 +247,7 @@ def _answer(
     request: int, controller: RecoveryController, f: NDArray[np.float64], n: NDArray[np.int64]
 ) -> None:
     """Answer the compiled loop's request with the controller's own objects (their caches)."""
-    from pushrecovery.kernels import batched_stepping as kernel
+    from pushrecovery.kernels.batched import stepping as kernel
     from pushrecovery.surfaces.cmp import cmp_region
 
     height = float(f[kernel.Z])

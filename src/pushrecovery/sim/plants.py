@@ -202,7 +202,7 @@ class FlywheelPlant(PlantBase):
         so ẋ can never turn back: the set is absorbing even with the joint stop.
         """
         x, xdot = float(state[0]), float(state[2])
-        # m L ẋ + I θ̇, in this order (the compiled batch repeats it: kernels/batched_stepping.py)
+        # m L ẋ + I θ̇, in this order (the compiled batch repeats it: kernels/batched/stepping.py)
         momentum = self._momentum[0] * xdot + self._momentum[1] * float(state[3])
         lower, upper = self.fall_limits
         return (x > upper and xdot >= 0.0 and momentum >= 0.0) or (
@@ -216,7 +216,7 @@ def _held_step(
     """X' = A X + B U for rows (A_i0..A_i3, B_i0, B_i1), summed left to right in floats.
 
     One fixed order of operations (numpy's mat-vec may take another, e.g. fused multiply-adds),
-    so that the compiled batch of :mod:`pushrecovery.kernels.batched_stepping` gives the same bits.
+    so that the compiled batch of :mod:`pushrecovery.kernels.batched.stepping` gives the same bits.
     """
     s0, s1, s2, s3 = (float(v) for v in state)
     return [

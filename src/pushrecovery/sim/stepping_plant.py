@@ -108,7 +108,7 @@ class SteppingPlant(PlantBase):
     def _start_swing(self, state: FloatArray, step_length: float) -> FloatArray:
         x, z, xdot = float(state[0]), float(state[2]), float(state[3])
         # sqrt(x² + z²) as written (math.hypot's algorithm varies between libraries; the
-        # compiled batch, kernels/batched_stepping.py, computes the same bits).
+        # compiled batch, kernels/batched/stepping.py, computes the same bits).
         length = math.sqrt(x * x + z * z)
         sign = 1.0 if step_length > 0.0 else -1.0
         lean = math.atan2(x, z)

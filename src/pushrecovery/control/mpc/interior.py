@@ -40,7 +40,7 @@ from pushrecovery.arguments import positive_float
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.riccati import check_structure, sparse_stages
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.kernels.mpc_interior import (
+from pushrecovery.kernels.mpc.interior import (
     COLD,
     CONVERGED,
     DIVERGED,
@@ -51,7 +51,7 @@ from pushrecovery.kernels.mpc_interior import (
     identify_active,
     solve_interior,
 )
-from pushrecovery.kernels.mpc_scales import dual_scales
+from pushrecovery.kernels.mpc.scales import dual_scales
 from pushrecovery.params import BodyParams
 
 __all__ = [

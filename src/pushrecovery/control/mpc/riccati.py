@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import require_type
 from pushrecovery.control.mpc.problem import MPCSettings
-from pushrecovery.kernels.mpc_riccati import scratch, solve_from
+from pushrecovery.kernels.mpc.riccati import scratch, solve_from
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 
@@ -110,7 +110,7 @@ def check_structure(a: FloatArray, b: FloatArray) -> None:
     """Raise ValueError unless A, B have the zeros the sparse solvers' kernels skip.
 
     The flywheel's exact discretisation leaves (x, ẋ) and (θ, θ̇) decoupled in A and the CoP's
-    column of B zero on θ, θ̇; the kernels (``kernels.mpc_riccati``, ``kernels.mpc_interior``) leave
+    column of B zero on θ, θ̇; the kernels (``kernels.mpc.riccati``, ``kernels.mpc.interior``) leave
     those products out. A model without these zeros is a bug here, not a user's input.
     """
     com, wheel = np.ix_([0, 2], [1, 3]), np.ix_([1, 3], [0, 2])

@@ -3,7 +3,7 @@ r"""Compiled (numba, cached on disk) interior point for the sparse Eq. (17), Ric
 One file on purpose (numba's disk cache does not see changes in the files of called kernels).
 See :mod:`~pushrecovery.control.mpc.interior` for the method; here, the arithmetic.
 
-Conventions as in :mod:`~pushrecovery.kernels.mpc_riccati`: stage i = 0..N−1 maps
+Conventions as in :mod:`~pushrecovery.kernels.mpc.riccati`: stage i = 0..N−1 maps
 (x_i, u_i) to x_{i+1} = A x_i + B u_i at cost x_{i+1}^T diag(wx_i) x_{i+1} + u_i^T diag(wu_i) u_i.
 Three bounded components per stage, j = 0 the CoP δ_i = u_i[0], j = 1 the torque τ_i = u_i[1],
 j = 2 the flywheel angle θ_{i+1} = x_{i+1}[1], each lo_j ≤ v ≤ hi_j. Slacks s⁻ = v − lo,

@@ -1,9 +1,9 @@
 """Compiled (numba, cached on disk) dual scales of the interior point.
 
 The scales and feedback of its start (:func:`dual_scales`); the active set of an iterate read
-in those scales is :func:`~pushrecovery.kernels.mpc_interior.identify_active`, beside the
+in those scales is :func:`~pushrecovery.kernels.mpc.interior.identify_active`, beside the
 iterations that call it. See :mod:`~pushrecovery.control.mpc.interior`. Apart from the
-iterations' kernels (:mod:`~pushrecovery.kernels.mpc_interior`): it calls none of them.
+iterations' kernels (:mod:`~pushrecovery.kernels.mpc.interior`): it calls none of them.
 """
 
 from __future__ import annotations

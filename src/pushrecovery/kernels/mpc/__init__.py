@@ -1,0 +1,1 @@
+"""The MPC's compiled solvers of Eq. (17): Riccati active-set passes, interior point, its scales."""
