@@ -1,7 +1,7 @@
 """The whole-body QP's cost (issue 19, item 3): the WBC at 500 Hz against MuJoCo alone.
 
 Two models, each pushed forward at 30 % of its CoP region's critical impulse at t = 0.1 s and
-run 3 s under the :class:`~pushrecovery.sim.mujoco.humanoid3d.wbc_control.WholeBodyController`
+run 3 s under the :class:`~pushrecovery.control.wbc.controller.WholeBodyController`
 (``mj_step1``, controller, ``mj_step2``, then the tick's other steps):
 
 * the Unitree G1 (33 kg, 29 torque motors, 1 ms steps, 2 per tick; the ``robots`` extra,

@@ -31,10 +31,10 @@ longest swing time and its largest foothold distance from the stance ankle.
 **Cause** (:meth:`StepRow.cause`), where measured and predicted differ by more than 10 %:
 the simple model takes a touchdown Δt_s after the push and a step as long as
 ``max_step_length``; the biped's swing lasts what its hip motors drive
-(``wbc_step_leg.leg_swing_time``), and its leg, standing with the hip ~0.99 ℓ above the
+(``control.wbc.stepper.leg.leg_swing_time``), and its leg, standing with the hip ~0.99 ℓ above the
 ankle, reaches far less than ℓ: the stepper lowers the pelvis for a long step
 (``StepSettings.knee_reach``, ``max_drop`` 0.2 m), which still leaves it short of ℓ. After a
-touchdown the trailing foot steps (``wbc_step_plan.choose_step``): several steps count.
+touchdown the trailing foot steps (``control.wbc.stepper.plan.choose_step``): several steps count.
 """
 
 from __future__ import annotations
@@ -145,10 +145,9 @@ def _body(params: BodyParams, model: Any = None, plant: Any = None) -> _Body:
 
 def _stepping_run(body: _Body, impulse: float, azimuth: float, duration: float,
                   swing_time: float | None) -> SteppingRun:  # fmt: skip
-    import mujoco
-
     from pushrecovery.control.wbc.controller import WholeBodyController
     from pushrecovery.control.wbc.stepper.settings import StepSettings
+    from pushrecovery.sim.mujoco.humanoid3d.measure import body_origins
     from pushrecovery.sim.mujoco.humanoid3d.wbc_push import push_humanoid
 
     controller = WholeBodyController(body.model, body.feet, body.upright, stepping=True,
@@ -166,10 +165,7 @@ def _stepping_run(body: _Body, impulse: float, azimuth: float, duration: float,
     landed = [s for s in stepper.steps if s.landed is not None]
     # Each foothold's distance from the stance foot's (the reach R of (S1)), from where the
     # feet stood (the foot bodies' origins, as ``StepRecord.landed``).
-    data = mujoco.MjData(body.model)
-    data.qpos[:] = body.qpos
-    mujoco.mj_kinematics(body.model, data)
-    where = {foot: np.array(data.xpos[body.model.body(foot).id][:2]) for foot in body.feet}
+    where = {foot: xyz[:2] for foot, xyz in body_origins(body.model, body.qpos, body.feet).items()}
     reaches = []
     for step in landed:
         (other,) = (foot for foot in body.feet if foot != step.foot)

@@ -18,7 +18,7 @@ from pushrecovery.control.wbc.bodies import sole_points
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["inertia_about_axis", "joint_id", "standing_qpos", "subtree"]
+__all__ = ["body_origins", "inertia_about_axis", "joint_id", "standing_qpos", "subtree"]
 
 
 def joint_id(model: Any, name: str) -> int:
@@ -29,6 +29,19 @@ def joint_id(model: Any, name: str) -> int:
     if index < 0:
         raise KeyError(f"the model has no joint {name!r}")
     return index
+
+
+def body_origins(model: Any, qpos: FloatArray, names: tuple[str, ...]) -> dict[str, FloatArray]:
+    """Return the world origin of each named body in pose ``qpos`` (forward kinematics) [m].
+
+    A KeyError names a body the model does not have.
+    """
+    import mujoco
+
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    return {name: np.array(data.xpos[model.body(name).id]) for name in names}
 
 
 def subtree(model: Any, root: int) -> list[int]:
