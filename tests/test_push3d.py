@@ -8,7 +8,7 @@ import pytest
 
 from pushrecovery import load_params
 from pushrecovery.cli import main
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.sim.mujoco.humanoid3d import robots
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
@@ -180,3 +180,14 @@ def test_the_critical_impulse_search_brackets_a_known_threshold():
         found, (low, high), strategy = bisect_critical(stands, **start, tolerance=0.01, **kwargs)
         assert low <= 12.3 < high and high - low <= 0.01 and found == low
         assert strategy == "hip"
+
+
+def test_make_plant3d_builds_only_the_3d_humanoids():
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant
+    from pushrecovery.sim.registry import make_plant3d
+
+    assert isinstance(make_plant3d("biped3d", P), Biped3DPlant)
+    with pytest.raises(InvalidParameterError, match=r"model must be one of \['biped3d', 'g1'\]"):
+        make_plant3d("torso", P)
+    with pytest.raises(ParameterTypeError, match="name must be a str"):
+        make_plant3d(3, P)

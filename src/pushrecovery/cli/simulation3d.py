@@ -7,10 +7,13 @@ from any direction (:mod:`pushrecovery.sim.mujoco.humanoid3d.runs3d`); the helpe
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pushrecovery.cli.options import params_from
 from pushrecovery.sim.registry import MUJOCO_3D_MODELS
+
+if TYPE_CHECKING:
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 
 __all__: list[str] = []
 
@@ -111,7 +114,9 @@ def _render_options(
     return {"camera": camera, "times": times}
 
 
-def _render_3d(plant: Any, run: Any, path: str, options: dict[str, Any]) -> dict[str, Any]:
+def _render_3d(
+    plant: Humanoid3DPlant, run: Any, path: str, options: dict[str, Any]
+) -> dict[str, Any]:
     """Write the filmstrip PNG and GIF of a recorded 3-D run (the JSON's new keys)."""
     import shutil
     from pathlib import Path
@@ -159,13 +164,13 @@ def _simulate_3d(
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import STATE_LABELS, wbc_for
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
     from pushrecovery.sim.push import Push3D
-    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.registry import make_plant3d
     from pushrecovery.surfaces.classify import classify as classify_state
 
     push = Push3D(0.0 if impulse is None else impulse, 0.0 if azimuth is None else azimuth)
     dvx, dvy = push.delta_velocity(params.mass)
     predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
-    plant: Any = make_plant(model, params, "mujoco")
+    plant = make_plant3d(model, params)
     wbc = wbc_for(plant, stepping=stepping)
     run = simulate_push3d(plant, wbc, push, duration=duration, record=bool(render))
     states, before, after = run.states, run.before_push, run.after_push
@@ -214,10 +219,10 @@ def _critical_3d(
     """Bisect the impulse at ``azimuth`` on a 3-D model (the JSON)."""
     from pushrecovery.arguments import positive_float
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d
-    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.registry import make_plant3d
 
     width = positive_float("tolerance", tolerance, "m/s") * params.mass
-    plant: Any = make_plant(model, params, "mujoco")
+    plant = make_plant3d(model, params)
     found = critical_push3d(
         plant, 0.0 if azimuth is None else azimuth, tolerance=width, duration=duration
     )

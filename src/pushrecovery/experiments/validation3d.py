@@ -51,7 +51,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
@@ -62,6 +62,9 @@ from pushrecovery.experiments.validation3d_predict import (
     push_lever,
 )
 from pushrecovery.params import BodyParams
+
+if TYPE_CHECKING:
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 
 __all__ = [
     "DEFAULT_AZIMUTHS",
@@ -111,7 +114,7 @@ class MeasuredCritical:
 
 
 def measure_critical_impulse(
-    plant: Any,
+    plant: Humanoid3DPlant,
     azimuth: float,
     *,
     hip: bool,

@@ -10,7 +10,7 @@ for the hip; and the lever of a push applied above the CoM (:func:`push_lever`).
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING
 
 from pushrecovery.arguments import bounded_float, finite_float, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
@@ -18,6 +18,9 @@ from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.plane import cmp_polygon
+
+if TYPE_CHECKING:
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 
 __all__ = [
     "CriticalErrors",
@@ -123,7 +126,7 @@ def predicted_critical_impulses(
     }
 
 
-def push_lever(plant: Any) -> tuple[float, float]:
+def push_lever(plant: Humanoid3DPlant) -> tuple[float, float]:
     """Return (d, z₀): the pushed torso's CoM height above the whole-body CoM, and z₀ [m].
 
     ``plant`` is a freshly reset 3-D plant (``sim.mujoco.humanoid3d.plant3d``).

@@ -42,7 +42,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -53,6 +53,9 @@ from pushrecovery.experiments.validation3d_predict import CriticalErrors, critic
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.n_step import step_options, viable_region
+
+if TYPE_CHECKING:
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 
 __all__ = [
     "FALL_MARGIN",
@@ -126,7 +129,7 @@ class _Body:
     upright: str  # the body the controller holds upright
 
 
-def _body(params: BodyParams, model: Any = None, plant: Any = None) -> _Body:
+def _body(params: BodyParams, model: Any = None, plant: Humanoid3DPlant | None = None) -> _Body:
     """Return the ``plant``'s body (a Humanoid3DPlant), else the biped3d of ``params``."""
     if plant is not None:
         from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
@@ -288,7 +291,7 @@ def measure_step_critical(
     duration: float = 3.0,
     model: Any = None,
     swing_time: float | None = None,
-    plant: Any = None,
+    plant: Humanoid3DPlant | None = None,
 ) -> tuple[float, tuple[float, float], int, SteppingRun]:
     """Bisect the largest impulse at ``azimuth`` [deg] the body stands with stepping.
 

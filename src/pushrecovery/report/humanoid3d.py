@@ -20,13 +20,16 @@ import json
 import os
 from dataclasses import asdict, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.report.config import HUMANOID3D_STRIPS
 from pushrecovery.report.context import _Context
 from pushrecovery.report.data import Filmstrip, Humanoid3DSection, Picture, Table
 from pushrecovery.report.markup import num, percent
+
+if TYPE_CHECKING:
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 
 __all__ = ["HINT", "humanoid3d_section"]
 
@@ -220,7 +223,7 @@ def _strip_run(ctx: _Context, spec: Strip) -> tuple[Any, float, str]:
     if model == "g1":
         from pushrecovery.sim.mujoco.humanoid3d.robots import robot_params
 
-        plant: Any = G1Plant(robot_params("g1"))
+        plant: Humanoid3DPlant = G1Plant(robot_params("g1"))
     else:
         plant = Biped3DPlant(ctx.params)
     state = plant.reset()

@@ -15,6 +15,7 @@ from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 if TYPE_CHECKING:  # listing the models must not load numpy (pushrecovery --help)
     from pushrecovery.params import BodyParams
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
     from pushrecovery.sim.plants import Plant
 
 __all__ = [
@@ -25,6 +26,7 @@ __all__ = [
     "PLANTS_3D",
     "available_models",
     "make_plant",
+    "make_plant3d",
 ]
 
 #: Backend -> model name -> "module:Class" of its plant.
@@ -99,4 +101,26 @@ def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plan
         )
     module, _, attribute = table[name].partition(":")
     plant: Plant = getattr(importlib.import_module(module), attribute)(params)
+    return plant
+
+
+def make_plant3d(name: str, params: BodyParams) -> Humanoid3DPlant:
+    """Build the 3-D humanoid ``name`` of :data:`PLANTS_3D` (a MuJoCo plant) with its own type.
+
+    :func:`make_plant` with the MuJoCo backend, for callers that use what only the 3-D plants
+    have (the whole-body controller, pushes from any azimuth).
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``name`` is not one of :data:`MUJOCO_3D_MODELS`.
+    """
+    from pushrecovery.arguments import require_type
+
+    require_type("name", name, str)
+    if name not in MUJOCO_3D_MODELS:
+        raise InvalidParameterError(
+            f"model must be one of {list(MUJOCO_3D_MODELS)} (a 3-D humanoid), got model={name!r}"
+        )
+    plant: Humanoid3DPlant = make_plant(name, params, "mujoco")  # type: ignore[assignment]
     return plant
