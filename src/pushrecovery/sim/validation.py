@@ -15,6 +15,9 @@ still meanwhile), so the prediction is offered twice: the paper's surface at the
 position, and a *corrected* one for the two things the physics adds to the ankle and hip
 surfaces: the CoP margin the feet need (docs/validation.md) and the CoM's travel during the push
 (x moves by v D / 2 under a constant force of duration D).
+
+Over 400 lines on purpose: one concept, the surfaces against the simulation, whose critical
+push, confusion matrix and their typed rows belong together.
 """
 
 from __future__ import annotations

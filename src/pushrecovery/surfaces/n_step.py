@@ -28,6 +28,9 @@ d_N = l Σ_{k=1}^N β^k = (d_{N−1} + l) β; a disc foot of radius r adds r (th
 d_N); the hip adds its offset. (S1) is exact under the independence conditions of
 :mod:`pushrecovery.surfaces.plane` and with the landing foot alone supporting after each
 touchdown (the double support of a touchdown, a hull, is not used: conservative).
+
+Over 400 lines on purpose: the model, its derivation and the exact N-step sets are one
+concept; the LP that checks them is :mod:`pushrecovery.surfaces.capture_lp_steps`.
 """
 
 from __future__ import annotations

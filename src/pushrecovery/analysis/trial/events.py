@@ -24,6 +24,9 @@ given what a reader of the trial asks of them:
   displacement along the axis lies in that range (None where the frame needed no step); and in
   the plane, the landing ankle against the one-step **capture region** of the state at
   foot-off (``capture_region``: its signed margin, + inside, and the recommended foothold).
+
+Over 400 lines on purpose: one concept, the trial's typed events, each field with its unit;
+the detections themselves are in :mod:`pushrecovery.analysis.events`.
 """
 
 from __future__ import annotations

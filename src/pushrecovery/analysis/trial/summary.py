@@ -3,6 +3,9 @@
 :class:`TrialSummary` is what :func:`~pushrecovery.analysis.trial.analyze` returns as
 ``TrialAnalysis.summary``; :meth:`TrialSummary.to_dict` is ``summary.json`` (and the CLI's
 ``--json``), whose keys are a contract (docs/analysis.md).
+
+Over 400 lines on purpose: one concept, the summary's typed fields, each with its unit and sign
+in its docstring, and the one serialiser that keeps the JSON's keys and order.
 """
 
 from __future__ import annotations
