@@ -41,6 +41,9 @@
 16. The whole-body QP (``benchmarks/wbc.py``, issue 19): the G1 (skipped with a one-line
    reason without the robots extra) and biped3d under the WBC at 500 Hz against MuJoCo alone
    on the same controls, the solve and tick median and p99. Target: ratio >= 0.5.
+17. A campaign's fixed cost (``benchmarks/campaign_cost.py``): ``pushrecovery campaign`` of 4
+   pushes with ``--workers 1`` (in-process) minus ``python -c "import pushrecovery"`` in the
+   same rounds, median and largest of 7, for three pairs. Target: median <= 1.5 s.
 """
 
 from __future__ import annotations
@@ -427,6 +430,7 @@ def analysis() -> None:
 
 
 def main() -> int:
+    import campaign_cost
     import mpc_horizons
     import mujoco_speed
     import plane
@@ -440,6 +444,7 @@ def main() -> int:
     mujoco_failed = mujoco_speed.main()
     trials_failed = trials.main()
     wbc_failed = wbc.main()
+    cost_failed = campaign_cost.main()
     ratio = surface()
     cli = startup()
     realtime()
@@ -454,7 +459,7 @@ def main() -> int:
     failed = ratio > 2.0 or cli > 1.5 or step_rate < 2e6 or step_ratio < 1000 or physics < 150
     failed = failed or bool(plane_failed) or bool(steps_failed) or bool(mpc_failed)
     failed = failed or bool(mujoco_failed) or bool(trials_failed) or bool(wbc_failed)
-    failed = failed or batch_rate < 5000 or step_batch_rate < 500
+    failed = failed or batch_rate < 5000 or step_batch_rate < 500 or bool(cost_failed)
     print("targets met" if not failed else "TARGET MISSED")
     return int(failed)
 

@@ -172,11 +172,14 @@ def push_geometry(model: str, params: BodyParams) -> tuple[tuple[float, float], 
     height above the whole-body CoM and z₀ the CoM's above the soles [m]. Built once per
     body and process (a MuJoCo model is compiled).
     """
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
     from pushrecovery.sim.registry import make_plant
 
     if model not in MODELS_3D:
         raise InvalidParameterError(f"model must be one of {list(MODELS_3D)}, got {model!r}")
-    plant: Any = make_plant(model, params, "mujoco")
+    plant = make_plant(model, params, "mujoco")
+    if not isinstance(plant, Humanoid3DPlant):  # the registry's 3-D models all are
+        raise TypeError(f"{model} is not a 3-D plant: {type(plant).__name__}")
     state = plant.reset()
     data = plant.data
     lever = float(data.xipos[plant.body_of("torso")][2]) - float(data.subtree_com[0][2])

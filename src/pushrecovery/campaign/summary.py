@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.campaign.arrow import column_array
 from pushrecovery.campaign.spec import CampaignSpec
 from pushrecovery.sim.critical import predicted_critical_velocity
 from pushrecovery.sim.validation import LABELS as VALIDATION_LABELS
@@ -128,9 +129,9 @@ class SummaryTally:
 
     def add(self, table: Any) -> None:
         """Count the pushes of ``table`` (a ``pyarrow.Table`` of the campaign's columns)."""
-        columns = {
-            name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names
-        }
+        wanted = ["outcome", "predicted", "used", "predicted_recovers", "predicted_steps"]
+        wanted += ["steps", *self.boundary_names]
+        columns = {name: column_array(table, name) for name in wanted if name in table.column_names}
         outcome, predicted, used = columns["outcome"], columns["predicted"], columns["used"]
         # A push without an outcome (its physics diverged, its worker died) is counted apart
         # and left out of the confusion matrix, the accuracy and the critical pushes.

@@ -113,7 +113,12 @@ _scheduler = click.option(
 @click.option(
     "--out", type=click.Path(file_okay=False), required=True, help="Directory of the campaign."
 )
-@_workers
+@click.option(
+    "--workers",
+    type=int,
+    default=None,
+    help="Local worker processes (default: all cores; 1: the pushes run in this process).",
+)
 @_scheduler
 @click.option(
     "--resume",
@@ -219,6 +224,9 @@ def campaign(
             scheduler=scheduler,
             resume=resume,
             progress=bar.update,
+            # --workers 1: in this process (no worker to start and import everything again;
+            # a push that crashes the engine ends the campaign, its finished batches kept).
+            isolated=workers != 1,
         )
     except KeyboardInterrupt:
         bar.close()

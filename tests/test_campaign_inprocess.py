@@ -1,0 +1,80 @@
+"""A campaign's fixed cost: --workers 1 runs in this process; a tiny ankle-PD campaign loops.
+
+The numbers are ``benchmarks/campaign_cost.py``'s; these tests check the paths and that the
+rows do not depend on them.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.campaign import CampaignSpec, execute
+from pushrecovery.campaign import pushes as pushes_module
+from pushrecovery.campaign.pushes import LOOP_UP_TO, run_batch
+from pushrecovery.campaign.spec import COMPILED_BATCH
+from pushrecovery.cli import main
+
+P = load_params()
+ARGS = ["campaign", "--model", "pendulum", "--controller", "ankle-pd", "--x0", "0", "0.05",
+        "0.05", "--xdot", "0", "0.4", "0.2", "--no-plot", "--json"]  # fmt: skip
+
+
+def run_cli(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    with pytest.raises(SystemExit) as caught:
+        main(list(args))
+    out, err = capsys.readouterr()
+    return int(caught.value.code or 0), out, err
+
+
+def test_one_worker_runs_the_campaign_in_this_process(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def pool(*args: Any) -> Any:
+        raise AssertionError("--workers 1 started a worker process")
+
+    monkeypatch.setattr(execute, "_processes", pool)
+    code, out, err = run_cli(capsys, *ARGS, "--workers", "1", "--out", str(tmp_path / "c"))
+    assert code == 0, err
+    assert json.loads(out)["pushes"] == 6
+
+
+@pytest.mark.parametrize("workers", ["0", "-3"])
+def test_bad_worker_counts_are_one_line_and_exit_2(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, workers: str
+) -> None:
+    code, _, err = run_cli(capsys, *ARGS, "--workers", workers, "--out", str(tmp_path / "c"))
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "workers must be >= 1" in lines[0], err
+    assert not (tmp_path / "c").exists()
+
+
+def test_the_compiled_pairs_are_sim_batched_s() -> None:
+    from pushrecovery.sim.batched import BATCHED
+
+    assert set(COMPILED_BATCH) == set(BATCHED)
+
+
+@pytest.mark.parametrize("model", ["pendulum", "lipm"])
+def test_a_tiny_ankle_pd_campaign_loops_and_gives_the_compiled_rows(
+    model: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    spec = CampaignSpec(
+        "analytic", model, "ankle-pd", P, x0=(-0.04, 0.11, 0.075), xdot=(-0.9, 0.9, 0.45),
+        sweeps={"toe": (0.12, 0.18, 0.06)}, duration=3.0,
+    )  # fmt: skip
+    assert spec.size <= LOOP_UP_TO
+    compiled = pushes_module._batched_rows(spec, spec.pushes(0))
+
+    def refuse(*args: Any) -> Any:
+        raise AssertionError("the compiled loop ran")
+
+    monkeypatch.setattr(pushes_module, "_batched_rows", refuse)
+    _, rows = run_batch(spec, 0)
+    assert {"recovered", "fell"} <= {row["outcome"] for row in rows}
+    assert repr(rows) == repr(compiled)  # every column, NaN and None included, to the bit
