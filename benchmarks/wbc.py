@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from pushrecovery.control.wbc.bodies import body_id
+from pushrecovery.control.wbc.observation import mujoco_observation
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION
 
 REPEAT = 5
@@ -59,7 +60,8 @@ def g1_case() -> Case | None:
 
     robot = describe_robot("g1")
     impulse = FRACTION * g1_ankle_impulse(robot)
-    return Case("G1", robot.model, robot.qpos, G1_TORSO, impulse, lambda: g1_controller(robot))
+    return Case("G1", robot.model, robot.qpos, G1_TORSO, impulse,
+                lambda observation: g1_controller(robot, observation))  # fmt: skip
 
 
 def biped_case() -> Case:
@@ -74,7 +76,7 @@ def biped_case() -> Case:
     reach = Support.from_params(params).polygon.ray_distance(0.0, 0.0, 0.0)
     impulse = FRACTION * params.mass * params.omega * reach
     return Case("biped3d", model, bent_knee_qpos(model), "torso", impulse,
-                lambda: WholeBodyController(model))  # fmt: skip
+                lambda seen: WholeBodyController(model, observation=seen))  # fmt: skip
 
 
 def _run(case: Case, controls: np.ndarray | None) -> dict[str, Any]:
@@ -92,16 +94,17 @@ def _run(case: Case, controls: np.ndarray | None) -> dict[str, Any]:
     ticks = round(DURATION / (steps * dt))
     start, stop = round(PUSH_TIME / dt), round((PUSH_TIME + PUSH_DURATION) / dt)
     controller = None
+    state = np.zeros(6)  # the CoM state (the WBC reads its observation)
     if controls is None:
-        controller = case.controller()
-        controller.reset(data)
+        controller = case.controller(mujoco_observation(model, data))
+        controller.reset(state)
     applied, solves, ticks_time = np.zeros((ticks, model.nu)), np.zeros(ticks), np.zeros(ticks)
     began = time.process_time()  # CPU time: a fair one-core cost on a shared machine
     for tick in range(ticks):
         if controller is not None:
             mujoco.mj_step1(model, data)
             tick_start = time.perf_counter()
-            data.ctrl[:] = controller.compute(data.time, data)
+            data.ctrl[:] = controller.compute(data.time, state).motors
             ticks_time[tick] = time.perf_counter() - tick_start
             assert controller.last is not None
             solves[tick] = controller.last.solve_time

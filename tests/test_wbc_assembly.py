@@ -19,12 +19,22 @@ import pytest
 from pushrecovery import load_params
 from pushrecovery.control.wbc.bodies import body_id
 from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.control.wbc.observation import mujoco_observation
 from pushrecovery.control.wbc.stepper.settings import StepSettings
 from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
+
+
+def wbc(model, data, **options):
+    """The whole-body controller on ``data``'s observation (the plants hand theirs)."""
+    return WholeBodyController(model, observation=mujoco_observation(model, data), **options)
+
+
+#: The CoM state the loop passes the WBC (unused: its laws read the observation).
+STILL = np.zeros(6)
 
 #: Relative agreement of the matrices: the same products summed in another order, rounding
 #: of 1e-16 per term over sums of ~50 terms [-].
@@ -119,16 +129,17 @@ def relative(a, b):
     return float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-300))
 
 
-def pushed_run(model, qpos, controller, torso, impulse, azimuth, duration, per_tick):
-    """Run ``controller`` after a push, checking every tick's QP against the reference.
+def pushed_run(model, qpos, make, torso, impulse, azimuth, duration, per_tick):
+    """Run ``make(observation)``'s controller after a push, checking every tick's QP.
 
-    Returns the worst relative differences (matrices, solution) and how many ticks had a foot
-    off the floor.
+    Returns the worst relative differences (matrices, solution), how many ticks had a foot
+    off the floor, and the controller.
     """
     data = mujoco.MjData(model)
     data.qpos[:] = qpos
     mujoco.mj_forward(model, data)
-    controller.reset(data)
+    controller = make(mujoco_observation(model, data))
+    controller.reset(STILL)
     body = body_id(model, torso)
     force = impulse / PUSH_DURATION * np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
     dt = float(model.opt.timestep)
@@ -137,15 +148,15 @@ def pushed_run(model, qpos, controller, torso, impulse, azimuth, duration, per_t
     reference, contacts = None, None
     for tick in range(round(duration / (per_tick * dt))):
         mujoco.mj_step1(model, data)
-        tasks = controller.tasks(data)
+        tasks = controller.tasks()
         qp = controller.qp
         ref = reference_qp(qp, data, tasks)
-        problem = qp.assemble(data, tasks)
+        problem = qp.assemble(controller.observation, tasks)
         assert problem.equalities == ref["equalities"]
         assert problem.rows.shape == ref["rows"].shape
         for name in ("hessian", "linear", "rows", "upper", "lower"):
             worst_matrix = max(worst_matrix, relative(getattr(problem, name), ref[name]))
-        solution = qp.solve(data, tasks)
+        solution = qp.solve(controller.observation, tasks)
         matrices = [ref[k] for k in ("hessian", "linear", "rows", "upper", "lower")]
         if reference is None or not np.array_equal(contacts, qp.contacts):
             sense = np.zeros(ref["rows"].shape[0], dtype=np.intc)
@@ -168,7 +179,7 @@ def pushed_run(model, qpos, controller, torso, impulse, azimuth, duration, per_t
                 mujoco.mj_step2(model, data)
             else:
                 mujoco.mj_step(model, data)
-    return worst_matrix, worst_solution, swings
+    return worst_matrix, worst_solution, swings, controller
 
 
 @pytest.fixture(scope="module")
@@ -185,10 +196,19 @@ def test_biped_qp_matches_the_reference_through_a_hip_push_and_a_step(params, mo
     """Ankle and hip balancing, then a lateral step: a foot leaves the contacts and lands."""
     polygon = Support.from_params(params).polygon
     impulse = 1.5 * params.mass * params.omega * polygon.ray_distance(0.0, 0.0, math.pi / 2)
-    controller = WholeBodyController(model, hip=params, stepping=True, params=params,
-                                     step_settings=StepSettings(swing_time=0.2))  # fmt: skip
-    worst_matrix, worst_solution, swings = pushed_run(
-        model, bent_knee_qpos(model), controller, "torso", impulse, math.pi / 2, 0.6, 4
+
+    def make(observation):
+        return WholeBodyController(
+            model,
+            observation=observation,
+            hip=params,
+            stepping=True,
+            params=params,
+            step_settings=StepSettings(swing_time=0.2),
+        )
+
+    worst_matrix, worst_solution, swings, controller = pushed_run(
+        model, bent_knee_qpos(model), make, "torso", impulse, math.pi / 2, 0.6, 4
     )
     assert swings > 20  # the step was taken: ticks with a foot off the floor were checked
     assert controller.hip is not None
@@ -209,10 +229,9 @@ def test_g1_qp_matches_the_reference_through_a_push():
     )
 
     robot = describe_robot("g1")
-    controller = g1_controller(robot)
-    worst_matrix, worst_solution, _ = pushed_run(
-        robot.model, robot.qpos, controller, G1_TORSO, 0.3 * g1_ankle_impulse(robot), 0.5,
-        0.3, 2,
+    worst_matrix, worst_solution, _, _ = pushed_run(
+        robot.model, robot.qpos, lambda observation: g1_controller(robot, observation),
+        G1_TORSO, 0.3 * g1_ankle_impulse(robot), 0.5, 0.3, 2,
     )  # fmt: skip
     assert worst_matrix < MATRIX_RTOL
     assert worst_solution < SOLUTION_RTOL
@@ -222,12 +241,12 @@ def test_a_task_of_the_wrong_shape_is_refused(model):
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)
     mujoco.mj_forward(model, data)
-    controller = WholeBodyController(model)
-    controller.reset(data)
+    controller = wbc(model, data)
+    controller.reset(STILL)
     qp = controller.qp
     wide = Task("wide", np.zeros((1, qp.size + 1)), np.zeros(1), 1.0)
     with pytest.raises(InvalidParameterError, match="wide"):
-        qp.solve(data, [wide])
+        qp.solve(controller.observation, [wide])
     short = Task("short", np.zeros((2, qp.nv)), np.zeros(3), 1.0)
     with pytest.raises(InvalidParameterError, match="short"):
-        qp.assemble(data, [short])
+        qp.assemble(controller.observation, [short])

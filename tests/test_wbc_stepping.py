@@ -2,12 +2,14 @@
 
 import math
 
+import mujoco
 import numpy as np
 import pytest
 
 from pushrecovery import load_params
 from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.control.wbc.foot_contact import foot_contact
+from pushrecovery.control.wbc.observation import mujoco_observation
 from pushrecovery.control.wbc.qp import WholeBodyQP
 from pushrecovery.control.wbc.stepper.leg import axis_inertia, leg_joints
 from pushrecovery.control.wbc.stepper.plan import lipm_com, quintic
@@ -17,6 +19,15 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos, push_biped3d
+
+
+def wbc(model, data, **options):
+    """The whole-body controller on ``data``'s observation (the plants hand theirs)."""
+    return WholeBodyController(model, observation=mujoco_observation(model, data), **options)
+
+
+#: The CoM state the loop passes the WBC (unused: its laws read the observation).
+STILL = np.zeros(6)
 
 #: The push, in CoP-region critical impulses (docs/plane.md): well outside the ankle region.
 OUTSIDE = 1.5
@@ -174,7 +185,7 @@ def test_swing_foot_contacts_in_the_qp(model):
     mujoco.mj_forward(model, data)
     qp = WholeBodyQP(model, [foot_contact(model, data, n) for n in ("left_foot", "right_foot")])
     qp.set_contacts([False, True])
-    solution = qp.solve(data, [])
+    solution = qp.solve(mujoco_observation(model, data), [])
     assert solution.ok and np.allclose(solution.wrenches[0], 0.0)
     with pytest.raises(InvalidParameterError, match="contacts"):
         qp.set_contacts([True])
@@ -193,7 +204,7 @@ def test_swing_foot_contacts_in_the_qp(model):
 )
 def test_bad_controller_inputs(model, kwargs, name):
     with pytest.raises(InvalidParameterError, match=name):
-        WholeBodyController(model, **kwargs)
+        wbc(model, mujoco.MjData(model), **kwargs)
 
 
 @pytest.mark.parametrize(

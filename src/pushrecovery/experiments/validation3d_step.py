@@ -149,15 +149,19 @@ def _body(params: BodyParams, model: Any = None, plant: Humanoid3DPlant | None =
 def _stepping_run(body: _Body, impulse: float, azimuth: float, duration: float,
                   swing_time: float | None) -> SteppingRun:  # fmt: skip
     from pushrecovery.control.wbc.controller import WholeBodyController
+    from pushrecovery.control.wbc.observation import HumanoidObservation
     from pushrecovery.control.wbc.stepper.settings import StepSettings
     from pushrecovery.sim.mujoco.humanoid3d.measure import body_origins
     from pushrecovery.sim.mujoco.humanoid3d.wbc_push import push_humanoid
 
-    controller = WholeBodyController(body.model, body.feet, body.upright, stepping=True,
-                                     params=body.params,
-                                     step_settings=StepSettings(swing_time=swing_time))  # fmt: skip
-    run = push_humanoid(body.model, body.qpos, controller, body.feet, body.torso, impulse,
+    def stepping(observation: HumanoidObservation) -> WholeBodyController:
+        return WholeBodyController(body.model, body.feet, body.upright, observation=observation,
+                                   stepping=True, params=body.params,
+                                   step_settings=StepSettings(swing_time=swing_time))  # fmt: skip
+
+    run = push_humanoid(body.model, body.qpos, stepping, body.feet, body.torso, impulse,
                         math.radians(azimuth), duration=duration)  # fmt: skip
+    controller = run.controller
     height = float(run.com[0, 2])
     down = bool(np.any(run.com[:, 2] < 0.7 * height)) or float(run.torso_tilt.max()) > 1.0
     xi = run.com[-1, :2] + run.com_velocity[-1, :2] / controller.omega

@@ -230,7 +230,8 @@ def _strip_run(ctx: _Context, spec: Strip) -> tuple[Any, float, str]:
     origin = (float(state[0]), float(state[1]))
     impulse = fraction * predicted_critical_impulses(plant.params, azimuth, origin=origin)["ankle"]
     if controller == "step":
-        wbc = WholeBodyController(plant.model, feet=plant.feet, torso=plant.upright, hip=None,
+        wbc = WholeBodyController(plant.model, feet=plant.feet, torso=plant.upright,
+                                  observation=plant.observation, hip=None,
                                   stepping=True, params=plant.params,
                                   step_settings=StepSettings(swing_time=0.2))  # fmt: skip
     else:

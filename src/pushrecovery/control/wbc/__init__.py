@@ -5,15 +5,22 @@ their tasks (``tasks/``) and limits (``limits/``), the QP stacks them under MuJo
 and the feet's contact rows and solves it (``qp``, ``least_distance``). docs/humanoid3d.md
 derives every law. The compiled kernels are :mod:`pushrecovery.kernels.wbc`.
 
-The WBC reads MuJoCo's ``MjModel`` and ``MjData`` (it may import ``mujoco``, as mink does) and
-nothing of ``pushrecovery.sim``: the plants (``sim.mujoco.humanoid3d.plant3d.wbc_for``) build
-it from above. Importing this package imports nothing: import the module you need.
+The WBC is a :class:`~pushrecovery.control.base.Controller` over a typed
+:class:`~.observation.HumanoidObservation` the plant hands it (views of the plant's own
+``MjData``: nothing copied per tick); it reads MuJoCo's ``MjModel`` (it may import ``mujoco``,
+as mink does) and nothing of ``pushrecovery.sim``: the plants
+(``sim.mujoco.humanoid3d.plant3d.wbc_for``) build it from above. Importing this package
+imports nothing: import the module you need.
 
 Modules
 -------
 controller
     :class:`~.controller.WholeBodyController`: the balance laws (DCM, torso, pelvis, posture),
-    the hip and the stepper, one QP per tick; ``reset(data)``, ``compute(t, data) -> ctrl``.
+    the hip and the stepper, one QP per tick; ``reset(state)``,
+    ``compute(t, state) -> HumanoidCommand``.
+observation
+    :class:`~.observation.HumanoidObservation` (what the WBC reads, built by
+    :func:`~.observation.mujoco_observation`) and :class:`~.observation.HumanoidCommand`.
 gains
     :class:`~.gains.WbcGains`, the tasks' gains and weights.
 qp

@@ -37,26 +37,35 @@ the torso stays upright and the posture fills the null space.
   the capture region's recommended foothold, re-planned during the swing; at touchdown it
   rejoins the contacts and the ankles balance about the new feet's midpoint.
 
-Contract: :class:`WholeBodyController` has the ``reset(state)`` / ``compute(t, state)`` pair of
-:class:`~pushrecovery.control.base.Controller`, with one deviation: its ``state`` is the
-``mujoco.MjData`` (positions, velocities and everything ``mj_forward`` computed from them),
-and ``compute`` returns the motor commands ``ctrl`` [N m] instead of a ``Command``.
+Contract: :class:`WholeBodyController` is a :class:`~pushrecovery.control.base.Controller`
+(``reset(state)``, ``compute(t, state)``; ``state`` the plant's CoM state,
+:data:`~.observation.HUMANOID_STATE`). Its laws read the whole body through the
+:class:`~.observation.HumanoidObservation` the plant hands it at construction (views of the
+physics' own arrays: nothing copied per tick), and ``compute`` returns a
+:class:`~.observation.HumanoidCommand`: the motor commands [N m], the DCM law's CoP, and the
+support polygon and stance the plant's fall rule reads when the controller steps.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.base import Controller
 from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.control.wbc.foot_contact import FootContact, foot_contact
 from pushrecovery.control.wbc.gains import WbcGains
 from pushrecovery.control.wbc.hip import UPRIGHT, HipLaw
 from pushrecovery.control.wbc.limits.joint_guard import GuardSettings, JointGuard
+from pushrecovery.control.wbc.observation import (
+    HUMANOID_STATE,
+    HumanoidCommand,
+    HumanoidObservation,
+)
 from pushrecovery.control.wbc.qp import WbcSolution, WholeBodyQP
 from pushrecovery.control.wbc.stepper.settings import StepSettings
 from pushrecovery.control.wbc.stepper.stepper import Stepper
@@ -88,13 +97,16 @@ def _rotation_vector(rot: Sequence[float], ref: Sequence[float]) -> FloatArray:
     return out
 
 
-class WholeBodyController:
+class WholeBodyController(Controller):
     """Ankle-strategy whole-body control of a floating-base humanoid (module docstring).
 
     Parameters
     ----------
     model : mujoco.MjModel
         The humanoid (free joint first, torque motors on joints).
+    observation : HumanoidObservation
+        What the laws read at every tick: the plant's (:func:`~.observation.mujoco_observation`
+        of the ``MjData`` the physics steps).
     feet : sequence of str
         Names of the foot bodies, all on the floor at reset and kept there.
     torso : str
@@ -117,10 +129,12 @@ class WholeBodyController:
     ------
     InvalidParameterError
         If a name is not a body of ``model``, ``feet`` is empty or repeats a body, the model
-        has joints other than the free root and hinges or slides, or ``gains`` is not a
-        :class:`WbcGains`.
+        has joints other than the free root and hinges or slides, ``gains`` is not a
+        :class:`WbcGains` or ``observation`` not a :class:`HumanoidObservation`.
     """
 
+    name: ClassVar[str] = "wbc"
+    state_labels: ClassVar[tuple[str, ...]] = HUMANOID_STATE
     #: The period the gains are meant for [s] (500 Hz).
     control_period = 0.002
 
@@ -131,12 +145,17 @@ class WholeBodyController:
         torso: str = "torso",
         gains: WbcGains | None = None,
         *,
+        observation: HumanoidObservation,
         hip: BodyParams | None = None,
         stepping: bool = False,
         params: BodyParams | None = None,
         step_settings: StepSettings | None = None,
         guard: GuardSettings | None = None,
     ) -> None:
+        if not isinstance(observation, HumanoidObservation):
+            raise InvalidParameterError(
+                f"observation must be a HumanoidObservation, got {type(observation).__name__}"
+            )
         if isinstance(feet, str) or not feet or len(set(feet)) != len(feet):
             raise InvalidParameterError(f"feet must be distinct body names, got {feet!r}")
         for name in (*feet, torso):
@@ -151,7 +170,7 @@ class WholeBodyController:
         gains = WbcGains() if gains is None else gains
         if not isinstance(gains, WbcGains):
             raise InvalidParameterError(f"gains must be a WbcGains, got {type(gains).__name__}")
-        self.model, self.gains = model, gains
+        self.model, self.gains, self.observation = model, gains, observation
         self.foot_names, self.torso = tuple(feet), body_id(model, torso)
         self.mass = float(model.body_subtreemass[0])
         self.gravity = np.array(model.opt.gravity, dtype=float)
@@ -176,14 +195,15 @@ class WholeBodyController:
         self.stepping, self.step_params, self.step_settings = stepping, params, step_settings
         self.stepper: Stepper | None = None
         self.guard = JointGuard(model, guard)  # with stepping, the stepper guards the knees
-        self._data: Any = None  # the MjData whose array views cop_target keeps
+        self._data: Any = None  # the observation whose array views cop_target keeps
 
-    def reset(self, state: Any) -> None:
-        """Take the reference posture, feet and balance point from ``state`` (an MjData).
+    def reset(self, state: FloatArray) -> None:
+        """Take the reference posture, feet and balance point from the observation now.
 
-        ``state`` must hold ``mj_forward``'s results; the feet must be on the floor.
+        ``state`` is the plant's CoM state (:data:`~.observation.HUMANOID_STATE`); the laws
+        read the observation, which must hold ``mj_forward``'s results, the feet on the floor.
         """
-        model, data = self.model, state
+        model, data = self.model, self.observation
         self.feet = tuple(foot_contact(model, data, name) for name in self.foot_names)
         self.qp = WholeBodyQP(model, self.feet)
         soles = np.vstack([sole_points(model, data, foot.body) for foot in self.feet])
@@ -230,7 +250,7 @@ class WholeBodyController:
                                    hip=self.hip_params is not None)  # fmt: skip
             self.qp.contact_damping = self.stepper.settings.contact_damping
 
-    def _set_support(self, data: Any, contacts: list[bool]) -> None:
+    def _set_support(self, data: HumanoidObservation, contacts: list[bool]) -> None:
         """Set the feet in contact, re-measure the support polygon and rebuild the hip law."""
         assert self.qp is not None
         self.qp.set_contacts(contacts)
@@ -242,7 +262,7 @@ class WholeBodyController:
             self.hip = HipLaw(self.hip_params, self.support, self._weight, self.omega,
                               self.control_period)  # fmt: skip
 
-    def _step(self, data: Any) -> bool:
+    def _step(self, data: HumanoidObservation) -> bool:
         """Run the stepping decision, lift-off, re-plan and touchdown; True if contacts changed."""
         stepper = self.stepper
         assert stepper is not None and self.support is not None
@@ -262,18 +282,17 @@ class WholeBodyController:
         self.posture = np.array(data.qpos[7:], dtype=float)
         return True
 
-    def cop_target(self, data: Any) -> FloatArray:
+    def cop_target(self) -> FloatArray:
         """Return the DCM law's CoP p_des clipped to the support polygon [m] (world xy).
 
         Computes the CoM velocity (``mj_subtreeVel``, which ``mj_forward`` leaves stale).
         """
-        import mujoco
-
+        data = self.observation
         if data is not self._data:  # views of the arrays a tick reads, once (a fixed arena)
             self._data, self._views = data, (
                 data.xmat, data.subtree_com, data.subtree_linvel, data.subtree_com[0],
                 data.xpos[self.torso], data.qvel, data.qpos)  # fmt: skip
-        mujoco.mj_subtreeVel(self.model, data)
+        data.subtree_vel()
         support, out, views = self.support, self._balance, self._views
         assert support is not None
         # One kernel: the torso's error (kept for _update), ξ = c + ċ/ω and the DCM law's CoP.
@@ -286,34 +305,33 @@ class WholeBodyController:
             return self._cop.copy()
         return np.array(support.nearest_point(float(out[5]), float(out[6])))
 
-    def tasks(self, data: Any) -> list[Task]:
-        """Return the QP's tasks at the state in ``data`` (module docstring, :mod:`.hip`)."""
+    def tasks(self) -> list[Task]:
+        """Return the QP's tasks at the observed state (module docstring, :mod:`.hip`)."""
+        data = self.observation
         momentum = self._update(data)
         assert self.qp is not None
         if self.stepper is not None:  # the swing foot (while it swings), the knee guard
             return self._stack.tasks(momentum, self.stepper.tasks(data, self.qp.size, self.qp.nv))
         return self._stack.tasks(momentum, self.guard.tasks(data.qpos, data.qvel, self.qp.nv))
 
-    def _update(self, data: Any) -> Task | None:
+    def _update(self, data: HumanoidObservation) -> Task | None:
         """Run the tick's laws; write the CoM, torso, pelvis and posture rows (:meth:`compute`).
 
         Returns the hip's momentum task (None when the hip is idle).
         """
-        import mujoco
-
         assert self.qp is not None
-        model, gains, nv, size = self.model, self.gains, self.qp.nv, self.qp.size
+        gains, nv, size = self.gains, self.qp.nv, self.qp.size
         # The DCM law's CoP (also ξ, the torso's orientation error, mj_subtreeVel, the views).
-        self.desired_cop = self.cop_target(data)
+        self.desired_cop = self.cop_target()
         stepper = self.stepper
         if stepper is not None and self._step(data):
-            self.desired_cop = self.cop_target(data)  # the new support polygon
+            self.desired_cop = self.cop_target()  # the new support polygon
         xmat, _, _, com, point, qvel, qpos = self._views
         error, hip, torso = self._error, self.hip, self.torso  # the hip law after _step's
         # Torso orientation and pelvis height: J q̈ + J̇ q̇ = a_des (matrices over q̈ only).
         jacp, jacr = self._jacp, self._jacr
-        mujoco.mj_jac(model, data, jacp, jacr, point, torso)
-        mujoco.mj_jacDot(model, data, self._dots_p, self._dots_r, point, torso)
+        data.jac(jacp, jacr, point, torso)
+        data.jac_dot(self._dots_p, self._dots_r, point, torso)
         # The torso's angular velocity [rad/s], world: the hip law's (ankle_targets has its own).
         spin = jacr @ qvel if hip is not None else _NO_SPIN
         hip_active = False
@@ -373,21 +391,30 @@ class WholeBodyController:
         rate = self._weight * np.array([-self.cmp_offset[1], self.cmp_offset[0]])
         return Task("momentum", matrix, rate, gains.hip_weight)
 
-    def compute(self, t: float, state: Any) -> FloatArray:
-        """Return the motor commands ``ctrl`` [N m] for the state in ``state`` (an MjData).
+    def compute(self, t: float, state: FloatArray) -> HumanoidCommand:
+        """Return the command for the observed state: motor commands ``ctrl`` [N m] and more.
 
-        ``t`` [s] is the time since reset (unused: the laws are time-invariant). Never raises
-        inside the loop: a tick DAQP cannot solve repeats the last command (``last.ok``).
+        ``t`` [s] is the time since reset and ``state`` the plant's CoM state (both unused:
+        the laws are time-invariant and read the observation). The command's ``motors`` is
+        the QP's ``ctrl``; ``cop``, ``cop_y`` the desired CoP [m] (world); with stepping its
+        ``support`` is the polygon of the feet in contact and ``stance`` False while a foot
+        swings. Never raises inside the loop: a tick DAQP cannot solve repeats the last
+        command (``last.ok``).
         """
         if self.qp is None:
             raise InvalidParameterError("call reset(state) before compute(t, state)")
+        data, stepper = self.observation, self.stepper
         # The tasks() as stacked rows (TaskStack), the QP's fast path.
-        momentum, stack, qp = self._update(state), self._stack, self.qp
+        momentum, stack, qp = self._update(data), self._stack, self.qp
         count = stack.nv if momentum is None else stack.extend([momentum])
-        if self.stepper is not None:
-            count = stack.extend(self.stepper.tasks(state, qp.size, qp.nv), count)
+        if stepper is not None:
+            count = stack.extend(stepper.tasks(data, qp.size, qp.nv), count)
         else:  # the guard's rows, no Task (the G1's knees are within their margins at each tick)
-            count = self.guard._stack_rows(state.qpos, state.qvel, stack.matrix, stack.targets,
+            count = self.guard._stack_rows(data.qpos, data.qvel, stack.matrix, stack.targets,
                                            stack.weights, count)  # fmt: skip
-        self.last = qp._solve_rows(state, stack.matrix, stack.targets, stack.weights, count)
-        return self.last.ctrl
+        self.last = last = qp._solve_rows(data, stack.matrix, stack.targets, stack.weights, count)
+        cop = self.desired_cop
+        if stepper is None:
+            return HumanoidCommand(float(cop[0]), cop_y=float(cop[1]), motors=last.ctrl)
+        return HumanoidCommand(float(cop[0]), cop_y=float(cop[1]), motors=last.ctrl,
+                               support=self.support, stance=stepper.swing is None)  # fmt: skip

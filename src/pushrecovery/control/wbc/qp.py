@@ -50,9 +50,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.wbc.buffers import Buffers, full_inertia, inertia_writer
+from pushrecovery.control.wbc.buffers import Buffers
 from pushrecovery.control.wbc.foot_contact import FootContact
 from pushrecovery.control.wbc.least_distance import LeastDistanceSolver
+from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.kernels.wbc import add_task, assemble_rows, constraints, sole_frames, sole_origins
@@ -184,9 +185,9 @@ class WholeBodyQP:
         self._regular_matrix = np.diag(self._regular)
         self._solver = LeastDistanceSolver(buf, self._n_equal, self.ctrl_low, self.ctrl_high)
         self.contact_damping = CONTACT_DAMPING  # k_c [1/s]: J q̈ + J̇ q̇ = −k_c J q̇
-        # The fast path's arguments after the tasks' (_tick_arguments), for one MjData and
+        # The fast path's arguments after the tasks' (_tick_arguments), for one observation and
         # contact set: MuJoCo's arrays are views of its fixed arena, read anew each tick.
-        self._data: Any = None
+        self._data: HumanoidObservation | None = None
         self._arguments: tuple[Any, ...] = ()
 
     def reset(self) -> None:
@@ -213,7 +214,9 @@ class WholeBodyQP:
             self._data = None  # the fast path's arguments name the contacts
             self._solver.forget()  # other rows: no warm start
 
-    def contact_jacobians(self, data: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
+    def contact_jacobians(
+        self, data: HumanoidObservation
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Return each foot's world Jacobian J (6 n × nv), J̇ q̇ (6 n) and sole-frame Jacobian.
 
         Rows per foot: linear then angular. The sole-frame Jacobian is blockwise Rᵀ J, R the
@@ -226,19 +229,17 @@ class WholeBodyQP:
                     buf.local)  # fmt: skip
         return buf.jac, buf.jac_dot, buf.local
 
-    def _jacobians(self, data: Any) -> None:
+    def _jacobians(self, data: HumanoidObservation) -> None:
         """Write MuJoCo's J and J̇ of each sole frame into the buffers (``jac``, ``dots``)."""
-        import mujoco
-
         if data is not self._data:
             self._tick_arguments(data)
-        model = self.model
+        jac, jac_dot = data.jac, data.jac_dot
         sole_origins(*self._origin_arguments)
         for point, lin, ang, lin_dot, ang_dot, body in self._views:  # rows of buf, per foot
-            mujoco.mj_jac(model, data, lin, ang, point, body)
-            mujoco.mj_jacDot(model, data, lin_dot, ang_dot, point, body)
+            jac(lin, ang, point, body)
+            jac_dot(lin_dot, ang_dot, point, body)
 
-    def assemble(self, data: Any, tasks: Sequence[Task]) -> WbcProblem:
+    def assemble(self, data: HumanoidObservation, tasks: Sequence[Task]) -> WbcProblem:
         """Build the QP of the module docstring at the state in ``data`` (:meth:`solve`).
 
         Written in place into the QP's buffers: the arrays are valid until the next call.
@@ -253,7 +254,7 @@ class WholeBodyQP:
         return WbcProblem(buf.hessian, buf.linear, buf.rows[:count], buf.upper[:count],
                           buf.lower[:count], self._n_equal)  # fmt: skip
 
-    def _assemble(self, data: Any, tasks: Sequence[Task]) -> int:
+    def _assemble(self, data: HumanoidObservation, tasks: Sequence[Task]) -> int:
         """Write the QP into the buffers (:meth:`assemble`); return its number of rows."""
         checked = []  # every task checked before the buffers change
         for task in tasks:
@@ -272,7 +273,12 @@ class WholeBodyQP:
         return self._constrain(data)
 
     def _assemble_rows(
-        self, data: Any, matrix: FloatArray, target: FloatArray, weights: FloatArray, count: int
+        self,
+        data: HumanoidObservation,
+        matrix: FloatArray,
+        target: FloatArray,
+        weights: FloatArray,
+        count: int,
     ) -> int:
         """:meth:`_assemble` of the first ``count`` stacked task rows, unchecked.
 
@@ -290,14 +296,14 @@ class WholeBodyQP:
                               *self._arguments)  # fmt: skip
         return int(count)
 
-    def _tick_arguments(self, data: Any) -> None:
+    def _tick_arguments(self, data: HumanoidObservation) -> None:
         """Gather :func:`.kernels.wbc.assemble_rows`' arrays after the tasks' and k_c.
 
         Also ``sole_origins``' arguments and the bound ``mj_fullM`` of ``data``.
         """
         buf = self._buf
         self._data = data
-        self._inertia = inertia_writer(self.model, data, buf.mass)
+        self._inertia = data.inertia_writer(buf.mass)
         self._origin_arguments = (data.xpos, data.xmat, self._bodies, self._origins, buf.points)
         self._arguments = (
             data.xmat, self._bodies, buf.dots, data.qvel, self._regular, buf.mass,
@@ -307,15 +313,15 @@ class WholeBodyQP:
             buf.lower, buf.offset,
         )  # fmt: skip
 
-    def _clear(self, data: Any) -> None:
+    def _clear(self, data: HumanoidObservation) -> None:
         """Start a tick: M and the contact Jacobians of ``data``, H = diag(ε), f = 0."""
         buf = self._buf
-        full_inertia(self.model, data, buf.mass)
+        data.inertia_writer(buf.mass)()
         self.contact_jacobians(data)
         np.copyto(buf.hessian, self._regular_matrix)
         buf.linear.fill(0.0)
 
-    def _constrain(self, data: Any) -> int:
+    def _constrain(self, data: HumanoidObservation) -> int:
         """Write the constraint rows (after the tasks); return the QP's number of rows."""
         buf = self._buf
         count = constraints(
@@ -326,7 +332,7 @@ class WholeBodyQP:
         )  # fmt: skip
         return int(count)
 
-    def solve(self, data: Any, tasks: Sequence[Task]) -> WbcSolution:
+    def solve(self, data: HumanoidObservation, tasks: Sequence[Task]) -> WbcSolution:
         """Solve the QP at the state in ``data`` (its M, bias and kinematics current).
 
         ``data`` must hold the results of ``mj_forward`` (or ``mj_step1``) for its qpos and
@@ -341,7 +347,12 @@ class WholeBodyQP:
         return self._solve_assembled(self._assemble(data, tasks))
 
     def _solve_rows(
-        self, data: Any, matrix: FloatArray, target: FloatArray, weights: FloatArray, count: int
+        self,
+        data: HumanoidObservation,
+        matrix: FloatArray,
+        target: FloatArray,
+        weights: FloatArray,
+        count: int,
     ) -> WbcSolution:
         """:meth:`solve` of stacked, unchecked task rows (:meth:`_assemble_rows`)."""
         return self._solve_assembled(self._assemble_rows(data, matrix, target, weights, count))

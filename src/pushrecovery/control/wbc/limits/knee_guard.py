@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.control.wbc.tasks.task import Task
 
 __all__ = ["knee_guard_tasks"]
@@ -26,7 +27,7 @@ __all__ = ["knee_guard_tasks"]
 
 def knee_guard_tasks(
     model: Any,
-    data: Any,
+    data: HumanoidObservation,
     knees: Sequence[int],
     size: int,
     *,
@@ -39,7 +40,7 @@ def knee_guard_tasks(
 
     Parameters
     ----------
-    model, data : mujoco.MjModel, mujoco.MjData
+    model, data : mujoco.MjModel, HumanoidObservation
         The humanoid and its state.
     knees : sequence of int
         The knee joints' ids (hinges; a negative id is skipped: a leg without a knee).

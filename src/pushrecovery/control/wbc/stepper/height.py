@@ -19,11 +19,11 @@ reaches 0.14 m from under its hip before the knee straightens onto its stop).
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.control.wbc.stepper.leg import Leg
 from pushrecovery.errors import InvalidParameterError
 
@@ -32,7 +32,7 @@ FloatArray = NDArray[np.float64]
 __all__ = ["leg_span", "pelvis_limit", "segment_lengths"]
 
 
-def segment_lengths(data: Any, leg: Leg) -> tuple[float, float]:
+def segment_lengths(data: HumanoidObservation, leg: Leg) -> tuple[float, float]:
     """Return the thigh (hip to knee anchor) and shank (knee anchor to ankle) lengths [m].
 
     The ankle is the foot body's origin (the ankle joint); constant for rigid segments.
@@ -56,7 +56,7 @@ def leg_span(thigh: float, shank: float, knee: float) -> float:
 
 
 def pelvis_limit(
-    data: Any,
+    data: HumanoidObservation,
     legs: tuple[Leg, ...],
     spans: tuple[float, ...],
     pelvis: int,
@@ -69,7 +69,7 @@ def pelvis_limit(
 
     Parameters
     ----------
-    data : mujoco.MjData
+    data : HumanoidObservation
         The state (after ``mj_kinematics``).
     legs : tuple of Leg
         The legs (their hip pitch anchors are the hips, their foot bodies the ankles).

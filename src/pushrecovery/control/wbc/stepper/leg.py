@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.control.wbc.stepper.plan import QUINTIC_PEAK, lipm_com
 
 FloatArray = NDArray[np.float64]
@@ -55,7 +56,7 @@ def leg_joints(model: Any, foot: int) -> Leg:
     return Leg(foot, **found)
 
 
-def axis_inertia(model: Any, data: Any, joint: int) -> float:
+def axis_inertia(model: Any, data: HumanoidObservation, joint: int) -> float:
     """Return the inertia of ``joint``'s subtree about its axis [kg m²], armature included.
 
     I = Σ_b m_b |a × (c_b − o)|² + aᵀ R_b I_b R_bᵀ a over the bodies b below the joint (a its
@@ -81,7 +82,7 @@ def axis_inertia(model: Any, data: Any, joint: int) -> float:
 
 def leg_swing_time(
     model: Any,
-    data: Any,
+    data: HumanoidObservation,
     leg: Leg,
     foothold: FloatArray,
     cop: FloatArray,
@@ -95,11 +96,9 @@ def leg_swing_time(
     was planned for [s] (the hip's displacement is taken over it), ``torque_share`` κ in
     (0, 1]. 0 when the leg has no hip joints named as :func:`leg_joints` finds them.
     """
-    import mujoco
-
     if leg.hip_pitch < 0 and leg.hip_roll < 0:
         return 0.0
-    mujoco.mj_subtreeVel(model, data)
+    data.subtree_vel()
     com = np.asarray(data.subtree_com[0][:2], dtype=float)
     vel = np.asarray(data.subtree_linvel[0][:2], dtype=float)
     hip_joint = leg.hip_pitch if leg.hip_pitch >= 0 else leg.hip_roll

@@ -57,6 +57,7 @@ from numpy.typing import NDArray
 from pushrecovery.control.wbc.bodies import sole_points
 from pushrecovery.control.wbc.foot_contact import FootContact
 from pushrecovery.control.wbc.limits.knee_guard import knee_guard_tasks
+from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.control.wbc.stepper.height import leg_span, pelvis_limit, segment_lengths
 from pushrecovery.control.wbc.stepper.leg import leg_joints, leg_swing_time
 from pushrecovery.control.wbc.stepper.plan import (
@@ -141,23 +142,23 @@ class Stepper:
     def _side(self, index: int) -> Stance:
         return Stance.LEFT if index == self.left else Stance.RIGHT
 
-    def _pose(self, data: Any, index: int) -> FootPose:
+    def _pose(self, data: HumanoidObservation, index: int) -> FootPose:
         body = self.feet[index].body
         rot = np.asarray(data.xmat[body]).reshape(3, 3)
         x, y = np.asarray(data.xpos[body])[:2]
         return FootPose(float(x), float(y), yaw_of(rot))
 
-    def _state(self, data: Any) -> tuple[float, float, float, float]:
+    def _state(self, data: HumanoidObservation) -> tuple[float, float, float, float]:
         com, vel = np.asarray(data.subtree_com[0]), np.asarray(data.subtree_linvel[0])
         return float(com[0]), float(com[1]), float(vel[0]), float(vel[1])
 
-    def _foothold(self, data: Any, swing: int, t: float) -> tuple[FloatArray, int]:
+    def _foothold(self, data: HumanoidObservation, swing: int, t: float) -> tuple[FloatArray, int]:
         """Plan the foothold of foot ``swing`` for a touchdown after t [s] (plan)."""
         stance = (self._side(1 - swing), self._pose(data, 1 - swing))
         return plan_foothold(self.params, self._state(data), stance,
                              self._pose(data, swing), t, hip=self.hip, cut=self.cut)  # fmt: skip
 
-    def _choose(self, data: Any, t: float) -> tuple[int, FloatArray, int]:
+    def _choose(self, data: HumanoidObservation, t: float) -> tuple[int, FloatArray, int]:
         """Choose the swing foot and plan its foothold (:func:`~.plan.choose_step`)."""
         poses = (self._pose(data, self.left), self._pose(data, 1 - self.left))
         landed = None
@@ -173,13 +174,13 @@ class Stepper:
         distance = float(region.signed_distance(float(xi[0]), float(xi[1])))
         return self.swing is None and distance < -self.settings.margin
 
-    def sole(self, data: Any, index: int) -> tuple[FloatArray, FloatArray]:
+    def sole(self, data: HumanoidObservation, index: int) -> tuple[FloatArray, FloatArray]:
         """Return the sole frame's origin [m] and orientation of foot ``index``."""
         foot = self.feet[index]
         rot = np.asarray(data.xmat[foot.body], dtype=float).reshape(3, 3)
         return np.asarray(data.xpos[foot.body]) + rot @ foot.origin, rot
 
-    def lift_off(self, data: Any) -> int:
+    def lift_off(self, data: HumanoidObservation) -> int:
         """Plan a step from double support and start its swing; return the swing foot's index.
 
         The swing time starts at ``swing_time`` and grows to what the swing hip needs for the
@@ -232,7 +233,7 @@ class Stepper:
         return (np.array([*xy, z]), np.array([*vxy, dz / span]),
                 np.array([*axy, ddz / span**2]))  # fmt: skip
 
-    def replan(self, data: Any) -> None:
+    def replan(self, data: HumanoidObservation) -> None:
         """Re-plan the foothold from the current state if it is time (module docstring)."""
         t, s = float(data.time), self.settings
         if self.swing is None or t >= self._start + s.replan_fraction * (self._end - self._start):
@@ -245,22 +246,22 @@ class Stepper:
         self._coeffs, self._planned = quintic(xy, vxy, axy, foothold, self._end - t), t
         record.plans.append((t, float(foothold[0]), float(foothold[1])))
 
-    def task(self, data: Any, size: int, nv: int) -> Task:
+    def task(self, data: HumanoidObservation, size: int, nv: int) -> Task:
         """Return the swing foot's task now (:func:`~.swing_foot.swing_foot_task`)."""
         assert self.swing is not None
-        return swing_foot_task(self._model, data, self.feet[self.swing].body,
+        return swing_foot_task(data, self.feet[self.swing].body,
                                self.sole(data, self.swing), self._rot,
                                self.reference(float(data.time)), self.settings, size,
                                nv)  # fmt: skip
 
-    def knee_guard(self, data: Any, size: int, nv: int) -> list[Task]:
+    def knee_guard(self, data: HumanoidObservation, size: int, nv: int) -> list[Task]:
         """Return the knee guard's task (:func:`~.knee_guard.knee_guard_tasks`), if any."""
         s = self.settings
         return knee_guard_tasks(self._model, data, [leg.knee for leg in self.legs], size,
                                 knee_min=s.knee_min, stiffness=s.stiffness, damping=s.damping,
                                 weight=s.knee_weight)  # fmt: skip
 
-    def pelvis_height(self, data: Any, height: float) -> float:
+    def pelvis_height(self, data: HumanoidObservation, height: float) -> float:
         """Return the pelvis height task's target [m]: ``height`` lowered for the legs' reach.
 
         min(height, :func:`~.height.pelvis_limit`) with every knee bent by at least
@@ -289,14 +290,14 @@ class Stepper:
                              foothold=foothold, shift=shift)  # fmt: skip
         return max(height - s.max_drop, min(height, limit))
 
-    def tasks(self, data: Any, size: int, nv: int) -> list[Task]:
+    def tasks(self, data: HumanoidObservation, size: int, nv: int) -> list[Task]:
         """Return the stepping tasks now: the swing foot's (while it swings), the knee guard."""
         tasks = self.knee_guard(data, size, nv)
         if self.swing is not None:
             tasks.append(self.task(data, size, nv))
         return tasks
 
-    def landed(self, data: Any) -> bool:
+    def landed(self, data: HumanoidObservation) -> bool:
         """Detect touchdown (module docstring); on it, record the landing and end the swing."""
         if self.swing is None:
             return False

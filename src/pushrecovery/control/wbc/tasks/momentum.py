@@ -14,10 +14,10 @@ World frame, x forward, y left, z up, SI units.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import NDArray
+
+from pushrecovery.control.wbc.observation import HumanoidObservation
 
 FloatArray = NDArray[np.float64]
 
@@ -25,13 +25,18 @@ __all__ = ["momentum_rows"]
 
 
 def momentum_rows(
-    data: Any, bodies: NDArray[np.intp], size: int, nv: int, com: FloatArray, origins: FloatArray
+    data: HumanoidObservation,
+    bodies: NDArray[np.intp],
+    size: int,
+    nv: int,
+    com: FloatArray,
+    origins: FloatArray,
 ) -> FloatArray:
     """Return the 3 × size rows A with A x = L̇ (module docstring) [N m per unit of w].
 
     Parameters
     ----------
-    data : mujoco.MjData
+    data : HumanoidObservation
         After ``mj_kinematics``: the feet's orientations ``xmat`` and positions ``xpos``.
     bodies : int array
         The feet's body ids, in the QP's order.

@@ -17,11 +17,11 @@ cannot step); gains and weights are the stepper's
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.control.wbc.stepper.plan import rotation_vector
 from pushrecovery.control.wbc.stepper.settings import StepSettings
 from pushrecovery.control.wbc.tasks.task import Task
@@ -32,8 +32,7 @@ __all__ = ["swing_foot_task"]
 
 
 def swing_foot_task(
-    model: Any,
-    data: Any,
+    data: HumanoidObservation,
     body: int,
     sole: tuple[FloatArray, FloatArray],
     lift_off: FloatArray,
@@ -46,8 +45,8 @@ def swing_foot_task(
 
     Parameters
     ----------
-    model, data : mujoco.MjModel, mujoco.MjData
-        The humanoid and its state (after ``mj_forward`` or ``mj_step1``).
+    data : HumanoidObservation
+        The humanoid's state (after ``mj_forward`` or ``mj_step1``).
     body : int
         The foot body's id.
     sole : tuple of float arrays, shapes (3,) and (3, 3)
@@ -62,13 +61,11 @@ def swing_foot_task(
     size, nv : int
         The QP's unknowns and the model's dofs: the task's matrix is (6, size), zeros beyond q̈.
     """
-    import mujoco
-
     s, (point, rot) = settings, sole
     jacp, jacr = np.zeros((3, nv)), np.zeros((3, nv))
     dotp, dotr = np.zeros((3, nv)), np.zeros((3, nv))
-    mujoco.mj_jac(model, data, jacp, jacr, point, body)
-    mujoco.mj_jacDot(model, data, dotp, dotr, point, body)
+    data.jac(jacp, jacr, point, body)
+    data.jac_dot(dotp, dotr, point, body)
     qvel = np.asarray(data.qvel, dtype=float)
     p_ref, v_ref, a_ref = reference
     linear = a_ref + s.stiffness * (p_ref - point) + s.damping * (v_ref - jacp @ qvel)

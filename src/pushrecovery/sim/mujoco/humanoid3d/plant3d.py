@@ -16,10 +16,14 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   applies the constant force J/Δ (cos ψ, sin ψ, 0) for Δ = :data:`PUSH_DURATION` (10 ms) at
   the pushed body's centre of mass (``xfrc_applied``), the motors holding their last ``ctrl``
   meanwhile: the whole body's momentum gains J, minus what the floor's friction takes.
-* **step(ctrl, dt)** holds the motor commands ``ctrl`` [N m] (the
-  :class:`~pushrecovery.control.wbc.controller.WholeBodyController`'s output: not a
-  ``Command``), clipped to the motors' ranges, for dt (rounded to physics steps);
-  ``applied`` is the clipped ``ctrl`` (``input_labels``: the motors' names).
+* **step(command, dt)** holds the motor commands of a
+  :class:`~pushrecovery.control.wbc.observation.HumanoidCommand` (``motors`` [N m], the
+  :class:`~pushrecovery.control.wbc.controller.WholeBodyController`'s output; any other
+  ``Command`` holds the last motors: the body holding still), clipped to the motors' ranges,
+  for dt (rounded to physics steps); ``applied`` is the clipped ``ctrl`` (``input_labels``:
+  the motors' names).
+* **observation**: the :class:`~pushrecovery.control.wbc.observation.HumanoidObservation`
+  the plant hands its controller (:func:`wbc_for`), views of its ``MjData`` built once.
 * **falling(state)**: the capture point ξ = c_xy + ċ_xy/ω (ω = sqrt(g/z₀), z₀ the CoM's
   standing height above the soles) farther than :meth:`~Humanoid3DPlant.fall_margin` =
   2 max(τmax, τmax_roll)/(m g) outside the support polygon P (the hull of both soles at
@@ -27,8 +31,7 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   falls; or the CoM below :data:`FALL_HEIGHT` z₀ (the body is down).
 * **at_rest(state, speed)**: |ċ_xy| <= speed and the CoM's ground point strictly inside P.
 
-:func:`~.runs3d.simulate_push3d` (:mod:`.runs3d`) is the loop of these plants (the one
-loop, ``sim.simulate``, hands the controller the state vector; the WBC reads the ``MjData``).
+:func:`~.runs3d.simulate_push3d` (:mod:`.runs3d`) is the loop of these plants.
 """
 
 from __future__ import annotations
@@ -40,9 +43,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, finite_float, require_type
-from pushrecovery.control.base import StepInfo
+from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.control.wbc.observation import (
+    HUMANOID_STATE,
+    HumanoidCommand,
+    mujoco_observation,
+)
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.params import BodyParams
@@ -65,7 +73,7 @@ __all__ = [
 ]
 
 #: The 3-D plants' state: the whole-body CoM and its velocity (world frame).
-STATE_LABELS = ("x", "y", "z", "xdot", "ydot", "zdot")
+STATE_LABELS = HUMANOID_STATE
 #: The WBC's period [s] (500 Hz).
 CONTROL_PERIOD = 0.002
 #: A CoM below this fraction of its standing height above the soles is down (fallen).
@@ -112,6 +120,7 @@ class Humanoid3DPlant:
         self.qpos = np.array(qpos, dtype=float)
         self.feet, self.torso, self.upright = feet, torso, upright
         self.data = mujoco.MjData(model)
+        self.observation = mujoco_observation(model, self.data)
         self.input_labels: tuple[str, ...] = tuple(model.actuator(i).name for i in range(model.nu))
         self.ctrl_range = np.array(model.actuator_ctrlrange, dtype=float)
         limited = np.asarray(model.actuator_ctrllimited, dtype=bool)
@@ -221,17 +230,32 @@ class Humanoid3DPlant:
         self.state = self._read()
         return self.state.copy()
 
-    def step(self, command: Any, dt: float) -> Step:
-        """Hold the motor commands ``command`` [N m] (clipped) for ``dt`` [s] (item 5)."""
+    def step(self, command: Command, dt: float) -> Step:
+        """Hold ``command``'s motor commands [N m] (clipped) for ``dt`` [s] (item 5).
+
+        A :class:`~pushrecovery.control.wbc.observation.HumanoidCommand` sets the motors; any
+        other :class:`~pushrecovery.control.base.Command` (or ``motors=None``) holds the last
+        ones.
+
+        Raises
+        ------
+        ParameterTypeError
+            If ``command`` is not a Command.
+        InvalidParameterError
+            If its ``motors`` are not ``nu`` finite numbers or ``dt`` is not in [1e-6, 1] s.
+        """
         import mujoco
 
-        ctrl = np.asarray(command, dtype=float)
-        if ctrl.shape != (self.model.nu,) or not np.all(np.isfinite(ctrl)):
-            raise InvalidParameterError(
-                f"command must be {self.model.nu} finite motor commands, got shape {ctrl.shape}"
-            )
+        require_type("command", command, Command)
+        if isinstance(command, HumanoidCommand) and command.motors is not None:
+            ctrl = np.asarray(command.motors, dtype=float)
+            if ctrl.shape != (self.model.nu,) or not np.all(np.isfinite(ctrl)):
+                raise InvalidParameterError(
+                    f"command motors must be {self.model.nu} finite motor commands, "
+                    f"got shape {ctrl.shape}"
+                )
+            self.ctrl = np.clip(ctrl, self.ctrl_range[:, 0], self.ctrl_range[:, 1])
         seconds = bounded_float("dt", dt, 1e-6, 1.0, "s")
-        self.ctrl = np.clip(ctrl, self.ctrl_range[:, 0], self.ctrl_range[:, 1])
         model, data = self.model, self.data
         data.ctrl[:] = self.ctrl
         mujoco.mj_step2(model, data)
@@ -370,6 +394,6 @@ def wbc_for(
     elif not isinstance(hip, bool):
         raise InvalidParameterError(f"hip must be a bool or None, got {hip!r}")
     return WholeBodyController(
-        plant.model, feet=plant.feet, torso=plant.upright, hip=plant.params if hip else None,
-        stepping=stepping, params=plant.params,
+        plant.model, feet=plant.feet, torso=plant.upright, observation=plant.observation,
+        hip=plant.params if hip else None, stepping=stepping, params=plant.params,
     )  # fmt: skip

@@ -143,7 +143,7 @@ def simulate_push3d(
     rest_speed = bounded_float("rest_speed", rest_speed, 1e-6, 10.0, "m/s")
     rest_duration = bounded_float("rest_duration", rest_duration, 0.0, 60.0, "s")
     state = plant.reset()
-    controller.reset(plant.data)
+    controller.reset(state)
     times, states = [float(plant.data.time)], [state]
     failed = 0
     frames: list[FloatArray] = []
@@ -157,9 +157,9 @@ def simulate_push3d(
 
     def tick() -> FloatArray:
         nonlocal failed
-        ctrl = controller.compute(float(plant.data.time), plant.data)
+        command = controller.compute(float(plant.data.time), plant.state)
         failed += 0 if controller.last is None or controller.last.ok else 1
-        return plant.step(ctrl, CONTROL_PERIOD).state
+        return plant.step(command, CONTROL_PERIOD).state
 
     for _ in range(round(push_time / CONTROL_PERIOD)):
         state = tick()

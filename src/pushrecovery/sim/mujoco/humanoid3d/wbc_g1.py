@@ -14,6 +14,7 @@ from typing import Any
 from pushrecovery.control.wbc.bodies import sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.control.wbc.gains import WbcGains
+from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.ground.polygon import convex_hull
 from pushrecovery.sim.mujoco.humanoid3d.robots import RobotDescription, describe_robot
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import WbcRun, push_humanoid
@@ -26,10 +27,17 @@ G1_TORSO = "torso_link"
 
 
 def g1_controller(
-    robot: RobotDescription, gains: WbcGains | None = None, *, hip: bool = False
+    robot: RobotDescription,
+    observation: HumanoidObservation,
+    gains: WbcGains | None = None,
+    *,
+    hip: bool = False,
 ) -> WholeBodyController:
-    """Return a :class:`WholeBodyController` for the G1 ``robot`` (its params for the hip)."""
-    return WholeBodyController(robot.model, G1_FEET, G1_TORSO, gains,
+    """Return a :class:`WholeBodyController` for the G1 ``robot`` (its params for the hip).
+
+    ``observation`` is the run's (:func:`~pushrecovery.control.wbc.observation.mujoco_observation`).
+    """
+    return WholeBodyController(robot.model, G1_FEET, G1_TORSO, gains, observation=observation,
                                hip=robot.params if hip else None)  # fmt: skip
 
 
@@ -67,6 +75,9 @@ def push_g1(
     ``robot`` reuses a :func:`~.robots.describe_robot` ("g1"); needs the ``robots`` extra.
     """
     robot = describe_robot("g1") if robot is None else robot
-    controller = g1_controller(robot, gains, hip=hip)
+
+    def controller(observation: HumanoidObservation) -> WholeBodyController:
+        return g1_controller(robot, observation, gains, hip=hip)
+
     return push_humanoid(robot.model, robot.qpos, controller, G1_FEET, G1_TORSO, impulse,
                          azimuth, duration=duration, push_time=push_time)  # fmt: skip

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,6 +24,7 @@ from numpy.typing import NDArray
 from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.control.wbc.gains import WbcGains
+from pushrecovery.control.wbc.observation import HumanoidObservation, mujoco_observation
 from pushrecovery.control.wbc.stepper.settings import StepSettings
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -172,9 +174,13 @@ def push_biped3d(
     """
     _check_push(impulse, azimuth, duration, push_time)
     model = biped3d_model(params) if model is None else model
-    controller = WholeBodyController(model, gains=gains, hip=params if hip else None,
-                                     stepping=stepping, params=params,
-                                     step_settings=step_settings)  # fmt: skip
+    compiled = model
+
+    def controller(observation: HumanoidObservation) -> WholeBodyController:
+        return WholeBodyController(compiled, gains=gains, observation=observation,
+                                   hip=params if hip else None, stepping=stepping,
+                                   params=params, step_settings=step_settings)  # fmt: skip
+
     feet = tuple(f"{side}_foot" for side in SIDES)
     return push_humanoid(model, bent_knee_qpos(model), controller, feet, "torso", impulse,
                          azimuth, duration=duration, push_time=push_time)  # fmt: skip
@@ -183,7 +189,7 @@ def push_biped3d(
 def push_humanoid(
     model: Any,
     qpos: FloatArray,
-    controller: WholeBodyController,
+    controller: Callable[[HumanoidObservation], WholeBodyController],
     feet: tuple[str, ...],
     torso: str,
     impulse: float,
@@ -192,11 +198,13 @@ def push_humanoid(
     duration: float = 3.0,
     push_time: float = 0.1,
 ) -> WbcRun:
-    """Stand ``model`` at ``qpos``, push body ``torso`` and run ``controller`` (module docstring).
+    """Stand ``model`` at ``qpos``, push body ``torso`` and run a controller (module docstring).
 
-    The controller runs every round(:attr:`~.WholeBodyController.control_period` / timestep)
-    physics steps (4 at 0.5 ms, 2 at the robots' 1 ms). ``feet`` names the foot bodies whose
-    sole lift is recorded. Arguments as :func:`push_biped3d`.
+    ``controller`` builds it on the run's observation
+    (:func:`~pushrecovery.control.wbc.observation.mujoco_observation`); it runs every
+    round(:attr:`~.WholeBodyController.control_period` / timestep) physics steps (4 at
+    0.5 ms, 2 at the robots' 1 ms). ``feet`` names the foot bodies whose sole lift is
+    recorded. Arguments as :func:`push_biped3d`.
     """
     import mujoco
 
@@ -204,12 +212,15 @@ def push_humanoid(
     data = mujoco.MjData(model)
     data.qpos[:] = qpos
     mujoco.mj_forward(model, data)
-    controller.reset(data)
+    observation = mujoco_observation(model, data)
+    built = controller(observation)
+    com_state = np.concatenate([data.subtree_com[0], data.subtree_linvel[0]])
+    built.reset(com_state)  # the WBC reads the observation
     body = body_id(model, torso)
     soles = [body_id(model, name) for name in feet]
     force = impulse / PUSH_DURATION * np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
     dt = float(model.opt.timestep)
-    per_tick = max(1, round(controller.control_period / dt))
+    per_tick = max(1, round(built.control_period / dt))
     ticks = round(duration / (per_tick * dt))
     start_step = round(push_time / dt)
     stop_step = start_step + round(PUSH_DURATION / dt)
@@ -219,9 +230,9 @@ def push_humanoid(
     for tick in range(ticks):
         mujoco.mj_step1(model, data)
         began = time.perf_counter()
-        data.ctrl[:] = controller.compute(data.time, data)
+        data.ctrl[:] = built.compute(data.time, com_state).motors
         control = time.perf_counter() - began
-        solution = controller.last
+        solution = built.last
         assert solution is not None
         columns["time"].append(float(data.time))
         columns["com"].append(np.array(data.subtree_com[0]))
@@ -230,8 +241,8 @@ def push_humanoid(
         columns["torso_tilt"].append(math.acos(min(1.0, float(data.xmat[body][8]))))
         columns["sole_lift"].append([float(sole_points(model, data, f)[:, 2].max()) for f in soles])
         columns["wrenches"].append(solution.wrenches)
-        columns["desired_cop"].append(controller.desired_cop.copy())
-        columns["cmp_offset"].append(controller.cmp_offset.copy())
+        columns["desired_cop"].append(built.desired_cop.copy())
+        columns["cmp_offset"].append(built.cmp_offset.copy())
         columns["ok"].append(solution.ok)
         columns["solve_time"].append(solution.solve_time)
         columns["control_time"].append(control)
@@ -247,4 +258,4 @@ def push_humanoid(
                 mujoco.mj_step(model, data)
         columns["physics_time"].append(time.perf_counter() - began)
     arrays = {k: np.array(v) for k, v in columns.items()}
-    return WbcRun(**arrays, controller=controller)
+    return WbcRun(**arrays, controller=built)
