@@ -11,6 +11,7 @@ from pushrecovery.cli import main
 from pushrecovery.control.base import Command
 from pushrecovery.control.wbc.observation import HumanoidCommand
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
+from pushrecovery.ground.polygon import convex_hull
 from pushrecovery.sim.mujoco.humanoid3d import robots
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
@@ -199,3 +200,23 @@ def test_make_plant3d_builds_only_the_3d_humanoids():
         make_plant3d("torso", P)
     with pytest.raises(ParameterTypeError, match="name must be a str"):
         make_plant3d(3, P)
+
+
+def test_a_stepping_controllers_support_reaches_the_fall_rule_through_the_step_info():
+    """The support a stepping WBC commands comes back in ``StepInfo.support``: the fall set is
+    then the body down only, and rest needs it under the CoM with no foot swinging.
+    """
+    plant = Biped3DPlant(P)
+    state = plant.reset()
+    fast = np.array([*state[:3], 5.0, 0.0, 0.0])  # ξ far beyond the feet: the plant's fall set
+    assert plant.falling(fast) and plant.info.support is None
+    far = convex_hull(np.array([[5.0, 5.0], [5.1, 5.0], [5.0, 5.1]]))
+    step = plant.step(HumanoidCommand(0.0, support=far, stance=False), CONTROL_PERIOD)
+    assert step.info.support is far and not step.info.stance and plant.info is step.info
+    assert not plant.falling(fast)  # a step answers it: down only
+    assert plant.falling(np.array([*state[:2], 0.5 * state[2], 0.0, 0.0, 0.0]))
+    assert not plant.at_rest(state, 1.0)  # a foot swings, and the CoM is off that support
+    plant.step(HumanoidCommand(0.0, support=plant.support, stance=True), CONTROL_PERIOD)
+    assert plant.at_rest(plant.state, 1.0)
+    plant.reset()
+    assert plant.info.support is None and plant.falling(fast)

@@ -29,7 +29,7 @@ import inspect
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -38,6 +38,9 @@ from pushrecovery.arguments import finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.lipm import ANKLE_STATE
 from pushrecovery.params import BodyParams
+
+if TYPE_CHECKING:
+    from pushrecovery.ground.polygon import ConvexPolygon
 
 __all__ = [
     "CONTROLLERS",
@@ -110,6 +113,10 @@ class StepInfo:
     footholds_xy : tuple of (float, float)
         World (x, y) of every stance ankle of the run so far on the ground plane [m]; empty
         for a sagittal plant.
+    support : ConvexPolygon or None
+        The support polygon (world xy [m]) of a controller that steps, as its last command
+        gave it (the feet it keeps on the floor): the 3-D plants' fall set and rest read it
+        (a capture point beyond it is what a step answers); None: the plant's own support.
     """
 
     stance: bool = True
@@ -117,6 +124,7 @@ class StepInfo:
     stop_impacts: int = 0
     measured_cop: float | None = None
     footholds_xy: tuple[tuple[float, float], ...] = ()
+    support: ConvexPolygon | None = None
 
 
 class Controller(ABC):

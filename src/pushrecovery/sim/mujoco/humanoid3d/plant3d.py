@@ -28,8 +28,11 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   standing height above the soles) farther than :meth:`~Humanoid3DPlant.fall_margin` =
   2 max(τmax, τmax_roll)/(m g) outside the support polygon P (the hull of both soles at
   reset): beyond what both hips' CMP offsets could bring back, the LIPM with a flywheel
-  falls; or the CoM below :data:`FALL_HEIGHT` z₀ (the body is down).
-* **at_rest(state, speed)**: |ċ_xy| <= speed and the CoM's ground point strictly inside P.
+  falls; or the CoM below :data:`FALL_HEIGHT` z₀ (the body is down). Under a controller that
+  steps (its command's ``support``, reported in the step's ``StepInfo.support``) a capture
+  point beyond the feet is what a step answers: the body down only.
+* **at_rest(state, speed)**: |ċ_xy| <= speed and the CoM's ground point strictly inside P
+  (the step's ``StepInfo.support`` when the controller steps, and no foot swinging).
 
 :func:`~.runs3d.simulate_push3d` (:mod:`.runs3d`) is the loop of these plants.
 """
@@ -133,6 +136,7 @@ class Humanoid3DPlant:
         self.state = np.zeros(len(STATE_LABELS))
         self.ctrl = np.zeros(int(model.nu))
         self.support: ConvexPolygon | None = None
+        self.info = StepInfo()  # the last step's report (its support: the fall rule's)
         self.floor = 0.0
         self.standing_height = 1.0
         self.omega = 1.0
@@ -167,6 +171,7 @@ class Humanoid3DPlant:
         gravity = float(np.linalg.norm(model.opt.gravity))
         self.omega = math.sqrt(gravity / self.standing_height)
         self.ctrl = np.zeros(int(model.nu))
+        self.info = StepInfo()
         self.state = self._read()
         return self.state.copy()
 
@@ -247,14 +252,18 @@ class Humanoid3DPlant:
         import mujoco
 
         require_type("command", command, Command)
-        if isinstance(command, HumanoidCommand) and command.motors is not None:
-            ctrl = np.asarray(command.motors, dtype=float)
-            if ctrl.shape != (self.model.nu,) or not np.all(np.isfinite(ctrl)):
-                raise InvalidParameterError(
-                    f"command motors must be {self.model.nu} finite motor commands, "
-                    f"got shape {ctrl.shape}"
-                )
-            self.ctrl = np.clip(ctrl, self.ctrl_range[:, 0], self.ctrl_range[:, 1])
+        info = self.info
+        if isinstance(command, HumanoidCommand):
+            if command.motors is not None:
+                ctrl = np.asarray(command.motors, dtype=float)
+                if ctrl.shape != (self.model.nu,) or not np.all(np.isfinite(ctrl)):
+                    raise InvalidParameterError(
+                        f"command motors must be {self.model.nu} finite motor commands, "
+                        f"got shape {ctrl.shape}"
+                    )
+                self.ctrl = np.clip(ctrl, self.ctrl_range[:, 0], self.ctrl_range[:, 1])
+            if command.stance is not info.stance or command.support is not info.support:
+                info = StepInfo(command.stance, (0.0,), 0, None, (), command.support)
         seconds = bounded_float("dt", dt, 1e-6, 1.0, "s")
         model, data = self.model, self.data
         data.ctrl[:] = self.ctrl
@@ -263,7 +272,8 @@ class Humanoid3DPlant:
             mujoco.mj_step(model, data)
         mujoco.mj_step1(model, data)
         self.state = self._read()
-        return Step(self.state, tuple(float(v) for v in self.ctrl), StepInfo(True, (0.0,), 0))
+        self.info = info
+        return Step(self.state, tuple(float(v) for v in self.ctrl), info)
 
     def fall_margin(self) -> float:
         """Return 2 max(τmax, τmax_roll)/(m g) [m]: both hips' largest CMP offset."""
@@ -285,20 +295,29 @@ class Humanoid3DPlant:
         return math.hypot(xi[0] - near[0], xi[1] - near[1])
 
     def falling(self, state: FloatArray) -> bool:
-        """Whether ``state`` is in the fall set (module docstring, contract item 6)."""
+        """Whether ``state`` is in the fall set (module docstring, contract item 6).
+
+        With the last step's ``StepInfo.support`` (a controller that steps): the body down.
+        """
         self.check_state(state)
         if float(state[2]) - self.floor < FALL_HEIGHT * self.standing_height:
             return True
-        return self.xcom_outside(state) > self.fall_margin()
+        return self.info.support is None and self.xcom_outside(state) > self.fall_margin()
 
     def at_rest(self, state: FloatArray, speed: float) -> bool:
-        """Whether |ċ_xy| <= ``speed`` [m/s] with the CoM over the support (item 6)."""
+        """Whether |ċ_xy| <= ``speed`` [m/s] with the CoM over the support (item 6).
+
+        The support is the last step's ``StepInfo.support`` when the controller steps (no
+        foot may swing), else the feet at reset.
+        """
         self.check_state(state)
         limit = finite_float("speed", speed, "m/s", allowed=">= 0")
         if limit < 0.0:
             raise InvalidParameterError(f"speed must be >= 0 m/s, got {limit:g}")
-        assert self.support is not None
-        inside = bool(self.support.contains(float(state[0]), float(state[1])))
+        info = self.info
+        support = self.support if info.support is None else info.support
+        assert support is not None
+        inside = info.stance and bool(support.contains(float(state[0]), float(state[1])))
         return inside and math.hypot(float(state[3]), float(state[4])) <= limit
 
     # -- measurements ----------------------------------------------------------------------

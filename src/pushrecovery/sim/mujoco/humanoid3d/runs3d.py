@@ -20,7 +20,6 @@ from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
-    FALL_HEIGHT,
     Humanoid3DPlant,
     wbc_for,
 )
@@ -183,11 +182,10 @@ def simulate_push3d(
             motor_peak = max(motor_peak, float(np.abs(ctrl - held)[plant.hip_motors].max()))
         hip_peak = max(hip_peak, weight * float(np.hypot(*controller.cmp_offset)))
         tilt_peak = max(tilt_peak, plant.torso_tilt())
-        fell, still = _judge(plant, controller, state, rest_speed)
-        if fell:
+        if plant.falling(state):
             outcome = Outcome.FELL
             break
-        resting = resting + CONTROL_PERIOD if still else 0.0
+        resting = resting + CONTROL_PERIOD if plant.at_rest(state, rest_speed) else 0.0
         if resting >= rest_duration - 1e-9:
             outcome = Outcome.RECOVERED
             break
@@ -206,23 +204,6 @@ def simulate_push3d(
         steps=_landed(controller),
         **_split(plant, frames),
     )
-
-
-def _judge(
-    plant: Humanoid3DPlant, controller: WholeBodyController, state: FloatArray, speed: float
-) -> tuple[bool, bool]:
-    """Return (fallen, at rest) of ``state``: the plant's fall set and rest, or with steps.
-
-    With the stepping task the feet move: the support polygon is the controller's (the feet
-    in contact), ξ beyond it is what a step answers (the controller steps), so the fall is
-    the CoM down only (below ``FALL_HEIGHT`` z₀), and rest needs both feet on the floor.
-    """
-    stepper = controller.stepper
-    if stepper is None:
-        return plant.falling(state), plant.at_rest(state, speed)
-    plant.support = controller.support
-    down = float(state[2]) - plant.floor < FALL_HEIGHT * plant.standing_height
-    return down, stepper.swing is None and plant.at_rest(state, speed)
 
 
 def _landed(controller: WholeBodyController) -> int:
