@@ -36,14 +36,17 @@ def _parquet(table: pa.Table) -> bytes:
     return sink.getvalue()
 
 
-def test_rows_become_the_table_from_pylist_gives() -> None:
-    ours = table_of_rows(ROWS, SCHEMA)
-    theirs = pa.Table.from_pylist(ROWS, schema=SCHEMA)
+@pytest.mark.parametrize("rows", [ROWS, ROWS[:3], ROWS[3:]])  # mixed keys; one key order
+@pytest.mark.parametrize("extra", [False, True])  # a column no row has: all null
+def test_rows_become_the_table_from_pylist_gives(rows: list, extra: bool) -> None:
+    schema = SCHEMA.append(pa.field("z", pa.int64(), metadata={"unit": "-"})) if extra else SCHEMA
+    ours = table_of_rows(rows, schema)
+    theirs = pa.Table.from_pylist(rows, schema=schema)
     assert ours.schema.equals(theirs.schema, check_metadata=True)
     assert repr(ours.to_pylist()) == repr(theirs.to_pylist())  # NaN, -0.0 and None included
     assert [c.null_count for c in ours.columns] == [c.null_count for c in theirs.columns]
     assert _parquet(ours) == _parquet(theirs)
-    assert table_of_rows([], SCHEMA).num_rows == 0
+    assert table_of_rows([], schema).num_rows == 0
 
 
 def test_columns_come_back_as_to_numpy_gives() -> None:

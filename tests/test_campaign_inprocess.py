@@ -78,3 +78,20 @@ def test_a_tiny_ankle_pd_campaign_loops_and_gives_the_compiled_rows(
     _, rows = run_batch(spec, 0)
     assert {"recovered", "fell"} <= {row["outcome"] for row in rows}
     assert repr(rows) == repr(compiled)  # every column, NaN and None included, to the bit
+
+
+@pytest.mark.parametrize("sweeps", [{}, {"toe": (0.12, 0.18, 0.06)}])
+@pytest.mark.parametrize("samples", [None, 7])
+def test_a_batch_s_pushes_are_the_numbered_pushes(sweeps: dict, samples: int | None) -> None:
+    # pushes() shares the bodies of equal swept values (and the spec's own without sweeps).
+    spec = CampaignSpec(
+        "analytic", "pendulum", "ankle-pd", P, x0=(0.0, 0.05, 0.05), xdot=(0.0, 0.4, 0.2),
+        sweeps=sweeps, samples=samples, batch_size=5,
+    )  # fmt: skip
+    batched = [push for b in spec.batch_indices() for push in spec.pushes(b)]
+    assert batched == [spec.push(i) for i in range(spec.size)]
+    for b in spec.batch_indices():  # one body per distinct swept values in a batch
+        pushes = spec.pushes(b)
+        assert len({id(push.params) for push in pushes}) == len({push.params for push in pushes})
+    if not sweeps:
+        assert all(push.params is spec.params for push in batched)

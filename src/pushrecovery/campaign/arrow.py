@@ -22,23 +22,16 @@ __all__ = ["column_array", "table_of_rows"]
 _MAX_STRING_BYTES = 2**31 - 1
 
 
-def _validity(values: Sequence[Any]) -> tuple[Any, int]:
-    """Return the validity bitmap (None without nulls) and the number of nulls."""
-    import pyarrow as pa
-
-    valid = np.fromiter((v is not None for v in values), dtype=np.bool_, count=len(values))
-    nulls = len(values) - int(np.count_nonzero(valid))
-    if not nulls:
-        return None, 0
-    return pa.py_buffer(np.packbits(valid, bitorder="little")), nulls
-
-
 def _array(values: Sequence[Any], arrow_type: Any, name: str) -> Any:
     """Return ``values`` (Python or numpy scalars, None for null) as an Arrow array."""
     import pyarrow as pa
 
     count = len(values)
-    validity, nulls = _validity(values)
+    nulls = sum(1 for v in values if v is None) if None in values else 0
+    validity = None
+    if nulls:
+        valid = np.fromiter((v is not None for v in values), dtype=np.bool_, count=count)
+        validity = pa.py_buffer(np.packbits(valid, bitorder="little"))
     if pa.types.is_string(arrow_type):
         encoded = [b"" if v is None else str(v).encode() for v in values]
         lengths = np.fromiter((len(b) for b in encoded), dtype=np.int64, count=count)
@@ -49,20 +42,18 @@ def _array(values: Sequence[Any], arrow_type: Any, name: str) -> Any:
         offsets[1:] = ends
         buffers = [validity, pa.py_buffer(offsets), pa.py_buffer(b"".join(encoded))]
         return pa.Array.from_buffers(arrow_type, count, buffers, null_count=nulls)
-    if pa.types.is_boolean(arrow_type):
-        bits = np.fromiter((bool(v) for v in values), dtype=np.bool_, count=count)
-        data = pa.py_buffer(np.packbits(bits, bitorder="little"))
-    elif pa.types.is_float64(arrow_type):
-        data = pa.py_buffer(
-            np.fromiter((0.0 if v is None else v for v in values), np.float64, count=count)
-        )
-    elif pa.types.is_int64(arrow_type):
-        data = pa.py_buffer(
-            np.fromiter((0 if v is None else v for v in values), np.int64, count=count)
-        )
-    else:
+    dtypes = {"bool": np.bool_, "double": np.float64, "int64": np.int64}
+    dtype = dtypes.get(str(arrow_type))
+    if dtype is None:
         raise InvalidParameterError(f"column {name} has type {arrow_type}, not a row column's")
-    return pa.Array.from_buffers(arrow_type, count, [validity, data], null_count=nulls)
+    if nulls:  # a null's slot holds 0 (masked by the validity bitmap)
+        values = [0 if v is None else v for v in values]
+    data: np.ndarray = np.array(values, dtype=dtype) if count else np.zeros(0, dtype=dtype)
+    if dtype is np.bool_:
+        data = np.packbits(data, bitorder="little")
+    return pa.Array.from_buffers(
+        arrow_type, count, [validity, pa.py_buffer(data)], null_count=nulls
+    )
 
 
 def table_of_rows(rows: Sequence[Mapping[str, Any]], schema: Any) -> Any:
@@ -87,8 +78,15 @@ def table_of_rows(rows: Sequence[Mapping[str, Any]], schema: Any) -> Any:
     """
     import pyarrow as pa
 
+    keys = list(rows[0]) if rows else []
+    if all(list(row) == keys for row in rows):  # one key order (a batch's rows): transpose
+        found = dict(zip(keys, zip(*(row.values() for row in rows), strict=True), strict=True))
+        nothing = (None,) * len(rows)
+        values: list[Sequence[Any]] = [found.get(name, nothing) for name in schema.names]
+    else:
+        values = [[row.get(name) for row in rows] for name in schema.names]
     columns = [
-        _array([row.get(field.name) for row in rows], field.type, field.name) for field in schema
+        _array(column, field.type, field.name) for column, field in zip(values, schema, strict=True)
     ]
     return pa.Table.from_arrays(columns, schema=schema)
 

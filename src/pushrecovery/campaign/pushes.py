@@ -191,8 +191,12 @@ def _inputs_and_prediction(spec: CampaignSpec, push: Push, found: _Prediction) -
         predicted_steps=-1 if found.steps is None else found.steps,
         predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
     )
-    row.update(dict.fromkeys(COLUMNS_3D))  # every row has every column
+    row.update(_NULL_3D)  # every row has every column
     return row
+
+
+#: The 3-D columns of a planar row: null.
+_NULL_3D: dict[str, Any] = dict.fromkeys(COLUMNS_3D)
 
 
 def _batched_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]]:
@@ -249,31 +253,22 @@ def _rows_of_runs(
     """Rows of pushes simulated together: each run's outcome with the push's verdict."""
     rows = []
     predictions = _predictions(pushes)
+    # Python floats and ints, as float(a[k]) and int(a[k]) give them (tolist: at C speed).
+    diverged, steps, peaks = (
+        runs.diverged.tolist(),
+        runs.steps.tolist(),
+        runs.peak_hip_torque.tolist(),
+    )
+    lows, highs, times = runs.cop_min.tolist(), runs.cop_max.tolist(), runs.times.tolist()
+    impacts = runs.stop_impacts.tolist()
     for k, push in enumerate(pushes):
-        if runs.diverged[k]:
+        if diverged[k]:
             rows.append(error_row(spec, push, "the physics diverged: a state is not finite"))
             continue
         outcome = runs.outcomes[k]
-        steps, peak = int(runs.steps[k]), float(runs.peak_hip_torque[k])
-        rows.append(
-            _row(
-                spec,
-                push,
-                _Simulated(
-                    outcome=outcome,
-                    used=strategy_used(steps, peak)
-                    if outcome is Outcome.RECOVERED
-                    else Strategy.FALL,
-                    steps=steps,
-                    peak_hip_torque=peak,
-                    cop_min=float(runs.cop_min[k]),
-                    cop_max=float(runs.cop_max[k]),
-                    time=float(runs.times[k]),
-                    stop_impacts=int(runs.stop_impacts[k]),
-                ),
-                predictions[k],
-            )
-        )
+        used = strategy_used(steps[k], peaks[k]) if outcome is Outcome.RECOVERED else Strategy.FALL
+        run = _Simulated(outcome, used, steps[k], peaks[k], lows[k], highs[k], times[k], impacts[k])
+        rows.append(_row(spec, push, run, predictions[k]))
     return rows
 
 

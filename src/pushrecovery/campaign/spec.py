@@ -231,7 +231,7 @@ class CampaignSpec:
         """Whether the model is a 3-D humanoid (the whole-body controller, azimuths)."""
         return self.model in MODELS_3D
 
-    @property
+    @functools.cached_property
     def strategy(self) -> str:
         """The highest strategy the controller has: ankle, hip or step."""
         if self.is_3d:
@@ -315,6 +315,8 @@ class CampaignSpec:
 
     def body(self, swept: tuple[float, ...]) -> BodyParams:
         """Return the body of one combination of the swept values (checked as any BodyParams)."""
+        if not self.sweeps:  # the spec's own body, checked when it was made
+            return self.params
         changes: dict[str, Any] = dict(zip(self.sweeps, (float(v) for v in swept), strict=True))
         try:
             return dataclasses.replace(self.params, **changes)
@@ -328,8 +330,13 @@ class CampaignSpec:
         x0: float,
         push: float,
         azimuth: float | None = None,
+        bodies: dict[tuple[float, ...], BodyParams] | None = None,
     ) -> Push:
-        body = self.body(swept)
+        body = bodies.get(swept) if bodies is not None else None
+        if body is None:
+            body = self.body(swept)
+            if bodies is not None:
+                bodies[swept] = body
         if not body.heel < x0 < body.toe:  # a bug, not input: the spec checked the box
             raise InvalidParameterError(f"x0 = {x0:g} m is off the foot of push {index}")
         values = tuple(float(v) for v in swept)
@@ -347,6 +354,10 @@ class CampaignSpec:
         """Push number ``index`` (0 <= index < size)."""
         if not 0 <= index < self.size:
             raise InvalidParameterError(f"index must be in [0, {self.size}), got {index}")
+        return self._numbered(index, None)
+
+    def _numbered(self, index: int, bodies: dict[tuple[float, ...], BodyParams] | None) -> Push:
+        """Push number ``index``; ``bodies`` keeps the bodies of the swept values built so far."""
         if self.samples is not None:
             rng = np.random.default_rng([self.seed, index])
             ranges = [*self.sweeps.values(), self.x0, self.push_range]
@@ -355,20 +366,22 @@ class CampaignSpec:
                 ranges.insert(-1, (min(turns), max(turns), 0.0))
             draws = [rng.uniform(r[0], r[1]) if r[1] > r[0] else r[0] for r in ranges]
             if self.is_3d:
-                return self._push(index, tuple(draws[:-3]), draws[-3], draws[-1], draws[-2])
-            return self._push(index, tuple(draws[:-2]), draws[-2], draws[-1])
+                return self._push(index, tuple(draws[:-3]), draws[-3], draws[-1], draws[-2], bodies)
+            return self._push(index, tuple(draws[:-2]), draws[-2], draws[-1], None, bodies)
         sweeps, x0s, pushes = self._axes
         turns = self._directions
         shape = [len(v) for v in sweeps] + [len(x0s), len(turns) or 1, len(pushes)]
         position = np.unravel_index(index, shape)
         swept = tuple(v[k] for v, k in zip(sweeps, position[:-3], strict=True))
         azimuth = turns[position[-2]] if self.is_3d else None
-        return self._push(index, swept, x0s[position[-3]], pushes[position[-1]], azimuth)
+        return self._push(index, swept, x0s[position[-3]], pushes[position[-1]], azimuth, bodies)
 
     def pushes(self, batch: int) -> list[Push]:
         """Return the pushes of batch number ``batch``."""
         start = batch * self.batch
-        return [self.push(i) for i in range(start, min(start + self.batch, self.size))]
+        stop = min(start + self.batch, self.size)
+        bodies: dict[tuple[float, ...], BodyParams] = {}  # a grid's bodies repeat
+        return [self._numbered(i, bodies) for i in range(start, stop)]
 
     def batch_indices(self) -> Iterator[int]:
         """Every batch number, in order."""
