@@ -23,6 +23,7 @@ raises the torque, which tips the foot further.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from typing import Any, ClassVar
 
 import numpy as np
@@ -65,7 +66,7 @@ TORQUE_HOLD = 0.01
 FloatArray = NDArray[np.float64]
 
 
-class MujocoPlant:
+class MujocoPlant(ABC):
     """What every MuJoCo plant shares: the model, pushes, measured CoP, falls, recording.
 
     Subclasses set ``model_name`` and the names of the pushed body and of the CoM body, and
@@ -226,21 +227,21 @@ class MujocoPlant:
             self._record(None)
 
     # --- state ---------------------------------------------------------------------------
+    @abstractmethod
     def read_state(self) -> FloatArray:
         """Return the controller's state from the current joint positions and velocities."""
-        raise NotImplementedError
 
+    @abstractmethod
     def actuate(self, cop: float, command: Command) -> float:
         """Set ``data.ctrl`` until the next torque refresh; return the applied hip torque [N m]."""
-        raise NotImplementedError
 
+    @abstractmethod
     def pose(self, x: float, xdot: float) -> None:
         """Set the joints for a CoM at x [m] moving at ẋ [m/s] after settling (subclasses)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def ankle_x(self) -> float:
         """World x of the stance ankle [m]."""
-        raise NotImplementedError
 
     def reset(self, x: float, xdot: float) -> FloatArray:
         """Lean so the CoM is x ahead of the ankle, moving at ẋ; feet flat, upper body upright.
@@ -394,6 +395,6 @@ class MujocoPlant:
             return True
         return self._subtree_com[0, 2] < self._fall_height or self.foot_tipped()
 
+    @abstractmethod
     def foot_tipped(self) -> bool:
         """Whether the stance foot has tipped beyond ``FOOT_TIP_LIMIT``."""
-        raise NotImplementedError
