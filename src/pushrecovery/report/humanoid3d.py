@@ -20,16 +20,14 @@ import json
 import os
 from dataclasses import asdict, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from pushrecovery.errors import PushRecoveryError
+from pushrecovery.experiments.filmstrip3d import STRIP_DURATION, filmstrip_run
 from pushrecovery.report.config import HUMANOID3D_STRIPS
 from pushrecovery.report.context import _Context
 from pushrecovery.report.data import Filmstrip, Humanoid3DSection, Picture, Table
 from pushrecovery.report.markup import num, percent
-
-if TYPE_CHECKING:
-    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 
 __all__ = ["HINT", "humanoid3d_section"]
 
@@ -205,45 +203,6 @@ def _polar(ctx: _Context, result: Any) -> Picture:
     return Picture(path, caption, "experiments.validation3d.run_validation3d")
 
 
-#: Simulated time of a filmstrip's run [s] (its frames may end earlier).
-STRIP_DURATION = 3.0
-
-
-def _strip_run(ctx: _Context, spec: Strip) -> tuple[Any, float, str]:
-    """Simulate one filmstrip's push (recorded): the recording, impulse [N s] and outcome."""
-    from pushrecovery.control.wbc.controller import WholeBodyController
-    from pushrecovery.control.wbc.stepper.settings import StepSettings
-    from pushrecovery.experiments.validation3d import predicted_critical_impulses
-    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, G1Plant, wbc_for
-    from pushrecovery.sim.mujoco.humanoid3d.render3d import Recording3D
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
-    from pushrecovery.sim.push import Push3D
-
-    model, azimuth, fraction, controller, _, times = spec
-    if model == "g1":
-        from pushrecovery.sim.mujoco.humanoid3d.robots import robot_params
-
-        plant: Humanoid3DPlant = G1Plant(robot_params("g1"))
-    else:
-        plant = Biped3DPlant(ctx.params)
-    state = plant.reset()
-    origin = (float(state[0]), float(state[1]))
-    impulse = fraction * predicted_critical_impulses(plant.params, azimuth, origin=origin)["ankle"]
-    if controller == "step":
-        wbc = WholeBodyController(plant.model, feet=plant.feet, torso=plant.upright,
-                                  observation=plant.observation, hip=None,
-                                  stepping=True, params=plant.params,
-                                  step_settings=StepSettings(swing_time=0.2))  # fmt: skip
-    else:
-        wbc = wbc_for(plant, hip=controller == "hip")
-    push = Push3D(impulse, azimuth)
-    # Simulated past the last frame so that the caption's outcome is decided.
-    duration = max(times[-1], STRIP_DURATION)
-    run = simulate_push3d(plant, wbc, push, duration=duration, push_time=0.1, record=True)
-    outcome = run.outcome.value + (f", {run.steps} step(s)" if run.steps else "")
-    return Recording3D.of_plant_run(plant, run), impulse, outcome
-
-
 def _strip(ctx: _Context, key: str, spec: Strip) -> Filmstrip:
     """Render (or reuse) one filmstrip of :data:`HUMANOID3D_STRIPS`."""
     import shutil
@@ -259,7 +218,9 @@ def _strip(ctx: _Context, key: str, spec: Strip) -> Filmstrip:
     if cached is not None and png.is_file():
         impulse, outcome = float(cached["impulse"]), str(cached["outcome"])
     else:
-        recording, impulse, outcome = _strip_run(ctx, spec)
+        recording, impulse, outcome = filmstrip_run(
+            ctx.params, model, azimuth, fraction, controller, times[-1]
+        )
         title = f"{caption}: {impulse:.1f} N s at {azimuth:g}°, {outcome}"
         shown = [t for t in times if t <= recording.time[-1]] or None  # a run that ended early
         render_recording3d(recording, png, title=title, times=shown, gif=False)
