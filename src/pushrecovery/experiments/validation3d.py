@@ -73,6 +73,7 @@ __all__ = [
     "MeasuredCritical",
     "Validation3D",
     "ValidationRow",
+    "azimuth_list",
     "critical_impulse_along",
     "measure_critical_impulse",
     "predicted_critical_impulses",
@@ -271,7 +272,22 @@ class Validation3D:
         return "\n".join(lines)
 
 
-def validation_plant(model: str, params: BodyParams | None = None) -> Any:
+def azimuth_list(azimuths: Sequence[float]) -> list[float]:
+    """Return ``azimuths`` [deg] as floats: a sequence of 1 to 72 angles in [-360, 360].
+
+    Raises
+    ------
+    InvalidParameterError
+        Not a sequence (a str is not one), too few or many angles, or one out of range.
+    """
+    if isinstance(azimuths, str) or not isinstance(azimuths, Sequence):
+        raise InvalidParameterError("azimuths must be a sequence of angles [deg]")
+    if not 1 <= len(azimuths) <= 72:
+        raise InvalidParameterError(f"azimuths must hold 1 to 72 angles, got {len(azimuths)}")
+    return [bounded_float("azimuths", a, -360.0, 360.0, "deg") for a in azimuths]
+
+
+def validation_plant(model: str, params: BodyParams | None = None) -> Humanoid3DPlant:
     """Return the 3-D plant that ``model`` is validated on.
 
     Parameters
@@ -338,11 +354,7 @@ def run_validation3d(
     """
     if model not in MODELS:
         raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
-    if isinstance(azimuths, str) or not isinstance(azimuths, Sequence):
-        raise InvalidParameterError("azimuths must be a sequence of angles [deg]")
-    if not 1 <= len(azimuths) <= 72:
-        raise InvalidParameterError(f"azimuths must hold 1 to 72 angles, got {len(azimuths)}")
-    angles = [bounded_float("azimuths", a, -360.0, 360.0, "deg") for a in azimuths]
+    angles = azimuth_list(azimuths)
     if isinstance(strategies, str) or not isinstance(strategies, Sequence):
         raise InvalidParameterError(f"strategies must be a sequence of {list(STRATEGIES)}")
     chosen = tuple(strategies)

@@ -364,16 +364,12 @@ def run_step_validation(
     InvalidParameterError
         Naming the bad argument.
     """
-    from pushrecovery.experiments.validation3d import MODELS, validation_plant
+    from pushrecovery.experiments.validation3d import MODELS, azimuth_list, validation_plant
     from pushrecovery.experiments.validation3d_predict import push_lever
 
     if model not in MODELS:
         raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
-    if isinstance(azimuths, str) or not isinstance(azimuths, Sequence):
-        raise InvalidParameterError("azimuths must be a sequence of angles [deg]")
-    if not 1 <= len(azimuths) <= 72:
-        raise InvalidParameterError(f"azimuths must hold 1 to 72 angles, got {len(azimuths)}")
-    angles = [bounded_float("azimuths", a, -360.0, 360.0, "deg") for a in azimuths]
+    angles = azimuth_list(azimuths)
     if params is not None:
         require_type("params", params, BodyParams)
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-3, 0.5)
