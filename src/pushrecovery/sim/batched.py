@@ -16,19 +16,22 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, require_type, sample_array
 from pushrecovery.control.ankle import default_pd_gains
-from pushrecovery.control.recovery import RecoveryController, plan_step_now
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import check_com_state
 from pushrecovery.sim.plants import PendulumPlant
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import DEFAULT_CONTROL_PERIOD, MAX_DURATION, RestCriterion
+
+if TYPE_CHECKING:  # the recovery controller loads the MPC and scipy: only its batches need it
+    from pushrecovery.control.recovery import RecoveryController
 
 __all__ = ["BATCHED", "BatchedRuns", "ankle_pd_pushes", "recovery_pushes"]
 
@@ -196,6 +199,7 @@ def recovery_pushes(
     ParameterTypeError
         ``bodies`` not a list or tuple of BodyParams.
     """
+    from pushrecovery.control.recovery import RecoveryController
     from pushrecovery.kernels.batched import stepping as kernel
 
     starts, speeds, ticks, rest_ticks = _checked_pushes(bodies, x0, xdot, duration)
@@ -247,6 +251,7 @@ def _answer(
     request: int, controller: RecoveryController, f: NDArray[np.float64], n: NDArray[np.int64]
 ) -> None:
     """Answer the compiled loop's request with the controller's own objects (their caches)."""
+    from pushrecovery.control.recovery import plan_step_now
     from pushrecovery.kernels.batched import stepping as kernel
     from pushrecovery.surfaces.cmp import cmp_region
 
