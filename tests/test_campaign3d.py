@@ -120,7 +120,8 @@ def test_cli_campaign_on_the_biped3d(capsys, tmp_path):
 
 def test_cli_validate_on_the_biped3d(capsys, tmp_path):
     code, text, err = run_cli(
-        capsys, "validate", "--model", "biped3d", "--azimuths", "90", "--strategy", "ankle",
+        capsys, "humanoid", "validate", "--model", "biped3d", "--azimuths", "90", "--strategy",
+        "ankle",
         "--rel-tolerance", "0.2", "--fractions", "0.5", "--duration", "1",
         "--out", str(tmp_path), "--workers", "1", "--json",
     )  # fmt: skip
@@ -148,10 +149,13 @@ def test_cli_validate_on_the_biped3d(capsys, tmp_path):
           "--xdot", "0", "1", "1", "--out", "x"), "need a 3-D model"),
         (("campaign", "--backend", "mujoco", "--model", "biped3d", "--strategy", "hip",
           "--controller", "wbc-hip", "--impulse", "5", "5", "1", "--out", "x"), "not both"),
-        (("validate", "--model", "biped3d", "--azimuths", "0,360"), "repeats"),
-        (("validate", "--model", "biped3d", "--fractions", "1,0.5"), "--fractions must be"),
-        (("validate", "--backend", "analytic", "--model", "biped3d"), "use --backend mujoco"),
-        (("validate", "--azimuths", "0,90"), "need a 3-D model"),
+        (("humanoid", "validate", "--model", "biped3d", "--azimuths", "0,360"), "repeats"),
+        (("humanoid", "validate", "--model", "biped3d", "--fractions", "1,0.5"),
+         "--fractions must be"),
+        (("validate", "--backend", "analytic", "--model", "biped3d"),
+         "use 'pushrecovery humanoid validate --model biped3d'"),
+        (("validate", "--azimuths", "0,90"),
+         "use 'pushrecovery humanoid validate --azimuths 0,90'"),
     ],
 )  # fmt: skip
 def test_bad_3d_requests_are_one_line_and_exit_2(capsys, args, words):
@@ -168,7 +172,7 @@ def test_validate_refuses_another_grid_in_the_same_out_in_one_line(capsys, tmp_p
     stored.mkdir(parents=True)
     (stored / "spec.json").write_text(json.dumps(spec.to_dict()))
     args = ("--model", "biped3d", "--no-critical", "--azimuths", "90", "--fractions", "0.5")
-    code, _, err = run_cli(capsys, "validate", *args, "--out", str(tmp_path))
+    code, _, err = run_cli(capsys, "humanoid", "validate", *args, "--out", str(tmp_path))
     assert code == 2 and err.count("\n") == 1 and "give another --out" in err
 
 
@@ -178,7 +182,7 @@ def test_validate_measures_the_step_column_of_the_biped(capsys, tmp_path):
     args = ("--model", "biped3d", "--strategy", "step", "--azimuth", "90", "--no-confusion",
             "--rel-tolerance", "0.2", "--duration", "2", "--out", str(tmp_path),
             "--json")  # fmt: skip
-    code, out, err = run_cli(capsys, "validate", *args)
+    code, out, err = run_cli(capsys, "humanoid", "validate", *args)
     assert code == 0, err
     data = json.loads(out)
     (row,) = data["step_critical"]

@@ -120,8 +120,8 @@ def run_cli(capsys, *args):
 
 
 def test_simulate_biped3d_recovers_a_small_push_and_reports_the_new_keys(capsys):
-    args = ("--backend", "mujoco", "--model", "biped3d", "--azimuth", "60", "--push", "8")
-    code, out, err = run_cli(capsys, "simulate", *args, "--duration", "4", "--json")
+    args = ("--model", "biped3d", "--azimuth", "60", "--push", "8")
+    code, out, err = run_cli(capsys, "humanoid", "simulate", *args, "--duration", "4", "--json")
     assert code == 0, err
     data = json.loads(out)
     assert data["recovered"] is True and data["outcome"] == "recovered"
@@ -137,13 +137,13 @@ def test_simulate_biped3d_recovers_a_small_push_and_reports_the_new_keys(capsys)
 def test_simulate_with_stepping_steps_where_the_balance_strategies_fall(capsys):
     # 50 N s to the left (1.5 x the ankle's 2-D limit): the whole-body controller falls
     # without stepping and recovers with one step when --stepping lets it.
-    args = ("--backend", "mujoco", "--model", "biped3d", "--azimuth", "90", "--push", "50",
+    args = ("humanoid", "simulate", "--model", "biped3d", "--azimuth", "90", "--push", "50",
             "--duration", "6", "--json")  # fmt: skip
-    code, out, err = run_cli(capsys, "simulate", *args)
+    code, out, err = run_cli(capsys, *args)
     assert code == 0, err
     still = json.loads(out)
     assert still["outcome"] == "fell" and still["steps"] == 0 and still["stepping"] is False
-    code, out, err = run_cli(capsys, "simulate", *args, "--stepping")
+    code, out, err = run_cli(capsys, *args, "--stepping")
     assert code == 0, err
     stepped = json.loads(out)
     assert stepped["recovered"] is True and stepped["steps"] >= 1
@@ -153,14 +153,17 @@ def test_simulate_with_stepping_steps_where_the_balance_strategies_fall(capsys):
 @pytest.mark.parametrize(
     ("args", "words"),
     [
-        (("simulate", "--backend", "mujoco", "--model", "biped3d", "--azimuth", "400"),
+        (("humanoid", "simulate", "--model", "biped3d", "--azimuth", "400"),
          "azimuth must be in [-360, 360]"),
-        (("simulate", "--model", "biped3d"), "use --backend mujoco"),
-        (("simulate", "--azimuth", "30"), "--azimuth needs a 3-D model"),
+        (("simulate", "--model", "biped3d"),
+         "--model biped3d is a 3-D humanoid: use 'pushrecovery humanoid simulate --model biped3d'"),
+        (("simulate", "--azimuth", "30"), "use 'pushrecovery humanoid simulate --azimuth 30'"),
         (("campaign", "--backend", "mujoco", "--model", "biped3d", "--out", "x"),
          "campaign needs one of --impulse, --fraction, --xdot"),
-        (("validate", "--model", "g1", "--azimuth", "400"), "--azimuth must be in [-360, 360]"),
-        (("simulate", "--model", "foot", "--stepping"), "--stepping applies to the 3-D models"),
+        (("humanoid", "validate", "--model", "g1", "--azimuth", "400"),
+         "--azimuth must be in [-360, 360]"),
+        (("simulate", "--model", "foot", "--stepping"),
+         "use 'pushrecovery humanoid simulate --stepping'"),
     ],
 )  # fmt: skip
 def test_bad_3d_requests_are_one_line_and_exit_2(capsys, args, words):
@@ -170,8 +173,7 @@ def test_bad_3d_requests_are_one_line_and_exit_2(capsys, args, words):
 
 def test_g1_without_the_robots_extra_is_one_line_and_exit_2(capsys, monkeypatch):
     monkeypatch.setattr(robots.importlib.util, "find_spec", lambda name: None)
-    code, _, err = run_cli(capsys, "simulate", "--backend", "mujoco", "--model", "g1",
-                           "--push", "3")  # fmt: skip
+    code, _, err = run_cli(capsys, "humanoid", "simulate", "--model", "g1", "--push", "3")
     assert code == 2 and err.count("\n") == 1
     assert "the G1 model needs the robots extra: pip install 'pushrecovery[robots]'" in err
 

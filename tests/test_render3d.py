@@ -256,7 +256,7 @@ def test_cli_renders_a_3d_run(gl: None, tmp_path: Path) -> None:
     from pushrecovery.cli.app import cli
 
     result = CliRunner().invoke(cli, [
-        "simulate", "--backend", "mujoco", "--model", "biped3d", "--azimuth", "90", "--push",
+        "humanoid", "simulate", "--model", "biped3d", "--azimuth", "90", "--push",
         "10", "--duration", "0.3", "--render", str(tmp_path / "side"), "--view-elevation",
         "30", "--frame-times", "0,0.2,0.4", "--json",
     ])  # fmt: skip
@@ -275,18 +275,19 @@ def test_cli_renders_a_3d_run(gl: None, tmp_path: Path) -> None:
         (["--view-azimuth", "nan", "--render", "x"], "--view-azimuth"),
         (["--frame-times", "0.3,0.1", "--render", "x"], "--frame-times"),
         (["--frame-times", "a", "--render", "x"], "--frame-times"),
-        (["--view-azimuth", "10"], "apply to --render of the 3-D"),
+        (["--view-azimuth", "10"], "apply to --render of the 3-D humanoids"),
     ],
 )
 def test_cli_bad_camera_flags_are_one_line_and_exit_2(capsys, args, match) -> None:
-    base = ["simulate", "--backend", "mujoco", "--model", "biped3d", "--push", "10"]
+    base = ["humanoid", "simulate", "--model", "biped3d", "--push", "10"]
     code, err = run_cli(capsys, *base, *args)
     assert code == 2 and match in err and err.count("\n") == 1 and "Traceback" not in err
 
 
 def test_cli_camera_flags_need_a_3d_model(capsys) -> None:
     code, err = run_cli(capsys, "simulate", "--xdot", "0.1", "--frame-times", "0.1")
-    assert code == 2 and "3-D models" in err
+    assert code == 2 and err.count("\n") == 1
+    assert "use 'pushrecovery humanoid simulate --frame-times 0.1'" in err
 
 
 def run_cli(capsys, *args: str) -> tuple[int, str]:

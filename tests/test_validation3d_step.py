@@ -106,7 +106,7 @@ def test_cli_validates_the_g1s_step_column(g1, tmp_path, capsys):
 
     from pushrecovery.cli import main
 
-    args = ["validate", "--model", "g1", "--strategy", "step", "--azimuth", "90",
+    args = ["humanoid", "validate", "--model", "g1", "--strategy", "step", "--azimuth", "90",
             "--rel-tolerance", "0.3", "--duration", "2", "--no-confusion", "--json",
             "--out", str(tmp_path)]  # fmt: skip
     with pytest.raises(SystemExit) as done:

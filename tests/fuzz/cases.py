@@ -61,7 +61,18 @@ STRINGS: dict[str, list[str]] = {
     ],
     "--scheduler": ["tcp://", "tcp://127.0.0.1:99999", "xyz", "tcp://:1"],
     "--preset": ["paper", "nope", ""],
-    "--model": ["stepping", "pendulum", "flywheel", "torso", "biped", "foot", "nope", ""],
+    "--model": [
+        "stepping",
+        "pendulum",
+        "flywheel",
+        "torso",
+        "biped",
+        "foot",
+        "biped3d",
+        "g1",
+        "nope",
+        "",
+    ],
     "--controller": ["recovery", "ankle-pd", "mpc", "bang-bang", "nope"],
     "--com-marker": ["CoM", "", "nope"],
     "--foot": ["left:LHEE,LTOE", "junk", ""],
@@ -69,7 +80,15 @@ STRINGS: dict[str, list[str]] = {
 STRINGS["--right-foot"] = STRINGS["--left-foot"]
 #: Commands that may run for minutes on valid input: fuzzed with one invalid body value, so
 #: that what is checked is that they refuse it before any work.
-HEAVY = {"report", "figures", "validate", "campaign"}
+HEAVY = {
+    "report",
+    "figures",
+    "validate",
+    "campaign",
+    "humanoid simulate",
+    "humanoid critical-push",
+    "humanoid validate",
+}
 INVALID_BODY = [
     ["--mass", "nan"], ["--gravity", "1e15"], ["--com-height", "-1"], ["--toe", "inf"],
     ["--leg-length", "1e300"], ["--max-steps", "0.5"], ["--heel", "0.3"],
@@ -86,10 +105,15 @@ class Case:
 
 
 def _commands() -> dict[str, click.Command]:
+    """Every command by its words: a group's (``humanoid``) as ``"humanoid simulate"``."""
     found = {}
     for name, (path, _) in COMMANDS.items():
         module, _, attribute = path.partition(":")
-        found[name] = getattr(importlib.import_module(module), attribute)
+        command = getattr(importlib.import_module(module), attribute)
+        if isinstance(command, click.Group):
+            found |= {f"{name} {sub}": c for sub, c in command.commands.items()}
+        else:
+            found[name] = command
     return found
 
 
@@ -116,7 +140,7 @@ def command_case(rng: random.Random, folder: Path) -> Case:
     commands = _commands()
     name = rng.choice(sorted(commands))
     command = commands[name]
-    args = [name]
+    args = name.split()
     params = [p for p in command.params if isinstance(p, click.Option) and p.opts[0] not in SKIP]
     for param in rng.sample(params, k=min(len(params), rng.choice([0, 1, 2, 3, 4, 6]))):
         option = max(param.opts, key=len)

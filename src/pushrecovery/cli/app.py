@@ -41,6 +41,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "pushrecovery.cli.figures:figures",
         "Reproduce the paper's figures and the ground-plane figure.",
     ),
+    "humanoid": (
+        "pushrecovery.cli.humanoid:humanoid",
+        "The 3-D humanoids (biped3d, g1) under the whole-body controller.",
+    ),
     "report": (
         "pushrecovery.cli.campaign:report",
         "The HTML report of a parameter set (the main job).",

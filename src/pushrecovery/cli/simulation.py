@@ -1,7 +1,8 @@
 """Commands that simulate one push or bisect one: ``simulate`` and ``critical-push``.
 
-Their shared options are in :mod:`pushrecovery.cli.simulation_options`, the 3-D models'
-helpers in :mod:`pushrecovery.cli.simulation3d`.
+Their shared options are in :mod:`pushrecovery.cli.simulation_options`. The planar models only:
+the 3-D humanoids are ``pushrecovery humanoid simulate`` and ``critical-push``
+(:mod:`pushrecovery.cli.humanoid`).
 """
 
 from __future__ import annotations
@@ -11,23 +12,14 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.families import humanoid_only
 from pushrecovery.cli.options import (
     body_options,
     emit,
     params_from,
 )
 from pushrecovery.cli.progress import Progress
-from pushrecovery.cli.simulation3d import (
-    _check_3d,
-    _check_views,
-    _critical_3d,
-    _params_3d,
-    _render_options,
-    _simulate_3d,
-)
 from pushrecovery.cli.simulation_options import (
-    MUJOCO_3D_MODEL_CHOICES,
-    _azimuth,
     _backend,
     _controller,
     _controller_options,
@@ -36,7 +28,6 @@ from pushrecovery.cli.simulation_options import (
     _model,
     _options_for,
     _push_velocity,
-    _views,
     _with,
 )
 
@@ -44,7 +35,7 @@ __all__ = ["critical_push", "simulate"]
 
 
 @click.command(short_help="Simulate a push; report recovered or fell.")
-@_with(_backend, _model, _controller, *_gains, _azimuth)
+@_with(_backend, _model("simulate"), _controller, *_gains)
 @click.option(
     "--x", "x", type=float, default=0.0, show_default=True, help="CoM position before the push [m]."
 )
@@ -70,7 +61,7 @@ __all__ = ["critical_push", "simulate"]
     "impulse",
     type=float,
     default=None,
-    help="Push as an impulse on the CoM [N s] (instead of --xdot); on the 3-D models at the torso.",
+    help="Push as an impulse on the CoM [N s] (instead of --xdot).",
 )
 @click.option(
     "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
@@ -92,16 +83,11 @@ __all__ = ["critical_push", "simulate"]
     type=click.Path(dir_okay=False),
     default=None,
     help="MuJoCo only: write a filmstrip PNG of the run to this file and an animated GIF "
-    "beside it (CoM, capture point and CoP drawn; on the 3-D models also the support polygon, "
-    "from a tracking camera: --view-azimuth, --view-elevation, --frame-times).",
+    "beside it (CoM, capture point and CoP drawn).",
 )
-@click.option(
-    "--stepping",
-    is_flag=True,
-    default=False,
-    help="3-D models: the whole-body controller may step (docs/humanoid3d.md, Stepping).",
+@humanoid_only(
+    "simulate", "--azimuth", "--stepping", "--view-azimuth", "--view-elevation", "--frame-times"
 )
-@_with(*_views)
 @body_options
 def simulate(
     backend: str,
@@ -110,7 +96,6 @@ def simulate(
     kp: float | None,
     kd: float | None,
     options: tuple[str, ...],
-    azimuth: float | None,
     x: float,
     xdot: float | None,
     y: float,
@@ -120,10 +105,6 @@ def simulate(
     control_period: float | None,
     plot: str | None,
     render: str | None,
-    stepping: bool,
-    view_azimuth: float | None,
-    view_elevation: float | None,
-    frame_times: str | None,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
@@ -132,9 +113,8 @@ def simulate(
     With --backend mujoco, --impulse is a real force at the CoM over 10 ms (the body holding
     still meanwhile) and the run starts as the push ends. With --model stepping-plane
     (controller recovery-plane) the body stands on both feet of the ground plane and --y,
-    --ydot add the sideways part (--impulse pushes along x). The 3-D models (--backend
-    mujoco --model biped3d or g1) take --impulse/--push at the torso at --azimuth and run
-    the whole-body controller (docs/humanoid3d.md), with --stepping allowed to step.
+    --ydot add the sideways part (--impulse pushes along x). The 3-D humanoids are
+    'pushrecovery humanoid simulate'.
     """
     from pushrecovery.control.base import make_controller
     from pushrecovery.sim.backend import Measuring, Recording
@@ -143,40 +123,6 @@ def simulate(
     from pushrecovery.sim.simulate import simulate as run
     from pushrecovery.surfaces.classify import classify as classify_state
 
-    if model in MUJOCO_3D_MODEL_CHOICES or azimuth is not None:
-        _check_3d(backend, model, controller, kp, kd, options, kwargs)
-        if not (x == 0.0 and xdot is None and y == 0.0 and ydot == 0.0):
-            from pushrecovery.errors import InvalidParameterError
-
-            raise InvalidParameterError(
-                f"--model {model} starts standing still: push it with --impulse and --azimuth "
-                "(no --x, --xdot, --y, --ydot)"
-            )
-        if plot:
-            from pushrecovery.errors import InvalidParameterError
-
-            raise InvalidParameterError(f"--plot is not available for {model} yet")
-        if not render:
-            _check_views(view_azimuth, view_elevation, frame_times)
-        pictures = _render_options(azimuth, view_azimuth, view_elevation, frame_times)
-        body = _params_3d(model, kwargs)
-        if render:
-            from pushrecovery.sim.mujoco.render import require_offscreen_gl
-
-            require_offscreen_gl()  # fail before the run, not after it
-        emit(
-            _simulate_3d(model, body, impulse, azimuth, duration, render, pictures, stepping),
-            as_json,
-        )
-        return
-    if stepping:
-        from pushrecovery.errors import InvalidParameterError
-
-        raise InvalidParameterError(
-            "--stepping applies to the 3-D models (--backend mujoco --model biped3d or g1); "
-            "the stepping models step with --model stepping or stepping-plane"
-        )
-    _check_views(view_azimuth, view_elevation, frame_times)
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)
     plane = model == "stepping-plane"
@@ -239,7 +185,7 @@ def simulate(
 
 
 @click.command("critical-push", short_help="Largest recoverable push, vs Eq. 4.")
-@_with(_backend, _model, _controller, *_gains, _azimuth)
+@_with(_backend, _model("critical-push"), _controller, *_gains)
 @click.option(
     "--x",
     "x",
@@ -271,6 +217,7 @@ def simulate(
     default=None,
     help="Controller period [s] (default: the controller's own, else 0.001).",
 )
+@humanoid_only("critical-push", "--azimuth")
 @body_options
 def critical_push(
     backend: str,
@@ -279,7 +226,6 @@ def critical_push(
     kp: float | None,
     kd: float | None,
     options: tuple[str, ...],
-    azimuth: float | None,
     x: float,
     direction: str,
     tolerance: float,
@@ -290,23 +236,10 @@ def critical_push(
 ) -> None:
     """Largest recoverable push from x by bisection, against the strategy's surface.
 
-    On the 3-D models (--backend mujoco --model biped3d or g1) the impulse at --azimuth is
-    bisected between a run that stands and one that falls within --duration (keep it short:
-    the whole-body controller runs about 5x real time), to --tolerance times the mass.
+    The 3-D humanoids are 'pushrecovery humanoid critical-push'.
     """
     from pushrecovery.sim.critical import critical_push as search
 
-    if model in MUJOCO_3D_MODEL_CHOICES or azimuth is not None:
-        _check_3d(backend, model, controller, kp, kd, options, kwargs)
-        if x != 0.0 or direction != "forward":
-            from pushrecovery.errors import InvalidParameterError
-
-            raise InvalidParameterError(
-                f"--model {model} starts standing still and takes --azimuth (no --x, --direction)"
-            )
-        params = _params_3d(model, kwargs)
-        emit(_critical_3d(model, params, azimuth, tolerance, duration), as_json)
-        return
     params = params_from(kwargs)
     bar = Progress(None, "critical push", "simulation")
     try:

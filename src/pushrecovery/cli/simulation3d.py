@@ -1,8 +1,9 @@
-"""The 3-D models of ``simulate`` and ``critical-push`` (issue 19): checks, body, runs.
+"""The runs of ``pushrecovery humanoid simulate`` and ``critical-push``: body, camera, runs.
 
-``--backend mujoco --model biped3d|g1 --azimuth DEG``: the whole-body controller after a push
-from any direction (:mod:`pushrecovery.sim.mujoco.humanoid3d.runs3d`); the helpers of
-:mod:`pushrecovery.cli.simulation`, apart so that each module holds one concept.
+``humanoid simulate --model biped3d|g1 --azimuth DEG``: the whole-body controller after a
+push from any direction (:mod:`pushrecovery.sim.mujoco.humanoid3d.runs3d`); the commands are
+in :mod:`pushrecovery.cli.humanoid`. :func:`params_3d` is also the body of the 3-D
+``validate`` and ``campaign``.
 """
 
 from __future__ import annotations
@@ -10,41 +11,33 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from pushrecovery.cli.options import params_from
-from pushrecovery.sim.registry import MUJOCO_3D_MODELS
 
 if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 
-__all__: list[str] = []
+__all__ = ["check_views", "critical_3d", "params_3d", "render_options", "simulate_3d"]
 
 
-def _check_3d(
-    backend: str,
-    model: str,
-    controller: str,
-    kp: float | None,
-    kd: float | None,
-    options: tuple[str, ...],
-    kwargs: dict[str, Any],
-) -> None:
-    """Refuse the options a 3-D run does not take, in one line each."""
-    from pushrecovery.errors import InvalidParameterError
+def params_3d(model: str, kwargs: dict[str, Any]) -> Any:
+    """Return the body of a 3-D model: the options' (biped3d) or the robot's own (g1).
 
-    if model not in MUJOCO_3D_MODELS:
-        raise InvalidParameterError(
-            f"--azimuth needs a 3-D model (--backend mujoco --model biped3d or g1), got {model!r}"
-        )
-    if backend != "mujoco":
-        raise InvalidParameterError(f"--model {model} is a 3-D MuJoCo model: use --backend mujoco")
-    if controller != "ankle-pd" or kp is not None or kd is not None or options:
-        raise InvalidParameterError(
-            f"--controller, --kp, --kd and --option do not apply to {model}: it runs the "
-            "whole-body controller"
-        )
+    Parameters
+    ----------
+    model : str
+        ``biped3d`` or ``g1``.
+    kwargs : dict
+        The command's keyword arguments; the body options are popped out of it (biped3d).
 
+    Returns
+    -------
+    BodyParams
+        The body the plant is built from.
 
-def _params_3d(model: str, kwargs: dict[str, Any]) -> Any:
-    """Return the body of a 3-D model: the options' (biped3d) or the robot's own (g1)."""
+    Raises
+    ------
+    InvalidParameterError
+        If ``g1`` is given a preset, a parameter file or a body flag.
+    """
     if model != "g1":
         return params_from(kwargs)
     from pushrecovery.cli.options import PARAM_FLAGS
@@ -61,26 +54,60 @@ def _params_3d(model: str, kwargs: dict[str, Any]) -> Any:
     return robot_params("g1")
 
 
-def _check_views(
+def check_views(
     view_azimuth: float | None, view_elevation: float | None, frame_times: str | None
 ) -> None:
-    """Refuse the 3-D camera flags where they do not apply (a planar model, no --render)."""
+    """Refuse the camera flags without ``--render``.
+
+    Parameters
+    ----------
+    view_azimuth, view_elevation : float or None
+        ``--view-azimuth``, ``--view-elevation`` [deg].
+    frame_times : str or None
+        ``--frame-times``.
+
+    Raises
+    ------
+    InvalidParameterError
+        If any of them is given.
+    """
     from pushrecovery.errors import InvalidParameterError
 
     if view_azimuth is not None or view_elevation is not None or frame_times is not None:
         raise InvalidParameterError(
             "--view-azimuth, --view-elevation and --frame-times apply to --render of the 3-D "
-            "models (--model biped3d or g1)"
+            "humanoids"
         )
 
 
-def _render_options(
+def render_options(
     azimuth: float | None,
     view_azimuth: float | None,
     view_elevation: float | None,
     frame_times: str | None,
 ) -> dict[str, Any]:
-    """Return the camera and filmstrip times of the 3-D ``--render`` (checked before the run)."""
+    """Return the camera and filmstrip times of the 3-D ``--render`` (checked before the run).
+
+    Parameters
+    ----------
+    azimuth : float or None
+        The push's azimuth [deg] (None: 0); the default camera looks across it.
+    view_azimuth, view_elevation : float or None
+        ``--view-azimuth``, ``--view-elevation`` [deg] (None: the default camera's).
+    frame_times : str or None
+        ``--frame-times T1,T2,...`` [s] (None: evenly spaced).
+
+    Returns
+    -------
+    dict
+        ``camera`` (``Camera3D``) and ``times`` (list of float or None), the keyword
+        arguments of ``render_recording3d``.
+
+    Raises
+    ------
+    InvalidParameterError
+        If a camera angle or the frame times are out of range, naming the flag.
+    """
     import itertools
     import math
 
@@ -142,22 +169,39 @@ def _render_3d(
     return data
 
 
-def _simulate_3d(
+def simulate_3d(
     model: str,
     params: Any,
     impulse: float | None,
     azimuth: float | None,
     duration: float,
     render: str | None = None,
-    render_options: dict[str, Any] | None = None,
+    pictures: dict[str, Any] | None = None,
     stepping: bool = False,
 ) -> dict[str, Any]:
     """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON).
 
-    ``stepping``: the controller may step (``wbc_for(plant, stepping=True)``).
+    Parameters
+    ----------
+    model : str
+        ``biped3d`` or ``g1``.
+    params : BodyParams
+        The body (:func:`params_3d`).
+    impulse, azimuth : float or None
+        The push at the torso [N s] and its direction [deg] (None: 0).
+    duration : float
+        Longest simulated time [s].
+    render : str or None
+        ``--render FILE``: the run is recorded and its filmstrip PNG and GIF written.
+    pictures : dict or None
+        The camera and frame times of ``render`` (:func:`render_options`).
+    stepping : bool
+        Whether the controller may step (``wbc_for(plant, stepping=True)``).
 
-    With ``render`` (``--render FILE``) the run is recorded and its filmstrip PNG and GIF
-    written (``render_options``: :func:`_render_options`).
+    Returns
+    -------
+    dict
+        The run's JSON (a public contract: keys, order and values).
     """
     import numpy as np
 
@@ -210,13 +254,32 @@ def _simulate_3d(
         "max_torso_tilt": run.max_torso_tilt,
         "failed_ticks": run.failed_ticks,
         "hip_task": plant.hip_task,
-    } | (_render_3d(plant, run, render, render_options or {}) if render else {})
+    } | (_render_3d(plant, run, render, pictures or {}) if render else {})
 
 
-def _critical_3d(
+def critical_3d(
     model: str, params: Any, azimuth: float | None, tolerance: float, duration: float
 ) -> dict[str, Any]:
-    """Bisect the impulse at ``azimuth`` on a 3-D model (the JSON)."""
+    """Bisect the impulse at ``azimuth`` on a 3-D model (the JSON).
+
+    Parameters
+    ----------
+    model : str
+        ``biped3d`` or ``g1``.
+    params : BodyParams
+        The body (:func:`params_3d`).
+    azimuth : float or None
+        The push's direction [deg] (None: 0).
+    tolerance : float
+        The final bracket's width as a velocity [m/s] (times the mass: an impulse).
+    duration : float
+        Longest simulated time per push [s].
+
+    Returns
+    -------
+    dict
+        The search's JSON (a public contract: keys, order and values).
+    """
     from pushrecovery.arguments import positive_float
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d
     from pushrecovery.sim.registry import make_plant3d
@@ -241,3 +304,8 @@ def _critical_3d(
         "strategy": found.strategy,
         "hip_task": plant.hip_task,
     }
+
+
+#: ``cli.campaign3d``'s name for :func:`params_3d` (until the campaign's own change imports
+#: the public name).
+_params_3d = params_3d

@@ -11,16 +11,16 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice
 from pushrecovery.control.registry import CONTROLLER_NAMES
-from pushrecovery.sim.registry import MODELS, MUJOCO_3D_MODELS, MUJOCO_MODELS
+from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
-__all__ = ["CONTROLLER_CHOICES", "MODEL_CHOICES", "MUJOCO_3D_MODEL_CHOICES", "MUJOCO_MODEL_CHOICES"]
+__all__ = ["CONTROLLER_CHOICES", "MODEL_CHOICES", "MUJOCO_MODEL_CHOICES"]
 
-#: The ``--model`` and ``--controller`` choices.
+#: The ``--model`` and ``--controller`` choices (the planar models; the 3-D humanoids are
+#: ``pushrecovery humanoid``'s).
 MODEL_CHOICES = MODELS
 MUJOCO_MODEL_CHOICES = MUJOCO_MODELS
-#: The 3-D models (MuJoCo, the whole-body controller; docs/humanoid3d.md).
-MUJOCO_3D_MODEL_CHOICES = MUJOCO_3D_MODELS
 CONTROLLER_CHOICES = CONTROLLER_NAMES
 
 
@@ -81,45 +81,25 @@ _backend = click.option(
     show_default=True,
     help="Physics: the analytic models, or MuJoCo (models foot, torso, biped).",
 )
-_model = click.option(
-    "--model",
-    type=click.Choice((*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES, *MUJOCO_3D_MODEL_CHOICES)),
-    default="lipm",
-    show_default=True,
-    help="Plant. Analytic: lipm, pendulum, flywheel, stepping, stepping-plane (on the ground "
-    "plane, with recovery-plane; simulate only); MuJoCo: foot (ankle), torso (hip), biped "
-    "(stepping); 3-D MuJoCo (the whole-body controller, --azimuth): biped3d, g1 (the robots "
-    "extra).",
-)
-_azimuth = click.option(
-    "--azimuth",
-    type=float,
-    default=None,
-    help="3-D models only: the push's direction [deg], 0 forward (+x), 90 left (+y); default 0.",
-)
-_views = (
-    click.option(
-        "--view-azimuth",
-        type=float,
-        default=None,
-        help="3-D models, --render: where the camera stands [deg], 0 in front of the body, 90 on "
-        "its left; default the push's azimuth - 90 (the push goes left to right).",
-    ),
-    click.option(
-        "--view-elevation",
-        type=float,
-        default=None,
-        help="3-D models, --render: the camera's elevation above the horizon [deg], in [-30, 89]; "
-        "default 25.",
-    ),
-    click.option(
-        "--frame-times",
-        default=None,
-        metavar="T1,T2,...",
-        help="3-D models, --render: the filmstrip's frame times [s] after the start, increasing "
-        "(default 6 evenly spaced).",
-    ),
-)
+
+
+def _model(command: str) -> Any:
+    """``--model`` of the planar ``command``; a 3-D humanoid is refused naming its command."""
+    return click.option(
+        "--model",
+        type=ModelChoice(
+            (*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES),
+            elsewhere={m: f"humanoid {command} --model {m}" for m in HUMANOID_MODELS},
+            family="a 3-D humanoid",
+        ),
+        default="lipm",
+        show_default=True,
+        help="Plant. Analytic: lipm, pendulum, flywheel, stepping, stepping-plane (on the "
+        "ground plane, with recovery-plane; simulate only); MuJoCo: foot (ankle), torso (hip), "
+        "biped (stepping). The 3-D humanoids: pushrecovery humanoid.",
+    )
+
+
 _controller = click.option(
     "--controller",
     type=click.Choice(CONTROLLER_CHOICES),

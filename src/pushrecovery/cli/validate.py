@@ -6,6 +6,7 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.families import humanoid_only
 from pushrecovery.cli.options import (
     body_options,
     echo_confusion,
@@ -34,51 +35,22 @@ __all__ = ["validate"]
 )
 @click.option(
     "--model",
-    "model3d",
-    type=click.Choice(("biped3d", "g1")),
     default=None,
-    help="3-D models (--backend mujoco): the critical push per azimuth and strategy against "
-    "the 2-D prediction, and the confusion matrix over azimuths x push sizes.",
+    hidden=True,
+    expose_value=False,
+    callback=lambda ctx, param, value: _refuse_model(value),
 )
-@click.option("--azimuth", type=float, default=None, help="3-D models: one push direction [deg].")
-@click.option(
+@humanoid_only(
+    "validate",
+    "--azimuth",
     "--azimuths",
-    default=None,
-    metavar="GRID",
-    help="3-D models: push directions, START:STOP:STEP or A,B,... [deg] (default 0:360:30).",
-)
-@click.option(
     "--fractions",
-    default=None,
-    metavar="A,B,...",
-    help="3-D models: the confusion matrix's pushes, as fractions of the ankle's predicted "
-    "critical push along each azimuth (default 0.5,0.9,1.1,1.5,2.0).",
-)
-@click.option(
     "--rel-tolerance",
-    type=float,
-    default=0.01,
-    show_default=True,
-    help="3-D models: each critical-push bracket's width, as a fraction of the prediction.",
-)
-@click.option(
     "--quick",
-    is_flag=True,
-    help="3-D models: azimuths 0 and 90, the ankle, a 3 % bracket, push sizes 0.5 and 1.5.",
-)
-@click.option(
     "--out",
-    type=click.Path(file_okay=False),
-    default="out/validate3d",
-    show_default=True,
-    help="3-D models: directory of the tables, plots and the confusion campaign.",
-)
-@click.option("--workers", type=int, default=None, help="3-D models: campaign workers.")
-@click.option(
-    "--critical/--no-critical",
-    default=True,
-    show_default=True,
-    help="3-D models: measure the critical pushes (else only the confusion matrix).",
+    "--workers",
+    "--critical",
+    "--no-critical",
 )
 @click.option(
     "--x0",
@@ -95,11 +67,7 @@ __all__ = ["validate"]
     help="Width of each critical-push bracket [m/s].",
 )
 @click.option(
-    "--duration",
-    type=float,
-    default=None,
-    help="Longest run per push [s] (default 6; 3-D: 3 per critical-push run, 5 per "
-    "confusion push).",
+    "--duration", type=float, default=6.0, show_default=True, help="Longest run per push [s]."
 )
 @click.option(
     "--grid",
@@ -120,18 +88,9 @@ __all__ = ["validate"]
 def validate(
     backend: str,
     strategies: tuple[str, ...],
-    model3d: str | None,
-    azimuth: float | None,
-    azimuths: str | None,
-    fractions: str | None,
-    rel_tolerance: float,
-    quick: bool,
-    out: str,
-    workers: int | None,
-    critical: bool,
     x0s: tuple[float, ...],
     tolerance: float,
-    duration: float | None,
+    duration: float,
     grid: tuple[float, float, float],
     confusion: bool,
     as_json: bool,
@@ -144,6 +103,7 @@ def validate(
     --x0, next to the surface's prediction (and, on MuJoCo, the prediction corrected for the CoP
     margin and the push's duration). The confusion matrix compares the strategy the surfaces
     predict for each push of the grid with the least strategy that recovers it in simulation.
+    The 3-D humanoids are 'pushrecovery humanoid validate'.
     """
     import sys
 
@@ -157,26 +117,6 @@ def validate(
         critical_table,
     )
 
-    if model3d is not None:
-        if backend != "mujoco":
-            raise InvalidParameterError(
-                f"--model {model3d} is a 3-D MuJoCo model: use --backend mujoco"
-            )
-        _validate_3d(model3d, strategies, critical, azimuth, azimuths, fractions, rel_tolerance,
-                     quick, out, workers, duration, confusion, as_json, kwargs)  # fmt: skip
-        return
-    if (
-        azimuth is not None
-        or azimuths is not None
-        or fractions is not None
-        or quick
-        or not critical
-    ):
-        raise InvalidParameterError(
-            "--azimuth(s), --fractions, --quick and --no-critical need a 3-D model "
-            "(--model biped3d or g1)"
-        )
-    duration = 6.0 if duration is None else duration
     params = params_from(kwargs)
     strategies = strategies or available_strategies(backend)
     missing = set(strategies) - set(available_strategies(backend))
@@ -251,74 +191,15 @@ def validate(
         )
 
 
-def _validate_3d(
-    model: str,
-    strategies: tuple[str, ...],
-    critical: bool,
-    azimuth: float | None,
-    azimuths: str | None,
-    fractions: str | None,
-    rel_tolerance: float,
-    quick: bool,
-    out: str,
-    workers: int | None,
-    duration: float | None,
-    confusion: bool,
-    as_json: bool,
-    kwargs: dict[str, Any],
-) -> None:
-    """``validate --model biped3d|g1`` (:mod:`pushrecovery.cli.validate3d`)."""
-    from pathlib import Path
-
-    from pushrecovery.cli.campaign3d import azimuths_from
-    from pushrecovery.cli.simulation3d import _params_3d
-    from pushrecovery.cli.validate3d import QUICK, Validate3DOptions, fraction_list, validate_3d
-    from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
-
-    quick_values: dict[str, Any] = QUICK if quick else {}
-    directions = azimuths_from(azimuth, azimuths) or quick_values.get("azimuths", DEFAULT_AZIMUTHS)
-    # The G1's hip task recovers nothing (docs/validation.md): its ankle and step by default.
-    usual = ("ankle", "step") if model == "g1" else ("ankle", "hip", "step")
-    chosen = strategies or quick_values.get("strategies", usual)
-    chosen = chosen if critical else ()
-    options = Validate3DOptions(
-        model=model,
-        azimuths=tuple(directions),
-        strategies=tuple(chosen),
-        rel_tolerance=quick_values.get("rel_tolerance", rel_tolerance),
-        duration=3.0 if duration is None else duration,
-        fractions=fraction_list(fractions, quick_values.get("fractions", DEFAULT_FRACTIONS)),
-        confusion_duration=5.0 if duration is None else duration,
-        confusion=confusion,
-        out=Path(out),
-        workers=workers,
-    )
-    data = validate_3d(options, _params_3d(model, kwargs))
-    if as_json:
-        emit(data, True)
+def _refuse_model(model: str | None) -> None:
+    """Refuse ``--model``: a 3-D humanoid names its command; --strategy picks the planar models."""
+    if model is None:
         return
-    for row in data.get("critical", []):
-        click.echo(
-            f"{row['strategy']:<7}{row['azimuth']:>6g} deg  predicted {row['predicted']:6.1f}  "
-            f"corrected {row['corrected']:6.1f}  measured {row['measured']:6.1f} N s  "
-            f"({100 * row['relative_error']:+.1f} %, "
-            f"corrected {100 * row['corrected_error']:+.1f} %)"
-        )
-    if "confusion" in data:
-        found = data["confusion"]
-        echo_confusion(
-            f"confusion (rows predicted, columns used), agreement {found['accuracy']:.3f}",
-            found["labels"],
-            found["counts"],
-        )
-        echo_confusion(
-            f"against the verdict corrected for the push's height, agreement "
-            f"{found['accuracy_corrected']:.3f}",
-            found["labels"],
-            found["counts_corrected"],
-        )
-        causes = ", ".join(f"{k} {v}" for k, v in found["causes"].items() if v and k != "agree")
-        click.echo(f"where they differ: {causes or 'nowhere'}")
-    files = {**data.get("files", {}), **data.get("confusion", {}).get("files", {})}
-    for name, path in files.items():
-        click.echo(f"{name:<18}{path}")
+    from pushrecovery.cli.families import refuse_humanoid_model
+    from pushrecovery.errors import InvalidParameterError
+
+    refuse_humanoid_model(model, "validate")
+    raise InvalidParameterError(
+        f"validate takes no --model (got {model!r}): --strategy picks the planar models; the "
+        "3-D humanoids are 'pushrecovery humanoid validate --model biped3d|g1'"
+    )

@@ -1,6 +1,6 @@
-"""The 3-D models of ``validate`` (biped3d, g1): the polar validation and the confusion matrix.
+"""``pushrecovery humanoid validate`` (biped3d, g1): the polar validation and confusion matrix.
 
-``validate --model biped3d|g1``: each strategy's critical push per azimuth against the 2-D
+``humanoid validate --model biped3d|g1``: each strategy's critical push per azimuth against the 2-D
 prediction (:mod:`pushrecovery.experiments.validation3d`, and for the step
 :mod:`pushrecovery.experiments.validation3d_step`: tables and one polar plot), then a 3-D
 campaign over azimuths × fractions of the ankle's predicted critical push under the
@@ -25,7 +25,7 @@ __all__ = ["QUICK", "Validate3DOptions", "validate_3d"]
 
 @dataclass(frozen=True)
 class Validate3DOptions:
-    """What ``validate`` asks of a 3-D model (the command's options, parsed)."""
+    """What ``humanoid validate`` asks of a 3-D model (the command's options, parsed)."""
 
     model: str
     azimuths: tuple[float, ...]

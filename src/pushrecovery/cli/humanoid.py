@@ -1,0 +1,354 @@
+"""The ``pushrecovery humanoid`` commands: the 3-D humanoids under the whole-body controller.
+
+``humanoid simulate``, ``humanoid critical-push`` and ``humanoid validate`` run biped3d and g1
+(MuJoCo, pushes at the torso from any azimuth; docs/humanoid3d.md) and list only the options
+that work for them (issue 31); the planar commands of the same names refuse the humanoids in
+one line naming these. The runs are in :mod:`pushrecovery.cli.simulation3d` and
+:mod:`pushrecovery.cli.validate3d`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import click
+
+from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, planar_only
+from pushrecovery.cli.options import body_options, echo_confusion, emit
+from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
+
+__all__ = ["humanoid"]
+
+#: The planar models, refused by the humanoid commands with the planar command's name.
+_PLANAR = (*MODELS, *MUJOCO_MODELS)
+#: The planar commands' options that no humanoid command has, refused in one line.
+_PLANAR_OPTIONS = ("--backend", "--controller", "--kp", "--kd", "--option", "--control-period")
+
+
+def _model(command: str) -> Any:
+    """``--model biped3d|g1``; a planar model is refused naming the planar ``command``."""
+    if command == "validate":  # the planar validate picks its models by --strategy
+        elsewhere = dict.fromkeys(_PLANAR, "validate --strategy ankle|hip|step")
+    else:
+        elsewhere = {model: f"{command} --model {model}" for model in _PLANAR}
+    return click.option(
+        "--model",
+        type=ModelChoice(HUMANOID_MODELS, elsewhere=elsewhere, family="a planar model"),
+        default="biped3d",
+        show_default=True,
+        help="The humanoid: biped3d (built from the body flags) or g1 (the Unitree G1, its own "
+        "body; the robots extra).",
+    )
+
+
+def _example(line: str) -> str:
+    """Return a help page's example: ``pushrecovery humanoid LINE``, kept on one line."""
+    return f"\b\nExample:\n  pushrecovery humanoid {line}"
+
+
+@click.group(
+    short_help="The 3-D humanoids (biped3d, g1) under the whole-body controller.",
+    no_args_is_help=True,
+)
+def humanoid() -> None:
+    """Run the 3-D humanoids (biped3d, g1) under the whole-body controller (docs/humanoid3d.md).
+
+    MuJoCo runs a pushed humanoid standing on both feet: the push is an impulse at the torso
+    from any --azimuth (0 forward, 90 left) and the whole-body controller balances it with the
+    ankles, the hips and, if allowed, a step. The planar models (lipm, pendulum, flywheel,
+    stepping, foot, torso, biped) are the commands of the same names outside this group.
+    """
+
+
+@humanoid.command(
+    short_help="Push a 3-D humanoid; report recovered or fell.",
+    epilog=_example("simulate --model biped3d --azimuth 90 --push 50 --stepping"),
+)
+@_model("simulate")
+@planar_only("simulate", *_PLANAR_OPTIONS, "--x", "--xdot", "--y", "--ydot", "--plot")
+@click.option(
+    "--azimuth",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="The push's direction [deg], 0 forward (+x), 90 left (+y).",
+)
+@click.option(
+    "--impulse",
+    "--push",
+    "impulse",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="The push: an impulse at the torso [N s], over 10 ms.",
+)
+@click.option(
+    "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
+)
+@click.option(
+    "--stepping",
+    is_flag=True,
+    default=False,
+    help="The whole-body controller may step (docs/humanoid3d.md, Stepping).",
+)
+@click.option(
+    "--render",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Write a filmstrip PNG of the run to this file and an animated GIF beside it (CoM, "
+    "capture point, CoP and support polygon drawn, from a tracking camera).",
+)
+@click.option(
+    "--view-azimuth",
+    type=float,
+    default=None,
+    help="--render: where the camera stands [deg], 0 in front of the body, 90 on its left; "
+    "default the push's azimuth - 90 (the push goes left to right).",
+)
+@click.option(
+    "--view-elevation",
+    type=float,
+    default=None,
+    help="--render: the camera's elevation above the horizon [deg], in [-30, 89]; default 25.",
+)
+@click.option(
+    "--frame-times",
+    default=None,
+    metavar="T1,T2,...",
+    help="--render: the filmstrip's frame times [s] after the start, increasing (default 6 "
+    "evenly spaced).",
+)
+@body_options
+def simulate(
+    model: str,
+    azimuth: float,
+    impulse: float,
+    duration: float,
+    stepping: bool,
+    render: str | None,
+    view_azimuth: float | None,
+    view_elevation: float | None,
+    frame_times: str | None,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Push a 3-D humanoid at the torso and run the whole-body controller; recovered or fell.
+
+    The body starts standing still on both feet; the push is --impulse [N s] at the torso
+    along --azimuth, and the run goes on for --duration (it stops early once the body falls or
+    has stood still). The report has the outcome, the strategy used (ankle, hip or step), the
+    ground plane's predicted strategy for the push and the peak torques. The body flags
+    (--preset, --params, --mass, ...) build biped3d; g1 has the robot's own body and refuses
+    them.
+    """
+    from pushrecovery.cli.simulation3d import check_views, params_3d, render_options, simulate_3d
+
+    if not render:
+        check_views(view_azimuth, view_elevation, frame_times)
+    pictures = render_options(azimuth, view_azimuth, view_elevation, frame_times)
+    body = params_3d(model, kwargs)
+    if render:
+        from pushrecovery.sim.mujoco.render import require_offscreen_gl
+
+        require_offscreen_gl()  # fail before the run, not after it
+    emit(simulate_3d(model, body, impulse, azimuth, duration, render, pictures, stepping), as_json)
+
+
+@humanoid.command(
+    "critical-push",
+    short_help="Largest recoverable push at an azimuth.",
+    epilog=_example("critical-push --model g1 --azimuth 90 --duration 1 --tolerance 0.05"),
+)
+@_model("critical-push")
+@planar_only("critical-push", *_PLANAR_OPTIONS, "--x", "--direction")
+@click.option(
+    "--azimuth",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="The push's direction [deg], 0 forward (+x), 90 left (+y).",
+)
+@click.option(
+    "--tolerance",
+    type=float,
+    default=1e-4,
+    show_default=True,
+    help="Width of the final bracket, as a velocity [m/s] (times the mass: an impulse).",
+)
+@click.option(
+    "--duration",
+    type=float,
+    default=10.0,
+    show_default=True,
+    help="Longest simulated time per push [s]; keep it short (about 5x real time).",
+)
+@body_options
+def critical_push(
+    model: str, azimuth: float, tolerance: float, duration: float, as_json: bool, **kwargs: Any
+) -> None:
+    """Largest push at the torso along --azimuth that the whole-body controller recovers.
+
+    The impulse is bisected between a run that stands and one that falls within --duration
+    (keep it short: the whole-body controller runs about 5x real time), to --tolerance times
+    the mass. The report has the critical impulse, its bracket, the number of simulations and
+    the strategy used just below it. The body flags (--preset, --params, --mass, ...) build
+    biped3d; g1 has the robot's own body and refuses them.
+    """
+    from pushrecovery.cli.simulation3d import critical_3d, params_3d
+
+    params = params_3d(model, kwargs)
+    emit(critical_3d(model, params, azimuth, tolerance, duration), as_json)
+
+
+@humanoid.command(
+    short_help="Critical pushes per azimuth and a confusion matrix, vs 2-D.",
+    epilog=_example("validate --model biped3d --quick --out out/validate3d"),
+)
+@_model("validate")
+@planar_only("validate", "--backend", "--x0", "--tolerance", "--grid")
+@click.option(
+    "--strategy",
+    "strategies",
+    type=click.Choice(("ankle", "hip", "step")),
+    multiple=True,
+    help="Strategies whose critical push to measure (repeatable; default ankle, hip and step, "
+    "on g1 ankle and step).",
+)
+@click.option("--azimuth", type=float, default=None, help="One push direction [deg].")
+@click.option(
+    "--azimuths",
+    default=None,
+    metavar="GRID",
+    help="Push directions, START:STOP:STEP or A,B,... [deg] (default 0:360:30).",
+)
+@click.option(
+    "--rel-tolerance",
+    type=float,
+    default=0.01,
+    show_default=True,
+    help="Each critical-push bracket's width, as a fraction of the prediction.",
+)
+@click.option(
+    "--fractions",
+    default=None,
+    metavar="A,B,...",
+    help="The confusion matrix's pushes, as fractions of the ankle's predicted critical push "
+    "along each azimuth (default 0.5,0.9,1.1,1.5,2.0).",
+)
+@click.option(
+    "--duration",
+    type=float,
+    default=None,
+    help="Longest run per push [s] (default 3 per critical-push run, 5 per confusion push).",
+)
+@click.option(
+    "--quick",
+    is_flag=True,
+    help="Azimuths 0 and 90, the ankle, a 3 % bracket, push sizes 0.5 and 1.5.",
+)
+@click.option(
+    "--critical/--no-critical",
+    default=True,
+    show_default=True,
+    help="Measure the critical pushes (else only the confusion matrix).",
+)
+@click.option(
+    "--confusion/--no-confusion",
+    default=True,
+    show_default=True,
+    help="Also run the confusion campaign over azimuths x push sizes.",
+)
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False),
+    default="out/validate3d",
+    show_default=True,
+    help="Directory of the tables, plots and the confusion campaign (which resumes).",
+)
+@click.option("--workers", type=int, default=None, help="The confusion campaign's workers.")
+@body_options
+def validate(
+    model: str,
+    strategies: tuple[str, ...],
+    azimuth: float | None,
+    azimuths: str | None,
+    rel_tolerance: float,
+    fractions: str | None,
+    duration: float | None,
+    quick: bool,
+    critical: bool,
+    confusion: bool,
+    out: str,
+    workers: int | None,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Measure critical pushes per azimuth against the 2-D prediction, and a confusion matrix.
+
+    For each --strategy and azimuth the critical push at the torso is bisected and set beside
+    the ground plane's prediction (and the prediction corrected for the push's height); then a
+    campaign over azimuths x --fractions of the ankle's predicted critical push, under the
+    whole-body controller with all its tasks, gives the confusion matrix of the predicted
+    against the used strategy. Tables, CSV, the polar plot and the campaign are written under
+    --out (the campaign resumes if interrupted). The body flags (--preset, --params, --mass,
+    ...) build biped3d; g1 has the robot's own body and refuses them.
+    """
+    from pathlib import Path
+
+    from pushrecovery.cli.campaign3d import azimuths_from
+    from pushrecovery.cli.simulation3d import params_3d
+    from pushrecovery.cli.validate3d import QUICK, Validate3DOptions, fraction_list, validate_3d
+    from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
+
+    quick_values: dict[str, Any] = QUICK if quick else {}
+    directions = azimuths_from(azimuth, azimuths) or quick_values.get("azimuths", DEFAULT_AZIMUTHS)
+    # The G1's hip task recovers nothing (docs/validation.md): its ankle and step by default.
+    usual = ("ankle", "step") if model == "g1" else ("ankle", "hip", "step")
+    chosen = strategies or quick_values.get("strategies", usual)
+    chosen = chosen if critical else ()
+    options = Validate3DOptions(
+        model=model,
+        azimuths=tuple(directions),
+        strategies=tuple(chosen),
+        rel_tolerance=quick_values.get("rel_tolerance", rel_tolerance),
+        duration=3.0 if duration is None else duration,
+        fractions=fraction_list(fractions, quick_values.get("fractions", DEFAULT_FRACTIONS)),
+        confusion_duration=5.0 if duration is None else duration,
+        confusion=confusion,
+        out=Path(out),
+        workers=workers,
+    )
+    data = validate_3d(options, params_3d(model, kwargs))
+    if as_json:
+        emit(data, True)
+        return
+    _echo_validation(data)
+
+
+def _echo_validation(data: dict[str, Any]) -> None:
+    """Print the critical pushes, the confusion matrices and the files of a 3-D validation."""
+    for row in data.get("critical", []):
+        click.echo(
+            f"{row['strategy']:<7}{row['azimuth']:>6g} deg  predicted {row['predicted']:6.1f}  "
+            f"corrected {row['corrected']:6.1f}  measured {row['measured']:6.1f} N s  "
+            f"({100 * row['relative_error']:+.1f} %, "
+            f"corrected {100 * row['corrected_error']:+.1f} %)"
+        )
+    if "confusion" in data:
+        found = data["confusion"]
+        echo_confusion(
+            f"confusion (rows predicted, columns used), agreement {found['accuracy']:.3f}",
+            found["labels"],
+            found["counts"],
+        )
+        echo_confusion(
+            f"against the verdict corrected for the push's height, agreement "
+            f"{found['accuracy_corrected']:.3f}",
+            found["labels"],
+            found["counts_corrected"],
+        )
+        causes = ", ".join(f"{k} {v}" for k, v in found["causes"].items() if v and k != "agree")
+        click.echo(f"where they differ: {causes or 'nowhere'}")
+    files = {**data.get("files", {}), **data.get("confusion", {}).get("files", {})}
+    for name, path in files.items():
+        click.echo(f"{name:<18}{path}")
