@@ -345,7 +345,7 @@ def batched() -> float:
     import time
 
     from pushrecovery.campaign import CampaignSpec
-    from pushrecovery.campaign.pushes import run_batch, run_push
+    from pushrecovery.campaign.pushes import push_rows, run_batch
 
     params = load_params()
     spec = CampaignSpec(
@@ -357,10 +357,8 @@ def batched() -> float:
     _, rows = run_batch(spec, 0)
     rate = len(rows) / (time.perf_counter() - start)
     sample = spec.pushes(0)[::48]  # the same pushes through the one-push loop
-    cache: dict = {}
     start = time.perf_counter()
-    for push in sample:
-        run_push(spec, push, cache)
+    push_rows(spec, sample, engine="loop")
     loop = len(sample) / (time.perf_counter() - start)
     print(
         f"campaign batch, pendulum + ankle-pd, one core: {rate:.0f} pushes/s ({len(rows)} "
@@ -375,7 +373,7 @@ def batched_stepping() -> float:
     from collections import Counter
 
     from pushrecovery.campaign import CampaignSpec
-    from pushrecovery.campaign.pushes import run_batch, run_push
+    from pushrecovery.campaign.pushes import push_rows, run_batch
 
     params = load_params()
     # The report's full analytic grid: ankle, hip (the MPC's QPs), one to three steps, falls.
@@ -390,10 +388,8 @@ def batched_stepping() -> float:
     _, rows = run_batch(spec, 0)
     rate = len(rows) / (time.perf_counter() - start)
     sample = spec.pushes(0)[::20]  # the same pushes through the one-push loop
-    cache: dict = {}
     start = time.perf_counter()
-    for push in sample:
-        run_push(spec, push, cache)
+    push_rows(spec, sample, engine="loop")
     loop = len(sample) / (time.perf_counter() - start)
     used = Counter(row["used"] for row in rows)
     print(

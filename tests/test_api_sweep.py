@@ -149,6 +149,10 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     "pushrecovery.control.base.make_controller": {"name": "ankle-pd"},
     "pushrecovery.sim.registry.make_plant": {"name": "pendulum"},
     "pushrecovery.sim.registry.make_plant3d": {"name": "biped3d"},
+    "pushrecovery.sim.many.run_many": {
+        "model": "pendulum", "controller": "ankle-pd", "bodies": [P], "x0": [0.0], "xdot": [0.1],
+        "duration": 0.2,
+    },
     "pushrecovery.ground.user_polygon.convex_polygon": {
         "name": "foot_polygon", "vertices": [[-0.05, -0.05], [0.15, -0.05], [0.15, 0.05]]
     },

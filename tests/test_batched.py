@@ -15,7 +15,7 @@ import pytest
 
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.campaign import CampaignSpec
-from pushrecovery.campaign.pushes import run_batch, run_push
+from pushrecovery.campaign.pushes import push_rows, run_batch, run_push
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.sim.batched import ankle_pd_pushes
 
@@ -35,9 +35,7 @@ def test_batched_rows_equal_the_one_push_loop(model: str, duration: float) -> No
     campaign = spec(model, duration)
     _, rows = run_batch(campaign, 0)  # the compiled loop
     assert len(rows) == campaign.size == 2 * 5 * 13
-    cache: dict = {}
-    for row, push in zip(rows, campaign.pushes(0), strict=True):
-        assert row == run_push(campaign, push, cache)
+    assert rows == push_rows(campaign, campaign.pushes(0), engine="loop")
     outcomes = {row["outcome"] for row in rows}
     assert outcomes == ({"recovered", "fell"} if duration > 1.0 else {"undecided", "fell"})
 
@@ -59,10 +57,8 @@ def test_a_start_off_the_model_is_refused_as_in_the_loop() -> None:
     far = Push(0, dataclasses.replace(P), (), 0.0, 1e6)  # a CoM velocity no body has
     with pytest.raises(InvalidParameterError):
         run_push(campaign, far)
-    from pushrecovery.campaign.pushes import _batched_rows
-
     with pytest.raises(InvalidParameterError):
-        _batched_rows(campaign, [far])
+        push_rows(campaign, [far], engine="compiled")
     assert np.isfinite(ankle_pd_pushes("lipm", [P], [0.0], [0.1], duration=1.0).times).all()
 
 

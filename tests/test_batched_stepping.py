@@ -16,11 +16,12 @@ import pytest
 
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.campaign import CampaignSpec
-from pushrecovery.campaign.pushes import run_batch, run_push
+from pushrecovery.campaign.pushes import push_rows, run_batch, run_push
 from pushrecovery.campaign.spec import Push
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.kernels.batched import stepping as kernel
-from pushrecovery.sim.batched import BATCHED, recovery_pushes
+from pushrecovery.sim.batched import recovery_pushes
+from pushrecovery.sim.many import COMPILED
 
 P = load_params()
 
@@ -35,12 +36,12 @@ def spec(duration: float = 10.0) -> CampaignSpec:
 @pytest.mark.parametrize("duration", [10.0, 0.4])
 def test_batched_rows_equal_the_one_push_loop(duration: float) -> None:
     campaign = spec(duration)
-    assert ("stepping", "recovery") in BATCHED
+    assert ("stepping", "recovery") in COMPILED
     _, rows = run_batch(campaign, 0)  # the compiled loop
     assert len(rows) == campaign.size == 2 * 3 * 25
-    cache: dict = {}
-    for row, push in zip(rows, campaign.pushes(0), strict=True):
-        assert row == run_push(campaign, push, cache), push
+    loop = push_rows(campaign, campaign.pushes(0), engine="loop")
+    for row, push, expected in zip(rows, campaign.pushes(0), loop, strict=True):
+        assert row == expected, push
     if duration > 1.0:
         # Every branch of the loop was taken: the ankles, the hip, one and several steps, falls.
         used = Counter(row["used"] for row in rows)
@@ -62,9 +63,7 @@ def test_a_batch_shares_its_controllers_as_the_loop_does() -> None:
         duration=campaign.duration, controllers=controllers,
     )  # fmt: skip
     assert set(controllers) == {p.params for p in pushes}
-    cache: dict = {}
-    for k, push in enumerate(pushes):
-        row = run_push(campaign, push, cache)
+    for k, row in enumerate(push_rows(campaign, pushes, engine="loop")):
         assert (runs.outcomes[k].value, float(runs.times[k])) == (row["outcome"], row["time"])
         assert float(runs.peak_hip_torque[k]) == row["peak_hip_torque"]
         assert int(runs.steps[k]) == row["steps"]
@@ -95,11 +94,9 @@ def test_bad_batches() -> None:
 
 
 def test_a_start_off_the_model_is_refused_as_in_the_loop() -> None:
-    from pushrecovery.campaign.pushes import _batched_rows
-
     campaign = spec()
     far = Push(0, dataclasses.replace(P), (), 0.0, 1e6)  # a CoM velocity no body has
     with pytest.raises(InvalidParameterError):
         run_push(campaign, far)
     with pytest.raises(InvalidParameterError):
-        _batched_rows(campaign, [far])
+        push_rows(campaign, [far], engine="compiled")

@@ -46,10 +46,10 @@ def test_grid_order_and_size():
 
 def test_default_batches_are_about_a_second_of_work():
     from pushrecovery.campaign.spec import COMPILED_BATCH
-    from pushrecovery.sim.batched import BATCHED
+    from pushrecovery.sim.many import COMPILED
 
     # Every pair the batch runner compiles has its larger default, and no other pair.
-    assert set(COMPILED_BATCH) == set(BATCHED)
+    assert set(COMPILED_BATCH) == set(COMPILED)
 
     def default(model, controller, samples, backend="analytic"):
         spec = CampaignSpec(backend, model, controller, P, x0=(0.0, 0.0, 1.0),

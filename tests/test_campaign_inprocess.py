@@ -15,9 +15,10 @@ import pytest
 from pushrecovery import load_params
 from pushrecovery.campaign import CampaignSpec, execute
 from pushrecovery.campaign import pushes as pushes_module
-from pushrecovery.campaign.pushes import LOOP_UP_TO, run_batch
+from pushrecovery.campaign.pushes import run_batch
 from pushrecovery.campaign.spec import COMPILED_BATCH
 from pushrecovery.cli import main
+from pushrecovery.sim.many import LOOP_UP_TO
 
 P = load_params()
 ARGS = ["campaign", "--model", "pendulum", "--controller", "ankle-pd", "--x0", "0", "0.05",
@@ -55,9 +56,9 @@ def test_bad_worker_counts_are_one_line_and_exit_2(
 
 
 def test_the_compiled_pairs_are_sim_batched_s() -> None:
-    from pushrecovery.sim.batched import BATCHED
+    from pushrecovery.sim.many import COMPILED
 
-    assert set(COMPILED_BATCH) == set(BATCHED)
+    assert set(COMPILED_BATCH) == set(COMPILED)
 
 
 @pytest.mark.parametrize("model", ["pendulum", "lipm"])
@@ -69,12 +70,13 @@ def test_a_tiny_ankle_pd_campaign_loops_and_gives_the_compiled_rows(
         sweeps={"toe": (0.12, 0.18, 0.06)}, duration=3.0,
     )  # fmt: skip
     assert spec.size <= LOOP_UP_TO
-    compiled = pushes_module._batched_rows(spec, spec.pushes(0))
+    compiled = pushes_module.push_rows(spec, spec.pushes(0), engine="compiled")
+    import pushrecovery.sim.many as many
 
     def refuse(*args: Any) -> Any:
         raise AssertionError("the compiled loop ran")
 
-    monkeypatch.setattr(pushes_module, "_batched_rows", refuse)
+    monkeypatch.setattr(many, "_compiled", refuse)
     _, rows = run_batch(spec, 0)
     assert {"recovered", "fell"} <= {row["outcome"] for row in rows}
     assert repr(rows) == repr(compiled)  # every column, NaN and None included, to the bit

@@ -37,10 +37,10 @@ def crash_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any
     return run_batch(spec, batch)
 
 
-def crash_push(spec: CampaignSpec, push: Any, cache: Any = None) -> dict[str, Any]:
+def crash_push(spec: CampaignSpec, push: Any) -> dict[str, Any]:
     if push.index == CRASH:
         os.kill(os.getpid(), signal.SIGSEGV)
-    return run_push(spec, push, cache)
+    return run_push(spec, push)
 
 
 def hang_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]]:
@@ -54,12 +54,12 @@ def hang_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]
     return batch, rows
 
 
-def hang_push(spec: CampaignSpec, push: Any, cache: Any = None) -> dict[str, Any]:
+def hang_push(spec: CampaignSpec, push: Any) -> dict[str, Any]:
     import time
 
     while push.index == HANG:
         time.sleep(1.0)  # outside the simulation: only the worker's watchdog ends it
-    return run_push(spec, push, cache)
+    return run_push(spec, push)
 
 
 def test_a_push_that_kills_its_worker_is_one_error_row() -> None:
@@ -82,14 +82,16 @@ def test_diverged_physics_is_an_error_row_and_the_batch_goes_on(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     _, reference = run_batch(SPEC, 0)
-    real = pushes_module.simulate
+    import pushrecovery.sim.simulate as loop_module
+
+    real = loop_module.simulate
 
     def diverging(plant: Any, controller: Any, state: Any, **kwargs: Any) -> Any:
         if abs(state[1] + 0.4) < 1e-9:  # the first push of the batch, ẋ = -0.4 m/s
             raise SimulationDiverged("MuJoCo: BADQACC at t = 0.1 s")
         return real(plant, controller, state, **kwargs)
 
-    monkeypatch.setattr(pushes_module, "simulate", diverging)
+    monkeypatch.setattr(loop_module, "simulate", diverging)  # the loop engine imports it per call
     _, rows = run_batch(SPEC, 0)
     assert rows[0]["outcome"] == "error" and rows[0]["xdot"] == pytest.approx(-0.4)
     assert rows[0]["error"].startswith("the physics diverged: MuJoCo: BADQACC")

@@ -111,7 +111,8 @@ def test_a_campaign_batch_of_foot_and_ankle_pd_runs_in_lockstep():
     # run_batch takes the lockstep rollout for MuJoCo's foot + ankle-pd; its rows are the
     # one-push loop's: the same verdicts, times within one tick, CoP excursions within 1 µm.
     from pushrecovery.campaign import CampaignSpec
-    from pushrecovery.campaign.pushes import ROLLOUT, run_batch, run_push
+    from pushrecovery.campaign.pushes import push_rows, run_batch
+    from pushrecovery.sim.many import ROLLOUT
 
     assert ("foot", "ankle-pd") in ROLLOUT
     campaign = CampaignSpec(
@@ -119,10 +120,9 @@ def test_a_campaign_batch_of_foot_and_ankle_pd_runs_in_lockstep():
         sweeps={"toe": (0.12, 0.16, 0.04)}, duration=4.0, batch_size=100,
     )  # fmt: skip
     _, rows = run_batch(campaign, 0)
-    cache: dict = {}
     outcomes = set()
-    for row, push in zip(rows, campaign.pushes(0), strict=True):
-        loop = run_push(campaign, push, cache)
+    loops = push_rows(campaign, campaign.pushes(0), engine="loop")
+    for row, push, loop in zip(rows, campaign.pushes(0), loops, strict=True):
         outcomes.add(loop["outcome"])
         close = ("time", "cop_min", "cop_max", "peak_ankle_torque")
         exact = {k: v for k, v in loop.items() if k not in close}

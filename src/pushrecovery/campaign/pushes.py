@@ -14,92 +14,65 @@ The 3-D models (``biped3d``, ``g1``) add columns, null on the others, and read s
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.pushes3d import error_row3d, run_push3d
 from pushrecovery.campaign.rows import COLUMNS, COLUMNS_3D, ERROR_OUTCOME
-from pushrecovery.campaign.spec import COMPILED_BATCH, CampaignSpec, Push
-from pushrecovery.control.base import make_controller
-from pushrecovery.errors import SimulationDiverged, SimulationTimeout
+from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.critical import pushed_state
-from pushrecovery.sim.registry import make_plant
+from pushrecovery.sim.many import COMPILED, LOOP_UP_TO, PushRuns, run_many
 from pushrecovery.sim.result import Outcome, strategy_used
-from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import (
     STRATEGY_CODES,
     Strategy,
     sagittal_verdicts,
 )
 
-if TYPE_CHECKING:
-    from pushrecovery.sim.batched import BatchedRuns
-
 __all__ = [
     "COLUMNS",
     "ERROR_OUTCOME",
-    "LOOP_UP_TO",
-    "ROLLOUT",
     "error_row",
+    "push_rows",
     "run_batch",
     "run_push",
 ]
 
-#: (model, controller) pairs of the MuJoCo backend simulated in lockstep with mujoco.rollout.
-ROLLOUT = frozenset({("foot", "ankle-pd")})
-#: A campaign of at most this many pushes of ``ankle-pd`` on ``pendulum`` or ``lipm`` runs
-#: them through the one-push loop, not the compiled batch: loading the compiled loop (numba's
-#: typing machinery, ``sim.batched`` and the MPC modules it imports) takes about a second, as
-#: long as ~100 pushes through the loop (~10 ms each). The rows are the same to the bit either
-#: way (tests/test_batched.py).
-LOOP_UP_TO = 32
+
+def run_push(spec: CampaignSpec, push: Push) -> dict[str, Any]:
+    """Simulate one push through the one-push loop; return its row (module docstring)."""
+    return push_rows(spec, [push], engine="loop")[0]
 
 
-def run_push(
-    spec: CampaignSpec, push: Push, cache: dict[BodyParams, Any] | None = None
-) -> dict[str, Any]:
-    """Simulate one push; return its row (module docstring).
+def push_rows(
+    spec: CampaignSpec,
+    pushes: list[Push],
+    *,
+    engine: str = "auto",
+    on_start: Callable[[int], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Simulate ``pushes`` of ``spec`` with one engine; return their rows, in order.
 
-    ``cache`` keeps one plant and controller per body across the pushes of a batch (MuJoCo
-    compiles a model per plant).
+    ``engine`` is :func:`~pushrecovery.sim.many.run_many`'s (the 3-D models run the loop);
+    the pushes share one plant and controller per body, as a batch does. ``on_start`` is
+    called with the number of pushes about to run as one unit (a worker arms its watchdog).
     """
-    cache = {} if cache is None else cache
     if spec.is_3d:
-        return run_push3d(spec, push, cache)
-    if push.params not in cache:
-        cache[push.params] = (
-            make_plant(spec.model, push.params, spec.backend),
-            make_controller(spec.controller, push.params),
-        )
-    plant, controller = cache[push.params]
-    state = pushed_state(plant, push.x0, push.xdot, force=spec.backend == "mujoco")
-    try:
-        run = simulate(
-            plant, controller, state, duration=spec.duration, wall_limit=spec.push_timeout
-        )
-    except SimulationDiverged as exc:  # this push only: the others of the batch go on
-        del cache[push.params]  # the engine's state is not to be trusted any more
-        return error_row(spec, push, f"the physics diverged: {exc}")
-    except SimulationTimeout as exc:
-        del cache[push.params]  # stopped mid-run: start the next push from a fresh engine
-        return error_row(spec, push, f"too slow: {exc}")
-    cops = run.cops
-    return _row(
-        spec,
-        push,
-        _Simulated(
-            outcome=run.outcome,
-            used=run.strategy_used() if run.recovered else Strategy.FALL,
-            steps=len(run.footholds) - 1,
-            peak_hip_torque=run.peak_hip_torque,
-            cop_min=float(cops.min()) if cops.size else math.nan,
-            cop_max=float(cops.max()) if cops.size else math.nan,
-            time=float(run.time[-1]),
-            stop_impacts=run.stop_impacts,
-        ),
-    )
+        cache: dict[BodyParams, Any] = {}  # one compiled plant per body
+        rows = []
+        for push in pushes:
+            if on_start is not None:
+                on_start(1)
+            rows.append(run_push3d(spec, push, cache))
+        return rows
+    runs = run_many(
+        spec.model, spec.controller, [p.params for p in pushes], [p.x0 for p in pushes],
+        [p.xdot for p in pushes], duration=spec.duration, backend=spec.backend, engine=engine,
+        push_timeout=spec.push_timeout, on_start=on_start,
+    )  # fmt: skip
+    return _rows_of_runs(spec, pushes, runs)
 
 
 @dataclass(frozen=True, slots=True)
@@ -199,71 +172,18 @@ def _inputs_and_prediction(spec: CampaignSpec, push: Push, found: _Prediction) -
 _NULL_3D: dict[str, Any] = dict.fromkeys(COLUMNS_3D)
 
 
-def _batched_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]]:
-    """Rows of pushes simulated together in a compiled loop (:mod:`pushrecovery.sim.batched`)."""
-    from pushrecovery.sim.batched import ankle_pd_pushes, recovery_pushes
-
-    bodies = [p.params for p in pushes]
-    starts, speeds = [p.x0 for p in pushes], [p.xdot for p in pushes]
-    if spec.controller == "recovery":
-        runs = recovery_pushes(bodies, starts, speeds, duration=spec.duration)
-    else:
-        runs = ankle_pd_pushes(spec.model, bodies, starts, speeds, duration=spec.duration)
-    return _rows_of_runs(spec, pushes, runs)
-
-
-def _rollout_rows(spec: CampaignSpec, pushes: list[Push]) -> list[dict[str, Any]]:
-    """Rows of MuJoCo pushes simulated in lockstep (:mod:`pushrecovery.sim.mujoco.rollout`).
-
-    One call per body, the pushes of each in batch order; the rows in push order.
-    """
-    import numpy as np
-
-    from pushrecovery.sim.batched import BatchedRuns
-    from pushrecovery.sim.mujoco.rollout import ankle_pd_rollout
-
-    bodies: dict[BodyParams, list[int]] = {}
-    for k, push in enumerate(pushes):
-        bodies.setdefault(push.params, []).append(k)
-    count = len(pushes)
-    outcomes: list[Outcome] = [Outcome.UNDECIDED] * count
-    times, cop_min, cop_max = np.empty(count), np.empty(count), np.empty(count)
-    diverged = np.zeros(count, dtype=np.bool_)
-    for params, members in bodies.items():
-        runs = ankle_pd_rollout(
-            params,
-            [pushes[k].x0 for k in members],
-            [pushes[k].xdot for k in members],
-            duration=spec.duration,
-        )
-        for j, k in enumerate(members):
-            outcomes[k] = runs.outcomes[j]
-        times[members], cop_min[members] = runs.times, runs.cop_min
-        cop_max[members], diverged[members] = runs.cop_max, runs.diverged
-    zeros = np.zeros(count, dtype=np.int64)
-    batched = BatchedRuns(
-        tuple(outcomes), times, cop_min, cop_max, zeros, np.zeros(count), zeros, diverged
-    )
-    return _rows_of_runs(spec, pushes, batched)
-
-
-def _rows_of_runs(
-    spec: CampaignSpec, pushes: list[Push], runs: BatchedRuns
-) -> list[dict[str, Any]]:
-    """Rows of pushes simulated together: each run's outcome with the push's verdict."""
+def _rows_of_runs(spec: CampaignSpec, pushes: list[Push], runs: PushRuns) -> list[dict[str, Any]]:
+    """Rows of simulated pushes: each run's outcome with the push's verdict."""
     rows = []
     predictions = _predictions(pushes)
     # Python floats and ints, as float(a[k]) and int(a[k]) give them (tolist: at C speed).
-    diverged, steps, peaks = (
-        runs.diverged.tolist(),
-        runs.steps.tolist(),
-        runs.peak_hip_torque.tolist(),
-    )
+    steps, peaks = runs.steps.tolist(), runs.peak_hip_torque.tolist()
     lows, highs, times = runs.cop_min.tolist(), runs.cop_max.tolist(), runs.times.tolist()
     impacts = runs.stop_impacts.tolist()
     for k, push in enumerate(pushes):
-        if diverged[k]:
-            rows.append(error_row(spec, push, "the physics diverged: a state is not finite"))
+        error = runs.errors[k]
+        if error is not None:
+            rows.append(error_row(spec, push, error))
             continue
         outcome = runs.outcomes[k]
         used = strategy_used(steps[k], peaks[k]) if outcome is Outcome.RECOVERED else Strategy.FALL
@@ -296,21 +216,15 @@ def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]
     with one_thread():
         try:
             pushes = spec.pushes(batch)
-            # COMPILED_BATCH names sim.batched.BATCHED's pairs (a test checks), so that the
-            # other campaigns do not import that module (the MPC and its kernels with it).
-            pair = (spec.model, spec.controller)
+            # A small ankle-pd campaign takes the loop (sim.many.LOOP_UP_TO), and every batch
+            # of a larger one of a compiled pair the compiled engine, whatever its size.
             small = spec.size <= LOOP_UP_TO and spec.controller == "ankle-pd"
-            if spec.backend == "analytic" and pair in COMPILED_BATCH and not small:
-                return batch, _batched_rows(spec, pushes)
-            if spec.backend == "mujoco" and (spec.model, spec.controller) in ROLLOUT:
-                # The whole batch at once: the pushes' time limits add up.
-                watchdog.arm(spec.push_timeout * len(pushes))
-                return batch, _rollout_rows(spec, pushes)
-            cache: dict[BodyParams, Any] = {}
-            rows = []
-            for push in pushes:
-                watchdog.arm(spec.push_timeout)
-                rows.append(run_push(spec, push, cache))
+            compiled = spec.backend == "analytic" and (spec.model, spec.controller) in COMPILED
+            engine = "loop" if small or spec.is_3d else "compiled" if compiled else "auto"
+            rows = push_rows(
+                spec, pushes, engine=engine,
+                on_start=lambda count: watchdog.arm(spec.push_timeout * count),
+            )  # fmt: skip
             return batch, rows
         finally:
             watchdog.disarm()

@@ -66,7 +66,7 @@ MAX_PUSH_TIMEOUT = 3600.0
 #: one-push loop (0.5-2 s on the reference machine, docs/campaigns.md).
 DEFAULT_BATCH = {"analytic": 100, "mujoco": 10}
 #: Largest default batch of the analytic pairs whose batch runs as one compiled loop
-#: (``sim.batched.BATCHED``): about a second of work too (~140 µs per pendulum push, ~30 µs
+#: (``sim.many.COMPILED``): about a second of work too (~140 µs per pendulum push, ~30 µs
 #: per LIPM push, ~1 ms per stepping + recovery push). A Dask task costs a few ms of
 #: scheduling and one Parquet file: at 100 such pushes per batch (12 ms of work) that would be
 #: most of a campaign's time.

@@ -33,10 +33,8 @@ from pushrecovery.sim.simulate import DEFAULT_CONTROL_PERIOD, MAX_DURATION, Rest
 if TYPE_CHECKING:  # the recovery controller loads the MPC and scipy: only its batches need it
     from pushrecovery.control.recovery import RecoveryController
 
-__all__ = ["BATCHED", "BatchedRuns", "ankle_pd_pushes", "recovery_pushes"]
+__all__ = ["BatchedRuns", "ankle_pd_pushes", "recovery_pushes"]
 
-#: (model, controller) pairs with a compiled loop.
-BATCHED = frozenset({("pendulum", "ankle-pd"), ("lipm", "ankle-pd"), ("stepping", "recovery")})
 _OUTCOMES = (Outcome.UNDECIDED, Outcome.RECOVERED, Outcome.FELL)
 
 
