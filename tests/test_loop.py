@@ -7,10 +7,10 @@ import pytest
 
 from pushrecovery import load_params
 from pushrecovery.control.base import Command, StepInfo, make_controller
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.sim.backend import Backend, Step
 from pushrecovery.sim.events import ScheduledPush
-from pushrecovery.sim.push import Push
+from pushrecovery.sim.push import Push, Push3D
 from pushrecovery.sim.registry import MODELS, make_plant
 from pushrecovery.sim.result import HIP_TORQUE_THRESHOLD, Outcome, SimulationResult
 from pushrecovery.sim.simulate import simulate
@@ -87,6 +87,7 @@ def test_keep_running_after_a_fall_and_the_decision_time():
     ("kwargs", "match"),
     [
         ({"push": ScheduledPush(5.0, Push(0.1))}, "push time must be before the end"),
+        ({"push": ScheduledPush(0.1, Push3D(5.0, 90.0))}, "Push3D\\) needs a 3-D model"),
         ({"plant_step": 0.01}, "plant_step must be <= the control period"),
         ({"plant_step": -1.0}, "plant_step must be"),
         ({"keep_running": (-1.0, 0.0)}, "keep_running must be"),
@@ -101,6 +102,41 @@ def test_bad_loop_arguments_are_refused(kwargs, match):
         ScheduledPush(-1.0, Push(0.1))
     with pytest.raises(InvalidParameterError, match="kind"):
         ScheduledPush(0.0, Push(0.1), kind="shove")
+    with pytest.raises(ParameterTypeError, match="push must be a Push or Push3D, got float"):
+        ScheduledPush(0.0, 0.3)  # type: ignore[arg-type]
+
+
+def test_the_3d_humanoids_run_in_the_one_loop():
+    # The plant's own clock and rows (Clocked): MuJoCo's time, a row before and one after the
+    # push's 10 ms of physics steps; the WBC keeps running through the push (react).
+    from pushrecovery.sim.backend import Clocked
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
+        CONTROL_PERIOD,
+        PUSH_DURATION,
+        Biped3DPlant,
+        wbc_for,
+    )
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
+
+    plant = Biped3DPlant(P)
+    assert isinstance(plant, Clocked)
+    push = ScheduledPush(4 * CONTROL_PERIOD, Push3D(10.0, 45.0), react=True)
+    run = simulate(plant, wbc_for(plant), plant.reset(), duration=10 * CONTROL_PERIOD,
+                   control_period=CONTROL_PERIOD, push=push)  # fmt: skip
+    assert run.outcome is Outcome.UNDECIDED and run.decided_time is None
+    assert len(run.time) == 10 + 2 and run.inputs.shape == (11, len(plant.input_labels))
+    assert run.time[-1] == plant.clock and np.array_equal(run.states[-1], plant.state)
+    assert plant.push_row == 5
+    assert run.time[5] - run.time[4] == pytest.approx(PUSH_DURATION)
+    assert np.diff(run.time)[[0, 1, 2, 3, 5, 6]] == pytest.approx(CONTROL_PERIOD)
+    assert np.array_equal(run.inputs[4], run.inputs[3])  # the motors hold during the push
+    assert np.hypot(*run.states[5, 3:5]) > np.hypot(*run.states[4, 3:5]) + 0.1
+    fell = simulate(plant, wbc_for(plant), plant.reset(), duration=1.0,
+                    control_period=CONTROL_PERIOD,
+                    push=ScheduledPush(0.0, Push3D(60.0, 90.0), react=True))  # fmt: skip
+    assert fell.outcome is Outcome.FELL and fell.decided_time == fell.time[-1] == plant.clock
+    with pytest.raises(InvalidParameterError, match="duration must be"):
+        simulate_push3d(plant, wbc_for(plant), Push3D(1.0, 0.0), duration=59.95)
 
 
 @pytest.mark.parametrize("model", MODELS)

@@ -24,8 +24,9 @@ simulate` is written against it alone):
 6. ``falling(state)`` tells whether the state is in the plant's absorbing fall set
    (docs/conventions.md); ``at_rest(state, speed)`` whether the CoM moves at most ``speed``
    [m/s] over the support.
-7. Optional capabilities are their own protocols: :class:`Recording` (frames for rendering)
-   and :class:`Measuring` (the CoP measured from contact forces). Check them with
+7. Optional capabilities are their own protocols: :class:`Recording` (frames for rendering),
+   :class:`Measuring` (the CoP measured from contact forces) and :class:`Clocked` (the plant's
+   own clock and rows: MuJoCo's time, a push lasting steps of its own). Check them with
    ``isinstance``; nothing else is looked up by name.
 """
 
@@ -45,10 +46,12 @@ from pushrecovery.sim.push import Push
 
 __all__ = [
     "Backend",
+    "Clocked",
     "Measuring",
     "PlantBase",
     "RecordedFrame",
     "Recording",
+    "RunRows",
     "Step",
     "check_com_state",
     "over_foot_at_rest",
@@ -80,8 +83,12 @@ class Backend(Protocol):
 
     name: ClassVar[str]
     state_labels: ClassVar[tuple[str, ...]]
-    input_labels: ClassVar[tuple[str, ...]]
     params: BodyParams
+
+    @property
+    def input_labels(self) -> tuple[str, ...]:
+        """The applied inputs of a step (item 1): a class's, or a model's own (MuJoCo's motors)."""
+        ...
 
     def reset(self, x: float, xdot: float) -> FloatArray:
         """Start a run standing with the CoM at x [m] moving at ẋ [m/s] (item 2)."""
@@ -137,6 +144,43 @@ class Measuring(Protocol):
 
     def measure(self) -> None:
         """Record the measured CoP at every step from now on (``measured_cops``)."""
+        ...
+
+
+class RunRows(NamedTuple):
+    """A run's rows as a :class:`Clocked` plant kept them.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n,)
+        The plant's clock at each row [s].
+    states : ndarray, shape (n, d)
+        The state at each row (``state_labels``).
+    inputs : ndarray, shape (n - 1, m)
+        The inputs held from each row to the next (``input_labels``).
+    """
+
+    time: FloatArray
+    states: FloatArray
+    inputs: FloatArray
+
+
+@runtime_checkable
+class Clocked(Protocol):
+    """A plant with its own clock and rows (MuJoCo's time; a push lasting steps of its own).
+
+    Its rows start at ``begin``; each ``step`` and each ``apply_push`` adds one (a push that
+    lasts its own physics steps has a row before it and one after it). The loop reads them
+    once, at the end of a run, in place of its own.
+    """
+
+    @property
+    def clock(self) -> float:
+        """The plant's time now [s]."""
+        ...
+
+    def run_rows(self) -> RunRows:
+        """Return the rows of the run since ``begin``."""
         ...
 
 

@@ -14,11 +14,11 @@ from typing import Literal, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float
+from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.control.base import Command
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.backend import Step
-from pushrecovery.sim.push import Push
+from pushrecovery.sim.push import Push, Push3D
 
 __all__ = ["ForcePushing", "Observer", "ScheduledPush", "VelocityJumping"]
 
@@ -31,8 +31,10 @@ class ScheduledPush:
     ----------
     time : float
         When the push starts [s], >= 0.
-    push : Push
-        The velocity jump it stands for (Δẋ [m/s]; the impulse is m Δẋ).
+    push : Push or Push3D
+        The velocity jump it stands for (Δẋ [m/s]; the impulse is m Δẋ), or a 3-D push
+        (impulse [N s], azimuth, body) that the plant's ``apply_push`` applies (the 3-D
+        humanoids, whose push lasts physics steps of their own).
     kind : {"force", "velocity"}
         ``force``: a force on the pushed body over the plant's push duration (plants with
         :class:`ForcePushing`; others take the jump); ``velocity``: an instantaneous jump.
@@ -43,11 +45,12 @@ class ScheduledPush:
     """
 
     time: float
-    push: Push
+    push: Push | Push3D
     kind: Literal["force", "velocity"] = "force"
     react: bool = False
 
     def __post_init__(self) -> None:
+        require_type("push", self.push, (Push, Push3D))
         time = finite_float("push time", self.time, "s")
         if time < 0.0:
             raise InvalidParameterError(f"push time must be >= 0 s, got {time:g}")

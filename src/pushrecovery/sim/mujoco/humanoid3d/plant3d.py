@@ -33,8 +33,15 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   point beyond the feet is what a step answers: the body down only.
 * **at_rest(state, speed)**: |ċ_xy| <= speed and the CoM's ground point strictly inside P
   (the step's ``StepInfo.support`` when the controller steps, and no foot swinging).
+* **Clocked** (:class:`~pushrecovery.sim.backend.Clocked`): ``clock`` is MuJoCo's time and
+  ``run_rows()`` the rows since ``reset``/``begin``: one per step and one after a push (whose
+  10 ms are physics steps of the plant's own), so the loop's result keeps MuJoCo's time and
+  the state on either side of the push. With ``recording`` set, each row also keeps
+  ``qpos``, ``qvel`` and ``ctrl`` (``frames``), and :attr:`~Humanoid3DPlant.max_torso_tilt`
+  is the largest torso tilt since the last push.
 
-:func:`~.runs3d.simulate_push3d` (:mod:`.runs3d`) is the loop of these plants.
+:func:`~pushrecovery.sim.simulate.simulate` is the loop of these plants
+(:func:`~.runs3d.simulate_push3d`: stand, push, run the whole-body controller).
 """
 
 from __future__ import annotations
@@ -57,7 +64,7 @@ from pushrecovery.control.wbc.observation import (
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.params import BodyParams
-from pushrecovery.sim.backend import Step
+from pushrecovery.sim.backend import RunRows, Step
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
 from pushrecovery.sim.push import Push, Push3D
@@ -140,6 +147,17 @@ class Humanoid3DPlant:
         self.floor = 0.0
         self.standing_height = 1.0
         self.omega = 1.0
+        #: Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (``frames``) from the next reset.
+        self.recording = False
+        self.frames: list[FloatArray] = []
+        #: The row just after the last push (None: no push since reset/begin).
+        self.push_row: int | None = None
+        #: The largest tilt of the upright body since the last push [rad] (0 before one).
+        self.max_torso_tilt = 0.0
+        self._upright_id = body_id(model, upright)
+        self._times: list[float] = []
+        self._states: list[FloatArray] = []
+        self._inputs: list[tuple[float, ...]] = []
         self.reset()
 
     # -- contract items 2-3 ----------------------------------------------------------------
@@ -173,6 +191,7 @@ class Humanoid3DPlant:
         self.ctrl = np.zeros(int(model.nu))
         self.info = StepInfo()
         self.state = self._read()
+        self._restart_rows()
         return self.state.copy()
 
     def check_state(self, state: FloatArray) -> None:
@@ -197,7 +216,34 @@ class Humanoid3DPlant:
             raise InvalidParameterError(
                 "state must be the 3-D plant's current state (from reset or apply_push)"
             )
+        self._restart_rows()
         return self.state.copy()
+
+    # -- Clocked (contract item 7) -----------------------------------------------------------
+
+    @property
+    def clock(self) -> float:
+        """MuJoCo's time since reset [s]."""
+        return float(self.data.time)
+
+    def run_rows(self) -> RunRows:
+        """Return the rows since reset/begin: one per step, one after each push."""
+        inputs = np.array(self._inputs, dtype=float).reshape(len(self._inputs), len(self.ctrl))
+        return RunRows(np.array(self._times), np.array(self._states), inputs)
+
+    def _restart_rows(self) -> None:
+        """Start the rows at the current state (no push yet)."""
+        self._times, self._states, self._inputs = [], [], []
+        self.frames, self.push_row, self.max_torso_tilt = [], None, 0.0
+        self._add_row()
+
+    def _add_row(self) -> None:
+        """Keep the clock, the state and (recording) MuJoCo's ``qpos``, ``qvel`` and ``ctrl``."""
+        self._times.append(float(self.data.time))
+        self._states.append(self.state)
+        if self.recording:
+            data = self.data
+            self.frames.append(np.concatenate([data.qpos, data.qvel, self.ctrl]))
 
     # -- contract items 4-6 ----------------------------------------------------------------
 
@@ -233,6 +279,9 @@ class Humanoid3DPlant:
             data.xfrc_applied[body, :3] = 0.0
         mujoco.mj_step1(model, data)
         self.state = self._read()
+        self._inputs.append(tuple(float(v) for v in self.ctrl))  # held during the push
+        self._add_row()
+        self.push_row, self.max_torso_tilt = len(self._times) - 1, self.torso_tilt()
         return self.state.copy()
 
     def step(self, command: Command, dt: float) -> Step:
@@ -273,7 +322,12 @@ class Humanoid3DPlant:
         mujoco.mj_step1(model, data)
         self.state = self._read()
         self.info = info
-        return Step(self.state, tuple(float(v) for v in self.ctrl), info)
+        applied = tuple(float(v) for v in self.ctrl)
+        self._inputs.append(applied)
+        self._add_row()
+        if self.push_row is not None:
+            self.max_torso_tilt = max(self.max_torso_tilt, self.torso_tilt())
+        return Step(self.state, applied, info)
 
     def fall_margin(self) -> float:
         """Return 2 max(τmax, τmax_roll)/(m g) [m]: both hips' largest CMP offset."""
@@ -334,7 +388,7 @@ class Humanoid3DPlant:
 
     def torso_tilt(self) -> float:
         """Return the angle between the upright body's z axis and the vertical [rad]."""
-        upright = self.data.xmat[body_id(self.model, self.upright)]
+        upright = self.data.xmat[self._upright_id]
         return math.acos(max(-1.0, min(1.0, float(upright[8]))))
 
 

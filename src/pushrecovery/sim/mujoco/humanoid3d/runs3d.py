@@ -17,7 +17,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, require_type
+from pushrecovery.control.base import Command
 from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.sim.backend import Step
+from pushrecovery.sim.events import ScheduledPush
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
     Humanoid3DPlant,
@@ -25,6 +28,7 @@ from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
 )
 from pushrecovery.sim.push import Push3D
 from pushrecovery.sim.result import Outcome, strategy_used
+from pushrecovery.sim.simulate import MAX_DURATION, RestCriterion, simulate
 
 FloatArray = NDArray[np.float64]
 
@@ -117,6 +121,11 @@ def simulate_push3d(
 ) -> Push3DRun:
     """Stand, push, and run the whole-body controller until a decision (module docstring).
 
+    The run is :func:`~pushrecovery.sim.simulate.simulate` (the one loop) with the push
+    scheduled at ``push_time`` and the controller reacting through it; its rows are the
+    plant's (MuJoCo's clock): the standing start, the state after the push and every tick after
+    it.
+
     Parameters
     ----------
     plant : Humanoid3DPlant
@@ -126,84 +135,89 @@ def simulate_push3d(
     push : Push3D
         The push, at ``push_time``.
     duration : float
-        Longest simulated time after the push, in (0, 60] s.
+        Longest simulated time after the push [s], in (0, 60 − ``push_time``].
     push_time : float
         Quiet standing before the push, in [0, 10] s.
     rest_speed, rest_duration : float
-        Recovered after |ċ_xy| <= rest_speed [m/s] over P for rest_duration [s] (both > 0).
+        Recovered after |ċ_xy| <= rest_speed [m/s] over P for rest_duration [s] (rest_speed
+        > 0; at least one tick at rest).
     record : bool
         Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (:class:`Push3DRun`), for rendering.
     """
     require_type("plant", plant, Humanoid3DPlant)
     require_type("controller", controller, WholeBodyController)
     require_type("push", push, Push3D)
-    duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
     push_time = bounded_float("push_time", push_time, 0.0, 10.0, "s")
+    duration = bounded_float("duration", duration, 1e-3, MAX_DURATION - push_time, "s")
     rest_speed = bounded_float("rest_speed", rest_speed, 1e-6, 10.0, "m/s")
     rest_duration = bounded_float("rest_duration", rest_duration, 0.0, 60.0, "s")
-    state = plant.reset()
-    controller.reset(state)
-    times, states = [float(plant.data.time)], [state]
-    failed = 0
-    frames: list[FloatArray] = []
-
-    def keep() -> None:
-        if record:
-            data = plant.data
-            frames.append(np.concatenate([data.qpos, data.qvel, plant.ctrl]))
-
-    keep()
-
-    def tick() -> FloatArray:
-        nonlocal failed
-        command = controller.compute(float(plant.data.time), plant.state)
-        failed += 0 if controller.last is None or controller.last.ok else 1
-        return plant.step(command, CONTROL_PERIOD).state
-
-    for _ in range(round(push_time / CONTROL_PERIOD)):
-        state = tick()
-    before, held = state.copy(), plant.ctrl.copy()
-    after = plant.apply_push(push)
-    times.append(float(plant.data.time))
-    states.append(after)
-    keep()
-    weight = plant.params.mass * plant.params.gravity
-    hip_peak, motor_peak = 0.0, 0.0
-    tilt_peak, peak = plant.torso_tilt(), float(np.abs(held).max(initial=0.0))
-    outcome, resting = Outcome.UNDECIDED, 0.0
-    for _ in range(max(1, round(duration / CONTROL_PERIOD))):
-        state = tick()
-        times.append(float(plant.data.time))
-        states.append(state)
-        keep()
-        ctrl = plant.ctrl
-        peak = max(peak, float(np.abs(ctrl).max(initial=0.0)))
-        if plant.hip_motors:
-            motor_peak = max(motor_peak, float(np.abs(ctrl - held)[plant.hip_motors].max()))
-        hip_peak = max(hip_peak, weight * float(np.hypot(*controller.cmp_offset)))
-        tilt_peak = max(tilt_peak, plant.torso_tilt())
-        if plant.falling(state):
-            outcome = Outcome.FELL
-            break
-        resting = resting + CONTROL_PERIOD if plant.at_rest(state, rest_speed) else 0.0
-        if resting >= rest_duration - 1e-9:
-            outcome = Outcome.RECOVERED
-            break
+    plant.recording = bool(record)
+    ticks = round(push_time / CONTROL_PERIOD) + max(1, round(duration / CONTROL_PERIOD))
+    figures = _ControllerFigures(controller, plant, round(push_time / CONTROL_PERIOD))
+    result = simulate(
+        plant, controller, plant.reset(),
+        duration=ticks * CONTROL_PERIOD,
+        control_period=CONTROL_PERIOD,
+        rest=RestCriterion(rest_speed, rest_duration),
+        push=ScheduledPush(push_time, push, react=True),
+        observers=(figures,),
+    )  # fmt: skip
+    after = plant.push_row
+    assert after is not None  # the push comes before the last tick (ticks > its tick)
+    rows = np.r_[0, after : len(result.time)]
+    inputs, held = result.inputs[after - 1 :], result.inputs[after - 1]
+    hips = plant.hip_motors
+    frames = np.array(plant.frames)[rows] if record else None
+    nq, nv = int(plant.model.nq), int(plant.model.nv)
     return Push3DRun(
-        outcome=outcome,
+        outcome=result.outcome,
         push=push,
-        time=np.array(times),
-        states=np.array(states),
-        after_push=after,
-        before_push=before,
-        peak_hip_torque=hip_peak,
-        peak_hip_motor_torque=motor_peak,
-        max_torso_tilt=tilt_peak,
-        peak_torque=peak,
-        failed_ticks=failed,
+        time=result.time[rows],
+        states=result.states[rows],
+        after_push=result.states[after].copy(),
+        before_push=result.states[after - 1].copy(),
+        peak_hip_torque=figures.peak_hip_torque,
+        peak_hip_motor_torque=max(0.0, float(np.abs(inputs[1:] - held)[:, hips].max()))
+        if hips
+        else 0.0,
+        max_torso_tilt=plant.max_torso_tilt,
+        peak_torque=float(np.abs(inputs).max(initial=0.0)),
+        failed_ticks=figures.failed_ticks,
         steps=_landed(controller),
-        **_split(plant, frames),
+        qpos=None if frames is None else frames[:, :nq],
+        qvel=None if frames is None else frames[:, nq : nq + nv],
+        ctrl=None if frames is None else frames[:, nq + nv :],
     )
+
+
+class _ControllerFigures:
+    """Observer of the controller's figures: DAQP's failed ticks, the hip law's peak after the push.
+
+    Parameters
+    ----------
+    controller : WholeBodyController
+        The controller of the run (its ``last`` solve and ``cmp_offset`` after each tick).
+    plant : Humanoid3DPlant
+        Its plant (the body's weight).
+    push_tick : int
+        The plant step at which the push comes.
+    """
+
+    def __init__(
+        self, controller: WholeBodyController, plant: Humanoid3DPlant, push_tick: int
+    ) -> None:
+        self.controller, self.push_tick = controller, push_tick
+        self.weight = plant.params.mass * plant.params.gravity
+        self.failed_ticks = 0
+        self.peak_hip_torque = 0.0
+
+    def on_step(self, index: int, step: Step, command: Command) -> None:
+        """Count a failed solve; after the push, keep the largest m g |δ| [N m]."""
+        controller = self.controller
+        self.failed_ticks += 0 if controller.last is None or controller.last.ok else 1
+        if index >= self.push_tick:
+            offset = self.weight * float(np.hypot(*controller.cmp_offset))
+            self.peak_hip_torque = max(self.peak_hip_torque, offset)
 
 
 def _landed(controller: WholeBodyController) -> int:
@@ -212,14 +226,6 @@ def _landed(controller: WholeBodyController) -> int:
     if stepper is None:
         return 0
     return sum(1 for step in stepper.steps if step.touchdown is not None)
-
-
-def _split(plant: Humanoid3DPlant, frames: list[FloatArray]) -> dict[str, FloatArray]:
-    """Return the recorded rows as ``qpos``, ``qvel`` and ``ctrl`` arrays (none if empty)."""
-    if not frames:
-        return {}
-    rows, nq, nv = np.array(frames), int(plant.model.nq), int(plant.model.nv)
-    return {"qpos": rows[:, :nq], "qvel": rows[:, nq : nq + nv], "ctrl": rows[:, nq + nv :]}
 
 
 @dataclass(frozen=True)
