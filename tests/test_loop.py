@@ -139,6 +139,32 @@ def test_the_3d_humanoids_run_in_the_one_loop():
         simulate_push3d(plant, wbc_for(plant), Push3D(1.0, 0.0), duration=59.95)
 
 
+def test_a_pushed_3d_run_carries_its_extras_in_the_result():
+    # run_push3d: the loop's result with the push's row, peaks and frames (Push3DExtras);
+    # Push3DRun.of keeps its rows from the push on, as simulate_push3d returns them.
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, wbc_for
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import Push3DRun, run_push3d, simulate_push3d
+
+    plant = Biped3DPlant(P)
+    push = Push3D(30.0, 0.0)
+    result = run_push3d(plant, wbc_for(plant), push, duration=0.2, push_time=0.01, record=True)
+    extras = result.extras
+    assert extras is not None and extras.push is push and extras.push_row == 6
+    assert extras.qpos is not None and len(extras.qpos) == len(result.time)
+    assert result.strategy_used() is Strategy.HIP and extras.peak_hip_torque > 1.0
+    run = Push3DRun.of(result)
+    again = simulate_push3d(plant, wbc_for(plant), push, duration=0.2, push_time=0.01, record=True)
+    assert run.strategy_used() == again.strategy_used() == "hip"
+    for name in ("time", "states", "after_push", "before_push", "qpos", "qvel", "ctrl"):
+        assert np.array_equal(getattr(run, name), getattr(again, name)), name
+    assert len(run.time) == len(result.time) - 5 and np.array_equal(run.after_push, run.states[1])
+    with pytest.raises(InvalidParameterError, match="pushed 3-D run"):
+        Push3DRun.of(simulate(make_plant("lipm", P), make_controller("ankle-pd", P),
+                              np.zeros(2), duration=0.01))  # fmt: skip
+    with pytest.raises(ParameterTypeError, match="result must be a SimulationResult"):
+        Push3DRun.of(run)  # type: ignore[arg-type]
+
+
 @pytest.mark.parametrize("model", MODELS)
 def test_every_analytic_plant_keeps_the_contract(model):
     plant: Backend = make_plant(model, P)

@@ -11,9 +11,17 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import finite_float
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.push import Push3D
 from pushrecovery.surfaces.classify import Strategy
 
-__all__ = ["HIP_TORQUE_THRESHOLD", "Outcome", "SimulationResult", "is_falling", "strategy_used"]
+__all__ = [
+    "HIP_TORQUE_THRESHOLD",
+    "Outcome",
+    "Push3DExtras",
+    "SimulationResult",
+    "is_falling",
+    "strategy_used",
+]
 
 #: Largest |hip torque| [N m] that still counts as not using the hip: a solver's rounding or
 #: a servo holding the upper body still (the MPC leaves 2e-5 N m on a push of 0), not CMP
@@ -69,6 +77,47 @@ _FIRST_KEYS = ("x", "xdot", "theta", "theta_dot", "z", "y", "ydot")
 
 
 @dataclass(frozen=True, slots=True)
+class Push3DExtras:
+    """What a pushed run of a 3-D humanoid measured beside its rows (``runs3d.run_push3d``).
+
+    Attributes
+    ----------
+    push : Push3D
+        The push.
+    push_row : int
+        The row just after the push (``states[push_row - 1]`` is the state as it began).
+    peak_hip_torque : float
+        Largest flywheel torque the WBC's hip law commanded after the push, m g |δ| (δ its
+        CMP offset) [N m]: 0 when the ankles sufficed.
+    peak_hip_motor_torque : float
+        Largest |hip pitch or roll motor command − its value before the push| after it [N m].
+    max_torso_tilt : float
+        Largest tilt of the upright body from the vertical after the push [rad].
+    peak_torque : float
+        Largest |motor command| from the push on [N m].
+    failed_ticks : int
+        Ticks DAQP did not solve (the last command repeated).
+    steps : int
+        Steps that landed (the controller's stepping task; 0 without it).
+    qpos, qvel, ctrl : float arrays, shapes (n, nq), (n, nv), (n, nu), or None
+        MuJoCo's ``qpos``, ``qvel`` and the held motor commands at each row of the result
+        (recorded runs, to replay and render them); None otherwise.
+    """
+
+    push: Push3D
+    push_row: int
+    peak_hip_torque: float
+    peak_hip_motor_torque: float
+    max_torso_tilt: float
+    peak_torque: float
+    failed_ticks: int
+    steps: int = 0
+    qpos: NDArray[np.float64] | None = None
+    qvel: NDArray[np.float64] | None = None
+    ctrl: NDArray[np.float64] | None = None
+
+
+@dataclass(frozen=True, slots=True)
 class SimulationResult:
     """A simulated run.
 
@@ -95,6 +144,8 @@ class SimulationResult:
         The entries of the states (the plant's ``state_labels``).
     decided_time : float or None
         When the outcome was decided [s] (None: undecided).
+    extras : Push3DExtras or None
+        A 3-D humanoid's pushed run: the push, its peaks, steps and recorded frames.
     """
 
     time: NDArray[np.float64]
@@ -108,6 +159,7 @@ class SimulationResult:
     footholds_xy: tuple[tuple[float, float], ...] = ()
     state_labels: tuple[str, ...] = ()
     decided_time: float | None = None
+    extras: Push3DExtras | None = None
 
     @property
     def cops(self) -> NDArray[np.float64]:
@@ -128,8 +180,12 @@ class SimulationResult:
         """Return the strategy the run used, whatever its outcome (the one definition).
 
         ``step`` if a foot landed, else ``hip`` if the hip torque exceeded
-        :data:`HIP_TORQUE_THRESHOLD`, else ``ankle``.
+        :data:`HIP_TORQUE_THRESHOLD`, else ``ankle`` (a 3-D humanoid's: its ``extras``' steps
+        and hip law's torque).
         """
+        extras = self.extras
+        if extras is not None:
+            return strategy_used(extras.steps, extras.peak_hip_torque)
         return strategy_used(len(self.footholds) - 1, self.peak_hip_torque)
 
     @property

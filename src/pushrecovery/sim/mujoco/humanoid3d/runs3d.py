@@ -1,17 +1,19 @@
-"""The loop of the 3-D plants and the critical push from any direction (issue 19, item 4).
+"""A pushed run of the 3-D plants and the critical push from any direction (issue 19, item 4).
 
-:func:`simulate_push3d`: quiet standing until ``push_time``, the push
+:func:`run_push3d`: quiet standing until ``push_time``, the push
 (:class:`~pushrecovery.sim.push.Push3D`), then the whole-body controller every
 :data:`~.plant3d.CONTROL_PERIOD` until the plant's fall set, rest over the support polygon for
-``rest_duration``, or ``duration`` (the one loop, ``sim.simulate``, hands its controller the
-state vector; the WBC reads MuJoCo's data). :func:`critical_push3d`: the largest impulse at an
-azimuth that does not fall. The plants are :mod:`.plant3d`'s.
+``rest_duration``, or ``duration``: the one loop, :func:`~pushrecovery.sim.simulate.simulate`,
+whose :class:`~pushrecovery.sim.result.SimulationResult` carries the run's
+:class:`~pushrecovery.sim.result.Push3DExtras`. :func:`simulate_push3d` is the same run as a
+:class:`Push3DRun` (its rows from the push on; the CLI's). :func:`critical_push3d`: the largest
+impulse at an azimuth that does not fall. The plants are :mod:`.plant3d`'s.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,6 +21,7 @@ from numpy.typing import NDArray
 from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.control.base import Command
 from pushrecovery.control.wbc.controller import WholeBodyController
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.backend import Step
 from pushrecovery.sim.events import ScheduledPush
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
@@ -27,7 +30,7 @@ from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     wbc_for,
 )
 from pushrecovery.sim.push import Push3D
-from pushrecovery.sim.result import Outcome, strategy_used
+from pushrecovery.sim.result import Outcome, Push3DExtras, SimulationResult, strategy_used
 from pushrecovery.sim.simulate import MAX_DURATION, RestCriterion, simulate
 
 FloatArray = NDArray[np.float64]
@@ -37,6 +40,7 @@ __all__ = [
     "Push3DRun",
     "bisect_critical",
     "critical_push3d",
+    "run_push3d",
     "simulate_push3d",
 ]
 
@@ -107,6 +111,40 @@ class Push3DRun:
         """
         return strategy_used(self.steps, self.peak_hip_torque).value
 
+    @classmethod
+    def of(cls, result: SimulationResult) -> Push3DRun:
+        """Return the run of :func:`run_push3d`'s ``result``: its rows from the push on.
+
+        Raises
+        ------
+        InvalidParameterError
+            If ``result`` has no :class:`~pushrecovery.sim.result.Push3DExtras`.
+        """
+        require_type("result", result, SimulationResult)
+        extras = result.extras
+        if extras is None:
+            raise InvalidParameterError("result must be a pushed 3-D run's (run_push3d)")
+        after = extras.push_row
+        rows = np.r_[0, after : len(result.time)]
+        frames = [None if a is None else a[rows] for a in (extras.qpos, extras.qvel, extras.ctrl)]
+        return cls(
+            outcome=result.outcome,
+            push=extras.push,
+            time=result.time[rows],
+            states=result.states[rows],
+            after_push=result.states[after].copy(),
+            before_push=result.states[after - 1].copy(),
+            peak_hip_torque=extras.peak_hip_torque,
+            peak_hip_motor_torque=extras.peak_hip_motor_torque,
+            max_torso_tilt=extras.max_torso_tilt,
+            peak_torque=extras.peak_torque,
+            failed_ticks=extras.failed_ticks,
+            qpos=frames[0],
+            qvel=frames[1],
+            ctrl=frames[2],
+            steps=extras.steps,
+        )
+
 
 def simulate_push3d(
     plant: Humanoid3DPlant,
@@ -119,12 +157,29 @@ def simulate_push3d(
     rest_duration: float = 0.5,
     record: bool = False,
 ) -> Push3DRun:
+    """Return :func:`run_push3d`'s run as a :class:`Push3DRun` (the same arguments)."""
+    return Push3DRun.of(
+        run_push3d(plant, controller, push, duration=duration, push_time=push_time,
+                   rest_speed=rest_speed, rest_duration=rest_duration, record=record)
+    )  # fmt: skip
+
+
+def run_push3d(
+    plant: Humanoid3DPlant,
+    controller: WholeBodyController,
+    push: Push3D,
+    *,
+    duration: float = 3.0,
+    push_time: float = 0.1,
+    rest_speed: float = 5e-3,
+    rest_duration: float = 0.5,
+    record: bool = False,
+) -> SimulationResult:
     """Stand, push, and run the whole-body controller until a decision (module docstring).
 
     The run is :func:`~pushrecovery.sim.simulate.simulate` (the one loop) with the push
     scheduled at ``push_time`` and the controller reacting through it; its rows are the
-    plant's (MuJoCo's clock): the standing start, the state after the push and every tick after
-    it.
+    plant's (MuJoCo's clock, a row on either side of the push).
 
     Parameters
     ----------
@@ -142,7 +197,12 @@ def simulate_push3d(
         Recovered after |ċ_xy| <= rest_speed [m/s] over P for rest_duration [s] (rest_speed
         > 0; at least one tick at rest).
     record : bool
-        Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (:class:`Push3DRun`), for rendering.
+        Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (the extras'), for rendering.
+
+    Returns
+    -------
+    SimulationResult
+        The run, its ``extras`` a :class:`~pushrecovery.sim.result.Push3DExtras`.
     """
     require_type("plant", plant, Humanoid3DPlant)
     require_type("controller", controller, WholeBodyController)
@@ -164,18 +224,13 @@ def simulate_push3d(
     )  # fmt: skip
     after = plant.push_row
     assert after is not None  # the push comes before the last tick (ticks > its tick)
-    rows = np.r_[0, after : len(result.time)]
     inputs, held = result.inputs[after - 1 :], result.inputs[after - 1]
     hips = plant.hip_motors
-    frames = np.array(plant.frames)[rows] if record else None
+    frames = np.array(plant.frames) if record else None
     nq, nv = int(plant.model.nq), int(plant.model.nv)
-    return Push3DRun(
-        outcome=result.outcome,
+    extras = Push3DExtras(
         push=push,
-        time=result.time[rows],
-        states=result.states[rows],
-        after_push=result.states[after].copy(),
-        before_push=result.states[after - 1].copy(),
+        push_row=after,
         peak_hip_torque=figures.peak_hip_torque,
         peak_hip_motor_torque=max(0.0, float(np.abs(inputs[1:] - held)[:, hips].max()))
         if hips
@@ -188,6 +243,7 @@ def simulate_push3d(
         qvel=None if frames is None else frames[:, nq : nq + nv],
         ctrl=None if frames is None else frames[:, nq + nv :],
     )
+    return replace(result, extras=extras)
 
 
 class _ControllerFigures:
