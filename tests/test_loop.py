@@ -163,6 +163,12 @@ def test_a_pushed_3d_run_carries_its_extras_in_the_result():
                               np.zeros(2), duration=0.01))  # fmt: skip
     with pytest.raises(ParameterTypeError, match="result must be a SimulationResult"):
         Push3DRun.of(run)  # type: ignore[arg-type]
+    from pushrecovery.sim.mujoco.humanoid3d.render3d import Recording3D
+
+    recorded = Recording3D.of_plant_run(plant, result)  # its rows from the push on
+    assert np.array_equal(recorded.time, run.time) and np.array_equal(recorded.qpos, run.qpos)
+    with pytest.raises(ParameterTypeError, match="run must be a SimulationResult or Push3DRun"):
+        Recording3D.of_plant_run(plant, extras)  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize("model", MODELS)

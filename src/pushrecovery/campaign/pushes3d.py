@@ -4,7 +4,7 @@ The body (``biped3d`` or ``g1``) stands, is pushed at its torso with J [N s] at 
 (:class:`~pushrecovery.sim.push.Push3D`, 10 ms, after 0.1 s of standing) and the whole-body
 controller runs with the tasks of the campaign's controller (``wbc-ankle``: ankles only;
 ``wbc-hip``: + the hip task; ``wbc-step``: + the hip and the stepping task;
-:func:`~pushrecovery.sim.mujoco.humanoid3d.runs3d.simulate_push3d`) until rest, a fall or
+:func:`~pushrecovery.sim.mujoco.humanoid3d.runs3d.run_push3d`) until rest, a fall or
 ``duration``. The columns of :mod:`.pushes` keep their names; in 3-D they read:
 
 =========================  ==================================================================
@@ -100,8 +100,8 @@ def run_push3d(
 
     ``cache`` keeps one plant per body across the pushes of a batch.
     """
+    from pushrecovery.sim.mujoco.humanoid3d import runs3d
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import PUSH_DURATION, wbc_for
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
     from pushrecovery.sim.push import Push3D
     from pushrecovery.sim.registry import make_plant
 
@@ -116,24 +116,22 @@ def run_push3d(
     controller = wbc_for(plant, hip=hip, stepping=strategy == "step")
     azimuth = 0.0 if push.azimuth is None else push.azimuth
     try:
-        run = simulate_push3d(
-            plant,
-            controller,
-            Push3D(push.impulse, azimuth),
-            duration=spec.duration,
+        run = runs3d.run_push3d(
+            plant, controller, Push3D(push.impulse, azimuth), duration=spec.duration,
             push_time=PUSH_TIME,
-            record=True,
-        )
+        )  # fmt: skip
     except SimulationDiverged as exc:  # this push only: the others of the batch go on
         del cache[push.params]
         return error_row3d(spec, push, f"the physics diverged: {exc}")
+    extras = run.extras
+    assert extras is not None  # run_push3d's result
     row = predict3d(spec, push)
     stepper = controller.stepper
     row.update(
         outcome=run.outcome.value,
-        used=run.strategy_used() if run.recovered else Strategy.FALL.value,
-        steps=run.steps,
-        peak_hip_torque=run.peak_hip_torque,
+        used=run.strategy_used().value if run.recovered else Strategy.FALL.value,
+        steps=extras.steps,
+        peak_hip_torque=extras.peak_hip_torque,
         peak_ankle_torque=math.nan,
         cop_min=math.nan,
         cop_max=math.nan,
@@ -141,10 +139,11 @@ def run_push3d(
         stop_impacts=0,
         error=None,
         lift_offs=0 if stepper is None else len(stepper.steps),
-        peak_hip_motor_torque=run.peak_hip_motor_torque,
-        max_torso_tilt=run.max_torso_tilt,
-        peak_torque_ratio=_torque_ratio(run.ctrl, plant.ctrl_range),
-        failed_ticks=run.failed_ticks,
+        peak_hip_motor_torque=extras.peak_hip_motor_torque,
+        max_torso_tilt=extras.max_torso_tilt,
+        # The motor commands held from the push on (the push's, then each tick's).
+        peak_torque_ratio=_torque_ratio(run.inputs[extras.push_row - 1 :], plant.ctrl_range),
+        failed_ticks=extras.failed_ticks,
     )
     return row
 

@@ -61,7 +61,7 @@ def filmstrip_run(
     from pushrecovery.experiments.validation3d import predicted_critical_impulses
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import wbc_for
     from pushrecovery.sim.mujoco.humanoid3d.render3d import Recording3D
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import run_push3d
     from pushrecovery.sim.push import Push3D
     from pushrecovery.sim.registry import make_plant3d
 
@@ -88,6 +88,7 @@ def filmstrip_run(
         wbc = wbc_for(plant, hip=controller == "hip")
     push = Push3D(impulse, azimuth)
     duration = max(last_frame, STRIP_DURATION)
-    run = simulate_push3d(plant, wbc, push, duration=duration, push_time=0.1, record=True)
-    outcome = run.outcome.value + (f", {run.steps} step(s)" if run.steps else "")
+    run = run_push3d(plant, wbc, push, duration=duration, push_time=0.1, record=True)
+    steps = 0 if run.extras is None else run.extras.steps
+    outcome = run.outcome.value + (f", {steps} step(s)" if steps else "")
     return Recording3D.of_plant_run(plant, run), impulse, outcome

@@ -1,7 +1,7 @@
 r"""Pictures of a pushed 3-D humanoid: frames of a recorded run, a filmstrip PNG and a GIF.
 
 :func:`run_frames` turns a run recorded by
-``simulate_push3d(plant, controller, push, record=True)`` into
+``run_push3d(plant, controller, push, record=True)`` into
 :class:`~pushrecovery.sim.mujoco.render.scene3d.Frame3D` (the overlays' points), replaying
 each chosen row on a copy of the model (``qpos``, ``qvel`` and the held ``ctrl``, then
 ``mj_forward``; the run's own ``MjData`` is not touched):
@@ -44,6 +44,7 @@ from pushrecovery.sim.mujoco.render.frames import select_indices, subsample_indi
 from pushrecovery.sim.mujoco.render.output import output_paths, write_animation, write_filmstrip
 from pushrecovery.sim.mujoco.render.overlay3d import LEGEND3D, Frame3D
 from pushrecovery.sim.mujoco.render.scene3d import Camera3D, fit_camera3d, render_frames3d
+from pushrecovery.sim.result import SimulationResult
 
 FloatArray = NDArray[np.float64]
 
@@ -74,7 +75,7 @@ def default_camera(azimuth: float, elevation: float = 25.0) -> Camera3D:
 class Recording3D:
     """A recorded 3-D run with what it takes to replay it (one row per recorded tick).
 
-    Build it with :meth:`of_plant_run` (``simulate_push3d(..., record=True)``) or
+    Build it with :meth:`of_plant_run` (``run_push3d(..., record=True)``) or
     :meth:`of_wbc_run` (``push_humanoid``/``push_biped3d``).
 
     Attributes
@@ -123,13 +124,18 @@ class Recording3D:
         positive_float("omega", self.omega, "1/s")
 
     @classmethod
-    def of_plant_run(cls, plant: Humanoid3DPlant, run: Push3DRun) -> Recording3D:
-        """Return the recording of ``simulate_push3d(plant, ..., record=True)``."""
+    def of_plant_run(cls, plant: Humanoid3DPlant, run: SimulationResult | Push3DRun) -> Recording3D:
+        """Return the recording of ``run_push3d(plant, ..., record=True)`` (or its Push3DRun).
+
+        Its rows are the standing start, the state after the push and every tick after it.
+        """
         require_type("plant", plant, Humanoid3DPlant)
-        require_type("run", run, Push3DRun)
+        require_type("run", run, (SimulationResult, Push3DRun))
+        if isinstance(run, SimulationResult):
+            run = Push3DRun.of(run)
         if run.qpos is None or run.qvel is None or run.ctrl is None:
             raise InvalidParameterError(
-                "run has no recorded states to render: simulate_push3d(..., record=True)"
+                "run has no recorded states to render: run_push3d(..., record=True)"
             )
         return cls(plant.model, tuple(plant.feet), plant.omega, plant.floor, run.push.azimuth,
                    run.time, run.qpos, run.qvel, run.ctrl, run.states[:, :3],

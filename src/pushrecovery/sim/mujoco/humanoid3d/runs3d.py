@@ -318,7 +318,7 @@ def critical_push3d(
 
     The upper end starts at m · 0.25 m/s and doubles while the body recovers (up to the
     push's largest impulse); then the bracket halves until it is at most ``tolerance`` [N s]
-    wide (in (0, 1e3]). Each run is :func:`simulate_push3d` with the plant's own WBC
+    wide (in (0, 1e3]). Each run is :func:`run_push3d` with the plant's own WBC
     (:func:`~.plant3d.wbc_for`: the hip task on the biped3d, not on the G1, whose critical
     pushes it lowers), ``duration`` [s] after the push; a run that has not fallen by then
     (recovered or still undecided) counts as standing: falls are decided within a second,
@@ -333,9 +333,9 @@ def critical_push3d(
     def recovers(impulse: float) -> tuple[bool, str]:
         nonlocal runs
         runs += 1
-        run = simulate_push3d(plant, wbc_for(plant), Push3D(impulse, azimuth, body),
-                              duration=duration)  # fmt: skip
-        return run.outcome is not Outcome.FELL, run.strategy_used()
+        run = run_push3d(plant, wbc_for(plant), Push3D(impulse, azimuth, body),
+                         duration=duration)  # fmt: skip
+        return run.outcome is not Outcome.FELL, run.strategy_used().value
 
     low, bracket, strategy = bisect_critical(recovers, 0.0, 0.25 * plant.params.mass, tolerance)
     return CriticalPush3D(low, bracket, runs, strategy)
