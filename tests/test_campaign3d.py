@@ -100,7 +100,7 @@ def test_bad_3d_specs(params, kwargs, words):
 def test_cli_campaign_on_the_biped3d(capsys, tmp_path):
     out = tmp_path / "c3d"
     code, text, err = run_cli(
-        capsys, "campaign", "--backend", "mujoco", "--model", "biped3d", "--azimuths", "0,90",
+        capsys, "humanoid", "campaign", "--model", "biped3d", "--azimuths", "0,90",
         "--fraction", "0.5", "0.5", "1", "--strategy", "ankle", "--duration", "1.5",
         "--out", str(out), "--workers", "1", "--json",
     )  # fmt: skip
@@ -139,16 +139,22 @@ def test_cli_validate_on_the_biped3d(capsys, tmp_path):
 @pytest.mark.parametrize(
     ("args", "words"),
     [
-        (("campaign", "--backend", "mujoco", "--model", "biped3d", "--azimuths", "0:x",
+        (("humanoid", "campaign", "--model", "biped3d", "--azimuths", "0:x",
           "--fraction", "0.5", "1", "0.5", "--out", "x"), "--azimuths needs"),
-        (("campaign", "--backend", "mujoco", "--model", "biped3d", "--azimuths", "0,720",
+        (("humanoid", "campaign", "--model", "biped3d", "--azimuths", "0,720",
           "--impulse", "5", "5", "1", "--out", "x"), "must be in [-360, 360]"),
-        (("campaign", "--backend", "mujoco", "--model", "biped3d", "--azimuth", "0",
+        (("humanoid", "campaign", "--model", "biped3d", "--azimuth", "0",
           "--azimuths", "0,90", "--impulse", "5", "5", "1", "--out", "x"), "not both"),
+        (("humanoid", "campaign", "--impulse", "5", "5", "1", "--fraction", "0.5", "1", "0.5",
+          "--out", "x"), "--impulse or --fraction, not both"),
+        (("humanoid", "campaign", "--model", "g1", "--param", "mass=30:40:10",
+          "--impulse", "5", "5", "1", "--out", "x"), "g1"),
         (("campaign", "--model", "stepping", "--azimuths", "0,90", "--x0", "0", "0", "1",
-          "--xdot", "0", "1", "1", "--out", "x"), "need a 3-D model"),
+          "--xdot", "0", "1", "1", "--out", "x"),
+         "use 'pushrecovery humanoid campaign --azimuths 0,90'"),
         (("campaign", "--backend", "mujoco", "--model", "biped3d", "--strategy", "hip",
-          "--controller", "wbc-hip", "--impulse", "5", "5", "1", "--out", "x"), "not both"),
+          "--impulse", "5", "5", "1", "--out", "x"),
+         "use 'pushrecovery humanoid campaign --model biped3d'"),
         (("humanoid", "validate", "--model", "biped3d", "--azimuths", "0,360"), "repeats"),
         (("humanoid", "validate", "--model", "biped3d", "--fractions", "1,0.5"),
          "--fractions must be"),

@@ -63,10 +63,31 @@ def test_humanoid_validate_runs(capsys, tmp_path) -> None:
     assert (tmp_path / "validation3d_biped3d.md").exists()
 
 
+def test_humanoid_campaign_runs_and_writes_the_3d_files(capsys, tmp_path) -> None:
+    out = tmp_path / "c3d"
+    code, text, err = run_cli(capsys, "humanoid", "campaign", "--azimuth", "90", "--impulse",
+                              "4", "4", "1", "--strategy", "ankle", "--duration", "0.3",
+                              "--no-plot", "--out", str(out), "--workers", "1")  # fmt: skip
+    assert code == 0, err
+    assert text.startswith("1 pushes (1 of 1 batches run now)") and "where they differ" in text
+    spec = json.loads((out / "spec.json").read_text())
+    assert spec["model"] == "biped3d" and spec["controller"] == "wbc-ankle"
+    assert spec["azimuths"] == [90.0] and spec["backend"] == "mujoco"
+    assert (out / "confusion3d.parquet").exists() and not (out / "confusion3d.png").exists()
+    # --resume alone completes the stored campaign; the planar command points here for it
+    code, text, err = run_cli(capsys, "humanoid", "campaign", "--resume", "--out", str(out),
+                              "--workers", "1", "--no-plot", "--json")  # fmt: skip
+    assert code == 0, err
+    assert json.loads(text)["pushes"] == 1
+    code, _, err = run_cli(capsys, "campaign", "--resume", "--out", str(out))
+    assert code == 2 and err.count("\n") == 1
+    assert f"use 'pushrecovery humanoid campaign --resume --out {out}'" in err
+
+
 def test_the_humanoid_group_lists_its_commands(capsys) -> None:
     code, out, _ = run_cli(capsys, "humanoid", "--help")
     assert code == 0
-    assert all(name in out for name in ("simulate", "critical-push", "validate"))
+    assert all(name in out for name in ("simulate", "critical-push", "validate", "campaign"))
     code, out, _ = run_cli(capsys, "--help")
     assert code == 0 and "The 3-D humanoids (biped3d, g1) under the whole-body" in out
 
@@ -95,6 +116,21 @@ def test_the_humanoid_group_lists_its_commands(capsys) -> None:
         (("validate", "--out", "x"), "use 'pushrecovery humanoid validate --out x'"),
         (("validate", "--workers", "1"), "use 'pushrecovery humanoid validate --workers 1'"),
         (("validate", "--rel-tolerance", "0.1"), "'pushrecovery humanoid validate --rel-tol"),
+        (("campaign", "--backend", "mujoco", "--model", "biped3d", "--out", "x"),
+         "--model biped3d is a 3-D humanoid: use 'pushrecovery humanoid campaign --model "
+         "biped3d'"),
+        (("campaign", "--model", "g1", "--out", "x"),
+         "use 'pushrecovery humanoid campaign --model g1'"),
+        (("campaign", "--azimuth", "30", "--out", "x"),
+         "use 'pushrecovery humanoid campaign --azimuth 30'"),
+        (("campaign", "--azimuths", "0:360:90", "--out", "x"),
+         "use 'pushrecovery humanoid campaign --azimuths 0:360:90'"),
+        (("campaign", "--fraction", "0.5", "2", "0.5", "--out", "x"),
+         "use 'pushrecovery humanoid campaign --fraction 0.5 2 0.5'"),
+        (("campaign", "--strategy", "hip", "--out", "x"),
+         "use 'pushrecovery humanoid campaign --strategy hip'"),
+        (("campaign", "--controller", "wbc-step", "--x0", "0", "0", "1", "--out", "x"),
+         "use 'pushrecovery humanoid campaign --strategy step'"),
     ],
 )  # fmt: skip
 def test_a_planar_command_refuses_the_humanoids_in_one_line(capsys, args, words) -> None:
@@ -120,6 +156,14 @@ def test_a_planar_command_refuses_the_humanoids_in_one_line(capsys, args, words)
         (("simulate", "--model", "g1", "--mass", "30"), "--model g1 has the robot's own body"),
         (("simulate", "--view-azimuth", "10"), "apply to --render of the 3-D humanoids"),
         (("simulate", "--nope", "1"), "No such option"),
+        (("campaign", "--model", "stepping", "--out", "x"),
+         "use 'pushrecovery campaign --model stepping'"),
+        (("campaign", "--backend", "mujoco", "--out", "x"), "--backend is an option of the planar"),
+        (("campaign", "--controller", "wbc-hip", "--out", "x"), "--controller is an option of"),
+        (("campaign", "--x0", "0", "0", "1", "--out", "x"), "--x0 is an option of the planar"),
+        (("campaign", "--xdot", "0", "1", "0.5", "--out", "x"), "--xdot is an option of the"),
+        (("campaign", "--out", "x"), "humanoid campaign needs one of --impulse, --fraction"),
+        (("campaign", "--resume", "--model", "g1", "--out", "x"), "give its whole spec or none"),
     ],
 )  # fmt: skip
 def test_a_humanoid_command_refuses_planar_things_in_one_line(capsys, args, words) -> None:
@@ -127,21 +171,27 @@ def test_a_humanoid_command_refuses_planar_things_in_one_line(capsys, args, word
     assert code == 2 and err.count("\n") == 1 and words in err and "Traceback" not in err
 
 
-@pytest.mark.parametrize("command", ["simulate", "critical-push", "validate"])
+@pytest.mark.parametrize("command", ["simulate", "critical-push", "validate", "campaign"])
 def test_each_help_lists_only_its_familys_models_and_options(capsys, command) -> None:
     code, planar, _ = run_cli(capsys, command, "--help")
     assert code == 0
     humanoid_only = ("--azimuth", "biped3d", "g1", "--stepping", "--view-", "--frame-times",
-                     "--quick", "--fractions", "--no-critical", "--workers",
-                     "--rel-tolerance")  # fmt: skip
+                     "--quick", "--fractions", "--no-critical", "--rel-tolerance",
+                     "--fraction")  # fmt: skip
+    if command == "campaign":  # the planar one has its own --workers; validate --strategy
+        humanoid_only += ("--strategy", "wbc-", "3-D:", "at the torso")
+    else:
+        humanoid_only += ("--workers",)
     for word in humanoid_only:
         assert word not in planar, (command, word)
     assert "pushrecovery humanoid" in planar  # where the 3-D humanoids went
     code, humanoid, _ = run_cli(capsys, "humanoid", command, "--help")
     assert code == 0
-    planar_only = ("--xdot", "--controller", "--backend", "--kp", "--option", "--plot",
-                   "--direction", "--x0", "--grid", "lipm", "pendulum", "stepping-plane",
+    planar_only = ("--xdot", "--controller", "--backend", "--kp", "--option", "--direction",
+                   "--x0", "--grid", "lipm", "pendulum", "stepping-plane",
                    "--control-period")  # fmt: skip
+    if command != "campaign":  # the campaigns' --plot/--no-plot writes their figures
+        planar_only += ("--plot",)
     for word in planar_only:
         assert word not in humanoid, (command, word)
     assert "[biped3d|g1]" in humanoid and "Example:" in humanoid

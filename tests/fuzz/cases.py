@@ -88,6 +88,7 @@ HEAVY = {
     "humanoid simulate",
     "humanoid critical-push",
     "humanoid validate",
+    "humanoid campaign",
 }
 INVALID_BODY = [
     ["--mass", "nan"], ["--gravity", "1e15"], ["--com-height", "-1"], ["--toe", "inf"],
@@ -148,7 +149,7 @@ def command_case(rng: random.Random, folder: Path) -> Case:
             args.append(option)
             continue
         args += [option, *_value(rng, param, option, folder)]
-    if name == "analyze" or name == "campaign":
+    if name in ("analyze", "campaign", "humanoid campaign"):
         args += ["--out", str(folder / "out")]
     if name == "analyze":
         args.insert(1, rng.choice(["missing.c3d", str(folder), "/dev/null"]))

@@ -1,4 +1,9 @@
-"""The ``campaign`` and ``report`` commands (registered on the group in :mod:`.app`)."""
+"""The ``campaign`` and ``report`` commands (registered on the group in :mod:`.app`).
+
+``campaign`` runs the planar models (analytic and sagittal MuJoCo); the 3-D humanoids' is
+``pushrecovery humanoid campaign`` (:mod:`pushrecovery.cli.humanoid`), and a 3-D model or
+option given here is refused in one line naming it (:mod:`pushrecovery.cli.families`).
+"""
 
 from __future__ import annotations
 
@@ -8,46 +13,33 @@ from typing import Any
 
 import click
 
-from pushrecovery.cli.campaign3d import OPTIONS_3D
-from pushrecovery.cli.options import body_options, echo_confusion, emit, params_from
-from pushrecovery.cli.progress import Progress
+from pushrecovery.cli.campaign_options import (
+    SCHEDULER,
+    echo_counts,
+    echo_files,
+    run_options,
+    run_spec,
+    sweeps_from,
+)
+from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, humanoid_only
+from pushrecovery.cli.options import body_options, emit, params_from
+from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
 __all__ = ["campaign", "report"]
 
 _triple: dict[str, Any] = {"nargs": 3, "type": float, "metavar": "START STOP STEP", "default": None}
 
 
-def _sweeps(pairs: tuple[str, ...]) -> dict[str, tuple[float, float, float]]:
-    """``NAME=START:STOP:STEP`` options as {name: (start, stop, step)}."""
-    from pushrecovery.errors import InvalidParameterError
+def _refuse_wbc(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    """Refuse the whole-body controller (``wbc-*``), naming ``humanoid campaign --strategy``."""
+    if value is not None and value.startswith("wbc-"):
+        from pushrecovery.errors import InvalidParameterError
 
-    sweeps = {}
-    for pair in pairs:
-        name, _, text = pair.partition("=")
-        parts = text.split(":")
-        try:
-            if not name or len(parts) != 3:
-                raise ValueError
-            values = tuple(float(p) for p in parts)
-        except ValueError:
-            raise InvalidParameterError(
-                f"--param needs NAME=START:STOP:STEP (e.g. torque_max=50:150:25), got {pair!r}"
-            ) from None
-        if name in sweeps:
-            raise InvalidParameterError(f"--param {name} given twice")
-        sweeps[name] = values
-    return sweeps  # type: ignore[return-value]
-
-
-_workers = click.option(
-    "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
-)
-_scheduler = click.option(
-    "--scheduler",
-    default=None,
-    metavar="ADDRESS",
-    help="Run the batches on a running dask.distributed scheduler (tcp://host:port).",
-)
+        raise InvalidParameterError(
+            f"--controller {value} is the 3-D humanoids' whole-body controller: use "
+            f"'pushrecovery humanoid campaign --strategy {value.removeprefix('wbc-')}'"
+        )
+    return value
 
 
 @click.command(short_help="Sweep pushes over starts, push sizes and parameters, at scale.")
@@ -60,84 +52,42 @@ _scheduler = click.option(
 )
 @click.option(
     "--model",
+    type=ModelChoice(
+        (*MODELS, *MUJOCO_MODELS),
+        elsewhere={m: f"humanoid campaign --model {m}" for m in HUMANOID_MODELS},
+        family="a 3-D humanoid",
+    ),
     default=None,
-    help="Plant (default: stepping on analytic, torso on mujoco; 3-D: biped3d, g1).",
+    help="Plant (default: stepping on analytic, torso on mujoco; foot, torso and biped are "
+    "MuJoCo's). The 3-D humanoids: pushrecovery humanoid campaign.",
 )
 @click.option(
     "--controller",
     default=None,
-    help="Controller (default: recovery / mpc; 3-D: wbc-ankle, wbc-hip, wbc-step).",
+    callback=_refuse_wbc,
+    help="Controller (default: recovery on analytic, mpc on mujoco).",
 )
-@click.option("--azimuth", type=float, default=None, help="3-D models: one push direction [deg].")
-@OPTIONS_3D[2]
-@OPTIONS_3D[0]
-@click.option(
-    "--x0", "x0", **_triple, help="CoM positions before the push [m] (3-D: 0, the default)."
+@humanoid_only(
+    "campaign", "--azimuth", "--azimuths", "--strategy", "--fraction", nargs={"--fraction": 3}
 )
+@click.option("--x0", "x0", **_triple, help="CoM positions before the push [m].")
 @click.option("--xdot", **_triple, help="Pushes as CoM velocities [m/s].")
-@click.option(
-    "--impulse", **_triple, help="Pushes as impulses at the CoM [N s] (3-D: at the torso)."
+@click.option("--impulse", **_triple, help="Pushes as impulses at the CoM [N s].")
+@run_options(
+    param_help="Sweep a body parameter (SI units), repeatable: e.g. torque_max=50:150:25.",
+    samples_help="Draw this many pushes uniformly from the ranges (with --seed) instead of the "
+    "grid.",
+    batch_size_help="Pushes per task (default about a second of work: 100 / 10 MuJoCo; up to "
+    "10,000 / 1,000 for the compiled pendulum, lipm / stepping + recovery pairs).",
 )
-@OPTIONS_3D[1]
-@click.option(
-    "--param",
-    "sweep_pairs",
-    multiple=True,
-    metavar="NAME=START:STOP:STEP",
-    help="Sweep a body parameter (SI units), repeatable: e.g. torque_max=50:150:25.",
-)
-@click.option(
-    "--samples",
-    type=int,
-    default=None,
-    help="Draw this many pushes uniformly from the ranges (with --seed) instead of the grid.",
-)
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of --samples.")
-@click.option(
-    "--duration", type=float, default=6.0, show_default=True, help="Longest time per push [s]."
-)
-@click.option(
-    "--batch-size",
-    type=int,
-    default=None,
-    help="Pushes per task (default about a second of work: 100 / 10 MuJoCo; up to 10,000 / "
-    "1,000 for the compiled pendulum, lipm / stepping + recovery pairs).",
-)
-@click.option(
-    "--push-timeout",
-    type=float,
-    default=120.0,
-    show_default=True,
-    help="Wall time a push may take [s]; a slower or hung push is an error row.",
-)
-@click.option(
-    "--out", type=click.Path(file_okay=False), required=True, help="Directory of the campaign."
-)
-@click.option(
-    "--workers",
-    type=int,
-    default=None,
-    help="Local worker processes (default: all cores; 1: the pushes run in this process).",
-)
-@_scheduler
-@click.option(
-    "--resume",
-    is_flag=True,
-    help="Complete the campaign in --out, running only the missing batches.",
-)
-@click.option("--plot/--no-plot", default=True, show_default=True, help="Write the plots.")
 @body_options
 def campaign(
     backend: str,
     model: str | None,
     controller: str | None,
-    azimuth: float | None,
-    azimuths: str | None,
-    strategy: str | None,
     x0: tuple[float, float, float] | None,
     xdot: tuple[float, float, float] | None,
     impulse: tuple[float, float, float] | None,
-    fraction: tuple[float, float, float] | None,
     sweep_pairs: tuple[str, ...],
     samples: int | None,
     seed: int,
@@ -159,43 +109,24 @@ def campaign(
     the counts, the accuracy of the prediction, the confusion matrix (predicted strategy vs the
     one used) and the empirical critical pushes against the analytic ones. Every finished
     batch is kept in OUT/batches: an interrupted campaign continues with --resume. The
-    result does not depend on the number of workers.
-
-    The 3-D models (--backend mujoco --model biped3d|g1) push the standing body at its torso
-    from each of --azimuths with each push (--impulse, or --fraction of the ankle's predicted
-    critical impulse along the azimuth) under the whole-body controller (--strategy); OUT
-    also gets the confusion matrix of predicted against used strategy (confusion3d.*).
+    result does not depend on the number of workers. The 3-D humanoids are 'pushrecovery
+    humanoid campaign'.
     """
-    from pushrecovery.campaign import CampaignSpec, read_spec, run_campaign
-    from pushrecovery.cli.campaign3d import azimuths_from, spec_3d
+    from pushrecovery.campaign import CampaignSpec, read_spec
     from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.sim.registry import MUJOCO_3D_MODELS
 
-    directions = azimuths_from(azimuth, azimuths)
-    three_d = model in MUJOCO_3D_MODELS
-    if not three_d and (directions is not None or strategy or fraction):
-        raise InvalidParameterError(
-            "--azimuth(s), --strategy and --fraction need a 3-D model (--backend mujoco "
-            f"--model biped3d or g1), got --model {model}"
-        )
     directory = Path(out)
-    pushes = (x0, xdot, impulse, fraction, directions)
-    if resume and all(value is None for value in pushes):
-        if sweep_pairs or samples is not None or model or controller or strategy:
+    if resume and x0 is None and xdot is None and impulse is None:
+        if sweep_pairs or samples is not None or model or controller:
             raise InvalidParameterError(
                 "--resume without --x0 runs the stored campaign: give its whole spec or none"
             )
         spec = read_spec(directory)  # the stored campaign, as it was asked for
-    elif three_d:
-        if xdot is None and impulse is None and fraction is None:
-            raise InvalidParameterError("campaign needs one of --impulse, --fraction, --xdot")
-        options = {
-            "backend": backend, "controller": controller, "strategy": strategy, "x0": x0,
-            "xdot": xdot, "impulse": impulse, "fraction": fraction, "directions": directions,
-            "sweeps": _sweeps(sweep_pairs), "samples": samples, "seed": seed,
-            "duration": duration, "batch_size": batch_size, "push_timeout": push_timeout,
-        }  # fmt: skip
-        spec = spec_3d(str(model), options, kwargs)
+        if spec.is_3d:
+            raise InvalidParameterError(
+                f"{directory} holds a campaign of the 3-D humanoid {spec.model}: use "
+                f"'pushrecovery humanoid campaign --resume --out {directory}'"
+            )
     else:
         params = params_from(kwargs)
         if x0 is None or (xdot is None and impulse is None):
@@ -208,44 +139,16 @@ def campaign(
             x0=x0,
             xdot=xdot,
             impulse=impulse,
-            sweeps=_sweeps(sweep_pairs),
+            sweeps=sweeps_from(sweep_pairs),
             samples=samples,
             seed=seed,
             duration=duration,
             batch_size=batch_size,
             push_timeout=push_timeout,
         )
-    bar = Progress(spec.size, "campaign", "push")
-    try:
-        result = run_campaign(
-            spec,
-            directory,
-            workers=workers,
-            scheduler=scheduler,
-            resume=resume,
-            progress=bar.update,
-            # --workers 1: in this process (no worker to start and import everything again;
-            # a push that crashes the engine ends the campaign, its finished batches kept).
-            isolated=workers != 1,
-        )
-    except KeyboardInterrupt:
-        bar.close()
-        click.echo(
-            f"pushrecovery: interrupted; the finished batches are in {directory}; "
-            "rerun with --resume to complete the campaign",
-            err=True,
-        )
-        sys.exit(130)
-    bar.close()
-    assert result is not None  # no max_batches
+    result = run_spec(spec, directory, workers, scheduler, resume)
     files = {"pushes": str(result.pushes_file), "summary": str(directory / "summary.json")}
-    confusion3d = None
-    if spec.is_3d:
-        from pushrecovery.cli.campaign3d import write_confusion
-
-        confusion3d, written = write_confusion(result.table, spec.model, directory, plot)
-        files.update(written)
-    elif plot:
+    if plot:
         from pushrecovery.plots.campaign import plot_critical_vs_parameter, plot_outcome_map
 
         files["outcome_map"] = str(
@@ -259,25 +162,8 @@ def campaign(
     if as_json:
         emit(summary, True)
         return
-    outcomes = summary["outcomes"]
-    click.echo(
-        f"{summary['pushes']} pushes ({result.ran} of {spec.batches} batches run now): "
-        f"{outcomes['recovered']} recovered, {outcomes['fell']} fell, "
-        f"{outcomes['undecided']} undecided"
-        + (f", {outcomes['error']} without an outcome" if outcomes.get("error") else "")
-        + "; prediction accuracy "
-        + ("n/a" if summary["accuracy"] is None else f"{summary['accuracy']:.3f}")
-    )
-    confusion = summary["confusion"]
-    echo_confusion(
-        "confusion (rows predicted, columns used):", confusion["labels"], confusion["counts"]
-    )
-    if confusion3d is not None:
-        from pushrecovery.cli.campaign3d import echo_causes
-
-        echo_causes(confusion3d)
-    for name, path in files.items():
-        click.echo(f"{name:<22}{path}")
+    echo_counts(summary, result.ran, spec.batches)
+    echo_files(files)
 
 
 @click.command(short_help="The HTML report of a parameter set (the main job).")
@@ -293,8 +179,10 @@ def campaign(
     is_flag=True,
     help="Larger campaigns and finer critical pushes (about 3 minutes instead of half of one).",
 )
-@_workers
-@_scheduler
+@click.option(
+    "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
+)
+@SCHEDULER
 @body_options
 def report(
     out: str,

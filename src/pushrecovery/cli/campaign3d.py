@@ -1,9 +1,10 @@
-"""The 3-D models of ``campaign`` (biped3d, g1): their spec, options and figure.
+"""The runs of ``pushrecovery humanoid campaign``: the spec, the confusion matrix, its lines.
 
-``campaign --backend mujoco --model biped3d|g1 --azimuths 0:360:30 --fraction 0.5 2 0.5
---strategy step``: the grid of azimuths × pushes under the whole-body controller
-(:mod:`pushrecovery.campaign.spec3d`, :mod:`pushrecovery.campaign.pushes3d`); apart from
-:mod:`pushrecovery.cli.campaign` so that each module holds one concept.
+``humanoid campaign --model biped3d|g1 --azimuths 0:360:30 --fraction 0.5 2 0.5 --strategy
+step``: the grid of azimuths × pushes under the whole-body controller
+(:mod:`pushrecovery.campaign.spec3d`, :mod:`pushrecovery.campaign.pushes3d`); the command is
+in :mod:`pushrecovery.cli.humanoid`. :func:`write_confusion` is also the confusion campaign's
+of ``humanoid validate``.
 """
 
 from __future__ import annotations
@@ -13,95 +14,98 @@ from typing import Any
 
 import click
 
-__all__ = [
-    "AZIMUTHS_HELP",
-    "OPTIONS_3D",
-    "azimuths_from",
-    "echo_causes",
-    "spec_3d",
-    "write_confusion",
-]
-
-AZIMUTHS_HELP = (
-    "3-D models: push directions [deg], START:STOP:STEP (a full turn's STOP, 360, is left "
-    "out) or a list A,B,...; 0 forward, 90 left."
-)
-
-_strategy = click.option(
-    "--strategy",
-    type=click.Choice(("ankle", "hip", "step")),
-    default=None,
-    help="3-D models: the whole-body controller's tasks: ankles only, + the hip task, + the hip "
-    "and stepping tasks (default step).",
-)
-_fraction = click.option(
-    "--fraction",
-    nargs=3,
-    type=float,
-    default=None,
-    metavar="START STOP STEP",
-    help="3-D models: pushes as fractions of the ankle's predicted critical impulse along each "
-    "azimuth [-].",
-)
-_azimuths = click.option("--azimuths", default=None, metavar="GRID", help=AZIMUTHS_HELP)
-#: The options ``campaign`` adds for the 3-D models.
-OPTIONS_3D = (_strategy, _fraction, _azimuths)
+__all__ = ["echo_causes", "spec_3d", "stored_spec_3d", "write_confusion"]
 
 
-def azimuths_from(azimuth: float | None, azimuths: str | None) -> tuple[float, ...] | None:
-    """Return the directions of ``--azimuth DEG`` or ``--azimuths GRID`` (not both), or None."""
-    from pushrecovery.campaign.spec3d import azimuth_grid, check_azimuths
-    from pushrecovery.errors import InvalidParameterError
+def spec_3d(model: str, params: Any, strategy: str | None, **options: Any) -> Any:
+    """Return the CampaignSpec of a 3-D campaign: the standing body, the whole-body controller.
 
-    if azimuth is not None and azimuths is not None:
-        raise InvalidParameterError("give --azimuth DEG or --azimuths GRID, not both")
-    if azimuths is not None:
-        return azimuth_grid(azimuths)
-    return None if azimuth is None else check_azimuths([azimuth], "--azimuth")
+    Parameters
+    ----------
+    model : str
+        ``biped3d`` or ``g1``.
+    params : BodyParams
+        The body (:func:`pushrecovery.cli.simulation3d.params_3d`).
+    strategy : str or None
+        ``--strategy``: the controller ``wbc-STRATEGY`` (None: ``wbc-step``).
+    **options
+        The rest of the spec: ``impulse``, ``fraction``, ``azimuths``, ``sweeps``,
+        ``samples``, ``seed``, ``duration``, ``batch_size``, ``push_timeout``.
 
+    Returns
+    -------
+    CampaignSpec
+        On the MuJoCo backend, from the standing posture (``x0`` 0).
 
-def spec_3d(
-    model: str,
-    options: dict[str, Any],
-    body: dict[str, Any],
-) -> Any:
-    """Return the CampaignSpec of a 3-D campaign from the command's ``options``.
-
-    ``options`` holds backend, controller, strategy, x0, xdot, impulse, fraction, directions
-    (:func:`azimuths_from`), sweeps, samples, seed, duration, batch_size, push_timeout;
-    ``body`` the body flags (``cli.simulation3d._params_3d``: the g1's own).
+    Raises
+    ------
+    InvalidParameterError
+        If the spec is not one (``CampaignSpec``'s checks).
     """
     from pushrecovery.campaign import CampaignSpec
-    from pushrecovery.cli.simulation3d import _params_3d
-    from pushrecovery.errors import InvalidParameterError
 
-    if options["backend"] != "mujoco":
-        raise InvalidParameterError(f"--model {model} is a 3-D MuJoCo model: use --backend mujoco")
-    if options["controller"] is not None and options["strategy"] is not None:
-        raise InvalidParameterError("give --strategy or --controller wbc-..., not both")
     return CampaignSpec(
         backend="mujoco",
         model=model,
-        controller=options["controller"] or f"wbc-{options['strategy'] or 'step'}",
-        params=_params_3d(model, body),
-        x0=options["x0"] or (0.0, 0.0, 1.0),
-        xdot=options["xdot"],
-        impulse=options["impulse"],
-        fraction=options["fraction"],
-        azimuths=options["directions"],
-        sweeps=options["sweeps"],
-        samples=options["samples"],
-        seed=options["seed"],
-        duration=options["duration"],
-        batch_size=options["batch_size"],
-        push_timeout=options["push_timeout"],
+        controller=f"wbc-{strategy or 'step'}",
+        params=params,
+        x0=(0.0, 0.0, 1.0),
+        xdot=None,
+        **options,
     )
+
+
+def stored_spec_3d(directory: Path) -> Any:
+    """Return the 3-D campaign stored in ``directory`` (``--resume`` without a spec).
+
+    Parameters
+    ----------
+    directory : Path
+        ``--out`` of the campaign.
+
+    Returns
+    -------
+    CampaignSpec
+        The stored spec, as it was asked for.
+
+    Raises
+    ------
+    InvalidParameterError
+        If the stored campaign is of a planar model, naming ``pushrecovery campaign``.
+    """
+    from pushrecovery.campaign import read_spec
+    from pushrecovery.errors import InvalidParameterError
+
+    spec = read_spec(directory)
+    if not spec.is_3d:
+        raise InvalidParameterError(
+            f"{directory} holds a campaign of the planar model {spec.model}: use "
+            f"'pushrecovery campaign --resume --out {directory}'"
+        )
+    return spec
 
 
 def write_confusion(
     table: Any, model: str, directory: Path, plot: bool = True
 ) -> tuple[Any, dict[str, str]]:
-    """Write a 3-D campaign's confusion matrix (Parquet, CSV, figure); return it and the paths."""
+    """Write a 3-D campaign's confusion matrix (Parquet, CSV, figure); return it and the paths.
+
+    Parameters
+    ----------
+    table : pyarrow.Table
+        The campaign's pushes.
+    model : str
+        ``biped3d`` or ``g1``.
+    directory : Path
+        Where ``confusion3d.*`` go.
+    plot : bool
+        Also write ``confusion3d.png``.
+
+    Returns
+    -------
+    tuple
+        The ``Confusion3D`` and {name: path} of the files written.
+    """
     from pushrecovery.experiments.confusion3d import confusion_from_rows
 
     result = confusion_from_rows(table.to_pylist(), model)
@@ -117,7 +121,13 @@ def write_confusion(
 
 
 def echo_causes(result: Any) -> None:
-    """Print the agreement of a confusion matrix and its pushes per cause."""
+    """Print the agreement of a confusion matrix and its pushes per cause.
+
+    Parameters
+    ----------
+    result : Confusion3D
+        :func:`write_confusion`'s.
+    """
     from pushrecovery.cli.options import echo_confusion
     from pushrecovery.experiments.confusion3d import LABELS
 

@@ -1,8 +1,8 @@
 """Which command runs which models: the planar commands and ``pushrecovery humanoid``.
 
-The planar commands (``simulate``, ``critical-push``, ``validate``) list only the planar
-models and their options, the ``humanoid`` commands only the 3-D humanoids (biped3d, g1) and
-theirs. A model or an option of the other family is refused in one line that names the
+The planar commands (``simulate``, ``critical-push``, ``validate``, ``campaign``) list only
+the planar models and their options, the ``humanoid`` commands only the 3-D humanoids (biped3d,
+g1) and theirs. A model or an option of the other family is refused in one line that names the
 command that takes it (issue 31): :class:`ModelChoice` for ``--model``,
 :func:`humanoid_only` for the humanoids' options, accepted by the planar commands without
 being listed (``hidden``) so that an old command line learns where it moved, and
@@ -90,7 +90,9 @@ class ModelChoice(click.Choice):
 _FLAGS = frozenset(("--stepping", "--quick", "--critical", "--no-critical"))
 
 
-def humanoid_only(command: str, *flags: str) -> Callable[[F], F]:
+def humanoid_only(
+    command: str, *flags: str, nargs: Mapping[str, int] | None = None
+) -> Callable[[F], F]:
     """Return hidden options of a planar command that refuse the 3-D humanoids' ``flags``.
 
     Parameters
@@ -102,6 +104,8 @@ def humanoid_only(command: str, *flags: str) -> Callable[[F], F]:
         The options (``--azimuth``); ``--stepping``, ``--quick``, ``--critical`` and
         ``--no-critical`` are flags, the others take one value, any text (refused before it is
         parsed).
+    nargs : mapping of str to int, optional
+        The options among ``flags`` that take several values (``{"--fraction": 3}``).
 
     Returns
     -------
@@ -116,10 +120,12 @@ def humanoid_only(command: str, *flags: str) -> Callable[[F], F]:
             f"'pushrecovery humanoid {command} {shown}'"
         )
 
-    return _refused(flags, message)
+    return _refused(flags, message, nargs or {})
 
 
-def planar_only(command: str, *flags: str) -> Callable[[F], F]:
+def planar_only(
+    command: str, *flags: str, nargs: Mapping[str, int] | None = None
+) -> Callable[[F], F]:
     """Return hidden options of a humanoid command that refuse the planar models' ``flags``.
 
     Parameters
@@ -127,7 +133,9 @@ def planar_only(command: str, *flags: str) -> Callable[[F], F]:
     command : str
         The humanoid command (``simulate`` for ``pushrecovery humanoid simulate``).
     *flags : str
-        The planar options (``--xdot``), each taking one value.
+        The planar options (``--xdot``), each taking one value, any text.
+    nargs : mapping of str to int, optional
+        The options among ``flags`` that take several values (``{"--x0": 3}``).
 
     Returns
     -------
@@ -142,11 +150,13 @@ def planar_only(command: str, *flags: str) -> Callable[[F], F]:
             f"'pushrecovery humanoid {command} --help'"
         )
 
-    return _refused(flags, message)
+    return _refused(flags, message, nargs or {})
 
 
-def _refused(flags: tuple[str, ...], message: Callable[[str, str], str]) -> Callable[[F], F]:
-    """Add the hidden ``flags``: each one given raises ``message(flag, flag and its value)``."""
+def _refused(
+    flags: tuple[str, ...], message: Callable[[str, str], str], nargs: Mapping[str, int]
+) -> Callable[[F], F]:
+    """Add the hidden ``flags``: each one given raises ``message(flag, flag and its values)``."""
 
     def refuse(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
         if value is None or value is False:
@@ -154,7 +164,8 @@ def _refused(flags: tuple[str, ...], message: Callable[[str, str], str]) -> Call
         from pushrecovery.errors import InvalidParameterError
 
         flag = param.opts[0]
-        raise InvalidParameterError(message(flag, flag if flag in _FLAGS else f"{flag} {value}"))
+        given = " ".join(value) if isinstance(value, tuple) else value
+        raise InvalidParameterError(message(flag, flag if flag in _FLAGS else f"{flag} {given}"))
 
     def apply(func: F) -> F:
         for flag in reversed(flags):
@@ -163,6 +174,7 @@ def _refused(flags: tuple[str, ...], message: Callable[[str, str], str]) -> Call
                 is_flag=flag in _FLAGS,
                 default=False if flag in _FLAGS else None,
                 type=None if flag in _FLAGS else str,
+                nargs=nargs.get(flag, 1),
                 hidden=True,
                 expose_value=False,
                 callback=refuse,

@@ -1,10 +1,11 @@
 """The ``pushrecovery humanoid`` commands: the 3-D humanoids under the whole-body controller.
 
-``humanoid simulate``, ``humanoid critical-push`` and ``humanoid validate`` run biped3d and g1
-(MuJoCo, pushes at the torso from any azimuth; docs/humanoid3d.md) and list only the options
-that work for them (issue 31); the planar commands of the same names refuse the humanoids in
-one line naming these. The runs are in :mod:`pushrecovery.cli.simulation3d` and
-:mod:`pushrecovery.cli.validate3d`.
+``humanoid simulate``, ``humanoid critical-push``, ``humanoid validate`` and ``humanoid
+campaign`` run biped3d and g1 (MuJoCo, pushes at the torso from any azimuth;
+docs/humanoid3d.md) and list only the options that work for them (issue 31); the planar
+commands of the same names refuse the humanoids in one line naming these. The runs are in
+:mod:`pushrecovery.cli.simulation3d`, :mod:`pushrecovery.cli.validate3d` and
+:mod:`pushrecovery.cli.campaign3d`.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.campaign_options import run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, planar_only
 from pushrecovery.cli.options import body_options, echo_confusion, emit
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
@@ -295,7 +297,7 @@ def validate(
     """
     from pathlib import Path
 
-    from pushrecovery.cli.campaign3d import azimuths_from
+    from pushrecovery.cli.azimuths import azimuths_from
     from pushrecovery.cli.simulation3d import params_3d
     from pushrecovery.cli.validate3d import QUICK, Validate3DOptions, fraction_list, validate_3d
     from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
@@ -323,6 +325,142 @@ def validate(
         emit(data, True)
         return
     _echo_validation(data)
+
+
+@humanoid.command(
+    short_help="Sweep pushes over azimuths, push sizes and parameters, at scale.",
+    epilog=_example(
+        "campaign --model biped3d --azimuths 0:360:90 --fraction 0.5 1.5 0.5 --out out/c3d"
+    ),
+)
+@_model("campaign")
+@planar_only(
+    "campaign", "--backend", "--controller", "--x0", "--xdot", nargs={"--x0": 3, "--xdot": 3}
+)
+@click.option(
+    "--azimuth", type=float, default=None, help="One push direction [deg], 0 forward, 90 left."
+)
+@click.option(
+    "--azimuths",
+    default=None,
+    metavar="GRID",
+    help="Push directions [deg], START:STOP:STEP (a full turn's STOP, 360, is left out) or a "
+    "list A,B,...; 0 forward, 90 left (default 0).",
+)
+@click.option(
+    "--impulse",
+    nargs=3,
+    type=float,
+    default=None,
+    metavar="START STOP STEP",
+    help="Pushes as impulses at the torso [N s], along each azimuth.",
+)
+@click.option(
+    "--fraction",
+    nargs=3,
+    type=float,
+    default=None,
+    metavar="START STOP STEP",
+    help="Pushes as fractions of the ankle's predicted critical impulse along each azimuth [-].",
+)
+@click.option(
+    "--strategy",
+    type=click.Choice(("ankle", "hip", "step")),
+    default=None,
+    help="The whole-body controller's tasks: ankles only, + the hip task, + the hip and "
+    "stepping tasks (default step).",
+)
+@run_options(
+    param_help="Sweep a body parameter of biped3d (SI units), repeatable: e.g. mass=60:80:10.",
+    samples_help="Draw this many pushes uniformly from the ranges (with --seed) instead of the "
+    "grid; the azimuth between the smallest and the largest given.",
+    batch_size_help="Pushes per task (default about a second of work).",
+)
+@body_options
+def campaign(
+    model: str,
+    azimuth: float | None,
+    azimuths: str | None,
+    impulse: tuple[float, float, float] | None,
+    fraction: tuple[float, float, float] | None,
+    strategy: str | None,
+    sweep_pairs: tuple[str, ...],
+    samples: int | None,
+    seed: int,
+    duration: float,
+    batch_size: int | None,
+    push_timeout: float,
+    out: str,
+    workers: int | None,
+    scheduler: str | None,
+    resume: bool,
+    plot: bool,
+    as_json: bool,
+    **kwargs: Any,
+) -> None:
+    """Push a 3-D humanoid from every azimuth with every push; compare with the prediction.
+
+    The standing body is pushed at its torso from each of --azimuths with each push (--impulse,
+    or --fraction of the ankle's predicted critical impulse along the azimuth) under the
+    whole-body controller (--strategy), and each run is set beside the ground plane's
+    predicted strategy: OUT/pushes.parquet has one row per push, OUT/summary.json the counts,
+    the accuracy and the critical pushes per azimuth, OUT/confusion3d.* the confusion matrix of
+    predicted against used strategy. Finished batches are kept: an interrupted campaign
+    continues with --resume. The body flags (--preset, --params, --mass, ...) build biped3d;
+    g1 has the robot's own body and refuses them and --param.
+    """
+    from pathlib import Path
+
+    from pushrecovery.cli.azimuths import azimuths_from
+    from pushrecovery.cli.campaign3d import echo_causes, spec_3d, stored_spec_3d, write_confusion
+    from pushrecovery.cli.campaign_options import echo_counts, echo_files, run_spec, sweeps_from
+    from pushrecovery.cli.simulation3d import params_3d
+    from pushrecovery.errors import InvalidParameterError
+
+    directory = Path(out)
+    directions = azimuths_from(azimuth, azimuths)
+    if resume and impulse is None and fraction is None and directions is None:
+        from click.core import ParameterSource
+
+        given = click.get_current_context().get_parameter_source("model")
+        if sweep_pairs or samples is not None or strategy or given is ParameterSource.COMMANDLINE:
+            raise InvalidParameterError(
+                "--resume without --impulse or --fraction runs the stored campaign: give its "
+                "whole spec or none"
+            )
+        spec = stored_spec_3d(directory)  # the stored campaign, as it was asked for
+    else:
+        if (impulse is None) == (fraction is None):
+            raise InvalidParameterError(
+                "humanoid campaign needs one of --impulse, --fraction"
+                if impulse is None
+                else "give --impulse or --fraction, not both"
+            )
+        spec = spec_3d(
+            model,
+            params_3d(model, kwargs),
+            strategy,
+            impulse=impulse,
+            fraction=fraction,
+            azimuths=directions,
+            sweeps=sweeps_from(sweep_pairs),
+            samples=samples,
+            seed=seed,
+            duration=duration,
+            batch_size=batch_size,
+            push_timeout=push_timeout,
+        )
+    result = run_spec(spec, directory, workers, scheduler, resume)
+    files = {"pushes": str(result.pushes_file), "summary": str(directory / "summary.json")}
+    confusion, written = write_confusion(result.table, spec.model, directory, plot)
+    files.update(written)
+    summary = {**result.summary, "files": files}
+    if as_json:
+        emit(summary, True)
+        return
+    echo_counts(summary, result.ran, spec.batches)
+    echo_causes(confusion)
+    echo_files(files)
 
 
 def _echo_validation(data: dict[str, Any]) -> None:

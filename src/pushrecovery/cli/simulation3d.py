@@ -304,8 +304,3 @@ def critical_3d(
         "strategy": found.strategy,
         "hip_task": plant.hip_task,
     }
-
-
-#: ``cli.campaign3d``'s name for :func:`params_3d` (until the campaign's own change imports
-#: the public name).
-_params_3d = params_3d
