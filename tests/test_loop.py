@@ -116,7 +116,7 @@ def test_the_3d_humanoids_run_in_the_one_loop():
         Biped3DPlant,
         wbc_for,
     )
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import run_push3d
 
     plant = Biped3DPlant(P)
     assert isinstance(plant, Clocked)
@@ -136,14 +136,14 @@ def test_the_3d_humanoids_run_in_the_one_loop():
                     push=ScheduledPush(0.0, Push3D(60.0, 90.0), react=True))  # fmt: skip
     assert fell.outcome is Outcome.FELL and fell.decided_time == fell.time[-1] == plant.clock
     with pytest.raises(InvalidParameterError, match="duration must be"):
-        simulate_push3d(plant, wbc_for(plant), Push3D(1.0, 0.0), duration=59.95)
+        run_push3d(plant, wbc_for(plant), Push3D(1.0, 0.0), duration=59.95)
 
 
 def test_a_pushed_3d_run_carries_its_extras_in_the_result():
     # run_push3d: the loop's result with the push's row, peaks and frames (Push3DExtras);
-    # Push3DRun.of keeps its rows from the push on, as simulate_push3d returns them.
+    # pushed_rows: the standing start, then every row from the end of the push on.
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, wbc_for
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import Push3DRun, run_push3d, simulate_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import pushed_rows, run_push3d
 
     plant = Biped3DPlant(P)
     push = Push3D(30.0, 0.0)
@@ -152,22 +152,22 @@ def test_a_pushed_3d_run_carries_its_extras_in_the_result():
     assert extras is not None and extras.push is push and extras.push_row == 6
     assert extras.qpos is not None and len(extras.qpos) == len(result.time)
     assert result.strategy_used() is Strategy.HIP and extras.peak_hip_torque > 1.0
-    run = Push3DRun.of(result)
-    again = simulate_push3d(plant, wbc_for(plant), push, duration=0.2, push_time=0.01, record=True)
-    assert run.strategy_used() == again.strategy_used() == "hip"
-    for name in ("time", "states", "after_push", "before_push", "qpos", "qvel", "ctrl"):
-        assert np.array_equal(getattr(run, name), getattr(again, name)), name
-    assert len(run.time) == len(result.time) - 5 and np.array_equal(run.after_push, run.states[1])
+    rows = pushed_rows(result)
+    assert rows.tolist() == [0, *range(6, len(result.time))]  # rows 1-5: standing, then the push
+    again = run_push3d(plant, wbc_for(plant), push, duration=0.2, push_time=0.01, record=True)
+    assert again.strategy_used() is Strategy.HIP
+    assert np.array_equal(again.states, result.states) and np.array_equal(again.time, result.time)
     with pytest.raises(InvalidParameterError, match="pushed 3-D run"):
-        Push3DRun.of(simulate(make_plant("lipm", P), make_controller("ankle-pd", P),
-                              np.zeros(2), duration=0.01))  # fmt: skip
+        pushed_rows(simulate(make_plant("lipm", P), make_controller("ankle-pd", P),
+                             np.zeros(2), duration=0.01))  # fmt: skip
     with pytest.raises(ParameterTypeError, match="result must be a SimulationResult"):
-        Push3DRun.of(run)  # type: ignore[arg-type]
+        pushed_rows(extras)  # type: ignore[arg-type]
     from pushrecovery.sim.mujoco.humanoid3d.render3d import Recording3D
 
     recorded = Recording3D.of_plant_run(plant, result)  # its rows from the push on
-    assert np.array_equal(recorded.time, run.time) and np.array_equal(recorded.qpos, run.qpos)
-    with pytest.raises(ParameterTypeError, match="run must be a SimulationResult or Push3DRun"):
+    assert np.array_equal(recorded.time, result.time[rows])
+    assert np.array_equal(recorded.qpos, extras.qpos[rows])
+    with pytest.raises(ParameterTypeError, match="result must be a SimulationResult"):
         Recording3D.of_plant_run(plant, extras)  # type: ignore[arg-type]
 
 

@@ -22,7 +22,7 @@ from pushrecovery.sim.mujoco.humanoid3d.render3d import (
     render_recording3d,
     run_frames,
 )
-from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
+from pushrecovery.sim.mujoco.humanoid3d.runs3d import run_push3d
 from pushrecovery.sim.mujoco.render import require_offscreen_gl
 from pushrecovery.sim.mujoco.render.frames import subsample_indices
 from pushrecovery.sim.mujoco.render.overlay3d import PULL, Frame3D, overlay_markers
@@ -69,8 +69,8 @@ def plant() -> Biped3DPlant:
 
 @pytest.fixture(scope="module")
 def recording(plant: Biped3DPlant) -> Recording3D:
-    run = simulate_push3d(plant, wbc_for(plant), Push3D(IMPULSE, AZIMUTH), duration=AFTER,
-                          record=True)  # fmt: skip
+    run = run_push3d(plant, wbc_for(plant), Push3D(IMPULSE, AZIMUTH), duration=AFTER,
+                     record=True)  # fmt: skip
     return Recording3D.of_plant_run(plant, run)
 
 
@@ -247,7 +247,7 @@ def test_bad_frames_and_options_are_refused(
 
 
 def test_an_unrecorded_run_is_refused(plant: Biped3DPlant) -> None:
-    run = simulate_push3d(plant, wbc_for(plant), Push3D(5.0, 0.0), duration=0.01)
+    run = run_push3d(plant, wbc_for(plant), Push3D(5.0, 0.0), duration=0.01)
     with pytest.raises(InvalidParameterError, match="record=True"):
         Recording3D.of_plant_run(plant, run)
 

@@ -14,6 +14,7 @@ from pushrecovery.cli.options import params_from
 
 if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
+    from pushrecovery.sim.result import SimulationResult
 
 __all__ = ["check_views", "critical_3d", "params_3d", "render_options", "simulate_3d"]
 
@@ -142,7 +143,7 @@ def render_options(
 
 
 def _render_3d(
-    plant: Humanoid3DPlant, run: Any, path: str, options: dict[str, Any]
+    plant: Humanoid3DPlant, run: SimulationResult, path: str, options: dict[str, Any]
 ) -> dict[str, Any]:
     """Write the filmstrip PNG and GIF of a recorded 3-D run (the JSON's new keys)."""
     import shutil
@@ -206,7 +207,7 @@ def simulate_3d(
     import numpy as np
 
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import STATE_LABELS, wbc_for
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import simulate_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import pushed_rows, run_push3d
     from pushrecovery.sim.push import Push3D
     from pushrecovery.sim.registry import make_plant3d
     from pushrecovery.surfaces.classify import classify as classify_state
@@ -216,8 +217,11 @@ def simulate_3d(
     predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
     plant = make_plant3d(model, params)
     wbc = wbc_for(plant, stepping=stepping)
-    run = simulate_push3d(plant, wbc, push, duration=duration, record=bool(render))
-    states, before, after = run.states, run.before_push, run.after_push
+    run = run_push3d(plant, wbc, push, duration=duration, record=bool(render))
+    extras = run.extras
+    assert extras is not None  # a pushed run's
+    states = run.states[pushed_rows(run)]
+    before, after = run.states[extras.push_row - 1], run.states[extras.push_row]
     return {
         "recovered": run.recovered,
         "outcome": run.outcome.value,
@@ -228,7 +232,7 @@ def simulate_3d(
         "max_excursion": float(
             np.hypot(states[:, 0] - states[0, 0], states[:, 1] - states[0, 1]).max()
         ),
-        "peak_torque": run.peak_torque,
+        "peak_torque": extras.peak_torque,
         "stop_impacts": 0,
         "initial_state": {"x": 0.0, "xdot": 0.0, "y": 0.0, "ydot": 0.0},
         "predicted": predicted.to_dict(),
@@ -246,13 +250,13 @@ def simulate_3d(
             "expected": [dvx, dvy],
             "measured": [float(after[3] - before[3]), float(after[4] - before[4])],
         },
-        "steps": run.steps,
+        "steps": extras.steps,
         "stepping": stepping,
-        "strategy": run.strategy_used(),
-        "peak_hip_torque": run.peak_hip_torque,
-        "peak_hip_motor_torque": run.peak_hip_motor_torque,
-        "max_torso_tilt": run.max_torso_tilt,
-        "failed_ticks": run.failed_ticks,
+        "strategy": run.strategy_used().value,
+        "peak_hip_torque": extras.peak_hip_torque,
+        "peak_hip_motor_torque": extras.peak_hip_motor_torque,
+        "max_torso_tilt": extras.max_torso_tilt,
+        "failed_ticks": extras.failed_ticks,
         "hip_task": plant.hip_task,
     } | (_render_3d(plant, run, render, pictures or {}) if render else {})
 

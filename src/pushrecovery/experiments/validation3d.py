@@ -51,7 +51,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
@@ -146,7 +146,7 @@ def measure_critical_impulse(
         For a non-positive guess, a tolerance or duration out of range.
     """
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import wbc_for
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical, simulate_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical, run_push3d
     from pushrecovery.sim.push import IMPULSE_MAX, Push3D
     from pushrecovery.sim.result import Outcome
 
@@ -163,10 +163,10 @@ def measure_critical_impulse(
             raise InvalidParameterError(
                 f"guess {guess:g} N s: no stand/fall bracket within {MAX_RUNS} runs"
             )
-        run = simulate_push3d(
+        run = run_push3d(
             plant, wbc_for(plant, hip=hip), Push3D(impulse, azimuth), duration=duration
         )
-        return run.outcome is not Outcome.FELL, run.strategy_used()
+        return run.outcome is not Outcome.FELL, run.strategy_used().value
 
     low, bracket, used = bisect_critical(
         stands, 0.8 * guess, min(1.2 * guess, IMPULSE_MAX), rel_tolerance * guess,

@@ -41,7 +41,7 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   is the largest torso tilt since the last push.
 
 :func:`~pushrecovery.sim.simulate.simulate` is the loop of these plants
-(:func:`~.runs3d.simulate_push3d`: stand, push, run the whole-body controller).
+(:func:`~.runs3d.run_push3d`: stand, push, run the whole-body controller).
 """
 
 from __future__ import annotations

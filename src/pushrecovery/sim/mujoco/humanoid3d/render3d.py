@@ -38,7 +38,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import convex_hull
 from pushrecovery.sim.mujoco.humanoid3d.measure import subtree
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
-from pushrecovery.sim.mujoco.humanoid3d.runs3d import Push3DRun
+from pushrecovery.sim.mujoco.humanoid3d.runs3d import pushed_rows
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import WbcRun
 from pushrecovery.sim.mujoco.render.frames import select_indices, subsample_indices
 from pushrecovery.sim.mujoco.render.output import output_paths, write_animation, write_filmstrip
@@ -124,22 +124,24 @@ class Recording3D:
         positive_float("omega", self.omega, "1/s")
 
     @classmethod
-    def of_plant_run(cls, plant: Humanoid3DPlant, run: SimulationResult | Push3DRun) -> Recording3D:
-        """Return the recording of ``run_push3d(plant, ..., record=True)`` (or its Push3DRun).
+    def of_plant_run(cls, plant: Humanoid3DPlant, run: SimulationResult) -> Recording3D:
+        """Return the recording of ``run_push3d(plant, ..., record=True)``.
 
-        Its rows are the standing start, the state after the push and every tick after it.
+        Its rows are :func:`~.runs3d.pushed_rows`: the standing start, the state after the
+        push and every tick after it.
         """
         require_type("plant", plant, Humanoid3DPlant)
-        require_type("run", run, (SimulationResult, Push3DRun))
-        if isinstance(run, SimulationResult):
-            run = Push3DRun.of(run)
-        if run.qpos is None or run.qvel is None or run.ctrl is None:
+        rows = pushed_rows(run)
+        extras = run.extras
+        assert extras is not None  # pushed_rows refuses a run without
+        if extras.qpos is None or extras.qvel is None or extras.ctrl is None:
             raise InvalidParameterError(
                 "run has no recorded states to render: run_push3d(..., record=True)"
             )
-        return cls(plant.model, tuple(plant.feet), plant.omega, plant.floor, run.push.azimuth,
-                   run.time, run.qpos, run.qvel, run.ctrl, run.states[:, :3],
-                   run.states[:, 3:6])  # fmt: skip
+        states = run.states[rows]
+        return cls(plant.model, tuple(plant.feet), plant.omega, plant.floor, extras.push.azimuth,
+                   run.time[rows], extras.qpos[rows], extras.qvel[rows], extras.ctrl[rows],
+                   states[:, :3], states[:, 3:6])  # fmt: skip
 
     @classmethod
     def of_wbc_run(cls, run: WbcRun, azimuth: float) -> Recording3D:

@@ -5,8 +5,8 @@
 :data:`~.plant3d.CONTROL_PERIOD` until the plant's fall set, rest over the support polygon for
 ``rest_duration``, or ``duration``: the one loop, :func:`~pushrecovery.sim.simulate.simulate`,
 whose :class:`~pushrecovery.sim.result.SimulationResult` carries the run's
-:class:`~pushrecovery.sim.result.Push3DExtras`. :func:`simulate_push3d` is the same run as a
-:class:`Push3DRun` (its rows from the push on; the CLI's). :func:`critical_push3d`: the largest
+:class:`~pushrecovery.sim.result.Push3DExtras` (:func:`pushed_rows`: the rows a reader of the
+push sees). :func:`critical_push3d`: the largest
 impulse at an azimuth that does not fall. The plants are :mod:`.plant3d`'s.
 """
 
@@ -30,138 +30,35 @@ from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     wbc_for,
 )
 from pushrecovery.sim.push import Push3D
-from pushrecovery.sim.result import Outcome, Push3DExtras, SimulationResult, strategy_used
+from pushrecovery.sim.result import Outcome, Push3DExtras, SimulationResult
 from pushrecovery.sim.simulate import MAX_DURATION, RestCriterion, simulate
 
 FloatArray = NDArray[np.float64]
 
 __all__ = [
     "CriticalPush3D",
-    "Push3DRun",
     "bisect_critical",
     "critical_push3d",
+    "pushed_rows",
     "run_push3d",
-    "simulate_push3d",
 ]
 
 
-@dataclass(frozen=True)
-class Push3DRun:
-    """The outcome of :func:`simulate_push3d`.
+def pushed_rows(result: SimulationResult) -> NDArray[np.intp]:
+    """Return the rows of a :func:`run_push3d` result that show the push.
 
-    Attributes
-    ----------
-    outcome : Outcome
-        recovered (at rest over P for ``rest_duration``), fell (the fall set) or undecided.
-    push : Push3D
-        The push.
-    time : float array, shape (n,)
-        Time of each control tick since reset [s].
-    states : float array, shape (n, 6)
-        The plant's state at each tick (:data:`STATE_LABELS`).
-    after_push : float array, shape (6,)
-        The state as the push ended.
-    before_push : float array, shape (6,)
-        The state as the push began.
-    peak_hip_torque : float
-        Largest flywheel torque the WBC's hip law commanded after the push, m g |δ| (δ its
-        CMP offset) [N m]: 0 when the ankles sufficed.
-    peak_hip_motor_torque : float
-        Largest |hip pitch or roll motor command − its value before the push| after it [N m]
-        (the hips also stop the torso's spin after a torso push, whatever the strategy).
-    max_torso_tilt : float
-        Largest tilt of the upright body from the vertical after the push [rad].
-    peak_torque : float
-        Largest |motor command| of the run [N m].
-    failed_ticks : int
-        Ticks DAQP did not solve (the last command repeated).
-    qpos, qvel, ctrl : float arrays, shapes (n, nq), (n, nv), (n, nu), or None
-        MuJoCo's ``qpos``, ``qvel`` and the held motor commands at each row of ``time``
-        (``simulate_push3d(..., record=True)``: to replay and render the run); None otherwise.
-    steps : int
-        Steps that landed (the controller's stepping task; 0 without it).
+    The standing start, then every row from the end of the push on (the rows during the 10 ms
+    push left out): what the CLI reports and a filmstrip shows.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``result`` has no :class:`~pushrecovery.sim.result.Push3DExtras`.
     """
-
-    outcome: Outcome
-    push: Push3D
-    time: FloatArray
-    states: FloatArray
-    after_push: FloatArray
-    before_push: FloatArray
-    peak_hip_torque: float
-    peak_hip_motor_torque: float
-    max_torso_tilt: float
-    peak_torque: float
-    failed_ticks: int
-    qpos: FloatArray | None = None
-    qvel: FloatArray | None = None
-    ctrl: FloatArray | None = None
-    steps: int = 0
-
-    @property
-    def recovered(self) -> bool:
-        """True when the body came to rest over its feet."""
-        return self.outcome is Outcome.RECOVERED
-
-    def strategy_used(self) -> str:
-        """Return ``step``, ``hip`` or ``ankle`` by the one definition (``sim.result``).
-
-        ``step`` if a step landed, else ``hip`` if ``peak_hip_torque`` exceeded its threshold
-        (1 N m), else ``ankle``.
-        """
-        return strategy_used(self.steps, self.peak_hip_torque).value
-
-    @classmethod
-    def of(cls, result: SimulationResult) -> Push3DRun:
-        """Return the run of :func:`run_push3d`'s ``result``: its rows from the push on.
-
-        Raises
-        ------
-        InvalidParameterError
-            If ``result`` has no :class:`~pushrecovery.sim.result.Push3DExtras`.
-        """
-        require_type("result", result, SimulationResult)
-        extras = result.extras
-        if extras is None:
-            raise InvalidParameterError("result must be a pushed 3-D run's (run_push3d)")
-        after = extras.push_row
-        rows = np.r_[0, after : len(result.time)]
-        frames = [None if a is None else a[rows] for a in (extras.qpos, extras.qvel, extras.ctrl)]
-        return cls(
-            outcome=result.outcome,
-            push=extras.push,
-            time=result.time[rows],
-            states=result.states[rows],
-            after_push=result.states[after].copy(),
-            before_push=result.states[after - 1].copy(),
-            peak_hip_torque=extras.peak_hip_torque,
-            peak_hip_motor_torque=extras.peak_hip_motor_torque,
-            max_torso_tilt=extras.max_torso_tilt,
-            peak_torque=extras.peak_torque,
-            failed_ticks=extras.failed_ticks,
-            qpos=frames[0],
-            qvel=frames[1],
-            ctrl=frames[2],
-            steps=extras.steps,
-        )
-
-
-def simulate_push3d(
-    plant: Humanoid3DPlant,
-    controller: WholeBodyController,
-    push: Push3D,
-    *,
-    duration: float = 3.0,
-    push_time: float = 0.1,
-    rest_speed: float = 5e-3,
-    rest_duration: float = 0.5,
-    record: bool = False,
-) -> Push3DRun:
-    """Return :func:`run_push3d`'s run as a :class:`Push3DRun` (the same arguments)."""
-    return Push3DRun.of(
-        run_push3d(plant, controller, push, duration=duration, push_time=push_time,
-                   rest_speed=rest_speed, rest_duration=rest_duration, record=record)
-    )  # fmt: skip
+    require_type("result", result, SimulationResult)
+    if result.extras is None:
+        raise InvalidParameterError("result must be a pushed 3-D run's (run_push3d)")
+    return np.r_[0, result.extras.push_row : len(result.time)]
 
 
 def run_push3d(
