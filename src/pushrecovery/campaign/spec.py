@@ -13,6 +13,9 @@ random campaign draws it uniformly between the smallest and largest azimuth), th
 be fractions of the ankle's predicted critical impulse along it (``fraction``), and the
 controller is the whole-body controller with one strategy set (``wbc-ankle``, ``wbc-hip``,
 ``wbc-step``).
+
+Over 400 lines on purpose: one concept, the spec and its checks; the 3-D part is in
+:mod:`.spec3d`.
 """
 
 from __future__ import annotations

@@ -6,6 +6,9 @@ docs/humanoid3d.md) and list only the options that work for them (issue 31); the
 commands of the same names refuse the humanoids in one line naming these. The runs are in
 :mod:`pushrecovery.cli.simulation3d`, :mod:`pushrecovery.cli.validate3d` and
 :mod:`pushrecovery.cli.campaign3d`.
+
+Over 400 lines on purpose: the four commands of one group, each mostly its options and
+their help, which a reader compares side by side.
 """
 
 from __future__ import annotations

@@ -44,6 +44,10 @@ Contract: :class:`WholeBodyController` is a :class:`~pushrecovery.control.base.C
 physics' own arrays: nothing copied per tick), and ``compute`` returns a
 :class:`~.observation.HumanoidCommand`: the motor commands [N m], the DCM law's CoP, and the
 support polygon and stance the plant's fall rule reads when the controller steps.
+
+Over 400 lines on purpose: the task laws above share the controller's state (the reset
+pose, the support, the stepper's phase) tick by tick; the tasks' rows and the QP are in
+:mod:`.tasks` and :mod:`.qp`.
 """
 
 from __future__ import annotations

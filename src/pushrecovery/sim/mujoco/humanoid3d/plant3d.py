@@ -42,6 +42,9 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
 
 :func:`~pushrecovery.sim.simulate.simulate` is the loop of these plants
 (:func:`~.runs3d.run_push3d`: stand, push, run the whole-body controller).
+
+Over 400 lines on purpose: one class and the contract it keeps, item by item; the models are
+in :mod:`.biped3d` and :mod:`.robots`, the run in :mod:`.runs3d`.
 """
 
 from __future__ import annotations
