@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -26,6 +25,7 @@ from pushrecovery.control.ankle import default_pd_gains
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import check_com_state
+from pushrecovery.sim.many import DIVERGED, PushRuns
 from pushrecovery.sim.plants import PendulumPlant
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import DEFAULT_CONTROL_PERIOD, MAX_DURATION, RestCriterion
@@ -33,41 +33,9 @@ from pushrecovery.sim.simulate import DEFAULT_CONTROL_PERIOD, MAX_DURATION, Rest
 if TYPE_CHECKING:  # the recovery controller loads the MPC and scipy: only its batches need it
     from pushrecovery.control.recovery import RecoveryController
 
-__all__ = ["BatchedRuns", "ankle_pd_pushes", "recovery_pushes"]
+__all__ = ["ankle_pd_pushes", "recovery_pushes"]
 
 _OUTCOMES = (Outcome.UNDECIDED, Outcome.RECOVERED, Outcome.FELL)
-
-
-@dataclass(frozen=True, slots=True)
-class BatchedRuns:
-    """The runs of :func:`ankle_pd_pushes`, one entry per push.
-
-    Attributes
-    ----------
-    outcomes : tuple of Outcome
-        Recovered, fell or undecided.
-    times : ndarray
-        Simulated time at which the run ended (its outcome decided, or the duration) [s].
-    cop_min, cop_max : ndarray
-        CoP excursion applied over the run [m].
-    steps : ndarray of int
-        Feet that landed (0 without legs).
-    peak_hip_torque : ndarray
-        Largest |hip torque| applied [N m] (0 without an upper body).
-    stop_impacts : ndarray of int
-        Times the upper body hit its joint stop.
-    diverged : ndarray of bool
-        Runs whose state stopped being finite (their other entries are not to be used).
-    """
-
-    outcomes: tuple[Outcome, ...]
-    times: NDArray[np.float64]
-    cop_min: NDArray[np.float64]
-    cop_max: NDArray[np.float64]
-    steps: NDArray[np.int64]
-    peak_hip_torque: NDArray[np.float64]
-    stop_impacts: NDArray[np.int64]
-    diverged: NDArray[np.bool_]
 
 
 def ankle_pd_pushes(
@@ -77,7 +45,7 @@ def ankle_pd_pushes(
     xdot: Sequence[float],
     *,
     duration: float,
-) -> BatchedRuns:
+) -> PushRuns:
     """Simulate the ankle PD after each push (x0[i], xdot[i]) on bodies[i].
 
     Parameters
@@ -94,7 +62,7 @@ def ankle_pd_pushes(
 
     Returns
     -------
-    BatchedRuns
+    PushRuns
         One entry per push, in order.
 
     Raises
@@ -144,16 +112,11 @@ def ankle_pd_pushes(
     )
     times: NDArray[np.float64] = end.astype(np.float64) * dt
     zeros = np.zeros(count, dtype=np.int64)
-    return BatchedRuns(
-        tuple(_OUTCOMES[c] for c in code.tolist()),
-        times,
-        cop_min,
-        cop_max,
-        steps=zeros,
-        peak_hip_torque=np.zeros(count),
-        stop_impacts=zeros,
-        diverged=np.zeros(count, dtype=np.bool_),
-    )
+    return PushRuns(
+        tuple(_OUTCOMES[c] for c in code.tolist()), times, cop_min, cop_max, steps=zeros,
+        peak_hip_torque=np.zeros(count), stop_impacts=zeros, errors=(None,) * count,
+        engine="compiled",
+    )  # fmt: skip
 
 
 def recovery_pushes(
@@ -163,7 +126,7 @@ def recovery_pushes(
     *,
     duration: float,
     controllers: dict[BodyParams, RecoveryController] | None = None,
-) -> BatchedRuns:
+) -> PushRuns:
     """Simulate the recovery controller on the stepping model after each push (x0[i], xdot[i]).
 
     What ``simulate(SteppingPlant(b), RecoveryController(b), [x0, 0, L, ẋ, 0, 0])`` gives with
@@ -186,7 +149,7 @@ def recovery_pushes(
 
     Returns
     -------
-    BatchedRuns
+    PushRuns
         One entry per push, in order.
 
     Raises
@@ -233,16 +196,11 @@ def recovery_pushes(
         steps[i], stops[i] = n[kernel.LANDINGS], n[kernel.STOPS]
         cop_min[i], cop_max[i], peak[i] = f[kernel.COP_MIN], f[kernel.COP_MAX], f[kernel.PEAK_TAU]
     times: NDArray[np.float64] = end.astype(np.float64) * DEFAULT_CONTROL_PERIOD
-    return BatchedRuns(
-        tuple(_OUTCOMES[c] for c in code.tolist()),
-        times,
-        cop_min,
-        cop_max,
-        steps=steps,
-        peak_hip_torque=peak,
-        stop_impacts=stops,
-        diverged=diverged,
-    )
+    return PushRuns(
+        tuple(_OUTCOMES[c] for c in code.tolist()), times, cop_min, cop_max, steps=steps,
+        peak_hip_torque=peak, stop_impacts=stops,
+        errors=tuple(DIVERGED if d else None for d in diverged.tolist()), engine="compiled",
+    )  # fmt: skip
 
 
 def _answer(

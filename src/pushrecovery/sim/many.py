@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,9 +28,6 @@ from pushrecovery.errors import (
 )
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.result import Outcome
-
-if TYPE_CHECKING:
-    from pushrecovery.sim.batched import BatchedRuns
 
 __all__ = ["COMPILED", "DIVERGED", "ENGINES", "LOOP_UP_TO", "ROLLOUT", "PushRuns", "run_many"]
 
@@ -153,7 +150,7 @@ def run_many(
         )
     chosen = _engine(engine, model, controller, backend, count)
     if chosen == "compiled":
-        return _of_batched(_compiled(model, controller, bodies, x0, xdot, duration), chosen)
+        return _compiled(model, controller, bodies, x0, xdot, duration)
     if chosen == "rollout":
         if on_start is not None:
             on_start(count)
@@ -185,20 +182,12 @@ def _compiled(
     x0: Sequence[float],
     xdot: Sequence[float],
     duration: float,
-) -> BatchedRuns:
+) -> PushRuns:
     from pushrecovery.sim.batched import ankle_pd_pushes, recovery_pushes
 
     if controller == "recovery":
         return recovery_pushes(bodies, x0, xdot, duration=duration)
     return ankle_pd_pushes(model, bodies, x0, xdot, duration=duration)
-
-
-def _of_batched(runs: BatchedRuns, engine: str) -> PushRuns:
-    return PushRuns(
-        runs.outcomes, runs.times, runs.cop_min, runs.cop_max, runs.steps,
-        runs.peak_hip_torque, runs.stop_impacts,
-        tuple(DIVERGED if d else None for d in runs.diverged.tolist()), engine,
-    )  # fmt: skip
 
 
 def _rollout(
