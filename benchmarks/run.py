@@ -340,6 +340,49 @@ def campaigns() -> None:
         shutil.rmtree(root, ignore_errors=True)
 
 
+def mujoco_campaign() -> float:
+    """A MuJoCo torso + MPC campaign's physics rate against raw mj_step of the same model.
+
+    The campaign's batches run in this process, warm (its steps: each push's 10 ms force and
+    its run until decided, one per millisecond); the baseline is ``mujoco.mj_step`` alone on
+    the torso model, as many steps, in the same run. Target >= 0.7 (issue 31).
+    """
+    import time
+
+    import mujoco
+
+    from pushrecovery.campaign import CampaignSpec
+    from pushrecovery.campaign.pushes import run_batch
+    from pushrecovery.sim.mujoco.models import TIMESTEP
+    from pushrecovery.sim.mujoco.plant import PUSH_DURATION
+    from pushrecovery.sim.registry import make_plant
+
+    params = load_params()
+    spec = CampaignSpec(
+        "mujoco", "torso", "mpc", params,
+        x0=(-0.03, 0.12, 0.03), xdot=(-0.6, 0.9, 0.1), batch_size=10,
+    )  # fmt: skip
+    run_batch(spec, 0)  # imports, compiled kernels, the model warm
+    begin = time.perf_counter()
+    rows = [row for batch in range(spec.batches) for row in run_batch(spec, batch)[1]]
+    work = time.perf_counter() - begin
+    steps = sum(round(row["time"] / TIMESTEP) + round(PUSH_DURATION / TIMESTEP) for row in rows)
+    plant = make_plant("torso", params, "mujoco")
+    plant.reset(0.0, 0.0)
+    model, data = plant.model, plant.data
+    begin = time.perf_counter()
+    for _ in range(steps):
+        mujoco.mj_step(model, data)
+    raw = time.perf_counter() - begin
+    ratio = raw / work
+    print(
+        f"campaign mujoco torso + mpc, {len(rows)} pushes ({steps} physics steps) in this "
+        f"process: {steps / work:.0f} steps/s; raw mj_step of the same model {steps / raw:.0f} "
+        f"steps/s; ratio {ratio:.2f} (target >= 0.7{'' if ratio >= 0.7 else ': MISSED'})"
+    )
+    return ratio
+
+
 def batched() -> float:
     """Pushes per second on one core: pendulum + ankle PD campaign batches (compiled loop)."""
     import time
@@ -451,11 +494,13 @@ def main() -> int:
     batch_rate = batched()
     step_batch_rate = batched_stepping()
     campaigns()
+    campaign_ratio = mujoco_campaign()
     analysis()
     failed = ratio > 2.0 or cli > 1.5 or step_rate < 2e6 or step_ratio < 1000 or physics < 150
     failed = failed or bool(plane_failed) or bool(steps_failed) or bool(mpc_failed)
     failed = failed or bool(mujoco_failed) or bool(trials_failed) or bool(wbc_failed)
     failed = failed or batch_rate < 5000 or step_batch_rate < 500 or bool(cost_failed)
+    failed = failed or campaign_ratio < 0.7
     print("targets met" if not failed else "TARGET MISSED")
     return int(failed)
 
