@@ -186,3 +186,24 @@ def test_each_3d_model_stands_still_2s_unpushed(case):
             assert (floor, geom) in touching or (geom, floor) in touching
         normal = data.xmat[foot].reshape(3, 3)[:, 2]
         assert np.arccos(min(1.0, normal[2])) < FLAT
+
+
+def test_body_origins_are_the_kinematics_of_the_pose_and_refuse_unknown_bodies():
+    from pushrecovery.sim.mujoco.humanoid3d.measure import body_origins
+
+    model = biped3d_model(load_params())
+    qpos = model.qpos0.copy()
+    qpos[:3] = (0.3, -0.2, 1.5)  # the free root moved: every body moves with it
+    moved = body_origins(model, qpos, ("torso", "left_foot"))
+    still = body_origins(model, model.qpos0, ("torso", "left_foot"))
+    for name in ("torso", "left_foot"):
+        # The root's translation by (dx, dy, dz), written by hand from the two poses.
+        np.testing.assert_allclose(
+            moved[name] - still[name], qpos[:3] - model.qpos0[:3], atol=1e-12
+        )
+    with pytest.raises(InvalidParameterError, match="no body 'nose'"):
+        body_origins(model, qpos, ("nose",))
+    with pytest.raises(InvalidParameterError, match="qpos must have shape"):
+        body_origins(model, qpos[:-1], ("torso",))
+    with pytest.raises(InvalidParameterError, match="qpos"):
+        body_origins(model, np.full(model.nq, np.nan), ("torso",))

@@ -14,7 +14,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import finite_array
 from pushrecovery.control.wbc.bodies import sole_points
+from pushrecovery.errors import InvalidParameterError
 
 FloatArray = NDArray[np.float64]
 
@@ -34,14 +36,26 @@ def joint_id(model: Any, name: str) -> int:
 def body_origins(model: Any, qpos: FloatArray, names: tuple[str, ...]) -> dict[str, FloatArray]:
     """Return the world origin of each named body in pose ``qpos`` (forward kinematics) [m].
 
-    A KeyError names a body the model does not have.
+    Raises
+    ------
+    InvalidParameterError
+        If ``qpos`` is not finite of shape (nq,), or the model has no body of a name.
     """
     import mujoco
 
+    qpos = finite_array("qpos", qpos)
+    if qpos.shape != (model.nq,):
+        raise InvalidParameterError(f"qpos must have shape ({model.nq},), got {qpos.shape}")
+    ids = {}
+    for name in names:
+        index = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name))
+        if index < 0:
+            raise InvalidParameterError(f"the model has no body {name!r}")
+        ids[name] = index
     data = mujoco.MjData(model)
     data.qpos[:] = qpos
     mujoco.mj_kinematics(model, data)
-    return {name: np.array(data.xpos[model.body(name).id]) for name in names}
+    return {name: np.array(data.xpos[index]) for name, index in ids.items()}
 
 
 def subtree(model: Any, root: int) -> list[int]:
