@@ -133,3 +133,23 @@ def test_a_campaign_batch_of_foot_and_ankle_pd_runs_in_lockstep():
         assert abs(row["cop_max"] - loop["cop_max"]) < 1e-6
     assert outcomes == {"recovered", "fell"}
     assert campaign.size == len(rows) == 20
+
+
+def test_a_small_foot_campaign_takes_the_rollout_too(monkeypatch):
+    # The loop's rows are the rollout's only within a tick: a campaign's engine must not depend
+    # on its size here (only the analytic compiled pairs run small campaigns in the loop).
+    import pushrecovery.sim.many as many
+    from pushrecovery.campaign import CampaignSpec
+    from pushrecovery.campaign.pushes import run_batch
+
+    campaign = CampaignSpec(
+        "mujoco", "foot", "ankle-pd", P, x0=(0.0, 0.0, 0.1), xdot=(0.2, 0.4, 0.2), duration=0.5,
+    )  # fmt: skip
+    assert campaign.size == 2
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the one-push loop ran")
+
+    monkeypatch.setattr(many, "_loop", refuse)
+    _, rows = run_batch(campaign, 0)
+    assert len(rows) == 2 and all(row["error"] is None for row in rows)

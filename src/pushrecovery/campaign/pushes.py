@@ -216,11 +216,14 @@ def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]
     with one_thread():
         try:
             pushes = spec.pushes(batch)
-            # A small ankle-pd campaign takes the loop (sim.many.LOOP_UP_TO), and every batch
-            # of a larger one of a compiled pair the compiled engine, whatever its size.
-            small = spec.size <= LOOP_UP_TO and spec.controller == "ankle-pd"
+            # A compiled pair's small ankle-pd campaign takes the loop (sim.many.LOOP_UP_TO),
+            # and every batch of a larger one the compiled engine, whatever its size; the rest
+            # as run_many picks (MuJoCo's foot + ankle-pd: the rollout, at any size).
             compiled = spec.backend == "analytic" and (spec.model, spec.controller) in COMPILED
-            engine = "loop" if small or spec.is_3d else "compiled" if compiled else "auto"
+            small = spec.size <= LOOP_UP_TO and spec.controller == "ankle-pd"
+            engine = (
+                "loop" if spec.is_3d or (compiled and small) else "compiled" if compiled else "auto"
+            )
             rows = push_rows(
                 spec, pushes, engine=engine,
                 on_start=lambda count: watchdog.arm(spec.push_timeout * count),
