@@ -46,6 +46,16 @@ def _model(command: str) -> Any:
     )
 
 
+#: The push's direction of a single run (simulate, critical-push).
+_azimuth = click.option(
+    "--azimuth",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="The push's direction [deg], 0 forward (+x), 90 left (+y).",
+)
+
+
 def _example(line: str) -> str:
     """Return a help page's example: ``pushrecovery humanoid LINE``, kept on one line."""
     return f"\b\nExample:\n  pushrecovery humanoid {line}"
@@ -71,13 +81,7 @@ def humanoid() -> None:
 )
 @_model("simulate")
 @planar_only("simulate", *_PLANAR_OPTIONS, "--x", "--xdot", "--y", "--ydot", "--plot")
-@click.option(
-    "--azimuth",
-    type=float,
-    default=0.0,
-    show_default=True,
-    help="The push's direction [deg], 0 forward (+x), 90 left (+y).",
-)
+@_azimuth
 @click.option(
     "--impulse",
     "--push",
@@ -166,13 +170,7 @@ def simulate(
 )
 @_model("critical-push")
 @planar_only("critical-push", *_PLANAR_OPTIONS, "--x", "--direction")
-@click.option(
-    "--azimuth",
-    type=float,
-    default=0.0,
-    show_default=True,
-    help="The push's direction [deg], 0 forward (+x), 90 left (+y).",
-)
+@_azimuth
 @click.option(
     "--tolerance",
     type=float,
