@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 OUT := out
 
-.PHONY: demo test bench lint fuzz venv clean
+.PHONY: demo test bench lint fuzz docs venv clean
 
 venv: $(STAMP)
 
@@ -23,8 +23,14 @@ demo: $(STAMP)
 	$(BIN)/pushrecovery report --out $(OUT)/report
 	@echo "open $(OUT)/report/index.html"
 
-test: $(STAMP)
+test: docs
 	$(BIN)/python -m pytest -q -n 2
+
+# The site (Sphinx): guides, topics, the API reference from the docstrings and the CLI reference
+# from click, into out/docs; a warning (a broken reference, a malformed docstring) fails the build.
+docs: $(STAMP)
+	$(BIN)/sphinx-build -q -W --keep-going -j 2 -b html -d $(OUT)/doctrees docs $(OUT)/docs
+	@echo "open $(OUT)/docs/index.html"
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run.py
