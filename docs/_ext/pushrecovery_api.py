@@ -62,7 +62,7 @@ def entry(module: ModuleType, name: str) -> list[str]:
     target = f"{module.__name__}.{name}"
     if inspect.isclass(obj):
         return [f".. autoclass:: {target}", "   :members:", "   :show-inheritance:", ""]
-    if callable(obj):
+    if inspect.isroutine(obj) or hasattr(obj, "py_func"):  # a function or a numba dispatcher
         return [f".. autofunction:: {target}", ""]
     return [f".. autodata:: {target}", "   :no-value:", ""]
 
