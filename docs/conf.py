@@ -35,7 +35,7 @@ exclude_patterns = ["_build", "_ext", "img/README.md"]
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 
-autodoc_typehints = "signature"
+autodoc_typehints = "none"  # the types are in the numpydoc Parameters; signatures stay short
 autodoc_member_order = "bysource"
 autodoc_default_options = {"undoc-members": False}
 python_maximum_signature_line_length = 88

@@ -16,6 +16,8 @@ from typing import Any
 
 from docutils import nodes
 from sphinx.application import Sphinx
+from sphinx.environment import BuildEnvironment
+from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 from sphinx.util.parsing import nested_parse_to_nodes
 
@@ -95,7 +97,26 @@ class PushRecoveryApi(SphinxDirective):
         return list(nested_parse_to_nodes(self.state, "\n".join(lines), allow_section_headings=True))
 
 
+logger = logging.getLogger(__name__)
+
+
+def check_every_object_documented(app: Sphinx, env: BuildEnvironment) -> None:
+    """Warn (an error under ``-W``) for a public function or class the reference lacks."""
+    if os.environ.get("PUSHRECOVERY_DOCS_NO_API"):
+        return
+    documented = set(env.get_domain("py").objects)
+    for module in public_modules("pushrecovery"):
+        for name in module.__all__:
+            obj = getattr(module, name)
+            if not (inspect.isclass(obj) or inspect.isroutine(obj) or hasattr(obj, "py_func")):
+                continue
+            target = f"{home(module, name)}.{name}"
+            if target not in documented:
+                logger.warning("%s is public but has no entry in the API reference", target)
+
+
 def setup(app: Sphinx) -> dict[str, Any]:
-    """Register the directive."""
+    """Register the directive and the check that the reference is complete."""
     app.add_directive("pushrecovery-api", PushRecoveryApi)
+    app.connect("env-check-consistency", check_every_object_documented)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
