@@ -63,8 +63,8 @@ class FootModel:
 
     .. math:: \{h + s u + t v : -o_h \le s \le |T - h| + o_t,\ t_- \le t \le t_+\},
 
-    [t_-, t_+] = [−w/2, w/2] (``lateral="midline"``: Plug-in Gait's HEE and TOE on the foot's
-    long axis) or, with ``lateral="ankle"``, the lateral edge through the ankle marker's
+    :math:`[t_-, t_+] = [-w/2, w/2]` (``lateral="midline"``: Plug-in Gait's HEE and TOE on the
+    foot's long axis) or, with ``lateral="ankle"``, the lateral edge through the ankle marker's
     projection (lateral malleolus, or a 5th-metatarsal marker given in that slot) moved out by
     ``lateral_offset``, the medial edge w inside it. The defaults reproduce the 1-D base of
     :mod:`pushrecovery.analysis.recording`; the offsets are assumptions to state, not data.

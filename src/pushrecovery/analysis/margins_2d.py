@@ -17,10 +17,10 @@ Body axes x = ap (forward +), y = ml (left +) [m]; the base per frame from
   :mod:`pushrecovery.analysis.margins` with the base's extents as the interval.
 - **Time to boundary of the CoP** (Slobounov et al. 1997; van Wegen, van Emmerik & Riccio
   2002, Hum Mov Sci 21:61-84; first-order form): with the CoP p moving at its velocity ṗ,
-  TtB = D(p, ṗ/|ṗ|)/|ṗ| [s], D the distance from p along ṗ to the boundary; 0 with p outside,
+  TtB = D(p, ṗ/‖ṗ‖)/‖ṗ‖ [s], D the distance from p along ṗ to the boundary; 0 with p outside,
   +inf with ṗ = 0.
 - **Time to boundary of the XCoM** (LIPM, the CoP held): ξ̇ = ω0 (ξ − p) gives
-  ξ(t) = p + (ξ − p) e^{ω0 t}, so TtB = ln(D(p, ξ − p)/|ξ − p|)/ω0 [s]; 0 with ξ outside,
+  ξ(t) = p + (ξ − p) e^{ω0 t}, so TtB = ln(D(p, ξ − p)/‖ξ − p‖)/ω0 [s]; 0 with ξ outside,
   +inf with ξ = p (the 2-D :func:`pushrecovery.analysis.margins.time_to_leave`).
 - **Verdicts**: :func:`pushrecovery.surfaces.classify_many.classify_states` against the
   library's :class:`~pushrecovery.ground.Support` of each stance phase (the CoP region, the
@@ -109,7 +109,7 @@ class Margins2D:
 def signed_distance(base: BasePolygons, points: ArrayLike) -> FloatArray:
     """Signed distance of one point per frame to that frame's polygon, + inside [m].
 
-    Inside min_i (b_i − n_i · p) (nearest edge line), outside −min_i |p − edge segment_i|, as
+    Inside min_i (b_i − n_i · p) (nearest edge line), outside −min_i dist(p, edge segment_i), as
     :meth:`pushrecovery.ground.ConvexPolygon.signed_distance`, over every frame at once.
 
     Raises

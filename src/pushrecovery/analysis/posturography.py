@@ -352,7 +352,7 @@ def quiet_standing(
     True when every CoP frame is present (the plate stays loaded), the CoP speed over 0.1 s
     (:data:`SPEED_LAG`) stays <= ``max_speed`` (a step or a push moves it at ~1 m/s), and,
     with ``force``, F_z stays >= :data:`~.recording.LOADED` and within ``max_load_change``
-    of its median (no step off, no jump) and the CoM acceleration |F_h| / m, m = median(F_z)
+    of its median (no step off, no jump) and the CoM acceleration ‖F_h‖ / m, m = median(F_z)
     / g, stays <= ``max_acceleration``. The defaults are not published values: they pass the
     biomdp Kistler quiet-standing trial (at most 0.32 m/s, 1.1 m/s², 11 %) and fail a step,
     a 1 m/s CoP ramp or an unloaded plate. One plate cannot tell that both feet are loaded.

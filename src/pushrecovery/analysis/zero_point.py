@@ -56,7 +56,7 @@ def zero_points(
         Horizontal ground reaction force [N], filtered (noise makes spurious crossings); NaN
         samples never count.
     tolerance : float
-        |F| up to this counts as zero [N], >= 0: a body standing still may never cross.
+        abs(F) up to this counts as zero [N], >= 0: a body standing still may never cross.
     spacing : float
         Shortest time between two zero points [s]: of closer ones only the first is kept (the
         velocity of an interval is a difference quotient over it, noisy when short).
@@ -64,8 +64,8 @@ def zero_points(
     Returns
     -------
     ndarray of int
-        Increasing indices: of each sign change the sample of smaller |F|, and the first and
-        last sample of each run with |F| <= tolerance.
+        Increasing indices: of each sign change the sample of smaller abs(F), and the first and
+        last sample of each run with abs(F) <= tolerance.
 
     Raises
     ------
@@ -141,7 +141,7 @@ def com_from_force(
     mass : float
         Body mass [kg], in [0.01, 1e4] (:data:`~pushrecovery.params.LIMITS`).
     tolerance : float, optional
-        |F| that counts as zero [N]; default ``ZERO_FORCE`` of the body weight (the CoM then
+        abs(F) that counts as zero [N]; default ``ZERO_FORCE`` of the body weight (the CoM then
         lies within that fraction of its height of the point above the CoP: 0.2 mm per metre).
     spacing : float
         Shortest interval between zero points [s] (:func:`zero_points`).

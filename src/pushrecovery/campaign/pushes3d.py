@@ -1,11 +1,12 @@
-r"""One push of a 3-D campaign as one row (runs on the workers; :mod:`.pushes` dispatches here).
+r"""One push of a 3-D campaign as one row (runs on the workers).
 
-The body (``biped3d`` or ``g1``) stands, is pushed at its torso with J [N s] at the azimuth ψ
-(:class:`~pushrecovery.sim.push.Push3D`, 10 ms, after 0.1 s of standing) and the whole-body
-controller runs with the tasks of the campaign's controller (``wbc-ankle``: ankles only;
-``wbc-hip``: + the hip task; ``wbc-step``: + the hip and the stepping task;
-:func:`~pushrecovery.sim.mujoco.humanoid3d.runs3d.run_push3d`) until rest, a fall or
-``duration``. The columns of :mod:`.pushes` keep their names; in 3-D they read:
+:mod:`~pushrecovery.campaign.pushes` dispatches here. The body (``biped3d`` or ``g1``) stands, is
+pushed at its torso with J [N s] at the azimuth ψ (:class:`~pushrecovery.sim.push.Push3D`, 10 ms,
+after 0.1 s of standing) and the whole-body controller runs with the tasks of the campaign's
+controller (``wbc-ankle``: ankles only; ``wbc-hip``: + the hip task; ``wbc-step``: + the hip and the
+stepping task; :func:`~pushrecovery.sim.mujoco.humanoid3d.runs3d.run_push3d`) until rest, a fall or
+``duration``. The columns of :mod:`~pushrecovery.campaign.pushes` keep their names; in 3-D they
+read:
 
 =========================  ==================================================================
 ``x0``, ``y0``             the standing CoM's ground point r₀ [m] (ankles' midpoint at 0)
@@ -17,9 +18,9 @@ controller runs with the tasks of the campaign's controller (``wbc-ankle``: ankl
 ``capture_point_y``
 ``cop_margin``, ...        the plane's signed margins (positive inside) [m]
 ``used``, ``steps``        the strategy the run used (``sim.result.strategy_used``: step if a
-                           step landed, hip if the hip law's m g |δ| passed 1 N m, else ankle)
+                           step landed, hip if the hip law's m g abs(δ) passed 1 N m, else ankle)
                            if it recovered, else fall; the steps that landed
-``peak_hip_torque``        the hip law's largest m g |δ| [N m]
+``peak_hip_torque``        the hip law's largest m g abs(δ) [N m]
 ``peak_ankle_torque``,     NaN (the WBC's CoP is not recorded per run)
 ``cop_min``, ``cop_max``
 ``time``                   simulated time from the push's end to the outcome [s]
@@ -29,9 +30,9 @@ controller runs with the tasks of the campaign's controller (``wbc-ankle``: ankl
 ``predicted_corrected``    the verdict for the push at the torso's height: the velocity
                            × (1 + d/z₀) (docs/validation.md, "the push's height")
 ``lift_offs``              steps begun (landed or not)
-``peak_hip_motor_torque``  largest |hip pitch or roll command − its value before| [N m]
+``peak_hip_motor_torque``  largest abs(hip pitch or roll command − its value before) [N m]
 ``max_torso_tilt``         largest tilt of the upright body [rad]
-``peak_torque_ratio``      largest |motor command| / its limit over the run [-] (1: saturated)
+``peak_torque_ratio``      largest abs(motor command) / its limit over the run [-] (1: saturated)
 ``failed_ticks``           ticks DAQP did not solve (the last command held)
 =========================  ==================================================================
 
@@ -149,7 +150,7 @@ def run_push3d(
 
 
 def _torque_ratio(ctrl: Any, ranges: Any) -> float:
-    """Return max over ticks and limited motors of |command| / limit [-] (NaN if none)."""
+    """Return max over ticks and limited motors of abs(command) / limit [-] (NaN if none)."""
     limits = np.max(np.abs(np.asarray(ranges, dtype=float)), axis=1)
     finite = np.isfinite(limits) & (limits > 0.0)
     if ctrl is None or not np.any(finite):

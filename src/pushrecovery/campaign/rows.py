@@ -10,8 +10,8 @@ whose fields carry their unit and a one-line description as field metadata (``un
 ``pyarrow.parquet.read_schema(path).field("x0").metadata``.
 
 The rows themselves are ``dict`` s from column name to value, built on the workers by
-:mod:`.pushes` (planar) and :mod:`.pushes3d` (3-D) and turned into a table by ``pyarrow``
-with this schema.
+:mod:`~pushrecovery.campaign.pushes` (planar) and :mod:`.pushes3d` (3-D) and turned into a table
+by ``pyarrow`` with this schema.
 """
 
 from __future__ import annotations

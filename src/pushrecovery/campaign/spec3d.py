@@ -48,7 +48,7 @@ MODELS_3D: tuple[str, ...] = ("biped3d", "g1")
 #: The whole-body controller's strategy sets, by campaign controller name: the highest
 #: strategy it may use (ankle only; + the hip task; + the hip and the stepping task).
 WBC_CONTROLLERS: Mapping[str, str] = {"wbc-ankle": "ankle", "wbc-hip": "hip", "wbc-step": "step"}
-#: Largest |azimuth| [deg] and most azimuths of a campaign.
+#: Largest abs(azimuth) [deg] and most azimuths of a campaign.
 AZIMUTH_LIMIT = 360.0
 MAX_AZIMUTHS = 360
 

@@ -12,7 +12,7 @@ has
   ``predicted_corrected``);
 * a **used** strategy: what the whole-body controller with all its tasks (``wbc-step``: ankle,
   hip, stepping) did in MuJoCo: ``step`` if a step landed, ``hip`` if the hip law's CMP offset
-  passed 1 N m (m g |δ|), ``ankle`` otherwise, and ``fall`` if the body did not come to rest
+  passed 1 N m (m g abs(δ)), ``ankle`` otherwise, and ``fall`` if the body did not come to rest
   (fell, or still moving at the end of the run).
 
 The pushes are a 3-D campaign's rows (``pushrecovery.campaign``, columns of
@@ -95,7 +95,7 @@ class ConfusionPush:
     steps, lift_offs : int
         Steps that landed, steps begun.
     peak_torque_ratio : float
-        Largest |motor command| / limit [-].
+        Largest abs(motor command) / limit [-].
     failed_ticks : int
         Ticks DAQP did not solve.
     """

@@ -137,7 +137,7 @@ def record_push(
         the stance ankle as the plant estimates it when the push ends [m, m/s]),
         ``predicted`` (:func:`~pushrecovery.surfaces.classify.classify` of that state,
         ``to_dict()``), ``used`` (``ankle``, ``hip`` or ``step``, the strategy the run used
-        whatever its outcome: ``step`` if the biped stepped, ``hip`` if |hip torque| exceeded
+        whatever its outcome: ``step`` if the biped stepped, ``hip`` if abs(hip torque) exceeded
         :data:`HIP_TORQUE_THRESHOLD`), ``peak_hip_torque`` [N m], ``hip_torque`` (n_analog,)
         [N m], ``plant_cop`` (n_analog,) (the plant's own ``measured_cop_world()``, world x
         of the CoP of the soles' normal forces on all plates and off them [m]), ``steps``,

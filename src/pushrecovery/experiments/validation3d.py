@@ -249,7 +249,7 @@ class Validation3D:
         return tuple(row for row in self.rows if row.strategy == strategy)
 
     def worst_error(self, strategy: str, *, corrected: bool = False) -> float:
-        """Largest |relative error| of ``strategy`` (against the corrected value if asked)."""
+        """Largest abs(relative error) of ``strategy`` (against the corrected value if asked)."""
         errors = [
             abs(row.corrected_error if corrected else row.relative_error)
             for row in self.rows_for(strategy)

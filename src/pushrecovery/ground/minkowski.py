@@ -3,7 +3,7 @@ r"""Minkowski algebra of convex polygons: weighted sums, intersections, regular 
 The capture regions of several steps (:mod:`pushrecovery.surfaces.n_step`) are
 weighted Minkowski sums ⊕_k w_k P_k of convex polygons: their support function is the weighted
 sum of support functions, h(d) = Σ_k w_k h_{P_k}(d) for w_k >= 0 (a negative weight is the
-point reflection −P_k scaled by |w_k|). A sum is built exactly by merging the terms' edges in
+point reflection −P_k scaled by abs(w_k)). A sum is built exactly by merging the terms' edges in
 order of angle (de Berg et al., *Computational Geometry*, Sec. 13.3), O(total edges log).
 """
 
@@ -83,7 +83,7 @@ def minkowski_sum(
 ) -> ConvexPolygon:
     """Return offset ⊕ w_1 P_1 ⊕ ... ⊕ w_n P_n for convex polygons P_k and real weights w_k.
 
-    Terms of weight 0 vanish; a negative weight gives |w| (−P). At least one term must have
+    Terms of weight 0 vanish; a negative weight gives abs(w) (−P). At least one term must have
     a non-zero weight.
 
     Parameters
@@ -281,7 +281,7 @@ def decompose(
     the shapes' vertex means and c = offset + Σ w_k c_k, the ray from c through the point
     leaves ``total`` at b = c + λ u on an edge of outward normal n; b is offset + Σ w_k v_k with
     v_k on the face of shape k that maximises n · p (a vertex, or along the edge for the
-    shapes that have one parallel to n). The point is the fraction s = |point − c| / λ of the
+    shapes that have one parallel to n). The point is the fraction s = ‖point − c‖ / λ of the
     way, so p_k = (1 − s) c_k + s v_k lies in shape k (convexity) and keeps the same relative
     depth in every shape: no term is pushed to its edge before the others.
 

@@ -140,7 +140,7 @@ class ConvexPolygon:
         return float(self.vertices[:, 1].max())
 
     def support(self, direction_x: float, direction_y: float) -> float:
-        """Support function h(d) = max over the polygon of d · p [m·|d|]."""
+        """Support function h(d) = max over the polygon of d · p [m·‖d‖]."""
         return float(np.max(self.vertices @ np.array([direction_x, direction_y])))
 
     def signed_distance(self, px: ArrayLike, py: ArrayLike) -> FloatArray:
@@ -233,7 +233,7 @@ class ConvexPolygon:
     def grown(self, half_x: float, half_y: float, yaw: float = 0.0) -> ConvexPolygon:
         """Minkowski sum with the box [−half_x, half_x] × [−half_y, half_y] [m], turned by yaw.
 
-        Its support function is h(d) + half_x |d · e_x| + half_y |d · e_y|, with e_x, e_y the
+        Its support function is h(d) + half_x abs(d · e_x) + half_y abs(d · e_y), with e_x, e_y the
         box's axes (yaw [rad] counter-clockwise from the world's x and y).
         """
         if half_x < 0.0 or half_y < 0.0:

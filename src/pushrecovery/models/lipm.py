@@ -2,7 +2,7 @@ r"""Linear inverted pendulum model (LIPM) with a movable centre of pressure, Sec
 
 The CoM moves at constant height L; with the CoP at δ the horizontal dynamics are
 
-.. math:: \\ddot x = \\omega^2 (x - \\delta), \\qquad \\omega^2 = g / L,
+.. math:: \ddot x = \omega^2 (x - \delta), \qquad \omega^2 = g / L,
 
 which is Eq. (3) with the CoP anywhere on the foot and Eq. (23) with f = -ω² δ. All functions
 broadcast over arrays of states. State order is ``[x, xdot]``: CoM position relative to the
@@ -75,11 +75,11 @@ def lipm_state(
 
     Eq. (24) with f / ω² = −δ reads
 
-    .. math:: x(t) = \\delta + (x_0 - \\delta)\\cosh\\omega t
-              + \\frac{\\dot x_0}{\\omega}\\sinh\\omega t,
+    .. math:: x(t) = \delta + (x_0 - \delta)\cosh\omega t
+              + \frac{\dot x_0}{\omega}\sinh\omega t,
 
     and its derivative gives the velocity
-    :math:`\\dot x(t) = \\omega (x_0 - \\delta)\\sinh\\omega t + \\dot x_0\\cosh\\omega t`.
+    :math:`\dot x(t) = \omega (x_0 - \delta)\sinh\omega t + \dot x_0\cosh\omega t`.
 
     Parameters
     ----------
@@ -118,9 +118,9 @@ def lipm_transition(omega: float, dt: float) -> tuple[FloatArray, FloatArray]:
     With the CoP held constant over the step, Eq. (24) is linear in (x, ẋ, δ):
     ``X[k+1] = A X[k] + B δ[k]`` with
 
-    .. math:: A = \\begin{bmatrix} c & s/\\omega \\\\ \\omega s & c \\end{bmatrix},\\quad
-              B = \\begin{bmatrix} 1 - c \\\\ -\\omega s \\end{bmatrix},\\quad
-              c = \\cosh\\omega\\,dt,\\ s = \\sinh\\omega\\,dt.
+    .. math:: A = \begin{bmatrix} c & s/\omega \\ \omega s & c \end{bmatrix},\quad
+              B = \begin{bmatrix} 1 - c \\ -\omega s \end{bmatrix},\quad
+              c = \cosh\omega\,dt,\ s = \sinh\omega\,dt.
 
     Parameters
     ----------

@@ -6,14 +6,14 @@ forward, so the CoM is at x = L sin θ, z = L cos θ. The ankle torque τ is the
 exerts on the body, positive for plantar flexion (it pushes the body backward and moves the
 CoP forward). Angular momentum about the ankle gives
 
-.. math:: m L^2 \\ddot\\theta = m g L \\sin\\theta - \\tau .
+.. math:: m L^2 \ddot\theta = m g L \sin\theta - \tau .
 
 Torque limit. Moments on the massless foot give τ = δ F_z with the exact normal force
 F_z = m (g + z̈) = A + τ sinθ / L, A = m g cos²θ − m L cosθ θ̇². Solving for τ,
 
-.. math:: \\tau(\\delta) = \\frac{\\delta A}{1 - \\delta\\sin\\theta / L},
+.. math:: \tau(\delta) = \frac{\delta A}{1 - \delta\sin\theta / L},
 
-which increases with δ while A > 0 and |δ| < L. A CoP command is therefore clipped to the foot
+which increases with δ while A > 0 and abs(δ) < L. A CoP command is therefore clipped to the foot
 and turned into exactly the torque that puts the CoP there, including the vertical acceleration
 of the CoM that the LIPM neglects. When A ≤ 0 the foot is unloaded and no torque can be
 transmitted (τ = 0). This is how the ankle torque is limited so that the CoP stays on the foot.
@@ -73,7 +73,7 @@ def ankle_torque_for_cop(
     theta_rate : float
         Lean rate [rad/s].
     cop : float
-        Desired CoP relative to the ankle, already on the foot [m]; |cop| < length.
+        Desired CoP relative to the ankle, already on the foot [m]; abs(cop) < length.
     mass, length, gravity : float
         m [kg], L [m] (ankle to CoM), g [m/s²].
     hip_torque : float
@@ -183,12 +183,12 @@ def _pendulum_acceleration(
 
 
 def lean_from_com(x: float, xdot: float, length: float) -> tuple[float, float]:
-    """Lean angle and rate (θ, θ̇) from the CoM state (x, ẋ); needs |x| < L.
+    """Lean angle and rate (θ, θ̇) from the CoM state (x, ẋ); needs abs(x) < L.
 
     Raises
     ------
     InvalidParameterError
-        If a value is not finite, ``length`` is outside [0.01, 10] m or |x| >= length.
+        If a value is not finite, ``length`` is outside [0.01, 10] m or abs(x) >= length.
     """
     x, xdot = finite_float("x", x, "m"), finite_float("xdot", xdot, "m/s")
     length = bounded_float("length", length, *LIMITS["com_height"])

@@ -171,8 +171,8 @@ def solve_step_angle(
     ------
     InvalidParameterError
         A value that is not finite, a length or gravity out of
-        :data:`~pushrecovery.params.LIMITS`, a lean outside [0, π/2), |v0| >= 10 sqrt(g L)
-        or |lean_rate| >= 10 sqrt(g / L) (the models' validity, as :func:`step_solution`;
+        :data:`~pushrecovery.params.LIMITS`, a lean outside [0, π/2), abs(v0) >= 10 sqrt(g L)
+        or abs(lean_rate) >= 10 sqrt(g / L) (the models' validity, as :func:`step_solution`;
         the squares overflow beyond), or shapes that do not broadcast.
     """
     length, gravity = _leg(length, gravity)
@@ -292,7 +292,7 @@ def step_solution(
     ------
     InvalidParameterError
         On a non-finite value, a length or gravity out of :data:`~pushrecovery.params.LIMITS`,
-        v0 < 1e-6 m/s, or |v0| >= 10 sqrt(g L) (ten times the speed at which the stance
+        v0 < 1e-6 m/s, or abs(v0) >= 10 sqrt(g L) (ten times the speed at which the stance
         foot leaves the floor: no step of this model, and float64 overflow beyond).
     """
     length = bounded_float("length", length, *LIMITS["leg_length"])

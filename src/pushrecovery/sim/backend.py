@@ -189,7 +189,7 @@ def check_com_state(
 ) -> None:
     """Reject CoM states outside every model's validity.
 
-    |x| < L (the CoM above the ankle's horizon) and |ẋ| < 10 sqrt(g L): ten times the speed at
+    abs(x) < L (the CoM above the ankle's horizon) and abs(ẋ) < 10 sqrt(g L): ten times the speed at
     which an upright pendulum's foot unloads (docs/conventions.md). ``names`` are the
     coordinate's in the messages (``("y", "ydot")`` sideways).
     """
@@ -211,7 +211,7 @@ def check_com_state(
 
 
 def over_foot_at_rest(state: FloatArray, params: BodyParams, speed: float) -> bool:
-    """Sagittal rest: |ẋ| <= ``speed`` [m/s] and the CoM strictly over the foot (heel, toe).
+    """Sagittal rest: abs(ẋ) <= ``speed`` [m/s] and the CoM strictly over the foot (heel, toe).
 
     ``state`` is a plant's (the CoM position first, its velocity at ``len // 2``; only those
     two are read). It runs at every control tick of a settled run: a float array, a body and

@@ -77,7 +77,7 @@ class CriticalPush:
     predicted_velocity: float
 
     def relative_error(self) -> float:
-        """Return (|velocity| − |predicted|) / |predicted|; < 0 when doing worse than Eq. 4."""
+        """Return (abs(velocity) − abs(predicted)) / abs(predicted); < 0: worse than Eq. 4."""
         predicted = abs(self.predicted_velocity)
         return (abs(self.velocity) - predicted) / predicted
 

@@ -61,7 +61,7 @@ class PushRuns:
     steps : ndarray of int
         Feet that landed (0 without legs).
     peak_hip_torque : ndarray
-        Largest |hip torque| applied [N m] (0 without an upper body).
+        Largest abs(hip torque) applied [N m] (0 without an upper body).
     stop_impacts : ndarray of int
         Times the upper body hit its joint stop.
     errors : tuple of str or None

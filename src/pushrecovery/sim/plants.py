@@ -124,7 +124,7 @@ class PendulumPlant(_AnklePlant):
 class FlywheelPlant(PlantBase):
     """LIPM plus flywheel (Eqs. 6, 7, 16), advanced exactly with the ZOH transition.
 
-    State ``[x, theta, xdot, theta_dot]``. The hip joint limit |θ| ≤ θmax is a hard stop: a
+    State ``[x, theta, xdot, theta_dot]``. The hip joint limit abs(θ) ≤ θmax is a hard stop: a
     step that ends past it puts the flywheel on the stop, at rest, and the stopping torque
     impulse P = −I θ̇ reacts on the CoM (Δẋ = −P / (m L), from Eqs. 6-7; m L ẋ + I θ̇ is
     conserved). The stop is checked at the end of each step with the end-of-step rate, an
@@ -149,7 +149,7 @@ class FlywheelPlant(PlantBase):
         return np.array([x, 0.0, xdot, 0.0])
 
     def check_state(self, state: FloatArray) -> None:
-        """Require ``[x, theta, xdot, theta_dot]`` with |θ| ≤ θmax."""
+        """Require ``[x, theta, xdot, theta_dot]`` with abs(θ) ≤ θmax."""
         if state.shape != (4,):
             raise InvalidParameterError(
                 f"state must be [x, theta, xdot, theta_dot], got shape {state.shape}"

@@ -22,7 +22,7 @@ __all__ = [
     "push_direction",
 ]
 
-#: Largest |azimuth| [deg] a 3-D push accepts (one turn either way).
+#: Largest abs(azimuth) [deg] a 3-D push accepts (one turn either way).
 AZIMUTH_MAX = 360.0
 #: Largest impulse [N s] a 3-D push accepts (a thousand times what topples a person).
 IMPULSE_MAX = 1e4

@@ -23,7 +23,7 @@ __all__ = [
     "strategy_used",
 ]
 
-#: Largest |hip torque| [N m] that still counts as not using the hip: a solver's rounding or
+#: Largest abs(hip torque) [N m] that still counts as not using the hip: a solver's rounding or
 #: a servo holding the upper body still (the MPC leaves 2e-5 N m on a push of 0), not CMP
 #: balancing (whose torques are tens of N m).
 HIP_TORQUE_THRESHOLD = 1.0
@@ -87,14 +87,14 @@ class Push3DExtras:
     push_row : int
         The row just after the push (``states[push_row - 1]`` is the state as it began).
     peak_hip_torque : float
-        Largest flywheel torque the WBC's hip law commanded after the push, m g |δ| (δ its
+        Largest flywheel torque the WBC's hip law commanded after the push, m g abs(δ) (δ its
         CMP offset) [N m]: 0 when the ankles sufficed.
     peak_hip_motor_torque : float
-        Largest |hip pitch or roll motor command − its value before the push| after it [N m].
+        Largest abs(hip pitch or roll motor command − its value before the push) after it [N m].
     max_torso_tilt : float
         Largest tilt of the upright body from the vertical after the push [rad].
     peak_torque : float
-        Largest |motor command| from the push on [N m].
+        Largest abs(motor command) from the push on [N m].
     failed_ticks : int
         Ticks DAQP did not solve (the last command repeated).
     steps : int
@@ -173,7 +173,7 @@ class SimulationResult:
 
     @property
     def peak_hip_torque(self) -> float:
-        """Largest |hip torque| held during the run [N m] (pitch on the plane)."""
+        """Largest abs(hip torque) held during the run [N m] (pitch on the plane)."""
         return float(np.abs(self.torques).max()) if self.torques.size else 0.0
 
     def strategy_used(self) -> Strategy:
@@ -226,7 +226,7 @@ class SimulationResult:
 def strategy_used(steps: int, peak_hip_torque: float) -> Strategy:
     """Return the strategy a run used (the one definition).
 
-    ``step`` if a foot landed (``steps`` > 0), else ``hip`` if the largest |hip torque| [N m]
+    ``step`` if a foot landed (``steps`` > 0), else ``hip`` if the largest abs(hip torque) [N m]
     exceeded :data:`HIP_TORQUE_THRESHOLD`, else ``ankle``.
 
     Raises

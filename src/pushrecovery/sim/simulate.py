@@ -54,7 +54,7 @@ class RestCriterion:
     Parameters
     ----------
     speed : float
-        Largest |ẋ| that counts as at rest [m/s].
+        Largest abs(ẋ) that counts as at rest [m/s].
     duration : float
         How long the CoM must stay at rest over the support (the plant's ``at_rest``: on the
         sagittal models heel < x < toe) [s].

@@ -132,7 +132,7 @@ def corrected_critical_velocity(
         If ``strategy`` is not a str or ``params`` not a
         :class:`~pushrecovery.params.BodyParams`.
     InvalidParameterError
-        A strategy other than ``ankle`` or ``hip``, ``direction`` other than ±1, |x0| >=
+        A strategy other than ``ankle`` or ``hip``, ``direction`` other than ±1, abs(x0) >=
         ``com_height`` (the CoM above the ankle's horizon, as
         :func:`~pushrecovery.sim.backend.check_com_state`; cos²φ0 vanishes there), a negative
         or non-finite ``cop_margin``, ``push_duration`` or ``timestep``, or a margin that
@@ -208,12 +208,12 @@ class CriticalRow:
 
     @property
     def relative_error(self) -> float:
-        """(|measured| − |predicted|) / |predicted|; negative when the body does worse."""
+        """(abs(measured) − abs(predicted)) / abs(predicted); negative when the body does worse."""
         return (abs(self.measured) - abs(self.predicted)) / abs(self.predicted)
 
     @property
     def corrected_error(self) -> float:
-        """(|measured| − |corrected|) / |corrected|, NaN without a corrected prediction."""
+        """(abs(measured) − abs(corrected)) / abs(corrected), NaN without a corrected prediction."""
         return (abs(self.measured) - abs(self.corrected)) / abs(self.corrected)
 
     def to_dict(self, mass: float) -> dict[str, Any]:

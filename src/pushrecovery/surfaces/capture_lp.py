@@ -1,13 +1,13 @@
 """The exact capture region of the discretised flywheel model, as a linear program.
 
-The dynamics (Eq. 16, exact zero-order hold) and every constraint (CoP on the foot, |τ| ≤ τmax,
-|θ| ≤ θmax) are linear, so the largest capture point from which *some* admissible input sequence
+The dynamics (Eq. 16, exact zero-order hold) and every constraint (CoP on the foot, abs(τ) ≤ τmax,
+abs(θ) ≤ θmax) are linear, so the largest capture point from which *some* admissible input sequence
 reaches a captured state is a linear program. This is an independent check of the bang-bang
 bound (corrected Eq. 15) that assumes nothing about the shape of the optimal input.
 
 Captured state at the horizon: capture point on the foot (CoP balancing takes over, Eq. 4) and
 the flywheel at rest within its limit. The LP restricts inputs to piecewise constants on a grid
-of ``dt`` (a subset of all inputs) and checks |θ| ≤ θmax at the samples and at three interior
+of ``dt`` (a subset of all inputs) and checks abs(θ) ≤ θmax at the samples and at three interior
 points of each step, where θ is a parabola. Between check points the parabola can exceed θmax
 by at most u h²/8 (u = τmax/I, h = dt/4): 8e-6 rad at dt = 0.01 s for the paper preset. So the
 LP value is below the supremum for a limit θmax + u h²/8, and it approaches the continuous-time
@@ -59,8 +59,8 @@ def largest_capture_point(
     """Largest capture point the flywheel model can capture, by linear programming.
 
     Starts from x = 0 with the flywheel at rest and maximises direction · ẋ(0) (so the capture
-    point ẋ(0)/ω) subject to the exact discrete dynamics, δ⁻ ≤ δ_k ≤ δ⁺, |τ_k| ≤ τmax,
-    |θ_k| ≤ θmax, and at the horizon δ⁻ ≤ ξ_N ≤ δ⁺, θ̇_N = 0. Only the capture point matters
+    point ẋ(0)/ω) subject to the exact discrete dynamics, δ⁻ ≤ δ_k ≤ δ⁺, abs(τ_k) ≤ τmax,
+    abs(θ_k) ≤ θmax, and at the horizon δ⁻ ≤ ξ_N ≤ δ⁺, θ̇_N = 0. Only the capture point matters
     (the bound is on ξ), so starting at x = 0 loses no generality.
 
     Parameters

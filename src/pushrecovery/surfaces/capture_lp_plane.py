@@ -3,7 +3,7 @@ r"""The capture region of the planar flywheel model, by linear programming along
 The planar model (:mod:`pushrecovery.models.flywheel_plane`: the LIPM in x and y plus an
 upper-body flywheel in pitch and one in roll, Eq. 16 per axis, exact zero-order hold) is linear
 and so is every constraint: the CoP in the support polygon P (its half-planes n_i · p ≤ b_i),
-|τ| ≤ τmax and |θ| ≤ θmax of each axis. So the support function of the set of capturable
+abs(τ) ≤ τmax and abs(θ) ≤ θmax of each axis. So the support function of the set of capturable
 initial capture points,
 
 .. math:: h(\mathbf d) = \max\ \mathbf d \cdot \boldsymbol\xi_0
@@ -13,8 +13,8 @@ initial capture points,
 is a linear program. Captured at the horizon: capture point ξ_N ∈ P (CoP balancing holds it,
 Eq. 4 in the plane) and both flywheels at rest (θ̇ = 0) within their limits. Sweeping d traces
 the (convex) capturable set without assuming anything about the shape of the optimal input; it
-checks the closed form of :mod:`pushrecovery.surfaces.plane`, h_P(d) + a_p |d · e_p| +
-a_r |d · e_r| (P grown by the corrected Eq. 15 offset of each axis).
+checks the closed form of :mod:`pushrecovery.surfaces.plane`, h_P(d) + a_p abs(d · e_p) +
+a_r abs(d · e_r) (P grown by the corrected Eq. 15 offset of each axis).
 
 Why that closed form, and when it is exact. With c = (τ_p e_p + τ_r e_r)/(m g) the CMP offset,
 ξ̇ = ω (ξ − p − c), so e^{−ωt} ξ(t) = ξ0 − ω∫_0^t e^{−ωs} (p + c) ds, and ξ stays bounded only if
@@ -22,7 +22,7 @@ Why that closed form, and when it is exact. With c = (τ_p e_p + τ_r e_r)/(m g)
 (weights integrating to 1): it ranges over P. Integrating the second by parts twice (flywheels
 from rest at 0, bounded), its component on axis j is (ω³ I_j / m g) ∫ e^{−ωs} θ_j ds, which
 ranges over [−a_j, a_j] (the bang-bang θ_j is pointwise maximal, errata E12). So every
-capturable ξ0 lies in P ⊕ {c_p e_p + c_r e_r : |c_j| ≤ a_j}; conversely ξ0 = q + Σ c_j e_j is
+capturable ξ0 lies in P ⊕ {c_p e_p + c_r e_r : abs(c_j) ≤ a_j}; conversely ξ0 = q + Σ c_j e_j is
 captured by holding p = q and driving axis j bang-bang for the T_j ≤ T_max,j that yields c_j
 (then ξ = q ∈ P with the flywheels at rest). The Minkowski sum is therefore an outer bound
 whenever each axis obeys its own limits, and it is the capturable set exactly when the admissible
@@ -35,8 +35,8 @@ isotropic at constant height (one ω); (iv) both flywheels start at rest at zero
 
 Grid and its error, as in the 1-D LP (:mod:`pushrecovery.surfaces.capture_lp`): the inputs are
 piecewise constant on a grid of ``dt`` (a subset of all inputs, so the LP is a lower bound when
-the angle limit holds everywhere) and |θ| ≤ θmax is checked at the samples and at three interior
-points of each step, where θ is a parabola with |θ̈| ≤ u = τmax/I. Between check points (h =
+the angle limit holds everywhere) and abs(θ) ≤ θmax is checked at the samples and at three interior
+points of each step, where θ is a parabola with abs(θ̈) ≤ u = τmax/I. Between check points (h =
 dt/4 apart) it can exceed θmax by at most u h²/8, so the LP value is at most the continuous-time
 supremum for the limits θmax + u h²/8 of each axis. When T_max = sqrt(I θmax/τmax) of each axis
 is a whole number of steps and the horizon is at least 2 T_max, the bang-bang witness is on the
@@ -118,7 +118,7 @@ def support_function_lp(
 
     Maximises d · ξ0, d = (cos ψ, sin ψ), over ξ0 and the CoP and torque sequences subject to
     the exact discrete dynamics (:func:`~pushrecovery.models.flywheel_plane.plane_discrete`),
-    p_k ∈ ``polygon``, |τ_k| ≤ τmax and |θ| ≤ θmax of each axis (at the samples and three
+    p_k ∈ ``polygon``, abs(τ_k) ≤ τmax and abs(θ) ≤ θmax of each axis (at the samples and three
     interior points of every step), and at the horizon ξ_N ∈ ``polygon`` and θ̇_N = 0 (module
     docstring for the grid error).
 

@@ -4,8 +4,8 @@ With the touchdown times fixed on a grid of ``dt``, the LIPM with steps and an u
 (:mod:`pushrecovery.surfaces.n_step`) is linear in everything the body chooses: the
 CoP sequence p_i (piecewise constant, in the support of its phase: the stance polygon S, then
 q_k + F_k after the k-th touchdown), the footholds q_k (q_k − q_{k−1} in the reach polygon
-R_k), and the pitch and roll torques of the upper body (piecewise constant, |τ| ≤ τmax, the
-flywheel angle |θ| ≤ θmax at the samples and three interior points of each step as in
+R_k), and the pitch and roll torques of the upper body (piecewise constant, abs(τ) ≤ τmax, the
+flywheel angle abs(θ) ≤ θmax at the samples and three interior points of each step as in
 :mod:`pushrecovery.surfaces.capture_lp_plane`, at rest at the end). The capture point follows
 ξ_{i+1} = E ξ_i − (E − 1)(p_i + c_i), E = e^{ω dt}, c_i the CMP offset τ_i/(m g) along the
 body's axes — exact for piecewise-constant inputs. Captured at the horizon: ξ in the last foot

@@ -56,8 +56,8 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
-#: Largest |x|, |y| [m] and |ẋ|, |ẏ| [m/s] of the states :func:`capture_region` takes, and so
-#: the largest |ξ| component (ω >= :data:`~pushrecovery.params.OMEGA_MIN`) [m].
+#: Largest abs(x), abs(y) [m] and abs(ẋ), abs(ẏ) [m/s] of the states :func:`capture_region`
+#: takes, and so the largest abs(ξ) component (ω >= :data:`~pushrecovery.params.OMEGA_MIN`) [m].
 MAX_POSITION = 1e3
 MAX_SPEED = 1e2
 MAX_CAPTURE_POINT = MAX_POSITION + MAX_SPEED / OMEGA_MIN

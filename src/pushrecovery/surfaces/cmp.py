@@ -13,7 +13,7 @@ Requiring ξ(2T) < δ⁺ (Eq. 9) gives Eq. (13), and dividing by e^{2ωT} the bo
 
 The printed Eq. (15) has (e^{ωT} − 1)² in place of (1 − e^{−ωT})², a factor e^{2ωT} (7.2 for
 the paper preset) too optimistic. This bound is also the supremum over *all* flywheel
-controllers that respect |τ| ≤ τmax and |θ| ≤ θmax from a flywheel at rest (errata E12): the
+controllers that respect abs(τ) ≤ τmax and abs(θ) ≤ θmax from a flywheel at rest (errata E12): the
 bang-bang profile maximises θ(t) at every t, and the capturable capture point is
 δ⁺ + (ω³ I / m g) ∫ e^{−ωs} θ(s) ds.
 """

@@ -3,7 +3,7 @@ r"""CoP-balancing (ankle strategy) decision surface, Eq. (4) of [Stephens07].
 A state (x, ẋ) of the LIPM can be brought to rest with the CoP on the foot if and only if its
 capture point ξ = x + ẋ/ω lies strictly between the foot edges:
 
-.. math:: \\delta^- < x + \\frac{\\dot x}{\\omega} < \\delta^+ .
+.. math:: \delta^- < x + \frac{\dot x}{\omega} < \delta^+ .
 
 Derivation (docs/errata.md, E1): ξ obeys ξ̇ = ω (ξ − δ), so with the CoP saturated at δ⁺ a
 capture point below δ⁺ moves back and one above it runs away as e^{ωt}; the boundary
@@ -140,7 +140,7 @@ def capture_margin(
 ) -> NDArray[np.float64]:
     """Signed distance of the capture points to the edges of a capture interval [m].
 
-    margin = min(ξ − lower, upper − ξ) = w − |ξ − c|, with c the centre and w the half width of
+    margin = min(ξ − lower, upper − ξ) = w − abs(ξ − c), with c the centre and w the half width of
     the interval: positive inside.
 
     Parameters

@@ -65,7 +65,7 @@ class Verdict:
 
 
 def _edges(polygon: ConvexPolygon) -> _Edges:
-    """Per edge: normal, offset, start vertex, edge vector, 1/|edge|² as Python floats."""
+    """Per edge: normal, offset, start vertex, edge vector, 1/‖edge‖² as Python floats."""
     v, n, b = polygon.vertices, polygon.normals, polygon.offsets
     rows = []
     for i in range(len(v)):

@@ -24,7 +24,7 @@ bound)
 .. math:: \mathcal C_{hip} = P \oplus [-a_x, a_x] \times [-a_y, a_y],
 
 an open set (its boundary is reached only as t → ∞, as in Eq. 4). Its support function is
-h_P(d) + a_x |d_x| + a_y |d_y|, checked against a linear program over CoP and torque sequences
+h_P(d) + a_x abs(d_x) + a_y abs(d_y), checked against a linear program over CoP and torque sequences
 (``tests/test_plane_cmp.py``). Margins are signed Euclidean distances of ξ to a region, positive
 inside (``docs/plane.md``).
 """
@@ -347,7 +347,7 @@ def plan_step_xy(
     Returns
     -------
     (tuple of float, StepDecision or None)
-        The line's unit vector e, and the plan (None when |s| >= leg_length: no step).
+        The line's unit vector e, and the plan (None when abs(s) >= leg_length: no step).
     """
     require_type("params", params, BodyParams)
     require_type("support", support, Support)

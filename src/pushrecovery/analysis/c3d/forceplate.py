@@ -100,11 +100,11 @@ def wrench_type2(channels: ArrayLike, origin: ArrayLike) -> tuple[FloatArray, Fl
 def wrench_type3(channels: ArrayLike, origin: ArrayLike) -> tuple[FloatArray, FloatArray]:
     """Force and moment about the top-surface centre from Kistler's 8 channels (plate frame).
 
-    Kistler's formulas with a = |origin x|, b = |origin y|, az0 = −|origin z|:
+    Kistler's formulas with a = abs(origin x), b = abs(origin y), az0 = −abs(origin z):
     F = (fx12 + fx34, fy14 + fy23, fz1 + fz2 + fz3 + fz4),
     Mx = b (fz1 + fz2 − fz3 − fz4) + Fy az0, My = a (−fz1 + fz2 + fz3 − fz4) − Fx az0,
     Mz = b (−fx12 + fx34) + a (fy14 − fy23). Sensor 1 sits at (+a, +b), 2 at (−a, +b),
-    3 at (−a, −b), 4 at (+a, −b), the sensor plane |az0| below the top surface.
+    3 at (−a, −b), 4 at (+a, −b), the sensor plane abs(az0) below the top surface.
 
     Parameters
     ----------

@@ -14,7 +14,7 @@ Record layout (little-endian on Intel and DEC files, big-endian on MIPS):
   record (from this field), uint8 description length, description;
 - parameter: int8 name length, int8 group id (> 0), name, int16 offset, int8 type (−1 char,
   1 byte, 2 int16, 4 float), uint8 number of dimensions (0-7), uint8 dimensions, data
-  (product of the dimensions × |type| bytes; |type| for a scalar), uint8 description
+  (product of the dimensions × abs(type) bytes; abs(type) for a scalar), uint8 description
   length, description.
 
 An offset of 0 (or a name length of 0) ends the section.

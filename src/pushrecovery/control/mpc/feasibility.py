@@ -9,18 +9,18 @@ integrator of its own: with s = (θ, θ̇), h = dt²/(2I) and g = dt/I,
           \quad b = \begin{bmatrix} h \\ g \end{bmatrix}.
 
 So the QP is feasible exactly when s_0 = (θ_0, θ̇_0) lies in the N-step viable set
-S_N = {s_0 : ∃ |τ_i| ≤ τmax, i < N, with |θ_i| ≤ θmax, i = 1..N}, whatever x_0, ẋ_0. With
-C = {|θ| ≤ θmax} and W = {τ b : |τ| ≤ τmax} (a segment), S_0 = R² and
+S_N = {s_0 : ∃ abs(τ_i) ≤ τmax, i < N, with abs(θ_i) ≤ θmax, i = 1..N}, whatever x_0, ẋ_0. With
+C = {abs(θ) ≤ θmax} and W = {τ b : abs(τ) ≤ τmax} (a segment), S_0 = R² and
 
 .. math:: S_k = \{ s : ∃ τ,\ A s + b τ ∈ C ∩ S_{k−1} \} = A^{−1} \bigl( (C ∩ S_{k−1}) ⊕ W \bigr),
 
 since A s + b τ ∈ P ⇔ A s ∈ P ⊕ (−W) = P ⊕ W. Each step maps a convex polygon to a convex
 polygon: a Minkowski sum with a segment (each vertex moved by ±τmax b, the two vertices where
 the move changes sign doubled), a clip by the strip C and the shear A^{−1}. Exact for any N ≥ 2
-when C ∩ S_0 is replaced by C ∩ {|θ̇| ≤ V}, V = 2 ((2 θmax + h τmax)/dt + g τmax): along any
-feasible plan |θ̇_{N−1}| ≤ (2 θmax + h τmax)/dt (from θ_N − θ_{N−1} = dt θ̇_{N−1} + h τ_{N−1})
-and |θ̇_N| ≤ |θ̇_{N−1}| + g τmax, so the box cuts nothing. For N = 1 the set is the strip
-|θ + dt θ̇| ≤ θmax + h τmax. The polygon has 68 vertices for the paper's body at N = 50, 100
+when C ∩ S_0 is replaced by C ∩ {abs(θ̇) ≤ V}, V = 2 ((2 θmax + h τmax)/dt + g τmax): along any
+feasible plan abs(θ̇_{N−1}) ≤ (2 θmax + h τmax)/dt (from θ_N − θ_{N−1} = dt θ̇_{N−1} + h τ_{N−1})
+and abs(θ̇_N) ≤ abs(θ̇_{N−1}) + g τmax, so the box cuts nothing. For N = 1 the set is the strip
+abs(θ + dt θ̇) ≤ θmax + h τmax. The polygon has 68 vertices for the paper's body at N = 50, 100
 and 200 and is built once per (I, τmax, θmax, dt, N) in a few ms.
 
 The test is a gauge. Scaling τmax and θmax by t scales S_N by t (the system is linear), so with
@@ -69,7 +69,7 @@ def _add_segment(poly: FloatArray, w: FloatArray) -> FloatArray:
 
 
 def _clip(poly: FloatArray, limit: float) -> FloatArray:
-    """Return the convex polygon ∩ {|θ| ≤ limit} (θ the first coordinate)."""
+    """Return the convex polygon ∩ {abs(θ) ≤ limit} (θ the first coordinate)."""
     for sign in (1.0, -1.0):
         value = sign * poly[:, 0] - limit  # ≤ 0 inside
         after = np.roll(value, -1)
@@ -156,7 +156,7 @@ class FlywheelFeasibility:
     def forced_braking(self, state: FloatArray) -> tuple[int, int]:
         """Return (k, side): full braking forced on the first k stages (k = 0: none).
 
-        On the boundary of S_N (γ = 1) the only plans that keep |θ| ≤ θmax brake at full
+        On the boundary of S_N (γ = 1) the only plans that keep abs(θ) ≤ θmax brake at full
         torque until the flywheel stops: from s_0, τ_i = side τmax with side = −sign θ̇_0
         brings θ to its peak θ_k, which is the bound ±θmax itself; any less braking at any of
         the first k stages would carry θ_k beyond it (θ_k increases with every τ_i, i < k,

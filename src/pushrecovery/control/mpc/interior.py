@@ -21,7 +21,7 @@ if they cannot (a degenerate stage), the interior point's own solution stands, c
 
 Scales. A bound's multiplier z is measured against H_jj × range_j, the multiplier that would
 move an unconstrained input by its whole range (H = 2 W^u_i + B^T S_{i+1} B, S the
-unconstrained problem's cost-to-go); the θ bound's against the torque's divided by |B_θτ|
+unconstrained problem's cost-to-go); the θ bound's against the torque's divided by abs(B_θτ)
 (θ moves by B_θτ τ), and a state's stationarity row against the inputs' scales divided by the
 entries of B that carry it. Convergence: every bound's residual and complementarity product below
 :data:`TOL` of its scale (× the range for products), every stationarity row below

@@ -5,7 +5,7 @@ r"""The MPC problem of Sec. III-B: horizon, weights and solver (Eq. 17).
 with X_i the state predicted i steps ahead by the exact discretisation of Eq. (16) and U_{i−1}
 the input applied over the step that leads to it. As printed, the weights γ^{N−i} *grow* toward
 the end of the horizon (γ < 1); the text's "discount factor" is a misnomer (errata E13). Hard
-constraints: δ⁻ ≤ δ ≤ δ⁺, |τ| ≤ τmax, |θ_i| ≤ θmax.
+constraints: δ⁻ ≤ δ ≤ δ⁺, abs(τ) ≤ τmax, abs(θ_i) ≤ θmax.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@ r"""Eq. (17) with the states kept, solved exactly by a warm-started active set a
 
 The sparse form of Eq. (17): variables u_0..u_{N−1} and x_1..x_N, the dynamics
 x_{i+1} = A x_i + B u_i as equalities, and per stage three inequality rows: δ⁻ ≤ δ_i ≤ δ⁺,
-|τ_i| ≤ τmax and |θ_{i+1}| ≤ θmax (θ_{i+1} = A_θ x_i + B_θ u_i, a row of stage i). For a fixed
+abs(τ_i) ≤ τmax and abs(θ_{i+1}) ≤ θmax (θ_{i+1} = A_θ x_i + B_θ u_i, a row of stage i). For a fixed
 set of rows held at their bounds, the minimiser is that of an equality-constrained LQ problem:
 a backward Riccati recursion (per stage, the inputs are split into the part the active rows fix,
 an affine function of x_i, and a free part minimised in closed form) and a forward pass give

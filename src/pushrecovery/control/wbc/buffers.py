@@ -1,4 +1,4 @@
-"""The whole-body QP's per-tick arrays, allocated once (:mod:`.qp`)."""
+"""The whole-body QP's per-tick arrays, allocated once (:mod:`~pushrecovery.control.wbc.qp`)."""
 
 from __future__ import annotations
 

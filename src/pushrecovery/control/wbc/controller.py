@@ -47,7 +47,7 @@ support polygon and stance the plant's fall rule reads when the controller steps
 
 Over 400 lines on purpose: the task laws above share the controller's state (the reset
 pose, the support, the stepper's phase) tick by tick; the tasks' rows and the QP are in
-:mod:`.tasks` and :mod:`.qp`.
+:mod:`.tasks` and :mod:`~pushrecovery.control.wbc.qp`.
 """
 
 from __future__ import annotations

@@ -1,9 +1,10 @@
-r"""The feet of the whole-body QP (:mod:`.qp`): each sole frame and its wrench constraints.
+r"""The feet of the whole-body QP: each sole frame and its wrench constraints.
 
 A foot's wrench w = (F, T) is the force and moment the floor exerts on it at its *sole frame*
 (the foot body's axes, its origin on the sole plane under the ankle; F_z > 0 pushes the foot
 up). Its linear constraints G w ≤ 0: unilateral contact, the friction pyramid inscribed in
-Coulomb's cone, the CoP inside the sole polygon and the yaw friction (:mod:`.qp`'s docstring).
+Coulomb's cone, the CoP inside the sole polygon and the yaw friction (the docstring of
+:mod:`~pushrecovery.control.wbc.qp`, the QP).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ class FootContact:
     mu : float
         Friction coefficient of the pyramid, μ' = μ/√2 [-].
     yaw_radius : float
-        Inscribed radius r of the sole polygon about the frame's origin [m] (|T_z| ≤ μ' r F_z).
+        Inscribed radius r of the sole polygon about the frame's origin [m] (abs(T_z) ≤ μ' r F_z).
     """
 
     name: str

@@ -1,4 +1,7 @@
-"""The gains and weights of the whole-body controller's tasks (:mod:`.controller`)."""
+"""The gains and weights of the whole-body controller's tasks.
+
+The controller is :mod:`~pushrecovery.control.wbc.controller`.
+"""
 
 from __future__ import annotations
 

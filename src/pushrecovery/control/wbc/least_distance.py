@@ -1,4 +1,4 @@
-r"""The whole-body QP's solve (:mod:`.qp`): DAQP on its least-distance form, motor rows last.
+r"""The whole-body QP's solve: DAQP on its least-distance form, motor rows last.
 
 :class:`~.qp.WholeBodyQP` writes the QP min ½ xᵀ H x + fᵀ x s.t. l ≤ A x ≤ u into its
 buffers (:mod:`.buffers`): the equality rows first, the wrench rows, then one row per

@@ -23,19 +23,19 @@ subject to
   docs/humanoid3d.md, "The whole-body controller");
   a foot off the floor (:meth:`WholeBodyQP.set_contacts`, a swing) has w_i = 0 instead and no
   wrench inequalities (its motion is a task, :mod:`.stepper.stepper`);
-* unilateral contact F_z ≥ 0 and a linearised friction pyramid |F_x|, |F_y| ≤ μ' F_z with
+* unilateral contact F_z ≥ 0 and a linearised friction pyramid abs(F_x), abs(F_y) ≤ μ' F_z with
   μ' = μ/√2 (the square inscribed in Coulomb's cone of μ; μ the larger sliding friction of
   the sole's and the floor's geoms, MuJoCo's mixing rule);
 * the CoP p = (−T_y, T_x)/F_z of each wrench inside its foot's sole polygon: for each edge
   n·p ≤ d, n_x (−T_y) + n_y T_x − d F_z ≤ 0 (linear in w);
-* yaw friction |T_z| ≤ μ' r F_z, r the sole polygon's inscribed radius about the sole frame's
+* yaw friction abs(T_z) ≤ μ' r F_z, r the sole polygon's inscribed radius about the sole frame's
   origin (a conservative bound of the torsional friction);
 * motor limits: the torque of each motor, τ_a / gear, within its ``actuator_ctrlrange``.
 
-The tasks A_k x = b_k are handed in by the controller (:mod:`.controller`): the CoM's
-acceleration, exact from Newton's law on the wrenches, m c̈ = m g + Σ_i R_i F_i; the torso's
-angular acceleration J_r q̈ + J̇_r q̇; the pelvis height z̈ = J_z q̈ + J̇_z q̇; and the posture
-q̈_j. Solved with DAQP (a dense dual active-set solver), its models kept between ticks (the
+The tasks A_k x = b_k are handed in by the controller (:mod:`~pushrecovery.control.wbc.controller`):
+the CoM's acceleration, exact from Newton's law on the wrenches, m c̈ = m g + Σ_i R_i F_i; the
+torso's angular acceleration J_r q̈ + J̇_r q̇; the pelvis height z̈ = J_z q̈ + J̇_z q̇; and the
+posture q̈_j. Solved with DAQP (a dense dual active-set solver), its models kept between ticks (the
 equality rows immutable, the last active set the warm start), first without the motor rows.
 The compiled kernels of :mod:`.kernels.wbc` assemble each tick in place and hand DAQP its
 least-distance form (H factored on its envelope). MuJoCo's types appear as ``Any``.

@@ -174,7 +174,7 @@ class MujocoPlant(ABC):
         Applied from the next :meth:`step` on (call after :meth:`reset`), over the
         whole physics steps nearest to ``duration`` (at least one), with the force that makes
         their total exactly ``impulse``. The velocity jump it stands for, J/m, must satisfy
-        the models' validity (|J/m| < 10 sqrt(g L)). Returns how long the force acts [s].
+        the models' validity (abs(J/m) < 10 sqrt(g L)). Returns how long the force acts [s].
         """
         if not (math.isfinite(impulse) and math.isfinite(duration)):
             raise InvalidParameterError(

@@ -19,7 +19,7 @@ the body's *absolute* lean φ = foot pitch + ankle angle, while an actuator feed
 transmission, the ankle angle alone: the stiffness an actuator adds to the joint-space
 equations is Σ c cᵀ (symmetric), and −k_p e_ankle (e_pitch + e_ankle)ᵀ is not, so no set of
 actuators expresses it. Measured on a grid of 86 pushes (docs/validation.md), the actuator
-form rocks the light foot in a limit cycle (|ẋ| ≈ 2e-3 m/s, never at rest: 48 verdicts
+form rocks the light foot in a limit cycle (abs(ẋ) ≈ 2e-3 m/s, never at rest: 48 verdicts
 differ) and, its torque clamp being constant where the map's edge torque depends on the load,
 tips the foot at the toe during saturated braking.
 
@@ -104,7 +104,7 @@ def ankle_pd_rollout(
     pushed at its CoM with the impulse m ẋ over 10 ms, then
     :class:`~pushrecovery.control.ankle.AnklePD` (default gains k_p = 3 m g L,
     k_d = k_p / ω) balances it at 1 kHz until it falls (the plant's absorbing fall set),
-    rests (|ẋ| <= 1e-3 m/s over the foot with an unsaturated command for 0.5 s) or
+    rests (abs(ẋ) <= 1e-3 m/s over the foot with an unsaturated command for 0.5 s) or
     ``duration`` runs out.
 
     Parameters
@@ -112,9 +112,9 @@ def ankle_pd_rollout(
     params : BodyParams
         The body (one model is compiled for all the pushes).
     x0 : sequence of float
-        CoM position before each push, relative to the ankle [m] (|x0| < L).
+        CoM position before each push, relative to the ankle [m] (abs(x0) < L).
     xdot : sequence of float
-        The velocity each push gives, J/m [m/s] (|ẋ| < 10 sqrt(g L)).
+        The velocity each push gives, J/m [m/s] (abs(ẋ) < 10 sqrt(g L)).
     duration : float
         Longest simulated time per push [s], in (0, 60].
     threads : int

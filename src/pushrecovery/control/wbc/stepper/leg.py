@@ -1,8 +1,8 @@
 """The swing leg of the whole-body controller's step: its joints, inertia and swing time.
 
 World frame, x forward, y left, z up, SI units. The swing-time bound is derived in
-:mod:`~.plan` (its module docstring); used by :class:`~.stepper.stepper.Stepper` and the knee
-and pelvis limits (:mod:`~.height`).
+:mod:`~pushrecovery.control.wbc.stepper.plan` (its module docstring); used by
+:class:`~.stepper.stepper.Stepper` and the knee and pelvis limits (:mod:`~.height`).
 """
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def leg_joints(model: Any, foot: int) -> Leg:
 def axis_inertia(model: Any, data: HumanoidObservation, joint: int) -> float:
     """Return the inertia of ``joint``'s subtree about its axis [kg m²], armature included.
 
-    I = Σ_b m_b |a × (c_b − o)|² + aᵀ R_b I_b R_bᵀ a over the bodies b below the joint (a its
+    I = Σ_b m_b ‖a × (c_b − o)‖² + aᵀ R_b I_b R_bᵀ a over the bodies b below the joint (a its
     unit axis, o its anchor, after ``mj_kinematics``).
     """
     axis = np.asarray(data.xaxis[joint], dtype=float)

@@ -176,7 +176,7 @@ def collides(params: BodyParams, stance: FootPose, start: FloatArray, end: Float
     """Whether the swing ankle's straight path from ``start`` to ``end`` [m] meets the stance sole.
 
     In the stance foot's frame, two soles of the body's length L = toe − heel and width w
-    (same yaw) overlap when the ankles' offset lies in the open box |Δx| < L, |Δy| < w;
+    (same yaw) overlap when the ankles' offset lies in the open box abs(Δx) < L, abs(Δy) < w;
     enlarged by ``clearance`` [m], sampled at 33 points of the path (1/32 of it apart).
     """
     c, s = math.cos(stance.yaw), math.sin(stance.yaw)

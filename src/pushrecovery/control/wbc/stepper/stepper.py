@@ -6,9 +6,9 @@ World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
 * **Decision** (double support): step when the capture point ξ = c + ċ/ω is beyond what the
   ankles (and the hip, if enabled) recover: its signed distance to the CoP region P (or the
   CMP region P ⊕ box(a'_x, a'_y), :class:`~.hip.HipLaw`) below −``margin``.
-* **Plan** (:mod:`.plan`): the foot on ξ's side of the ankles' midpoint swings
-  (within ``follow_time`` of a touchdown, the trailing foot unless the landed foot's plan
-  captures in fewer steps, :func:`~.plan.choose_step`); the library's one-step
+* **Plan** (:mod:`~pushrecovery.control.wbc.stepper.plan`): the foot on ξ's side of the ankles'
+  midpoint swings (within ``follow_time`` of a touchdown, the trailing foot unless the landed
+  foot's plan captures in fewer steps, :func:`~.plan.choose_step`); the library's one-step
   (else two-step) capture region of the state now, the stance foot's measured pose, a
   touchdown after t_s, and (when the controller has its hip task) the hip's box; its
   recommended ``foothold`` (the region's Chebyshev centre) is the landing ankle's target;

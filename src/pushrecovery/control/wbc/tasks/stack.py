@@ -1,11 +1,12 @@
-"""The whole-body controller's tasks as one stack of rows (:mod:`.controller`, :mod:`.qp`).
+"""The whole-body controller's tasks as one stack of rows.
 
-The QP's cost Σ_k W_k ‖A_k x − b_k‖² is a sum over rows: row r of weight W_r adds
-W_r a_rᵀ a_r to H and −W_r a_rᵀ b_r to f. :class:`TaskStack` keeps every task of a tick as
-rows of one matrix (with one target and one weight per row), so that the QP takes them in
-one compiled call (``WholeBodyQP._solve_rows``) instead of a :class:`~.task.Task`, a check and
-a call per task. Row order: the CoM (2), the torso (3), the pelvis height (1) and the posture
-(nv − 6), written in place by the ankle controller's kernel (``kernels.wbc.ankle_targets``),
+Used by the controller (:mod:`~pushrecovery.control.wbc.controller`) and its QP
+(:mod:`~pushrecovery.control.wbc.qp`). The QP's cost Σ_k W_k ‖A_k x − b_k‖² is a sum over rows: row
+r of weight W_r adds W_r a_rᵀ a_r to H and −W_r a_rᵀ b_r to f. :class:`TaskStack` keeps every task
+of a tick as rows of one matrix (with one target and one weight per row), so that the QP takes them
+in one compiled call (``WholeBodyQP._solve_rows``) instead of a :class:`~.task.Task`, a check and a
+call per task. Row order: the CoM (2), the torso (3), the pelvis height (1) and the posture
+(nv − 6 rows), written in place by the ankle controller's kernel (``kernels.wbc.ankle_targets``),
 then the tick's other tasks (the hip's momentum, the stepper's, the joint guard's).
 """
 

@@ -92,7 +92,7 @@ def inertia_about_axis(
 ) -> float:
     """Return the inertia of ``bodies`` about the line through ``point`` along ``axis`` [kg m^2].
 
-    Σ_b m_b |a × (c_b − p)|² + aᵀ R_b diag(I_b) R_bᵀ a with each body's centre of mass c_b and
+    Σ_b m_b ‖a × (c_b − p)‖² + aᵀ R_b diag(I_b) R_bᵀ a with each body's centre of mass c_b and
     principal frame R_b (``data.xipos``, ``data.ximat`` after ``mj_kinematics``), ``a`` the unit
     axis: the composite inertia the bodies present to a hinge along that line.
     """

@@ -31,7 +31,7 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   falls; or the CoM below :data:`FALL_HEIGHT` z₀ (the body is down). Under a controller that
   steps (its command's ``support``, reported in the step's ``StepInfo.support``) a capture
   point beyond the feet is what a step answers: the body down only.
-* **at_rest(state, speed)**: |ċ_xy| <= speed and the CoM's ground point strictly inside P
+* **at_rest(state, speed)**: ‖ċ_xy‖ <= speed and the CoM's ground point strictly inside P
   (the step's ``StepInfo.support`` when the controller steps, and no foot swinging).
 * **Clocked** (:class:`~pushrecovery.sim.backend.Clocked`): ``clock`` is MuJoCo's time and
   ``run_rows()`` the rows since ``reset``/``begin``: one per step and one after a push (whose
@@ -362,7 +362,7 @@ class Humanoid3DPlant:
         return self.info.support is None and self.xcom_outside(state) > self.fall_margin()
 
     def at_rest(self, state: FloatArray, speed: float) -> bool:
-        """Whether |ċ_xy| <= ``speed`` [m/s] with the CoM over the support (item 6).
+        """Whether ‖ċ_xy‖ <= ``speed`` [m/s] with the CoM over the support (item 6).
 
         The support is the last step's ``StepInfo.support`` when the controller steps (no
         foot may swing), else the feet at reset.

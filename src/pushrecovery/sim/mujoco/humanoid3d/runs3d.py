@@ -91,7 +91,7 @@ def run_push3d(
     push_time : float
         Quiet standing before the push, in [0, 10] s.
     rest_speed, rest_duration : float
-        Recovered after |ċ_xy| <= rest_speed [m/s] over P for rest_duration [s] (rest_speed
+        Recovered after ‖ċ_xy‖ <= rest_speed [m/s] over P for rest_duration [s] (rest_speed
         > 0; at least one tick at rest).
     record : bool
         Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (the extras'), for rendering.
@@ -165,7 +165,7 @@ class _ControllerFigures:
         self.peak_hip_torque = 0.0
 
     def on_step(self, index: int, step: Step, command: Command) -> None:
-        """Count a failed solve; after the push, keep the largest m g |δ| [N m]."""
+        """Count a failed solve; after the push, keep the largest m g abs(δ) [N m]."""
         controller = self.controller
         self.failed_ticks += 0 if controller.last is None or controller.last.ok else 1
         if index >= self.push_tick:

@@ -11,7 +11,7 @@ fixed height: it tracks the body. MuJoCo's free camera takes azimuth φ + 180° 
 −θ. :func:`fit_camera3d` picks the distance and the height so that the moving geoms' bounding
 boxes (relative to the CoM's ground point, over the run) fit with a margin, by the pinhole
 model: a point at (x, y) in the camera's right/up axes and at depth D + p·f (f the viewing
-direction) is in the image when |x| <= (D + p·f) tan(fovx/2) and |y| <= (D + p·f)
+direction) is in the image when abs(x) <= (D + p·f) tan(fovx/2) and abs(y) <= (D + p·f)
 tan(fovy/2).
 """
 
