@@ -24,7 +24,7 @@ Markers (Vicon Plug-in Gait labels), each (n_points, 3) [m]:
   the sole (where the ankle hinge sits, ``ANKLE_HEIGHT``). Left feet at y = +0.1 m, right feet
   at y = −0.1 m (stance width ``2 STANCE_HALF_WIDTH`` = 0.2 m). The models are sagittal: for
   ``foot`` and ``torso`` the single model foot stands for both feet side by side (L and R
-  markers coincide in x and z; the real contacts stay at |y| ≤ 0.05 m, the sole's half width,
+  markers coincide in x and z; the real contacts stay at abs(y) ≤ 0.05 m, the sole's half width,
   so the plates' CoP is at y = 0, between the feet); for ``biped`` L is the model's ``left``
   leg (drawn at y = +0.1 m, which stands first and is the stance leg of the first step) and R
   its ``right`` leg (y = −0.1 m, the first swing leg).

@@ -14,7 +14,7 @@ Bodies and joints
     about the hip roll axis (the x line through the hip centre) ``flywheel_inertia_roll``:
     the flywheel of Sec. III in pitch and roll. The principal inertia at its own CoM is that
     minus the parallel-axis term m_u (c² + x_u²) (pitch) or m_u c² (roll); the yaw inertia is
-    max((I_x + I_y)/4, |I_x − I_y|), the least that keeps the triangle inequalities.
+    max((I_x + I_y)/4, abs(I_x − I_y)), the least that keeps the triangle inequalities.
 ``<side>_thigh``
     At y = ±``stance_width``/2 below the hip centre: a 3-DoF hip, hinges ``<side>_hip_yaw``
     (z), ``<side>_hip_roll`` (x) and ``<side>_hip_pitch`` (y), in that order (a gimbal at one
