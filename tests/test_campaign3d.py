@@ -2,7 +2,7 @@
 
 The runs are tiny (one or two pushes of half the ankle's predicted limit, 1.5 s): they check
 the plumbing (rows, columns, files, the pushes' sizes against a hand computation), not the
-physics, which docs/validation.md measures.
+physics, which docs/validation3d.md measures.
 """
 
 import json
@@ -129,7 +129,7 @@ def test_cli_validate_on_the_biped3d(capsys, tmp_path):
     data = json.loads(text)
     (critical,) = data["critical"]
     # the side, bisected to 20 % of the corrected prediction: below the plain 2-D prediction
-    # (docs/validation.md: −14 %), above the bracket's widest miss
+    # (docs/validation3d.md: −14 %), above the bracket's widest miss
     assert 0.6 * critical["predicted"] < critical["measured"] < critical["predicted"]
     assert sum(map(sum, data["confusion"]["counts"])) == 1
     assert (tmp_path / "validation3d_biped3d.png").exists()

@@ -65,7 +65,7 @@ def test_with_the_extra_the_section_has_polar_plots_tables_and_filmstrips(
     (table,) = section.tables
     assert [row[:2] for row in table.rows] == [("90", "ankle")]
     # The measured critical push: below the fall of the bracket, within 20 % of the
-    # prediction's push-height correction (docs/validation.md: +3.8 % at 90° at 1 %).
+    # prediction's push-height correction (docs/validation3d.md: +3.8 % at 90° at 1 %).
     measured, corrected = float(table.rows[0][4]), float(table.rows[0][3])
     assert measured == pytest.approx(corrected, rel=0.2)
     if section.rendering is None:  # offscreen OpenGL available

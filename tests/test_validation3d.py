@@ -5,7 +5,7 @@ feet (heel −0.05, toe 0.15, width 0.10 m, ankles 0.20 m apart; m = 72 kg, L = 
 measured ankle critical push of the biped3d at 0° and 90° is bisected coarsely (3 % of the
 prediction: 0.8 N s) and must lie within 10 % of the prediction corrected for the push's
 height (module docstring of ``experiments.validation3d``): the uncorrected LIPM prediction
-is 14-16 % high (docs/validation.md, "3-D: the critical push from every direction").
+is 11-15 % high (docs/validation3d.md, "The critical push from every direction").
 """
 
 import math

@@ -87,7 +87,7 @@ def test_the_g1_steps_beyond_its_ankles_and_short_of_the_one_step_prediction(g1)
     """Forward: the G1 with stepping stands pushes its CoP region cannot hold.
 
     The CoP region's plain limit m ω (toe − x₀) is above what the G1's ankles hold (10.3 N s
-    against 15.2, docs/validation.md): stepping must stand more than that, and less than the
+    against 15.2, docs/validation3d.md): stepping must stand more than that, and less than the
     one-step region's plain prediction.
     """
     p = g1.params
@@ -143,7 +143,7 @@ def test_bad_inputs(params, call, name):
 
 def test_the_g1s_controller_has_no_hip_task_unless_asked_and_the_biped3ds_has(g1):
     # Measured: on the G1 the hip task lowers the critical push at every azimuth
-    # (docs/validation.md), so its default WBC balances without it; the biped3d keeps it.
+    # (docs/validation3d.md), so its default WBC balances without it; the biped3d keeps it.
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, wbc_for
 
     assert wbc_for(g1).hip_params is None

@@ -431,7 +431,7 @@ def test_the_hip_brakes_for_the_measured_spin_of_the_torso(params, model):
 
 @needs_robots
 def test_the_g1_recovers_a_forward_push_at_80_percent_of_its_corrected_ankle_limit(g1):
-    """J*/(1 + d/z₀) (docs/validation.md: the push at torso_link, d above the CoM); with the
+    """J*/(1 + d/z₀) (docs/validation3d.md: the push at torso_link, d above the CoM); with the
     feet's drift undamped (k_c = 0) the feet tipped on their toes and slid, and it fell.
     """
     from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import G1_TORSO, g1_ankle_impulse, push_g1
