@@ -38,11 +38,11 @@ class StrategyPushes:
     Attributes
     ----------
     ankle : float
-        ``ANKLE_FRACTION`` of the ankle's critical push.
+        ``ANKLE_FRACTION`` of the ankle's critical push [m/s].
     hip : float
-        Midway between the ankle's and the hip's critical pushes.
+        Midway between the ankle's and the hip's critical pushes [m/s].
     step : float
-        ``STEP_FRACTION`` of the way from the hip's critical push to one step's.
+        ``STEP_FRACTION`` of the way from the hip's critical push to one step's [m/s].
     """
 
     ankle: float

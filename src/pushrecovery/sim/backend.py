@@ -66,7 +66,8 @@ class Step(NamedTuple):
     Attributes
     ----------
     state : ndarray
-        The state after the step (``state_labels``).
+        The state after the step (``state_labels``): positions [m] and angles [rad], then
+        their rates [m/s], [rad/s].
     applied : tuple of float
         The inputs held over the step (``input_labels``): CoP [m], then torques [N m].
     info : StepInfo
@@ -155,9 +156,11 @@ class RunRows(NamedTuple):
     time : ndarray, shape (n,)
         The plant's clock at each row [s].
     states : ndarray, shape (n, d)
-        The state at each row (``state_labels``).
+        The state at each row (``state_labels``): positions [m] and angles [rad], then their
+        rates [m/s], [rad/s].
     inputs : ndarray, shape (n - 1, m)
-        The inputs held from each row to the next (``input_labels``).
+        The inputs held from each row to the next (``input_labels``): CoP [m], then torques
+        [N m] (a 3-D humanoid's: its motor commands [N m]).
     """
 
     time: FloatArray

@@ -101,7 +101,9 @@ class Push3DExtras:
         Steps that landed (the controller's stepping task; 0 without it).
     qpos, qvel, ctrl : float arrays, shapes (n, nq), (n, nv), (n, nu), or None
         MuJoCo's ``qpos``, ``qvel`` and the held motor commands at each row of the result
-        (recorded runs, to replay and render them); None otherwise.
+        (recorded runs, to replay and render them); None otherwise. ``qpos`` [m] for slide and
+        free-joint positions, [-] for the free joint's unit quaternion, [rad] for hinges;
+        ``qvel`` [m/s] and [rad/s] likewise; ``ctrl`` the motors' torques [N m] (gear 1).
     """
 
     push: Push3D

@@ -41,7 +41,7 @@ class CaptureLP:
     cops, torques : ndarray, shape (N,)
         The optimal inputs [m], [N m].
     states : ndarray, shape (N + 1, 4)
-        The optimal trajectory ``[x, θ, ẋ, θ̇]``.
+        The optimal trajectory ``[x, θ, ẋ, θ̇]`` [m, rad, m/s, rad/s].
     dt : float
         Grid step [s].
     """

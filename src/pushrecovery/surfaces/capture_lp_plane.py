@@ -91,7 +91,8 @@ class PlaneCaptureLP:
     torques : ndarray, shape (N, 2)
         The optimal pitch and roll torques [N m].
     states : ndarray, shape (N + 1, 8)
-        The optimal trajectory ``(x, y, θp, θr, ẋ, ẏ, θ̇p, θ̇r)`` from x = y = 0.
+        The optimal trajectory ``(x, y, θp, θr, ẋ, ẏ, θ̇p, θ̇r)`` from x = y = 0 [m, m, rad, rad,
+        m/s, m/s, rad/s, rad/s].
     dt : float
         Grid step [s].
     """

@@ -268,7 +268,7 @@ class StepFrame:
     ankle_x, ankle_y : float
         The stance's ankle (the ankles' midpoint in double support) [m].
     heading_x, heading_y : float
-        Unit vector of the stance's heading.
+        Unit vector of the stance's heading [-].
     swing : float
         −1: the right foot lands (left stance), +1: the left (right stance), 0: the foot on
         the side of the step (double support).

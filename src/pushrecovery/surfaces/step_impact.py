@@ -58,7 +58,7 @@ class TouchdownImpact:
     margin, margin_impact : float
         Their signed distances to what the rest of the plan captures [m], + inside.
     speed_ratio : float
-        ‖v⁺_h‖ / ‖v_h‖: the share of the horizontal speed the impact leaves.
+        ‖v⁺_h‖ / ‖v_h‖ [-]: the share of the horizontal speed the impact leaves.
     """
 
     time: float

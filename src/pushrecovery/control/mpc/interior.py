@@ -114,7 +114,7 @@ class InteriorPointSolver:
     inputs : ndarray, shape (N, 2)
         (δ [m], τ [N m]) of the last converged solve (fresh arrays each solve).
     states : ndarray, shape (N + 1, 4)
-        Its predicted states X_0..X_N.
+        Its predicted states X_0..X_N, ``[x, θ, ẋ, θ̇]`` [m, rad, m/s, rad/s].
     iterations : int
         Iterations of the last solve (−1: did not converge in :data:`MAX_ITERATIONS`).
     verified : bool

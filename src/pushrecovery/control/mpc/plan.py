@@ -26,16 +26,19 @@ class Plan:
     feasible : bool
         False when the QP had no solution; the inputs are then the saturated fallback.
     inputs, states : ndarray or callable returning one
-        The plan's inputs (N, 2) and predicted states (N + 1, 4), or how to compute them.
+        The plan's inputs (N, 2), (δ [m], τ [N m]), and predicted states (N + 1, 4),
+        ``[x, θ, ẋ, θ̇]`` [m, rad, m/s, rad/s], or how to compute them.
 
     Attributes
     ----------
     first_input : ndarray, shape (2,)
+        (δ [m], τ [N m]) applied now.
     feasible : bool
+        False when the QP had no solution.
     inputs : ndarray, shape (N, 2)
         (δ [m], τ [N m]) for each step.
     states : ndarray, shape (N + 1, 4)
-        Predicted ``[x, θ, ẋ, θ̇]``, starting with the measured state.
+        Predicted ``[x, θ, ẋ, θ̇]`` [m, rad, m/s, rad/s], starting with the measured state.
     """
 
     __slots__ = ("_inputs", "_states", "feasible", "first_input")
@@ -62,7 +65,7 @@ class Plan:
 
     @property
     def states(self) -> FloatArray:
-        """Predicted ``[x, θ, ẋ, θ̇]`` X_0..X_N, shape (N + 1, 4)."""
+        """Predicted ``[x, θ, ẋ, θ̇]`` X_0..X_N [m, rad, m/s, rad/s], shape (N + 1, 4)."""
         states = self._states
         if callable(states):
             states = self._states = states()

@@ -143,7 +143,7 @@ class RiccatiSolver:
     inputs : ndarray, shape (N, 2)
         (δ [m], τ [N m]) of the last verified solve.
     states : ndarray, shape (N + 1, 4)
-        Its predicted states X_0..X_N.
+        Its predicted states X_0..X_N, ``[x, θ, ẋ, θ̇]`` [m, rad, m/s, rad/s].
     active : ndarray of int8, shape (N, 3)
         Its active set: rows (δ_i, τ_i, θ_{i+1}), −1 at the lower bound, +1 at the upper.
     passes : int

@@ -73,8 +73,10 @@ def draw_capture_plane(
         The body.
     support : Support
         Stance and feet.
-    speeds, headings
-        The pushes (:func:`plane_samples`).
+    speeds : array_like, optional
+        Push speeds [m/s] (:func:`plane_samples`).
+    headings : int or array_like
+        Number of push headings, or the headings [rad] counter-clockwise from +x.
     samples : PlaneSamples, optional
         Precomputed samples (else :func:`plane_samples`).
     limits : array_like, optional
@@ -283,8 +285,13 @@ def capture_plane_panels(
         The body.
     supports : sequence of Support, optional
         One column each; default the three stances on the default feet.
-    speeds, headings, thresholds
-        As :func:`capture_plane_figure`; the default speeds are the same for every column.
+    speeds : array_like, optional
+        Push speeds [m/s], as :func:`capture_plane_figure`; the default speeds are the same for
+        every column.
+    headings : int or array_like
+        Number of push headings, or the headings [rad] counter-clockwise from +x.
+    thresholds : bool
+        Print the per-direction push limits [m/s] of each strategy.
 
     Returns
     -------

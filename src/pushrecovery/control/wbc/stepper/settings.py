@@ -45,9 +45,9 @@ class StepSettings:
     replan_fraction : float
         Re-plan only in this first fraction of the swing, in [0, 1].
     torque_share : float or None
-        κ in [0.001, 1]: the share of the swing hip's motor limit the swing may take; the
-        swing lasts at least what that torque needs (:func:`~.leg.leg_swing_time`),
-        up to ``max_swing_time``. None: always ``swing_time``.
+        κ in [0.001, 1], a fraction: the share of the swing hip's motor limit the swing may take;
+        the swing lasts at least what that torque needs (:func:`~.leg.leg_swing_time`), up to
+        ``max_swing_time``. None: always ``swing_time``.
     max_swing_time : float
         The longest swing [s], in [0.05, 2], ≥ ``swing_time``.
     knee_min : float

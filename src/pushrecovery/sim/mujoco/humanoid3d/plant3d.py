@@ -103,7 +103,8 @@ class Humanoid3DPlant:
     model : mujoco.MjModel
         The humanoid: a free root joint first, torque motors.
     qpos : float array
-        Its standing posture, soles on the floor.
+        Its standing posture, soles on the floor, in MuJoCo's units: [m] for slide and free-joint
+        positions, [-] for the free joint's unit quaternion, [rad] for hinges.
     feet : tuple of str
         The foot bodies (left, right).
     torso : str

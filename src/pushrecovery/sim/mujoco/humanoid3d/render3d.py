@@ -93,7 +93,9 @@ class Recording3D:
     time : float array, shape (n,)
         [s], non-decreasing.
     qpos, qvel, ctrl : float arrays, shapes (n, nq), (n, nv), (n, nu)
-        MuJoCo's state and the motor commands held at each row.
+        MuJoCo's state and the motor commands held at each row: ``qpos`` [m] for slide and
+        free-joint positions, [-] for the free joint's unit quaternion, [rad] for hinges;
+        ``qvel`` [m/s] and [rad/s] likewise; ``ctrl`` the motors' torques [N m] (gear 1).
     com, com_velocity : float arrays, shape (n, 3)
         Whole-body CoM [m] and its velocity [m/s].
     """

@@ -182,7 +182,8 @@ class RobotDescription:
     model : mujoco.MjModel
         The model of :func:`load_robot`.
     qpos : float array
-        The standing pose (soles on the floor).
+        The standing pose (soles on the floor), in MuJoCo's units: [m] for slide and free-joint
+        positions, [-] for the free joint's unit quaternion, [rad] for hinges.
     legs : list of int
         The body at the top of each leg (left, right).
     feet : list of int

@@ -77,7 +77,8 @@ class StandingPD:
         model : mujoco.MjModel
             Its actuators must be torque motors (gear 1) on hinge joints.
         qpos : float array
-            The standing posture (:func:`~.measure.standing_qpos`).
+            The standing posture (:func:`~.measure.standing_qpos`), in MuJoCo's units: [m] for slide
+            and free-joint positions, [-] for the free joint's unit quaternion, [rad] for hinges.
         legs : list of int
             Body ids at the top of each leg (the hip's first body): joints in their subtrees
             also move the body above them (module docstring).

@@ -78,7 +78,10 @@ class WbcRun:
         Wall time of the DAQP solve, of the whole controller tick, and of the tick's physics
         steps [s] (diagnostics, not for tests).
     qpos, qvel, ctrl : float arrays, shapes (n, nq), (n, nv), (n, nu)
-        MuJoCo's state and the tick's motor commands (to replay and render the run).
+        MuJoCo's state and the tick's motor commands (to replay and render the run):
+        ``qpos`` [m] for slide and free-joint positions, [-] for the free joint's unit
+        quaternion, [rad] for hinges; ``qvel`` [m/s] and [rad/s] likewise; ``ctrl`` the
+        motors' torques [N m] (gear 1).
     controller : WholeBodyController
         The controller after the run (its feet's constraints and support polygon).
     """

@@ -35,7 +35,8 @@ class Frame:
     time : float
         Simulation time [s].
     qpos : NDArray[np.float64]
-        Copy of ``data.qpos`` (shape ``(model.nq,)``).
+        Copy of ``data.qpos`` (shape ``(model.nq,)``), in MuJoCo's units: [m] for slide and
+        free-joint positions, [-] for the free joint's unit quaternion, [rad] for hinges.
     com : tuple[float, float]
         CoM position (x, z) in world coordinates [m].
     capture_point : float

@@ -60,7 +60,8 @@ class Frame3D:
     time : float
         Simulation time [s].
     qpos : NDArray[np.float64]
-        ``data.qpos`` (shape ``(model.nq,)``).
+        ``data.qpos`` (shape ``(model.nq,)``), in MuJoCo's units: [m] for slide and free-joint
+        positions, [-] for the free joint's unit quaternion, [rad] for hinges.
     com : tuple[float, float, float]
         Whole-body CoM [m].
     capture_point : tuple[float, float]
