@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from pushrecovery.cli.app import example
 from pushrecovery.cli.options import PARAM_FLAGS, body_options, emit
 
 if TYPE_CHECKING:
@@ -33,7 +34,10 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     return name, parts[0], parts[1], parts[2]
 
 
-@click.command(short_help="Per-frame margins and strategies of measured trials (CSV, C3D).")
+@click.command(
+    short_help="Per-frame margins and strategies of measured trials (CSV, C3D).",
+    epilog=example("pushrecovery analyze trial.csv --units mm --out out/trial"),
+)
 @click.argument("inputs", nargs=-1, required=True, metavar="FILE|FOLDER|GLOB...")
 @click.option(
     "--out",
@@ -140,8 +144,8 @@ def _foot(text: str) -> tuple[str, str, str, str]:
 @click.option(
     "--normalise",
     is_flag=True,
-    help="Add Hof's dimensionless columns (*_norm): lengths / leg length l, velocities / "
-    "sqrt(g l), times * sqrt(g/l).",
+    help="Add Hof's dimensionless columns (named ..._norm): lengths / leg length l, "
+    "velocities / sqrt(g l), times * sqrt(g/l).",
 )
 @click.option(
     "--plot/--no-plot",
@@ -158,6 +162,11 @@ def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) ->
     are analysed, each with its own base of support; mass and CoM height come from the
     subjects table, the flags, the file, else (mass) the force plates. One file writes its
     outputs into OUT; many write one folder per trial and the tables of trials and events.
+    Positions are in the lab frame [m], ap forward and ml to the subject's left; margins are
+    signed distances of the capture point to the base of support [m], positive inside. Prints
+    the frames analysed, the body and where it came from, the most demanding strategy and the
+    least CoP margin per direction, the step events and gaps, and the files; --json prints the
+    whole summary (summary.json, with the files).
     """
     from pushrecovery.analysis.trial import AnalysisSettings
 

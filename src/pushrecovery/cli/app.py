@@ -12,7 +12,10 @@ import click
 
 from pushrecovery import __version__
 
-__all__ = ["COMMANDS", "cli"]
+__all__ = ["COMMANDS", "EXAMPLE_WIDTH", "cli", "example"]
+
+#: Longest line of an example [characters]: with click's indent, an 80-column terminal.
+EXAMPLE_WIDTH = 74
 
 #: Command name -> ("module:attribute", one-line help).
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -35,7 +38,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     ),
     "critical-push": (
         "pushrecovery.cli.simulation:critical_push",
-        "Largest recoverable push, vs Eq. 4.",
+        "Largest recoverable push, against its surface's prediction.",
     ),
     "figures": (
         "pushrecovery.cli.figures:figures",
@@ -59,6 +62,44 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "Critical pushes and a confusion matrix in simulation vs the surfaces.",
     ),
 }
+
+
+def example(*lines: str) -> str:
+    r"""Return a help page's epilog: its example command lines, each kept on its own line.
+
+    Parameters
+    ----------
+    *lines : str
+        Whole command lines, ``pushrecovery ...``; each one runs as it is written
+        (``tests/test_cli_help.py`` runs them), files written under ``out/``. A line longer
+        than :data:`EXAMPLE_WIDTH` is continued on the next with a shell's `` \``.
+
+    Returns
+    -------
+    str
+        ``Example:`` (or ``Examples:``) and the lines in a click ``\b`` paragraph, which click
+        prints without rewrapping and sphinx-click renders as a line block.
+    """
+    heading = "Example:" if len(lines) == 1 else "Examples:"
+    return "\b\n" + heading + "\n" + "\n".join(_wrapped(line) for line in lines)
+
+
+def _wrapped(line: str) -> str:
+    """Break ``line`` before options (each with its values) to lines of EXAMPLE_WIDTH at most."""
+    chunks: list[str] = []
+    for word in line.split():
+        option = word.startswith("--") or (word.startswith("-") and word[1:2].isalpha())
+        if option or not chunks:  # "--xdot -1 2 0.25" is one chunk
+            chunks.append(word)
+        else:
+            chunks[-1] += " " + word
+    rows = [chunks[0]]
+    for chunk in chunks[1:]:
+        if len(rows[-1]) + 1 + len(chunk) > EXAMPLE_WIDTH - (4 if len(rows) > 1 else 0):
+            rows.append(chunk)
+        else:
+            rows[-1] += " " + chunk
+    return " \\\n".join(f"  {row}" if i == 0 else f"      {row}" for i, row in enumerate(rows))
 
 
 class LazyGroup(click.Group):
@@ -90,12 +131,17 @@ class LazyGroup(click.Group):
     cls=LazyGroup,
     no_args_is_help=True,
     context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100},
+    epilog=example("pushrecovery classify --x 0.0 --xdot 0.7", "pushrecovery bounds --json"),
 )
 @click.version_option(__version__, prog_name="pushrecovery")
 def cli() -> None:
     """Predict whether a pushed humanoid falls, and recover it (Stephens, Humanoid Push Recovery).
 
-    SI units throughout; x is forward, y left, positions relative to the ankle (sagittal) or
-    to the ankles' midpoint (ground plane). Every command takes the body-parameter flags and
-    --json.
+    SI units throughout (m, s, kg, N; angles in rad, push azimuths in degrees); x is forward,
+    y left, positions relative to the ankle (sagittal commands) or to the ankles' midpoint
+    (ground plane), velocities and pushes positive forward and left. The body is the paper's
+    unless --preset, --params FILE or the body flags (--mass, --com-height, ...) change it
+    (the Unitree G1 of 'pushrecovery humanoid' has its own). Every command prints a table, or
+    with --json JSON whose keys are a stable contract (new keys are added, none
+    renamed or dropped); bad input ends with one line on stderr and exit status 2.
     """

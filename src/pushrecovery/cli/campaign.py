@@ -13,6 +13,7 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.app import example
 from pushrecovery.cli.campaign_options import (
     SCHEDULER,
     echo_counts,
@@ -42,7 +43,14 @@ def _refuse_wbc(ctx: click.Context, param: click.Parameter, value: str | None) -
     return value
 
 
-@click.command(short_help="Sweep pushes over starts, push sizes and parameters, at scale.")
+@click.command(
+    short_help="Sweep pushes over starts, push sizes and parameters, at scale.",
+    epilog=example(
+        "pushrecovery campaign --x0 0 0.05 0.05 --xdot -1 2 0.25 --workers 1 --out out/campaign",
+        "pushrecovery campaign --model flywheel --controller mpc --x0 0 0 1 --xdot 0 1 0.1 "
+        "--param torque_max=50:150:50 --workers 1 --out out/sweep",
+    ),
+)
 @click.option(
     "--backend",
     type=click.Choice(("analytic", "mujoco")),
@@ -71,8 +79,8 @@ def _refuse_wbc(ctx: click.Context, param: click.Parameter, value: str | None) -
     "campaign", "--azimuth", "--azimuths", "--strategy", "--fraction", nargs={"--fraction": 3}
 )
 @click.option("--x0", "x0", **_triple, help="CoM positions before the push [m].")
-@click.option("--xdot", **_triple, help="Pushes as CoM velocities [m/s].")
-@click.option("--impulse", **_triple, help="Pushes as impulses at the CoM [N s].")
+@click.option("--xdot", **_triple, help="Pushes as CoM velocities, forward positive [m/s].")
+@click.option("--impulse", **_triple, help="Pushes as impulses at the CoM, forward positive [N s].")
 @run_options(
     param_help="Sweep a body parameter (SI units), repeatable: e.g. torque_max=50:150:25.",
     samples_help="Draw this many pushes uniformly from the ranges (with --seed) instead of the "
@@ -104,13 +112,16 @@ def campaign(
 ) -> None:
     """Simulate every push of a sweep and compare each with the surfaces' prediction.
 
-    Each push records its inputs, the predicted strategy and margins, the outcome, the peak
-    torques and the CoP excursion (OUT/pushes.parquet, one row per push); OUT/summary.json has
-    the counts, the accuracy of the prediction, the confusion matrix (predicted strategy vs the
-    one used) and the empirical critical pushes against the analytic ones. Every finished
-    batch is kept in OUT/batches: an interrupted campaign continues with --resume. The
-    result does not depend on the number of workers. The 3-D humanoids are 'pushrecovery
-    humanoid campaign'.
+    The grid is every --x0 [m, from the ankle] with every push (--xdot or --impulse, each
+    START STOP STEP with STOP included) and every --param value, or --samples pushes drawn
+    from those ranges. Prints the counts of outcomes, the accuracy and the confusion matrix,
+    and the files written. Each push records its inputs, the predicted strategy and margins,
+    the outcome, the peak torques and the CoP excursion (OUT/pushes.parquet, one row per
+    push); OUT/summary.json has the counts, the accuracy of the prediction, the confusion
+    matrix (predicted strategy vs the one used) and the empirical critical pushes against the
+    analytic ones. Every finished batch is kept in OUT/batches: an interrupted campaign
+    continues with --resume. The result does not depend on the number of workers. The 3-D
+    humanoids are 'pushrecovery humanoid campaign'.
     """
     from pushrecovery.campaign import CampaignSpec, read_spec
     from pushrecovery.errors import InvalidParameterError
@@ -166,7 +177,10 @@ def campaign(
     echo_files(files)
 
 
-@click.command(short_help="The HTML report of a parameter set (the main job).")
+@click.command(
+    short_help="The HTML report of a parameter set (the main job).",
+    epilog=example("pushrecovery report --out out/report"),
+)
 @click.option(
     "--out",
     type=click.Path(file_okay=False),
@@ -177,7 +191,7 @@ def campaign(
 @click.option(
     "--full",
     is_flag=True,
-    help="Larger campaigns and finer critical pushes (about 3 minutes instead of half of one).",
+    help="Larger campaigns (up to ten times the pushes) and finer critical pushes.",
 )
 @click.option(
     "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
@@ -194,8 +208,12 @@ def report(
 ) -> None:
     """Write one self-contained HTML page about a parameter set.
 
-    Parameters, bounds, the strategy map, every paper figure, an analytic and a MuJoCo
-    campaign, the MuJoCo critical pushes and a filmstrip per strategy.
+    The body of the flags: its parameters, bounds and thresholds, the strategy map, the
+    ground plane, capture regions, every paper figure, campaigns on the analytic models and in
+    MuJoCo with their accuracy and confusion matrices, the MuJoCo critical pushes, a filmstrip
+    per strategy and the 3-D humanoid; SI units throughout. Prints the page's path
+    (OUT/index.html); the campaigns are kept in OUT and reused by a rerun with the same body
+    and grids.
     """
     from pushrecovery.report import write_report
 

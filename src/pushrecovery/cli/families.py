@@ -22,6 +22,7 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 __all__ = [
     "HUMANOID_MODELS",
+    "ListedChoice",
     "ModelChoice",
     "humanoid_only",
     "planar_only",
@@ -56,7 +57,33 @@ def refuse_humanoid_model(model: str, command: str) -> None:
         )
 
 
-class ModelChoice(click.Choice):
+class ListedChoice(click.Choice):
+    """A choice whose help lists only the values that work; others pass on without a listing.
+
+    An unlisted value is handed to the command as it is, which refuses it in its own words
+    (``critical-push --model stepping-plane``: the critical push is sagittal): the help does
+    not offer what the command refuses, and the refusal stays the command's.
+
+    Parameters
+    ----------
+    choices : sequence of str
+        The values listed in the help.
+    unlisted : sequence of str, optional
+        Values accepted without being listed.
+    """
+
+    def __init__(self, choices: tuple[str, ...], unlisted: tuple[str, ...] = ()) -> None:
+        super().__init__(choices)
+        self.unlisted = tuple(unlisted)
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """Return ``value`` if it is a choice or an unlisted value; else click's error."""
+        if isinstance(value, str) and value in self.unlisted:
+            return value
+        return super().convert(value, param, ctx)
+
+
+class ModelChoice(ListedChoice):
     """A ``--model`` choice that lists its family's models and points the others elsewhere.
 
     Parameters
@@ -68,10 +95,18 @@ class ModelChoice(click.Choice):
         --model g1"``); refused in one line naming it, without being listed.
     family : str
         What the ``elsewhere`` models are, for the message (``"a 3-D humanoid"``).
+    unlisted : sequence of str, optional
+        Models of this family that the command refuses itself (:class:`ListedChoice`).
     """
 
-    def __init__(self, choices: tuple[str, ...], elsewhere: Mapping[str, str], family: str) -> None:
-        super().__init__(choices)
+    def __init__(
+        self,
+        choices: tuple[str, ...],
+        elsewhere: Mapping[str, str],
+        family: str,
+        unlisted: tuple[str, ...] = (),
+    ) -> None:
+        super().__init__(choices, unlisted)
         self.elsewhere = dict(elsewhere)
         self.family = family
 

@@ -7,12 +7,16 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.app import example
 from pushrecovery.cli.options import body_options, emit, params_from
 
 __all__ = ["figures"]
 
 
-@click.command(short_help="Reproduce the paper's figures and the ground-plane figure.")
+@click.command(
+    short_help="Reproduce the paper's figures and the ground-plane figure.",
+    epilog=example("pushrecovery figures --out out/figures --format png"),
+)
 @click.option(
     "--out",
     type=click.Path(file_okay=False),
@@ -33,9 +37,11 @@ __all__ = ["figures"]
 def figures(out: str, formats: tuple[str, ...], as_json: bool, **kwargs: Any) -> None:
     """Reproduce the paper's figures (Fig. 3, 5, 6, 9, 10) into a directory.
 
-    Also plane.png/svg: the capture-point plane (x forward, y left [m]) with the support
-    polygon (ankle), the CMP region (hip) and pushes coloured by the strategy they need, in
-    double, left and right support.
+    The figures are drawn for the body of the flags (SI units on the axes), from simulations
+    of the paper's pushes on the analytic models. Also plane.png/svg: the capture-point plane
+    (x forward, y left [m]) with the support polygon (ankle), the CMP region (hip) and pushes
+    coloured by the strategy they need, in double, left and right support. Prints the files
+    written, one per figure and --format.
     """
     from pushrecovery.cli.progress import Progress
     from pushrecovery.experiments.paper_figures import paper_runs

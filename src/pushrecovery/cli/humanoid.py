@@ -17,9 +17,10 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.app import example
 from pushrecovery.cli.campaign_options import run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, planar_only
-from pushrecovery.cli.options import body_options, echo_confusion, emit
+from pushrecovery.cli.options import body_options_of, echo_confusion, emit
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
 __all__ = ["humanoid"]
@@ -56,28 +57,31 @@ _azimuth = click.option(
 )
 
 
-def _example(line: str) -> str:
-    """Return a help page's example: ``pushrecovery humanoid LINE``, kept on one line."""
-    return f"\b\nExample:\n  pushrecovery humanoid {line}"
+#: The body flags of the humanoid commands: they build biped3d; g1 refuses them.
+_body_options = body_options_of("biped3d")
 
 
 @click.group(
     short_help="The 3-D humanoids (biped3d, g1) under the whole-body controller.",
     no_args_is_help=True,
+    epilog=example("pushrecovery humanoid simulate --push 20 --duration 3"),
 )
 def humanoid() -> None:
     """Run the 3-D humanoids (biped3d, g1) under the whole-body controller (docs/humanoid3d.md).
 
     MuJoCo runs a pushed humanoid standing on both feet: the push is an impulse at the torso
     from any --azimuth (0 forward, 90 left) and the whole-body controller balances it with the
-    ankles, the hips and, if allowed, a step. The planar models (lipm, pendulum, flywheel,
-    stepping, foot, torso, biped) are the commands of the same names outside this group.
+    ankles, the hips and, if allowed, a step. Azimuths are in degrees, impulses in N s, the
+    rest SI. The body flags (--preset, --params, --mass, ...) build biped3d; g1, the Unitree G1
+    (the robots extra), has its own body and refuses them. The planar models (lipm, pendulum,
+    flywheel, stepping, foot, torso, biped) are the commands of the same names outside this
+    group.
     """
 
 
 @humanoid.command(
     short_help="Push a 3-D humanoid; report recovered or fell.",
-    epilog=_example("simulate --model biped3d --azimuth 90 --push 50 --stepping"),
+    epilog=example("pushrecovery humanoid simulate --azimuth 90 --push 50 --stepping --duration 5"),
 )
 @_model("simulate")
 @planar_only("simulate", *_PLANAR_OPTIONS, "--x", "--xdot", "--y", "--ydot", "--plot")
@@ -127,7 +131,7 @@ def humanoid() -> None:
     help="--render: the filmstrip's frame times [s] after the start, increasing (default 6 "
     "evenly spaced).",
 )
-@body_options
+@_body_options
 def simulate(
     model: str,
     azimuth: float,
@@ -145,8 +149,9 @@ def simulate(
 
     The body starts standing still on both feet; the push is --impulse [N s] at the torso
     along --azimuth, and the run goes on for --duration (it stops early once the body falls or
-    has stood still). The report has the outcome, the strategy used (ankle, hip or step), the
-    ground plane's predicted strategy for the push and the peak torques. The body flags
+    has stood still). Prints the outcome (recovered, fell or undecided: not at rest yet), the
+    strategy used (ankle, hip or step) and the steps, the ground plane's predicted strategy
+    for the push, the peak torques [N m] and the torso's largest tilt [rad]. The body flags
     (--preset, --params, --mass, ...) build biped3d; g1 has the robot's own body and refuses
     them.
     """
@@ -166,7 +171,9 @@ def simulate(
 @humanoid.command(
     "critical-push",
     short_help="Largest recoverable push at an azimuth.",
-    epilog=_example("critical-push --model g1 --azimuth 90 --duration 1 --tolerance 0.05"),
+    epilog=example(
+        "pushrecovery humanoid critical-push --azimuth 90 --duration 1 --tolerance 0.05"
+    ),
 )
 @_model("critical-push")
 @planar_only("critical-push", *_PLANAR_OPTIONS, "--x", "--direction")
@@ -185,7 +192,7 @@ def simulate(
     show_default=True,
     help="Longest simulated time per push [s]; keep it short (about 5x real time).",
 )
-@body_options
+@_body_options
 def critical_push(
     model: str, azimuth: float, tolerance: float, duration: float, as_json: bool, **kwargs: Any
 ) -> None:
@@ -193,9 +200,9 @@ def critical_push(
 
     The impulse is bisected between a run that stands and one that falls within --duration
     (keep it short: the whole-body controller runs about 5x real time), to --tolerance times
-    the mass. The report has the critical impulse, its bracket, the number of simulations and
-    the strategy used just below it. The body flags (--preset, --params, --mass, ...) build
-    biped3d; g1 has the robot's own body and refuses them.
+    the mass. Prints the critical impulse [N s] and velocity [m/s], their bracket, the number
+    of simulations and the strategy used just below it. The body flags (--preset, --params,
+    --mass, ...) build biped3d; g1 has the robot's own body and refuses them.
     """
     from pushrecovery.cli.simulation3d import critical_3d, params_3d
 
@@ -205,7 +212,10 @@ def critical_push(
 
 @humanoid.command(
     short_help="Critical pushes per azimuth and a confusion matrix, vs 2-D.",
-    epilog=_example("validate --model biped3d --quick --out out/validate3d"),
+    epilog=example(
+        "pushrecovery humanoid validate --azimuth 0 --strategy ankle --rel-tolerance 0.1 "
+        "--duration 1 --no-confusion --out out/validate3d"
+    ),
 )
 @_model("validate")
 @planar_only("validate", "--backend", "--x0", "--tolerance", "--grid")
@@ -269,7 +279,7 @@ def critical_push(
     help="Directory of the tables, plots and the confusion campaign (which resumes).",
 )
 @click.option("--workers", type=int, default=None, help="The confusion campaign's workers.")
-@body_options
+@_body_options
 def validate(
     model: str,
     strategies: tuple[str, ...],
@@ -292,8 +302,10 @@ def validate(
     the ground plane's prediction (and the prediction corrected for the push's height); then a
     campaign over azimuths x --fractions of the ankle's predicted critical push, under the
     whole-body controller with all its tasks, gives the confusion matrix of the predicted
-    against the used strategy. Tables, CSV, the polar plot and the campaign are written under
-    --out (the campaign resumes if interrupted). The body flags (--preset, --params, --mass,
+    against the used strategy. Prints per strategy and azimuth the predicted, corrected and
+    measured critical impulse [N s] with the errors, then the confusion matrices and the
+    files: tables, CSV, the polar plot and the campaign, under --out (the campaign resumes if
+    interrupted); --quick is a shorter first look. The body flags (--preset, --params, --mass,
     ...) build biped3d; g1 has the robot's own body and refuses them.
     """
     from pathlib import Path
@@ -330,8 +342,9 @@ def validate(
 
 @humanoid.command(
     short_help="Sweep pushes over azimuths, push sizes and parameters, at scale.",
-    epilog=_example(
-        "campaign --model biped3d --azimuths 0:360:90 --fraction 0.5 1.5 0.5 --out out/c3d"
+    epilog=example(
+        "pushrecovery humanoid campaign --azimuth 90 --fraction 0.5 1.5 1.0 --duration 2 "
+        "--workers 1 --out out/c3d"
     ),
 )
 @_model("campaign")
@@ -377,7 +390,7 @@ def validate(
     "grid; the azimuth between the smallest and the largest given.",
     batch_size_help="Pushes per task (default about a second of work).",
 )
-@body_options
+@_body_options
 def campaign(
     model: str,
     azimuth: float | None,
@@ -406,9 +419,10 @@ def campaign(
     whole-body controller (--strategy), and each run is set beside the ground plane's
     predicted strategy: OUT/pushes.parquet has one row per push, OUT/summary.json the counts,
     the accuracy and the critical pushes per azimuth, OUT/confusion3d.* the confusion matrix of
-    predicted against used strategy. Finished batches are kept: an interrupted campaign
-    continues with --resume. The body flags (--preset, --params, --mass, ...) build biped3d;
-    g1 has the robot's own body and refuses them and --param.
+    predicted against used strategy. Prints the counts of outcomes, the accuracy, the
+    confusion matrix, where prediction and run differ, and the files. Finished batches are
+    kept: an interrupted campaign continues with --resume. The body flags (--preset, --params,
+    --mass, ...) build biped3d; g1 has the robot's own body and refuses them and --param.
     """
     from pathlib import Path
 

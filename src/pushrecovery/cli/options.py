@@ -54,19 +54,56 @@ PARAM_FLAGS: tuple[tuple[str, str, str], ...] = (
 
 def body_options(func: F) -> F:
     """Add ``--preset``, ``--params FILE``, one flag per parameter and ``--json``."""
-    for flag, field, text in reversed(PARAM_FLAGS):
-        func = click.option(flag, field, type=float, default=None, help=text)(func)
+    return _body_options(func, None)
+
+
+def body_options_of(model: str) -> Callable[[F], F]:
+    """Return :func:`body_options` whose body flags say that they build ``model`` only.
+
+    Parameters
+    ----------
+    model : str
+        The one model the body flags build (``biped3d``: the G1 has its own body and refuses
+        ``--preset``, ``--params`` and the body flags).
+
+    Returns
+    -------
+    callable
+        The click decorator.
+    """
+
+    def apply(func: F) -> F:
+        return _body_options(func, model)
+
+    return apply
+
+
+def _body_options(func: F, only: str | None) -> F:
+    def text(help_text: str) -> str:
+        if only is None:
+            return help_text
+        if help_text.split()[0][1:].islower():  # "Body mass" -> "body mass"; "CoM", "TOML" kept
+            help_text = help_text[0].lower() + help_text[1:]
+        return f"{only} only: {help_text}"
+
+    for flag, field, help_text in reversed(PARAM_FLAGS):
+        func = click.option(flag, field, type=float, default=None, help=text(help_text))(func)
     func = click.option(
         "--params",
         "params_file",
         type=click.Path(dir_okay=False),
         default=None,
-        help="TOML file of parameters (overrides the preset).",
+        help=text("TOML file of parameters (overrides the preset)."),
     )(func)
-    func = click.option("--preset", default="paper", show_default=True, help="Built-in preset.")(
-        func
-    )
-    return click.option("--json", "as_json", is_flag=True, help="Print JSON.")(func)
+    func = click.option(
+        "--preset", default="paper", show_default=True, help=text("Built-in preset.")
+    )(func)
+    return click.option(
+        "--json",
+        "as_json",
+        is_flag=True,
+        help="Print JSON instead of the table; its keys are stable.",
+    )(func)
 
 
 def support_options(func: F) -> F:

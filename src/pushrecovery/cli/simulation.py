@@ -12,12 +12,9 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.app import example
 from pushrecovery.cli.families import humanoid_only
-from pushrecovery.cli.options import (
-    body_options,
-    emit,
-    params_from,
-)
+from pushrecovery.cli.options import body_options, emit, params_from
 from pushrecovery.cli.progress import Progress
 from pushrecovery.cli.simulation_options import (
     _backend,
@@ -34,12 +31,31 @@ from pushrecovery.cli.simulation_options import (
 __all__ = ["critical_push", "simulate"]
 
 
-@click.command(short_help="Simulate a push; report recovered or fell.")
-@_with(_backend, _model("simulate"), _controller, *_gains)
-@click.option(
-    "--x", "x", type=float, default=0.0, show_default=True, help="CoM position before the push [m]."
+@click.command(
+    short_help="Simulate a push; report recovered or fell.",
+    epilog=example(
+        "pushrecovery simulate --model flywheel --controller mpc --xdot 0.6",
+        "pushrecovery simulate --model stepping --controller recovery --impulse 60 "
+        "--plot out/step.png",
+        "pushrecovery simulate --backend mujoco --model foot --impulse 15 --duration 3 --json",
+    ),
 )
-@click.option("--xdot", type=float, default=None, help="CoM velocity just after the push [m/s].")
+@_with(_backend, _model("simulate"), _controller("simulate"), *_gains)
+@click.option(
+    "--x",
+    "x",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="CoM position before the push, forward from the ankle (stepping-plane: from the "
+    "ankles' midpoint) [m].",
+)
+@click.option(
+    "--xdot",
+    type=float,
+    default=None,
+    help="CoM velocity just after the push, forward [m/s] (default 0).",
+)
 @click.option(
     "--y",
     "y",
@@ -61,7 +77,8 @@ __all__ = ["critical_push", "simulate"]
     "impulse",
     type=float,
     default=None,
-    help="Push as an impulse on the CoM [N s] (instead of --xdot).",
+    help="Push as an impulse on the CoM, forward [N s] (instead of --xdot: the velocity "
+    "impulse / mass; on MuJoCo a real force over 10 ms).",
 )
 @click.option(
     "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
@@ -110,11 +127,16 @@ def simulate(
 ) -> None:
     """Simulate a push on a model with a controller; report recovered or fell.
 
-    With --backend mujoco, --impulse is a real force at the CoM over 10 ms (the body holding
-    still meanwhile) and the run starts as the push ends. With --model stepping-plane
-    (controller recovery-plane) the body stands on both feet of the ground plane and --y,
-    --ydot add the sideways part (--impulse pushes along x). The 3-D humanoids are
-    'pushrecovery humanoid simulate'.
+    The body stands at --x and is pushed to --xdot (or by --impulse, forward positive); the
+    run goes on for --duration or until it has fallen or come to rest. Prints the outcome
+    (recovered, fell or undecided: not at rest yet), the final state (SI units, angles in
+    rad), the largest CoM excursion [m], the peak torque [N m], the steps taken and the
+    surfaces' predicted strategy for the push (with its margins [m], positive inside); on
+    MuJoCo also the state the push left and the CoP it measured [m]. With --backend mujoco,
+    --impulse is a real force at the CoM over 10 ms (the body holding still meanwhile) and the
+    run starts as the push ends. With --model stepping-plane (controller recovery-plane) the
+    body stands on both feet of the ground plane and --y, --ydot add the sideways part
+    (--impulse pushes along x). The 3-D humanoids are 'pushrecovery humanoid simulate'.
     """
     from pushrecovery.control.base import make_controller
     from pushrecovery.sim.backend import Measuring, Recording
@@ -184,8 +206,15 @@ def simulate(
     emit(data, as_json)
 
 
-@click.command("critical-push", short_help="Largest recoverable push, vs Eq. 4.")
-@_with(_backend, _model("critical-push"), _controller, *_gains)
+@click.command(
+    "critical-push",
+    short_help="Largest recoverable push, against its surface's prediction.",
+    epilog=example(
+        "pushrecovery critical-push --model lipm --controller ankle-pd --tolerance 0.001",
+        "pushrecovery critical-push --model flywheel --controller mpc --direction backward --json",
+    ),
+)
+@_with(_backend, _model("critical-push"), _controller("critical-push"), *_gains)
 @click.option(
     "--x",
     "x",
@@ -195,7 +224,12 @@ def simulate(
     help="CoM position before the push, on the foot [m].",
 )
 @click.option(
-    "--direction", type=click.Choice(("forward", "backward")), default="forward", show_default=True
+    "--direction",
+    type=click.Choice(("forward", "backward")),
+    default="forward",
+    show_default=True,
+    help="Direction of the push: forward (+x) or backward (-x; the velocities printed are "
+    "then negative).",
 )
 @click.option(
     "--tolerance",
@@ -236,7 +270,15 @@ def critical_push(
 ) -> None:
     """Largest recoverable push from x by bisection, against the strategy's surface.
 
-    The 3-D humanoids are 'pushrecovery humanoid critical-push'.
+    The body stands at --x on the foot [m, from the ankle] and is pushed along --direction;
+    the push, a CoM velocity, is bisected between one that the controller recovers and one
+    that falls within --duration, to --tolerance [m/s] (on MuJoCo each push is a real force
+    over 10 ms, searched as its velocity impulse / mass). Prints the critical velocity [m/s]
+    and impulse [N s] (signed: backward negative), its bracket, the number of simulations and
+    the relative error against the prediction of the controller's strategy (ankle: Eq. 4; hip:
+    corrected Eq. 15; step: the single-step limit), and on MuJoCo the prediction corrected
+    for the CoP margin and the push's duration. The 3-D humanoids are 'pushrecovery humanoid
+    critical-push'.
     """
     from pushrecovery.sim.critical import critical_push as search
 

@@ -11,7 +11,7 @@ from typing import Any
 
 import click
 
-from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice
+from pushrecovery.cli.families import HUMANOID_MODELS, ListedChoice, ModelChoice
 from pushrecovery.control.registry import CONTROLLER_NAMES
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
@@ -79,37 +79,66 @@ _backend = click.option(
     type=click.Choice(("analytic", "mujoco")),
     default="analytic",
     show_default=True,
-    help="Physics: the analytic models, or MuJoCo (models foot, torso, biped).",
+    help="Physics: the analytic models (a push is a velocity jump), or MuJoCo (models foot, "
+    "torso, biped; a push is a real force).",
 )
+
+#: The models and controllers each planar command does not run: accepted and refused by the
+#: command in its own words, but not listed in its help (the critical push is sagittal).
+_UNLISTED: dict[str, dict[str, tuple[str, ...]]] = {
+    "simulate": {"model": (), "controller": ()},
+    "critical-push": {"model": ("stepping-plane",), "controller": ("recovery-plane",)},
+}
 
 
 def _model(command: str) -> Any:
     """``--model`` of the planar ``command``; a 3-D humanoid is refused naming its command."""
+    unlisted = _UNLISTED[command]["model"]
+    plane = (
+        "; on the ground plane: stepping-plane (two feet, --y and --ydot; with recovery-plane)"
+        if "stepping-plane" not in unlisted
+        else " (the critical push is sagittal: stepping-plane runs with simulate only)"
+    )
     return click.option(
         "--model",
         type=ModelChoice(
-            (*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES),
+            tuple(m for m in (*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES) if m not in unlisted),
             elsewhere={m: f"humanoid {command} --model {m}" for m in HUMANOID_MODELS},
             family="a 3-D humanoid",
+            unlisted=unlisted,
         ),
         default="lipm",
         show_default=True,
-        help="Plant. Analytic: lipm, pendulum, flywheel, stepping, stepping-plane (on the "
-        "ground plane, with recovery-plane; simulate only); MuJoCo: foot (ankle), torso (hip), "
-        "biped (stepping). The 3-D humanoids: pushrecovery humanoid.",
+        help="Plant. Analytic: lipm, pendulum (ankle only), flywheel (+ hip), stepping (+ a "
+        f"step) on the sagittal line{plane}. MuJoCo (--backend mujoco): foot, torso, biped. "
+        "The 3-D humanoids: pushrecovery humanoid.",
     )
 
 
-_controller = click.option(
-    "--controller",
-    type=click.Choice(CONTROLLER_CHOICES),
-    default="ankle-pd",
-    show_default=True,
-    help="Controller.",
-)
+def _controller(command: str) -> Any:
+    """Return ``--controller`` of the planar ``command``, naming the models of each controller."""
+    unlisted = _UNLISTED[command]["controller"]
+    plane = "" if "recovery-plane" in unlisted else "; recovery-plane: stepping-plane"
+    return click.option(
+        "--controller",
+        type=ListedChoice(
+            tuple(c for c in CONTROLLER_CHOICES if c not in unlisted), unlisted=unlisted
+        ),
+        default="ankle-pd",
+        show_default=True,
+        help="Controller, for the models it runs: ankle-saturated, ankle-pd, "
+        "ankle-capture-point: every model; bang-bang: flywheel, stepping, torso, biped; mpc: "
+        f"flywheel, torso; recovery: stepping, biped{plane}.",
+    )
+
+
 _gains = (
-    click.option("--kp", type=float, default=None, help="ankle-pd stiffness [N m/rad]."),
-    click.option("--kd", type=float, default=None, help="ankle-pd damping [N m s/rad]."),
+    click.option(
+        "--kp", type=float, default=None, help="ankle-pd only: ankle stiffness [N m/rad]."
+    ),
+    click.option(
+        "--kd", type=float, default=None, help="ankle-pd only: ankle damping [N m s/rad]."
+    ),
     click.option(
         "--option",
         "options",

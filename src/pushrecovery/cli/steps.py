@@ -7,13 +7,27 @@ from typing import Any
 
 import click
 
-from pushrecovery.cli.options import body_options, emit, params_from, support_from, support_options
+from pushrecovery.cli.app import example
+from pushrecovery.cli.options import (
+    body_options,
+    emit,
+    params_from,
+    support_from,
+    support_options,
+)
 from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["capture_region_command"]
 
 
-@click.command("capture-region", short_help="Footholds that capture a state with N steps.")
+@click.command(
+    "capture-region",
+    short_help="Footholds that capture a state with N steps.",
+    epilog=example(
+        "pushrecovery capture-region --x 0.0 --xdot 0.6 --ydot 0.2",
+        "pushrecovery capture-region --x 0.0 --xdot 0.9 --steps 2 --plot out/regions.png --json",
+    ),
+)
 @click.option("--x", "x", type=float, required=True, help="CoM position, forward [m].")
 @click.option(
     "--y", "y", type=float, default=0.0, show_default=True, help="CoM position, left [m]."
@@ -75,10 +89,13 @@ def capture_region_command(
 ) -> None:
     """Footholds of the landing foot (its ankle, world frame [m]) that capture the state.
 
-    The LIPM with the support's feet, the reach (max_step_length about the stance ankle),
-    touchdowns min_step_time apart and the hip's box (docs/steps.md). Prints the region's
-    vertices and area, and the recommended foothold: the region's Chebyshev centre, the one
-    farthest from its edges. An empty region has no vertices (null in JSON).
+    The state is the CoM's position and velocity in the frame of the feet, x forward and y
+    left (by default the ankles' midpoint is the origin). The LIPM with the support's feet,
+    the reach (max_step_length about the stance ankle), touchdowns min_step_time apart and the
+    hip's box (docs/steps.md). Prints the landing foot, the touchdown time [s], the region's
+    vertices [m] and area [m^2], and the recommended foothold [m]: the region's Chebyshev
+    centre, the one farthest from its edges; then the capture point [m], the support and the
+    state. An empty region has no vertices (null in JSON).
     """
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.surfaces.capture_region import capture_region

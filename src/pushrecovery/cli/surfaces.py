@@ -6,6 +6,7 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.app import example
 from pushrecovery.cli.options import (
     body_options,
     emit,
@@ -18,15 +19,25 @@ from pushrecovery.cli.options import (
 __all__ = ["bounds", "classify", "step"]
 
 
-@click.command(short_help="Capture-point bounds of each strategy.")
+@click.command(
+    short_help="Capture-point bounds of each strategy.",
+    epilog=example(
+        "pushrecovery bounds", "pushrecovery bounds --torque-max 50 --stance left --json"
+    ),
+)
 @support_options
 @body_options
 def bounds(as_json: bool, **kwargs: Any) -> None:
     """Capture-point bounds of each balance strategy (Eq. 4, corrected Eq. 15).
 
-    On the sagittal line (cop, cmp, thresholds [m/s] from x = 0) and on the ground plane
-    (plane: the support polygon, the CMP region and the thresholds along forward, backward,
-    left and right for the chosen --stance).
+    Prints the body (params), omega = sqrt(g/L) [1/s] and, on the sagittal line, the
+    capture-point interval of the ankle strategy (cop: [heel, toe], Eq. 4) and of the hip
+    strategy (cmp: corrected Eq. 15, its margin beyond the foot and the longest bang-bang half
+    period t_max [s]) in metres from the ankle, forward positive; the thresholds: the largest
+    CoM velocity from x = 0 that each strategy recovers, [backward, forward] [m/s] (steps: for
+    each number of steps, and inf, the limit); and on the ground plane (plane) the support
+    polygon and the CMP region [m, from the ankles' midpoint, x forward, y left] and the
+    thresholds forward, backward, left and right [m/s] for the chosen --stance.
     """
     from pushrecovery.surfaces.bounds import bounds_data
 
@@ -34,7 +45,13 @@ def bounds(as_json: bool, **kwargs: Any) -> None:
     emit(bounds_data(params, support_from(kwargs, params)), as_json)
 
 
-@click.command(short_help="Strategy a CoM state needs: ankle, hip, step or fall.")
+@click.command(
+    short_help="Strategy a CoM state needs: ankle, hip, step or fall.",
+    epilog=example(
+        "pushrecovery classify --x 0.0 --xdot 0.7",
+        "pushrecovery classify --x 0.0 --xdot 0.3 --ydot 0.4 --stance left --json",
+    ),
+)
 @click.option(
     "--x", "x", type=float, required=True, help="CoM position, forward, from the ankle(s) [m]."
 )
@@ -59,11 +76,14 @@ def classify(
 ) -> None:
     """Which strategy the CoM state needs: ankle, hip, step or fall.
 
-    Without --y, --ydot, --stance, --left-foot or --right-foot: the paper's sagittal model, x
-    relative to the ankle of a foot [heel, toe]. With any of them: the ground plane, x forward
-    and y left in the frame of the feet (by default the ankles' midpoint is the origin, in
-    every stance), where the support polygon and the CMP region are 2-D and the margins are
-    signed distances of the capture point to them [m], positive inside.
+    Prints the capture point x + xdot/omega [m], the least strategy that recovers the state,
+    the margins of the capture point to the CoP, CMP and step bounds [m] (positive inside),
+    the number of steps and, for a step, the step and the plan (footholds [m], touchdowns
+    [s]). Without --y, --ydot, --stance, --left-foot or --right-foot: the paper's sagittal
+    model, x relative to the ankle of a foot [heel, toe]. With any of them: the ground plane,
+    x forward and y left in the frame of the feet (by default the ankles' midpoint is the
+    origin, in every stance), where the support polygon and the CMP region are 2-D and the
+    margins are signed distances of the capture point to them [m], positive inside.
     """
     from pushrecovery.surfaces.classify import classify as classify_state
 
@@ -85,7 +105,12 @@ def classify(
     emit({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)
 
 
-@click.command(short_help="Optimal step after a push (Sec. IV, Eq. 21).")
+@click.command(
+    short_help="Optimal step after a push (Sec. IV, Eq. 21).",
+    epilog=example(
+        "pushrecovery step --v0 0.8", "pushrecovery step --v0-range 0.5 1.0 0.25 --json"
+    ),
+)
 @click.option(
     "--v0",
     "speeds",
@@ -108,7 +133,17 @@ def step(
     as_json: bool,
     **kwargs: Any,
 ) -> None:
-    """Optimal step (Eq. 21) and the range of recovering steps for initial CoM velocities."""
+    """Optimal step (Eq. 21) and the range of recovering steps for initial CoM velocities.
+
+    Sec. IV's stepping model: the CoM above the stance ankle moves forward at v0 [m/s] and the
+    swing leg lands at the stance leg's lean theta [rad, positive forward] of Eq. 21, which
+    puts the capture point after impact on the new ankle. Prints per v0 theta and its rate
+    [rad/s], the time to impact [s], the step length (foot to foot) and the CoM-to-foot
+    distance [m], the CoM velocity before (x forward, z up) and after impact [m/s], the CoM
+    height after impact [m], the angles and step lengths that recover (the capture point on
+    the new foot), the step centred on it, and whether the stance leg stays in compression
+    and the step is within max_step_length; with --json, one object for one v0, else a list.
+    """
     from pushrecovery.arguments import finite_array
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.models.stepping import step_solution

@@ -6,6 +6,7 @@ from typing import Any
 
 import click
 
+from pushrecovery.cli.app import example
 from pushrecovery.cli.families import humanoid_only
 from pushrecovery.cli.options import (
     body_options,
@@ -18,7 +19,13 @@ from pushrecovery.cli.options import (
 __all__ = ["validate"]
 
 
-@click.command(short_help="Critical pushes and a confusion matrix in simulation vs the surfaces.")
+@click.command(
+    short_help="Critical pushes and a confusion matrix in simulation vs the surfaces.",
+    epilog=example(
+        "pushrecovery validate --backend analytic --strategy ankle --strategy hip",
+        "pushrecovery validate --strategy ankle --x0 0 --no-confusion --json",
+    ),
+)
 @click.option(
     "--backend",
     type=click.Choice(("analytic", "mujoco")),
@@ -103,7 +110,10 @@ def validate(
     --x0, next to the surface's prediction (and, on MuJoCo, the prediction corrected for the CoP
     margin and the push's duration). The confusion matrix compares the strategy the surfaces
     predict for each push of the grid with the least strategy that recovers it in simulation.
-    The 3-D humanoids are 'pushrecovery humanoid validate'.
+    Prints one row per strategy, direction and --x0 [m, from the ankle]: the predicted, the
+    corrected and the measured critical push as CoM velocities [m/s] (backward negative) and
+    the relative errors, then the confusion matrix (rows predicted, columns needed) and its
+    accuracy. The 3-D humanoids are 'pushrecovery humanoid validate'.
     """
     import sys
 
