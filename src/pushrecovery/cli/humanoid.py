@@ -102,7 +102,7 @@ def humanoid() -> None:
     "--stepping",
     is_flag=True,
     default=False,
-    help="The whole-body controller may step (docs/humanoid3d.md, Stepping).",
+    help="The whole-body controller may step (docs/humanoid3d_stepping.md).",
 )
 @click.option(
     "--render",
@@ -190,7 +190,8 @@ def simulate(
     type=float,
     default=10.0,
     show_default=True,
-    help="Longest simulated time per push [s]; keep it short (about 5x real time).",
+    help="Longest simulated time per push [s]; keep it short (every push of the bisection "
+    "runs the whole-body controller this long at most).",
 )
 @_body_options
 def critical_push(
@@ -199,10 +200,11 @@ def critical_push(
     """Largest push at the torso along --azimuth that the whole-body controller recovers.
 
     The impulse is bisected between a run that stands and one that falls within --duration
-    (keep it short: the whole-body controller runs about 5x real time), to --tolerance times
-    the mass. Prints the critical impulse [N s] and velocity [m/s], their bracket, the number
-    of simulations and the strategy used just below it. The body flags (--preset, --params,
-    --mass, ...) build biped3d; g1 has the robot's own body and refuses them.
+    (keep it short: every push of the bisection is a run of the whole-body controller), to
+    --tolerance times the mass. Prints the critical impulse [N s] and velocity [m/s], their
+    bracket, the number of simulations and the strategy used just below it. The body flags
+    (--preset, --params, --mass, ...) build biped3d; g1 has the robot's own body and refuses
+    them.
     """
     from pushrecovery.cli.simulation3d import critical_3d, params_3d
 
