@@ -28,12 +28,14 @@ extensions = [
     "myst_parser",
     "sphinx_click",
     "pushrecovery_api",
+    "cli_examples",
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 exclude_patterns = ["_build", "_ext", "img/README.md"]
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
+smartquotes_action = "qe"  # keep "--flag" as typed (no en dash) so examples copy and run
 
 autodoc_typehints = "none"  # the types are in the numpydoc Parameters; signatures stay short
 autodoc_member_order = "bysource"
