@@ -23,7 +23,7 @@ release = version = pushrecovery.__version__
 extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.mathjax",
-    "sphinx-mathjax-offline",  # MathJax served from the built site: equations render offline
+    "offline_mathjax",  # MathJax served from the built site: equations render offline
     "numpydoc",
     "myst_parser",
     "sphinx_click",

@@ -7,10 +7,13 @@ name added to an ``__all__`` appears in the reference without editing a page.
 
 from __future__ import annotations
 
+import functools
 import importlib
 import inspect
 import os
 import pkgutil
+import re
+import typing
 from types import ModuleType
 from typing import Any
 
@@ -42,20 +45,38 @@ def public_modules(package: str) -> list[ModuleType]:
     return modules
 
 
+def is_documented_object(obj: Any) -> bool:
+    """A class or a function (numba dispatchers included): what gets its own entry."""
+    return inspect.isclass(obj) or inspect.isroutine(obj) or hasattr(obj, "py_func")
+
+
+@functools.cache
+def homes() -> dict[int, str]:
+    """For each public class and function, the one ``module.name`` that documents it.
+
+    The module that defines it if that module exports it, else the first module (in name
+    order) that exports it: a package re-exporting a private module's class documents it.
+    """
+    found: dict[int, str] = {}
+    for module in public_modules("pushrecovery"):
+        for name in module.__all__:
+            obj = getattr(module, name)
+            if not is_documented_object(obj):
+                continue
+            defined = getattr(obj, "__module__", None) or ""
+            if defined != module.__name__ and not defined.startswith(EXCLUDED):
+                defining = importlib.import_module(defined)
+                own = getattr(obj, "__name__", name)  # an alias (Plant = Backend) is its class
+                if own in getattr(defining, "__all__", ()):
+                    found[id(obj)] = f"{defined}.{own}"
+                    continue
+            found.setdefault(id(obj), f"{module.__name__}.{name}")
+    return found
+
+
 def home(module: ModuleType, name: str) -> str:
-    """The module that documents ``module.name``: where it is defined, else ``module``."""
-    obj = getattr(module, name)
-    defined = getattr(obj, "__module__", None)
-    if (
-        (inspect.isclass(obj) or inspect.isfunction(obj))
-        and defined
-        and defined != module.__name__
-        and not defined.startswith(EXCLUDED)
-    ):
-        defining = importlib.import_module(defined)
-        if name in getattr(defining, "__all__", ()):
-            return defined
-    return module.__name__
+    """The ``module.name`` that documents ``module.name`` (:func:`homes`; data stays put)."""
+    return homes().get(id(getattr(module, name)), f"{module.__name__}.{name}")
 
 
 def entry(module: ModuleType, name: str) -> list[str]:
@@ -64,9 +85,16 @@ def entry(module: ModuleType, name: str) -> list[str]:
     target = f"{module.__name__}.{name}"
     if inspect.isclass(obj):
         return [f".. autoclass:: {target}", "   :members:", "   :show-inheritance:", ""]
-    if inspect.isroutine(obj) or hasattr(obj, "py_func"):  # a function or a numba dispatcher
+    if is_documented_object(obj):  # a function or a numba dispatcher
         return [f".. autofunction:: {target}", ""]
+    if typing.get_origin(obj) is not None:  # a type alias: its value is its documentation
+        return [f".. py:data:: {target}", f"   :value: {typing_repr(obj)}", ""]
     return [f".. autodata:: {target}", "   :no-value:", ""]
+
+
+def typing_repr(alias: Any) -> str:
+    """``tuple[float, float]`` rather than the alias's module-qualified repr."""
+    return re.sub(r"\b(?:numpy\.typing|numpy|builtins|typing)\.", "", repr(alias))
 
 
 class PushRecoveryApi(SphinxDirective):
@@ -87,10 +115,10 @@ class PushRecoveryApi(SphinxDirective):
                 if name.startswith("__"):
                     continue
                 where = home(module, name)
-                if where == module.__name__:
+                if where == f"{module.__name__}.{name}":
                     lines += entry(module, name)
                 else:
-                    elsewhere.append(f":py:obj:`{name} <{where}.{name}>`")
+                    elsewhere.append(f":py:obj:`{name} <{where}>`")
             if elsewhere:
                 lines += ["Also exported here: " + ", ".join(elsewhere) + ".", ""]
             self.env.note_dependency(module.__file__ or "")
@@ -107,10 +135,9 @@ def check_every_object_documented(app: Sphinx, env: BuildEnvironment) -> None:
     documented = set(env.get_domain("py").objects)
     for module in public_modules("pushrecovery"):
         for name in module.__all__:
-            obj = getattr(module, name)
-            if not (inspect.isclass(obj) or inspect.isroutine(obj) or hasattr(obj, "py_func")):
+            if not is_documented_object(getattr(module, name)):
                 continue
-            target = f"{home(module, name)}.{name}"
+            target = home(module, name)
             if target not in documented:
                 logger.warning("%s is public but has no entry in the API reference", target)
 
