@@ -84,7 +84,8 @@ def entry(module: ModuleType, name: str) -> list[str]:
     obj: Any = getattr(module, name)
     target = f"{module.__name__}.{name}"
     if inspect.isclass(obj):
-        return [f".. autoclass:: {target}", "   :members:", "   :show-inheritance:", ""]
+        bases = ["   :show-inheritance:"] if obj.__bases__ != (object,) else []
+        return [f".. autoclass:: {target}", "   :members:", *bases, ""]
     if is_documented_object(obj):  # a function or a numba dispatcher
         return [f".. autofunction:: {target}", ""]
     if typing.get_origin(obj) is not None:  # a type alias: its value is its documentation
