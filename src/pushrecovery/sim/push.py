@@ -27,7 +27,8 @@ AZIMUTH_MAX = 360.0
 #: Largest impulse [N s] a 3-D push accepts (a thousand times what topples a person).
 IMPULSE_MAX = 1e4
 
-Direction = str  # "forward" or "backward"
+#: A push direction along x: ``"forward"`` or ``"backward"``.
+Direction = str
 
 
 def direction_sign(direction: str) -> float:
