@@ -209,3 +209,12 @@ def test_report_has_the_steps_section(params: BodyParams, tmp_path: Path) -> Non
     assert len(rows) == params.max_steps + 1  # N = 1 ... max_steps, ∞
     forward = [float(r[2]) for r in rows]
     assert forward == sorted(forward)  # more steps, bigger pushes
+
+
+def test_a_dot_in_the_figure_name_is_kept(tmp_path: Path) -> None:
+    # s02_push0.30_time once became s02_push0.png, and the next push's figure overwrote it.
+    from matplotlib.figure import Figure
+
+    paths = save_figure(Figure(), tmp_path / "s02_push0.30_time", ("png", "svg"))
+    assert [p.name for p in paths] == ["s02_push0.30_time.png", "s02_push0.30_time.svg"]
+    assert all(p.exists() for p in paths)

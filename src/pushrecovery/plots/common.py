@@ -93,12 +93,15 @@ def shade_regions(
 
 
 def save_figure(fig: Figure, stem: Path, formats: Iterable[str]) -> list[Path]:
-    """Save ``fig`` as ``stem.<fmt>`` for each format; return the paths."""
+    """Save ``fig`` as ``stem.<fmt>`` for each format; return the paths.
+
+    The format is appended to the stem's name, so a stem with a dot (``push0.30``) keeps it.
+    """
     paths = []
     try:
         stem.parent.mkdir(parents=True, exist_ok=True)
         for fmt in formats:
-            path = stem.with_suffix(f".{fmt}")
+            path = stem.with_name(f"{stem.name}.{fmt}")
             fig.savefig(path, dpi=150)
             paths.append(path)
     except OSError as exc:
