@@ -256,3 +256,21 @@ def test_report_rejects_unknown_sections_and_sizes(params: BodyParams, tmp_path:
     with pytest.raises(InvalidParameterError, match="section"):
         write_report(params, tmp_path, skip=("nope",))
     assert not (tmp_path / "index.html").exists()
+
+
+def test_one_worker_runs_the_campaigns_in_this_process(
+    params: BodyParams, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # write_report documents workers=1 as "this process"; it once isolated the pushes in a worker.
+    import pushrecovery.campaign as campaign
+
+    seen = []
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs.get("isolated", True))
+        return run_campaign(*args, **kwargs)
+
+    monkeypatch.setattr(campaign, "run_campaign", spy)
+    skip = ("bounds", "map", "plane", "figures", "sweep", "planar")
+    write_report(params, tmp_path, mujoco=False, skip=skip, workers=1, **TINY)
+    assert seen == [False]

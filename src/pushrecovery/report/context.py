@@ -77,8 +77,13 @@ def _campaign(ctx: _Context, key: str, spec: Any) -> Any:
             same = False
         if not same:  # another grid or body: start this campaign afresh
             shutil.rmtree(directory)
-    result = run_campaign(
-        spec, directory, workers=ctx.workers, scheduler=ctx.scheduler, resume=True
+    result = run_campaign(  # workers=1: this process, as write_report documents (and the CLI)
+        spec,
+        directory,
+        workers=ctx.workers,
+        scheduler=ctx.scheduler,
+        resume=True,
+        isolated=ctx.workers != 1,
     )
     assert result is not None  # no max_batches
     if result.ran < spec.batches:
