@@ -5,6 +5,7 @@ library's simulators), written out as measured data.
 """
 
 import math
+import re
 import warnings
 
 import numpy as np
@@ -343,8 +344,12 @@ def test_millimetres_read_as_metres_are_refused(tmp_path):
     t, states, cop = _push_trial(0.25)
     path = tmp_path / "mm.csv"
     _write_csv(path, t, states, cop, scale=1000.0)
-    with pytest.raises(InputFileError, match="units"):
+    with pytest.raises(InputFileError, match="units") as info:
         read_csv_recording(path, units="m")
+    # Each quantity with its own unit (the message once said "at most 5 m, m/s").
+    assert re.search(
+        r"excursion of [\d.]+ m is not a standing body's \(at most \d m\)", str(info.value)
+    )
 
 
 def test_gaps_are_interpolated_or_excluded_and_reported(tmp_path):

@@ -111,20 +111,19 @@ def _check_time(path: Path, time: FloatArray) -> None:
 def _check_plausible(path: Path, recording: Recording, units: str) -> None:
     """Refuse lengths no standing body produces (a file in mm read as metres, say)."""
     hint = f"check --units (read as {units})"
-    checks: list[tuple[str, FloatArray | None, float]] = [
-        ("CoM excursion", _span(recording.com), 5.0),
-        ("CoP excursion", _span(recording.cop), 3.0),
-        ("CoM speed", _largest(recording.com_velocity), 10.0),
+    checks: list[tuple[str, FloatArray | None, float, str]] = [
+        ("CoM excursion", _span(recording.com), 5.0, "m"),
+        ("CoP excursion", _span(recording.cop), 3.0, "m"),
+        ("CoM speed", _largest(recording.com_velocity), 10.0, "m/s"),
     ]
     for axis, edges in recording.base.items():
-        checks.append(
-            (f"base of support width along {axis}", _largest(edges[:, 1] - edges[:, 0]), 2.0)
-        )
-    for name, value, limit in checks:
+        width = _largest(edges[:, 1] - edges[:, 0])
+        checks.append((f"base of support width along {axis}", width, 2.0, "m"))
+    for name, value, limit, unit in checks:
         if value is not None and float(np.max(value)) > limit:
             raise InputFileError(
-                f"{path}: {name} of {float(np.max(value)):.4g} m is not a standing body's "
-                f"(at most {limit:g} m, m/s); {hint}"
+                f"{path}: {name} of {float(np.max(value)):.4g} {unit} is not a standing body's "
+                f"(at most {limit:g} {unit}); {hint}"
             )
     if recording.com_height is not None and not 0.2 <= recording.com_height <= 3.0:
         raise InputFileError(
