@@ -45,3 +45,13 @@ def test_landing_page_example_runs_and_prints_what_it_says(capsys):
 
 def test_lab_note_check_can_fail():
     assert LAB_NOTES.search("re-measured in the second Session")
+
+
+@pytest.mark.parametrize("page", [p for p in PAGES if "```toml" in p.read_text()], ids=str)
+def test_parameter_files_shown_load(page, tmp_path):
+    from pushrecovery import load_params
+
+    for i, block in enumerate(re.findall(r"```toml\n(.*?)```", page.read_text(), flags=re.S)):
+        path = tmp_path / f"{i}.toml"
+        path.write_text(block)
+        load_params(file=path)
