@@ -15,7 +15,8 @@ median at N = 50 <= 15x that baseline and its p99 <= 20x its median (the issue's
 N = 50); the median at N = 200 <= 5x the median at N = 50; at every horizon no tick over the
 20 ms period. N = 100 and 200's p99 are printed: a third of their ticks need the interior
 point, whose iterations grow with N (medians 11, 20 and 46 at N = 50, 100, 200), and their p99
-is 70-110x the warm passes' median (docs/mpc.md). Also
+is 70-110x the warm passes' median (docs/performance.md, "Per tick: a controller's or a
+monitor's call"; the route in docs/mpc.md). Also
 printed: the time to build the controller (its QP and workspace), once per body and horizon.
 """
 

@@ -13,7 +13,7 @@
 6. MuJoCo with the controller in the loop (``torso`` + MPC at 50 Hz, 3 s after a push) as a
    real-time factor on one core, against MuJoCo stepping the same model alone for the same
    time, and against the ceiling of any loop: MuJoCo alone plus the MPC's own ticks. Target:
-   >= 150x real time (above that ceiling on this machine, docs/validation.md).
+   >= 150x real time (above that ceiling on this machine, docs/performance.md, "Simulation").
 7. Pushes per second for a batch (20 pushes, each to recovery or fall) on MuJoCo, ``foot`` +
    ankle PD and ``torso`` + MPC, against the same batch on the analytic pendulum / flywheel.
 8. Campaigns (``pushrecovery campaign``): pushes per second on the analytic and MuJoCo backends

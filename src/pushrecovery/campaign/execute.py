@@ -70,7 +70,7 @@ class CampaignResult:
         """Every push (a ``pyarrow.Table``), read from :attr:`pushes_file` on first use.
 
         The whole table in memory: for campaigns too large for that, query the Parquet files
-        lazily instead (``pyarrow.dataset``, DuckDB, polars; docs/campaigns.md).
+        lazily instead (``pyarrow.dataset``, DuckDB, polars; docs/campaigns.md, "At scale").
         """
         return _read(self.pushes_file)
 

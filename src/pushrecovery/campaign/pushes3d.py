@@ -28,7 +28,8 @@ read:
 ``fraction``               J / J*_ankle(ψ) (:func:`~.spec3d.critical_impulse`)
 ``ankle_critical``         J*_ankle(ψ) = m ω ρ_P(r₀, ψ) [N s]
 ``predicted_corrected``    the verdict for the push at the torso's height: the velocity
-                           × (1 + d/z₀) (docs/validation.md, "the push's height")
+                           × (1 + d/z₀) (docs/validation3d.md, "The critical push from
+                           every direction")
 ``lift_offs``              steps begun (landed or not)
 ``peak_hip_motor_torque``  largest abs(hip pitch or roll command − its value before) [N m]
 ``max_torso_tilt``         largest tilt of the upright body [rad]

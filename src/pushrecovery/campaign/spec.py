@@ -66,7 +66,7 @@ BACKENDS: Mapping[str, tuple[str, ...]] = {
 DEFAULT_PUSH_TIMEOUT = 120.0
 MAX_PUSH_TIMEOUT = 3600.0
 #: Pushes per batch when the spec does not say: about a second of work per batch through the
-#: one-push loop (0.5-2 s on the reference machine, docs/campaigns.md).
+#: one-push loop (0.5-2 s on the reference machine; docs/campaigns.md, "Execution").
 DEFAULT_BATCH = {"analytic": 100, "mujoco": 10}
 #: Largest default batch of the analytic pairs whose batch runs as one compiled loop
 #: (``sim.many.COMPILED``): about a second of work too (~140 µs per pendulum push, ~30 µs

@@ -1,6 +1,7 @@
 r"""What a campaign on the 3-D models adds: push directions, the WBC's strategies, predictions.
 
-A campaign on ``biped3d`` or ``g1`` (``--backend mujoco``, docs/humanoid3d.md) pushes the
+A campaign on ``biped3d`` or ``g1`` (``--backend mujoco``, docs/campaigns.md, "The 3-D
+humanoids") pushes the
 standing body at its torso with an impulse J [N s] at each azimuth ψ [deg] (0 forward +x, 90
 left +y) under the whole-body controller with the tasks of one strategy
 (:data:`WBC_CONTROLLERS`). The pushes may be given as fractions f of the ankle strategy's
@@ -228,7 +229,7 @@ def predict_push(
     ``impulse`` J [N s] at ``azimuth`` ψ [deg]: ``surfaces.classify.classify`` on the body's
     double support (module docstring). The corrected verdict is the same for the velocity
     × (1 + d/z₀), ``lever_ratio`` = d/z₀ >= 0 (the push at the torso's height:
-    docs/validation.md).
+    docs/validation3d.md, "The critical push from every direction").
 
     Returns
     -------

@@ -2,10 +2,10 @@
 
 ``humanoid simulate``, ``humanoid critical-push``, ``humanoid validate`` and ``humanoid
 campaign`` run biped3d and g1 (MuJoCo, pushes at the torso from any azimuth;
-docs/humanoid3d.md) and list only the options that work for them (issue 31); the planar
-commands of the same names refuse the humanoids in one line naming these. The runs are in
-:mod:`pushrecovery.cli.simulation3d`, :mod:`pushrecovery.cli.validate3d` and
-:mod:`pushrecovery.cli.campaign3d`.
+docs/humanoid3d_pushes.md, "The commands") and list only the options that work for them
+(issue 31); the planar commands of the same names refuse the humanoids in one line naming
+these. The runs are in :mod:`pushrecovery.cli.simulation3d`, :mod:`pushrecovery.cli.validate3d`
+and :mod:`pushrecovery.cli.campaign3d`.
 
 Over 400 lines on purpose: the four commands of one group, each mostly its options and
 their help, which a reader compares side by side.
@@ -67,7 +67,7 @@ _body_options = body_options_of("biped3d")
     epilog=example("pushrecovery humanoid simulate --push 20 --duration 3"),
 )
 def humanoid() -> None:
-    """Run the 3-D humanoids (biped3d, g1) under the whole-body controller (docs/humanoid3d.md).
+    """Run the 3-D humanoids (biped3d, g1) under the whole-body controller.
 
     MuJoCo runs a pushed humanoid standing on both feet: the push is an impulse at the torso
     from any --azimuth (0 forward, 90 left) and the whole-body controller balances it with the
@@ -75,7 +75,7 @@ def humanoid() -> None:
     rest SI. The body flags (--preset, --params, --mass, ...) build biped3d; g1, the Unitree G1
     (the robots extra), has its own body and refuses them. The planar models (lipm, pendulum,
     flywheel, stepping, foot, torso, biped) are the commands of the same names outside this
-    group.
+    group. The commands are described in docs/humanoid3d_pushes.md.
     """
 
 
@@ -319,7 +319,8 @@ def validate(
 
     quick_values: dict[str, Any] = QUICK if quick else {}
     directions = azimuths_from(azimuth, azimuths) or quick_values.get("azimuths", DEFAULT_AZIMUTHS)
-    # The G1's hip task recovers nothing (docs/validation.md): its ankle and step by default.
+    # The G1's hip task recovers nothing (docs/validation3d.md, "G1: no hip strategy"): its
+    # ankle and step by default.
     usual = ("ankle", "step") if model == "g1" else ("ankle", "hip", "step")
     chosen = strategies or quick_values.get("strategies", usual)
     chosen = chosen if critical else ()

@@ -17,8 +17,9 @@ has
 
 The pushes are a 3-D campaign's rows (``pushrecovery.campaign``, columns of
 ``campaign.pushes3d``; the ``validate`` command runs one): :func:`confusion_from_rows` reads
-them. Where predicted and used differ, :func:`classify_cause` names the reason (:data:`CAUSES`,
-docs/validation.md): the counting and the causes are pure functions of the rows.
+them. Where predicted and used differ, :func:`classify_cause` names the reason (:data:`CAUSES`;
+docs/validation3d.md, "The confusion matrix: predicted against used strategy"): the counting
+and the causes are pure functions of the rows.
 """
 
 from __future__ import annotations

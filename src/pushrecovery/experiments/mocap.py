@@ -19,9 +19,9 @@ the lab as an observer: the controller computes a command at its own period, hel
 (zero-order hold), and the fall and rest criteria are the simulator's, from the end of the
 push; the run goes on to the end of the recording after a recovery, ``FALL_TAIL`` after a
 fall. With 1 ms plant steps the ``foot`` and ``torso`` plants refresh their torque map every
-1 ms instead of every ``TORQUE_HOLD`` = 10 ms with the MPC's 20 ms ticks (docs/validation.md:
-< 0.1 % on critical pushes); ``foot`` with ``ankle-pd`` (1 ms ticks) and ``biped`` (1 ms
-servos) are unchanged.
+1 ms instead of every ``TORQUE_HOLD`` = 10 ms with the MPC's 20 ms ticks (CHANGELOG.md:
+< 0.1 % on critical pushes; docs/performance.md, "Simulation"); ``foot`` with ``ankle-pd``
+(1 ms ticks) and ``biped`` (1 ms servos) are unchanged.
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ on the legs moves the centroidal moment pivot (CMP) to δ + τ/(m g):
           I \ddot\theta = \tau,
 
 which is Eq. (6) (ω²/(m g) = 1/(m L)) and Eq. (7). The state derivative on the left of the
-printed Eq. (16) repeats (ẋ, θ̇); it is (ẋ, θ̇, ẍ, θ̈) (docs/errata.md, E9).
+printed Eq. (16) repeats (ẋ, θ̇); it is (ẋ, θ̇, ẍ, θ̈) (docs/errata.md, E10).
 """
 
 from __future__ import annotations

@@ -41,7 +41,8 @@ _RUN_ORDER = (
     "filmstrips",
     "humanoid3d",
 )
-#: Filmstrips: strategy -> (model, controller, caption), as docs/validation.md; the push is the
+#: Filmstrips: strategy -> (model, controller, caption), as docs/validation.md, "Filmstrips"; the
+#: push is the
 #: body's own (:func:`~pushrecovery.experiments.pushes.strategy_pushes`: 25, 40 and 80 N s for
 #: the paper's body).
 FILMSTRIPS: Mapping[str, tuple[str, str, str]] = {

@@ -17,7 +17,8 @@ et al. 2012's 3-D LIPM with a finite foot and a reaction mass), simulated:
   (:func:`~pushrecovery.surfaces.n_step.reach_polygon`) and the stance foot's yaw. At the
   touchdown the stance foot lifts (the model of the analysis: one foot carries the body from
   touchdown to touchdown), so the landed foot alone is the new support. The LIPM keeps its
-  height: no impact (docs/steps.md, "Impact", for what Sec. IV's impact would take).
+  height: no impact (docs/steps.md, "What Sec. IV's single step gets wrong, and what this
+  fixes", for what Sec. IV's impact would take).
 - **Fall**: the CoM farther than ``max_step_length`` from the support polygon and moving away:
   no foot can land under it any more within a step's reach.
 """

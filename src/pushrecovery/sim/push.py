@@ -1,6 +1,6 @@
 """What a push is: an instantaneous jump of the CoM velocity (docs/conventions.md).
 
-In 3-D (:class:`Push3D`, docs/humanoid3d.md) a push is an impulse J [N s] on a named body,
+In 3-D (:class:`Push3D`, docs/humanoid3d_pushes.md) a push is an impulse J [N s] on a named body,
 horizontal, at an azimuth ψ in degrees: 0 forward (+x), 90 to the left (+y).
 """
 
@@ -83,7 +83,7 @@ def push_direction(azimuth: float) -> tuple[float, float]:
 
 @dataclass(frozen=True, slots=True)
 class Push3D:
-    """A horizontal impulsive push on a named body of a 3-D model (docs/humanoid3d.md).
+    """A horizontal impulsive push on a named body of a 3-D model (docs/humanoid3d_pushes.md).
 
     Parameters
     ----------

@@ -44,7 +44,8 @@ PLANTS: dict[str, dict[str, str]] = {
         "biped": "pushrecovery.sim.mujoco.biped:MujocoBipedPlant",
     },
 }
-#: The MuJoCo backend's 3-D humanoids (docs/humanoid3d.md): their state is the CoM's in 3-D
+#: The MuJoCo backend's 3-D humanoids (docs/humanoid3d_pushes.md, "The plants"): their state
+#: is the CoM's in 3-D
 #: and their controller the whole-body QP, so they are apart from the sagittal models above
 #: (``MUJOCO_MODELS``, which the sagittal loop, validation and campaigns iterate).
 PLANTS_3D: dict[str, str] = {

@@ -13,7 +13,8 @@ step      ``biped``               ``stepping``                ``recovery``
 On MuJoCo a push is a real force at the CoM (an impulse over ``PUSH_DURATION``, the body holding
 still meanwhile), so the prediction is offered twice: the paper's surface at the pre-push
 position, and a *corrected* one for the two things the physics adds to the ankle and hip
-surfaces: the CoP margin the feet need (docs/validation.md) and the CoM's travel during the push
+surfaces: the CoP margin the feet need (docs/validation.md, "From the paper's commands to joint
+torques") and the CoM's travel during the push
 (x moves by v D / 2 under a constant force of duration D).
 
 Over 400 lines on purpose: one concept, the surfaces against the simulation, whose critical

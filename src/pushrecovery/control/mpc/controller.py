@@ -31,7 +31,8 @@ PASSES_AFTER_FAILURE = 2
 #: an interior, small enough that its active set is the problem's (with full braking held).
 RELAXED = 1e-3
 #: The relaxed interior point's warm start: the last verified set's rows start with s z at
-#: this × dual scale × range (the other's 3.0, GUIDE_CENTRE); measured in docs/mpc.md.
+#: this × dual scale × range (the other's 3.0, GUIDE_CENTRE); set by ``make bench``'s boundary
+#: ticks (docs/mpc.md, "The route's constants").
 RELAXED_GUIDE_CENTRE = 10.0
 #: The interior point is not asked within this relative margin of S_N's boundary (the
 #: boundary's own margin, BOUNDARY): there the feasible set has no interior and its iterates
@@ -56,8 +57,8 @@ class MPCController(Controller):
     (:class:`InteriorPointSolver`) whose active set the passes verify; on its boundary, the
     passes with full braking held; last, the condensed QP (:class:`CondensedQP`, built on
     first need) in a warm-started DAQP workspace (the attribute ``workspace``). docs/mpc.md
-    has the measurements. Other solvers, or ``workspace = None``, go through
-    ``qpsolvers.solve_qp`` on the condensed QP.
+    describes the route, docs/performance.md has its timings. Other solvers, or
+    ``workspace = None``, go through ``qpsolvers.solve_qp`` on the condensed QP.
 
     Parameters
     ----------
@@ -168,12 +169,13 @@ class MPCController(Controller):
         # riccati.active holds its optimal set (kept by a failed solve) to start DAQP from.
         previous_verified = riccati is not None and riccati.verified
         # After a tick the warm passes failed, the next one's usually fail too: a few passes,
-        # then the interior point (PASSES_AFTER_FAILURE, measured in docs/mpc.md).
+        # then the interior point (PASSES_AFTER_FAILURE; docs/mpc.md, "The route's constants").
         passes = PASSES_AFTER_FAILURE if self._passes_failed else MAX_PASSES
         gauge = -1.0
         if self._boundary:
             # The last tick was on S_N's boundary, where the passes without full braking held
-            # rarely verify the next tick (docs/mpc.md): when this one is too, its route at once.
+            # rarely verify the next tick (docs/mpc.md, "The route's constants"): when this one is
+            # too, its route at once.
             gauge = self._gauge(state)
             if gauge >= 1.0 - INTERIOR_MARGIN:
                 passes = 0
@@ -256,7 +258,8 @@ class MPCController(Controller):
             if not forced[0]:
                 return None
             # The passes from the last set come after the relaxed interior point, not before:
-            # tried first they rarely verify a boundary tick and cost time on each (docs/mpc.md).
+            # tried first they rarely verify a boundary tick and cost time on each (docs/mpc.md,
+            # "The route's constants").
             interior = self._relaxed
 
         def verify(active: NDArray[np.int8]) -> bool:

@@ -2,8 +2,9 @@
 
 Organised by concept, as mink (kevinzakka/mink) is: each tick the controller's laws write
 their tasks (``tasks/``) and limits (``limits/``), the QP stacks them under MuJoCo's dynamics
-and the feet's contact rows and solves it (``qp``, ``least_distance``). docs/humanoid3d.md
-derives every law. The compiled kernels are :mod:`pushrecovery.kernels.wbc`.
+and the feet's contact rows and solves it (``qp``, ``least_distance``). docs/humanoid3d_wbc.md
+derives every law, docs/humanoid3d_stepping.md the stepping task's. The compiled kernels are
+:mod:`pushrecovery.kernels.wbc`.
 
 The WBC is a :class:`~pushrecovery.control.base.Controller` over a typed
 :class:`~.observation.HumanoidObservation` the plant hands it (views of the plant's own

@@ -340,7 +340,8 @@ class WholeBodyController(Controller):
         spin = jacr @ qvel if hip is not None else _NO_SPIN
         hip_active = False
         # No hip task while a foot swings: the step owns the recovery (the confusion matrix's
-        # steps that failed fell from 10 to 2 of 60 pushes, docs/validation.md); the torso's
+        # steps that failed fell from 10 to 2 of 60 pushes; docs/validation3d.md, "The confusion
+        # matrix: predicted against used strategy"); the torso's
         # paced return goes on.
         if stepper is not None and stepper.swing is not None:
             self.cmp_offset = np.zeros(2)

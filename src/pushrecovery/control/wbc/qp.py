@@ -1,4 +1,4 @@
-r"""Task-space inverse dynamics as one QP on MuJoCo's own dynamics (docs/humanoid3d.md).
+r"""Task-space inverse dynamics as one QP on MuJoCo's own dynamics (docs/humanoid3d_wbc.md).
 
 Each control tick solves, for the joint accelerations q̈ ∈ R^nv and one 6-D contact wrench
 w_i = (F_i, T_i) per foot on the floor (the force and moment the floor exerts on foot i at
@@ -20,7 +20,7 @@ subject to
   of the sole frame (``mj_jac``), J̇_i q̇ its bias acceleration (``mj_jacDot``) [m/s², rad/s²]
   and k_c ≥ 0 (``contact_damping``, :data:`CONTACT_DAMPING` = 20 /s) a damping of a drifting
   foot [1/s] (with k_c = 0 the feet crept and tipped under MuJoCo's soft contact unseen:
-  docs/humanoid3d.md, "The whole-body controller");
+  docs/humanoid3d_wbc.md, "The QP");
   a foot off the floor (:meth:`WholeBodyQP.set_contacts`, a swing) has w_i = 0 instead and no
   wrench inequalities (its motion is a task, :mod:`.stepper.stepper`);
 * unilateral contact F_z ≥ 0 and a linearised friction pyramid abs(F_x), abs(F_y) ≤ μ' F_z with

@@ -46,7 +46,8 @@ class MujocoFootPlant(MujocoPlant):
     pushed_body: ClassVar[str] = "body"
     #: The CoP → torque map depends on the lean and its rate only, which change little in
     #: 10 ms: holding its torque that long moves the critical pushes by < 0.1 % against a
-    #: refresh at every step (docs/validation.md), and makes the loop 1.3× faster.
+    #: refresh at every step, and makes the loop 1.3× faster (CHANGELOG.md; docs/performance.md,
+    #: "Simulation", has the loop's speed).
     torque_hold: ClassVar[float] = TORQUE_HOLD
 
     def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:

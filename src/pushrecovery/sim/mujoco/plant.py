@@ -80,7 +80,8 @@ class MujocoPlant(ABC):
     cop_margin : float
         The CoP command is clipped to the foot shortened by this much at each edge [m],
         in [0, (toe − heel)/4]: with soft contacts the CoP reaches an edge only as the other
-        edge lifts, i.e. as the foot starts to tip (docs/validation.md).
+        edge lifts, i.e. as the foot starts to tip (docs/validation.md, "From the paper's commands
+        to joint torques").
     """
 
     name: ClassVar[str]

@@ -18,7 +18,7 @@ range), which would let one rollout run the whole duration open-loop? The ankle 
 the body's *absolute* lean φ = foot pitch + ankle angle, while an actuator feeds back its own
 transmission, the ankle angle alone: the stiffness an actuator adds to the joint-space
 equations is Σ c cᵀ (symmetric), and −k_p e_ankle (e_pitch + e_ankle)ᵀ is not, so no set of
-actuators expresses it. Measured on a grid of 86 pushes (docs/validation.md), the actuator
+actuators expresses it. Measured on a grid of 86 pushes (CHANGELOG.md), the actuator
 form rocks the light foot in a limit cycle (abs(ẋ) ≈ 2e-3 m/s, never at rest: 48 verdicts
 differ) and, its torque clamp being constant where the map's edge torque depends on the load,
 tips the foot at the toe during saturated braking.

@@ -4,9 +4,9 @@ The QP (:mod:`~pushrecovery.control.wbc.qp`) models the motors, the contacts and
 dynamics, but not a joint's range: the constraint force of a joint on its stop (MuJoCo's limit
 constraint) is missing from its dynamics rows, so a task that drives a joint onto its stop gets a
 wrong answer from the QP, and a leg on the knee's stop is also straight, a kinematic singularity of
-the contact Jacobian (the QP becomes ill-conditioned). Measured on the biped3d's hip
-push (docs/humanoid3d.md, "Controller"): the torso pitched 0.95 rad forward while the CoM
-task held the CoM over the feet and the pelvis task held the hips at their height; the
+the contact Jacobian (the QP becomes ill-conditioned). Measured on the biped3d's hip push
+(the knee guard of docs/humanoid3d_wbc.md, "The QP"): the torso pitched 0.95 rad forward while
+the CoM task held the CoM over the feet and the pelvis task held the hips at their height; the
 hips moved back 0.11 m and the knees straightened onto their stop (0 rad; −0.01 to −0.015
 rad, pressed into it, with the feet's drift damped); with the guard they stay at 0.098 rad.
 

@@ -430,8 +430,8 @@ class G1Plant(Humanoid3DPlant):
     """
 
     name: ClassVar[str] = "g1"
-    #: The hip task lowers the G1's critical push at every azimuth (docs/validation.md, its
-    #: hip column: 9.3 N s forward against the ankles' 10.3; with stepping it falls at 11-15
+    #: The hip task lowers the G1's critical push at every azimuth (docs/validation3d.md, "G1:
+    #: no hip strategy": 9.3 N s forward against the ankles' 10.3; with stepping it falls at 11-15
     #: N s where stepping alone stands): off unless asked for.
     hip_task: ClassVar[bool] = False
 

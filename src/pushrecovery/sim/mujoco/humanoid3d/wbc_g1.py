@@ -1,4 +1,4 @@
-"""The Unitree G1 under the whole-body controller (docs/humanoid3d.md).
+"""The Unitree G1 under the whole-body controller (docs/humanoid3d_wbc.md).
 
 The G1 of :func:`~.robots.describe_robot` (torque motors, 1 ms steps, its ``stand`` keyframe
 lowered onto the floor): feet ``left_ankle_roll_link`` and ``right_ankle_roll_link`` (four

@@ -1,4 +1,4 @@
-"""Push the 3-D biped and let the whole-body controller recover (docs/humanoid3d.md).
+"""Push the 3-D biped and let the whole-body controller recover (docs/humanoid3d_wbc.md).
 
 The biped stands with its knees bent by ``knee`` (a straight knee sits on its joint stop,
 whose constraint force the QP does not model): hip pitch −knee/2, knee +knee, ankle pitch
