@@ -272,30 +272,6 @@ class WholeBodyQP:
             add_task(buf.hessian, buf.linear, matrix, target, weight)
         return self._constrain(data)
 
-    def _assemble_rows(
-        self,
-        data: HumanoidObservation,
-        matrix: FloatArray,
-        target: FloatArray,
-        weights: FloatArray,
-        count: int,
-    ) -> int:
-        """:meth:`_assemble` of the first ``count`` stacked task rows, unchecked.
-
-        The controller's fast path: ``matrix`` (≥ count, size), ``target`` and ``weights``
-        (≥ count), all C-contiguous float64, row r of weight ``weights[r]``, its tasks' rows in
-        their order; after MuJoCo's calls one compiled call (:func:`.kernels.wbc.assemble_rows`)
-        instead of a check and a call per task and kernel (the same sums: the same QP to the
-        last bit).
-        """
-        if data is not self._data:
-            self._tick_arguments(data)
-        self._inertia()  # full_inertia
-        self._jacobians(data)
-        count = assemble_rows(matrix, target, weights, count, float(self.contact_damping),
-                              *self._arguments)  # fmt: skip
-        return int(count)
-
     def _tick_arguments(self, data: HumanoidObservation) -> None:
         """Gather :func:`.kernels.wbc.assemble_rows`' arrays after the tasks' and k_c.
 
@@ -354,8 +330,21 @@ class WholeBodyQP:
         weights: FloatArray,
         count: int,
     ) -> WbcSolution:
-        """:meth:`solve` of stacked, unchecked task rows (:meth:`_assemble_rows`)."""
-        return self._solve_assembled(self._assemble_rows(data, matrix, target, weights, count))
+        """:meth:`solve` of the first ``count`` stacked task rows, unchecked.
+
+        The controller's fast path: ``matrix`` (≥ count, size), ``target`` and ``weights``
+        (≥ count), all C-contiguous float64, row r of weight ``weights[r]``, its tasks' rows in
+        their order; after MuJoCo's calls one compiled call (:func:`.kernels.wbc.assemble_rows`)
+        instead of a check and a call per task and kernel (the same sums: the same QP to the
+        last bit).
+        """
+        if data is not self._data:
+            self._tick_arguments(data)
+        self._inertia()  # full_inertia
+        self._jacobians(data)
+        count = assemble_rows(matrix, target, weights, count, float(self.contact_damping),
+                              *self._arguments)  # fmt: skip
+        return self._solve_assembled(int(count))
 
     def _solve_assembled(self, count: int) -> WbcSolution:
         """Solve the QP of ``count`` rows in the buffers (:meth:`solve`, :mod:`.least_distance`)."""
