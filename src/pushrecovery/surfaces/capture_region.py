@@ -149,14 +149,9 @@ def capture_region(
     require_type("params", params, BodyParams)
     require_type("support", support, Support)
     t = params.min_step_time if swing_time is None else finite_float("swing_time", swing_time, "s")
-    if not 0.0 <= t <= 5.0:
-        raise InvalidParameterError(f"swing_time must be in [0, 5] s, got {t:g}")
-    if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= 50:
-        raise InvalidParameterError(f"steps must be a whole number in [1, 50], got {steps!r}")
-    if timing not in ("exact", "after"):
-        raise InvalidParameterError(f"timing must be 'exact' or 'after', got {timing!r}")
-    require_type("hip", hip, (bool, np.bool_))
-    hip = bool(hip)
+    if not 0.0 <= t <= MAX_STEP_TIME:
+        raise InvalidParameterError(f"swing_time must be in [0, {MAX_STEP_TIME:g}] s, got {t:g}")
+    hip = _checked_plan(steps, timing, hip)
     xi = _capture_point(x, y, xdot, ydot, params)
     if swing is None and support.stance is Stance.DOUBLE:
         centre = support.ankle
@@ -168,7 +163,7 @@ def capture_region(
     if timing == "exact":  # the compiled pipeline: a balance loop asks at every tick
         polygon, foothold = _foothold_and_centre(xi, params, option, t, steps, hip)
         return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
-    polygon = _foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
+    polygon = foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
     foothold = None if polygon is None else chebyshev_centre_unchecked(polygon)
     return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
 
@@ -276,7 +271,7 @@ def _foothold_and_centre(
         terms.window_offsets,
     )
     if not ok:  # pragma: no cover - the compiled simplex found no start: the numpy path
-        region = _foothold_region(xi, params, option, t, steps, hip=hip)
+        region = foothold_region(xi, params, option, t, steps, hip=hip)
         return region, None if region is None else chebyshev_centre_unchecked(region)
     if len(vertices) < 3:
         return None, None
@@ -313,27 +308,7 @@ def foothold_region(
     require_type("params", params, BodyParams)
     require_type("option", option, StepOption)
     touchdown = bounded_float("touchdown", touchdown, 0.0, MAX_STEP_TIME, "s")
-    if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= MAX_STEPS:
-        raise InvalidParameterError(
-            f"steps must be a whole number in [1, {MAX_STEPS}], got {steps!r}"
-        )
-    if timing not in ("exact", "after"):
-        raise InvalidParameterError(f"timing must be 'exact' or 'after', got {timing!r}")
-    require_type("hip", hip, (bool, np.bool_))
-    return _foothold_region(xi, params, option, touchdown, steps, timing=timing, hip=bool(hip))
-
-
-def _foothold_region(
-    xi: FloatArray,
-    params: BodyParams,
-    option: StepOption,
-    touchdown: float,
-    steps: int,
-    *,
-    timing: Literal["exact", "after"] = "exact",
-    hip: bool = True,
-) -> ConvexPolygon | None:
-    """:func:`foothold_region` of checked arguments."""
+    hip = _checked_plan(steps, timing, hip)
     landing = landing_viable(params, option.swing, option.yaw, steps - 1)
     box = hip_box(params, option.yaw) if hip else None
     boxes: list[tuple[float, Shape]] = [] if box is None else [(1.0, box)]
@@ -346,6 +321,18 @@ def _foothold_region(
     if timing == "exact":
         return clip(at, window)
     return _after(at, xi, boxes, option.stance, window)
+
+
+def _checked_plan(steps: int, timing: str, hip: bool) -> bool:
+    """Check the plan's ``steps``, ``timing`` and ``hip``; return ``hip`` as a bool."""
+    if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= MAX_STEPS:
+        raise InvalidParameterError(
+            f"steps must be a whole number in [1, {MAX_STEPS}], got {steps!r}"
+        )
+    if timing not in ("exact", "after"):
+        raise InvalidParameterError(f"timing must be 'exact' or 'after', got {timing!r}")
+    require_type("hip", hip, (bool, np.bool_))
+    return bool(hip)
 
 
 @functools.lru_cache(maxsize=64)
