@@ -67,7 +67,7 @@ def _catalogue() -> dict[str, Callable[[Any], Any]]:
         flywheel_discrete,
         flywheel_propagate,
     )
-    from pushrecovery.models.lipm import lipm_propagate, lipm_state, lipm_transition
+    from pushrecovery.models.lipm import lipm_state, lipm_transition
     from pushrecovery.models.pendulum import pendulum_acceleration
     from pushrecovery.models.stepping import step_solution
     from pushrecovery.sim.critical import critical_push
@@ -117,7 +117,7 @@ def _catalogue() -> dict[str, Callable[[Any], Any]]:
         "plan_step(v)": lambda v: plan_step(v, 0.5, PARAMS),
         "step_thresholds(v)": lambda v: step_thresholds(v),
         "lipm_state(t=v)": lambda v: lipm_state(v, 0.0, 0.1, 0.0, PARAMS.omega),
-        "lipm_propagate(omega=v)": lambda v: lipm_propagate(0.0, 0.1, 0.0, v, 0.01),
+        "lipm_state(omega=v)": lambda v: lipm_state(0.01, 0.0, 0.1, 0.0, v),
         "lipm_transition(dt=v)": lambda v: lipm_transition(PARAMS.omega, v),
         "flywheel_propagate(dt=v)": lambda v: flywheel_propagate(
             np.zeros(4), (0.0, 0.0), PARAMS, v

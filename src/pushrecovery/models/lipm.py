@@ -21,7 +21,6 @@ from pushrecovery.params import OMEGA_MAX, OMEGA_MIN
 __all__ = [
     "ANKLE_STATE",
     "lipm_acceleration",
-    "lipm_propagate",
     "lipm_state",
     "lipm_transition",
 ]
@@ -142,30 +141,3 @@ def lipm_transition(omega: float, dt: float) -> tuple[FloatArray, FloatArray]:
         )
     c, s = np.cosh(omega * dt), np.sinh(omega * dt)
     return np.array([[c, s / omega], [omega * s, c]]), np.array([1.0 - c, -omega * s])
-
-
-def lipm_propagate(
-    x: ArrayLike, xdot: ArrayLike, cop: ArrayLike, omega: float, dt: float
-) -> tuple[FloatArray, FloatArray]:
-    """Advance arrays of LIPM states by dt with the CoP held (exact, vectorised).
-
-    Same as :func:`lipm_state` at t = dt, written with the transition of
-    :func:`lipm_transition` so that many states advance in one call.
-
-    Parameters
-    ----------
-    x, xdot : array_like
-        CoM positions [m] and velocities [m/s].
-    cop : array_like
-        CoP held over the step [m].
-    omega : float
-        sqrt(g / L) [1/s].
-    dt : float
-        Step length [s].
-
-    Returns
-    -------
-    x, xdot : ndarray
-        The states after dt.
-    """
-    return lipm_state(dt, x, xdot, cop, omega)
