@@ -14,14 +14,7 @@ from typing import Any
 import click
 
 from pushrecovery.cli.app import example
-from pushrecovery.cli.campaign_options import (
-    SCHEDULER,
-    echo_counts,
-    echo_files,
-    run_options,
-    run_spec,
-    sweeps_from,
-)
+from pushrecovery.cli.campaign_options import SCHEDULER, CampaignRun, run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, humanoid_only
 from pushrecovery.cli.options import body_options, emit, params_from
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
@@ -96,17 +89,6 @@ def campaign(
     x0: tuple[float, float, float] | None,
     xdot: tuple[float, float, float] | None,
     impulse: tuple[float, float, float] | None,
-    sweep_pairs: tuple[str, ...],
-    samples: int | None,
-    seed: int,
-    duration: float,
-    batch_size: int | None,
-    push_timeout: float,
-    out: str,
-    workers: int | None,
-    scheduler: str | None,
-    resume: bool,
-    plot: bool,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
@@ -123,21 +105,12 @@ def campaign(
     continues with --resume. The result does not depend on the number of workers. The 3-D
     humanoids are 'pushrecovery humanoid campaign'.
     """
-    from pushrecovery.campaign import CampaignSpec, read_spec
+    from pushrecovery.campaign import CampaignSpec
     from pushrecovery.errors import InvalidParameterError
 
-    directory = Path(out)
-    if resume and x0 is None and xdot is None and impulse is None:
-        if sweep_pairs or samples is not None or model or controller:
-            raise InvalidParameterError(
-                "--resume without --x0 runs the stored campaign: give its whole spec or none"
-            )
-        spec = read_spec(directory)  # the stored campaign, as it was asked for
-        if spec.is_3d:
-            raise InvalidParameterError(
-                f"{directory} holds a campaign of the 3-D humanoid {spec.model}: use "
-                f"'pushrecovery humanoid campaign --resume --out {directory}'"
-            )
+    run = CampaignRun.pop(kwargs)
+    if run.resume and x0 is None and xdot is None and impulse is None:
+        spec = run.stored("--x0", bool(model or controller), three_d=False)
     else:
         params = params_from(kwargs)
         if x0 is None or (xdot is None and impulse is None):
@@ -150,18 +123,14 @@ def campaign(
             x0=x0,
             xdot=xdot,
             impulse=impulse,
-            sweeps=sweeps_from(sweep_pairs),
-            samples=samples,
-            seed=seed,
-            duration=duration,
-            batch_size=batch_size,
-            push_timeout=push_timeout,
+            **run.spec_options(),
         )
-    result = run_spec(spec, directory, workers, scheduler, resume)
-    files = {"pushes": str(result.pushes_file), "summary": str(directory / "summary.json")}
-    if plot:
+    result = run.run(spec)
+    files: dict[str, str] = {}
+    if run.plot:
         from pushrecovery.plots.campaign import plot_critical_vs_parameter, plot_outcome_map
 
+        directory = result.directory
         files["outcome_map"] = str(
             plot_outcome_map(result.table, spec, directory / "outcome_map.png")
         )
@@ -169,12 +138,7 @@ def campaign(
             files["critical_vs_parameter"] = str(
                 plot_critical_vs_parameter(result.summary, directory / "critical_vs_parameter.png")
             )
-    summary = {**result.summary, "files": files}
-    if as_json:
-        emit(summary, True)
-        return
-    echo_counts(summary, result.ran, spec.batches)
-    echo_files(files)
+    run.show(result, files, as_json)
 
 
 @click.command(

@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-__all__ = ["echo_causes", "spec_3d", "stored_spec_3d", "write_confusion"]
+__all__ = ["echo_causes", "spec_3d", "write_confusion"]
 
 
 def spec_3d(model: str, params: Any, strategy: str | None, **options: Any) -> Any:
@@ -53,36 +53,6 @@ def spec_3d(model: str, params: Any, strategy: str | None, **options: Any) -> An
         xdot=None,
         **options,
     )
-
-
-def stored_spec_3d(directory: Path) -> Any:
-    """Return the 3-D campaign stored in ``directory`` (``--resume`` without a spec).
-
-    Parameters
-    ----------
-    directory : Path
-        ``--out`` of the campaign.
-
-    Returns
-    -------
-    CampaignSpec
-        The stored spec, as it was asked for.
-
-    Raises
-    ------
-    InvalidParameterError
-        If the stored campaign is of a planar model, naming ``pushrecovery campaign``.
-    """
-    from pushrecovery.campaign import read_spec
-    from pushrecovery.errors import InvalidParameterError
-
-    spec = read_spec(directory)
-    if not spec.is_3d:
-        raise InvalidParameterError(
-            f"{directory} holds a campaign of the planar model {spec.model}: use "
-            f"'pushrecovery campaign --resume --out {directory}'"
-        )
-    return spec
 
 
 def write_confusion(

@@ -10,24 +10,18 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, TypeVar
 
 import click
 
-from pushrecovery.cli.options import echo_confusion
+from pushrecovery.cli.options import echo_confusion, emit
 from pushrecovery.cli.progress import Progress
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-__all__ = [
-    "SCHEDULER",
-    "echo_counts",
-    "echo_files",
-    "run_options",
-    "run_spec",
-    "sweeps_from",
-]
+__all__ = ["SCHEDULER", "CampaignRun", "run_options"]
 
 #: ``--scheduler ADDRESS`` (``campaign``, ``humanoid campaign``, ``report``).
 SCHEDULER = click.option(
@@ -108,24 +102,167 @@ def run_options(*, param_help: str, samples_help: str, batch_size_help: str) -> 
     return apply
 
 
-def sweeps_from(pairs: tuple[str, ...]) -> dict[str, tuple[float, float, float]]:
-    """Return the ``--param NAME=START:STOP:STEP`` options as {name: (start, stop, step)}.
+@dataclass(frozen=True)
+class CampaignRun:
+    """A campaign command's options of :func:`run_options`, as given; the run and its printout."""
 
-    Parameters
-    ----------
-    pairs : tuple of str
-        The ``--param`` values.
+    sweep_pairs: tuple[str, ...]
+    samples: int | None
+    seed: int
+    duration: float
+    batch_size: int | None
+    push_timeout: float
+    out: str
+    workers: int | None
+    scheduler: str | None
+    resume: bool
+    plot: bool
 
-    Returns
-    -------
-    dict
-        Parameter name -> (start, stop, step).
+    @classmethod
+    def pop(cls, kwargs: dict[str, Any]) -> CampaignRun:
+        """Pop the run's options out of a command's keyword arguments."""
+        return cls(**{option.name: kwargs.pop(option.name) for option in fields(cls)})
 
-    Raises
-    ------
-    InvalidParameterError
-        If one is not ``NAME=START:STOP:STEP`` with numbers, or a name is given twice.
-    """
+    def spec_options(self) -> dict[str, Any]:
+        """Return the ``CampaignSpec`` keywords of the run: ``sweeps`` to ``push_timeout``.
+
+        Raises
+        ------
+        InvalidParameterError
+            If a ``--param`` is not ``NAME=START:STOP:STEP`` with numbers, or a name is given
+            twice.
+        """
+        return {
+            "sweeps": _sweeps(self.sweep_pairs),
+            "samples": self.samples,
+            "seed": self.seed,
+            "duration": self.duration,
+            "batch_size": self.batch_size,
+            "push_timeout": self.push_timeout,
+        }
+
+    def stored(self, pushes: str, asked: bool, three_d: bool) -> Any:
+        """Return the campaign stored in ``--out``: ``--resume`` given without pushes.
+
+        Parameters
+        ----------
+        pushes : str
+            The command's push options, for the message (``"--x0"``).
+        asked : bool
+            Whether another option of the spec was given on the command line (refused).
+        three_d : bool
+            Whether the command runs the 3-D humanoids (a campaign of the other family is
+            refused, naming the command that runs it).
+
+        Returns
+        -------
+        CampaignSpec
+            The stored spec, as it was asked for.
+        """
+        from pushrecovery.campaign import read_spec
+        from pushrecovery.errors import InvalidParameterError
+
+        if self.sweep_pairs or self.samples is not None or asked:
+            raise InvalidParameterError(
+                f"--resume without {pushes} runs the stored campaign: give its whole spec or none"
+            )
+        directory = Path(self.out)
+        spec = read_spec(directory)
+        if spec.is_3d != three_d:
+            family, command = (
+                ("the 3-D humanoid", "humanoid campaign")
+                if spec.is_3d
+                else ("the planar model", "campaign")
+            )
+            raise InvalidParameterError(
+                f"{directory} holds a campaign of {family} {spec.model}: use "
+                f"'pushrecovery {command} --resume --out {directory}'"
+            )
+        return spec
+
+    def run(self, spec: Any) -> Any:
+        """Run ``spec`` into ``--out`` with a progress bar; Ctrl-C keeps the finished batches.
+
+        ``--workers 1`` runs the pushes in this process (no worker to start and import
+        everything again; a push that crashes the engine ends the campaign, its finished
+        batches kept). An interrupted campaign exits with status 130.
+
+        Returns
+        -------
+        CampaignResult
+            The table, the summary and the number of batches run now.
+        """
+        from pushrecovery.campaign import run_campaign
+
+        bar = Progress(spec.size, "campaign", "push")
+        try:
+            result = run_campaign(
+                spec,
+                Path(self.out),
+                workers=self.workers,
+                scheduler=self.scheduler,
+                resume=self.resume,
+                progress=bar.update,
+                isolated=self.workers != 1,
+            )
+        except KeyboardInterrupt:
+            bar.close()
+            click.echo(
+                f"pushrecovery: interrupted; the finished batches are in {Path(self.out)}; "
+                "rerun with --resume to complete the campaign",
+                err=True,
+            )
+            sys.exit(130)
+        bar.close()
+        assert result is not None  # no max_batches
+        return result
+
+    def show(
+        self, result: Any, files: dict[str, str], as_json: bool, *more: Callable[[], None]
+    ) -> None:
+        """Print the summary with its files as JSON, or its counts, ``more`` and the files.
+
+        Parameters
+        ----------
+        result : CampaignResult
+            :meth:`run`'s.
+        files : dict
+            Name -> path of the files the command wrote beside the pushes and the summary.
+        as_json : bool
+            ``--json``.
+        *more : callable
+            Printers of further lines, after the confusion matrix.
+        """
+        summary = result.summary
+        files = {
+            "pushes": str(result.pushes_file),
+            "summary": str(result.directory / "summary.json"),
+            **files,
+        }
+        if as_json:
+            emit({**summary, "files": files}, True)
+            return
+        outcomes = summary["outcomes"]
+        click.echo(
+            f"{summary['pushes']} pushes ({result.ran} of {result.spec.batches} batches run "
+            f"now): {outcomes['recovered']} recovered, {outcomes['fell']} fell, "
+            f"{outcomes['undecided']} undecided"
+            + (f", {outcomes['error']} without an outcome" if outcomes.get("error") else "")
+            + "; prediction accuracy "
+            + ("n/a" if summary["accuracy"] is None else f"{summary['accuracy']:.3f}")
+        )
+        confusion = summary["confusion"]
+        echo_confusion(
+            "confusion (rows predicted, columns used):", confusion["labels"], confusion["counts"]
+        )
+        for echo in more:
+            echo()
+        for name, path in files.items():
+            click.echo(f"{name:<22}{path}")
+
+
+def _sweeps(pairs: tuple[str, ...]) -> dict[str, tuple[float, float, float]]:
+    """Return the ``--param NAME=START:STOP:STEP`` options as {name: (start, stop, step)}."""
     from pushrecovery.errors import InvalidParameterError
 
     sweeps = {}
@@ -144,91 +281,3 @@ def sweeps_from(pairs: tuple[str, ...]) -> dict[str, tuple[float, float, float]]
             raise InvalidParameterError(f"--param {name} given twice")
         sweeps[name] = values
     return sweeps  # type: ignore[return-value]
-
-
-def run_spec(
-    spec: Any, directory: Path, workers: int | None, scheduler: str | None, resume: bool
-) -> Any:
-    """Run a campaign with a progress bar; Ctrl-C keeps the finished batches and exits 130.
-
-    Parameters
-    ----------
-    spec : CampaignSpec
-        The campaign.
-    directory : Path
-        ``--out``.
-    workers : int or None
-        ``--workers``; 1 runs the pushes in this process (no worker to start and import
-        everything again; a push that crashes the engine ends the campaign, its finished
-        batches kept).
-    scheduler : str or None
-        ``--scheduler``.
-    resume : bool
-        ``--resume``.
-
-    Returns
-    -------
-    CampaignResult
-        The table, the summary and the number of batches run now.
-    """
-    from pushrecovery.campaign import run_campaign
-
-    bar = Progress(spec.size, "campaign", "push")
-    try:
-        result = run_campaign(
-            spec,
-            directory,
-            workers=workers,
-            scheduler=scheduler,
-            resume=resume,
-            progress=bar.update,
-            isolated=workers != 1,
-        )
-    except KeyboardInterrupt:
-        bar.close()
-        click.echo(
-            f"pushrecovery: interrupted; the finished batches are in {directory}; "
-            "rerun with --resume to complete the campaign",
-            err=True,
-        )
-        sys.exit(130)
-    bar.close()
-    assert result is not None  # no max_batches
-    return result
-
-
-def echo_counts(summary: dict[str, Any], ran: int, batches: int) -> None:
-    """Print a campaign's outcomes, its accuracy and its confusion matrix.
-
-    Parameters
-    ----------
-    summary : dict
-        The campaign's summary (``summary.json``).
-    ran, batches : int
-        The batches run now, and all of them.
-    """
-    outcomes = summary["outcomes"]
-    click.echo(
-        f"{summary['pushes']} pushes ({ran} of {batches} batches run now): "
-        f"{outcomes['recovered']} recovered, {outcomes['fell']} fell, "
-        f"{outcomes['undecided']} undecided"
-        + (f", {outcomes['error']} without an outcome" if outcomes.get("error") else "")
-        + "; prediction accuracy "
-        + ("n/a" if summary["accuracy"] is None else f"{summary['accuracy']:.3f}")
-    )
-    confusion = summary["confusion"]
-    echo_confusion(
-        "confusion (rows predicted, columns used):", confusion["labels"], confusion["counts"]
-    )
-
-
-def echo_files(files: dict[str, str]) -> None:
-    """Print the files a campaign wrote, one ``name path`` a line.
-
-    Parameters
-    ----------
-    files : dict
-        Name -> path.
-    """
-    for name, path in files.items():
-        click.echo(f"{name:<22}{path}")

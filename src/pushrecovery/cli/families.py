@@ -148,14 +148,8 @@ def humanoid_only(
         The click decorator: the options are not listed, not passed to the command, and one
         given is refused in one line naming ``pushrecovery humanoid COMMAND``.
     """
-
-    def message(flag: str, shown: str) -> str:
-        return (
-            f"{flag} is an option of the 3-D humanoids (biped3d, g1): use "
-            f"'pushrecovery humanoid {command} {shown}'"
-        )
-
-    return _refused(flags, message, nargs or {})
+    message = "{flag} is an option of the 3-D humanoids (biped3d, g1): use "
+    return _refused(command, flags, nargs, message + "'pushrecovery humanoid {command} {shown}'")
 
 
 def planar_only(
@@ -178,20 +172,15 @@ def planar_only(
         The click decorator: the options are not listed, not passed to the command, and one
         given is refused in one line pointing to ``pushrecovery humanoid COMMAND --help``.
     """
-
-    def message(flag: str, shown: str) -> str:
-        return (
-            f"{flag} is an option of the planar models, not of the 3-D humanoids: see "
-            f"'pushrecovery humanoid {command} --help'"
-        )
-
-    return _refused(flags, message, nargs or {})
+    message = "{flag} is an option of the planar models, not of the 3-D humanoids: see "
+    return _refused(command, flags, nargs, message + "'pushrecovery humanoid {command} --help'")
 
 
 def _refused(
-    flags: tuple[str, ...], message: Callable[[str, str], str], nargs: Mapping[str, int]
+    command: str, flags: tuple[str, ...], nargs: Mapping[str, int] | None, message: str
 ) -> Callable[[F], F]:
-    """Add the hidden ``flags``: each one given raises ``message(flag, flag and its values)``."""
+    """Add the hidden ``flags``: one given raises ``message`` filled in (``{shown}``: as given)."""
+    counts = nargs or {}
 
     def refuse(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
         if value is None or value is False:
@@ -200,7 +189,8 @@ def _refused(
 
         flag = param.opts[0]
         given = " ".join(value) if isinstance(value, tuple) else value
-        raise InvalidParameterError(message(flag, flag if flag in _FLAGS else f"{flag} {given}"))
+        shown = flag if flag in _FLAGS else f"{flag} {given}"
+        raise InvalidParameterError(message.format(flag=flag, command=command, shown=shown))
 
     def apply(func: F) -> F:
         for flag in reversed(flags):
@@ -209,7 +199,7 @@ def _refused(
                 is_flag=flag in _FLAGS,
                 default=False if flag in _FLAGS else None,
                 type=None if flag in _FLAGS else str,
-                nargs=nargs.get(flag, 1),
+                nargs=counts.get(flag, 1),
                 hidden=True,
                 expose_value=False,
                 callback=refuse,

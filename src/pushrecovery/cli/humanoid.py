@@ -18,7 +18,7 @@ from typing import Any
 import click
 
 from pushrecovery.cli.app import example
-from pushrecovery.cli.campaign_options import run_options
+from pushrecovery.cli.campaign_options import CampaignRun, run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, planar_only
 from pushrecovery.cli.options import body_options_of, echo_confusion, emit
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
@@ -401,17 +401,6 @@ def campaign(
     impulse: tuple[float, float, float] | None,
     fraction: tuple[float, float, float] | None,
     strategy: str | None,
-    sweep_pairs: tuple[str, ...],
-    samples: int | None,
-    seed: int,
-    duration: float,
-    batch_size: int | None,
-    push_timeout: float,
-    out: str,
-    workers: int | None,
-    scheduler: str | None,
-    resume: bool,
-    plot: bool,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
@@ -427,26 +416,19 @@ def campaign(
     kept: an interrupted campaign continues with --resume. The body flags (--preset, --params,
     --mass, ...) build biped3d; g1 has the robot's own body and refuses them and --param.
     """
-    from pathlib import Path
-
     from pushrecovery.cli.azimuths import azimuths_from
-    from pushrecovery.cli.campaign3d import echo_causes, spec_3d, stored_spec_3d, write_confusion
-    from pushrecovery.cli.campaign_options import echo_counts, echo_files, run_spec, sweeps_from
+    from pushrecovery.cli.campaign3d import echo_causes, spec_3d, write_confusion
     from pushrecovery.cli.simulation3d import params_3d
     from pushrecovery.errors import InvalidParameterError
 
-    directory = Path(out)
+    run = CampaignRun.pop(kwargs)
     directions = azimuths_from(azimuth, azimuths)
-    if resume and impulse is None and fraction is None and directions is None:
+    if run.resume and impulse is None and fraction is None and directions is None:
         from click.core import ParameterSource
 
         given = click.get_current_context().get_parameter_source("model")
-        if sweep_pairs or samples is not None or strategy or given is ParameterSource.COMMANDLINE:
-            raise InvalidParameterError(
-                "--resume without --impulse or --fraction runs the stored campaign: give its "
-                "whole spec or none"
-            )
-        spec = stored_spec_3d(directory)  # the stored campaign, as it was asked for
+        asked = bool(strategy) or given is ParameterSource.COMMANDLINE
+        spec = run.stored("--impulse or --fraction", asked, three_d=True)
     else:
         if (impulse is None) == (fraction is None):
             raise InvalidParameterError(
@@ -461,24 +443,11 @@ def campaign(
             impulse=impulse,
             fraction=fraction,
             azimuths=directions,
-            sweeps=sweeps_from(sweep_pairs),
-            samples=samples,
-            seed=seed,
-            duration=duration,
-            batch_size=batch_size,
-            push_timeout=push_timeout,
+            **run.spec_options(),
         )
-    result = run_spec(spec, directory, workers, scheduler, resume)
-    files = {"pushes": str(result.pushes_file), "summary": str(directory / "summary.json")}
-    confusion, written = write_confusion(result.table, spec.model, directory, plot)
-    files.update(written)
-    summary = {**result.summary, "files": files}
-    if as_json:
-        emit(summary, True)
-        return
-    echo_counts(summary, result.ran, spec.batches)
-    echo_causes(confusion)
-    echo_files(files)
+    result = run.run(spec)
+    confusion, files = write_confusion(result.table, spec.model, result.directory, run.plot)
+    run.show(result, files, as_json, lambda: echo_causes(confusion))
 
 
 def _echo_validation(data: dict[str, Any]) -> None:
