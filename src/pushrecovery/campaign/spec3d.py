@@ -173,18 +173,12 @@ def push_geometry(model: str, params: BodyParams) -> tuple[tuple[float, float], 
     height above the whole-body CoM and z₀ the CoM's above the soles [m]. Built once per
     body and process (a MuJoCo model is compiled).
     """
-    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
-    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.registry import make_plant3d
 
     if model not in MODELS_3D:
         raise InvalidParameterError(f"model must be one of {list(MODELS_3D)}, got {model!r}")
-    plant = make_plant(model, params, "mujoco")
-    if not isinstance(plant, Humanoid3DPlant):  # the registry's 3-D models all are
-        raise TypeError(f"{model} is not a 3-D plant: {type(plant).__name__}")
-    state = plant.reset()
-    data = plant.data
-    lever = float(data.xipos[plant.body_of("torso")][2]) - float(data.subtree_com[0][2])
-    return (float(state[0]), float(state[1])), lever / float(plant.standing_height)
+    plant = make_plant3d(model, params)
+    return plant.standing_origin, plant.push_lever / float(plant.standing_height)
 
 
 def standing_origin(model: str, params: BodyParams) -> tuple[float, float]:

@@ -62,7 +62,6 @@ from pushrecovery.experiments.validation3d_predict import (
     CriticalErrors,
     critical_impulse_along,
     predicted_critical_impulses,
-    push_lever,
 )
 from pushrecovery.params import BodyParams
 
@@ -80,7 +79,6 @@ __all__ = [
     "critical_impulse_along",
     "measure_critical_impulse",
     "predicted_critical_impulses",
-    "push_lever",
     "run_validation3d",
     "validation_plant",
 ]
@@ -367,47 +365,19 @@ def run_validation3d(
         )
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-4, 0.5)
     duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
-    if params is not None:
-        require_type("params", params, BodyParams)
     plant = validation_plant(model, params)
-    body = plant.params
-    state = plant.reset()
-    origin = (float(state[0]), float(state[1]))
-    lever, height = push_lever(plant)
-    factor = 1.0 / (1.0 + lever / height)
+    body, origin, lever = plant.params, plant.standing_origin, plant.push_lever
+    factor = 1.0 / (1.0 + lever / float(plant.standing_height))
     rows = []
     for angle in angles:
         predicted = predicted_critical_impulses(body, angle, origin=origin)
         for strategy in chosen:
+            guess = factor * predicted[strategy]
             found = measure_critical_impulse(
-                plant,
-                angle,
-                hip=strategy == "hip",
-                guess=factor * predicted[strategy],
-                rel_tolerance=rel_tolerance,
+                plant, angle, hip=strategy == "hip", guess=guess, rel_tolerance=rel_tolerance,
                 duration=duration,
-            )
-            rows.append(
-                ValidationRow(
-                    azimuth=angle,
-                    strategy=strategy,
-                    predicted=predicted[strategy],
-                    corrected=factor * predicted[strategy],
-                    measured=found.impulse,
-                    bracket=found.bracket,
-                    runs=found.runs,
-                    strategy_used=found.strategy_used,
-                )
-            )
-    return Validation3D(
-        model=model,
-        rows=tuple(rows),
-        mass=body.mass,
-        omega=body.omega,
-        origin=origin,
-        lever=lever,
-        standing_height=height,
-        rel_tolerance=rel_tolerance,
-        duration=duration,
-        strategies=chosen,
-    )
+            )  # fmt: skip
+            rows.append(ValidationRow(angle, strategy, predicted[strategy], guess, found.impulse,
+                                      found.bracket, found.runs, found.strategy_used))  # fmt: skip
+    return Validation3D(model, tuple(rows), body.mass, body.omega, origin, lever,
+                        float(plant.standing_height), rel_tolerance, duration, chosen)  # fmt: skip

@@ -3,14 +3,12 @@
 The impulse J* = m ω d(ψ) that puts the capture point of the standing body on the boundary of
 a region along the azimuth ψ: the support polygon P for the ankle strategy (Eq. 4 in the
 plane), P grown by the hips' CMP offsets (the corrected Eq. 15, ``surfaces.plane.cmp_polygon``)
-for the hip; and the lever of a push applied above the CoM (:func:`push_lever`). Used by
-:mod:`pushrecovery.experiments.validation3d`.
+for the hip. Used by :mod:`pushrecovery.experiments.validation3d`.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from pushrecovery.arguments import bounded_float, finite_float, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
@@ -19,14 +17,10 @@ from pushrecovery.ground.support import Support
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.plane import cmp_polygon
 
-if TYPE_CHECKING:
-    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
-
 __all__ = [
     "CriticalErrors",
     "critical_impulse_along",
     "predicted_critical_impulses",
-    "push_lever",
 ]
 
 
@@ -124,14 +118,3 @@ def predicted_critical_impulses(
         name: critical_impulse_along(region, start, azimuth, params.mass, rate)
         for name, region in regions.items()
     }
-
-
-def push_lever(plant: Humanoid3DPlant) -> tuple[float, float]:
-    """Return (d, z₀): the pushed torso's CoM height above the whole-body CoM, and z₀ [m].
-
-    ``plant`` is a freshly reset 3-D plant (``sim.mujoco.humanoid3d.plant3d``).
-    """
-    data = plant.data
-    torso = plant.body_of("torso")
-    lever = float(data.xipos[torso][2]) - float(data.subtree_com[0][2])
-    return lever, float(plant.standing_height)

@@ -48,7 +48,7 @@ import numpy as np
 
 from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.experiments.validation3d import DEFAULT_AZIMUTHS
+from pushrecovery.experiments.validation3d import DEFAULT_AZIMUTHS, MAX_RUNS
 from pushrecovery.experiments.validation3d_predict import CriticalErrors, critical_impulse_along
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
@@ -68,8 +68,6 @@ __all__ = [
 
 #: A run ending with ξ this far outside its feet's support polygon fell [m].
 FALL_MARGIN = 0.05
-#: Most runs of one bisection.
-MAX_RUNS = 40
 
 
 def predicted_step_critical(
@@ -365,7 +363,6 @@ def run_step_validation(
         Naming the bad argument.
     """
     from pushrecovery.experiments.validation3d import MODELS, azimuth_list, validation_plant
-    from pushrecovery.experiments.validation3d_predict import push_lever
 
     if model not in MODELS:
         raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
@@ -375,10 +372,8 @@ def run_step_validation(
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-3, 0.5)
     duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
     plant = validation_plant(model, params)
-    params = plant.params
-    state = plant.reset()
-    origin = (float(state[0]), float(state[1]))
-    lever, height = push_lever(plant)
+    params, origin, height = plant.params, plant.standing_origin, float(plant.standing_height)
+    lever = plant.push_lever
     factor = 1.0 / (1.0 + lever / height)
     rows = []
     for angle in angles:

@@ -151,6 +151,10 @@ class Humanoid3DPlant:
         self.floor = 0.0
         self.standing_height = 1.0
         self.omega = 1.0
+        #: Standing (at reset): the CoM's ground point r₀ [m] and the pushed torso's CoM
+        #: height above the whole-body CoM d [m], the lever of a push (docs/validation3d.md).
+        self.standing_origin = (0.0, 0.0)
+        self.push_lever = 0.0
         #: Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (``frames``) from the next reset.
         self.recording = False
         self.frames: list[FloatArray] = []
@@ -195,6 +199,9 @@ class Humanoid3DPlant:
         self.ctrl = np.zeros(int(model.nu))
         self.info = StepInfo()
         self.state = self._read()
+        self.standing_origin = (float(self.state[0]), float(self.state[1]))
+        torso = body_id(model, self.torso)
+        self.push_lever = float(data.xipos[torso][2]) - float(data.subtree_com[0][2])
         self._restart_rows()
         return self.state.copy()
 
