@@ -40,7 +40,11 @@ from pushrecovery.sim.mujoco.humanoid3d.measure import subtree
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 from pushrecovery.sim.mujoco.humanoid3d.runs3d import pushed_rows
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import WbcRun
-from pushrecovery.sim.mujoco.render.frames import select_indices, subsample_indices
+from pushrecovery.sim.mujoco.render.frames import (
+    nearest_indices,
+    select_indices,
+    subsample_indices,
+)
 from pushrecovery.sim.mujoco.render.output import output_paths, write_animation, write_filmstrip
 from pushrecovery.sim.mujoco.render.overlay3d import LEGEND3D, Frame3D
 from pushrecovery.sim.mujoco.render.scene3d import Camera3D, fit_camera3d, render_frames3d
@@ -303,12 +307,7 @@ def filmstrip_rows(time: FloatArray, times: Sequence[float] | None, panels: int)
             f"times must be within the run, [{first:.3f}, {last:.3f}] s, got "
             f"[{wanted[0]:g}, {wanted[-1]:g}] s"
         )
-    if len(time) == 1:
-        return [0]
-    right = np.clip(np.searchsorted(time, wanted), 1, len(time) - 1)
-    left = right - 1
-    nearest = np.where(np.abs(time[left] - wanted) <= np.abs(time[right] - wanted), left, right)
-    return [int(r) for r in np.unique(nearest)]
+    return nearest_indices(time, wanted)
 
 
 def _check_size(name: str, size: object) -> tuple[int, int]:

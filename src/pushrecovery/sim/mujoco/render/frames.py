@@ -5,20 +5,16 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.errors import InvalidParameterError
 
-if TYPE_CHECKING:
-    pass
-
-
 __all__ = [
     "Frame",
     "FrameLike",
+    "nearest_indices",
     "select_indices",
     "select_times",
     "subsample",
@@ -83,15 +79,16 @@ def _as_frames(frames: Sequence[FrameLike]) -> list[Frame]:
 
 
 # --- frames and camera ---------------------------------------------------------------------
-def _times(frames: Sequence[Frame]) -> NDArray[np.float64]:
-    times = np.array([f.time for f in frames], dtype=float)
-    if not np.all(np.isfinite(times)) or np.any(np.diff(times) < 0.0):
-        raise InvalidParameterError("frame times must be finite and non-decreasing")
-    return times
+def nearest_indices(times: NDArray[np.float64], targets: NDArray[np.float64]) -> list[int]:
+    """Return the indices of the times nearest to the targets, without repeats, in order.
 
-
-def _nearest(times: NDArray[np.float64], targets: NDArray[np.float64]) -> list[int]:
-    """Return the indices of the times nearest to the targets, without repeats, in order."""
+    Parameters
+    ----------
+    times : ndarray
+        Frame times [s], non-decreasing, at least one.
+    targets : ndarray
+        The times wanted [s], increasing.
+    """
     if len(times) == 1:
         return [0]
     right = np.clip(np.searchsorted(times, targets), 1, len(times) - 1)
@@ -119,7 +116,7 @@ def subsample_indices(times: ArrayLike, fps: float) -> list[int]:
         raise InvalidParameterError(f"fps must be > 0 1/s, got {fps:g}")
     t = _checked_times(times)
     count = math.floor((t[-1] - t[0]) * fps + 1e-9) + 1
-    return _nearest(t, np.append(t[0] + np.arange(count) / fps, t[-1]))
+    return nearest_indices(t, np.append(t[0] + np.arange(count) / fps, t[-1]))
 
 
 def select_indices(times: ArrayLike, count: int) -> list[int]:
@@ -140,7 +137,7 @@ def select_indices(times: ArrayLike, count: int) -> list[int]:
     if count < 1:
         raise InvalidParameterError(f"count must be >= 1, got {count}")
     t = _checked_times(times)
-    return _nearest(t, np.linspace(t[0], t[-1], count))
+    return nearest_indices(t, np.linspace(t[0], t[-1], count))
 
 
 def _checked_times(times: ArrayLike) -> NDArray[np.float64]:
@@ -170,7 +167,7 @@ def subsample(frames: Sequence[FrameLike], fps: float) -> list[Frame]:
     if not (math.isfinite(fps) and fps > 0.0):
         raise InvalidParameterError(f"fps must be > 0 1/s, got {fps:g}")
     frames = _as_frames(frames)
-    return [frames[i] for i in subsample_indices(_times(frames), fps)]
+    return [frames[i] for i in subsample_indices([f.time for f in frames], fps)]
 
 
 def select_times(frames: Sequence[FrameLike], count: int) -> list[Frame]:
@@ -191,4 +188,4 @@ def select_times(frames: Sequence[FrameLike], count: int) -> list[Frame]:
     if count < 1:
         raise InvalidParameterError(f"count must be >= 1, got {count}")
     frames = _as_frames(frames)
-    return [frames[i] for i in select_indices(_times(frames), count)]
+    return [frames[i] for i in select_indices([f.time for f in frames], count)]

@@ -29,18 +29,8 @@ __all__ = [
 
 #: How long the last GIF frame is held before the animation loops [s].
 HOLD_LAST = 1.0
-
-
-_LABEL_HEIGHT = 20
-
-
-_LEGEND_HEIGHT = 22
-
-
-_TITLE_HEIGHT = 22
-
-
-_GAP = 4
+# Heights of a filmstrip's label, legend and title strips and the gap between panels [px].
+_LABEL_HEIGHT, _LEGEND_HEIGHT, _TITLE_HEIGHT, _GAP = 20, 22, 22, 4
 
 
 # --- images ----------------------------------------------------------------------------------
@@ -157,15 +147,11 @@ def write_animation(
 
     Parameters
     ----------
-    images : Sequence[NDArray[np.uint8]]
-        RGB images of one shape ``(height, width, 3)``.
-    times : Sequence[float]
-        Time of each image [s], non-decreasing; frame delays follow them (rounded to the
-        GIF's 10 ms unit without drift); the last frame is held ``HOLD_LAST`` s.
+    images, times, legend
+        As :func:`write_filmstrip`'s, the times [s] non-decreasing: frame delays follow them
+        (rounded to the GIF's 10 ms unit without drift); the last frame is held ``HOLD_LAST`` s.
     path : Path
         Output file (GIF); parents are created.
-    legend : sequence of (str, RGBA)
-        The markers' names and colours (default the side view's CoM, capture point, CoP).
 
     Returns
     -------

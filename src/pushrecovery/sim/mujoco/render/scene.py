@@ -6,7 +6,7 @@ import importlib
 import math
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
@@ -18,7 +18,13 @@ from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 
 if TYPE_CHECKING:
     import mujoco
-from pushrecovery.sim.mujoco.render.frames import Frame, FrameLike, _as_frames, _times, select_times
+from pushrecovery.sim.mujoco.render.frames import (
+    Frame,
+    FrameLike,
+    _as_frames,
+    _checked_times,
+    select_times,
+)
 
 __all__ = [
     "AZIMUTH",
@@ -170,27 +176,36 @@ def _check_qpos(model: mujoco.MjModel, frame: Frame) -> None:
         )
 
 
-def _body_extent(model: mujoco.MjModel, frames: Sequence[Frame]) -> NDArray[np.float64]:
-    """World x and z of the corners of the bounding boxes of the moving geoms, ``(n, 2)`` [m].
+def _moving_boxes(model: mujoco.MjModel, frames: Sequence[Any]) -> Iterator[tuple[Any, ...]]:
+    """Replay each frame (``mj_kinematics``); yield it and its moving geoms' bounding boxes.
 
-    Geoms of the world body (floor, static scenery) are left out; up to ``_EXTENT_SAMPLES``
-    frames evenly spaced in time are replayed.
+    Moving: not the world body's (floor, static scenery). The boxes: rotations ``(g, 3, 3)``,
+    centres ``(g, 3)`` [m] and half sizes ``(g, 3)`` [m].
     """
     mj = _mujoco_for_rendering()
     moving = np.flatnonzero(np.asarray(model.geom_bodyid) != 0)
-    if moving.size == 0:
-        return np.empty((0, 2))
     aabb = np.asarray(model.geom_aabb, dtype=float)[moving]
     data = mj.MjData(model)
-    points = []
-    for f in select_times(frames, _EXTENT_SAMPLES):
+    for f in frames:
         data.qpos[:] = f.qpos
         mj.mj_kinematics(model, data)
         rot = np.asarray(data.geom_xmat, dtype=float)[moving].reshape(-1, 3, 3)
         centre = np.asarray(data.geom_xpos, dtype=float)[moving] + np.einsum(
             "gij,gj->gi", rot, aabb[:, :3]
         )
-        half = np.einsum("gij,gj->gi", np.abs(rot), aabb[:, 3:])
+        yield f, rot, centre, aabb[:, 3:]
+
+
+def _body_extent(model: mujoco.MjModel, frames: Sequence[Frame]) -> NDArray[np.float64]:
+    """World x and z of the corners of the moving geoms' boxes, ``(n, 2)`` [m].
+
+    At up to ``_EXTENT_SAMPLES`` frames evenly spaced in time (:func:`_moving_boxes`).
+    """
+    if not np.any(np.asarray(model.geom_bodyid) != 0):
+        return np.empty((0, 2))
+    points = []
+    for _, rot, centre, size in _moving_boxes(model, select_times(frames, _EXTENT_SAMPLES)):
+        half = np.einsum("gij,gj->gi", np.abs(rot), size)
         for sign in (-1.0, 1.0):
             points.append((centre + sign * half)[:, [0, 2]])
     return np.concatenate(points)
@@ -222,7 +237,7 @@ def fit_view(model: mujoco.MjModel, frames: Sequence[FrameLike], aspect: float) 
     if not (math.isfinite(aspect) and aspect > 0.0):
         raise InvalidParameterError(f"aspect must be > 0, got {aspect:g}")
     frames = _as_frames(frames)
-    _times(frames)
+    _checked_times([f.time for f in frames])
     for f in frames:
         _check_qpos(model, f)
     com = np.array([f.com for f in frames], dtype=float).reshape(-1, 2)
@@ -269,19 +284,57 @@ def _add_geom(
     scene.ngeom += 1
 
 
-def _backdrop_emission(model: mujoco.MjModel) -> float:
-    """Emission that brings the backdrop to about its own colour whatever the lights.
+def _wall_emission(model: mujoco.MjModel, normal: NDArray[np.float64]) -> float:
+    """Emission that brings a wall facing ``normal`` to about its own colour whatever the lights.
 
-    Estimates the light on a wall facing the camera (-y): the headlight (ambient and diffuse)
-    plus each light's ambient and diffuse (as if directional) terms.
+    Estimates the light on the wall: the headlight (ambient and diffuse) plus each light's
+    ambient and diffuse (as if directional) terms.
     """
     head = model.vis.headlight
     light = float(np.mean(head.ambient) + np.mean(head.diffuse)) if head.active else 0.0
     for k in range(model.nlight):
         direction = np.asarray(model.light_dir[k], dtype=float)
-        facing = max(0.0, float(direction[1]) / max(float(np.linalg.norm(direction)), 1e-9))
+        facing = max(0.0, -float(direction @ normal) / max(float(np.linalg.norm(direction)), 1e-9))
         light += float(np.mean(model.light_ambient[k]) + np.mean(model.light_diffuse[k]) * facing)
     return max(0.0, 1.0 - light)
+
+
+def _render_each(
+    model: mujoco.MjModel,
+    frames: Sequence[Any],
+    size: tuple[int, int],
+    distance: float,
+    aim: Callable[[Any, Any], None],
+    decorate: Callable[[Any, Any, Any, float], None],
+    shadows: bool,
+) -> list[NDArray[np.uint8]]:
+    """Replay each frame (``mj_forward``) and render it from the free camera.
+
+    Images of (width, height) ``size`` [px]; ``aim(camera, frame)`` places the camera,
+    ``decorate(mj, scene, frame, radius)`` adds the overlays, ``radius`` [m] being
+    ``MARKER_SCALE`` of the height seen at ``distance`` [m].
+    """
+    mj = _mujoco_for_rendering()
+    renderer = _open_renderer(model, size[0], size[1])
+    data = mj.MjData(model)
+    camera = mj.MjvCamera()
+    camera.type = mj.mjtCamera.mjCAMERA_FREE
+    half_tan = math.tan(math.radians(float(model.vis.global_.fovy)) / 2.0)
+    radius = MARKER_SCALE * 2.0 * distance * half_tan
+    images: list[NDArray[np.uint8]] = []
+    try:
+        for f in frames:
+            data.qpos[:] = f.qpos
+            mj.mj_forward(model, data)
+            aim(camera, f)
+            renderer.update_scene(data, camera=camera)
+            scene = renderer.scene
+            scene.flags[mj.mjtRndFlag.mjRND_SHADOW] = shadows
+            decorate(mj, scene, f, radius)
+            images.append(renderer.render().copy())
+    finally:
+        renderer.close()
+    return images
 
 
 def _decorate(
@@ -357,32 +410,19 @@ def render_frames(
         If offscreen OpenGL is unavailable (message names ``MUJOCO_GL``).
     """
     frames = _as_frames(frames)
-    _times(frames)
+    _checked_times([f.time for f in frames])
     for f in frames:
         _check_qpos(model, f)
-    view = view if view is not None else fit_view(model, frames, width / height)
-    mj = _mujoco_for_rendering()
-    renderer = _open_renderer(model, width, height)
-    data = mj.MjData(model)
-    camera = mj.MjvCamera()
-    camera.type = mj.mjtCamera.mjCAMERA_FREE
-    camera.lookat[:] = view.lookat
-    camera.distance = view.distance
-    camera.azimuth = view.azimuth
-    camera.elevation = view.elevation
-    half_tan = math.tan(math.radians(float(model.vis.global_.fovy)) / 2.0)
-    radius = MARKER_SCALE * 2.0 * view.distance * half_tan
-    backdrop = _backdrop_emission(model)
-    images: list[NDArray[np.uint8]] = []
-    try:
-        for f in frames:
-            data.qpos[:] = f.qpos
-            mj.mj_forward(model, data)
-            renderer.update_scene(data, camera=camera)
-            scene = renderer.scene
-            scene.flags[mj.mjtRndFlag.mjRND_SHADOW] = shadows
-            _decorate(mj, scene, f if markers else None, view, radius, backdrop)
-            images.append(renderer.render().copy())
-    finally:
-        renderer.close()
-    return images
+    seen = view if view is not None else fit_view(model, frames, width / height)
+    backdrop = _wall_emission(model, np.array([0.0, -1.0, 0.0]))  # the wall behind y = 0
+
+    def aim(camera: Any, frame: Frame) -> None:
+        camera.lookat[:] = seen.lookat
+        camera.distance, camera.azimuth, camera.elevation = (
+            seen.distance, seen.azimuth, seen.elevation,
+        )  # fmt: skip
+
+    def decorate(mj: Any, scene: Any, frame: Frame, radius: float) -> None:
+        _decorate(mj, scene, frame if markers else None, seen, radius, backdrop)
+
+    return _render_each(model, frames, (width, height), seen.distance, aim, decorate, shadows)

@@ -32,10 +32,10 @@ from pushrecovery.sim.mujoco.render.overlay3d import Frame3D, Marker, overlay_ma
 from pushrecovery.sim.mujoco.render.scene import (
     BACKDROP_DISTANCE,
     BACKDROP_RGBA,
-    MARKER_SCALE,
     _add_geom,
-    _mujoco_for_rendering,
-    _open_renderer,
+    _moving_boxes,
+    _render_each,
+    _wall_emission,
 )
 
 if TYPE_CHECKING:
@@ -120,22 +120,12 @@ def _check_frames(model: mujoco.MjModel, frames: Sequence[Frame3D]) -> None:
 
 def _body_points(model: mujoco.MjModel, frames: Sequence[Frame3D]) -> FloatArray:
     """Corners of the moving geoms' boxes relative to each frame's CoM ground point, (n, 3)."""
-    mj = _mujoco_for_rendering()
-    moving = np.flatnonzero(np.asarray(model.geom_bodyid) != 0)
-    aabb = np.asarray(model.geom_aabb, dtype=float)[moving]
-    data = mj.MjData(model)
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     points = []
-    for k in select_indices([f.time for f in frames], _EXTENT_SAMPLES):
-        f = frames[k]
-        data.qpos[:] = f.qpos
-        mj.mj_kinematics(model, data)
-        rot = np.asarray(data.geom_xmat, dtype=float)[moving].reshape(-1, 3, 3)
-        centre = np.asarray(data.geom_xpos, dtype=float)[moving] + np.einsum(
-            "gij,gj->gi", rot, aabb[:, :3]
-        )
+    sampled = [frames[k] for k in select_indices([f.time for f in frames], _EXTENT_SAMPLES)]
+    for f, rot, centre, size in _moving_boxes(model, sampled):
         corners = centre[:, None, :] + np.einsum(
-            "gij,gkj->gki", rot, signs[None, :, :] * aabb[:, None, 3:]
+            "gij,gkj->gki", rot, signs[None, :, :] * size[:, None, :]
         )
         offset = np.array([f.com[0], f.com[1], 0.0])
         points.append(corners.reshape(-1, 3) - offset)
@@ -191,21 +181,6 @@ def _add_line(mj: Any, scene: Any, marker: Marker) -> None:
     mj.mjv_connector(geom, mj.mjtGeom.mjGEOM_CAPSULE, marker.radius, a, b)
 
 
-def _wall_emission(model: mujoco.MjModel, normal: FloatArray) -> float:
-    """Emission that brings a wall facing ``normal`` to about its own colour.
-
-    As :func:`~.scene._backdrop_emission` for any wall: the headlight's ambient and diffuse
-    light plus each light's ambient and diffuse (as if directional) terms on the wall.
-    """
-    head = model.vis.headlight
-    light = float(np.mean(head.ambient) + np.mean(head.diffuse)) if head.active else 0.0
-    for k in range(model.nlight):
-        direction = np.asarray(model.light_dir[k], dtype=float)
-        facing = max(0.0, -float(direction @ normal) / max(float(np.linalg.norm(direction)), 1e-9))
-        light += float(np.mean(model.light_ambient[k]) + np.mean(model.light_diffuse[k]) * facing)
-    return max(0.0, 1.0 - light)
-
-
 def _add_backdrop(mj: Any, scene: Any, view: View3D, look: FloatArray, emission: float) -> None:
     """Add a light wall facing the camera, ``BACKDROP_DISTANCE`` behind what it looks at."""
     if scene.ngeom >= scene.maxgeom:
@@ -253,48 +228,30 @@ def render_frames3d(
     Returns
     -------
     list[NDArray[np.uint8]]
-        One ``(height, width, 3)`` RGB image per frame.
-
-    Raises
-    ------
-    PushRecoveryError
-        If offscreen OpenGL is unavailable (message names ``MUJOCO_GL``).
+        One ``(height, width, 3)`` RGB image per frame (errors as
+        :func:`~pushrecovery.sim.mujoco.render.scene.render_frames`'s).
     """
     _check_frames(model, frames)
-    if view is None:
-        view = fit_camera3d(model, frames, camera or Camera3D(), width / max(height, 1))
-    mj = _mujoco_for_rendering()
-    renderer = _open_renderer(model, width, height)
-    data = mj.MjData(model)
-    cam = mj.MjvCamera()
-    cam.type = mj.mjtCamera.mjCAMERA_FREE
-    cam.distance = view.distance
-    cam.azimuth = view.camera.azimuth + 180.0
-    cam.elevation = -view.camera.elevation
-    half_tan = math.tan(math.radians(float(model.vis.global_.fovy)) / 2.0)
-    radius = MARKER_SCALE * 2.0 * view.distance * half_tan
-    forward, _, _ = _axes(view.camera)
+    seen = view or fit_camera3d(model, frames, camera or Camera3D(), width / max(height, 1))
+    forward, _, _ = _axes(seen.camera)
     level = np.array([forward[0], forward[1], 0.0]) / math.hypot(forward[0], forward[1])
     backdrop = _wall_emission(model, -level)
-    images: list[NDArray[np.uint8]] = []
-    try:
-        for f in frames:
-            data.qpos[:] = f.qpos
-            mj.mj_forward(model, data)
-            cam.lookat[:] = (f.com[0], f.com[1], view.height)
-            renderer.update_scene(data, camera=cam)
-            scene = renderer.scene
-            scene.flags[mj.mjtRndFlag.mjRND_SHADOW] = shadows
-            scene.flags[mj.mjtRndFlag.mjRND_REFLECTION] = shadows  # both: slow
-            _add_backdrop(mj, scene, view, np.array(cam.lookat, dtype=float), backdrop)
-            if markers:
-                for marker in overlay_markers(f, camera_eye(view, f.com), radius):
-                    if len(marker.points) == 1:
-                        _add_geom(mj, scene, mj.mjtGeom.mjGEOM_SPHERE, (marker.radius, 0, 0),
-                                  np.array(marker.points[0]), marker.rgba, 0.5)  # fmt: skip
-                    else:
-                        _add_line(mj, scene, marker)
-            images.append(renderer.render().copy())
-    finally:
-        renderer.close()
-    return images
+
+    def aim(cam: Any, f: Frame3D) -> None:
+        cam.lookat[:] = (f.com[0], f.com[1], seen.height)
+        cam.distance = seen.distance
+        cam.azimuth = seen.camera.azimuth + 180.0
+        cam.elevation = -seen.camera.elevation
+
+    def decorate(mj: Any, scene: Any, f: Frame3D, radius: float) -> None:
+        scene.flags[mj.mjtRndFlag.mjRND_REFLECTION] = shadows  # with the shadows: both slow
+        look = np.array([f.com[0], f.com[1], seen.height], dtype=float)
+        _add_backdrop(mj, scene, seen, look, backdrop)
+        for marker in overlay_markers(f, camera_eye(seen, f.com), radius) if markers else ():
+            if len(marker.points) == 1:
+                _add_geom(mj, scene, mj.mjtGeom.mjGEOM_SPHERE, (marker.radius, 0, 0),
+                          np.array(marker.points[0]), marker.rgba, 0.5)  # fmt: skip
+            else:
+                _add_line(mj, scene, marker)
+
+    return _render_each(model, frames, (width, height), seen.distance, aim, decorate, shadows)
