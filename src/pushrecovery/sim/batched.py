@@ -150,15 +150,7 @@ def recovery_pushes(
     Returns
     -------
     PushRuns
-        One entry per push, in order.
-
-    Raises
-    ------
-    InvalidParameterError
-        Sequences of different lengths, a start no model can have, a duration outside
-        (0, 60] s.
-    ParameterTypeError
-        ``bodies`` not a list or tuple of BodyParams.
+        One entry per push, in order; the errors are :func:`ankle_pd_pushes`'s (no model).
     """
     from pushrecovery.control.recovery import RecoveryController
     from pushrecovery.kernels.batched import stepping as kernel

@@ -37,7 +37,7 @@ from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import critical_push, pushed_state
-from pushrecovery.sim.registry import MUJOCO_MODELS, make_plant
+from pushrecovery.sim.registry import MUJOCO_MODELS, available_models, make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify, strategy_region
 
@@ -88,23 +88,9 @@ def _setup(backend: str, strategy: str) -> tuple[str, str]:
 
 
 def available_strategies(backend: str) -> tuple[str, ...]:
-    """Return the strategies whose model exists on ``backend``.
-
-    Raises
-    ------
-    ParameterTypeError
-        If ``backend`` is not a str.
-    InvalidParameterError
-        If it names no backend.
-    """
-    require_type("backend", backend, str)
-    if backend not in SETUPS:
-        raise InvalidParameterError(f"backend must be one of {sorted(SETUPS)}, got {backend!r}")
-    return tuple(
-        strategy
-        for strategy, (model, _) in SETUPS[backend].items()
-        if backend != "mujoco" or model in MUJOCO_MODELS
-    )
+    """Return the strategies whose model exists on ``backend`` (raises as ``available_models``)."""
+    models = available_models(backend)
+    return tuple(strategy for strategy, (model, _) in SETUPS[backend].items() if model in models)
 
 
 def corrected_critical_velocity(
