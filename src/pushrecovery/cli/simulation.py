@@ -16,17 +16,7 @@ from pushrecovery.cli.app import example
 from pushrecovery.cli.families import humanoid_only
 from pushrecovery.cli.options import body_options, emit, params_from
 from pushrecovery.cli.progress import Progress
-from pushrecovery.cli.simulation_options import (
-    _backend,
-    _controller,
-    _controller_options,
-    _gains,
-    _measured_cop,
-    _model,
-    _options_for,
-    _push_velocity,
-    _with,
-)
+from pushrecovery.cli.simulation_options import controller_options, planar_run, timing
 
 __all__ = ["critical_push", "simulate"]
 
@@ -40,14 +30,9 @@ __all__ = ["critical_push", "simulate"]
         "pushrecovery simulate --backend mujoco --model foot --impulse 15 --duration 3 --json",
     ),
 )
-@_with(_backend, _model("simulate"), _controller("simulate"), *_gains)
-@click.option(
-    "--x",
-    "x",
-    type=float,
-    default=0.0,
-    show_default=True,
-    help="CoM position before the push, forward from the ankle (stepping-plane: from the "
+@planar_run(
+    "simulate",
+    x_help="CoM position before the push, forward from the ankle (stepping-plane: from the "
     "ankles' midpoint) [m].",
 )
 @click.option(
@@ -80,15 +65,7 @@ __all__ = ["critical_push", "simulate"]
     help="Push as an impulse on the CoM, forward [N s] (instead of --xdot: the velocity "
     "impulse / mass; on MuJoCo a real force over 10 ms).",
 )
-@click.option(
-    "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
-)
-@click.option(
-    "--control-period",
-    type=float,
-    default=None,
-    help="Controller period [s] (default: the controller's own, else 0.001).",
-)
+@timing(duration_help="Longest simulated time [s].")
 @click.option(
     "--plot",
     type=click.Path(dir_okay=False),
@@ -110,9 +87,6 @@ def simulate(
     backend: str,
     model: str,
     controller: str,
-    kp: float | None,
-    kd: float | None,
-    options: tuple[str, ...],
     x: float,
     xdot: float | None,
     y: float,
@@ -180,9 +154,7 @@ def simulate(
             initial[1], initial[5] = y, ydot  # the planar state's y and ẏ
     result = run(
         plant,
-        make_controller(
-            controller, params, **_options_for(controller, _controller_options(kp, kd, options))
-        ),
+        make_controller(controller, params, **controller_options(controller, kwargs)),
         initial,
         duration=duration,
         control_period=control_period,
@@ -214,15 +186,7 @@ def simulate(
         "pushrecovery critical-push --model flywheel --controller mpc --direction backward --json",
     ),
 )
-@_with(_backend, _model("critical-push"), _controller("critical-push"), *_gains)
-@click.option(
-    "--x",
-    "x",
-    type=float,
-    default=0.0,
-    show_default=True,
-    help="CoM position before the push, on the foot [m].",
-)
+@planar_run("critical-push", x_help="CoM position before the push, on the foot [m].")
 @click.option(
     "--direction",
     type=click.Choice(("forward", "backward")),
@@ -238,28 +202,13 @@ def simulate(
     show_default=True,
     help="Width of the final velocity bracket [m/s].",
 )
-@click.option(
-    "--duration",
-    type=float,
-    default=10.0,
-    show_default=True,
-    help="Longest simulated time per push [s].",
-)
-@click.option(
-    "--control-period",
-    type=float,
-    default=None,
-    help="Controller period [s] (default: the controller's own, else 0.001).",
-)
+@timing(duration_help="Longest simulated time per push [s].")
 @humanoid_only("critical-push", "--azimuth")
 @body_options
 def critical_push(
     backend: str,
     model: str,
     controller: str,
-    kp: float | None,
-    kd: float | None,
-    options: tuple[str, ...],
     x: float,
     direction: str,
     tolerance: float,
@@ -294,7 +243,7 @@ def critical_push(
             tolerance=tolerance,
             duration=duration,
             control_period=control_period,
-            controller_options=_options_for(controller, _controller_options(kp, kd, options)),
+            controller_options=controller_options(controller, kwargs),
             backend=backend,
             progress=bar.update,
         )
@@ -344,3 +293,25 @@ def _critical_prediction(
         data["corrected_velocity"] = corrected
         data["corrected_impulse"] = params.mass * corrected
     return data
+
+
+def _push_velocity(xdot: float | None, impulse: float | None, mass: float) -> float:
+    """Return the CoM velocity of ``--xdot`` [m/s] or ``--impulse`` [N s] (not both; else 0)."""
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.sim.push import Push
+
+    if xdot is not None and impulse is not None:
+        raise InvalidParameterError("give either --xdot [m/s] or --impulse [N s], not both")
+    if impulse is not None:
+        return Push.from_impulse(impulse, mass).delta_velocity
+    return 0.0 if xdot is None else xdot
+
+
+def _measured_cop(cops: list[float]) -> dict[str, float | None]:
+    """Range of the CoP MuJoCo measured from the contact forces, relative to the ankle [m]."""
+    import math
+
+    finite = [cop for cop in cops if not math.isnan(cop)]
+    if not finite:
+        return {"min": None, "max": None}
+    return {"min": min(finite), "max": max(finite)}

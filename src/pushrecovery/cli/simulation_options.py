@@ -2,12 +2,13 @@
 
 The model and controller choices are read from the registries
 (:mod:`pushrecovery.sim.registry`, :mod:`pushrecovery.control.registry`), which name them
-without importing them.
+without importing them; the 3-D humanoids are ``pushrecovery humanoid``'s.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 import click
 
@@ -15,43 +16,75 @@ from pushrecovery.cli.families import HUMANOID_MODELS, ListedChoice, ModelChoice
 from pushrecovery.control.registry import CONTROLLER_NAMES
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
-__all__ = ["CONTROLLER_CHOICES", "MODEL_CHOICES", "MUJOCO_MODEL_CHOICES"]
+F = TypeVar("F", bound=Callable[..., Any])
 
-#: The ``--model`` and ``--controller`` choices (the planar models; the 3-D humanoids are
-#: ``pushrecovery humanoid``'s).
-MODEL_CHOICES = MODELS
-MUJOCO_MODEL_CHOICES = MUJOCO_MODELS
-CONTROLLER_CHOICES = CONTROLLER_NAMES
+__all__ = ["controller_options", "planar_run", "timing"]
 
 
-def _push_velocity(xdot: float | None, impulse: float | None, mass: float) -> float:
+def planar_run(command: str, x_help: str) -> Callable[[F], F]:
+    """Return the options that open a planar run's help: the plant, the controller, the start.
+
+    Parameters
+    ----------
+    command : str
+        ``simulate`` or ``critical-push`` (the models and controllers it lists).
+    x_help : str
+        The help of ``--x``, the CoM's start.
+
+    Returns
+    -------
+    callable
+        The click decorator adding ``--backend``, ``--model``, ``--controller``, ``--kp``,
+        ``--kd``, ``--option`` (``options``) and ``--x``, in this order.
+    """
+    return _with(
+        _backend,
+        _model(command),
+        _controller(command),
+        *_gains,
+        click.option("--x", "x", type=float, default=0.0, show_default=True, help=x_help),
+    )
+
+
+def timing(duration_help: str) -> Callable[[F], F]:
+    """Return ``--duration`` (default 10 s, with ``duration_help``) and ``--control-period``."""
+    return _with(
+        click.option("--duration", type=float, default=10.0, show_default=True, help=duration_help),
+        click.option(
+            "--control-period",
+            type=float,
+            default=None,
+            help="Controller period [s] (default: the controller's own, else 0.001).",
+        ),
+    )
+
+
+def controller_options(controller: str, kwargs: dict[str, Any]) -> dict[str, Any]:
+    """Pop ``--kp``, ``--kd`` and ``--option`` out of a command's kwargs: the controller's options.
+
+    Parameters
+    ----------
+    controller : str
+        ``--controller``.
+    kwargs : dict
+        The command's keyword arguments.
+
+    Returns
+    -------
+    dict
+        The keyword arguments of ``make_controller`` given (``stiffness``, ``damping`` and each
+        ``--option NAME=VALUE``, its name's ``-`` read as ``_``).
+
+    Raises
+    ------
+    InvalidParameterError
+        If an ``--option`` is not ``NAME=NUMBER``, or ``--kp``/``--kd`` is given to another
+        controller than ``ankle-pd``.
+    """
     from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.sim.push import Push
 
-    if xdot is not None and impulse is not None:
-        raise InvalidParameterError("give either --xdot [m/s] or --impulse [N s], not both")
-    if impulse is not None:
-        return Push.from_impulse(impulse, mass).delta_velocity
-    return 0.0 if xdot is None else xdot
-
-
-def _measured_cop(cops: list[float]) -> dict[str, float | None]:
-    """Range of the CoP MuJoCo measured from the contact forces, relative to the ankle [m]."""
-    import math
-
-    finite = [cop for cop in cops if not math.isnan(cop)]
-    if not finite:
-        return {"min": None, "max": None}
-    return {"min": min(finite), "max": max(finite)}
-
-
-def _controller_options(
-    kp: float | None, kd: float | None, pairs: tuple[str, ...] = ()
-) -> dict[str, Any]:
-    from pushrecovery.errors import InvalidParameterError
-
-    options: dict[str, Any] = {"stiffness": kp, "damping": kd}
-    for pair in pairs:
+    options: dict[str, Any] = {"stiffness": kwargs.pop("kp"), "damping": kwargs.pop("kd")}
+    for pair in kwargs.pop("options"):
         name, sep, text = pair.partition("=")
         if not sep or not name:
             raise InvalidParameterError(f"--option must be NAME=VALUE, got {pair!r}")
@@ -60,17 +93,9 @@ def _controller_options(
         except ValueError:
             raise InvalidParameterError(f"--option {name} must be a number, got {text!r}") from None
         options[name.replace("-", "_")] = value
-    return {k: v for k, v in options.items() if v is not None}
-
-
-def _options_for(controller: str, options: dict[str, Any]) -> dict[str, Any]:
-    """Drop the ankle-pd gain flags for other controllers (they default to None anyway)."""
-    if controller != "ankle-pd":
-        for gain in ("stiffness", "damping"):
-            if gain in options:
-                from pushrecovery.errors import InvalidParameterError
-
-                raise InvalidParameterError(f"--kp/--kd apply to ankle-pd, not {controller!r}")
+    options = {k: v for k, v in options.items() if v is not None}
+    if controller != "ankle-pd" and ("stiffness" in options or "damping" in options):
+        raise InvalidParameterError(f"--kp/--kd apply to ankle-pd, not {controller!r}")
     return options
 
 
@@ -102,7 +127,7 @@ def _model(command: str) -> Any:
     return click.option(
         "--model",
         type=ModelChoice(
-            tuple(m for m in (*MODEL_CHOICES, *MUJOCO_MODEL_CHOICES) if m not in unlisted),
+            tuple(m for m in (*MODELS, *MUJOCO_MODELS) if m not in unlisted),
             elsewhere={m: f"humanoid {command} --model {m}" for m in HUMANOID_MODELS},
             family="a 3-D humanoid",
             unlisted=unlisted,
@@ -122,7 +147,7 @@ def _controller(command: str) -> Any:
     return click.option(
         "--controller",
         type=ListedChoice(
-            tuple(c for c in CONTROLLER_CHOICES if c not in unlisted), unlisted=unlisted
+            tuple(c for c in CONTROLLER_NAMES if c not in unlisted), unlisted=unlisted
         ),
         default="ankle-pd",
         show_default=True,
