@@ -117,16 +117,23 @@ def validate_3d(options: Validate3DOptions, params: Any) -> dict[str, Any]:
     return data
 
 
-def _row(row: Any) -> dict[str, Any]:
+def _critical(row: Any) -> dict[str, Any]:
+    """Return a row's predicted, corrected and measured critical push [N s], and the errors."""
     return {
-        "azimuth": row.azimuth,
-        "strategy": row.strategy,
         "predicted": row.predicted,
         "corrected": row.corrected,
         "measured": row.measured,
         "bracket": list(row.bracket),
         "relative_error": row.relative_error,
         "corrected_error": row.corrected_error,
+    }
+
+
+def _row(row: Any) -> dict[str, Any]:
+    return {
+        "azimuth": row.azimuth,
+        "strategy": row.strategy,
+        **_critical(row),
         "strategy_used": row.strategy_used,
     }
 
@@ -134,12 +141,7 @@ def _row(row: Any) -> dict[str, Any]:
 def _step_row(row: Any, step: Any) -> dict[str, Any]:
     return {
         "azimuth": row.azimuth,
-        "predicted": row.predicted,
-        "corrected": row.corrected,
-        "measured": row.measured,
-        "bracket": list(row.bracket),
-        "relative_error": row.relative_error,
-        "corrected_error": row.corrected_error,
+        **_critical(row),
         "steps": row.steps,
         "swing_time": row.swing_time,
         "step_length": row.step_length,
