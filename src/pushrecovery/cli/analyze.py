@@ -20,6 +20,33 @@ _UNITS = ("m", "cm", "mm")
 _AP_AXES = ("x", "-x", "y", "-y", "z", "-z")
 
 
+#: (flag, default, help) of the AnalysisSettings fields named by the flags (SI units).
+_SETTINGS: tuple[tuple[str, float | None, str], ...] = (
+    ("--cutoff", 6.0, "Low-pass cutoff of the CoM and markers [Hz] (0: none)."),
+    ("--force-cutoff", 10.0, "Low-pass cutoff of the force-plate signals [Hz] (0: none)."),
+    ("--max-gap", 0.1, "Longest gap that is interpolated [s]; longer gaps are excluded."),
+    (
+        "--contact-height",
+        0.02,
+        "A foot supports while its lower marker is within this of its lowest [m].",
+    ),
+    (
+        "--ankle-ap",
+        None,
+        "Lab position of the fixed feet along ap [m] (default: 0.05 m behind the mean CoP).",
+    ),
+    ("--ankle-ml", None, "Lab position of the fixed feet along ml [m] (default: the mean CoP)."),
+)
+
+
+def _settings_options(func: Any) -> Any:
+    """Add one option per :data:`_SETTINGS` row."""
+    for flag, default, text in reversed(_SETTINGS):
+        shown = default is not None
+        func = click.option(flag, type=float, default=default, show_default=shown, help=text)(func)
+    return func
+
+
 def _foot(text: str) -> tuple[str, str, str, str]:
     """``NAME=HEEL,TOE,ANKLE`` -> (name, heel, toe, ankle)."""
     from pushrecovery.errors import InvalidParameterError
@@ -101,46 +128,7 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     metavar="NAME=HEEL,TOE,ANKLE",
     help="C3D foot markers (default the Plug-in Gait LHEE,LTOE,LANK and RHEE,RTOE,RANK).",
 )
-@click.option(
-    "--cutoff",
-    type=float,
-    default=6.0,
-    show_default=True,
-    help="Low-pass cutoff of the CoM and markers [Hz] (0: none).",
-)
-@click.option(
-    "--force-cutoff",
-    type=float,
-    default=10.0,
-    show_default=True,
-    help="Low-pass cutoff of the force-plate signals [Hz] (0: none).",
-)
-@click.option(
-    "--max-gap",
-    type=float,
-    default=0.1,
-    show_default=True,
-    help="Longest gap that is interpolated [s]; longer gaps are excluded.",
-)
-@click.option(
-    "--contact-height",
-    type=float,
-    default=0.02,
-    show_default=True,
-    help="A foot supports while its lower marker is within this of its lowest [m].",
-)
-@click.option(
-    "--ankle-ap",
-    type=float,
-    default=None,
-    help="Lab position of the fixed feet along ap [m] (default: 0.05 m behind the mean CoP).",
-)
-@click.option(
-    "--ankle-ml",
-    type=float,
-    default=None,
-    help="Lab position of the fixed feet along ml [m] (default: the mean CoP).",
-)
+@_settings_options
 @click.option(
     "--normalise",
     is_flag=True,
@@ -179,14 +167,9 @@ def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) ->
             "feet": [_foot(text) for text in feet] if feet else None,
         },
     }
+    fields = [flag[2:].replace("-", "_") for flag, _, _ in _SETTINGS]
     settings = AnalysisSettings(
-        cutoff=kwargs.pop("cutoff"),
-        force_cutoff=kwargs.pop("force_cutoff"),
-        max_gap=kwargs.pop("max_gap"),
-        contact_height=kwargs.pop("contact_height"),
-        ankle_ap=kwargs.pop("ankle_ap"),
-        ankle_ml=kwargs.pop("ankle_ml"),
-        normalise=kwargs.pop("normalise"),
+        **{field: kwargs.pop(field) for field in fields}, normalise=kwargs.pop("normalise")
     )
     single = len(inputs) == 1 and Path(inputs[0]).is_file()
     batch = {name: kwargs.pop(name) for name in ("subjects", "workers", "scheduler", "resume")}
