@@ -14,9 +14,9 @@ from typing import Any
 import click
 
 from pushrecovery.cli.app import example
-from pushrecovery.cli.campaign_options import SCHEDULER, CampaignRun, run_options
+from pushrecovery.cli.campaign_options import SCHEDULER, WORKERS, CampaignRun, run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, humanoid_only
-from pushrecovery.cli.options import body_options, emit, params_from
+from pushrecovery.cli.options import body_options, emit, out_option, params_from
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
 __all__ = ["campaign", "report"]
@@ -145,21 +145,13 @@ def campaign(
     short_help="The HTML report of a parameter set (the main job).",
     epilog=example("pushrecovery report --out out/report"),
 )
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False),
-    default="out/report",
-    show_default=True,
-    help="Directory of the report (index.html and the campaigns).",
-)
+@out_option("out/report", "Directory of the report (index.html and the campaigns).")
 @click.option(
     "--full",
     is_flag=True,
     help="Larger campaigns (up to ten times the pushes) and finer critical pushes.",
 )
-@click.option(
-    "--workers", type=int, default=None, help="Local worker processes (default: all cores)."
-)
+@WORKERS
 @SCHEDULER
 @body_options
 def report(

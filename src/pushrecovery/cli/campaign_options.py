@@ -16,13 +16,20 @@ from typing import Any, TypeVar
 
 import click
 
-from pushrecovery.cli.options import echo_confusion, emit
+from pushrecovery.cli.options import duration_option, echo_confusion, emit, out_option
 from pushrecovery.cli.progress import Progress
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-__all__ = ["SCHEDULER", "CampaignRun", "run_options"]
+__all__ = ["SCHEDULER", "WORKERS", "CampaignRun", "run_options"]
 
+#: ``--workers`` of the campaigns (``campaign``, ``humanoid campaign``, ``report``).
+WORKERS = click.option(
+    "--workers",
+    type=int,
+    default=None,
+    help="Local worker processes (default: all cores; 1: the pushes run in this process).",
+)
 #: ``--scheduler ADDRESS`` (``campaign``, ``humanoid campaign``, ``report``).
 SCHEDULER = click.option(
     "--scheduler",
@@ -58,13 +65,7 @@ def run_options(*, param_help: str, samples_help: str, batch_size_help: str) -> 
         ),
         click.option("--samples", type=int, default=None, help=samples_help),
         click.option("--seed", type=int, default=0, show_default=True, help="Seed of --samples."),
-        click.option(
-            "--duration",
-            type=float,
-            default=6.0,
-            show_default=True,
-            help="Longest time per push [s].",
-        ),
+        duration_option(6.0, "Longest time per push [s]."),
         click.option("--batch-size", type=int, default=None, help=batch_size_help),
         click.option(
             "--push-timeout",
@@ -73,18 +74,8 @@ def run_options(*, param_help: str, samples_help: str, batch_size_help: str) -> 
             show_default=True,
             help="Wall time a push may take [s]; a slower or hung push is an error row.",
         ),
-        click.option(
-            "--out",
-            type=click.Path(file_okay=False),
-            required=True,
-            help="Directory of the campaign.",
-        ),
-        click.option(
-            "--workers",
-            type=int,
-            default=None,
-            help="Local worker processes (default: all cores; 1: the pushes run in this process).",
-        ),
+        out_option(None, "Directory of the campaign."),
+        WORKERS,
         SCHEDULER,
         click.option(
             "--resume",

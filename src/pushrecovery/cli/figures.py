@@ -8,7 +8,7 @@ from typing import Any
 import click
 
 from pushrecovery.cli.app import example
-from pushrecovery.cli.options import body_options, emit, params_from
+from pushrecovery.cli.options import body_options, emit, out_option, params_from
 
 __all__ = ["figures"]
 
@@ -17,13 +17,7 @@ __all__ = ["figures"]
     short_help="Reproduce the paper's figures and the ground-plane figure.",
     epilog=example("pushrecovery figures --out out/figures --format png"),
 )
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False),
-    default="out/figures",
-    show_default=True,
-    help="Directory for the figures.",
-)
+@out_option("out/figures", "Directory for the figures.")
 @click.option(
     "--format",
     "formats",

@@ -20,7 +20,13 @@ import click
 from pushrecovery.cli.app import example
 from pushrecovery.cli.campaign_options import CampaignRun, run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, planar_only
-from pushrecovery.cli.options import body_options_of, echo_confusion, emit
+from pushrecovery.cli.options import (
+    body_options_of,
+    duration_option,
+    echo_confusion,
+    emit,
+    out_option,
+)
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
 __all__ = ["humanoid"]
@@ -95,9 +101,7 @@ def humanoid() -> None:
     show_default=True,
     help="The push: an impulse at the torso [N s], over 10 ms.",
 )
-@click.option(
-    "--duration", type=float, default=10.0, show_default=True, help="Longest simulated time [s]."
-)
+@duration_option(10.0, "Longest simulated time [s].")
 @click.option(
     "--stepping",
     is_flag=True,
@@ -185,13 +189,10 @@ def simulate(
     show_default=True,
     help="Width of the final bracket, as a velocity [m/s] (times the mass: an impulse).",
 )
-@click.option(
-    "--duration",
-    type=float,
-    default=10.0,
-    show_default=True,
-    help="Longest simulated time per push [s]; keep it short (every push of the bisection "
-    "runs the whole-body controller this long at most).",
+@duration_option(
+    10.0,
+    "Longest simulated time per push [s]; keep it short (every push of the bisection runs the "
+    "whole-body controller this long at most).",
 )
 @_body_options
 def critical_push(
@@ -250,11 +251,8 @@ def critical_push(
     help="The confusion matrix's pushes, as fractions of the ankle's predicted critical push "
     "along each azimuth (default 0.5,0.9,1.1,1.5,2.0).",
 )
-@click.option(
-    "--duration",
-    type=float,
-    default=None,
-    help="Longest run per push [s] (default 3 per critical-push run, 5 per confusion push).",
+@duration_option(
+    None, "Longest run per push [s] (default 3 per critical-push run, 5 per confusion push)."
 )
 @click.option(
     "--quick",
@@ -273,12 +271,8 @@ def critical_push(
     show_default=True,
     help="Also run the confusion campaign over azimuths x push sizes.",
 )
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False),
-    default="out/validate3d",
-    show_default=True,
-    help="Directory of the tables, plots and the confusion campaign (which resumes).",
+@out_option(
+    "out/validate3d", "Directory of the tables, plots and the confusion campaign (which resumes)."
 )
 @click.option("--workers", type=int, default=None, help="The confusion campaign's workers.")
 @_body_options

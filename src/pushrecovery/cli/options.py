@@ -1,4 +1,4 @@
-"""Options every command shares: the body parameters and ``--json``."""
+"""Options every command shares: the body parameters and ``--json``; ``--out``, ``--duration``."""
 
 from __future__ import annotations
 
@@ -104,6 +104,25 @@ def _body_options(func: F, only: str | None) -> F:
         is_flag=True,
         help="Print JSON instead of the table; its keys are stable.",
     )(func)
+
+
+def out_option(default: str | None, help_text: str) -> Callable[[F], F]:
+    """Return ``--out DIRECTORY``: required without a ``default``, else shown with it."""
+    return click.option(
+        "--out",
+        type=click.Path(file_okay=False),
+        default=default,
+        show_default=default is not None,
+        required=default is None,
+        help=help_text,
+    )
+
+
+def duration_option(default: float | None, help_text: str) -> Callable[[F], F]:
+    """Return ``--duration`` [s], the longest run, its ``default`` shown unless None."""
+    return click.option(
+        "--duration", type=float, default=default, show_default=default is not None, help=help_text
+    )
 
 
 def support_options(func: F) -> F:

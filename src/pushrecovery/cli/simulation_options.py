@@ -13,6 +13,7 @@ from typing import Any, TypeVar
 import click
 
 from pushrecovery.cli.families import HUMANOID_MODELS, ListedChoice, ModelChoice
+from pushrecovery.cli.options import duration_option
 from pushrecovery.control.registry import CONTROLLER_NAMES
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
@@ -49,7 +50,7 @@ def planar_run(command: str, x_help: str) -> Callable[[F], F]:
 def timing(duration_help: str) -> Callable[[F], F]:
     """Return ``--duration`` (default 10 s, with ``duration_help``) and ``--control-period``."""
     return _with(
-        click.option("--duration", type=float, default=10.0, show_default=True, help=duration_help),
+        duration_option(10.0, duration_help),
         click.option(
             "--control-period",
             type=float,

@@ -10,6 +10,7 @@ from pushrecovery.cli.app import example
 from pushrecovery.cli.families import humanoid_only
 from pushrecovery.cli.options import (
     body_options,
+    duration_option,
     echo_confusion,
     emit,
     params_from,
@@ -73,9 +74,7 @@ __all__ = ["validate"]
     show_default=True,
     help="Width of each critical-push bracket [m/s].",
 )
-@click.option(
-    "--duration", type=float, default=6.0, show_default=True, help="Longest run per push [s]."
-)
+@duration_option(6.0, "Longest run per push [s].")
 @click.option(
     "--grid",
     nargs=3,
