@@ -30,7 +30,7 @@ import numpy as np
 
 from pushrecovery import load_params
 from pushrecovery.control.base import make_controller
-from pushrecovery.control.mpc import FlywheelFeasibility, MPCController, MPCSettings
+from pushrecovery.control.mpc import FlywheelFeasibility, MPCController, MPCSettings, Status
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 
@@ -94,9 +94,10 @@ def _ticks_us(
                     times.append(clock() - begin)
                 if replay or not run:
                     continue
-                verified += controller.riccati is not None and controller.riccati.passes > 0
+                plan = controller.last_plan
+                verified += plan is not None and plan.status is Status.VERIFIED
                 interior += controller.interior is not None and controller.interior.iterations != 0
-                if controller.last_plan is not None and not controller.last_plan.feasible:
+                if plan is not None and not plan.feasible:
                     outside = exact.gauge(state) > 1.0
                     infeasible, failed = infeasible + outside, failed + (not outside)
         replays.append(times)

@@ -7,7 +7,8 @@ from hypothesis import strategies as st
 from qpsolvers import Problem, solve_problem
 
 from pushrecovery import InvalidParameterError, load_params
-from pushrecovery.control.mpc import CondensedQP, MPCController, MPCSettings
+from pushrecovery.control.mpc import CondensedQP, MPCController, MPCSettings, Status
+from pushrecovery.control.mpc.solvers import SolveQpSolver
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.sim.critical import critical_push
 from pushrecovery.sim.registry import make_plant
@@ -163,26 +164,30 @@ def test_constrained_solution_equals_an_independent_one(x0, horizon):
 def test_daqp_workspace_matches_qpsolvers():
     # The default route keeps the QP in a DAQP workspace warm-started tick to tick; replay
     # pushed runs that saturate the inputs (one recovers, one falls), then infeasible states,
-    # through it and through qpsolvers' cold solve_qp (the route of the other solvers).
+    # through it and through qpsolvers' cold solve_qp with DAQP (the route of the other
+    # solvers, and of DAQP without its workspace).
     plant = make_plant("flywheel", P)
     runs = [simulate(plant, MPCController(P), plant.reset(0.0, v)) for v in (0.64, -0.5)]
     infeasible = [np.array([0.0, 0.9, 0.0, 5.0]), np.array([0.05, -0.95, 0.1, -3.0])]
     start = runs[0].states[:2]
     states = [*runs[0].states, *runs[1].states, *infeasible, *start]
-    fast, slow = MPCController(P), MPCController(P)
-    slow.workspace = None
-    assert fast.workspace is not None
+    fast = MPCController(P)
+    slow = SolveQpSolver(fast.qp, "daqp")
+    assert fast.route.daqp is not None
     fast.reset(states[0])
     scale = np.array([P.toe - P.heel, P.torque_max])
     feasible, saturated = [], False
     for x in states:
-        a, b = fast.plan(x), slow.plan(x)
+        a, b = fast.plan(x), slow.solve(x)
         feasible.append(a.feasible)
         if a.feasible != b.feasible:
             # At the edge of feasibility (θ 0.994 rad, 0.35 rad/s toward the 1 rad stop) the
             # one-sided rows qpsolvers builds lose a feasible point: the sparse QP decides.
             assert a.feasible and abs(x[1]) > 0.99
             sparse_solution(x)  # asserts it is feasible
+            continue
+        if not a.feasible:  # both: the controller's fallback, qpsolvers' failure
+            assert a.status is Status.INFEASIBLE and b.status is Status.FAILED
             continue
         saturated |= bool(np.any(np.abs(b.inputs[:, 1]) >= P.torque_max - 1e-9))
         # DAQP stops within 1e-9 of its unit rows: the inputs agree to ~1e-8 of their ranges.

@@ -104,7 +104,7 @@ def test_infeasible_ticks_skip_daqp_with_daqps_verdict(horizon):
     feasibility = FlywheelFeasibility(P, settings)
     fast, slow = MPCController(P, settings), MPCController(P, settings)
     # Never beyond the band: the same route as `fast` except that DAQP is always asked.
-    slow._gauge = lambda x0, gauge=slow._gauge: min(gauge(x0), 1.0)
+    slow.route.gauge = lambda x0, gauge=slow.route.gauge: min(gauge(x0), 1.0)
     qp = shared_qp(P, settings)
     rows = qp.scaled_inequality
     asked = 0
@@ -118,12 +118,12 @@ def test_infeasible_ticks_skip_daqp_with_daqps_verdict(horizon):
             state[1::2] *= factor / gauge
             fast.reset(state)
             slow.reset(state)
-            workspace = fast.workspace
+            daqp = fast.route.daqp
             calls = []
-            solve = workspace.solve
-            workspace.solve = lambda x, solve=solve, calls=calls: calls.append(1) or solve(x)
+            solve = daqp.solve
+            daqp.solve = lambda x, g, solve=solve, calls=calls: calls.append(1) or solve(x, g)
             plan = fast.plan(state)
-            del workspace.solve
+            del daqp.solve
             expected = slow.plan(state)
             assert plan.feasible == expected.feasible
             np.testing.assert_array_equal(plan.first_input, expected.first_input)
@@ -145,6 +145,6 @@ def test_infeasible_ticks_skip_daqp_with_daqps_verdict(horizon):
 def test_controllers_share_one_qp():
     one, two = MPCController(P), MPCController(P)
     assert one.qp is two.qp and not one.qp.scaled_hessian.flags.writeable
-    assert one.workspace is not two.workspace
+    assert one.route.daqp is not two.route.daqp
     x0 = np.array([0.02, 0.5, 0.3, 2.0])
     np.testing.assert_array_equal(one.plan(x0).first_input, two.plan(x0).first_input)

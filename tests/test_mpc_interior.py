@@ -5,8 +5,14 @@ import math
 import numpy as np
 import pytest
 
-from pushrecovery.control.mpc import FlywheelFeasibility, MPCController, MPCSettings
-from pushrecovery.control.mpc.interior import InteriorPointSolver
+from pushrecovery.control.mpc import (
+    FlywheelFeasibility,
+    MPCController,
+    MPCSettings,
+    SparseQP,
+    Status,
+)
+from pushrecovery.control.mpc.solvers import Guess, InteriorPointSolver, RiccatiSolver
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.kernels.mpc import interior as kernels
 from pushrecovery.sim.registry import make_plant
@@ -22,15 +28,16 @@ def kkt_residuals(solver, u, x, nu, sl, su, zl, zu):
     Stationarity in u_i and x_{i+1} of J + Σ ν_i^T (x_{i+1} − A x_i − B u_i) − z⁻ (v − lo)
     − z⁺ (hi − v), the bounds' slack equations and the dynamics.
     """
-    a, b, n = solver.a, solver.b, u.shape[0]
-    grad_u = 2 * solver.wu * u - nu @ b
+    p = solver.problem
+    a, b, n = p.a, p.b, u.shape[0]
+    grad_u = 2 * p.wu * u - nu @ b
     grad_u -= zl[:, :2] - zu[:, :2]
     later = np.vstack([nu[1:], np.zeros((1, 4))])
-    grad_x = 2 * solver.wx * x[1:] + nu - later @ a
+    grad_x = 2 * p.wx * x[1:] + nu - later @ a
     grad_x[:, 1] -= zl[:, 2] - zu[:, 2]
     values = np.column_stack([u, x[1:, 1]])
-    lower = values - solver.bounds[:, 0] - sl
-    upper = solver.bounds[:, 1] - values - su
+    lower = values - p.bounds[:, 0] - sl
+    upper = p.bounds[:, 1] - values - su
     dynamics = x[1:] - x[:-1] @ a.T - u @ b.T
     return grad_u, grad_x, lower, upper, dynamics, n
 
@@ -40,20 +47,21 @@ def test_a_full_newton_step_solves_the_linearised_kkt_system():
     # interior iterate (random multipliers, inputs off their bounds), one full step of the
     # predictor must zero the linear residuals (stationarity, slacks) and meet the linearised
     # complementarity s Δz + z Δs = −s z.
-    solver = InteriorPointSolver(P, MPCSettings(horizon=8))
+    solver = InteriorPointSolver(SparseQP(P, MPCSettings(horizon=8)))
+    p = solver.problem
     rng = np.random.default_rng(1)
     n = 8
     u = rng.normal(size=(n, 2)) * [0.3, 150.0]
     x = np.zeros((n + 1, 4))
     x[0] = [0.01, 0.1, -0.4, 0.5]
     for i in range(n):
-        x[i + 1] = solver.a @ x[i] + solver.b @ u[i]
+        x[i + 1] = p.a @ x[i] + p.b @ u[i]
     nu = rng.normal(size=(n, 4))
     sl, su, zl, zu = (rng.uniform(0.1, 1.0, (n, 3)) for _ in range(4))
     work = np.zeros((17, n + 1, 4))
     rdu, rdx, rl, ru = work[0, :n, :2], work[1, :n], work[2, :n, :3], work[3, :n, :3]
-    kernels._residuals(solver.a, solver.b, solver.wx, solver.wu, solver.bounds, u, x, nu, sl,
-                       su, zl, zu, rdu, rdx, rl, ru, work[15, :n, :2], work[16, :n])  # fmt: skip
+    kernels._residuals(p.a, p.b, p.wx, p.wu, p.bounds, u, x, nu, sl, su, zl, zu, rdu, rdx, rl,
+                       ru, work[15, :n, :2], work[16, :n])  # fmt: skip
     grad_u, grad_x, lower, _, _, _ = kkt_residuals(solver, u, x, nu, sl, su, zl, zu)
     np.testing.assert_allclose(rdu, grad_u, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(rdx, grad_x, rtol=1e-12, atol=1e-9)
@@ -61,7 +69,7 @@ def test_a_full_newton_step_solves_the_linearised_kkt_system():
     target_l, target_u = -sl * zl, -su * zu
     steps = [np.zeros((n, 2)), np.zeros((n + 1, 4)), np.zeros((n, 4))]
     steps += [np.zeros((n, 3)) for _ in range(4)]
-    kernels._newton(solver.a, solver.b, solver.wx, solver.wu, sl, su, zl, zu, rdu, rdx, rl, ru,
+    kernels._newton(p.a, p.b, p.wx, p.wu, sl, su, zl, zu, rdu, rdx, rl, ru,
                     target_l, target_u, True, np.zeros((n + 1, 4, 4)), np.zeros((n, 2, 4)),
                     np.zeros((n, 2, 2)), np.zeros((n + 1, 4)), np.zeros((n, 4, 2)),
                     np.zeros((n, 4, 4)), np.zeros((n, 2)), np.zeros((n, 2)),
@@ -81,7 +89,8 @@ def test_the_interior_point_equals_the_sparse_qp(horizon):
     # Riccati verification) gives quadprog's first input of the sparse QP to 1e-6 of the
     # ranges, and its plan keeps every bound to 1e-9 of its range.
     settings = MPCSettings(horizon=horizon)
-    solver = InteriorPointSolver(P, settings)
+    solver = InteriorPointSolver(SparseQP(P, settings))
+    bounds = solver.problem.bounds
     feasibility = FlywheelFeasibility(P, settings)
     rng = np.random.default_rng(horizon)
     solved = 0
@@ -92,13 +101,14 @@ def test_the_interior_point_equals_the_sparse_qp(horizon):
         x0 = rng.uniform([-0.03, -0.6, -0.5, -2.0], [0.1, 0.6, 0.6, 2.0]) * wide
         if feasibility.gauge(x0) > 0.99:
             continue
-        assert solver.solve(x0)
+        plan = solver.solve(x0)
+        assert plan.status is Status.CONVERGED and plan.iterations == solver.iterations > 0
         reference = sparse_solution(x0, settings)
-        np.testing.assert_allclose(solver.inputs[0] / SCALE, reference[0] / SCALE, atol=1e-6)
-        span = solver.bounds[:, 1] - solver.bounds[:, 0]
-        values = np.column_stack([solver.inputs, solver.states[1:, 1]])
-        assert (values >= solver.bounds[:, 0] - 1e-9 * span).all()
-        assert (values <= solver.bounds[:, 1] + 1e-9 * span).all()
+        np.testing.assert_allclose(plan.first_input / SCALE, reference[0] / SCALE, atol=1e-6)
+        span = bounds[:, 1] - bounds[:, 0]
+        values = np.column_stack([plan.inputs, plan.states[1:, 1]])
+        assert (values >= bounds[:, 0] - 1e-9 * span).all()
+        assert (values <= bounds[:, 1] + 1e-9 * span).all()
         solved += 1
 
 
@@ -114,22 +124,24 @@ def test_a_backward_push_is_planned_at_long_horizons():
     assert plan.feasible
     reference = sparse_solution(x0, controller.settings)
     np.testing.assert_allclose(plan.first_input / SCALE, reference[0] / SCALE, atol=1e-6)
-    solver = InteriorPointSolver(P, MPCSettings(horizon=200))
-    assert solver.solve(x0)
+    solver = InteriorPointSolver(SparseQP(P, MPCSettings(horizon=200)))
+    p = solver.problem
+    plan = solver.solve(x0)
+    assert plan.status is Status.CONVERGED
     (sl, su), (zl, zu) = solver._slacks, solver._bound_multipliers
     nu = solver._multipliers
-    u, x = solver.inputs, solver.states
+    u, x = plan.inputs, plan.states
     grad_u, grad_x, lower, upper, dynamics, _ = kkt_residuals(solver, u, x, nu, sl, su, zl, zu)
-    size_u = np.abs(2 * solver.wu * u) + np.abs(nu) @ np.abs(solver.b) + zl[:, :2] + zu[:, :2]
+    size_u = np.abs(2 * p.wu * u) + np.abs(nu) @ np.abs(p.b) + zl[:, :2] + zu[:, :2]
     assert (np.abs(grad_u) <= 1e-8 * np.maximum(size_u, solver.scales[:, :2])).all()
     size_x = (
-        np.abs(2 * solver.wx * x[1:])
+        np.abs(2 * p.wx * x[1:])
         + np.abs(nu)
-        + np.abs(np.vstack([nu[1:], 0 * nu[:1]])) @ np.abs(solver.a)
+        + np.abs(np.vstack([nu[1:], 0 * nu[:1]])) @ np.abs(p.a)
     )
     size_x[:, 1] += zl[:, 2] + zu[:, 2]
     assert (np.abs(grad_x) <= 1e-8 * np.maximum(size_x, solver.scales[:, 3:])).all()
-    span = solver.bounds[:, 1] - solver.bounds[:, 0]
+    span = p.bounds[:, 1] - p.bounds[:, 0]
     assert (np.abs(lower) <= 1e-9 * span).all() and (np.abs(upper) <= 1e-9 * span).all()
     assert np.abs(dynamics).max() <= 1e-9 * np.abs(x).max()
     assert (sl > 0).all() and (su > 0).all() and (zl > 0).all() and (zu > 0).all()
@@ -141,7 +153,7 @@ def test_closed_loop_runs_need_daqp_only_at_the_boundary():
     # Pushed runs at N = 50: every tick is solved by the passes or the interior point except
     # those within INTERIOR_MARGIN of S_N's boundary (no interior there): full braking held, then
     # DAQP.
-    from pushrecovery.control.mpc.controller import INTERIOR_MARGIN
+    from pushrecovery.control.mpc.solvers.route import INTERIOR_MARGIN
 
     plant = make_plant("flywheel", P)
     feasibility = FlywheelFeasibility(P, MPCSettings())
@@ -150,9 +162,11 @@ def test_closed_loop_runs_need_daqp_only_at_the_boundary():
         run = simulate(plant, controller, plant.reset(0.0, push))
         controller.reset(run.states[0])
         calls = []
-        workspace = controller.workspace
-        solve = workspace.solve
-        workspace.solve = lambda x, solve=solve, calls=calls: calls.append(x.copy()) or solve(x)
+        daqp = controller.route.daqp
+        solve = daqp.solve
+        daqp.solve = lambda x, guess, solve=solve, calls=calls: (
+            calls.append(x.copy()) or solve(x, guess)
+        )
         for state in run.states[:-1]:
             controller.plan(state)
         for state in calls:
@@ -161,8 +175,9 @@ def test_closed_loop_runs_need_daqp_only_at_the_boundary():
 
 def test_bad_iterate_reports_failure_not_nan():
     # An infeasible QP (θ̇ far beyond what τmax can stop): the interior point gives up.
-    solver = InteriorPointSolver(P, MPCSettings())
-    assert not solver.solve(np.array([0.0, 0.9, 0.0, 30.0]))
+    solver = InteriorPointSolver(SparseQP(P, MPCSettings()))
+    plan = solver.solve(np.array([0.0, 0.9, 0.0, 30.0]))
+    assert plan.status is Status.FAILED and not plan.feasible
     assert solver.iterations == -1
 
 
@@ -189,25 +204,26 @@ def test_boundary_ticks_solved_with_forced_braking_equal_daqp():
     # Ticks of a pushed run on S_N's boundary: the passes with the braking held, started from
     # DAQP's active set, verify and give DAQP's first input (another method on the condensed
     # QP) to 1e-6 of the ranges.
-    from pushrecovery.control.mpc.riccati import RiccatiSolver
-
     settings = MPCSettings()
     feasibility = FlywheelFeasibility(P, settings)
     plant = make_plant("flywheel", P)
     run = simulate(plant, MPCController(P), plant.reset(0.0, 0.65))
-    controller, solver = MPCController(P, settings), RiccatiSolver(P, settings)
+    controller, solver = MPCController(P, settings), RiccatiSolver(SparseQP(P, settings))
+    daqp = controller.route.daqp
     compared = 0
     for state in run.states[:-1]:
         if feasibility.gauge(state) < 1.0 - 1e-9:
             continue
-        controller.workspace.reset()
-        scaled = controller.workspace.solve(state)
-        assert scaled is not None
-        daqp = controller.qp.first_input(state, scaled)
-        solver.seed(controller.workspace.active_set())
-        if not solver.solve(state, shift=False, forced=feasibility.forced_braking(state)):
+        daqp.reset()
+        condensed = daqp.solve(state)
+        assert condensed.status is Status.SOLVED
+        forced = feasibility.forced_braking(state)
+        plan = solver.solve(state, Guess(condensed.active, shift=False, forced=forced))
+        if not plan.feasible:
             continue
-        np.testing.assert_allclose(solver.inputs[0] / SCALE, daqp / SCALE, atol=1e-6)
+        np.testing.assert_allclose(
+            plan.first_input / SCALE, condensed.first_input / SCALE, atol=1e-6
+        )
         compared += 1
     assert compared >= 3
 
@@ -218,27 +234,20 @@ def test_the_cold_start_is_the_unconstrained_optimum():
     # recursion's (test_mpc.riccati_first_input) where no bound binds.
     from test_mpc import riccati_first_input
 
-    solver = InteriorPointSolver(P, MPCSettings())
+    solver = InteriorPointSolver(SparseQP(P, MPCSettings()))
     for x0 in ([0.0, 0.0, 0.05, 0.0], [0.01, 0.02, -0.03, 0.1]):
         x0 = np.array(x0)
         np.testing.assert_allclose(solver.feedback[0] @ x0, riccati_first_input(x0), rtol=1e-9)
 
 
-def test_the_sparse_solvers_refuse_what_is_not_a_body_or_settings():
-    from pushrecovery.control.mpc.riccati import RiccatiSolver
-
-    for solver in (InteriorPointSolver, RiccatiSolver):
-        with pytest.raises(ParameterTypeError, match="params"):
-            solver("paper", MPCSettings())
-        with pytest.raises(ParameterTypeError, match="settings"):
-            solver(P, {"horizon": 50})
+def test_the_sparse_problem_refuses_what_is_not_a_body_or_settings():
+    with pytest.raises(ParameterTypeError, match="params"):
+        SparseQP("paper", MPCSettings())
+    with pytest.raises(ParameterTypeError, match="settings"):
+        SparseQP(P, {"horizon": 50})
 
 
-@pytest.mark.parametrize(
-    ("name", "value"),
-    [("guide_floor", 0.0), ("guide_floor", 1.5), ("guide_floor", math.nan),
-     ("guide_centre", 0.0), ("guide_centre", -1.0), ("guide_centre", math.inf)],
-)  # fmt: skip
-def test_bad_warm_start_settings_are_refused(name, value):
-    with pytest.raises(InvalidParameterError, match=name):
-        InteriorPointSolver(P, MPCSettings(horizon=8), **{name: value})
+@pytest.mark.parametrize("value", [0.0, -1.0, math.inf, math.nan])
+def test_bad_warm_start_settings_are_refused(value):
+    with pytest.raises(InvalidParameterError, match="guide_centre"):
+        InteriorPointSolver(SparseQP(P, MPCSettings(horizon=8)), guide_centre=value)

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from pushrecovery.control.mpc import MPCController, MPCSettings
-from pushrecovery.control.mpc.riccati import RiccatiSolver
+from pushrecovery.control.mpc import MPCController, MPCSettings, SparseQP, Status
+from pushrecovery.control.mpc.solvers import Guess, RiccatiSolver
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from test_mpc import P, sparse_solution
@@ -19,26 +19,29 @@ def test_verified_riccati_solutions_equal_the_sparse_qp(horizon):
     # of the uncondensed QP (states kept as variables) to 1e-6 of the ranges.
     settings = MPCSettings(horizon=horizon)
     controller = MPCController(P, settings)
-    solver = RiccatiSolver(P, settings)
+    problem = SparseQP(P, settings)
+    solver = RiccatiSolver(problem)
     rng = np.random.default_rng(horizon)
     constrained = 0
     for _ in range(6):
         x0 = rng.uniform([-0.03, -0.5, -0.5, -1.0], [0.1, 0.5, 0.6, 1.0])
-        assert controller.workspace is not None
-        if controller.workspace.solve(x0) is None:
+        daqp = controller.route.daqp
+        assert daqp is not None
+        active = daqp.solve(x0).active
+        if active is None:
             continue
-        active = controller.workspace.active_set()
-        solver.seed(active)
         # τ_i and θ_{i+1} both at a bound (a state constraint) included: the θ row is carried
         # back to the stage whose torque is free.
-        assert solver.solve(x0, shift=False)
-        assert solver.passes == 1
+        plan = solver.solve(x0, Guess(active, shift=False))
+        assert plan.status is Status.VERIFIED
+        assert plan.iterations == 1
+        np.testing.assert_array_equal(plan.active, solver.active)
         constrained += bool(np.abs(solver.active).sum())
         reference = sparse_solution(x0, settings)
-        np.testing.assert_allclose(solver.inputs[0] / SCALE, reference[0] / SCALE, atol=1e-6)
+        np.testing.assert_allclose(plan.first_input / SCALE, reference[0] / SCALE, atol=1e-6)
         # The predicted states are the inputs simulated (states kept, not condensed).
         np.testing.assert_allclose(
-            solver.states, controller.qp.simulate(x0, solver.inputs), rtol=0, atol=1e-9
+            plan.states, problem.simulate(x0, plan.inputs), rtol=0, atol=1e-9
         )
     assert constrained >= 2
 
@@ -55,7 +58,7 @@ def test_closed_loop_ticks_take_the_riccati_route_and_are_exact(horizon):
     verified = []
     for k, state in enumerate(run.states[:-1]):
         plan = controller.plan(state)
-        verified.append(controller.riccati.passes > 0)
+        verified.append(plan.status is Status.VERIFIED)
         if k % 15 == 1:
             reference = sparse_solution(state, controller.settings)
             np.testing.assert_allclose(plan.first_input / SCALE, reference[0] / SCALE, atol=1e-6)
@@ -63,21 +66,18 @@ def test_closed_loop_ticks_take_the_riccati_route_and_are_exact(horizon):
 
 
 def test_a_wrong_active_set_is_not_accepted():
-    # The KKT check can fail: with one pass allowed and a wrong start, the solve is refused.
-    settings = MPCSettings()
-    solver = RiccatiSolver(P, settings)
+    # The KKT check can fail: with one pass allowed and a wrong start, the solve is refused,
+    # the pass having changed its working set (the KKT check refused it, not a degenerate
+    # recursion), and the solver keeps its start.
+    solver = RiccatiSolver(SparseQP(P, MPCSettings()))
     x0 = np.array([0.0, 0.0, 0.6, 0.0])
-    assert not solver.solve(x0, max_passes=1)  # from the empty set in one pass
-    solver.active[:, 1] = 1  # full torque forward over the whole horizon: wrong
-    guess = solver.active.copy()
-    from pushrecovery.kernels.mpc.riccati import CHANGED, _pass
-
-    outcome = _pass(
-        x0, solver.a, solver.b, solver.wx, solver.wu, guess, solver.bounds, solver.tols,
-        1e-9, solver.inputs, solver.states, solver._gains, solver._offsets, solver._curvature,
-        solver.multipliers, 0,
-    )  # fmt: skip
-    assert outcome == CHANGED
+    assert solver.solve(x0, Guess(budget=1)).status is Status.FAILED  # the empty set, 1 pass
+    wrong = np.zeros_like(solver.active)
+    wrong[:, 1] = 1  # full torque forward over the whole horizon: wrong
+    plan = solver.solve(x0, Guess(wrong, shift=False, budget=1))
+    assert plan.status is Status.FAILED and not plan.feasible and not solver.verified
+    assert not np.array_equal(solver._guess, wrong)
+    np.testing.assert_array_equal(solver.active, wrong)
 
 
 def test_without_hip_torque_the_controller_skips_the_riccati_route():
@@ -92,22 +92,21 @@ def test_without_hip_torque_the_controller_skips_the_riccati_route():
 def test_daqp_seeded_with_the_verified_set_ends_on_it():
     # The verified set of the passes, as DAQP's sense flags, is DAQP's own optimal set.
     controller = MPCController(P)
-    solver = controller.riccati
-    assert solver is not None
+    solver, daqp = controller.route.riccati, controller.route.daqp
+    assert solver is not None and daqp is not None
     x0 = np.array([0.06, 0.2, 0.45, -1.0])
     solver.reset()
-    verified = solver.solve(x0, shift=False) or solver.solve(x0, shift=False)
-    if not verified:  # a cold start the passes cannot take: seed them from DAQP first
-        controller.workspace.solve(x0)
-        solver.seed(controller.workspace.active_set())
-        assert solver.solve(x0, shift=False)
-    workspace = controller.workspace
-    workspace.seed(solver.active)
-    scaled = workspace.solve(x0)
-    assert scaled is not None
-    np.testing.assert_array_equal(workspace.active_set(), solver.active)
-    first = controller.qp.first_input(x0, scaled)
-    np.testing.assert_allclose(first / SCALE, solver.inputs[0] / SCALE, atol=1e-6)
+    here = Guess(shift=False)
+    plan = solver.solve(x0, here)
+    if not plan.feasible:
+        plan = solver.solve(x0, here)
+    if not plan.feasible:  # a cold start the passes cannot take: seed them from DAQP first
+        plan = solver.solve(x0, Guess(daqp.solve(x0).active, shift=False))
+        assert plan.status is Status.VERIFIED
+    seeded = daqp.solve(x0, Guess(solver.active))
+    assert seeded.status is Status.SOLVED
+    np.testing.assert_array_equal(seeded.active, solver.active)
+    np.testing.assert_allclose(seeded.first_input / SCALE, plan.first_input / SCALE, atol=1e-6)
 
 
 @pytest.mark.parametrize("horizon", [50, 200])
@@ -119,34 +118,34 @@ def test_a_resumed_recursion_equals_a_whole_one(horizon):
     # multipliers. States with the flywheel near its limit: θ rows carried back.
     settings = MPCSettings(horizon=horizon)
     controller = MPCController(P, settings)
-    assert controller.workspace is not None
+    daqp = controller.route.daqp
+    assert daqp is not None
+    problem = SparseQP(P, settings)
     theta = 0.9 * P.flywheel_angle_max
     rng = np.random.default_rng(7 + horizon)
-    resumed = RiccatiSolver(P, settings)  # one solver through every state: it resumes
+    resumed = RiccatiSolver(problem)  # one solver through every state: it resumes
     compared = 0
     for _ in range(60):
         if compared >= 12:
             break
         x0 = rng.uniform([-0.03, -theta, -0.5, -2.0], [0.1, theta, 0.6, 2.0])
-        if controller.workspace.solve(x0) is None:
+        active = daqp.solve(x0).active
+        if active is None:
             continue
-        active = controller.workspace.active_set()
         for stage in (None, 0, 2, 5, 10, 20):  # the set, then with one stage's rows cleared
             start = active.copy()
             if stage is not None:
                 start[stage] = 0
-            fresh = RiccatiSolver(P, settings)
-            resumed.seed(start)
-            fresh.seed(start)
-            ok = resumed.solve(x0, shift=False)
-            assert ok == fresh.solve(x0, shift=False)
-            assert resumed.passes == fresh.passes
-            if ok:
+            fresh = RiccatiSolver(problem)
+            one = resumed.solve(x0, Guess(start, shift=False))
+            two = fresh.solve(x0, Guess(start, shift=False))
+            assert one.status == two.status and one.iterations == two.iterations
+            if one.feasible:
                 compared += 1
-                np.testing.assert_array_equal(resumed.inputs, fresh.inputs)
-                np.testing.assert_array_equal(resumed.states, fresh.states)
+                np.testing.assert_array_equal(one.inputs, two.inputs)
+                np.testing.assert_array_equal(one.states, two.states)
                 np.testing.assert_array_equal(resumed.multipliers, fresh.multipliers)
-                np.testing.assert_array_equal(resumed.active, fresh.active)
+                np.testing.assert_array_equal(one.active, two.active)
     assert compared >= 12
 
 
@@ -159,13 +158,13 @@ def test_the_recursion_resumed_inside_a_carried_chain_equals_a_whole_one(horizon
     # k lies inside the chain.
     from pushrecovery.kernels.mpc.riccati import _backward, scratch
 
-    solver = RiccatiSolver(P, MPCSettings(horizon=horizon))
+    p = SparseQP(P, MPCSettings(horizon=horizon))
     n = horizon
 
     def recursion(active, start, work, arrays):
         gains, offsets, curvature = arrays
-        return _backward(solver.a, solver.b, solver.wx, solver.wu, active, solver.bounds,
-                         gains, offsets, curvature, work[0], work[2], start, work[3])  # fmt: skip
+        return _backward(p.a, p.b, p.wx, p.wu, active, p.bounds, gains, offsets, curvature,
+                         work[0], work[2], start, work[3])  # fmt: skip
 
     def fresh_arrays():
         return np.zeros((n, 2, 4)), np.zeros((n, 2)), np.zeros((n, 2))

@@ -191,7 +191,3 @@ class FlywheelFeasibility:
         The smallest t for which the QP with bounds t τmax and t θmax is feasible.
         """
         return max(0.0, float((self.facets @ state[1::2]).max()))
-
-    def infeasible(self, state: FloatArray) -> bool:
-        """Tell whether the QP is infeasible beyond every solver's tolerance (γ > 1 + BAND)."""
-        return bool((self.facets @ state[1::2]).max() > 1.0 + BAND)

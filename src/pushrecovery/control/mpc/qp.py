@@ -38,6 +38,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
+from pushrecovery.control.mpc.plan import Plan, Status
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
@@ -115,7 +116,7 @@ class CondensedQP:
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
         n = settings.horizon
-        a, b = self._a, self._b = flywheel_discrete(params, settings.dt)
+        a, b = flywheel_discrete(params, settings.dt)
         self.params, self.settings = params, settings
         k = self.gain = _gain(params, a, b, settings)
         closed = a + b @ k
@@ -193,13 +194,25 @@ class CondensedQP:
         states[1:] = (self.phi @ x0 + self.gamma @ (self.scale * scaled)).reshape(-1, 4)
         return states
 
-    def simulate(self, x0: FloatArray, inputs: FloatArray) -> FloatArray:
-        """States X_0..X_N, shape (N + 1, 4), of inputs U of shape (N, 2) applied open loop."""
-        states = np.empty((inputs.shape[0] + 1, 4))
-        states[0] = x0
-        for i, u in enumerate(inputs):
-            states[i + 1] = self._a @ states[i] + self._b @ u
-        return states
+    def plan(
+        self,
+        x0: FloatArray,
+        scaled: FloatArray,
+        active: NDArray[np.int8] | None = None,
+        iterations: int = 0,
+    ) -> Plan:
+        """Return the SOLVED plan of the solution Ṽ from x0: the first input now, the rest later.
+
+        ``scaled`` is kept (not copied); ``active`` and ``iterations`` are the solver's.
+        """
+        return Plan(
+            Status.SOLVED,
+            self.first_input(x0, scaled),
+            lambda: self.inputs(x0, scaled),
+            lambda: self.predict(x0, scaled),
+            active,
+            iterations,
+        )
 
 
 @functools.lru_cache(maxsize=8)

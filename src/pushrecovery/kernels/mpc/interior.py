@@ -1,7 +1,7 @@
 r"""Compiled (numba, cached on disk) interior point for the sparse Eq. (17), Riccati steps.
 
 One file on purpose (numba's disk cache does not see changes in the files of called kernels).
-See :mod:`~pushrecovery.control.mpc.interior` for the method; here, the arithmetic.
+See :mod:`~pushrecovery.control.mpc.solvers.interior` for the method; here, the arithmetic.
 
 Conventions as in :mod:`~pushrecovery.kernels.mpc.riccati`: stage i = 0..N−1 maps
 (x_i, u_i) to x_{i+1} = A x_i + B u_i at cost x_{i+1}^T diag(wx_i) x_{i+1} + u_i^T diag(wu_i) u_i.
@@ -18,9 +18,10 @@ x_{i+1} − A x_i − B u_i = 0. The Lagrangian's gradient (the dual residual r_
 with ν_N = 0. The iterate satisfies the dynamics exactly (it starts from a simulation and
 every Newton step does), so there is no primal residual of the equalities.
 
-A and B have the flywheel's structure (:func:`~.riccati.check_structure`): the CoM (x, ẋ) and
-the flywheel (θ, θ̇) evolve apart, A block-diagonal in that split, and the CoP moves the CoM
-only (B's δ column zero on θ, θ̇). The products skip those zeros, term by term the same sums.
+A and B have the flywheel's structure
+(checked by :class:`~pushrecovery.control.mpc.problem.SparseQP`): the CoM (x, ẋ) and the flywheel
+(θ, θ̇) evolve apart, A block-diagonal in that split, and the CoP moves the CoM only (B's δ
+column zero on θ, θ̇). The products skip those zeros, term by term the same sums.
 """
 
 from __future__ import annotations
@@ -32,17 +33,16 @@ import numpy as np
 _FRACTION = 0.99
 # A start's slacks are at least this fraction of their range, its products s z this fraction
 # of dual scale × range: cold (the unconstrained solution) and warm (the last tick's plan
-# shifted, near the solution: closer to the boundary, less centred; 13 iterations to a
-# verified set instead of 20 in the benchmark's runs).
+# shifted, near the solution: closer to the boundary, less centred; docs/mpc.md, "The route's
+# constants").
 COLD, WARM = 1, 2
 # solve_interior's outcomes.
 CONVERGED, SETTLED, DIVERGED, EXHAUSTED = 0, 1, -1, -2
 _FLOOR = (0.0, 0.1, 0.01)
 _CENTRE = (0.0, 1.0, 0.01)
-# A warm start's rows at a bound in the last verified active set (shifted): slack at most this
-# fraction of the range, product s z this fraction of dual scale × range (the benchmark's
-# interior-point ticks: 15.5 iterations on average and 22 at most to a verified set without,
-# 12.4 and 15 with). The defaults of solve_interior's ``guide_floor`` and ``guide_centre``.
+# A warm start's rows at a bound in the last verified active set (shifted): slack at most
+# GUIDE_FLOOR of the range, product s z GUIDE_CENTRE (the default of solve_interior's
+# ``guide_centre``) of dual scale × range (docs/mpc.md, "The route's constants").
 GUIDE_FLOOR, GUIDE_CENTRE = 0.003, 3.0
 
 
@@ -341,8 +341,7 @@ def _newton(  # type: ignore[no-untyped-def]
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _start(  # type: ignore[no-untyped-def]
-    x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, guide, guide_floor,
-    guide_centre,
+    x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, guide, guide_centre,
 ):  # fmt: skip
     """Write a start from x0: ``start`` COLD or WARM (the inputs already in ``u``).
 
@@ -352,7 +351,7 @@ def _start(  # type: ignore[no-untyped-def]
     at least a fraction of their range (an infeasible start), products s z a fraction of the
     bound's dual scale × range (``_FLOOR``, ``_CENTRE``). WARM also takes ``guide`` (N, 3),
     the last verified active set (unshifted; zeros: none): its rows start near their bounds
-    with larger multipliers (``guide_floor``, ``guide_centre``: as ``_FLOOR``, ``_CENTRE``).
+    with larger multipliers (GUIDE_FLOOR, ``guide_centre``: as ``_FLOOR``, ``_CENTRE``).
     """
     floor, centre = _FLOOR[start], _CENTRE[start]
     n = u.shape[0]
@@ -378,10 +377,10 @@ def _start(  # type: ignore[no-untyped-def]
             if start == WARM:
                 side = guide[i + 1, j] if i + 1 < n else guide[i, j]  # shifted by a stage
                 if side < 0:
-                    sl[i, j] = min(sl[i, j], guide_floor * span)
+                    sl[i, j] = min(sl[i, j], GUIDE_FLOOR * span)
                     zl[i, j] = guide_centre * scale[i, j] / sl[i, j] * span
                 elif side > 0:
-                    su[i, j] = min(su[i, j], guide_floor * span)
+                    su[i, j] = min(su[i, j], GUIDE_FLOOR * span)
                     zu[i, j] = guide_centre * scale[i, j] / su[i, j] * span
 
 
@@ -389,7 +388,7 @@ def _start(  # type: ignore[no-untyped-def]
 def solve_interior(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, bounds, scale, feedback, tol, dual_tol, max_iter, start, guide,
     u, x, nu, sl, su, zl, zu, work, big_s, gain, hinv, vec_s, sbs, closeds, active,
-    settle_tol, settle_rows, guide_floor, guide_centre,
+    settle_tol, settle_rows, guide_centre,
 ):  # fmt: skip
     """Mehrotra predictor-corrector iterations: (status, their number).
 
@@ -420,7 +419,7 @@ def solve_interior(  # type: ignore[no-untyped-def]
     mdu, mdx = work[15, :n, :2], work[16, :n]
     if start:
         _start(x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, guide,
-               guide_floor, guide_centre)  # fmt: skip
+               guide_centre)  # fmt: skip
     for it in range(max_iter):
         _residuals(a, b, wx, wu, bounds, u, x, nu, sl, su, zl, zu, rdu, rdx, rl, ru, mdu, mdx)
         mu = 0.0

@@ -2,7 +2,7 @@ r"""Compiled (numba, cached on disk) primal-dual active-set solve of Eq. (17) by
 
 One file on purpose: numba's disk cache does not see changes in the files of the functions a
 kernel calls, so the kernels that call each other live together. See
-:mod:`~pushrecovery.control.mpc.riccati` for the method; here, the arithmetic.
+:mod:`~pushrecovery.control.mpc.solvers.riccati` for the method; here, the arithmetic.
 
 Conventions. Stage i = 0..N−1 maps (x_i, u_i) to x_{i+1} = A x_i + B u_i at cost
 x_{i+1}^T diag(wx_i) x_{i+1} + u_i^T diag(wu_i) u_i. Each stage has three constraint rows,
@@ -24,13 +24,14 @@ to stage i − 1 (τ_i and θ_{i+1} both at a bound: a row on θ_i, θ̇_i). Row
 is given, make the active set infeasible. The multipliers are the dual of this: the unknown ones
 are carried back in λ (λ = l + L w) until a stage's stationarity fixes them.
 
-Speed. A and B have the flywheel's structure (:func:`~.riccati.check_structure`): A
-block-diagonal in (x, ẋ) and (θ, θ̇), B's CoP column zero on θ, θ̇. The products skip those
-zeros, and a stage's matrices stay in scalars (numba reloads arrays, which may alias, after
-every store): term by term the same sums in the same order as plain loops, so the same results
-(a skipped term is ±0, which leaves a nonzero sum as it is; a sum the loops started from 0.0
-keeps that start, ``0.0 + …``, so that an all-zero one stays +0). A solve's scratch is allocated
-once (:func:`scratch`), not per pass.
+Speed. A and B have the flywheel's structure
+(checked by :class:`~pushrecovery.control.mpc.problem.SparseQP`): A block-diagonal in (x, ẋ) and
+(θ, θ̇), B's CoP column zero on θ, θ̇. The products skip those zeros, and a stage's matrices
+stay in scalars (numba reloads arrays, which may alias, after every store): term by term the
+same sums in the same order as plain loops, so the same results (a skipped term is ±0, which
+leaves a nonzero sum as it is; a sum the loops started from 0.0 keeps that start, ``0.0 + …``,
+so that an all-zero one stays +0). A solve's scratch is allocated once (:func:`scratch`), not
+per pass.
 """
 
 from __future__ import annotations
@@ -477,11 +478,19 @@ def _multipliers(a, b, wx, wu, active, inputs, states, mult, floats, ints):  # t
 
 
 @numba.njit(cache=True, nogil=True)
-def _pass_in(  # type: ignore[no-untyped-def]
+def _pass(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains, offsets, curvature,
     mult, forced, work, swept,
 ):  # fmt: skip
-    """:func:`_pass` on the scratch ``work`` of :func:`scratch` and the sweep's record ``swept``.
+    """Solve with ``active`` fixed, check the KKT conditions, update ``active`` if they fail.
+
+    Returns OPTIMAL (``inputs``, ``states`` are the exact solution), CHANGED (``active`` now
+    holds the next guess) or DEGENERATE (rows left on x_0, or multipliers not unique). The next
+    guess adds the violated rows; only when none is violated does it release the row whose
+    multiplier has the most wrong sign. The torques of the first ``forced`` stages are
+    equalities (held, whatever their multipliers' signs) and those stages' θ rows are not
+    checked: see :func:`solve_from`. ``work``: the scratch of :func:`scratch` (the passes of
+    :func:`solve_active_set` share one).
 
     ``swept`` (N + 1, 3): rows 0..N−1 the active set whose recursion ``gains``, ``offsets`` and
     ``curvature`` hold, ``swept[N, 0]`` 1 if they hold one. The recursion depends on the set
@@ -596,41 +605,6 @@ def _pass_in(  # type: ignore[no-untyped-def]
 
 
 @numba.njit(cache=True, nogil=True)
-def _pass(  # type: ignore[no-untyped-def]
-    x0,
-    a,
-    b,
-    wx,
-    wu,
-    active,
-    bounds,
-    tols,
-    dual_tol,
-    inputs,
-    states,
-    gains,
-    offsets,
-    curvature,
-    mult,
-    forced,
-):
-    """Solve with ``active`` fixed, check the KKT conditions, update ``active`` if they fail.
-
-    Returns OPTIMAL (``inputs``, ``states`` are the exact solution), CHANGED (``active`` now
-    holds the next guess) or DEGENERATE (rows left on x_0, or multipliers not unique). The next
-    guess adds the violated rows; only when none is violated does it release the row whose
-    multiplier has the most wrong sign. The torques of the first ``forced`` stages are
-    equalities (held, whatever their multipliers' signs) and those stages' θ rows are not
-    checked: see :func:`solve_from`. Allocates its scratch (the passes of
-    :func:`solve_active_set` share one).
-    """
-    work = scratch(wx.shape[0])
-    swept = np.zeros((wx.shape[0] + 1, 3), dtype=np.int8)  # no recursion on record
-    return _pass_in(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains,
-                    offsets, curvature, mult, forced, work, swept)  # fmt: skip
-
-
-@numba.njit(cache=True, nogil=True)
 def solve_active_set(  # type: ignore[no-untyped-def]
     x0,
     a,
@@ -658,11 +632,11 @@ def solve_active_set(  # type: ignore[no-untyped-def]
     and ``active`` its active set. −1: degenerate, or no verified optimum within
     ``max_passes`` (cycling, or an infeasible problem). ``work``: the scratch of
     :func:`scratch`, the caller's (kept from solve to solve: an allocation per tick cost
-    ~1 µs); ``swept``: the record of the last recursion (:func:`_pass_in`).
+    ~1 µs); ``swept``: the record of the last recursion (:func:`_pass`).
     """
     for k in range(max_passes):
-        outcome = _pass_in(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states,
-                           gains, offsets, curvature, mult, forced, work, swept)  # fmt: skip
+        outcome = _pass(x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states,
+                        gains, offsets, curvature, mult, forced, work, swept)  # fmt: skip
         if outcome == OPTIMAL:
             return k + 1
         if outcome == DEGENERATE:
@@ -705,10 +679,11 @@ def solve_from(  # type: ignore[no-untyped-def]
     the last stage keeping its rows); on success the verified set is copied back into
     ``active``, on failure ``active`` is left as it was. One call per tick, so the Python
     side does no array work. ``floats``, ``ints``, ``origins``, ``saved``: the scratch of
-    :func:`scratch`, and ``swept`` the recursion's record (:func:`_pass_in`); both the
+    :func:`scratch`, and ``swept`` the recursion's record (:func:`_pass`); both the
     caller's, kept from solve to solve.
 
-    From the empty set at most ``empty_passes`` passes (:data:`~.riccati.EMPTY_PASSES`).
+    From the empty set at most ``empty_passes`` passes
+    (:data:`~pushrecovery.control.mpc.solvers.riccati.EMPTY_PASSES`).
 
     The first ``forced`` stages' torques are held at the bound of sign ``forced_side`` and
     their θ rows left out: the flywheel on the edge of its viable set, where braking at full

@@ -2,7 +2,7 @@
 
 The scales and feedback of its start (:func:`dual_scales`); the active set of an iterate read
 in those scales is :func:`~pushrecovery.kernels.mpc.interior.identify_active`, beside the
-iterations that call it. See :mod:`~pushrecovery.control.mpc.interior`. Apart from the
+iterations that call it. See :mod:`~pushrecovery.control.mpc.solvers.interior`. Apart from the
 iterations' kernels (:mod:`~pushrecovery.kernels.mpc.interior`): it calls none of them.
 """
 

@@ -26,30 +26,29 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.qp import CondensedQP
+from pushrecovery.control.mpc.solvers.base import Guess
 
-__all__ = ["ITER_BUDGET", "PRIMAL_TOL", "DaqpWorkspace"]
+__all__ = ["ITER_BUDGET", "PRIMAL_TOL", "DaqpSolver"]
 
 FloatArray = NDArray[np.float64]
 
 #: Largest constraint violation DAQP accepts (scaled units; its default is 1e-6).
 PRIMAL_TOL = 1e-9
 #: Active-set iterations before DAQP gives up, times the horizon N (its default is 10,000
-#: iterations): 200 at N = 50, 50 at N = 200. It is asked only for the ticks on the
-#: flywheel's viable-set boundary that neither the Riccati passes nor the interior point
-#: solve: there, in the benchmark's pushed runs, its solves took at most 109 iterations at
-#: N = 50, and at N = 100 and 200 it failed numerically after 280-950 (2 successes at
-#: N = 100, after 631 and 651), 40-120 ms a tick; capped, a failed tick costs a few ms and
-#: brakes with the fallback as before.
+#: iterations): 200 at N = 50, 50 at N = 200 (docs/mpc.md, "The route's constants").
 ITER_BUDGET = 10_000
 
 # DAQP's ``sense`` flags (daqp constants.h): bit 0 active, bit 1 at the lower bound. Indexed by
 # side + 1 of the active sets below: −1 (lower) → 3, 0 → 0, +1 (upper) → 1.
 _SENSE_OF_SIDE = np.array([3, 0, 1], dtype=np.intc)
 
+_WARM = Guess()
 
-class DaqpWorkspace:
-    """A ``daqp.Model`` of one :class:`CondensedQP`, solved from a state each tick.
+
+class DaqpSolver:
+    """A ``daqp.Model`` of one :class:`~pushrecovery.control.mpc.qp.CondensedQP`, solved each tick.
 
     Parameters
     ----------
@@ -62,6 +61,11 @@ class DaqpWorkspace:
         If ``daqp`` is missing or too old for its ``Model`` workspace API as used here.
     RuntimeError
         If DAQP rejects the problem at setup (e.g. a Hessian it cannot factorise).
+
+    Attributes
+    ----------
+    qp : CondensedQP
+        The problem.
     """
 
     def __init__(self, qp: CondensedQP) -> None:
@@ -76,8 +80,7 @@ class DaqpWorkspace:
         self._lower = np.zeros(rows)
         self._upper = np.zeros(rows)
         self._cold = np.zeros(rows, dtype=np.intc)  # no constraint active
-        self._sense = np.zeros(rows, dtype=np.intc)  # a seeded start (see seed())
-        self._seeded = False
+        self._sense = np.zeros(rows, dtype=np.intc)  # a guess's start (see solve())
         model = daqp.Model()
         # The same contiguous buffers, rewritten in place, are handed to update() each tick.
         # The matrices are this workspace's own copies: daqp takes writable buffers only, and
@@ -95,8 +98,6 @@ class DaqpWorkspace:
             raise ImportError("this daqp Model ignores its primal_tol setting")
         self._model: Any = model
         self._warm = False
-        #: DAQP's multipliers of the last solution's rows (None after a failure).
-        self.multipliers: FloatArray | None = None
 
     def __reduce__(self) -> tuple[Any, ...]:
         # The C workspace cannot be pickled: rebuild it (cold) from the problem instead.
@@ -105,60 +106,52 @@ class DaqpWorkspace:
     def reset(self) -> None:
         """Start the next solve cold, from an empty active set."""
         self._warm = False
-        self._seeded = False
 
-    def seed(self, active: NDArray[np.int8]) -> None:
-        """Start the next solve from ``active``, an optimal active set of a recent tick.
+    def solve(self, x0: FloatArray, guess: Guess = _WARM) -> Plan:
+        """Solve the QP from state ``x0``: a SOLVED plan, or FAILED if DAQP found no solution.
 
-        ``active`` has shape (N, 3), rows (δ_i, τ_i, θ_{i+1}) with −1 at the lower bound, +1
-        at the upper, in the layout of :meth:`active_set` (condensed rows: δ_i at 2i, τ_i at
-        2i + 1, θ_{i+1} at 2N + i). Meant for the verified set of the Riccati passes' last
-        tick: exactly the set this workspace would have ended with had it solved that tick,
-        so the next solve starts as warm as if DAQP ran every tick. A seeded solve that
-        fails is retried cold, as any warm one.
-        """
-        n = active.shape[0]
-        sides = active.astype(np.intp) + 1
-        self._sense[: 2 * n] = _SENSE_OF_SIDE[sides[:, :2].ravel()]
-        self._sense[2 * n :] = _SENSE_OF_SIDE[sides[:, 2]]
-        self._seeded = True
-
-    def solve(self, x0: FloatArray) -> FloatArray | None:
-        """Scaled inputs Ũ of the QP from state ``x0``, or None if DAQP found no solution.
-
-        Failures are reported as by qpsolvers (``None`` for any exit flag <= 0), and only once a
-        cold solve has failed too, so that feasibility never depends on the previous ticks. The
-        solve after a failure starts cold: the active set it left behind is no guide.
+        The solve starts from the last solution's active set, or ``guess.active`` (N, 3)
+        (condensed rows: δ_i at 2i, τ_i at 2i + 1, θ_{i+1} at 2N + i; unshifted), meant for the
+        verified set of the Riccati passes' last tick: exactly the set DAQP would have ended
+        with had it solved that tick, so the solve starts as warm as if DAQP ran every tick.
+        Failures are reported as by qpsolvers (any exit flag <= 0), and only once a cold solve
+        has failed too, so that feasibility never depends on the previous ticks. The solve
+        after a failure starts cold: the active set it left behind is no guide. The plan's
+        ``active`` is the set of the signs of DAQP's multipliers (+ at an upper bound); a plan
+        that is not finite is FAILED, with that set.
         """
         model = self._model
         self.qp.vectors_into(x0, self._linear, self._lower, self._upper)
-        warm = self._warm or self._seeded
-        if self._seeded:
+        warm = self._warm or guess.active is not None
+        if guess.active is not None:
+            n = guess.active.shape[0]
+            sides = guess.active.astype(np.intp) + 1
+            self._sense[: 2 * n] = _SENSE_OF_SIDE[sides[:, :2].ravel()]
+            self._sense[2 * n :] = _SENSE_OF_SIDE[sides[:, 2]]
             model.update(f=self._linear, bupper=self._upper, blower=self._lower, sense=self._sense)
-            self._seeded = False
         elif self._warm:
             model.update(f=self._linear, bupper=self._upper, blower=self._lower)
         else:
             self._cold.fill(0)
             model.update(f=self._linear, bupper=self._upper, blower=self._lower, sense=self._cold)
         solution, _, flag, info = model.solve()
+        iterations = int(info.get("iterations", 0))
         if flag <= 0 and warm:
             self._cold.fill(0)
             model.update(sense=self._cold)
             solution, _, flag, info = model.solve()
+            iterations += int(info.get("iterations", 0))
         self._warm = flag > 0
-        self.multipliers = info["lam"] if flag > 0 else None
-        return solution if flag > 0 else None
+        if flag <= 0:
+            return Plan.failed()
+        active = self._active_set(info["lam"])
+        if not np.isfinite(solution).all():
+            return Plan.failed(active)
+        return self.qp.plan(x0, solution.copy(), active, iterations)
 
-    def active_set(self) -> NDArray[np.int8] | None:
-        """Return the last solution's active set as (N, 3) rows (δ_i, τ_i, θ_{i+1}), ±1 at a bound.
-
-        From the signs of DAQP's multipliers (+ at an upper bound), in the layout of
-        :class:`~pushrecovery.control.mpc.riccati.RiccatiSolver`; None after a failure.
-        """
-        lam = self.multipliers
-        if lam is None:
-            return None
+    @staticmethod
+    def _active_set(lam: FloatArray) -> NDArray[np.int8]:
+        """Return the rows' active set as (N, 3) rows (δ_i, τ_i, θ_{i+1}), ±1 at a bound."""
         n = lam.size // 3
         active = np.zeros((n, 3), dtype=np.int8)
         active[:, :2] = np.sign(lam[: 2 * n]).reshape(n, 2)
