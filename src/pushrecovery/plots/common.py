@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pushrecovery.errors import InputFileError
+from pushrecovery.errors import InputFileError, InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import cop_region
@@ -20,7 +20,10 @@ if TYPE_CHECKING:
 __all__ = [
     "FALL_COLOUR",
     "HIP_COLOUR",
+    "PLOT_FORMATS",
     "RECOVER_COLOUR",
+    "check_plot_path",
+    "frame_points",
     "new_figure",
     "save_figure",
     "shade_regions",
@@ -29,6 +32,24 @@ __all__ = [
 RECOVER_COLOUR = "#2e7d32"
 HIP_COLOUR = "#ef6c00"
 FALL_COLOUR = "#c62828"
+#: Suffixes of the files a plot is written to (its format).
+PLOT_FORMATS = frozenset({".png", ".svg", ".pdf"})
+
+
+def check_plot_path(path: Path) -> Path:
+    """Return ``path`` as a Path ending in one of :data:`PLOT_FORMATS` (any case), else raise.
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming the file and the formats.
+    """
+    path = Path(path)
+    if path.suffix.lower() not in PLOT_FORMATS:
+        raise InvalidParameterError(
+            f"plot must end in one of {sorted(PLOT_FORMATS)}, got {path.name!r}"
+        )
+    return path
 
 
 def new_figure(width: float = 6.4, height: float = 4.8) -> tuple[Figure, Axes]:
@@ -37,6 +58,14 @@ def new_figure(width: float = 6.4, height: float = 4.8) -> tuple[Figure, Axes]:
 
     fig = Figure(figsize=(width, height), layout="constrained")
     return fig, fig.add_subplot()
+
+
+def frame_points(ax: Axes, points: np.ndarray, margin: float) -> None:
+    """Limit ``ax`` to the (x, y) ``points`` [m] grown by ``margin`` [m], at equal scales."""
+    low, high = points.min(axis=0) - margin, points.max(axis=0) + margin
+    ax.set_xlim(low[0], high[0])
+    ax.set_ylim(low[1], high[1])
+    ax.set_aspect("equal")
 
 
 def shade_regions(

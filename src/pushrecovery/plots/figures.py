@@ -10,9 +10,9 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-from matplotlib.axes import Axes
 
 from pushrecovery.experiments.paper_figures import PaperRuns
 from pushrecovery.models.flywheel import max_spin_up_time
@@ -45,47 +45,23 @@ __all__ = [
 PAPER_FIGURES = ("fig3a", "fig3b", "fig5a", "fig5b", "fig6a", "fig6b", "fig9", "fig10")
 
 
-def _limits(params: BodyParams) -> tuple[tuple[float, float], tuple[float, float]]:
-    span = params.toe - params.heel
-    xlim = (params.heel - 0.5 * span, params.toe + 0.5 * span)
-    vmax = params.omega * span * 1.3
-    return xlim, (-vmax, vmax)
-
-
-def _draw_runs(ax: Axes, runs: Iterable[SimulationResult]) -> None:
-    """Phase paths (x, ẋ) of ankle-model runs, green recovered, red fell."""
-    for run in runs:
-        colour = RECOVER_COLOUR if run.recovered else FALL_COLOUR
-        ax.plot(run.states[:, 0], run.states[:, 1], color=colour, lw=1.2)
-        ax.plot(run.states[0, 0], run.states[0, 1], "o", color=colour, ms=3)
-
-
 def fig3a(
     params: BodyParams, runs: Iterable[SimulationResult], formats: Iterable[str], out: Path
 ) -> list[Path]:
     """Fig. 3(a): open-loop saturated ankle torque on the LIPM from upright, pushed."""
-    fig, ax = new_figure()
-    xlim, ylim = _limits(params)
-    shade_regions(ax, params, xlim, ylim)
-    _draw_runs(ax, runs)
-    ax.set_title("Fig. 3(a): saturated ankle torque, LIPM (green recovers, red falls)")
-    return save_figure(fig, out / "fig3a", formats)
+    title = "Fig. 3(a): saturated ankle torque, LIPM (green recovers, red falls)"
+    return _phase(params, runs, title, out / "fig3a", formats, hip=False)
 
 
 def fig3b(
     params: BodyParams, runs: Iterable[SimulationResult], formats: Iterable[str], out: Path
 ) -> list[Path]:
     """Fig. 3(b): saturated PD ankle control of the nonlinear pendulum from many states."""
-    fig, ax = new_figure()
-    xlim, ylim = _limits(params)
-    shade_regions(ax, params, xlim, ylim)
-    _draw_runs(ax, runs)
-    ax.set_title(
+    title = (
         "Fig. 3(b): saturated PD ankle control, nonlinear pendulum\n"
-        "(pushes 15 % inside / outside Eq. (4); falls drawn until certain)",
-        fontsize=10,
+        "(pushes 15 % inside / outside Eq. (4); falls drawn until certain)"
     )
-    return save_figure(fig, out / "fig3b", formats)
+    return _phase(params, runs, title, out / "fig3b", formats, hip=False, fontsize=10)
 
 
 def write_figures(
@@ -156,22 +132,38 @@ def plane(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
 
 def _phase(
     params: BodyParams,
-    runs: list[SimulationResult],
+    runs: Iterable[SimulationResult],
     title: str,
     stem: Path,
-    formats: tuple[str, ...],
+    formats: Iterable[str],
+    *,
+    hip: bool = True,
+    **title_style: Any,
 ) -> list[Path]:
+    """Phase paths (x, ẋ) of runs, green recovered, red fell, over the shaded regions.
+
+    ``hip``: the flywheel model's runs (ẋ its state's third entry) over the CMP region, with
+    a legend; else the ankle models' (ẋ the second) over the CoP region.
+    """
     fig, ax = new_figure()
     span = params.toe - params.heel
-    xlim = (params.heel - span, params.toe + span)
-    vmax = params.omega * (cmp_region(params).upper - params.heel) * 1.1
-    shade_regions(ax, params, xlim, (-0.5 * vmax, vmax), hip=True)
+    if hip:
+        xlim = (params.heel - span, params.toe + span)
+        vmax = params.omega * (cmp_region(params).upper - params.heel) * 1.1
+        ylim = (-0.5 * vmax, vmax)
+    else:
+        xlim = (params.heel - 0.5 * span, params.toe + 0.5 * span)
+        vmax = params.omega * span * 1.3
+        ylim = (-vmax, vmax)
+    shade_regions(ax, params, xlim, ylim, hip=hip)
+    speed = 2 if hip else 1
     for run in runs:
         colour = RECOVER_COLOUR if run.recovered else FALL_COLOUR
-        ax.plot(run.states[:, 0], run.states[:, 2], color=colour, lw=1.2)
-        ax.plot(run.states[0, 0], run.states[0, 2], "o", color=colour, ms=3)
-    ax.legend(loc="lower left", fontsize=8)
-    ax.set_title(title, fontsize=10)
+        ax.plot(run.states[:, 0], run.states[:, speed], color=colour, lw=1.2)
+        ax.plot(run.states[0, 0], run.states[0, speed], "o", color=colour, ms=3)
+    if hip:
+        ax.legend(loc="lower left", fontsize=8)
+    ax.set_title(title, **title_style)
     return save_figure(fig, stem, formats)
 
 
@@ -234,6 +226,7 @@ def fig5(
         "Fig. 5(a): bang-bang hip torque + saturated ankle\n(orange band: corrected Eq. (15))",
         out / "fig5a",
         formats,
+        fontsize=10,
     )
     spin_up = max_spin_up_time(params)
     files += _time_panels(
@@ -261,6 +254,7 @@ def fig6(
         "Fig. 6(a): receding-horizon control, paper's weights\n(orange band: corrected Eq. (15))",
         out / "fig6a",
         formats,
+        fontsize=10,
     )
     small_large = [runs[0], runs[3], runs[4]]
     files += _time_panels(

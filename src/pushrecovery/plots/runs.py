@@ -12,23 +12,24 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
-from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
-from pushrecovery.plots.common import FALL_COLOUR, RECOVER_COLOUR, save_figure, shade_regions
+from pushrecovery.plots.common import (
+    FALL_COLOUR,
+    RECOVER_COLOUR,
+    check_plot_path,
+    frame_points,
+    save_figure,
+    shade_regions,
+)
 from pushrecovery.sim.result import SimulationResult
 from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["plane_run_figure", "save_run"]
 
-_FORMATS = {".png", ".svg", ".pdf"}
-
 
 def save_run(result: SimulationResult, params: BodyParams, path: Path) -> Path:
     """Write a two-panel plot of ``result`` to ``path`` (format from the extension)."""
-    if path.suffix.lower() not in _FORMATS:
-        raise InvalidParameterError(
-            f"plot must end in one of {sorted(_FORMATS)}, got {path.name!r}"
-        )
+    path = check_plot_path(path)
     if result.states.shape[1] == 8:
         figure = plane_run_figure(result, params)
         return save_figure(figure, path.with_suffix(""), [path.suffix.lstrip(".")])[0]
@@ -91,11 +92,7 @@ def plane_run_figure(result: SimulationResult, params: BodyParams) -> Figure:
     # Points, not a line: the CoP jumps from foot to foot.
     ax.plot(result.inputs[:, 0], result.inputs[:, 1], "m.", ms=3, label="CoP")
     ax.plot(states[0, 0], states[0, 1], "o", color=colour)
-    points = np.vstack([states[:, 0:2], np.array(result.footholds_xy)])
-    low, high = points.min(axis=0) - 0.2, points.max(axis=0) + 0.2
-    ax.set_xlim(low[0], high[0])
-    ax.set_ylim(low[1], high[1])
-    ax.set_aspect("equal")
+    frame_points(ax, np.vstack([states[:, 0:2], np.array(result.footholds_xy)]), 0.2)
     ax.set_xlabel("x, forward [m]")
     ax.set_ylabel("y, left [m]")
     steps = len(result.footholds_xy) - 1

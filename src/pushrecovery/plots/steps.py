@@ -19,7 +19,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
-from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR
+from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR, frame_points
 from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["STEP_COLOURS", "capture_regions_figure", "n_step_map_figure"]
@@ -89,11 +89,7 @@ def draw_capture_regions(
         xytext=(x, y),
         arrowprops={"arrowstyle": "->", "color": "0.3", "lw": 1.0},
     )
-    points = np.vstack(corners)
-    low, high = points.min(axis=0) - 0.1, points.max(axis=0) + 0.1
-    ax.set_xlim(low[0], high[0])
-    ax.set_ylim(low[1], high[1])
-    ax.set_aspect("equal")
+    frame_points(ax, np.vstack(corners), 0.1)
     ax.set_xlabel("x [m] (forward)")
     ax.set_ylabel("y [m] (left)")
     speed = math.hypot(xdot, ydot)

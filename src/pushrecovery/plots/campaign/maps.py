@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pushrecovery.params import BodyParams
-from pushrecovery.plots.common import save_figure
+from pushrecovery.plots.common import check_plot_path, save_figure
 
 if TYPE_CHECKING:
     from pushrecovery.campaign.spec import CampaignSpec
@@ -17,7 +17,6 @@ from pushrecovery.plots.campaign.style import (
     MAX_PANELS,
     STRATEGY_COLOURS,
     UNITS,
-    _check_path,
     _columns,
     _draw_boundaries,
 )
@@ -91,7 +90,7 @@ def plot_outcome_map(table: Any, spec: CampaignSpec, path: Path) -> Path:
     Path
         The file written.
     """
-    path = _check_path(path)
+    path = check_plot_path(path)
     columns = _columns(table)
     panels = _panels(spec, columns)
     from matplotlib.figure import Figure
@@ -120,40 +119,21 @@ def plot_outcome_map(table: Any, spec: CampaignSpec, path: Path) -> Path:
         pad = 0.08 * (high - low)
         xlim = (low - pad, high + pad)
         _draw_boundaries(ax, body, xlim, vmax, legend=k == 0)
-        for name in ("ankle", "hip", "step"):
-            pick = mask & (used == name) & recovered
+        layers: list[tuple[Any, str, dict[str, Any]]] = [
+            (mask & (used == name) & recovered, f"used {name}",
+             {"s": size, "color": STRATEGY_COLOURS[name], "zorder": 3})
+            for name in ("ankle", "hip", "step")
+        ]  # fmt: skip
+        layers += [
+            (mask & ~recovered, "fell or undecided",
+             {"s": 1.2 * size, "marker": "x", "color": _FELL_COLOUR, "zorder": 3}),
+            (mask & disagree, "verdict ≠ outcome",
+             {"s": 3.6 * size, "facecolors": "none", "edgecolors": "black", "lw": 0.9,
+              "zorder": 4}),
+        ]  # fmt: skip
+        for pick, label, style in layers:
             if pick.any():
-                ax.scatter(
-                    x0[pick],
-                    xdot[pick],
-                    s=size,
-                    color=STRATEGY_COLOURS[name],
-                    label=f"used {name}" if k == 0 else None,
-                    zorder=3,
-                )
-        pick = mask & ~recovered
-        if pick.any():
-            ax.scatter(
-                x0[pick],
-                xdot[pick],
-                s=1.2 * size,
-                marker="x",
-                color=_FELL_COLOUR,
-                label="fell or undecided" if k == 0 else None,
-                zorder=3,
-            )
-        pick = mask & disagree
-        if pick.any():
-            ax.scatter(
-                x0[pick],
-                xdot[pick],
-                s=3.6 * size,
-                facecolors="none",
-                edgecolors="black",
-                lw=0.9,
-                label="verdict ≠ outcome" if k == 0 else None,
-                zorder=4,
-            )
+                ax.scatter(x0[pick], xdot[pick], label=label if k == 0 else None, **style)
         ax.set_xlim(*xlim)
         ax.set_ylim(-vmax, vmax)
         ax.set_xlabel("CoM position before the push x0 [m]")
@@ -193,7 +173,7 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     from pushrecovery.surfaces.classify import STRATEGY_CODES, classify_states
     from pushrecovery.surfaces.step_regions import sagittal_step_interval
 
-    path = _check_path(path)
+    path = check_plot_path(path)
     if xdot_max is None:
         interval = sagittal_step_interval(params)
         xdot_max = 1.25 * params.omega * max(abs(interval.lower), abs(interval.upper))

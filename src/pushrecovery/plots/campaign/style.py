@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -64,18 +63,6 @@ STEP_LIMIT_POINTS = 15
 
 
 _FELL_COLOUR = "0.45"
-
-
-_FORMATS = {".png", ".svg", ".pdf"}
-
-
-def _check_path(path: Path) -> Path:
-    path = Path(path)
-    if path.suffix.lower() not in _FORMATS:
-        raise InvalidParameterError(
-            f"plot must end in one of {sorted(_FORMATS)}, got {path.name!r}"
-        )
-    return path
 
 
 def step_limit_curve(

@@ -9,11 +9,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.plots.common import save_figure
+from pushrecovery.plots.common import check_plot_path, save_figure
 
 if TYPE_CHECKING:
     pass
-from pushrecovery.plots.campaign.style import UNITS, _check_path
+from pushrecovery.plots.campaign.style import UNITS
 
 __all__ = [
     "plot_critical_vs_parameter",
@@ -49,7 +49,7 @@ def plot_critical_vs_parameter(summary: Mapping[str, Any], path: Path) -> Path:
     """
     import matplotlib
 
-    path = _check_path(path)
+    path = check_plot_path(path)
     sweeps = [name for name, _ in summary["spec"]["sweeps"]]
     if len(sweeps) != 1:
         raise InvalidParameterError(
