@@ -3,14 +3,8 @@
 :func:`write_report` writes ``OUT/index.html``.
 """
 
-from pushrecovery.report.html import (
-    MUJOCO_SECTIONS,
-    SECTIONS,
-    SIZES,
-    PushGrid,
-    ReportGrids,
-    write_report,
-)
+from pushrecovery.report.config import MUJOCO_SECTIONS, SECTIONS, SIZES, PushGrid, ReportGrids
+from pushrecovery.report.html import write_report
 
 __all__ = [
     "MUJOCO_SECTIONS",

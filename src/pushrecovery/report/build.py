@@ -11,6 +11,7 @@ The sections, their keys and the grids: :mod:`pushrecovery.report.html`.
 
 from __future__ import annotations
 
+import functools
 import os
 import time
 from collections.abc import Callable, Collection, Mapping
@@ -19,7 +20,7 @@ from pathlib import Path
 
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
-from pushrecovery.report.campaigns import _analytic, _biped, _mujoco, _planar, _sweep
+from pushrecovery.report.campaigns import CAMPAIGNS, _sweep, campaign_section
 from pushrecovery.report.config import (
     _RUN_ORDER,
     MUJOCO_SECTIONS,
@@ -43,11 +44,8 @@ _BUILDERS: Mapping[str, Callable[[_Context], Section]] = {
     "plane": _plane,
     "steps": _steps,
     "figures": _figures,
-    "analytic": _analytic,
-    "planar": _planar,
+    **{key: functools.partial(campaign_section, key=key) for key in CAMPAIGNS},
     "sweep": _sweep,
-    "mujoco": _mujoco,
-    "biped": _biped,
     "critical": _critical,
     "filmstrips": _filmstrips,
     "humanoid3d": humanoid3d_section,

@@ -99,20 +99,75 @@ def _disagreements(pushes: Any) -> Disagreements:
     )
 
 
-def _campaign_section(
-    ctx: _Context, key: str, spec: Any, lead: str, *, boundary: bool = True
-) -> CampaignSection:
-    """Run a campaign; return its accuracy, confusion matrix, outcome map and boundary table."""
+#: The campaign sections: key -> (backend, model, controller, the grid (its field of
+#: ``ReportGrids``), the lead paragraph; ``{froude}`` is √(g l) [m/s]).
+CAMPAIGNS: Mapping[str, tuple[str, str, str, str, str]] = {
+    "analytic": (
+        "analytic",
+        "stepping",
+        "recovery",
+        "analytic",
+        "Every push of a grid over the start x0 and the push ẋ on Sec. IV's stepping model "
+        "(rigid legs that land symmetrically, the impact of Eqs. 18–20) with the push-recovery "
+        "controller (ankle, then hip, then Sec. IV's step, planned again at every touchdown), "
+        "against the strategy the surfaces predict: Eq. (4), corrected Eq. (15) and N-step "
+        "capturability. The locked swing leg cannot carry a CoM faster than √(g l) = "
+        "{froude:.2f} m/s: the stance foot would leave the floor, which this model counts as a "
+        "fall and the LIPM's verdict does not see (docs/steps.md). The next section runs the "
+        "model of the N-step analysis.",
+    ),
+    "planar": (
+        "analytic",
+        "stepping-plane",
+        "recovery-plane",
+        "analytic",
+        "The same pushes on the model of the N-step analysis: the planar LIPM with flywheels "
+        "whose feet land where and when commanded, no sooner than min_step_time after the "
+        "lift, within reach (stepping-plane), from double support. The plan-following "
+        "controller (recovery-plane) takes the steps of the N-step plan and plans again at "
+        "every touchdown; the verdict is classify's (Eq. 4, corrected Eq. 15, N-step "
+        "capturability).",
+    ),
+    "mujoco": (
+        "mujoco",
+        "torso",
+        "mpc",
+        "mujoco",
+        "The same comparison in real physics: the MuJoCo torso (foot, leg, upper body on a hip "
+        "hinge) pushed by real forces and balanced by the receding-horizon controller (Eqs. "
+        "16–17), against Eq. (4) and corrected Eq. (15).",
+    ),
+    "biped": (
+        "mujoco",
+        "biped",
+        "recovery",
+        "biped",
+        "Pushes on the MuJoCo biped with the push-recovery controller, which steps when the "
+        "capture point leaves the CMP region (corrected Eq. 15) and takes Sec. IV's step, "
+        "planned again at every touchdown, against the strategy the surfaces predict "
+        "(Eq. 4, corrected Eq. 15, N-step capturability).",
+    ),
+}
+
+
+def campaign_section(ctx: _Context, key: str) -> CampaignSection:
+    """Run the campaign ``key`` of :data:`CAMPAIGNS`; return it as a section of the page.
+
+    Its accuracy, confusion matrix, outcome map and boundary table (none for ``planar``).
+    """
     from pushrecovery.plots.campaign import plot_outcome_map
 
+    backend, model, controller, grid, lead = CAMPAIGNS[key]
+    spec = _spec(ctx, backend, model, controller, getattr(ctx.grids, grid))
+    froude = math.sqrt(ctx.params.gravity * ctx.params.leg_length)
     result = _campaign(ctx, key, spec)
     summary = result.summary
     outcomes = summary["outcomes"]
     picture = plot_outcome_map(result.table, spec, result.directory / "outcome-map.png")
-    rows = summary["boundary"] if boundary else []
+    rows = summary["boundary"] if key != "planar" else []
     return CampaignSection(
         key=key,
-        lead=lead,
+        lead=lead.format(froude=froude),
         backend=spec.backend,
         model=spec.model,
         controller=spec.controller,
@@ -147,40 +202,6 @@ def _resolution(row: Mapping[str, Any]) -> float | None:
     return 0.5 * abs(high - low) / abs(row["analytic"])
 
 
-def _analytic(ctx: _Context) -> CampaignSection:
-    spec = _spec(ctx, "analytic", "stepping", "recovery", ctx.grids.analytic)
-    froude = math.sqrt(ctx.params.gravity * ctx.params.leg_length)
-    return _campaign_section(
-        ctx,
-        "analytic",
-        spec,
-        "Every push of a grid over the start x0 and the push ẋ on Sec. IV's stepping model "
-        "(rigid legs that land symmetrically, the impact of Eqs. 18–20) with the push-recovery "
-        "controller (ankle, then hip, then Sec. IV's step, planned again at every touchdown), "
-        "against the strategy the surfaces predict: Eq. (4), corrected Eq. (15) and N-step "
-        "capturability. The locked swing leg cannot carry a CoM faster than √(g l) = "
-        f"{froude:.2f} m/s: the stance foot would leave the floor, which this model counts as a "
-        "fall and the LIPM's verdict does not see (docs/steps.md). The next section runs the "
-        "model of the N-step analysis.",
-    )
-
-
-def _planar(ctx: _Context) -> CampaignSection:
-    spec = _spec(ctx, "analytic", "stepping-plane", "recovery-plane", ctx.grids.analytic)
-    return _campaign_section(
-        ctx,
-        "planar",
-        spec,
-        "The same pushes on the model of the N-step analysis: the planar LIPM with flywheels "
-        "whose feet land where and when commanded, no sooner than min_step_time after the "
-        "lift, within reach (stepping-plane), from double support. The plan-following "
-        "controller (recovery-plane) takes the steps of the N-step plan and plans again at "
-        "every touchdown; the verdict is classify's (Eq. 4, corrected Eq. 15, N-step "
-        "capturability).",
-        boundary=False,
-    )
-
-
 def _sweep(ctx: _Context) -> SweepSection:
     from pushrecovery.plots.campaign import UNITS, plot_critical_vs_parameter
 
@@ -204,29 +225,4 @@ def _sweep(ctx: _Context) -> SweepSection:
             "bar) and analytic (dashed).",
         ),
         boundary=_boundary_table(result.summary),
-    )
-
-
-def _mujoco(ctx: _Context) -> CampaignSection:
-    spec = _spec(ctx, "mujoco", "torso", "mpc", ctx.grids.mujoco)
-    return _campaign_section(
-        ctx,
-        "mujoco",
-        spec,
-        "The same comparison in real physics: the MuJoCo torso (foot, leg, upper body on a hip "
-        "hinge) pushed by real forces and balanced by the receding-horizon controller (Eqs. "
-        "16–17), against Eq. (4) and corrected Eq. (15).",
-    )
-
-
-def _biped(ctx: _Context) -> CampaignSection:
-    spec = _spec(ctx, "mujoco", "biped", "recovery", ctx.grids.biped)
-    return _campaign_section(
-        ctx,
-        "biped",
-        spec,
-        "Pushes on the MuJoCo biped with the push-recovery controller, which steps when the "
-        "capture point leaves the CMP region (corrected Eq. 15) and takes Sec. IV's step, "
-        "planned again at every touchdown, against the strategy the surfaces predict "
-        "(Eq. 4, corrected Eq. 15, N-step capturability).",
     )

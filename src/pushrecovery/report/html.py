@@ -27,51 +27,24 @@ Sections, in the page's order (key: content):
   (:mod:`pushrecovery.report.humanoid3d`).
 
 The grids come in two sizes: ``small`` (the default, about a minute on two cores) and ``full``;
-any grid can be replaced (:class:`PushGrid`), any section left out (``skip``).
+any grid can be replaced (:class:`~pushrecovery.report.PushGrid`), any section left out (``skip``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection
 from pathlib import Path
+from typing import Any
 
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.params import BodyParams
 from pushrecovery.report.build import build_report
-from pushrecovery.report.config import (
-    MUJOCO_SECTIONS,
-    SECTIONS,
-    SIZES,
-    PushGrid,
-    ReportGrids,
-)
 from pushrecovery.report.render import render_report
 
-__all__ = [
-    "MUJOCO_SECTIONS",
-    "SECTIONS",
-    "SIZES",
-    "PushGrid",
-    "ReportGrids",
-    "write_report",
-]
+__all__ = ["write_report"]
 
 
 def write_report(
-    params: BodyParams | None = None,
-    out_dir: Path | str = Path("out/report"),
-    *,
-    size: str = "small",
-    full: bool = False,
-    analytic_grid: PushGrid | None = None,
-    sweep_grid: PushGrid | None = None,
-    mujoco_grid: PushGrid | None = None,
-    biped_grid: PushGrid | None = None,
-    mujoco: bool = True,
-    skip: Collection[str] = (),
-    workers: int | None = None,
-    scheduler: str | None = None,
-    progress: Callable[[str], None] | None = None,
+    params: BodyParams | None = None, out_dir: Path | str = Path("out/report"), **options: Any
 ) -> Path:
     """Compute every section of the report and write ``out_dir/index.html``.
 
@@ -91,9 +64,15 @@ def write_report(
         The body; default the built-in preset (:func:`pushrecovery.load_params`).
     out_dir : path
         Output directory, created if missing.
+    **options
+        The keyword arguments of :func:`~pushrecovery.report.build.build_report`, all
+        keyword-only: the other parameters below.
+
+    Other Parameters
+    ----------------
     size : {"small", "full"}
-        Grid size (:data:`SIZES`): ``small`` (default) runs in about a minute on two cores,
-        ``full`` is about ten times larger.
+        Grid size (:data:`~pushrecovery.report.SIZES`): ``small`` (default) runs in about a
+        minute on two cores, ``full`` is about ten times larger.
     full : bool
         Shorthand for ``size="full"``.
     analytic_grid, sweep_grid, mujoco_grid, biped_grid : PushGrid, optional
@@ -102,7 +81,7 @@ def write_report(
         Include the MuJoCo sections (``mujoco``, ``biped``, ``critical``, ``filmstrips``,
         ``humanoid3d``).
     skip : collection of str
-        Section keys to leave out (:data:`SECTIONS`).
+        Section keys to leave out (:data:`~pushrecovery.report.SECTIONS`).
     workers : int, optional
         Worker processes of the campaigns (1: this process; default all cores).
     scheduler : str, optional
@@ -120,21 +99,7 @@ def write_report(
     InvalidParameterError
         On an unknown size or section key, or an invalid grid.
     """
-    report = build_report(
-        params,
-        out_dir,
-        size=size,
-        full=full,
-        analytic_grid=analytic_grid,
-        sweep_grid=sweep_grid,
-        mujoco_grid=mujoco_grid,
-        biped_grid=biped_grid,
-        mujoco=mujoco,
-        skip=skip,
-        workers=workers,
-        scheduler=scheduler,
-        progress=progress,
-    )
+    report = build_report(params, out_dir, **options)
     path = Path(out_dir) / "index.html"
     partial = path.with_suffix(".partial")
     try:
