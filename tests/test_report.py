@@ -7,6 +7,7 @@ import re
 from dataclasses import replace
 from html import unescape
 from pathlib import Path
+from typing import Any
 
 import pyarrow.parquet as pq
 import pytest
@@ -37,41 +38,35 @@ from pushrecovery.surfaces.bounds import bounds_data
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
+def _campaign(directory: Path, model: str, controller: str, **grid: Any) -> CampaignResult:
+    """Run an analytic campaign of the paper's body in this process."""
+    result = run_campaign(
+        CampaignSpec("analytic", model, controller, load_params(), **grid), directory, workers=1
+    )
+    assert result is not None
+    return result
+
+
 @pytest.fixture(scope="module")
 def ankle_campaign(tmp_path_factory: pytest.TempPathFactory) -> CampaignResult:
     """Pendulum + ankle PD, 2 starts x 5 pushes."""
-    from pushrecovery import load_params
-
-    spec = CampaignSpec(
-        "analytic",
-        "pendulum",
-        "ankle-pd",
-        load_params(),
-        x0=(0.0, 0.05, 0.05),
-        xdot=(-0.4, 0.6, 0.25),
+    directory = tmp_path_factory.mktemp("ankle")
+    return _campaign(
+        directory, "pendulum", "ankle-pd", x0=(0.0, 0.05, 0.05), xdot=(-0.4, 0.6, 0.25)
     )
-    result = run_campaign(spec, tmp_path_factory.mktemp("ankle"), workers=1)
-    assert result is not None
-    return result
 
 
 @pytest.fixture(scope="module")
 def sweep_campaign(tmp_path_factory: pytest.TempPathFactory) -> CampaignResult:
     """Flywheel + MPC from upright, 6 pushes for each of two hip torque limits."""
-    from pushrecovery import load_params
-
-    spec = CampaignSpec(
-        "analytic",
+    return _campaign(
+        tmp_path_factory.mktemp("sweep"),
         "flywheel",
         "mpc",
-        load_params(),
         x0=(0.0, 0.0, 1.0),
         xdot=(-0.5, 0.75, 0.25),
         sweeps={"torque_max": (0.0, 100.0, 100.0)},
     )
-    result = run_campaign(spec, tmp_path_factory.mktemp("sweep"), workers=1)
-    assert result is not None
-    return result
 
 
 def test_outcome_map_writes_a_png(ankle_campaign: CampaignResult, tmp_path: Path) -> None:

@@ -157,20 +157,9 @@ def planar_only(
 ) -> Callable[[F], F]:
     """Return hidden options of a humanoid command that refuse the planar models' ``flags``.
 
-    Parameters
-    ----------
-    command : str
-        The humanoid command (``simulate`` for ``pushrecovery humanoid simulate``).
-    *flags : str
-        The planar options (``--xdot``), each taking one value, any text.
-    nargs : mapping of str to int, optional
-        The options among ``flags`` that take several values (``{"--x0": 3}``).
-
-    Returns
-    -------
-    callable
-        The click decorator: the options are not listed, not passed to the command, and one
-        given is refused in one line pointing to ``pushrecovery humanoid COMMAND --help``.
+    As :func:`humanoid_only`, ``command`` the humanoid command itself and ``flags`` the planar
+    options (``--xdot``; ``nargs``: ``{"--x0": 3}``), each taking any text: one given is
+    refused in one line pointing to ``pushrecovery humanoid COMMAND --help``.
     """
     message = "{flag} is an option of the planar models, not of the 3-D humanoids: see "
     return _refused(command, flags, nargs, message + "'pushrecovery humanoid {command} --help'")

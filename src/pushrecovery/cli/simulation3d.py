@@ -268,10 +268,8 @@ def critical_3d(
 
     Parameters
     ----------
-    model : str
-        ``biped3d`` or ``g1``.
-    params : BodyParams
-        The body (:func:`params_3d`).
+    model, params
+        The model and its body, as :func:`simulate_3d`'s.
     azimuth : float or None
         The push's direction [deg] (None: 0).
     tolerance : float
