@@ -88,20 +88,11 @@ def trial_events(job: Any, summary: TrialSummary) -> list[dict[str, Any]]:
     """
     subject = subject_name(job)
     rows = [
-        EventRow(
-            trial=job.name,
-            subject=subject,
-            axis=event.axis,
-            kind="step needed",
-            time=event.time,
-            end=event.end,
-            step_length=event.step_length,
-            step_length_min=event.step_length_min,
-            step_length_max=event.step_length_max,
-            capture_point=event.capture_point,
-        )
+        EventRow(job.name, subject, event.axis, "step needed", event.time, event.end,
+                 event.step_length, event.step_length_min, event.step_length_max,
+                 event.capture_point)
         for event in summary.step_events
-    ]
+    ]  # fmt: skip
     for start, end in summary.checks.flights:
         rows.append(EventRow(job.name, subject, "", "flight", start, end))
     events = summary.events
@@ -147,13 +138,5 @@ def _at(
 ) -> EventRow:
     """Return an event row with the axis' margins at the event's frame."""
     here = margins.axes[axis]
-    return EventRow(
-        trial=trial,
-        subject=subject,
-        axis=axis,
-        kind=kind,
-        time=time,
-        capture_point=here.capture_point,
-        cop_margin=here.cop_margin,
-        strategy=here.strategy,
-    )
+    return EventRow(trial, subject, axis, kind, time, capture_point=here.capture_point,
+                    cop_margin=here.cop_margin, strategy=here.strategy)  # fmt: skip

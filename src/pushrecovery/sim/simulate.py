@@ -246,18 +246,10 @@ def simulate(
     else:
         times, states, inputs = np.arange(k + 1, dtype=np.float64) * h, states[: k + 1], inputs[:k]
     return SimulationResult(
-        time=times,
-        states=states,
-        inputs=inputs,
-        outcome=outcome,
-        model=plant.name,
-        controller=controller.name,
-        stop_impacts=info.stop_impacts,
-        footholds=info.footholds,
-        footholds_xy=info.footholds_xy,
-        state_labels=plant.state_labels,
+        times, states, inputs, outcome, plant.name, controller.name, info.stop_impacts,
+        info.footholds, info.footholds_xy, plant.state_labels,
         decided_time=None if decided < 0 else decided_clock,
-    )
+    )  # fmt: skip
 
 
 def _steps_after(seconds: float, h: float) -> int:
