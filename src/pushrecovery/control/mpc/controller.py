@@ -99,7 +99,8 @@ class MPCController(Controller):
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """First input of the plan from ``state`` (δ [m], τ [N m])."""
-        plan = self.last_plan = self.plan(np.asarray(state, dtype=np.float64))
+        state = np.asarray(state, dtype=np.float64)
+        plan = self.last_plan = self.route.solve(state, self.last_plan)  # as plan(), inlined
         cop, torque = plan.first_input.tolist()
         p = self.params
         # Clip what the solver's tolerance may leave a hair outside the limits (as

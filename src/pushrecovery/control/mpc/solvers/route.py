@@ -61,6 +61,7 @@ RELAXED_GUIDE_CENTRE = 10.0
 INTERIOR_MARGIN = BOUNDARY
 
 _WARM = Guess()
+_VERIFIED = Status.VERIFIED  # a module global: an enum member through its class costs ~0.1 µs
 _WARM_PASSES = Guess(budget=MAX_PASSES)
 _PASSES_AFTER_FAILURE = Guess(budget=PASSES_AFTER_FAILURE)
 
@@ -197,7 +198,7 @@ class Route:
                 warm = None
         if riccati is not None and warm is not None:
             plan = riccati.solve(x0, warm)
-            if plan.status is Status.VERIFIED:
+            if plan.status is _VERIFIED:
                 self.passes_failed = self.boundary = False
                 return plan
         self.passes_failed = riccati is not None
