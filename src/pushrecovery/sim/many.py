@@ -150,11 +150,7 @@ def run_many(
         )
     chosen = _engine(engine, model, controller, backend, count)
     if chosen == "compiled":
-        from pushrecovery.sim.batched import ankle_pd_pushes, recovery_pushes
-
-        if controller == "recovery":
-            return recovery_pushes(bodies, x0, xdot, duration=duration)
-        return ankle_pd_pushes(model, bodies, x0, xdot, duration=duration)
+        return _compiled(model, controller, bodies, x0, xdot, duration)
     if chosen == "rollout":
         if on_start is not None:
             on_start(count)
@@ -177,6 +173,21 @@ def _engine(engine: str, model: str, controller: str, backend: str, count: int) 
             f"engine {engine!r} does not run {model} + {controller} on the {backend} backend"
         )
     return engine
+
+
+def _compiled(
+    model: str,
+    controller: str,
+    bodies: Sequence[BodyParams],
+    x0: Sequence[float],
+    xdot: Sequence[float],
+    duration: float,
+) -> PushRuns:
+    from pushrecovery.sim.batched import ankle_pd_pushes, recovery_pushes
+
+    if controller == "recovery":
+        return recovery_pushes(bodies, x0, xdot, duration=duration)
+    return ankle_pd_pushes(model, bodies, x0, xdot, duration=duration)
 
 
 def _rollout(
