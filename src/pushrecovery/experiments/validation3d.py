@@ -45,9 +45,6 @@ it is at most ``rel_tolerance`` × the prediction wide; the measured value is it
 
 **Relative error** (measured − predicted)/predicted, negative when the body does worse than
 the simple model.
-
-Over 400 lines on purpose: the prediction and the measurement of one table are one concept,
-and their derivation is here beside the code.
 """
 
 from __future__ import annotations

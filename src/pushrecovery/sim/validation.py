@@ -16,9 +16,6 @@ position, and a *corrected* one for the two things the physics adds to the ankle
 surfaces: the CoP margin the feet need (docs/validation.md, "From the paper's commands to joint
 torques") and the CoM's travel during the push
 (x moves by v D / 2 under a constant force of duration D).
-
-Over 400 lines on purpose: one concept, the surfaces against the simulation, whose critical
-push, confusion matrix and their typed rows belong together.
 """
 
 from __future__ import annotations

@@ -21,13 +21,14 @@ for the physics. Any failure to create the OpenGL context is reported as a
 """
 
 from pushrecovery.sim.mujoco.render.frames import Frame, FrameLike, select_times, subsample
+from pushrecovery.sim.mujoco.render.gl import require_offscreen_gl
 from pushrecovery.sim.mujoco.render.output import (
     output_paths,
     render_run,
     write_animation,
     write_filmstrip,
 )
-from pushrecovery.sim.mujoco.render.scene import View, fit_view, render_frames, require_offscreen_gl
+from pushrecovery.sim.mujoco.render.scene import View, fit_view, render_frames
 
 __all__ = [
     "Frame",

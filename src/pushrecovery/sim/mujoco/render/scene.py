@@ -1,20 +1,16 @@
-"""Rendering frames off-screen with MuJoCo: the GL context, the view, the overlay markers."""
+"""Rendering frames off-screen with MuJoCo: the view, the overlay markers, the render loop."""
 
 from __future__ import annotations
 
-import importlib
 import math
-import os
-import sys
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
-from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.errors import InvalidParameterError
 
 if TYPE_CHECKING:
     import mujoco
@@ -25,6 +21,7 @@ from pushrecovery.sim.mujoco.render.frames import (
     _checked_times,
     select_times,
 )
+from pushrecovery.sim.mujoco.render.gl import _mujoco_for_rendering, _open_renderer
 
 __all__ = [
     "AZIMUTH",
@@ -40,47 +37,26 @@ __all__ = [
     "View",
     "fit_view",
     "render_frames",
-    "require_offscreen_gl",
 ]
 
 
 #: RGBA colours of the overlay markers (also used by the legends).
 COM_RGBA = (1.0, 0.0, 0.0, 1.0)
-
-
 CAPTURE_POINT_RGBA = (0.1, 0.3, 1.0, 1.0)
-
-
 COP_RGBA = (0.0, 0.8, 0.0, 1.0)
-
-
 #: Legend entries: label and RGBA colour.
 LEGEND = (("CoM", COM_RGBA), ("capture point", CAPTURE_POINT_RGBA), ("CoP", COP_RGBA))
-
-
 #: Markers are moved this far towards the camera [m] (along the line of sight, so they are
 #: drawn at the same pixel) so that the body does not hide them.
 MARKER_OFFSET = 0.25
-
-
 #: Marker radius as a fraction of the visible height.
 MARKER_SCALE = 0.018
-
-
 #: Default side camera angles [deg]: x from left to right, seen slightly from above.
 AZIMUTH = 90.0
-
-
 ELEVATION = -10.0
-
-
 #: Backdrop: a light wall behind the plane y = 0, at this y [m], and its colour.
 BACKDROP_DISTANCE = 3.0
-
-
 BACKDROP_RGBA = (0.8, 0.86, 0.94, 1.0)
-
-
 _EXTENT_SAMPLES = 12
 
 
@@ -104,69 +80,6 @@ class View:
     distance: float
     azimuth: float = AZIMUTH
     elevation: float = ELEVATION
-
-
-# --- OpenGL --------------------------------------------------------------------------------
-def _gl_name() -> str:
-    return os.environ.get("MUJOCO_GL", "")
-
-
-def _gl_error(exc: BaseException) -> PushRecoveryError:
-    detail = (str(exc).strip().splitlines() or [""])[0] or type(exc).__name__
-    if len(detail) > 120:
-        detail = detail[:117] + "..."
-    return PushRecoveryError(
-        f"cannot render offscreen with MUJOCO_GL={_gl_name()!r} ({type(exc).__name__}: "
-        f"{detail}); set MUJOCO_GL=egl (headless) or glfw (with a display)"
-    )
-
-
-def _mujoco_for_rendering() -> ModuleType:
-    """Import ``mujoco`` with its OpenGL backend following ``MUJOCO_GL`` (egl by default)."""
-    if sys.platform.startswith("linux"):
-        os.environ.setdefault("MUJOCO_GL", "egl")
-    try:
-        import mujoco
-
-        # The module the Renderer takes its GLContext class from (it looks the class up
-        # there when a Renderer is created).
-        renderer_module = sys.modules.get(getattr(mujoco.Renderer, "__module__", ""))
-        gl_context = getattr(renderer_module, "gl_context", None)
-        chosen = getattr(gl_context, "_MUJOCO_GL", None)
-        if gl_context is not None and chosen is not None:
-            if chosen != _gl_name().lower().strip():
-                # mujoco was imported before MUJOCO_GL was set: select the backend again.
-                importlib.reload(gl_context)
-    except Exception as exc:  # an invalid MUJOCO_GL raises RuntimeError, a broken one others
-        raise _gl_error(exc) from exc
-    return mujoco
-
-
-def _open_renderer(model: mujoco.MjModel, width: int, height: int) -> mujoco.Renderer:
-    mj = _mujoco_for_rendering()
-    buffer = (model.vis.global_.offwidth, model.vis.global_.offheight)
-    if not (0 < width <= buffer[0] and 0 < height <= buffer[1]):
-        raise InvalidParameterError(
-            f"image size must be within the model's offscreen buffer {buffer[0]}x{buffer[1]} "
-            f"px, got {width}x{height}"
-        )
-    try:
-        return mj.Renderer(model, height=height, width=width)
-    except Exception as exc:  # FatalError, ImportError, AttributeError, ... by backend
-        raise _gl_error(exc) from exc
-
-
-def require_offscreen_gl() -> None:
-    """Check that offscreen rendering works (call it before a long run to fail early).
-
-    Raises
-    ------
-    PushRecoveryError
-        If no OpenGL context can be created; the message names ``MUJOCO_GL``.
-    """
-    mj = _mujoco_for_rendering()
-    model = mj.MjModel.from_xml_string("<mujoco/>")
-    _open_renderer(model, 8, 8).close()
 
 
 def _check_qpos(model: mujoco.MjModel, frame: Frame) -> None:
