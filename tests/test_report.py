@@ -269,3 +269,21 @@ def test_one_worker_runs_the_campaigns_in_this_process(
     skip = ("bounds", "map", "plane", "figures", "sweep", "planar")
     write_report(params, tmp_path, mujoco=False, skip=skip, workers=1, **TINY)
     assert seen == [False]
+
+
+def test_a_campaign_with_no_outcome_has_no_accuracy(
+    params: BodyParams, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Every push an error row (physics diverged, worker died): accuracy None, once a TypeError.
+    import pushrecovery.report.campaigns as campaigns
+
+    real = campaigns._campaign
+
+    def no_outcome(ctx, key, spec):
+        result = real(ctx, key, spec)
+        return replace(result, summary={**result.summary, "accuracy": None})
+
+    monkeypatch.setattr(campaigns, "_campaign", no_outcome)
+    skip = ("bounds", "map", "plane", "figures", "sweep", "planar")
+    write_report(params, tmp_path, mujoco=False, skip=skip, workers=1, **TINY)
+    assert "<strong>Accuracy —</strong>" in (tmp_path / "index.html").read_text()

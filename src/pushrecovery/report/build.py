@@ -20,7 +20,7 @@ from pathlib import Path
 
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
-from pushrecovery.report.campaigns import CAMPAIGNS, _sweep, campaign_section
+from pushrecovery.report.campaigns import CAMPAIGNS, _sweep, accuracy, campaign_section
 from pushrecovery.report.config import (
     _RUN_ORDER,
     MUJOCO_SECTIONS,
@@ -156,7 +156,7 @@ def _verdict(params: BodyParams, ctx: _Context) -> Verdict:
         hip=float(data["hip"][1]),
         step=float(data["step"][1]),
         scores=tuple(
-            (SECTIONS[key], float(summary["accuracy"]), int(summary["pushes"]))
+            (SECTIONS[key], accuracy(summary), int(summary["pushes"]))
             for key, summary in ctx.summaries.items()
         ),
     )

@@ -150,6 +150,12 @@ CAMPAIGNS: Mapping[str, tuple[str, str, str, str, str]] = {
 }
 
 
+def accuracy(summary: Mapping[str, Any]) -> float | None:
+    """Return a campaign summary's accuracy [-]; None when no push has an outcome (all errors)."""
+    value = summary["accuracy"]
+    return None if value is None else float(value)
+
+
 def campaign_section(ctx: _Context, key: str) -> CampaignSection:
     """Run the campaign ``key`` of :data:`CAMPAIGNS`; return it as a section of the page.
 
@@ -176,7 +182,7 @@ def campaign_section(ctx: _Context, key: str) -> CampaignSection:
         fell=int(outcomes["fell"]),
         undecided=int(outcomes["undecided"]),
         errors=int(outcomes.get("error", 0)),
-        accuracy=float(summary["accuracy"]),
+        accuracy=accuracy(summary),
         verdicts=_verdict_counts(result.table, f"verdicts-{key}"),
         confusion=_confusion(summary, f"confusion-{key}"),
         disagreements=_disagreements(result.table),
@@ -218,7 +224,7 @@ def _sweep(ctx: _Context) -> SweepSection:
         parameter=name,
         unit=UNITS.get(name, ""),
         pushes=int(result.summary["pushes"]),
-        accuracy=float(result.summary["accuracy"]),
+        accuracy=accuracy(result.summary),
         picture=Picture(
             picture,
             "Critical push against the swept parameter: simulated (the grid's bracket as error "

@@ -217,7 +217,7 @@ class CampaignSection(Section):
     fell: int
     undecided: int
     errors: int  # pushes without an outcome (physics diverged, worker died): not in accuracy
-    accuracy: float
+    accuracy: float | None  # None: no push has an outcome
     verdicts: VerdictCounts
     confusion: ConfusionMatrix
     disagreements: Disagreements
@@ -236,7 +236,7 @@ class SweepSection(Section):
     parameter: str
     unit: str
     pushes: int
-    accuracy: float
+    accuracy: float | None  # None: no push has an outcome
     picture: Picture
     boundary: Table
 
@@ -294,7 +294,7 @@ class Verdict:
     ankle: float  # [m/s], Eq. (4)
     hip: float  # [m/s], corrected Eq. (15)
     step: float  # [m/s], the N-step verdict
-    scores: tuple[tuple[str, float, int], ...]  # (section title, accuracy, pushes)
+    scores: tuple[tuple[str, float | None, int], ...]  # (section title, accuracy, pushes)
 
 
 @dataclass(frozen=True)
