@@ -25,8 +25,10 @@ from sphinx.util.docutils import SphinxDirective
 from sphinx.util.parsing import nested_parse_to_nodes
 
 # Subpackages whose objects are not part of the reference: the CLI is documented from click
-# (cli.md) and the compiled kernels are an implementation detail behind the public API.
+# (cli.md) and the compiled kernels are an implementation detail behind the public API, but for
+# the thread cap a balance loop sets (INCLUDED).
 EXCLUDED = ("pushrecovery.cli", "pushrecovery.kernels", "pushrecovery.__main__")
+INCLUDED = ("pushrecovery.kernels.threads",)
 
 
 def public_modules(package: str) -> list[ModuleType]:
@@ -37,7 +39,8 @@ def public_modules(package: str) -> list[ModuleType]:
         names += [m.name for m in pkgutil.walk_packages(root.__path__, package + ".")]
     modules = []
     for name in sorted(names):
-        if name.startswith(EXCLUDED) or any(p.startswith("_") for p in name.split(".")[1:]):
+        hidden = name.startswith(EXCLUDED) and name not in INCLUDED
+        if hidden or any(p.startswith("_") for p in name.split(".")[1:]):
             continue
         module = importlib.import_module(name)
         if getattr(module, "__all__", None):
