@@ -1,32 +1,20 @@
 r"""Push recovery on the ground plane: ankle, hip, then the N-step plan, re-planned at touchdowns.
 
 The controller of the planar stepping model (``stepping-plane``; state
-``[x, y, θp, θr, ẋ, ẏ, θ̇p, θ̇r]``, world frame). It works on the capture point
-ξ = r + ṙ/ω, whose LIPM dynamics are ξ̇ = ω (ξ − p − c), with p the CoP and c = (τp e_p +
-τr e_r)/(m g) the CMP offset of the hip torques. The body is captured when
+``[x, y, θp, θr, ẋ, ẏ, θ̇p, θ̇r]``, world frame) works on the capture point: with c the CMP
+offset of the hip torques, the body is captured when
 
 .. math:: \xi(t) = \omega\int_t^\infty e^{-\omega(s - t)}\,\big(p(s) + c(s)\big)\,ds ,
 
-so a hip manoeuvre already under way contributes its remaining share
-h(t) = ω∫_t^∞ e^{−ω(s−t)} c(s) ds and the feet have to capture ξ_e = ξ − h. Each tick:
-
-1. **Touchdown** (the time the step was commanded for): the landed foot is the support; the
-   plan is dropped and made again below from the new state (re-planning at each touchdown).
-2. **Ankle**: ξ_e strictly inside the support polygon: the CoP at ξ_e (ξ_e then stays put and
-   the CoM converges to it).
-3. **Hip**: ξ inside the CMP region (:func:`~pushrecovery.surfaces.plane.cmp_polygon`) and the
-   hip still unused: ξ is split into a CoP in the support and a share of the hip's box
-   (:func:`~pushrecovery.ground.minkowski.decompose`, every term equally deep); the share is
-   produced by the bang-bang profile of corrected Eq. (15) (+τ over T_max, −τ over T_max, per
-   axis) scaled to it. Its remaining share h(t) is known in closed form (:func:`hip_share`).
-4. **Step**: the smallest N whose region C_N holds ξ_e (:class:`~pushrecovery.surfaces.
-   step_regions.StepRegions`, with the hip only while unused; beyond ``max_steps`` the plan
-   of ``max_steps`` steps, a best effort flagged ``saturated``): lift the plan's first foot,
-   land it at its first foothold at its first touchdown, hold the plan's first CoP meanwhile
-   and start the plan's hip share. After the touchdown step 1 runs again.
-
-The controller keeps its own copy of the feet, moved by the steps it commands (the plant lands
-a foot at the commanded time and foothold; plans are within reach and ``min_step_time``).
+so a hip manoeuvre under way contributes its remaining share h(t) (:func:`hip_share`) and the
+feet have to capture ξ_e = ξ − h. Each tick: at the commanded touchdown the landed foot is the
+support and the plan is dropped; ξ_e inside the support → the CoP at ξ_e (ankle); ξ inside the
+CMP region with the hip unused → ξ split over the support and the hip's box
+(:func:`~pushrecovery.ground.minkowski.decompose`) and the bang-bang profile started (hip);
+else the plan of the smallest N whose region C_N holds ξ_e
+(:class:`~pushrecovery.surfaces.step_regions.StepRegions`; beyond ``max_steps`` a best effort
+flagged ``saturated``). docs/steps.md, "Multi-step recovery on the ground plane", gives the
+details. The controller keeps its own copy of the feet, moved by the steps it commands.
 """
 
 from __future__ import annotations

@@ -10,40 +10,13 @@ initial capture points,
           \quad\text{over } \boldsymbol\xi_0 \text{ from which some admissible input sequence
           reaches a captured state,}
 
-is a linear program. Captured at the horizon: capture point ξ_N ∈ P (CoP balancing holds it,
-Eq. 4 in the plane) and both flywheels at rest (θ̇ = 0) within their limits. Sweeping d traces
-the (convex) capturable set without assuming anything about the shape of the optimal input; it
-checks the closed form of :mod:`pushrecovery.surfaces.plane`, h_P(d) + a_p abs(d · e_p) +
-a_r abs(d · e_r) (P grown by the corrected Eq. 15 offset of each axis).
-
-Why that closed form, and when it is exact. With c = (τ_p e_p + τ_r e_r)/(m g) the CMP offset,
-ξ̇ = ω (ξ − p − c), so e^{−ωt} ξ(t) = ξ0 − ω∫_0^t e^{−ωs} (p + c) ds, and ξ stays bounded only if
-ξ0 = ω∫_0^∞ e^{−ωs} p ds + ω∫_0^∞ e^{−ωs} c ds. The first term is a weighted mean of points of P
-(weights integrating to 1): it ranges over P. Integrating the second by parts twice (flywheels
-from rest at 0, bounded), its component on axis j is (ω³ I_j / m g) ∫ e^{−ωs} θ_j ds, which
-ranges over [−a_j, a_j] (the bang-bang θ_j is pointwise maximal, errata E12). So every
-capturable ξ0 lies in P ⊕ {c_p e_p + c_r e_r : abs(c_j) ≤ a_j}; conversely ξ0 = q + Σ c_j e_j is
-captured by holding p = q and driving axis j bang-bang for the T_j ≤ T_max,j that yields c_j
-(then ξ = q ∈ P with the flywheels at rest). The Minkowski sum is therefore an outer bound
-whenever each axis obeys its own limits, and it is the capturable set exactly when the admissible
-inputs form a product: (i) the CoP may be anywhere in P whatever the hip torques (no friction,
-foot-tipping or per-foot loading constraint couples them; in double support any split of the
-load between the feet); (ii) the torque and joint limits are per axis (a box, not a combined
-limit such as ‖τ‖ ≤ τmax or an elliptic joint range, which would cut the box's corners); (iii)
-the body's pitch and roll axes keep their heading (no yaw during the recovery) and the LIPM is
-isotropic at constant height (one ω); (iv) both flywheels start at rest at zero.
-
-Grid and its error, as in the 1-D LP (:mod:`pushrecovery.surfaces.capture_lp`): the inputs are
-piecewise constant on a grid of ``dt`` (a subset of all inputs, so the LP is a lower bound when
-the angle limit holds everywhere) and abs(θ) ≤ θmax is checked at the samples and at three interior
-points of each step, where θ is a parabola with abs(θ̈) ≤ u = τmax/I. Between check points (h =
-dt/4 apart) it can exceed θmax by at most u h²/8, so the LP value is at most the continuous-time
-supremum for the limits θmax + u h²/8 of each axis. When T_max = sqrt(I θmax/τmax) of each axis
-is a whole number of steps and the horizon is at least 2 T_max, the bang-bang witness is on the
-grid and the LP value lies between the two suprema (up to the solver's tolerance, 1e-9 here).
-
-Starting the CoM at the origin (velocity ω ξ0) loses no generality: only the capture point
-enters the constraints (the convergent component of the LIPM is free).
+is a linear program; captured at the horizon means ξ_N ∈ P with both flywheels at rest within
+their limits. Sweeping d traces the (convex) capturable set without assuming the shape of the
+optimal input; it checks the closed form of :mod:`pushrecovery.surfaces.plane`, h_P(d) +
+a_p abs(d · e_p) + a_r abs(d · e_r), derived, with when it is exact, in docs/plane.md ("The
+CMP (hip) region: derivation"). The grid of ``dt`` and its error bound are those of the 1-D LP
+(:mod:`pushrecovery.surfaces.capture_lp`). Starting the CoM at the origin (velocity ω ξ0) loses
+no generality: only the capture point enters the constraints.
 """
 
 from __future__ import annotations

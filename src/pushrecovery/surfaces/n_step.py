@@ -1,33 +1,19 @@
 r"""N-step capturability: the LIPM with feet, a reach and a step time, and the hip.
 
-The model is that of :mod:`pushrecovery.surfaces.plane` (ξ̇ = ω (ξ − p − c): the CoP p in the
-current support, the CMP offset c of the upper body) with steps: at touchdown times
-t_1 < t_2 < ... the landing foot F_k, its ankle at q_k, becomes the support and the previous
-stance foot lifts. A foothold lies in the reach polygon R_k about the stance ankle,
-q_k − q_{k−1} ∈ R_k, and touchdowns are at least Δt_s apart (``min_step_time``); the first
-comes no sooner than Δt_s after deciding to step (or after the remaining swing time).
-
-**Derivation** (``docs/steps.md``). ξ stays bounded if and only if
-ξ_0 = ω∫_0^∞ e^{−ωs} (p(s) + c(s)) ds. Split the CoP integral at the touchdowns, with
-a_k = e^{−ω t_k} and a_{N+1} = 0: over each phase it is a weighted mean of points of that
-phase's support, so it ranges over (1 − a_1) S ⊕ Σ_k (a_k − a_{k+1}) (q_k + F_k), each point
-reached with a CoP held still. With q_k = q_0 + r_1 + ... + r_k,
-Σ_k (a_k − a_{k+1}) q_k = a_1 q_0 + Σ_j a_j r_j. The hip's term ranges over the box H of
-:func:`~pushrecovery.surfaces.plane.cmp_polygon` whatever the touchdowns (the flywheel keeps
-turning through them). So the capture points captured by N steps at these times are
+The model is that of :mod:`pushrecovery.surfaces.plane` (ξ̇ = ω (ξ − p − c)) with steps: at
+touchdown times t_1 < t_2 < ... the landing foot F_k, its ankle at q_k, becomes the support,
+the foothold within the reach polygon R_k about the stance ankle and touchdowns at least Δt_s
+(``min_step_time``) apart. With a_k = e^{−ω t_k} and a_{N+1} = 0, the capture points captured
+by N steps at these times are
 
 .. math:: C_N = H \oplus (1 - a_1) S \oplus \{a_1 q_0\}
           \oplus \bigoplus_{k=1}^N (a_k - a_{k+1}) F_k \oplus \bigoplus_{j=1}^N a_j R_j,
           \qquad (S1)
 
-a convex polygon (a Minkowski sum, :mod:`pushrecovery.ground.minkowski`), with support function
-h(d) = h_H + (1 − a_1) h_S + a_1 d·q_0 + Σ (a_k − a_{k+1}) h_{F_k} + Σ a_j h_{R_j}  (S2).
-Along one direction with point feet (h_F = 0), a disc reach l, touchdowns Δt_s apart from Δt_s
-(a_k = β^k, β = e^{−ωΔt_s}) and no hip, (S2) is Koolen et al. (2012)'s
-d_N = l Σ_{k=1}^N β^k = (d_{N−1} + l) β; a disc foot of radius r adds r (their finite-foot
-d_N); the hip adds its offset. (S1) is exact under the independence conditions of
-:mod:`pushrecovery.surfaces.plane` and with the landing foot alone supporting after each
-touchdown (the double support of a touchdown, a hull, is not used: conservative).
+a convex polygon (:mod:`pushrecovery.ground.minkowski`) with support function
+h(d) = h_H + (1 − a_1) h_S + a_1 d·q_0 + Σ (a_k − a_{k+1}) h_{F_k} + Σ a_j h_{R_j} (S2), H the
+hip's box. Along one direction with point feet it is Koolen et al. (2012)'s d_N. docs/steps.md
+("The N-step capturable set (S1)") derives it and states when it is exact.
 
 Over 400 lines on purpose: the model, its derivation and the exact N-step sets are one
 concept; the LP that checks them is :mod:`pushrecovery.surfaces.capture_lp_steps`.

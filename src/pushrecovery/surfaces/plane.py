@@ -1,32 +1,20 @@
 r"""The capture point and the CoP (ankle) and CMP (hip) regions on the ground plane.
 
 The LIPM of Eq. (6) holds in each horizontal axis with the same ω = sqrt(g/L); the upper body
-torques in pitch (moving the CMP along its x axis, Eq. 6) and in roll (along its y axis):
+torques in pitch and roll move the CMP:
 
 .. math:: \ddot{\mathbf r} = \omega^2 (\mathbf r - \mathbf p - \mathbf c), \qquad
           \boldsymbol\xi = \mathbf r + \dot{\mathbf r} / \omega, \qquad
           \dot{\boldsymbol\xi} = \omega (\boldsymbol\xi - \mathbf p - \mathbf c),
 
 with the CoP p in the support polygon P and the CMP offset c = (τ_pitch, τ_roll)/(m g) in the
-body's axes. Integrating, a state is captured (ξ stays bounded and the flywheels end at rest)
-only if
-
-.. math:: \boldsymbol\xi_0 = \omega\int_0^\infty e^{-\omega s}\,\mathbf p(s)\,ds
-          + \omega\int_0^\infty e^{-\omega s}\,\mathbf c(s)\,ds .
-
-The first term is a weighted mean of points of P (the weights integrate to 1), so it ranges over
-P; the second ranges, axis by axis, over [−a_i, a_i] with a_i the corrected Eq. (15) offset of
-that axis (errata E11, E12: bang-bang is the supremum). When the constraints on p and on each
-axis's torque and angle are independent of one another, the two terms are chosen independently
-and the capturable set is the Minkowski sum (without that independence it is still an outer
-bound)
+body's axes. The capturable set of the hip is the Minkowski sum
 
 .. math:: \mathcal C_{hip} = P \oplus [-a_x, a_x] \times [-a_y, a_y],
 
-an open set (its boundary is reached only as t → ∞, as in Eq. 4). Its support function is
-h_P(d) + a_x abs(d_x) + a_y abs(d_y), checked against a linear program over CoP and torque sequences
-(``tests/test_plane_cmp.py``). Margins are signed Euclidean distances of ξ to a region, positive
-inside (``docs/plane.md``).
+a_i the corrected Eq. (15) offset of each axis (exact when the constraints on p and on each
+axis are independent, an outer bound otherwise; docs/plane.md, "The CMP (hip) region:
+derivation"). Margins are signed Euclidean distances of ξ to a region, positive inside.
 """
 
 from __future__ import annotations

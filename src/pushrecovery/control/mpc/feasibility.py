@@ -1,36 +1,18 @@
 r"""Exact feasibility of Eq. (17): the flywheel's N-step viable set, a polygon in (θ, θ̇).
 
-Only two of Eq. (17)'s constraints can conflict. The CoP rows δ⁻ ≤ δ_i ≤ δ⁺ bound inputs that
-no other row involves (there is no constraint on x), and the exact discretisation of Eq. (16)
+Only the θ rows can make Eq. (17) infeasible, and the exact discretisation of Eq. (16)
 (:func:`~pushrecovery.models.flywheel.flywheel_discrete`) leaves the flywheel a double
-integrator of its own: with s = (θ, θ̇), h = dt²/(2I) and g = dt/I,
+integrator of its own, s_{i+1} = A s_i + b τ_i with s = (θ, θ̇), h = dt²/(2I), g = dt/I,
 
-.. math:: s_{i+1} = A s_i + b τ_i, \qquad A = \begin{bmatrix} 1 & dt \\ 0 & 1 \end{bmatrix},
+.. math:: A = \begin{bmatrix} 1 & dt \\ 0 & 1 \end{bmatrix},
           \quad b = \begin{bmatrix} h \\ g \end{bmatrix}.
 
-So the QP is feasible exactly when s_0 = (θ_0, θ̇_0) lies in the N-step viable set
-S_N = {s_0 : ∃ abs(τ_i) ≤ τmax, i < N, with abs(θ_i) ≤ θmax, i = 1..N}, whatever x_0, ẋ_0. With
-C = {abs(θ) ≤ θmax} and W = {τ b : abs(τ) ≤ τmax} (a segment), S_0 = R² and
-
-.. math:: S_k = \{ s : ∃ τ,\ A s + b τ ∈ C ∩ S_{k−1} \} = A^{−1} \bigl( (C ∩ S_{k−1}) ⊕ W \bigr),
-
-since A s + b τ ∈ P ⇔ A s ∈ P ⊕ (−W) = P ⊕ W. Each step maps a convex polygon to a convex
-polygon: a Minkowski sum with a segment (each vertex moved by ±τmax b, the two vertices where
-the move changes sign doubled), a clip by the strip C and the shear A^{−1}. Exact for any N ≥ 2
-when C ∩ S_0 is replaced by C ∩ {abs(θ̇) ≤ V}, V = 2 ((2 θmax + h τmax)/dt + g τmax): along any
-feasible plan abs(θ̇_{N−1}) ≤ (2 θmax + h τmax)/dt (from θ_N − θ_{N−1} = dt θ̇_{N−1} + h τ_{N−1})
-and abs(θ̇_N) ≤ abs(θ̇_{N−1}) + g τmax, so the box cuts nothing. For N = 1 the set is the strip
-abs(θ + dt θ̇) ≤ θmax + h τmax. The polygon has 68 vertices for the paper's body at N = 50, 100
-and 200 and is built once per (I, τmax, θmax, dt, N) in a few ms.
-
-The test is a gauge. Scaling τmax and θmax by t scales S_N by t (the system is linear), so with
-S_N = {s : n_k · s ≤ 1} the gauge γ(s) = max(0, max_k n_k · s) is the smallest t for which the
-QP with bounds t τmax, t θmax is feasible, and the QP is feasible exactly when γ(s_0) ≤ 1.
-The controller skips DAQP only when γ(s_0) > 1 + :data:`BAND`: a solver that accepts each row
-violated by up to a fraction ε of its bound returns a plan only for γ(s_0) ≤ 1 + ε, and DAQP's
-largest ε (1e−9 on rows of unit norm in its scaled variables) is 1.5e−8 at N = 50, 2.0e−7 at
-N = 100 and 4.0e−5 at N = 200 (late-horizon torque rows), the Riccati passes' 2e−9; inside the
-band DAQP decides, as before.
+So the QP is feasible exactly when s_0 lies in the N-step viable set S_N, built by
+S_k = A^{−1}((C ∩ S_{k−1}) ⊕ W), C = {abs(θ) ≤ θmax}, W = {τ b : abs(τ) ≤ τmax}, and the test
+is the gauge γ(s) = max(0, max_k n_k · s) of S_N = {s : n_k · s ≤ 1}: the QP is feasible
+exactly when γ(s_0) ≤ 1. The controller skips DAQP only when γ(s_0) > 1 + :data:`BAND`
+(DAQP's own tolerance). docs/mpc.md, "Exact feasibility: the flywheel's viable set", derives
+the recursion, its starting box and the band.
 """
 
 from __future__ import annotations

@@ -1,53 +1,18 @@
-r"""The whole-body balance controller: the ankle strategy's tasks for :class:`~.qp.WholeBodyQP`.
+"""The whole-body balance controller: the ankle strategy's tasks for :class:`~.qp.WholeBodyQP`.
 
-Tasks, each an acceleration a PD law asks for (world frame, x forward, y left, z up, SI):
+Each tick the laws ask for accelerations (world frame, x forward, y left, z up, SI): the CoM
+under the DCM law p_des = clip_P(ξ + (k_ξ/ω)(ξ − ξ₀)), c̈_xy = ω²(c_xy − p_des) (CoP balancing,
+Eq. 3; weight 10), the torso upright (1), the pelvis height (1) and the posture (0.01), gains
+and weights in :class:`WbcGains`; with ``hip=params`` the CMP law of :mod:`.hip`, with
+``stepping=True`` the stepper of :mod:`.stepper.stepper`, without stepping the joint guard of
+:mod:`.limits.joint_guard`. docs/humanoid3d_wbc.md, "The tasks" and "The contract", gives each
+law and the contract: a :class:`~pushrecovery.control.base.Controller` over the
+:class:`~.observation.HumanoidObservation` the plant hands it (views of the physics' arrays),
+``compute`` returning a :class:`~.observation.HumanoidCommand`.
 
-* **CoM, CoP balancing (ankle)**: with ω = sqrt(g/z_c) (z_c the CoM height above the soles at
-  reset), the capture point ξ = c + ċ/ω (:func:`~pushrecovery.surfaces.plane.capture_point_xy`)
-  and its rest point ξ₀ (the CoM's ground point at reset), the desired CoP is the DCM law
-
-  .. math:: \mathbf p_{des} = \operatorname{clip}_P\big(\boldsymbol\xi
-            + (k_\xi/\omega)(\boldsymbol\xi - \boldsymbol\xi_0)\big),
-            \qquad \ddot{\mathbf c}_{xy} = \omega^2 (\mathbf c_{xy} - \mathbf p_{des}),
-
-  clipped to the support polygon P of the feet (the convex hull of their soles, the ``Support``
-  of the plane's surfaces). Unclipped, ξ̇ = ω(ξ − p) = −k_ξ (ξ − ξ₀): the capture point returns
-  to ξ₀ at rate k_ξ; clipped, the CoP stays on the edge of P, the saturated CoP balancing of
-  Eq. (3), which recovers every state whose ξ is inside P (Eq. 4). In the QP the CoM task is
-  exact from Newton's law, m c̈ = m g + Σ R_i F_i (z row: c̈_z = 0 is left to the pelvis).
-* **Torso upright**: α = −k_R e − d_R ω_t, e the rotation vector of R_t R_t0ᵀ (R_t0 the torso's
-  orientation at reset), ω_t its angular velocity [rad/s²].
-* **Pelvis height**: z̈ = k_z (z_0 − z) − d_z ż of the torso body's origin [m/s²].
-* **Posture**: q̈_j = k_q (q_j0 − q_j) − d_q q̇_j of every joint dof [rad/s²].
-
-Weights (:class:`WbcGains`): CoM 10, torso 1, pelvis 1, posture 0.01: the CoM law dominates,
-the torso stays upright and the posture fills the null space.
-
-* **Hip, CMP balancing** (``hip=params``, :mod:`.hip`): when the capture point leaves the
-  CoP region, the bang-bang law of Stephens Sec. III commands a CMP offset δ beyond the foot:
-  a momentum task L̇_xy = m g (−δ_y, δ_x) (weight 10), the CoM task c̈ = ω² (c − p_des − δ)
-  with p_des on the edge, the torso task's pitch and roll relaxed (weight 1e-3; its yaw keeps
-  its gains and weight) while it acts; afterwards the torso returns upright under k_R = 4,
-  d_R = 4, paced by the CoP's room (``HipLaw.paced_return``), until within 0.01 rad.
-* **Joint guard** (:mod:`.limits.joint_guard`, without stepping; the stepper guards its knees): the
-  knees kept 0.1 rad off their stops.
-
-* **Stepping** (``stepping=True``, :mod:`.stepper.stepper`): when ξ is beyond the ankles' (and the
-  hip's) region, the foot on ξ's side leaves the contacts and a swing-foot task carries it to
-  the capture region's recommended foothold, re-planned during the swing; at touchdown it
-  rejoins the contacts and the ankles balance about the new feet's midpoint.
-
-Contract: :class:`WholeBodyController` is a :class:`~pushrecovery.control.base.Controller`
-(``reset(state)``, ``compute(t, state)``; ``state`` the plant's CoM state,
-:data:`~.observation.HUMANOID_STATE`). Its laws read the whole body through the
-:class:`~.observation.HumanoidObservation` the plant hands it at construction (views of the
-physics' own arrays: nothing copied per tick), and ``compute`` returns a
-:class:`~.observation.HumanoidCommand`: the motor commands [N m], the DCM law's CoP, and the
-support polygon and stance the plant's fall rule reads when the controller steps.
-
-Over 400 lines on purpose: the task laws above share the controller's state (the reset
-pose, the support, the stepper's phase) tick by tick; the tasks' rows and the QP are in
-:mod:`.tasks` and :mod:`~pushrecovery.control.wbc.qp`.
+Over 400 lines on purpose: the task laws share the controller's state (the reset pose, the
+support, the stepper's phase) tick by tick; the tasks' rows and the QP are in :mod:`.tasks` and
+:mod:`~pushrecovery.control.wbc.qp`.
 """
 
 from __future__ import annotations

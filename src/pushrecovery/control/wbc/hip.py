@@ -1,61 +1,15 @@
-r"""The hip (CMP balancing) law of the whole-body controller: Stephens Sec. III as a feedback.
+"""The hip (CMP balancing) law of the whole-body controller: Stephens Sec. III as a feedback.
 
-Centroidal angular momentum (Lee & Goswami 2012; Orin, Goswami & Lee 2013): the floor's
-wrenches w_i = (F_i, T_i) (sole frames, orientation R_i, origin p_i) change the whole body's
-angular momentum about its CoM c at the rate
-
-.. math:: \dot{\mathbf L} = \sum_i (\mathbf p_i - \mathbf c) \times R_i \mathbf F_i
-          + R_i \mathbf T_i ,
-
-linear in w (:func:`~.momentum.momentum_rows`). With the total vertical force F_z ≈ m g and
-the CoM at a constant height, the horizontal CoM dynamics are those of the LIPM about the
-centroidal moment pivot (CMP; Popovic, Hofmann & Herr 2005, Hofmann et al. 2009):
-
-.. math:: \ddot c_x = \omega^2 (c_x - p_x - \delta_x), \quad
-          \ddot c_y = \omega^2 (c_y - p_y - \delta_y), \qquad
-          \delta_x = \dot L_y / (m g), \quad \delta_y = -\dot L_x / (m g),
-
-p the CoP and δ the CMP's offset from it: Stephens' Eq. (6) with δ = τ/(m g), τ the torque
-the hips put on the upper body (the flywheel). δ_x > 0 (the CMP ahead of the CoP, against a
-forward fall) needs L̇_y > 0: the upper body pitches forward; δ_y > 0 needs L̇_x < 0: it
-rolls to the left. Both into the fall, as in Hofmann et al.'s Fig. 1.
-
-**The law** (per horizontal axis k ∈ {x, y}, :class:`HipLaw`): Stephens' bang-bang torque
-profile (Eqs. 8-12: +τmax for T₁, then −τmax until the flywheel is at rest) run as a switching
-feedback on the measured state. With a_k = τmax,k/(m g), δ⁺ the support polygon's edge on the
-side of the fall (its bounding box, the stance facing +x), s = ±1 that side, h = s L (the
-flywheel's momentum into the fall, L the centroidal angular momentum about the axis: L_y for
-x, −L_x for y), θ = s φ the upper body's tilt into the fall (φ from the torso's rotation since
-reset), I the flywheel's inertia and θmax its angle limit:
-
-* *idle → push* when the library's decision (:meth:`HipLaw.decide`: the capture point ξ
-  outside the CoP region P, the support polygon; inside the CMP region P ⊕ box(a'_x, a'_y) of
-  :func:`~pushrecovery.surfaces.plane.cmp_polygon`, a' the corrected Eq. (15) offsets, is
-  "hip", beyond it "step") says ξ left P, on the side where ξ_k is beyond P's bounding box;
-  the commanded offset is δ_k = s a_k;
-* *push → brake* when braking now (δ_k = −s a_k for T_b = h/τmax, the CoP on δ⁺) would still
-  bring ξ back to μ_ξ inside the edge, s(ξ_k − δ⁺) ≤ −a_k (1 − e^{−ω T_b}) − μ_ξ (from
-  ξ̇ = ω(ξ − δ⁺ − δ), integrated over T_b; the margin μ_ξ = 2 cm absorbs the model's errors:
-  F_z ≠ m g while the torso turns, the CoM's height drop, and leaves the ankles room to bring
-  the torso back), or when the flywheel would not stop before its limit, θ + Δθ ≥ θmax with
-  Δθ = max(h²/(2 I τmax), θ̇ T_b / 2): the flywheel's stopping angle, and the measured spin
-  θ̇ of the upper body over the braking time (the legs turn against the torso, so the torso
-  turns faster than h/I: on the biped3d it overran θmax by 0.06 rad with the first alone);
-* *brake → idle* when h ≤ 0; the brake's torque is min(τmax, h/Δt) so it ends at rest.
-
-While an axis acts, the torso-upright task is relaxed (its weight × ``torso_relaxed``) and the
-momentum task L̇_{x,y} = m g (−δ_y, δ_x) and the CoM task c̈ = ω²(c − p_des − δ) drive the QP;
-afterwards the torso comes back upright under the gentle return gains, and the usual gains
-once it is within :data:`UPRIGHT` of upright.
-
-**The paced return** (:meth:`HipLaw.paced_return`): the torso's return is itself a CMP offset,
-δ = (I α_y, −I_roll α_x)/(m g) for the return law's angular acceleration α, and the DCM law
-needs the CMP at r = ξ + (k_ξ/ω)(ξ − ξ₀): the CoP must be r − δ, inside the support's box
-shrunk by μ_p. So δ is clipped to [r − (high − μ_p), r − (low + μ_p)] and toward zero (never
-past the return law's δ, never against it: a torso that cannot return yet is held), α
-follows δ, and the CoP target is r − δ. Without it the return (k_R = 4 from θ ≈ 1 rad asks
-δ ≈ 0.06 m) needed the CoP beyond the toe while ξ sat 2 cm inside it: ξ left P again, the
-hip pushed a second time from near θmax, and the feet unloaded.
+With F_z ≈ m g the CoM obeys the LIPM about the CMP p + δ, δ = (L̇_y, −L̇_x)/(m g) (L the
+centroidal angular momentum, :func:`~.momentum.momentum_rows`). Per horizontal axis,
+:class:`HipLaw` runs Stephens' bang-bang torque profile (Eqs. 8-12) as a switching feedback on
+the measured state: *idle → push* when the library's decision (:meth:`HipLaw.decide`) says ξ
+left the CoP region P inside the CMP region of
+:func:`~pushrecovery.surfaces.plane.cmp_polygon`; *push → brake* when braking now still brings ξ
+μ_ξ inside the edge, or the flywheel would overrun θmax; *brake → idle* when the momentum into
+the fall is spent. Afterwards the torso returns upright, paced by the CoP's room
+(:meth:`HipLaw.paced_return`), until within :data:`UPRIGHT`. docs/humanoid3d_wbc.md, "The hip
+task", derives each switch and the paced return.
 """
 
 from __future__ import annotations

@@ -1,44 +1,21 @@
 r"""Task-space inverse dynamics as one QP on MuJoCo's own dynamics (docs/humanoid3d_wbc.md).
 
 Each control tick solves, for the joint accelerations q̈ ∈ R^nv and one 6-D contact wrench
-w_i = (F_i, T_i) per foot on the floor (the force and moment the floor exerts on foot i at
-its *sole frame*: the foot body's axes, its origin on the sole plane under the ankle; F_z > 0
-pushes the foot up), the weighted least-squares problem (Del Prete, Mansard et al., "TSID",
-and Wensing & Orin, "Generation of dynamic humanoid behaviors through task-space control
-with conic optimization", ICRA 2013):
+w_i = (F_i, T_i) per foot on the floor (the floor's force and moment on foot i at its sole
+frame; F_z > 0 pushes the foot up), the weighted least-squares problem (Del Prete, Mansard et
+al., "TSID"; Wensing & Orin, ICRA 2013)
 
 .. math:: \min_{x = (\ddot q, w)} \sum_k W_k \lVert A_k x - b_k \rVert^2
           + \epsilon_a \lVert \ddot q \rVert^2 + \epsilon_f \lVert w \rVert^2
 
-subject to
-
-* the floating-base (and every unactuated dof's) rows of the dynamics, with MuJoCo's joint-space
-  inertia M (``mj_fullM``, armature included) and bias h = ``qfrc_bias`` − ``qfrc_passive``
-  (Coriolis, centrifugal and gravity, minus springs and damping) [N, N m]:
-  M_u q̈ + h_u = J_{c,u}^T w (the actuated rows give the torques τ = M_a q̈ + h_a − J_{c,a}^T w);
-* each foot fixed on the floor: J_i q̈ + J̇_i q̇ = −k_c J_i q̇ with J_i the 6 × nv world Jacobian
-  of the sole frame (``mj_jac``), J̇_i q̇ its bias acceleration (``mj_jacDot``) [m/s², rad/s²]
-  and k_c ≥ 0 (``contact_damping``, :data:`CONTACT_DAMPING` = 20 /s) a damping of a drifting
-  foot [1/s] (with k_c = 0 the feet crept and tipped under MuJoCo's soft contact unseen:
-  docs/humanoid3d_wbc.md, "The QP");
-  a foot off the floor (:meth:`WholeBodyQP.set_contacts`, a swing) has w_i = 0 instead and no
-  wrench inequalities (its motion is a task, :mod:`.stepper.stepper`);
-* unilateral contact F_z ≥ 0 and a linearised friction pyramid abs(F_x), abs(F_y) ≤ μ' F_z with
-  μ' = μ/√2 (the square inscribed in Coulomb's cone of μ; μ the larger sliding friction of
-  the sole's and the floor's geoms, MuJoCo's mixing rule);
-* the CoP p = (−T_y, T_x)/F_z of each wrench inside its foot's sole polygon: for each edge
-  n·p ≤ d, n_x (−T_y) + n_y T_x − d F_z ≤ 0 (linear in w);
-* yaw friction abs(T_z) ≤ μ' r F_z, r the sole polygon's inscribed radius about the sole frame's
-  origin (a conservative bound of the torsional friction);
-* motor limits: the torque of each motor, τ_a / gear, within its ``actuator_ctrlrange``.
-
-The tasks A_k x = b_k are handed in by the controller (:mod:`~pushrecovery.control.wbc.controller`):
-the CoM's acceleration, exact from Newton's law on the wrenches, m c̈ = m g + Σ_i R_i F_i; the
-torso's angular acceleration J_r q̈ + J̇_r q̇; the pelvis height z̈ = J_z q̈ + J̇_z q̇; and the
-posture q̈_j. Solved with DAQP (a dense dual active-set solver), its models kept between ticks (the
-equality rows immutable, the last active set the warm start), first without the motor rows.
-The compiled kernels of :mod:`.kernels.wbc` assemble each tick in place and hand DAQP its
-least-distance form (H factored on its envelope). MuJoCo's types appear as ``Any``.
+subject to the floating-base rows of the dynamics M_u q̈ + h_u = J_{c,u}^T w, each foot on the
+floor fixed, J_i q̈ + J̇_i q̇ = −k_c J_i q̇ (:data:`CONTACT_DAMPING` k_c [1/s]; a swinging foot
+has w_i = 0 instead, :meth:`WholeBodyQP.set_contacts`), unilateral contact and a friction
+pyramid abs(F_x), abs(F_y) ≤ μ' F_z (μ' = μ/√2), each foot's CoP (−T_y, T_x)/F_z inside its
+sole polygon, yaw friction abs(T_z) ≤ μ' r F_z and the motor limits; the tasks A_k x = b_k come
+from :mod:`~pushrecovery.control.wbc.controller`. Solved with DAQP, its model kept between
+ticks, first without the motor rows; :mod:`.kernels.wbc` assembles each tick in place and hands
+DAQP its least-distance form. MuJoCo's types appear as ``Any``.
 """
 
 from __future__ import annotations

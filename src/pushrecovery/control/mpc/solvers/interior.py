@@ -1,33 +1,21 @@
-r"""Eq. (17) with the states kept, solved by a primal-dual interior point with Riccati steps.
+"""Eq. (17) with the states kept, solved by a primal-dual interior point with Riccati steps.
 
-The sparse form (:class:`~pushrecovery.control.mpc.problem.SparseQP`: inputs u_i and states x_{i+1},
-dynamics as equalities, three bounded components per stage: δ_i, τ_i, θ_{i+1}), solved by
-Mehrotra's predictor-corrector method (Nocedal & Wright 2006, Alg. 16.4) from a cold start.
-Every bound is a bound on one variable, so eliminating the slacks and the bounds' multipliers
-leaves, at each Newton step, an equality-constrained LQ problem with diagonal weights
-2W + Σ (Σ = z/s on the bounded components): a Riccati recursion solves it in O(N) with 4 × 4
-and 2 × 2 algebra (Rao, Wright & Rawlings 1998), and the corrector reuses the predictor's
-factors. A pure state bound (θ_{i+1} at its limit while τ_i is at its own), which the
-active-set passes cannot represent, is for it a diagonal weight like any other.
+The sparse form (:class:`~pushrecovery.control.mpc.problem.SparseQP`: inputs u_i and states
+x_{i+1}, dynamics as equalities, three bounded components per stage: δ_i, τ_i, θ_{i+1}), solved
+by Mehrotra's predictor-corrector method (Nocedal & Wright 2006, Alg. 16.4). Every bound is a
+bound on one variable, so each Newton step is an equality-constrained LQ problem with diagonal
+weights 2W + z/s: a Riccati recursion solves it in O(N) (Rao, Wright & Rawlings 1998), and the
+corrector reuses the predictor's factors. A pure state bound (θ_{i+1} at its limit while τ_i is
+at its own) is for it a diagonal weight like any other.
 
-Its place in the route (:mod:`~pushrecovery.control.mpc.solvers.route`): the passes of
-:class:`~pushrecovery.control.mpc.solvers.riccati.RiccatiSolver` solve most ticks in a few µs
-from the previous tick's active set; a tick they do not verify (a push's first tick, an active
-set far from the last, a degenerate stage) comes here, no Hessian ever formed (its conditioning
-does not grow with N, as the condensed QP's does). The iterate's active set (a bound whose
-multiplier exceeds its slack in the units below) is offered to the passes (``polish``), which
-verify the KKT conditions exactly; if they cannot (a degenerate stage), the interior point's
-own solution stands, converged to :data:`TOL` of every scale. Its iteration counts and the
-constants they set are in docs/mpc.md, "The route's constants".
-
-Scales. A bound's multiplier z is measured against H_jj × range_j, the multiplier that would
-move an unconstrained input by its whole range (H = 2 W^u_i + B^T S_{i+1} B, S the
-unconstrained problem's cost-to-go); the θ bound's against the torque's divided by abs(B_θτ)
-(θ moves by B_θτ τ), and a state's stationarity row against the inputs' scales divided by the
-entries of B that carry it. Convergence: every bound's residual and complementarity product below
-:data:`TOL` of its scale (× the range for products), every stationarity row below
-:data:`DUAL_TOL` of its own. Measured against DAQP on the condensed QP
-(``tests/test_mpc_interior.py``): first inputs equal to better than 1e-7 of their ranges.
+In the route (:mod:`~pushrecovery.control.mpc.solvers.route`; docs/mpc.md, "How a tick is
+solved") it takes the ticks the warm Riccati passes do not verify, and offers its active set
+to the passes (``polish``); if they cannot verify it, its own solution stands, converged to
+:data:`TOL` of every scale. Scales: a bound's multiplier z is measured against H_jj × range_j
+(H = 2 W^u_i + B^T S_{i+1} B, S the unconstrained problem's cost-to-go), the θ bound's against
+the torque's divided by abs(B_θτ), and a state's stationarity row against the inputs' scales
+divided by the entries of B that carry it; converged when every residual and complementarity
+product is below :data:`TOL` of its scale and every stationarity row below :data:`DUAL_TOL`.
 """
 
 from __future__ import annotations

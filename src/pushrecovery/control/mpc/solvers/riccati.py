@@ -2,12 +2,9 @@ r"""Eq. (17) with the states kept, solved exactly by a warm-started active set a
 
 The sparse form of Eq. (17): variables u_0..u_{N−1} and x_1..x_N, the dynamics
 x_{i+1} = A x_i + B u_i as equalities, and per stage three inequality rows: δ⁻ ≤ δ_i ≤ δ⁺,
-abs(τ_i) ≤ τmax and abs(θ_{i+1}) ≤ θmax (θ_{i+1} = A_θ x_i + B_θ u_i, a row of stage i). For a fixed
-set of rows held at their bounds, the minimiser is that of an equality-constrained LQ problem:
-a backward Riccati recursion (per stage, the inputs are split into the part the active rows fix,
-an affine function of x_i, and a free part minimised in closed form) and a forward pass give
-it in O(N) with 2 × 2 and 4 × 4 algebra, without ever forming the N-sized Hessian. A backward
-pass of the costates
+abs(τ_i) ≤ τmax and abs(θ_{i+1}) ≤ θmax. For a fixed set of rows held at their bounds, the
+minimiser is that of an equality-constrained LQ problem: a backward Riccati recursion and a
+forward pass give it in O(N) with 2 × 2 and 4 × 4 algebra, and a backward pass of the costates
 
 .. math::
 
@@ -15,30 +12,17 @@ pass of the costates
     2 W^u_i u_i + B^T λ_{i+1} + μ_i = 0
 
 gives the multipliers μ (input rows) and ν (θ rows) of the active rows. The point is Eq. (17)'s
-minimiser exactly when the KKT conditions hold: the inactive rows within their bounds (to
-:data:`PRIMAL_TOL` of each range) and every multiplier of the right sign (to
-:data:`DUAL_TOL` of the displacement it would cause, μ_j / H_jj against the range of input j,
-with H the stage's input Hessian W^u_i + B^T S_{i+1} B). The QP is strictly convex, so that
-point is unique.
+(unique) minimiser exactly when the inactive rows hold (to :data:`PRIMAL_TOL` of each range)
+and every multiplier has the right sign (to :data:`DUAL_TOL` of the displacement it would
+cause, μ_j / H_jj against the range of input j, H = W^u_i + B^T S_{i+1} B).
 
-The active set is found by primal–dual active-set passes (Hintermüller, Ito & Kunisch 2002):
-each pass releases the rows whose multipliers have the wrong sign and adds the violated ones.
-A receding horizon makes this cheap: the next tick's active set is nearly the previous one
-shifted by a stage, which is where the passes start (two or three passes per tick in a pushed
-run). There is no Hessian to condition: the Riccati recursion is the numerically stable way to
-solve an LQ problem at any horizon, and its cost grows linearly with N. The pass budgets are
-set by ``make bench`` (docs/mpc.md, "The route's constants").
-
-A stage where τ_i and θ_{i+1} are both at a bound makes the θ row a pure state constraint:
-it is carried back through the stages whose torques are held to the latest one whose torque is
-free (the derivation is in the kernel's docstring). On the boundary of the flywheel's viable
-set the caller may hold the first stages' torques at full braking (``Guess.forced``, the only
-plans there) instead. When the passes do not verify an optimum (cycling, an infeasible QP, too
-many passes) the route (:mod:`~pushrecovery.control.mpc.solvers.route`) solves the tick by the
-interior point (:mod:`~pushrecovery.control.mpc.solvers.interior`), whose active set the passes
-then verify, or near the viable set's boundary by DAQP on the condensed QP, and may
-:meth:`RiccatiSolver.seed` the next tick with its active set. Everything here depends on the
-body (through A, B, the bounds) and the settings only, and costs about 0.1 ms to set up.
+The active set is found by primal–dual active-set passes (Hintermüller, Ito & Kunisch 2002),
+started from the last tick's set shifted by a stage; docs/mpc.md, "How a tick is solved",
+gives the pass budgets, the state rows carried back (derived in
+:mod:`pushrecovery.kernels.mpc.riccati`), the braking held on the viable set's boundary and
+what the route (:mod:`~pushrecovery.control.mpc.solvers.route`) does when the passes do not
+verify an optimum. Everything here depends on the body (through A, B, the bounds) and the
+settings only, and costs about 0.1 ms to set up.
 """
 
 from __future__ import annotations

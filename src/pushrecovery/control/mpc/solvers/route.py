@@ -1,24 +1,15 @@
 """The route of a tick: which solver solves it, in what order (docs/mpc.md, "How a tick is solved").
 
-:meth:`Route.solve` is the controller's one entry. With ``solver="daqp"`` (the default), each step
-only if the previous one did not give a plan:
-
-1. the Riccati passes from the last tick's active set shifted by one stage
-   (:class:`~pushrecovery.control.mpc.solvers.riccati.RiccatiSolver`);
-2. the exact feasibility test (the gauge of the flywheel's viable set,
-   :class:`~pushrecovery.control.mpc.feasibility.FlywheelFeasibility`): beyond every solver's
-   tolerance, the fallback at once;
-3. inside the viable set, the interior point
-   (:class:`~pushrecovery.control.mpc.solvers.interior.InteriorPointSolver`), whose active set
-   the passes verify; on its boundary, where the feasible set has no interior, full braking
-   held and the passes from the active sets of the interior point on a problem with θmax
-   :data:`RELAXED` larger, then from the last tick's set;
-4. the condensed QP in a warm DAQP workspace
-   (:class:`~pushrecovery.control.mpc.solvers.daqp.DaqpSolver`, built on first need);
-5. the saturated fallback (INFEASIBLE): the CoP at the capture point clipped to the foot, full
-   torque braking the flywheel, held over the horizon.
-
-Other solvers, or ``daqp`` without its workspace, solve the condensed QP through
+:meth:`Route.solve` is the controller's one entry. With ``solver="daqp"`` (the default), each
+step only if the previous one did not give a plan: the warm Riccati passes
+(:class:`~pushrecovery.control.mpc.solvers.riccati.RiccatiSolver`); the exact feasibility test
+(:class:`~pushrecovery.control.mpc.feasibility.FlywheelFeasibility`), beyond every solver's
+tolerance the fallback at once; inside the viable set the interior point
+(:class:`~pushrecovery.control.mpc.solvers.interior.InteriorPointSolver`), whose active set the
+passes verify, and on its boundary full braking held with the passes started from a problem
+with θmax :data:`RELAXED` larger; the condensed QP in a warm DAQP workspace
+(:class:`~pushrecovery.control.mpc.solvers.daqp.DaqpSolver`); last the saturated fallback
+(INFEASIBLE). Other solvers, or ``daqp`` without its workspace, solve the condensed QP through
 ``qpsolvers.solve_qp`` at every tick
 (:class:`~pushrecovery.control.mpc.solvers.solve_qp.SolveQpSolver`), then the fallback.
 """

@@ -1,27 +1,18 @@
 r"""The joint-range guard of the whole-body controller: keep every joint off its stops.
 
-The QP (:mod:`~pushrecovery.control.wbc.qp`) models the motors, the contacts and the rigid-body
-dynamics, but not a joint's range: the constraint force of a joint on its stop (MuJoCo's limit
-constraint) is missing from its dynamics rows, so a task that drives a joint onto its stop gets a
-wrong answer from the QP, and a leg on the knee's stop is also straight, a kinematic singularity of
-the contact Jacobian (the QP becomes ill-conditioned). Measured on the biped3d's hip push
-(the knee guard of docs/humanoid3d_wbc.md, "The QP"): the torso pitched 0.95 rad forward while
-the CoM task held the CoM over the feet and the pelvis task held the hips at their height; the
-hips moved back 0.11 m and the knees straightened onto their stop (0 rad; −0.01 to −0.015
-rad, pressed into it, with the feet's drift damped); with the guard they stay at 0.098 rad.
-
-**The guard** (:class:`JointGuard`): for each guarded joint (by default the knees,
-:class:`GuardSettings`), a limited hinge or slide with range
-[q_lo, q_hi] and a margin μ_q, while its predicted position q̂ = q + T min(q̇, 0) (T the
-look-ahead) is within the margin, q̂ < q_lo + μ_q, the task
+The QP (:mod:`~pushrecovery.control.wbc.qp`) does not model a joint's range: a task that drives
+a joint onto its stop gets a wrong answer, and a leg on the knee's stop is straight, a
+singularity of the contact Jacobian. (On the biped3d's hip push the knees straightened onto
+their stop; with the guard they stay at 0.098 rad.) :class:`JointGuard` gives each guarded
+joint (by default the knees, :class:`GuardSettings`) with range [q_lo, q_hi] and margin μ_q,
+while its predicted position q̂ = q + T min(q̇, 0) is within the margin, the task
 
 .. math:: \ddot q = k \max(q_{lo} + \mu_q - q, 0) - d \min(\dot q, 0)
 
 of weight W (and the mirror image at q_hi; an edge inside which the reference posture lies
-moves to the posture, :meth:`JointGuard.set_posture`): a damper on the approach and a spring back to
-the margin's edge, never a pull towards the stop (at the switch, q̂ = q_lo + μ_q, its target
-is the damper's alone, small when the joint is slow). A soft task, not a hard bound: a hard
-bound can conflict with the contact rows and the torque limits and leave the QP infeasible.
+moves to the posture, :meth:`JointGuard.set_posture`): a damper on the approach and a spring
+back to the margin's edge, never a pull towards the stop. A soft task, not a hard bound, which
+could conflict with the contact rows and the torque limits (docs/humanoid3d_wbc.md, "The QP").
 """
 
 from __future__ import annotations

@@ -1,31 +1,18 @@
 r"""Planning a step of the whole-body controller: the swing leg, its foothold and swing time.
 
-World frame, x forward, y left, z up, SI units. Used by :class:`~.stepper.stepper.Stepper`.
+World frame, x forward, y left, z up, SI units. Used by :class:`~.stepper.stepper.Stepper`:
+:func:`plan_foothold` takes the recommended ``foothold`` (the Chebyshev centre) of the
+library's one-step capture region
+(:func:`~pushrecovery.surfaces.capture_region.capture_region`) for the stance foot alone, cut
+to the half-plane ``min_step_width`` out on the landing side when the straight swing would meet
+the stance sole (:func:`collides`, :func:`planning_params`), with a two-step plan and a clipped
+fallback after it; :func:`choose_step` picks the foot (the library's side rule; after a
+touchdown the trailing foot, unless the landed foot's plan captures in fewer steps); and
+:func:`~.leg.leg_swing_time` the swing time the swing hip can drive,
 
-* **Foothold** (:func:`plan_foothold`): the library's one-step capture region
-  (:func:`~pushrecovery.surfaces.capture_region.capture_region`) of the CoM state for a
-  touchdown after t, the stance foot's measured pose as a single-support
-  :class:`~pushrecovery.ground.support.Support` (a crossed or touching pair of feet is no
-  valid double support; the swing foot is named instead); its recommended ``foothold`` (the
-  region's Chebyshev centre). An empty region falls back to the first foothold of a two-step
-  plan, then to the stance ankle plus the capture point's offset clipped to the step length.
-  **No crossing**: when the straight swing to that foothold meets the stance sole
-  (:func:`collides`), the region cut to the half-plane ``min_step_width`` out on the landing
-  foot's side (:func:`planning_params`).
-* **Which foot** (:func:`choose_step`): the library's side rule; after a touchdown the
-  trailing foot, unless the landed foot's plan captures in fewer steps.
-* **Swing time** (:func:`~.leg.leg_swing_time`): the step time of the plan is what
-  the swing hip can drive. The swing foot's quintic (rest to rest, distance d in time T) peaks at
-  a = (10/√3) d / T²; the leg swings about the hip, so with Δθ = d/ℓ (ℓ the hip's height
-  above the floor), I the leg's inertia about the hip axis and a share κ of the hip motor's
-  limit τ,
+.. math:: T \ge \sqrt{\frac{10}{\sqrt 3}\,\frac{\Delta\theta\, I}{\kappa\, \tau}}
 
-  .. math:: T \ge \sqrt{\frac{10}{\sqrt 3}\,\frac{\Delta\theta\, I}{\kappa\, \tau}}
-
-  per axis (pitch for the forward part of d, roll for the lateral part, in the pelvis'
-  heading), d the change of the foot's offset from the hip: the hip moves with the CoM,
-  c(T) = p + (c − p) cosh ωT + (ċ/ω) sinh ωT (the LIPM on the stance ankle p).
-  :class:`~.stepper.stepper.Stepper` re-plans with the longer time until the two agree.
+per axis. docs/humanoid3d_stepping.md, "The plan", gives each rule and why.
 """
 
 from __future__ import annotations

@@ -1,49 +1,15 @@
-r"""The stepping task of the whole-body controller: decide, plan, swing and land a foot.
+"""The stepping task of the whole-body controller: decide, plan, swing and land a foot.
 
-World frame, x forward, y left, z up, SI units. A :class:`Stepper` runs inside
-:class:`~.controller.WholeBodyController` (``stepping=True``) at every control tick:
-
-* **Decision** (double support): step when the capture point ξ = c + ċ/ω is beyond what the
-  ankles (and the hip, if enabled) recover: its signed distance to the CoP region P (or the
-  CMP region P ⊕ box(a'_x, a'_y), :class:`~.hip.HipLaw`) below −``margin``.
-* **Plan** (:mod:`~pushrecovery.control.wbc.stepper.plan`): the foot on ξ's side of the ankles'
-  midpoint swings (within ``follow_time`` of a touchdown, the trailing foot unless the landed
-  foot's plan captures in fewer steps, :func:`~.plan.choose_step`); the library's one-step
-  (else two-step) capture region of the state now, the stance foot's measured pose, a
-  touchdown after t_s, and (when the controller has its hip task) the hip's box; its
-  recommended ``foothold`` (the region's Chebyshev centre) is the landing ankle's target;
-  when the straight swing to it would meet the stance sole, the region cut to the half-plane
-  ``foot_width`` + ``clearance`` out on the landing side (no crossing steps). t_s starts at
-  ``swing_time`` (default the body's ``min_step_time``) and grows to what a share
-  ``torque_share`` of the swing hip's motor limit needs for that foothold (the plan redone
-  for the longer time), up to ``max_swing_time``.
-* **Swing**: the foot is dropped from the QP's contacts (:meth:`~.qp.WholeBodyQP.set_contacts`)
-  and its sole frame tracks a reference: in x, y a quintic from the reference's position,
-  velocity and acceleration to the foothold with zero velocity and acceleration at the
-  touchdown time t_1; in z, with s = (t − t_0)/(t_1 − t_0),
-
-  .. math:: z(s) = z_0 + (z_1 - z_0)(10 s^3 - 15 s^4 + 6 s^5) + 64 h\, s^3 (1 - s)^3,
-
-  h the lift [m], z_1 = z_0 − ``sink`` (aimed just below the floor so that the sole meets
-  it); after t_1 the reference keeps sinking at ``sink_speed``. The task
-  (:mod:`~.tasks.swing_foot`) is the sole frame's acceleration J q̈ + J̇ q̇ = a_ref + k_p
-  (p_ref − p) + k_d (v_ref − v) (linear) and −k_R e − d_R ω (angular, e the rotation vector
-  from the lift-off orientation); its vertical row weighs ``lift_weight`` times more (a foot
-  that stays on the floor cannot step).
-* **Knee guard** (always, with stepping, :mod:`~.limits.knee_guard`): a knee below
-  ``knee_min`` or reaching it within 50 ms gets the task q̈ = k_p (q_min − q) − d_p q̇: the QP
-  does not model the joint stop, and a stance knee driven onto it made the QP infeasible
-  (torque limits with the contact rows).
-* **Pelvis height** (:meth:`Stepper.pelvis_height`, :mod:`.height`): the pelvis
-  task's target lowered so that every knee stays bent by ``knee_reach`` (the swinging leg at
-  its foothold), by at most ``max_drop``.
-* **Re-plan**: every ``replan_period`` until ``replan_fraction`` of the swing, the foothold
-  is recomputed from the current state in single support with the remaining swing time, and
-  the x, y quintic restarts from the reference's current state.
-* **Touchdown**: after half the swing, when the foot's lowest sole point is within ``contact``
-  of the floor; the foot rejoins the contacts, the support polygon and the balance point (the
-  ankles' midpoint) are re-measured, and the ankles balance: a second step follows if ξ is
-  still beyond the new region (by the trailing foot, above).
+A :class:`Stepper` runs inside :class:`~.controller.WholeBodyController` (``stepping=True``) at
+every control tick (world frame, x forward, y left, z up, SI units): in double support it steps
+when ξ = c + ċ/ω is more than ``margin`` beyond the ankles' (and the hip's) region; the foot is
+dropped from the QP's contacts (:meth:`~.qp.WholeBodyQP.set_contacts`) and its sole tracks a
+quintic swing to the foothold of :mod:`~pushrecovery.control.wbc.stepper.plan`, re-planned
+every ``replan_period`` early in the swing, with the knee guard of :mod:`~.limits.knee_guard`
+and the pelvis lowered (:meth:`Stepper.pelvis_height`, :mod:`.height`); it lands when its sole
+is within ``contact`` of the floor after half the swing, and the ankles balance about the new
+feet (a second step follows if ξ is still beyond the new region). docs/humanoid3d_stepping.md
+gives each phase's law and constants.
 """
 
 from __future__ import annotations
