@@ -15,11 +15,9 @@ from numpy.typing import NDArray
 from pushrecovery.arguments import bounded_float, finite_float, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
-    Shape,
     decompose_unchecked,
     minkowski_sum_loop,
     minkowski_sum_unchecked,
-    stacked_shapes,
 )
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance
@@ -258,19 +256,6 @@ def _numpy_foothold(  # pragma: no cover - only when the compiled simplex fails
     option = _world_option(swing, yaw, stance_key, np.zeros(2))
     _, foothold = _foothold_and_centre(relative, params, option, touchdown, steps, hip)
     return foothold
-
-
-def _split(
-    target: FloatArray, split: list[tuple[float, Shape]]
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Decompose ``target`` in the sum of ``split`` (compiled: a plan does it at every step)."""
-    from pushrecovery.kernels.polygons import decompose_loop, minkowski_loop
-
-    stacked, counts, weights = stacked_shapes(split)
-    origin = np.zeros(2)
-    total = minkowski_loop(stacked, counts, weights, origin)
-    points, _ = decompose_loop(target, stacked, counts, weights, origin, total)
-    return points[0], points[1], points[2]
 
 
 def _decomposed(
