@@ -26,6 +26,7 @@ import numpy as np
 from pushrecovery import load_params
 from pushrecovery.control import make_controller
 from pushrecovery.sim.critical import pushed_state
+from pushrecovery.sim.push import Push
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import RestCriterion, simulate
 
@@ -62,7 +63,7 @@ def realtime() -> tuple[float, float, float, float]:
 
     def start() -> np.ndarray:
         plant.reset(0.0, 0.0)
-        return plant.push(IMPULSE)
+        return plant.apply_push(Push.from_impulse(IMPULSE, params.mass))
 
     # The trajectory once, recorded: the state after the push and every step's controls.
     state = start()

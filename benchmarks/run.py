@@ -59,6 +59,7 @@ import numpy as np
 
 from pushrecovery import load_params
 from pushrecovery.control import make_controller
+from pushrecovery.sim.push import PUSH_DURATION, Push
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.cop import cop_margin
@@ -196,10 +197,11 @@ def mujoco_realtime() -> float:
     params = load_params()
     plant, ctrl = make_plant("torso", params, "mujoco"), make_controller("mpc", params)
     never = RestCriterion(duration=1e3)  # run the whole 3 s
+    push = Push.from_impulse(40.0, params.mass)
 
     def loop():
         plant.reset(0.0, 0.0)
-        simulate(plant, ctrl, plant.push(40.0), duration=3.0, rest=never)
+        simulate(plant, ctrl, plant.apply_push(push), duration=3.0, rest=never)
 
     def bare():
         plant.reset(0.0, 0.0)
@@ -211,7 +213,7 @@ def mujoco_realtime() -> float:
             ctrl.compute(0.02 * k, state)
 
     plant.reset(0.0, 0.0)
-    states = simulate(plant, ctrl, plant.push(40.0), duration=3.0, rest=never).states[:-1]
+    states = simulate(plant, ctrl, plant.apply_push(push), duration=3.0, rest=never).states[:-1]
     # The settling before each run (0.3 s of physics) is in both timings.
     settle = best(lambda: plant.reset(0.0, 0.0), number=1)
     wall = best(loop) - settle
@@ -247,7 +249,7 @@ def batch() -> None:
         def mujoco_batch(plant=plant, ctrl=ctrl):
             for v in speeds:
                 plant.reset(0.0, 0.0)
-                simulate(plant, ctrl, plant.push(params.mass * v), duration=6.0)
+                simulate(plant, ctrl, plant.apply_push(Push(v)), duration=6.0)
 
         def analytic_batch(reference=reference, ctrl=ctrl, starts=starts):
             for state in starts:
@@ -354,7 +356,6 @@ def mujoco_campaign() -> float:
     from pushrecovery.campaign import CampaignSpec
     from pushrecovery.campaign.pushes import run_batch
     from pushrecovery.sim.mujoco.models import TIMESTEP
-    from pushrecovery.sim.mujoco.plant import PUSH_DURATION
     from pushrecovery.sim.registry import make_plant
 
     params = load_params()

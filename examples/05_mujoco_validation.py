@@ -14,6 +14,7 @@ import numpy as np
 from pushrecovery import load_params
 from pushrecovery.control import make_controller
 from pushrecovery.sim.mujoco.render import render_run
+from pushrecovery.sim.push import Push
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.sim.validation import LABELS, confusion_matrix, critical_table
@@ -75,9 +76,8 @@ def main() -> None:
         plant = make_plant(model, params, "mujoco")
         plant.record()
         plant.reset(0.0, 0.0)
-        result = simulate(
-            plant, make_controller(controller, params), plant.push(impulse), duration=4.0
-        )
+        pushed = plant.apply_push(Push.from_impulse(impulse, params.mass))
+        result = simulate(plant, make_controller(controller, params), pushed, duration=4.0)
         files = render_run(
             plant.model,
             plant.frames,

@@ -40,7 +40,7 @@ def test_a_scheduled_push_is_the_pushed_start_delayed():
         make_controller("ankle-pd", P),
         start,
         duration=3.0 + quiet,
-        push=ScheduledPush(quiet, Push(0.4), kind="velocity"),
+        push=ScheduledPush(quiet, Push(0.4, "velocity")),
     )
     direct = simulate(
         make_plant("pendulum", P), make_controller("ankle-pd", P), np.array([0.0, 0.4])
@@ -101,7 +101,7 @@ def test_bad_loop_arguments_are_refused(kwargs, match):
     with pytest.raises(InvalidParameterError, match="push time"):
         ScheduledPush(-1.0, Push(0.1))
     with pytest.raises(InvalidParameterError, match="kind"):
-        ScheduledPush(0.0, Push(0.1), kind="shove")
+        Push(0.1, "shove")  # type: ignore[arg-type]
     with pytest.raises(ParameterTypeError, match="push must be a Push or Push3D, got float"):
         ScheduledPush(0.0, 0.3)  # type: ignore[arg-type]
 

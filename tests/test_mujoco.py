@@ -7,6 +7,7 @@ import pytest
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import Command, make_controller
 from pushrecovery.sim.critical import critical_push
+from pushrecovery.sim.push import Push
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.sim.validation import mujoco_corrected_prediction
@@ -18,7 +19,7 @@ def run(controller, v=0.0, impulse=None, duration=6.0, model="foot"):
     plant = make_plant(model, P, "mujoco")
     state = plant.reset(0.0, v if impulse is None else 0.0)
     if impulse is not None:
-        state = plant.push(impulse)
+        state = plant.apply_push(Push.from_impulse(impulse, P.mass))
     return plant, simulate(plant, make_controller(controller, P), state, duration=duration)
 
 
@@ -76,7 +77,7 @@ def test_push_as_a_real_force():
 def test_push_ends_with_the_momentum_of_the_impulse():
     plant = make_plant("torso", P, "mujoco")
     plant.reset(0.0, 0.0)
-    state = plant.push(36.0)
+    state = plant.apply_push(Push.from_impulse(36.0, P.mass))
     # The contact pushes back only through the ankle torque holding the CoP under the CoM:
     # over 10 ms the CoM gains J / m = 0.5 m/s to within the gravity moment's share (< 1 %).
     assert state[2] == pytest.approx(0.5, rel=0.01)
@@ -107,10 +108,19 @@ def test_bad_mujoco_requests():
     with pytest.raises(InvalidParameterError, match="backend must be"):
         make_plant("foot", P, "bullet")
     plant = make_plant("foot", P, "mujoco")
-    with pytest.raises(InvalidParameterError, match="duration must be >= the MuJoCo step"):
-        plant.schedule_push(10.0, duration=4e-4)
-    with pytest.raises(InvalidParameterError, match="impulse and duration must be finite"):
-        plant.schedule_push(float("nan"))
+    plant.reset(0.0, 0.0)
+    with pytest.raises(InvalidParameterError, match=r"duration must be >= the MuJoCo step 0\.001"):
+        plant.apply_push(Push.from_impulse(10.0, P.mass, duration=4e-4))
+    with pytest.raises(InvalidParameterError, match="impulse must be a finite number"):
+        Push.from_impulse(float("nan"), P.mass)
+    with pytest.raises(InvalidParameterError, match=r"duration must be a finite number > 0 \[s\]"):
+        Push(0.1, duration=float("inf"))
+    limit = r"xdot must satisfy \|xdot\| < 10 sqrt\(g L\)"
+    for kind in ("force", "velocity"):
+        with pytest.raises(InvalidParameterError, match=limit):
+            plant.apply_push(Push(40.0, kind))
+    with pytest.raises(InvalidParameterError, match="push kind must be 'force' or 'velocity'"):
+        Push(0.1, "shove")  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(
@@ -246,12 +256,33 @@ def test_cli_mujoco_bad_input_is_one_line(capsys, args, words):
 def test_push_a_named_body():
     plant = make_plant("torso", P, "mujoco")
     plant.reset(0.0, 0.0)
-    at_com = plant.push(20.0)
+    at_com = plant.apply_push(Push.from_impulse(20.0, P.mass))
     plant.reset(0.0, 0.0)
-    named = plant.push(20.0, body="torso")  # the CoM body by name: the same push
+    # The CoM body by name: the same push.
+    named = plant.apply_push(Push.from_impulse(20.0, P.mass, body="torso"))
     np.testing.assert_array_equal(at_com, named)
     with pytest.raises(InvalidParameterError, match="body must be one of"):
-        plant.push(20.0, body="head")
+        plant.apply_push(Push.from_impulse(20.0, P.mass, body="head"))
+    with pytest.raises(InvalidParameterError, match="body must be a body name of 1 to 100"):
+        Push(0.1, body="")
+
+
+def test_scheduled_push_acts_from_the_next_step():
+    plant = make_plant("torso", P, "mujoco")
+    before = plant.reset(0.0, 0.0)
+    now = plant.apply_push(Push.from_impulse(20.0, P.mass, duration=0.0104, scheduled=True))
+    np.testing.assert_array_equal(now, before)  # nothing moves yet
+    assert plant.push_left == pytest.approx(0.010)  # 10 whole 1 ms steps
+    plant.step(Command(0.0), 0.004)
+    assert plant.push_left == pytest.approx(0.006)
+    pushed = plant.step(Command(0.0), 0.006).state
+    assert plant.push_left == 0.0 and plant.push_now == 0.0
+    assert pushed[2] > 0.2  # J / m = 0.28 m/s, less what the ankle held
+    # A velocity jump is now, the pose kept.
+    jumped = plant.apply_push(Push(0.2, "velocity"))
+    # The CoM velocity, the pose restored (the foot's rate stays, the torso upright and at rest).
+    assert jumped[2] == pytest.approx(pushed[2] + 0.2, abs=1e-3)
+    assert jumped[0] == pytest.approx(pushed[0], abs=1e-12)
 
 
 @pytest.mark.parametrize("model", ["foot", "torso", "biped"])

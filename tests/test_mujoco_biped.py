@@ -10,6 +10,7 @@ import pytest
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.control import make_controller
 from pushrecovery.sim.mujoco.biped import LEG_MASS, MujocoBipedPlant, biped_model
+from pushrecovery.sim.push import Push
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import RestCriterion, simulate
 from pushrecovery.surfaces.step import step_critical_velocity, step_thresholds
@@ -44,7 +45,7 @@ def run(v=0.0, impulse=None, duration=5.0, rest=None, first_step=None):
     plant = MujocoBipedPlant(P)
     state = plant.reset(0.0, v if impulse is None else 0.0)
     if impulse is not None:
-        plant.schedule_push(impulse)
+        plant.apply_push(Push.from_impulse(impulse, P.mass, scheduled=True))
     controller = recovery(first_step=first_step)
     result = simulate(plant, controller, state, duration=duration, rest=rest)
     return plant, controller, result
@@ -150,7 +151,7 @@ def test_forward_pushes_from_ahead_of_the_ankle_recover(v):
     assert v < step_critical_velocity(0.05, 1.0, P)  # one step recovers it (2.60 m/s)
     plant = MujocoBipedPlant(P)
     plant.reset(0.05, 0.0)
-    state = plant.push(P.mass * v)
+    state = plant.apply_push(Push(v))
     controller = recovery()
     result = simulate(plant, controller, state, duration=3.0)
     assert result.recovered and len(controller.steps) == 1

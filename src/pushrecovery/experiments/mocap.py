@@ -9,7 +9,7 @@ data (C3D files) can be tested against what the simulation really did
 Closed loop
 -----------
 The controller runs from the start of the quiet standing. During a force push the body holds
-still as in ``plant.push`` (CoP under the CoM, no hip torque; a human's reaction takes longer
+still as in ``plant.apply_push`` (CoP under the CoM, no hip torque; a human's reaction takes longer
 than the 10 ms push) and as the push ends the controller restarts on the pushed state: the
 response is then the one of ``pushed_state(..., force=True)`` + ``simulate()`` in the
 campaigns and the validation (``react_during_push=True`` keeps the controller running
@@ -44,8 +44,8 @@ from pushrecovery.sim.mujoco.lab import (
     plate_channels,
 )
 from pushrecovery.sim.mujoco.models import TIMESTEP
-from pushrecovery.sim.mujoco.plant import PUSH_DURATION, MujocoPlant
-from pushrecovery.sim.push import Push
+from pushrecovery.sim.mujoco.plant import MujocoPlant
+from pushrecovery.sim.push import PUSH_DURATION, Push
 from pushrecovery.sim.registry import MUJOCO_MODELS, make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.sim.validation import SETUPS
@@ -120,9 +120,9 @@ def record_push(
     react_during_push : bool
         False (default): the body holds still during a force push (CoP under the CoM, no hip
         torque, no step) and the controller restarts on the pushed state as the push ends,
-        as ``plant.push`` and the campaigns do, so that the response is the one the surfaces
+        as ``plant.apply_push`` and the campaigns do, so that the response is the one the surfaces
         predict for ``truth["state_after_push"]``. True: the controller keeps running during
-        the push (``schedule_push`` before ``simulate``); the ``recovery`` controller then
+        the push (a scheduled ``apply_push`` before ``simulate``); the ``recovery`` controller then
         plans its step 5-8 ms into the push on a part of the velocity (0.74 m instead of
         0.82 m for 1.3 m/s from x0 = 0).
 
@@ -208,8 +208,7 @@ def record_push(
     # No push: a zero jump, so that the controller restarts and rest counts from there too.
     scheduled = ScheduledPush(
         push_step * h,
-        Push(velocity),
-        kind="force" if impulse is not None else "velocity",
+        Push(velocity, "force" if impulse is not None else "velocity"),
         react=react_during_push,
     )
     run = simulate(

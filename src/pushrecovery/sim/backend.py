@@ -13,9 +13,11 @@ simulate` is written against it alone):
    the entry and its range, for a state the model cannot start from; ``begin(state)`` checks
    it and starts a run from it (as returned by ``reset``/``apply_push``, or any valid state),
    returning it. A run's records (footholds, stop impacts, measurements) start here.
-4. ``apply_push(push)`` pushes now (:class:`~pushrecovery.sim.push.Push`): a jump of the CoM
-   velocity on the analytic models, a force on the pushed body over the push's duration on
-   MuJoCo (the body holding still meanwhile), and returns the state after it.
+4. ``apply_push(push)`` is the one way to push (:class:`~pushrecovery.sim.push.Push`): a jump
+   of the CoM velocity on the analytic models; on MuJoCo a jump (``kind="velocity"``) or a
+   force on a body over the push's duration, now with the body holding still, or from the
+   next step on (``scheduled``). It returns the state after the push (scheduled: the state
+   now).
 5. ``step(command, dt)`` holds ``command`` for ``dt`` [s] and returns a :class:`Step`: the new
    state, the inputs the plant applied (commands are clipped to the feet and the torque
    limits: physics, not politeness) and a :class:`~pushrecovery.control.base.StepInfo`
@@ -322,16 +324,16 @@ class PlantBase:
         return state.copy()
 
     def apply_push(self, push: Push) -> FloatArray:
-        """Add the push's velocity jump to the CoM velocity now (contract item 4)."""
+        """Add the push's velocity jump to the CoM velocity now (contract item 4).
+
+        Every push is its jump here: ``kind``, ``duration``, ``body`` and ``scheduled`` are
+        how MuJoCo applies it.
+        """
         state = self.state.copy()
         state[len(state) // 2] += push.delta_velocity
         check_com_state(float(state[0]), float(state[len(state) // 2]), self.params)
         self.state = state
         return state.copy()
-
-    def jump_velocity(self, delta: float) -> FloatArray:
-        """Add ``delta`` [m/s] to the CoM velocity now: the analytic push."""
-        return self.apply_push(Push(delta))
 
     def step(self, command: Command, dt: float) -> Step:
         """Hold ``command`` for ``dt`` [s] (contract item 5).

@@ -9,10 +9,7 @@ nothing else runs a loop of its own.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, Protocol, runtime_checkable
-
-import numpy as np
-from numpy.typing import NDArray
+from typing import Protocol, runtime_checkable
 
 from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.control.base import Command
@@ -20,7 +17,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.backend import Step
 from pushrecovery.sim.push import Push, Push3D
 
-__all__ = ["ForcePushing", "Observer", "ScheduledPush", "VelocityJumping"]
+__all__ = ["ForcePushing", "Observer", "ScheduledPush"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -32,12 +29,10 @@ class ScheduledPush:
     time : float
         When the push starts [s], >= 0.
     push : Push or Push3D
-        The velocity jump it stands for (Δẋ [m/s]; the impulse is m Δẋ), or a 3-D push
-        (impulse [N s], azimuth, body) that the plant's ``apply_push`` applies (the 3-D
-        humanoids, whose push lasts physics steps of their own).
-    kind : {"force", "velocity"}
-        ``force``: a force on the pushed body over the plant's push duration (plants with
-        :class:`ForcePushing`; others take the jump); ``velocity``: an instantaneous jump.
+        The push the plant's ``apply_push`` applies at ``time``: a :class:`Push`, applied
+        scheduled (a velocity jump, or on MuJoCo a force over the following steps,
+        :class:`ForcePushing`), or a 3-D push (impulse [N s], azimuth, body) of the 3-D
+        humanoids, whose push lasts physics steps of their own.
     react : bool
         False (default): the body holds still during a force push (CoP under the CoM, no
         hip torque, no step) and the controller restarts on the pushed state as it ends, as
@@ -46,7 +41,6 @@ class ScheduledPush:
 
     time: float
     push: Push | Push3D
-    kind: Literal["force", "velocity"] = "force"
     react: bool = False
 
     def __post_init__(self) -> None:
@@ -54,27 +48,19 @@ class ScheduledPush:
         time = finite_float("push time", self.time, "s")
         if time < 0.0:
             raise InvalidParameterError(f"push time must be >= 0 s, got {time:g}")
-        if self.kind not in ("force", "velocity"):
-            raise InvalidParameterError(
-                f"push kind must be 'force' or 'velocity', got {self.kind!r}"
-            )
 
 
 @runtime_checkable
 class ForcePushing(Protocol):
-    """A plant whose pushes are forces over time (MuJoCo)."""
+    """A plant whose force push lasts steps of the run (the planar MuJoCo plants).
 
-    def schedule_push(self, impulse: float) -> float:
-        """Push with ``impulse`` [N s] from the next step on; return how long it lasts [s]."""
-        ...
+    After a scheduled ``apply_push`` (``Push(..., scheduled=True)``) the force acts over the
+    plant's next steps for ``push_left``.
+    """
 
-
-@runtime_checkable
-class VelocityJumping(Protocol):
-    """A plant whose CoM velocity can jump by Δẋ [m/s] now (the analytic push)."""
-
-    def jump_velocity(self, delta: float) -> NDArray[np.float64]:
-        """Add ``delta`` [m/s] to the CoM velocity now; return the state."""
+    @property
+    def push_left(self) -> float:
+        """How long the force of the push still acts [s] (0: no push)."""
         ...
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 from pushrecovery.arguments import bounded_float, finite_float, positive_float
 from pushrecovery.errors import InvalidParameterError
@@ -15,6 +16,7 @@ from pushrecovery.errors import InvalidParameterError
 __all__ = [
     "AZIMUTH_MAX",
     "IMPULSE_MAX",
+    "PUSH_DURATION",
     "Direction",
     "Push",
     "Push3D",
@@ -26,6 +28,8 @@ __all__ = [
 AZIMUTH_MAX = 360.0
 #: Largest impulse [N s] a 3-D push accepts (a thousand times what topples a person).
 IMPULSE_MAX = 1e4
+#: Default duration of a force push [s].
+PUSH_DURATION = 0.01
 
 #: A push direction along x: ``"forward"`` or ``"backward"``.
 Direction = str
@@ -42,29 +46,84 @@ def direction_sign(direction: str) -> float:
 
 @dataclass(frozen=True, slots=True)
 class Push:
-    """An impulsive push, given as the CoM velocity jump it causes.
+    """An impulsive push, given as the CoM velocity jump it causes, and how a plant applies it.
+
+    The analytic models take every push as its jump; the planar MuJoCo plants apply a force
+    push as J = m Δẋ [N s] over ``duration`` on ``body`` (``MujocoPlant.apply_push``).
 
     Parameters
     ----------
     delta_velocity : float
         Jump of the CoM velocity Δẋ [m/s], positive forward (+x).
+    kind : {"force", "velocity"}
+        ``"force"`` (default): the model's own push (a force on MuJoCo); ``"velocity"``: an
+        instantaneous jump of the CoM velocity, the pose kept, on every model.
+    duration : float
+        How long a force push lasts [s], > 0 (MuJoCo: at least one physics step); 10 ms
+        (:data:`PUSH_DURATION`) by default.
+    body : str, optional
+        The MuJoCo body a force push acts on, at its centre of mass (1 to 100 characters);
+        default the plant's pushed body, whose push the CoP map accounts for.
+    scheduled : bool
+        False (default): push now, the body holding still (CoP under the CoM, no hip torque),
+        and return the state just after the push. True: the force acts from the plant's next
+        step on, under whatever the controller commands; ``apply_push`` returns the state now.
+        A jump is always now.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``delta_velocity`` is not finite, ``kind`` is neither name, ``duration`` is not
+        > 0 or ``body`` is not a name of 1 to 100 characters.
     """
 
     delta_velocity: float
+    kind: Literal["force", "velocity"] = "force"
+    duration: float = PUSH_DURATION
+    body: str | None = None
+    scheduled: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(
             self, "delta_velocity", finite_float("delta_velocity", self.delta_velocity, "m/s")
         )
+        if self.kind not in ("force", "velocity"):
+            raise InvalidParameterError(
+                f"push kind must be 'force' or 'velocity', got {str(self.kind)[:40]!r}"
+            )
+        if self.duration != PUSH_DURATION:  # the default needs no check (pushes are many)
+            object.__setattr__(self, "duration", positive_float("duration", self.duration, "s"))
+        if self.body is not None:
+            _check_body(self.body)
 
     @classmethod
-    def from_impulse(cls, impulse: float, mass: float) -> Push:
-        """Push from an impulse J [N s] on a body of mass m [kg]: Δẋ = J / m."""
-        return cls(finite_float("impulse", impulse, "N s") / positive_float("mass", mass, "kg"))
+    def from_impulse(
+        cls,
+        impulse: float,
+        mass: float,
+        *,
+        duration: float = PUSH_DURATION,
+        body: str | None = None,
+        scheduled: bool = False,
+    ) -> Push:
+        """Return the force push of an impulse J [N s] on a body of mass m [kg]: Δẋ = J / m.
+
+        ``duration``, ``body`` and ``scheduled`` as in :class:`Push`.
+        """
+        velocity = finite_float("impulse", impulse, "N s") / positive_float("mass", mass, "kg")
+        return cls(velocity, "force", duration, body, scheduled)
 
     def impulse(self, mass: float) -> float:
         """Return the impulse J = m Δẋ [N s] of this push on a body of mass m [kg]."""
         return mass * self.delta_velocity
+
+
+def _check_body(body: object) -> None:
+    """Require a body name a MuJoCo model could have (whether it has it is the plant's check)."""
+    if not (isinstance(body, str) and 0 < len(body) <= 100):
+        raise InvalidParameterError(
+            f"body must be a body name of 1 to 100 characters, got {str(body)[:40]!r}"
+        )
 
 
 def push_direction(azimuth: float) -> tuple[float, float]:
@@ -109,10 +168,7 @@ class Push3D:
     def __post_init__(self) -> None:
         impulse = bounded_float("impulse", self.impulse, 0.0, IMPULSE_MAX, "N s")
         azimuth = bounded_float("azimuth", self.azimuth, -AZIMUTH_MAX, AZIMUTH_MAX, "deg")
-        if not (isinstance(self.body, str) and 0 < len(self.body) <= 100):
-            raise InvalidParameterError(
-                f"body must be a body name of 1 to 100 characters, got {str(self.body)[:40]!r}"
-            )
+        _check_body(self.body)
         object.__setattr__(self, "impulse", impulse)
         object.__setattr__(self, "azimuth", azimuth)
 

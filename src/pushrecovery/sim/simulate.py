@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -14,12 +14,7 @@ from pushrecovery.control.base import Command, Controller, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged, SimulationTimeout
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS
 from pushrecovery.sim.backend import Clocked, PlantBase
-from pushrecovery.sim.events import (
-    ForcePushing,
-    Observer,
-    ScheduledPush,
-    VelocityJumping,
-)
+from pushrecovery.sim.events import ForcePushing, Observer, ScheduledPush
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.push import Push
 from pushrecovery.sim.result import Outcome, SimulationResult
@@ -148,7 +143,7 @@ def simulate(
     if (
         push is not None
         and not isinstance(push.push, Push)
-        and isinstance(plant, VelocityJumping | ForcePushing)
+        and isinstance(plant, PlantBase | ForcePushing)
     ):
         raise InvalidParameterError(
             f"a 3-D push (Push3D) needs a 3-D model, got the {plant.name} model: push with a Push"
@@ -262,17 +257,17 @@ def _start_push(
 ) -> tuple[np.ndarray, int]:
     """Start ``push`` at plant step k; return the state and the step at which it is over.
 
-    A force acts over the plant's following steps (the plant tells how many); a jump is over
-    at once.
+    A force acts over the plant's following steps (the plant tells how long); a jump (and a
+    3-D humanoid's push, over its own physics steps) is over at once.
     """
     kick = push.push
-    if isinstance(kick, Push):
-        if push.kind == "force" and isinstance(plant, ForcePushing):
-            lasts = plant.schedule_push(kick.impulse(plant.params.mass))
-            return state, k + max(1, math.ceil(lasts / h - 1e-9))
-        if isinstance(plant, VelocityJumping):
-            return plant.jump_velocity(kick.delta_velocity), k
-    return plant.apply_push(kick), k  # type: ignore[arg-type]
+    if isinstance(kick, Push) and not kick.scheduled:
+        kick = replace(kick, scheduled=True)  # the loop holds the body still itself
+    pushed = plant.apply_push(kick)  # type: ignore[arg-type]
+    left = plant.push_left if isinstance(plant, ForcePushing) else 0.0
+    if left > 0.0:  # nothing changes before the next step
+        return state, k + max(1, math.ceil(left / h - 1e-9))
+    return pushed, k
 
 
 def check_run(

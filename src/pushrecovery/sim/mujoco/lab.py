@@ -47,7 +47,7 @@ plates, and what the floor carries there is missing from both (counted by
 
 Every contact between the floor and a body geom (normally a sole; after a fall also the rest of
 the body) is assigned to the plate whose area contains its point. A force push acts at the
-pushed body's centre of mass (``plant.schedule_push``), not through the floor: the plates see
+pushed body's centre of mass (``plant.apply_push``), not through the floor: the plates see
 it only through the dynamics, as a real plate would (Newton: J + ∫F_x dt = m Δv).
 """
 

@@ -34,10 +34,10 @@ FloatArray = NDArray[np.float64]
 class MujocoFootPlant(MujocoPlant):
     """Rigid body on a tipping foot, in MuJoCo (model ``foot``): the pendulum of Fig. 3(b).
 
-    A push can be a velocity jump (:meth:`reset`) or a real force:
-    :meth:`schedule_push` applies an impulse [N s] at the CoM over a short duration at the
-    start of the run. The rest criterion of the simulator (CoM at rest over the foot,
-    unsaturated command) decides recovery, as for the analytic models.
+    A push can be a velocity jump (:meth:`reset`) or a real force: :meth:`apply_push` applies
+    an impulse [N s] at the CoM over a short duration. The rest criterion of the simulator
+    (CoM at rest over the foot, unsaturated command) decides recovery, as for the analytic
+    models.
     """
 
     name: ClassVar[str] = "mujoco-foot"

@@ -29,6 +29,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.params import BodyParams
@@ -40,7 +41,7 @@ from pushrecovery.sim.mujoco.engine import (
     unstable_warnings,
 )
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, MODEL_BUILDERS, TIMESTEP
-from pushrecovery.sim.push import Push
+from pushrecovery.sim.push import PUSH_DURATION, Push
 
 __all__ = [
     "DEFAULT_COP_MARGIN",
@@ -56,8 +57,6 @@ __all__ = [
 SETTLE_TIME = 0.3
 #: Default CoP margin inside the foot edges [m].
 DEFAULT_COP_MARGIN = 0.002
-#: Default duration of a force push [s].
-PUSH_DURATION = 0.01
 #: Foot pitch beyond which a foot counts as tipped over [rad].
 FOOT_TIP_LIMIT = 0.2
 #: Longest hold of the ankle and hip torques of ``foot`` and ``torso`` [s].
@@ -164,53 +163,64 @@ class MujocoPlant(ABC):
         return text
 
     # --- pushes and recording ------------------------------------------------------------
-    def schedule_push(
-        self, impulse: float, duration: float = PUSH_DURATION, body: str | None = None
-    ) -> float:
-        """Push the body at its CoM with ``impulse`` [N s] (+x forward) over ``duration`` [s].
+    def apply_push(self, push: Push) -> FloatArray:
+        """Push (contract item 4) and return the state after it (scheduled: the state now).
 
-        ``body`` names another MuJoCo body to push (at that body's own centre of mass, e.g.
-        ``"foot"``); the CoP map then does not know the push, so the CoP wanders during it.
+        A ``"velocity"`` push adds Δẋ [m/s] to the CoM velocity now, the pose kept. A
+        ``"force"`` push acts with J = m Δẋ [N s] (+x forward) on ``push.body`` (default the
+        pushed body) at that body's centre of mass, over the whole physics steps nearest to
+        ``push.duration`` (at least one) with the force that makes their total exactly J;
+        :attr:`push_left` is how long it still acts. On another body the CoP map does not
+        know the push, so the CoP wanders during it.
 
-        Applied from the next :meth:`step` on (call after :meth:`reset`), over the
-        whole physics steps nearest to ``duration`` (at least one), with the force that makes
-        their total exactly ``impulse``. The velocity jump it stands for, J/m, must satisfy
-        the models' validity (abs(J/m) < 10 sqrt(g L)). Returns how long the force acts [s].
+        Scheduled (``push.scheduled``), the force acts from the next :meth:`step` on (call
+        after :meth:`reset` or :meth:`begin`). Otherwise it acts now while the body holds
+        still (the CoP under the CoM, no hip torque), and the state returned is the state
+        just after the push, the moment the paper's velocity jump stands for; the clock
+        restarts there, so a controller started on it sees the push as it ends.
+
+        Raises
+        ------
+        InvalidParameterError
+            If ``push.duration`` is shorter than the MuJoCo step, ``push.body`` is not a body
+            of the model, or the CoM velocity it stands for leaves abs(ẋ) < 10 sqrt(g L).
         """
-        if not (math.isfinite(impulse) and math.isfinite(duration)):
+        require_type("push", push, Push)
+        delta = push.delta_velocity
+        if push.kind == "velocity":
+            state = self.read_state()
+            if delta == 0.0:
+                return state
+            x, xdot = float(state[0]), float(state[len(state) // 2]) + delta
+            check_com_state(x, xdot, self.params)
+            self.pose(x, xdot)
+            self._mj.mj_forward(self.model, self.data)
+            return self.read_state()
+        if push.duration < self._substep:
             raise InvalidParameterError(
-                f"impulse and duration must be finite, got {impulse:g} N s, {duration:g} s"
+                f"duration must be >= the MuJoCo step {self._substep:g} s, got {push.duration:g}"
             )
-        if duration < self._substep:
-            raise InvalidParameterError(
-                f"duration must be >= the MuJoCo step {self._substep:g} s, got {duration:g}"
-            )
-        check_com_state(0.0, impulse / self.params.mass, self.params)
-        target = self.pushed_body if body is None else body
+        check_com_state(0.0, delta, self.params)
+        target = self.pushed_body if push.body is None else push.body
         try:
             self._push_target = self.model.body(target).id
         except KeyError:
             names = [self.model.body(i).name for i in range(1, self.model.nbody)]
-            raise InvalidParameterError(f"body must be one of {names}, got {body!r}") from None
-        self._push_steps = round(duration / self._substep)
-        self._push_force = impulse / (self._push_steps * self._substep)
-        return self._push_steps * self._substep
-
-    def push(
-        self, impulse: float, duration: float = PUSH_DURATION, body: str | None = None
-    ) -> FloatArray:
-        """Push now with ``impulse`` [N s] (+x forward) over ``duration`` [s]; return the state.
-
-        The force acts at the CoM while the body holds still: the CoP under the CoM, no hip
-        torque. The returned state is the state just after the push, the moment the paper's
-        velocity jump stands for; a controller started on it sees the push as it ends.
-        """
-        self.schedule_push(impulse, duration, body)
+            raise InvalidParameterError(f"body must be one of {names}, got {push.body!r}") from None
+        self._push_steps = round(push.duration / self._substep)
+        self._push_force = push.impulse(self.params.mass) / (self._push_steps * self._substep)
         state = self.read_state()
+        if push.scheduled:
+            return state
         while self._push_steps > 0:
             state, _, _ = self._hold(Command(float(state[0])), self._substep)
         self._start_clock()
         return state
+
+    @property
+    def push_left(self) -> float:
+        """How long the force of the push still acts [s] (0: no push)."""
+        return self._push_steps * self._substep
 
     def record(self) -> None:
         """Record a frame at every :meth:`step` from now on (see :attr:`frames`)."""
@@ -286,20 +296,6 @@ class MujocoPlant(ABC):
     def _restart_records(self) -> None:
         self.stop_impacts = 0
         self._first_ankle = self.ankle_x()
-
-    def jump_velocity(self, delta: float) -> FloatArray:
-        """Add ``delta`` [m/s] to the CoM velocity now, the body's pose kept (a velocity push)."""
-        state = self.read_state()
-        if delta == 0.0:
-            return state
-        check_com_state(float(state[0]), float(state[len(state) // 2]) + delta, self.params)
-        self.pose(float(state[0]), float(state[len(state) // 2]) + delta)
-        self._mj.mj_forward(self.model, self.data)
-        return self.read_state()
-
-    def apply_push(self, push: Push) -> FloatArray:
-        """Push at the CoM with the impulse m Δẋ over ``PUSH_DURATION`` (contract item 4)."""
-        return self.push(push.impulse(self.params.mass))
 
     def info(self) -> StepInfo:
         """Return the report of the run so far (contract item 5): stance, footholds, CoP."""

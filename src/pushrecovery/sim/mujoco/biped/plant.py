@@ -52,7 +52,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
     Same state, commands, ``footholds`` and ``fall_limits`` as
     :class:`~pushrecovery.sim.plants.SteppingPlant`; the module docstring describes the model
     and how commands become joint torques. A push can be a velocity (:meth:`reset`) or
-    a force (:meth:`schedule_push`, on the torso at the hip).
+    a force (:meth:`apply_push`, on the torso at the hip).
     """
 
     name: ClassVar[str] = "mujoco-biped"
