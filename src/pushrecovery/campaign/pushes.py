@@ -20,13 +20,12 @@ from typing import Any
 
 from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.pushes3d import error_row3d, run_push3d
-from pushrecovery.campaign.rows import COLUMNS, COLUMNS_3D, ERROR_OUTCOME
+from pushrecovery.campaign.rows import COLUMNS, COLUMNS_3D, ERROR_OUTCOME, verdict_columns
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.many import COMPILED, LOOP_UP_TO, PushRuns, run_many
 from pushrecovery.sim.result import Outcome, strategy_used
 from pushrecovery.surfaces.classify import (
-    STRATEGY_CODES,
     Strategy,
     sagittal_verdicts,
 )
@@ -146,23 +145,9 @@ def _row(
 
 def _inputs_and_prediction(spec: CampaignSpec, push: Push, found: _Prediction) -> dict[str, Any]:
     """Return the columns of a row that do not depend on the run: the push and its verdict."""
-    # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
-    reach = STRATEGY_CODES.index(Strategy(spec.strategy))
-    row: dict[str, Any] = {
-        f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
-    }
-    row.update(
-        index=push.index,
-        x0=push.x0,
-        xdot=push.xdot,
-        impulse=push.impulse,
-        predicted=found.strategy.value,
-        capture_point=found.capture_point,
-        cop_margin=found.cop_margin,
-        cmp_margin=found.cmp_margin,
-        step_margin=found.step_margin,
-        predicted_steps=-1 if found.steps is None else found.steps,
-        predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
+    margins = (found.cop_margin, found.cmp_margin, found.step_margin)
+    row = verdict_columns(
+        spec, push, push.x0, found.strategy, found.capture_point, margins, found.steps
     )
     row.update(_NULL_3D)  # every row has every column
     return row

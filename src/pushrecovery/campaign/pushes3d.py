@@ -5,40 +5,9 @@ pushed at its torso with J [N s] at the azimuth ψ (:class:`~pushrecovery.sim.pu
 after 0.1 s of standing) and the whole-body controller runs with the tasks of the campaign's
 controller (``wbc-ankle``: ankles only; ``wbc-hip``: + the hip task; ``wbc-step``: + the hip and the
 stepping task; :func:`~pushrecovery.sim.mujoco.humanoid3d.runs3d.run_push3d`) until rest, a fall or
-``duration``. The columns of :mod:`~pushrecovery.campaign.pushes` keep their names; in 3-D they
-read:
-
-=========================  ==================================================================
-``x0``, ``y0``             the standing CoM's ground point r₀ [m] (ankles' midpoint at 0)
-``xdot``                   J/m, the CoM velocity the push gives along ψ [m/s]
-``predicted``              the ground plane's verdict (``surfaces.classify.classify`` with y,
-                           ẏ) for r₀ and the velocity J/m (cos ψ, sin ψ): ankle, hip, step or
-                           fall, on the body's double support (``Support.from_params``)
-``capture_point``,         ξ = r₀ + J/(m ω) (cos ψ, sin ψ) [m]
-``capture_point_y``
-``cop_margin``, ...        the plane's signed margins (positive inside) [m]
-``used``, ``steps``        the strategy the run used (``sim.result.strategy_used``: step if a
-                           step landed, hip if the hip law's m g abs(δ) passed 1 N m, else ankle)
-                           if it recovered, else fall; the steps that landed
-``peak_hip_torque``        the hip law's largest m g abs(δ) [N m]
-``peak_ankle_torque``,     NaN (the WBC's CoP is not recorded per run)
-``cop_min``, ``cop_max``
-``time``                   simulated time from the push's end to the outcome [s]
-``azimuth``                ψ [deg]
-``fraction``               J / J*_ankle(ψ) (:func:`~.spec3d.critical_impulse`)
-``ankle_critical``         J*_ankle(ψ) = m ω ρ_P(r₀, ψ) [N s]
-``predicted_corrected``    the verdict for the push at the torso's height: the velocity
-                           × (1 + d/z₀) (docs/validation3d.md, "The critical push from
-                           every direction")
-``lift_offs``              steps begun (landed or not)
-``peak_hip_motor_torque``  largest abs(hip pitch or roll command − its value before) [N m]
-``max_torso_tilt``         largest tilt of the upright body [rad]
-``peak_torque_ratio``      largest abs(motor command) / its limit over the run [-] (1: saturated)
-``failed_ticks``           ticks DAQP did not solve (the last command held)
-=========================  ==================================================================
-
-The written file carries these readings as its fields' metadata (:func:`.rows.row_schema`,
-family ``"3d"``).
+``duration``. The columns of :mod:`~pushrecovery.campaign.pushes` keep their names; how each
+reads in 3-D, with its unit, is the field metadata of :func:`.rows.row_schema` (family ``"3d"``),
+which the written file carries.
 """
 
 from __future__ import annotations
@@ -48,12 +17,12 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery.campaign.rows import ERROR_OUTCOME, ERROR_OUTCOME_3D
+from pushrecovery.campaign.rows import ERROR_OUTCOME, ERROR_OUTCOME_3D, verdict_columns
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.campaign.spec3d import critical_impulse, predict_push, push_geometry
 from pushrecovery.errors import SimulationDiverged
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
+from pushrecovery.surfaces.strategy import Strategy
 
 __all__ = ["PUSH_TIME", "error_row3d", "predict3d", "run_push3d"]
 
@@ -62,29 +31,16 @@ PUSH_TIME = 0.1
 
 
 def predict3d(spec: CampaignSpec, push: Push) -> dict[str, Any]:
-    """Return the columns of a 3-D push that do not depend on the run (module docstring)."""
+    """Return the columns of a 3-D push that do not depend on the run: the push and its verdict."""
     params = push.params
     azimuth = 0.0 if push.azimuth is None else push.azimuth
     (x0, y0), ratio = push_geometry(spec.model, params)
     found, corrected = predict_push(params, (x0, y0), push.impulse, azimuth, ratio)
-    reach = STRATEGY_CODES.index(Strategy(spec.strategy))
     xi = found.capture_point_xy or (math.nan, math.nan)
     ankle = critical_impulse(params, (x0, y0), azimuth)
-    row: dict[str, Any] = {
-        f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
-    }
+    margins = (found.margins["cop"], found.margins["cmp"], found.margins["step"])
+    row = verdict_columns(spec, push, x0, found.strategy, float(xi[0]), margins, found.steps)
     row.update(
-        index=push.index,
-        x0=x0,
-        xdot=push.xdot,
-        impulse=push.impulse,
-        predicted=found.strategy.value,
-        capture_point=float(xi[0]),
-        cop_margin=found.margins["cop"],
-        cmp_margin=found.margins["cmp"],
-        step_margin=found.margins["step"],
-        predicted_steps=-1 if found.steps is None else found.steps,
-        predicted_recovers=STRATEGY_CODES.index(found.strategy) <= reach,
         azimuth=azimuth,
         fraction=push.impulse / ankle if push.fraction is None else push.fraction,
         ankle_critical=ankle,

@@ -20,9 +20,13 @@ import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal, cast
+from typing import TYPE_CHECKING, Any, Literal, cast
 
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
+
+if TYPE_CHECKING:
+    from pushrecovery.campaign.spec import CampaignSpec, Push
 
 __all__ = [
     "COLUMNS",
@@ -35,6 +39,7 @@ __all__ = [
     "Family",
     "columns",
     "row_schema",
+    "verdict_columns",
 ]
 
 Family = Literal["planar", "3d"]
@@ -221,6 +226,55 @@ def _columns(family: Family, sweeps: tuple[str, ...]) -> tuple[Column, ...]:
           for n in sweeps),
         *fixed,
     )  # fmt: skip
+
+
+def verdict_columns(
+    spec: CampaignSpec,
+    push: Push,
+    x0: float,
+    strategy: Strategy,
+    capture_point: float,
+    margins: tuple[float, float, float],
+    steps: int | None,
+) -> dict[str, Any]:
+    """Return the columns a row starts with, either family: the push and the surfaces' verdict.
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+        The campaign (its sweeps and its controller's strategy).
+    push : Push
+        The push (``index``, ``param_<name>``, ``xdot``, ``impulse``).
+    x0 : float
+        The ``x0`` column [m].
+    strategy : Strategy
+        The predicted strategy.
+    capture_point : float
+        The ``capture_point`` column [m].
+    margins : (float, float, float)
+        ``cop_margin``, ``cmp_margin`` and ``step_margin`` [m], positive inside.
+    steps : int or None
+        Steps predicted (None: a fall, written -1).
+    """
+    # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
+    reach = STRATEGY_CODES.index(Strategy(spec.strategy))
+    row: dict[str, Any] = {
+        f"param_{name}": value for name, value in zip(spec.sweeps, push.swept, strict=True)
+    }
+    row.update(
+        index=push.index,
+        x0=x0,
+        xdot=push.xdot,
+        impulse=push.impulse,
+        predicted=strategy.value,
+        capture_point=capture_point,
+        cop_margin=margins[0],
+        cmp_margin=margins[1],
+        step_margin=margins[2],
+        predicted_steps=-1 if steps is None else steps,
+        predicted_recovers=STRATEGY_CODES.index(strategy) <= reach,
+    )
+    return row
 
 
 def row_schema(family: Family, sweeps: Sequence[str] = ()) -> Any:
