@@ -163,15 +163,11 @@ class TrialsResult:
         """
         import pyarrow.parquet as pq
 
+        from pushrecovery.analysis.trial.settings import pandas_table
+
         if table not in ("trials", "events"):
             raise InvalidParameterError(f"table must be 'trials' or 'events', got {table!r:.40}")
-        try:
-            import pandas  # noqa: F401
-        except ImportError:
-            raise InvalidParameterError(
-                "to_pandas needs pandas: pip install 'pushrecovery[tables]'"
-            ) from None
-        return pq.read_table(self.files[table]).to_pandas()
+        return pandas_table(pq.read_table(self.files[table]))
 
 
 def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict[str, Any]:

@@ -24,6 +24,7 @@ __all__ = [
     "AnalysisSettings",
     "TrialAnalysis",
     "body_for",
+    "pandas_table",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -135,11 +136,17 @@ class TrialAnalysis:
 
     def to_pandas(self) -> Any:
         """Return the frames as a ``pandas.DataFrame`` (needs the ``tables`` extra: pandas)."""
-        return _pandas(self.to_arrow())
+        return pandas_table(self.to_arrow())
 
 
-def _pandas(table: Any) -> Any:
-    """Return a pyarrow table as a pandas DataFrame, or say how to get pandas."""
+def pandas_table(table: Any) -> Any:
+    """Return a pyarrow table as a pandas DataFrame, or say how to get pandas.
+
+    Raises
+    ------
+    InvalidParameterError
+        Without pandas (the ``tables`` extra).
+    """
     try:
         import pandas  # noqa: F401
     except ImportError:
