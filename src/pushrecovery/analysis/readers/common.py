@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -12,10 +11,6 @@ from numpy.typing import NDArray
 from pushrecovery.analysis.recording import Recording
 from pushrecovery.arguments import require_type
 from pushrecovery.errors import InputFileError, InvalidParameterError
-
-if TYPE_CHECKING:
-    pass
-
 
 __all__ = [
     "AP_AXES",

@@ -4,15 +4,9 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pushrecovery.analysis.recording import AXES, LOADED, Recording
-from pushrecovery.errors import InputFileError
-
-if TYPE_CHECKING:
-    pass
 from pushrecovery.analysis.readers.c3d_files import read_c3d_recording
 from pushrecovery.analysis.readers.common import (
     MIN_FRAMES,
@@ -23,6 +17,8 @@ from pushrecovery.analysis.readers.common import (
     _path,
     _unit_scale,
 )
+from pushrecovery.analysis.recording import AXES, LOADED, Recording
+from pushrecovery.errors import InputFileError
 
 __all__ = [
     "CSV_COLUMNS",
@@ -89,7 +85,7 @@ def read_recording(path: str | Path, **options: object) -> Recording:
 
 # --- CSV ---------------------------------------------------------------------------------
 def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
-    """Read a CSV trial (module docstring).
+    """Read a CSV trial (columns: :data:`CSV_COLUMNS`, docs/analysis.md "CSV format").
 
     Parameters
     ----------

@@ -4,16 +4,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.plots.common import check_plot_path, save_figure
-
-if TYPE_CHECKING:
-    pass
 from pushrecovery.plots.campaign.style import UNITS
+from pushrecovery.plots.common import check_plot_path, save_figure
 
 __all__ = [
     "plot_critical_vs_parameter",
