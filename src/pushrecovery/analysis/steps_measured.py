@@ -1,37 +1,11 @@
 """Foot-off and foot-contact from plates or markers, and the steps a subject took, measured.
 
-**Foot contact from a plate** (:func:`foot_events_from_force`): the unloaded runs of
-:func:`~pushrecovery.analysis.events.flight_phases` on one foot's own plate (vertical force
-below ``threshold``, default 20 N); a foot-off at the first unloaded sample of a run, a
-foot-contact at the first loaded sample after it.
-
-**Foot on the floor from markers** (:func:`foot_events_from_markers`), from the heel and toe
-markers' heights above the floor, the floor of each marker being the lowest it gets in the trial
-(a heel marker sits higher than a toe marker; the rule of
-:func:`~pushrecovery.analysis.recording.support_from_feet`), and their vertical speeds from the
-low-passed heights (zero-lag Butterworth, ``cutoff``,
-:func:`~pushrecovery.analysis.signals.smooth_and_differentiate`). With hysteresis:
-
-* foot-contact at the first frame in which a marker is low (at most ``contact_height`` above
-  its floor, the position constraint of O'Connor et al. 2007, Gait Posture 25:469-474) *and*
-  still (vertical speed at most ``max_speed``: the velocity threshold of Ghoussayni et al.
-  2004, Gait Posture 20:266-272, on the vertical speed only, so that a foot carried by a belt
-  counts as on the floor);
-* foot-off at the first frame in which no marker is low any more (a foot rolling over its toes
-  moves its markers before it leaves: a speed criterion would fire early).
-
-Off-floor runs and contacts shorter than ``min_duration`` are merged away as in
-:func:`~pushrecovery.analysis.events.flight_phases`; missing frames keep the state before them.
-A step whose markers never rise ``contact_height`` (a shuffle) is not seen.
-
-**Measured steps** (:func:`measured_steps`): each foot-off of a foot paired with its next
-foot-contact. The foot's position is the midpoint of its heel and toe markers along ap and ml
-(on the foot's long axis, as the foot velocity algorithm of O'Connor et al. 2007); with
-``position="stance"`` (default) the start is its median over the stance before the foot-off
-and the end its median over the stance after the contact (the foot flat: robust to the heel
-rising at push-off and to marker noise), with ``position="event"`` the midpoint at the event
-times (for a foot carried by a moving belt). Length and width are the ap and ml displacements
-end − start (forward and leftward positive).
+A foot's own plate gives its events from the unloaded runs of
+:func:`~pushrecovery.analysis.events.flight_phases` (:func:`foot_events_from_force`); its heel
+and toe markers give them by height and vertical speed above each marker's floor, with
+hysteresis (:func:`foot_events_from_markers`); :func:`measured_steps` pairs each foot-off with
+the foot's next contact. docs/events.md ("Foot events", "Measured steps") has the rules, their
+sources (O'Connor et al. 2007, Ghoussayni et al. 2004) and their limits.
 """
 
 from __future__ import annotations
@@ -111,8 +85,8 @@ class MeasuredStep:
     length, width : float
         Displacement of the foot along ap (forward +) and ml (left +) [m].
     start_ap, start_ml, end_ap, end_ml : float
-        The foot's position before and after the step [m] (module docstring); NaN when its
-        markers are missing throughout the stance.
+        The foot's position (midpoint of its heel and toe markers) before and after the step
+        [m]; NaN when its markers are missing throughout the stance.
     """
 
     foot: str
@@ -201,7 +175,13 @@ def foot_events_from_markers(
     cutoff: float = 10.0,
     min_duration: float = MIN_DURATION,
 ) -> list[FootEvent]:
-    """Foot-off and foot-contact of one foot from its heel and toe markers (module docstring).
+    """Foot-off and foot-contact of one foot from its heel and toe markers.
+
+    A marker is low while at most ``contact_height`` above its floor (the lowest it gets in the
+    trial). Foot-contact is the first frame in which a marker is low and its vertical speed
+    (of the heights low-passed at ``cutoff``) is at most ``max_speed``; foot-off the first frame
+    in which no marker is low any more. Off-floor runs and contacts shorter than
+    ``min_duration`` are merged away; missing frames keep the state before them.
 
     Parameters
     ----------
@@ -282,7 +262,13 @@ def measured_steps(
     onset: float | None = None,
     position: Literal["stance", "event"] = "stance",
 ) -> list[MeasuredStep]:
-    """Measure the steps from foot-off and foot-contact pairs and the markers (module doc).
+    """Measure the steps from foot-off and foot-contact pairs and the markers.
+
+    Each foot-off of a foot pairs with its next foot-contact. The foot's position is the
+    midpoint of its heel and toe markers; with ``position="stance"`` the start is its median
+    over the stance before the foot-off and the end its median over the stance after the
+    contact, with ``position="event"`` the midpoint at the event times. Length and width are
+    the ap and ml displacements end − start (forward and leftward positive).
 
     Parameters
     ----------

@@ -1,22 +1,12 @@
 r"""What a campaign on the 3-D models adds: push directions, the WBC's strategies, predictions.
 
 A campaign on ``biped3d`` or ``g1`` (``--backend mujoco``, docs/campaigns.md, "The 3-D
-humanoids") pushes the
-standing body at its torso with an impulse J [N s] at each azimuth ψ [deg] (0 forward +x, 90
-left +y) under the whole-body controller with the tasks of one strategy
+humanoids") pushes the standing body at its torso with an impulse J [N s] at each azimuth ψ
+[deg] (0 forward +x, 90 left +y) under the whole-body controller with the tasks of one strategy
 (:data:`WBC_CONTROLLERS`). The pushes may be given as fractions f of the ankle strategy's
-predicted critical impulse along ψ (:func:`critical_impulse`), J = f J*_ankle(ψ), so that
-one grid means the same from every direction (the side's limit is not the front's).
-
-The prediction along ψ is the ground plane's (``docs/plane.md``): the standing CoM's ground
-point r₀ (the plant's own, :func:`standing_origin`) gets the velocity J/m (cos ψ, sin ψ), its
-capture point ξ = r₀ + J/(m ω) (cos ψ, sin ψ), and a strategy recovers while ξ is inside its
-region R, so that
-
-.. math:: J^*_R(\psi) = m\,\omega\,\rho_R(\mathbf r_0, \psi),
-
-ρ_R the distance from r₀ to R's boundary along ψ, R the support polygon P (ankle, Eq. 4 in
-the plane) or the CMP region P ⊕ box(a_pitch, a_roll) (hip, corrected Eq. 15).
+predicted critical impulse along ψ (:func:`critical_impulse`), J = f J*_ankle(ψ), so that one
+grid means the same from every direction (the side's limit is not the front's). The prediction
+is the ground plane's (:func:`predict_push`; docs/validation3d.md derives it).
 """
 
 from __future__ import annotations
@@ -189,7 +179,12 @@ def standing_origin(model: str, params: BodyParams) -> tuple[float, float]:
 def critical_impulse(
     params: BodyParams, origin: tuple[float, float], azimuth: float, strategy: str = "ankle"
 ) -> float:
-    """Return J*_R(ψ) = m ω ρ_R(r₀, ψ) [N s] (module docstring) for ``ankle`` or ``hip``.
+    """Return J*_R(ψ) = m ω ρ_R(r₀, ψ) [N s] for ``ankle`` or ``hip``.
+
+    The push J along ψ gives the standing CoM's ground point r₀ the velocity J/m (cos ψ, sin ψ)
+    and its capture point ξ = r₀ + J/(m ω) (cos ψ, sin ψ); ρ_R is the distance from r₀ to the
+    boundary of the region R along ψ: the support polygon P (ankle, Eq. 4 in the plane) or the
+    CMP region P ⊕ box(a_pitch, a_roll) (hip, corrected Eq. 15).
 
     Raises
     ------
@@ -221,7 +216,7 @@ def predict_push(
 
     The standing CoM at ``origin`` r₀ [m] gets the velocity J/m (cos ψ, sin ψ) from
     ``impulse`` J [N s] at ``azimuth`` ψ [deg]: ``surfaces.classify.classify`` on the body's
-    double support (module docstring). The corrected verdict is the same for the velocity
+    double support. The corrected verdict is the same for the velocity
     × (1 + d/z₀), ``lever_ratio`` = d/z₀ >= 0 (the push at the torso's height:
     docs/validation3d.md, "The critical push from every direction").
 

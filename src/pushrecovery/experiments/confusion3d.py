@@ -1,25 +1,13 @@
 r"""The confusion matrix of the strategy predicted against the strategy used, on the 3-D bodies.
 
-Issue 19 item 5. Over a grid of push azimuths ψ (0 forward, 90 left) and push sizes, given as
-fractions f of the ankle's predicted critical impulse along ψ (J = f m ω ρ_P(r₀, ψ)), each push
-has
-
-* a **predicted** strategy: the library's decision on the ground plane
-  (``surfaces.classify.classify`` with the body's parameters, for the standing CoM r₀ and the
-  velocity J/m along ψ): ``ankle`` (ξ inside the support polygon, Eq. 4), ``hip`` (inside the
-  CMP region, corrected Eq. 15), ``step`` (at most ``max_steps`` steps capture it) or
-  ``fall``; and the same for the push corrected for its height (velocity × (1 + d/z₀),
-  ``predicted_corrected``);
-* a **used** strategy: what the whole-body controller with all its tasks (``wbc-step``: ankle,
-  hip, stepping) did in MuJoCo: ``step`` if a step landed, ``hip`` if the hip law's CMP offset
-  passed 1 N m (m g abs(δ)), ``ankle`` otherwise, and ``fall`` if the body did not come to rest
-  (fell, or still moving at the end of the run).
-
-The pushes are a 3-D campaign's rows (``pushrecovery.campaign``, columns of
-``campaign.pushes3d``; the ``validate`` command runs one): :func:`confusion_from_rows` reads
-them. Where predicted and used differ, :func:`classify_cause` names the reason (:data:`CAUSES`;
-docs/validation3d.md, "The confusion matrix: predicted against used strategy"): the counting
-and the causes are pure functions of the rows.
+Each push of a 3-D campaign (columns of :mod:`~pushrecovery.campaign.pushes3d`, read by
+:func:`confusion_from_rows`) has a **predicted** strategy, the ground plane's verdict
+(``surfaces.classify.classify``) for the standing CoM and the velocity J/m along ψ, also for
+the push corrected for its height (``predicted_corrected``), and a **used** one, what the
+whole-body controller did in MuJoCo: ``step`` if a step landed, ``hip`` if the hip law's CMP
+offset passed 1 N m, ``ankle`` otherwise, ``fall`` if the body did not come to rest. Where they
+differ, :func:`classify_cause` names the reason (:data:`CAUSES`). docs/validation3d.md, "The
+confusion matrix: predicted against used strategy", has the grid and the numbers.
 """
 
 from __future__ import annotations
@@ -90,7 +78,7 @@ class ConfusionPush:
     impulse : float
         J [N s].
     predicted, predicted_corrected, used : str
-        Labels of :data:`LABELS` (module docstring).
+        Labels of :data:`LABELS`: predicted, predicted for the push's height, used.
     outcome : str
         recovered, fell or undecided.
     steps, lift_offs : int
@@ -192,7 +180,7 @@ def confusion_counts(
 
 @dataclass(frozen=True)
 class Confusion3D:
-    """The matrix of one model and controller (module docstring).
+    """The matrix of one model and controller: predicted (rows) against used (columns).
 
     Attributes
     ----------

@@ -1,50 +1,13 @@
 r"""The 2-D prediction of the critical push against the 3-D bodies, from every direction.
 
-Issue 19 item 5 (first part). For a 3-D model (``biped3d``, or ``g1`` with the ``robots``
-extra) and a list of push azimuths ψ (0 forward +x, 90 left +y, degrees), each strategy's
-**predicted** critical impulse comes from the ground plane's surfaces (``docs/plane.md``) and
-its **measured** one from the whole-body controller in MuJoCo.
-
-**Prediction.** A push of impulse J [N s] at azimuth ψ gives the standing body (CoM ground
-point r₀, at rest) the velocity J/m (cos ψ, sin ψ), so its capture point jumps to
-
-.. math:: \boldsymbol\xi = \mathbf r_0 + \frac{J}{m\,\omega}\,(\cos\psi, \sin\psi).
-
-A strategy recovers while ξ is inside its region R (open): the CoP region R = P, the support
-polygon (the hull of both feet, ``Support.from_params``), for the ankle; the CMP region
-R = P ⊕ box(a_pitch, a_roll) (``surfaces.plane.cmp_polygon``, the corrected Eq. 15 offsets)
-for the hip. The critical impulse is where ξ reaches R's boundary along ψ:
-
-.. math:: J^*_R(\psi) = m\,\omega\,\rho_R(\mathbf r_0, \psi),
-
-ρ_R the distance from r₀ to R's boundary along ψ (``ConvexPolygon.ray_distance``) [m]. For a
-rectangle foot [heel, toe] × [±w/2] with the ankles at y = ±s/2 and r₀ = (x₀, 0): forward
-J* = m ω (toe − x₀), left J* = m ω (s/2 + w/2). Here ω = sqrt(g/L) of the body's params and
-r₀ the plant's own standing CoM (the biped3d's is 1 cm ahead of the ankles).
-
-**Corrected prediction (the push's height).** The plants push the torso's CoM, d [m] above
-the whole-body CoM, not the CoM itself: the push also gives the body the centroidal angular
-momentum L₀ = J d (pitching it into the fall). The WBC holds the torso upright, so the floor
-must take L₀ out again through the CMP: ∫ m g δ dt = −L₀ with δ the CMP's offset from the CoP
-*against* the recovery. Taken out fast (within a fraction of 1/ω), it moves the capture point
-by ω L₀ / (m g) = J d/(m ω z₀) more (ω² = g/z₀), so
-
-.. math:: \boldsymbol\xi_{eff} = \mathbf r_0 + \frac{J}{m\,\omega}\Bigl(1 + \frac{d}{z_0}\Bigr)
-          (\cos\psi, \sin\psi), \qquad
-          J^{*}_{corr} = \frac{J^*}{1 + d/z_0},
-
-z₀ the CoM's standing height above the soles [m]. It is an approximation: slower removal
-(weighted by e^{−ωs}) costs less, so the corrected value is a lower estimate.
-
-**Measurement.** The largest impulse at ψ that does not fall within ``duration`` (the plant's
-fall set: ξ beyond P by both hips' CMP reach, or the CoM down; a run still undecided counts as
-standing, as in ``critical_push3d``), under the WBC with the ankles only (``hip=False``) for the
-ankle and with its hip task for the hip. The bracket starts at 0.8 and 1.2 times the corrected
-prediction, widens (×0.7 down, ×1.3 up) until it holds a stand and a fall, then halves until
-it is at most ``rel_tolerance`` × the prediction wide; the measured value is its low end.
-
-**Relative error** (measured − predicted)/predicted, negative when the body does worse than
-the simple model.
+For a 3-D model (``biped3d``, or ``g1`` with the ``robots`` extra) and push azimuths ψ (0 forward
++x, 90 left +y, degrees), each strategy's **predicted** critical impulse J* = m ω ρ_R(r₀, ψ)
+comes from the ground plane's regions (:mod:`~pushrecovery.experiments.validation3d_predict`),
+its **corrected** one J*/(1 + d/z₀) puts back the push's height d above the CoM, and its
+**measured** one is bisected under the whole-body controller in MuJoCo
+(:func:`measure_critical_impulse`). The relative error is (measured − predicted)/predicted.
+docs/validation3d.md, "The critical push from every direction", has the derivation and the
+numbers.
 """
 
 from __future__ import annotations
@@ -121,7 +84,13 @@ def measure_critical_impulse(
     rel_tolerance: float = 0.01,
     duration: float = 3.0,
 ) -> MeasuredCritical:
-    """Bracket and bisect the critical impulse at ``azimuth`` under the WBC (module doc).
+    """Bracket and bisect the critical impulse at ``azimuth`` under the WBC.
+
+    The largest impulse that does not fall within ``duration`` (a run still undecided counts as
+    standing), under the WBC with the ankles only (``hip=False``) or with its hip task. The
+    bracket starts at 0.8 and 1.2 × ``guess``, widens (×0.7 down, ×1.3 up) until it holds a
+    stand and a fall, then halves until at most ``rel_tolerance`` × ``guess`` wide; the
+    measured value is its low end.
 
     Parameters
     ----------
@@ -184,7 +153,7 @@ class ValidationRow(CriticalErrors):
     strategy : str
         ``ankle`` or ``hip``.
     predicted : float
-        m ω ρ_R (module docstring) [N s].
+        m ω ρ_R(r₀, ψ), ρ_R the distance from r₀ to the region's boundary along ψ [N s].
     corrected : float
         predicted / (1 + d/z₀): the push at the torso's height [N s].
     measured : float

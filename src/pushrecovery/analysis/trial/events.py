@@ -1,32 +1,13 @@
 """A trial's events: perturbation onset, foot-off and foot-contact, the steps taken (issue 18).
 
-The detections are :mod:`pushrecovery.analysis.events` and
-:mod:`pushrecovery.analysis.steps_measured` (docs/events.md); here they are run on a trial and
-given what a reader of the trial asks of them:
-
-- **onset**: from the horizontal ground reaction force over the mass (the CoM acceleration by
-  Newton, when the plates carry the only horizontal external force) when the trial has plates,
-  else from the CoM acceleration of the kinematics; the resultant of ap and ml, its baseline
-  the trial's first 0.5 s (:func:`~pushrecovery.analysis.events.perturbation_onset`, k = 3 SD
-  for 20 ms). The kinematics are low-passed forward and backward (zero lag), which spreads an
-  abrupt push over about ±1/f_c; the less noise, the earlier in that spread the threshold is
-  crossed: an onset found on them may lead the true one by up to 1/f_c (0.17 s at 6 Hz),
-  never lag it (tests/test_trial_checks.py). Prefer plates.
-- **foot events** (``foot-off``, ``foot-contact``): from a foot's own force plate where each
-  foot stands on one plate of a C3D file with several (the plate whose loaded CoP lies nearest
-  the foot's heel-toe midpoint; 20 N), else from the foot markers; and the **steps** they make
-  (latency from the onset, length, width, duration; the positions from the markers).
-- **margins at each event**: the frame nearest the event's time, per axis: capture point, CoP
-  margin, strategy and time to leave.
-- **the step taken against the recommended one**: at the step's foot-off frame, per axis, the
-  step the surfaces recommend there (Eq. 21 on the axis' line) and the range of first steps that
-  capture the state (the capture region on that line); ``within`` says whether the foot's
-  displacement along the axis lies in that range (None where the frame needed no step); and in
-  the plane, the landing ankle against the one-step **capture region** of the state at
-  foot-off (``capture_region``: its signed margin, + inside, and the recommended foothold).
-
-Over 400 lines on purpose: one concept, the trial's typed events, each field with its unit;
-the detections themselves are in :mod:`pushrecovery.analysis.events`.
+The detections of :mod:`pushrecovery.analysis.events` and
+:mod:`pushrecovery.analysis.steps_measured` run on a trial: the onset on the horizontal ground
+reaction force over the mass (else on the CoM acceleration of the kinematics, which may lead
+the push by up to 1/f_c: prefer plates), the foot events from each foot's own plate (else its
+markers), the steps they make; each event with the verdicts of its frame, each step against
+the recommended one (:class:`StepComparison`) and the capture region at its foot-off
+(:class:`CaptureRegionCheck`). docs/events.md, "How the trial analysis uses them", has the
+details.
 """
 
 from __future__ import annotations
@@ -111,7 +92,8 @@ class Onset:
     time : float or None
         Onset [s]; None when none was found (or the trial is quiet standing).
     signal : str
-        The signal it was detected on (module docstring).
+        The signal it was detected on: the horizontal ground reaction force over the mass,
+        or the CoM acceleration of the kinematics without plates.
     margins : FrameMargins or None
         The verdicts at the onset's frame.
     note : str or None
@@ -279,7 +261,7 @@ def _margins_at(
 def _onset(
     recording: Recording, time: FloatArray, velocity: FloatArray, mass: float
 ) -> tuple[float | None, str]:
-    """Perturbation onset [s] and the signal it was found on (module docstring)."""
+    """Perturbation onset [s] and the signal it was found on (plates first)."""
     if recording.force is not None and recording.force_time is not None:
         signal_time = recording.force_time
         signal = np.hypot(recording.force[:, 0], recording.force[:, 1]) / mass
@@ -430,7 +412,7 @@ def trial_events(
     com: FloatArray | None = None,
     plane: tuple[Any, BodyParams] | None = None,
 ) -> TrialEvents:
-    """Return the trial's onset, foot events and steps with their margins (module docstring).
+    """Return the trial's onset, foot events and steps with their margins.
 
     ``time`` [s] and ``velocity`` (n, 2) [m/s] are the analysis' frames, ``per_axis`` their
     margins, ``mass`` the subject's [kg]; with ``com`` (n, 2) [m] and ``plane`` (the base
