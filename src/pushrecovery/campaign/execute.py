@@ -1,20 +1,11 @@
 """Run a campaign's batches on this process, local worker processes or a Dask cluster.
 
-Files in the campaign's directory:
-
-- ``spec.json``: the spec (:meth:`CampaignSpec.to_dict`), written first;
-- ``batches/batch-NNNNNN.parquet``: each finished batch, written by this process as soon as a
-  worker returns it (to a temporary name, then renamed: a file there is always complete);
-- ``pushes.parquet``: every push in index order, once all batches are there;
-- ``summary.json``: :func:`~pushrecovery.campaign.summary.summarize` of the pushes.
-
-An interrupted campaign (Ctrl-C, a lost worker, a killed process) keeps every finished batch;
-``resume`` runs only the missing ones. Each push depends on the spec and its index only, so the
-result is the same whatever the number of workers and the order batches finish in.
-
-Workers: ``workers`` local processes (``concurrent.futures.ProcessPoolExecutor``, default: all
-cores; ``workers=1, isolated=False``: this process), or, with ``scheduler``, the workers of a
-running ``dask.distributed`` scheduler at that address (``tcp://host:port``).
+The campaign's directory holds ``spec.json`` (written first), each finished batch as
+``batches/batch-NNNNNN.parquet`` (written under a temporary name, then renamed: a file there is
+always complete), then ``pushes.parquet`` (every push in index order) and ``summary.json``. An
+interrupted campaign keeps every finished batch and ``resume`` runs only the missing ones; each
+push depends on the spec and its index only, so the result is the same whatever the number of
+workers and the order batches finish in (docs/campaigns.md, "Files", "Execution").
 """
 
 from __future__ import annotations
@@ -219,7 +210,8 @@ def run_campaign(
     spec : CampaignSpec
         The campaign.
     directory : path
-        Where its files go (module docstring); created if missing.
+        Where its files go (``spec.json``, ``batches/``, ``pushes.parquet``, ``summary.json``);
+        created if missing.
     workers : int, optional
         Local worker processes; default all cores. Ignored with ``scheduler``.
     scheduler : str, optional

@@ -2,21 +2,13 @@
 
 :func:`find_trials` turns files, folders (searched recursively for ``*.csv`` and ``*.c3d``)
 and glob patterns into a sorted list of trials; :func:`run_trials` analyses each one as
-``pushrecovery analyze`` does a single file, writes its per-frame outputs into
-``OUT/trials/<trial>/`` and its rows into ``OUT/trials/<trial>/trial.json`` (written last:
-a trial with that file is finished, and ``resume`` skips it), then joins them into
-
-- ``OUT/trials.parquet`` and ``trials.csv``: one row per trial and axis
-  (:class:`~pushrecovery.campaign.trial_rows.TrialRow`: the standard measures, where every
-  assumption came from, the data-quality flags; a trial that could not be read or analysed
-  is a row with ``status`` = ``failed`` and the reason);
-- ``OUT/events.parquet`` and ``events.csv``: one row per event
-  (:class:`~pushrecovery.campaign.trial_events.EventRow`);
-- ``OUT/summary.json``: counts and the measures across trials per subject.
-
-A trial's body comes from the subjects table (:mod:`pushrecovery.campaign.subjects`), then the
-flags, the file and the preset. Only the project's own errors (an unreadable or malformed file,
-a trial without a CoM) make a ``failed`` row: anything else is a bug and stops the batch.
+``pushrecovery analyze`` does a single file into ``OUT/trials/<trial>/``, its rows last into
+``trial.json`` (a trial with that file is finished: ``resume`` skips it), then joins them into
+``OUT/trials.parquet`` (:class:`~pushrecovery.campaign.trial_rows.TrialRow`, one row per trial
+and axis; a trial that could not be read or analysed is a ``failed`` row), ``OUT/events.parquet``
+(:class:`~pushrecovery.campaign.trial_events.EventRow`), their CSV twins and
+``OUT/summary.json``. Only the project's own errors make a ``failed`` row: anything else is a
+bug and stops the batch. docs/analysis.md, "Many trials", has the details.
 """
 
 from __future__ import annotations
@@ -240,7 +232,7 @@ def run_trials(
     after: AfterTrial | None = None,
     progress: Callable[[int], None] | None = None,
 ) -> TrialsResult:
-    """Analyse every job (module docstring) and join the tables.
+    """Analyse every job (each into ``out/trials/<trial>/``) and join the tables.
 
     Parameters
     ----------
