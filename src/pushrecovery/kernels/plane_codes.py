@@ -46,47 +46,29 @@ def polygon_margin(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-
     margins.
     """
     count = edges.shape[0]
-    if count == EDGE_BLOCKS[0]:
-        return _margins_4(x, y, xdot, ydot, inv_omega, edges, out)
-    if count == EDGE_BLOCKS[1]:
-        return _margins_8(x, y, xdot, ydot, inv_omega, edges, out)
-    return _margins_any(x, y, xdot, ydot, inv_omega, edges, out)
+    kernel = _MARGINS[count] if count in _MARGINS else _MARGINS[0]
+    return kernel(x, y, xdot, ydot, inv_omega, edges, out)
 
 
-@numba.njit(parallel=True, cache=True, nogil=True)
-def _margins_4(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
-    bad = 0
-    for i in numba.prange(x.shape[0]):
-        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
-        margin = _point_margin(edges, EDGE_BLOCKS[0], px, py)
-        out[i] = margin
-        if not math.isfinite(margin):
-            bad += 1
-    return bad
+# Each loop is built for one edge count (0: the table's own, at run time): a count frozen in
+# the closure is a compile-time constant, which lets the loop over edges unroll. Each build is
+# named after its count, so that it has a disk cache of its own (``_margins_4``, ...).
+def _margins_loop(count):  # type: ignore[no-untyped-def]
+    def margins(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
+        bad = 0
+        for i in numba.prange(x.shape[0]):
+            px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+            margin = _point_margin(edges, count if count else edges.shape[0], px, py)
+            out[i] = margin
+            if not math.isfinite(margin):
+                bad += 1
+        return bad
+
+    margins.__qualname__ = f"_margins_{count or 'any'}"
+    return numba.njit(parallel=True, cache=True, nogil=True)(margins)
 
 
-@numba.njit(parallel=True, cache=True, nogil=True)
-def _margins_8(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
-    bad = 0
-    for i in numba.prange(x.shape[0]):
-        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
-        margin = _point_margin(edges, EDGE_BLOCKS[1], px, py)
-        out[i] = margin
-        if not math.isfinite(margin):
-            bad += 1
-    return bad
-
-
-@numba.njit(parallel=True, cache=True, nogil=True)
-def _margins_any(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
-    bad = 0
-    for i in numba.prange(x.shape[0]):
-        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
-        margin = _point_margin(edges, edges.shape[0], px, py)
-        out[i] = margin
-        if not math.isfinite(margin):
-            bad += 1
-    return bad
+_MARGINS = {count: _margins_loop(count) for count in (0, *EDGE_BLOCKS)}
 
 
 @numba.njit(parallel=True, cache=True, nogil=True)
@@ -125,57 +107,31 @@ def plane_codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type
     """
     args = (x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out)
     if cop_edges.shape[0] == cmp_edges.shape[0] == EDGE_BLOCKS[0]:
-        return _codes_4(*args)
+        return _CODES[EDGE_BLOCKS[0]](*args)
     if cop_edges.shape[0] <= EDGE_BLOCKS[1] and cmp_edges.shape[0] <= EDGE_BLOCKS[1]:
-        return _codes_8(*args[:5], padded_edges(cop_edges, 1), padded_edges(cmp_edges, 1), out)
-    return _codes_any(*args)
+        cop_edges, cmp_edges = padded_edges(cop_edges, 1), padded_edges(cmp_edges, 1)
+        return _CODES[EDGE_BLOCKS[1]](*args[:5], cop_edges, cmp_edges, out)
+    return _CODES[0](*args)
 
 
-# The three loops differ in their edge count only: a compile-time constant is what lets the
-# loops over edges unroll (a shared helper returning a tuple is 2-5x slower).
-@numba.njit(parallel=True, cache=True, nogil=True)
-def _codes_4(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
-    beyond = 0
-    bad = 0
-    for i in numba.prange(x.shape[0]):
-        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
-        cop = _max_excess(cop_edges, EDGE_BLOCKS[0], px, py)
-        hip = _max_excess(cmp_edges, EDGE_BLOCKS[0], px, py)
-        code = 0 if cop < 0.0 else (1 if hip < 0.0 else 3)
-        out[i] = code
-        beyond += code == 3
-        bad += not (abs(px) + abs(py) < np.inf)  # NaN or infinite
-    return beyond, bad
+# As :func:`_margins_loop`: one build per edge count (a shared helper returning a tuple of
+# both regions' excesses is 2-5x slower than these fused loops).
+def _codes_loop(count):  # type: ignore[no-untyped-def]
+    def codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
+        beyond = 0
+        bad = 0
+        for i in numba.prange(x.shape[0]):
+            px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
+            cop = _max_excess(cop_edges, count if count else cop_edges.shape[0], px, py)
+            hip = _max_excess(cmp_edges, count if count else cmp_edges.shape[0], px, py)
+            code = 0 if cop < 0.0 else (1 if hip < 0.0 else 3)
+            out[i] = code
+            beyond += code == 3
+            bad += not (abs(px) + abs(py) < np.inf)  # NaN or infinite
+        return beyond, bad
 
-
-@numba.njit(parallel=True, cache=True, nogil=True)
-def _codes_8(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
-    beyond = 0
-    bad = 0
-    for i in numba.prange(x.shape[0]):
-        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
-        cop = _max_excess(cop_edges, EDGE_BLOCKS[1], px, py)
-        hip = _max_excess(cmp_edges, EDGE_BLOCKS[1], px, py)
-        code = 0 if cop < 0.0 else (1 if hip < 0.0 else 3)
-        out[i] = code
-        beyond += code == 3
-        bad += not (abs(px) + abs(py) < np.inf)  # NaN or infinite
-    return beyond, bad
-
-
-@numba.njit(parallel=True, cache=True, nogil=True)
-def _codes_any(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
-    beyond = 0
-    bad = 0
-    for i in numba.prange(x.shape[0]):
-        px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
-        cop = _max_excess(cop_edges, cop_edges.shape[0], px, py)
-        hip = _max_excess(cmp_edges, cmp_edges.shape[0], px, py)
-        code = 0 if cop < 0.0 else (1 if hip < 0.0 else 3)
-        out[i] = code
-        beyond += code == 3
-        bad += not (abs(px) + abs(py) < np.inf)  # NaN or infinite
-    return beyond, bad
+    codes.__qualname__ = f"_codes_{count or 'any'}"
+    return numba.njit(parallel=True, cache=True, nogil=True)(codes)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -186,6 +142,9 @@ def _max_excess(edges, count, px, py):  # type: ignore[no-untyped-def]
         e = edges[k, 0] * px + edges[k, 1] * py - edges[k, 2]
         excess = e if e > excess else excess
     return excess
+
+
+_CODES = {count: _codes_loop(count) for count in (0, *EDGE_BLOCKS)}
 
 
 def padded_edges(table, smallest=0):  # type: ignore[no-untyped-def]
