@@ -312,7 +312,7 @@ def test_pure_loops_run_uncompiled():
     heel, toe = np.full(7, P.heel), np.full(7, P.toe)
     values, flags = np.empty((6, 7)), np.empty((2, 7), dtype=bool)
     args = (P.com_height, P.gravity, P.max_step_length)
-    step_scalar.decide_parallel(x, 5 * x, heel, toe, *args, values, flags)
+    step_scalar.decide_each(x, 5 * x, heel, toe, *args, values, flags)
     compiled = kernels.plan(x, 5 * x, heel, toe, *args)
     np.testing.assert_allclose(values, compiled[0], rtol=0, atol=SAME_CODE)
     np.testing.assert_array_equal(flags, compiled[1])

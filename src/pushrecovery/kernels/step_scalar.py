@@ -32,7 +32,7 @@ if TYPE_CHECKING:
 MAX_STEP_ANGLE = 0.25 * math.pi
 #: Shortest step that counts as a step, foot to foot [m].
 MIN_STEP_LENGTH = 0.05
-#: The loop of the parallel kernels: plain ``range`` here, ``numba.prange`` once compiled.
+#: The loop of the array kernels: plain ``range`` here, ``numba.prange`` once compiled.
 prange = range
 
 Decision = tuple[float, bool, bool, float, float, float, float, float]
@@ -310,7 +310,7 @@ def _store(i: int, decision: Decision, values: NDArray[float64], flags: NDArray[
     flags[1, i] = feasible
 
 
-def decide_serial(
+def decide_each(
     x: NDArray[float64],
     xdot: NDArray[float64],
     heel: NDArray[float64],
@@ -322,27 +322,11 @@ def decide_serial(
     flags: NDArray[bool_],
 ) -> None:
     """:func:`decide` for every state of flat arrays, into ``values`` and ``flags`` (_store)."""
-    for i in range(x.shape[0]):
-        _store(i, decide(x[i], xdot[i], heel[i], toe[i], height, gravity, reach), values, flags)
-
-
-def decide_parallel(
-    x: NDArray[float64],
-    xdot: NDArray[float64],
-    heel: NDArray[float64],
-    toe: NDArray[float64],
-    height: float,
-    gravity: float,
-    reach: float,
-    values: NDArray[float64],
-    flags: NDArray[bool_],
-) -> None:
-    """:func:`decide_serial` over threads, once compiled (``prange``)."""
     for i in prange(x.shape[0]):
         _store(i, decide(x[i], xdot[i], heel[i], toe[i], height, gravity, reach), values, flags)
 
 
-def solve_serial(
+def solve_each(
     energy: NDArray[float64],
     lean: NDArray[float64],
     target: NDArray[float64],
@@ -351,18 +335,5 @@ def solve_serial(
     out: NDArray[float64],
 ) -> None:
     """:func:`step_angle` for every element of flat arrays, into ``out`` [rad]."""
-    for i in range(energy.shape[0]):
-        out[i] = step_angle(energy[i], lean[i], target[i], length, gravity)
-
-
-def solve_parallel(
-    energy: NDArray[float64],
-    lean: NDArray[float64],
-    target: NDArray[float64],
-    length: float,
-    gravity: float,
-    out: NDArray[float64],
-) -> None:
-    """:func:`solve_serial` over threads, once compiled (``prange``)."""
     for i in prange(energy.shape[0]):
         out[i] = step_angle(energy[i], lean[i], target[i], length, gravity)

@@ -47,13 +47,17 @@ DECIDE_SIGNATURE = numba.types.Tuple(
 _NAMESPACE: dict[str, Any] = dict(vars(step_scalar), prange=numba.prange)
 
 
-def _build(name: str, signature: Any = None, **options: Any) -> Any:
+def _build(name: str, signature: Any = None, as_name: str | None = None, **options: Any) -> Any:
     """Return a numba dispatcher of ``step_scalar.<name>``, its callees compiled ones.
 
     With a ``signature`` it is compiled (or loaded from the cache) now, and never again.
+    ``as_name`` names the build: numba's cache index is named after the function's qualified
+    name, and its key leaves the options out, so the serial and the parallel build of one
+    function need names of their own, or each would load the other's machine code.
     """
     function = getattr(step_scalar, name)
     rebound = types.FunctionType(function.__code__, _NAMESPACE, function.__name__)
+    rebound.__qualname__ = as_name or name
     rebound.__doc__ = function.__doc__
     return numba.njit(signature, cache=True, nogil=True, **options)(rebound)
 
@@ -69,10 +73,12 @@ _compile("capture_residual", inline="always")
 _compile("step_angle")
 decide = _compile("decide")
 _compile("_store", inline="always")
-_decide_serial = _compile("decide_serial")
-_decide_parallel = _compile("decide_parallel", parallel=True)
-_solve_serial = _compile("solve_serial")
-_solve_parallel = _compile("solve_parallel", parallel=True)
+# The array loops, each built serial and parallel (without ``parallel`` numba runs ``prange``
+# as ``range``).
+_decide_serial = _build("decide_each", as_name="decide_serial")
+_decide_parallel = _build("decide_each", as_name="decide_parallel", parallel=True)
+_solve_serial = _build("solve_each", as_name="solve_serial")
+_solve_parallel = _build("solve_each", as_name="solve_parallel", parallel=True)
 
 
 def scalar_decide() -> Callable[..., step_scalar.Decision]:
