@@ -19,14 +19,14 @@ along ψ. Beside the +y edge of C₁ for a left step of a rectangle foot, ρ = w
 (w the foot's width, s the stance width, l the reach).
 **Corrected** (the push's height, as the ankle and hip columns): J*/(1 + d/z₀).
 
-**Measured.** The largest impulse at ψ the body stands (:func:`~.wbc_push.push_humanoid` at
-the plant's pushed body, its whole-body controller with ``stepping=True``: ankles and steps,
-no hip task) by ``runs3d.bisect_critical``: a run
-*falls* when the CoM drops below 0.7 z₀ or the torso tilts more than 1 rad within
-``duration``, or ends with ξ more than :data:`FALL_MARGIN` outside the support polygon of the
-feet it stands on then (the plant's fall set, ``plant3d``, is measured against the feet at
-reset, which a step leaves). Each stood run at the measured impulse reports its steps, their
-longest swing time and its largest foothold distance from the stance ankle.
+**Measured.** The largest impulse at ψ the body stands (:func:`~.runs3d.run_push3d` at the
+plant's pushed body, its whole-body controller with ``stepping=True``: ankles and steps, no
+hip task) by ``runs3d.bisect_critical``: a run *falls* when it ends in the plant's fall set
+(under a controller that steps: the CoM below 0.7 z₀, ``plant3d``) or the torso tilted more
+than 1 rad after the push, or ends with ξ more than :data:`FALL_MARGIN` outside the support
+polygon of the feet it stands on then (undecided within ``duration``). Each stood run at the
+measured impulse reports its steps, their longest swing time and its largest foothold
+distance from the stance ankle.
 
 **Cause** (:meth:`StepRow.cause`), where measured and predicted differ by more than 10 %:
 the simple model takes a touchdown Δt_s after the push and a step as long as
@@ -42,7 +42,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -115,54 +115,23 @@ class SteppingRun:
     step_length: float
 
 
-@dataclass(frozen=True)
-class _Body:
-    """What a stepping run needs of a 3-D body: its model, standing pose and named bodies."""
-
-    params: BodyParams
-    model: Any
-    qpos: Any
-    feet: tuple[str, ...]
-    torso: str  # the pushed body
-    upright: str  # the body the controller holds upright
-
-
-def _body(params: BodyParams, model: Any = None, plant: Humanoid3DPlant | None = None) -> _Body:
-    """Return the ``plant``'s body (a Humanoid3DPlant), else the biped3d of ``params``."""
-    if plant is not None:
-        from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
-
-        require_type("plant", plant, Humanoid3DPlant)
-        if plant.params != params:
-            raise InvalidParameterError("plant must be of the body params (plant.params)")
-        return _Body(params, plant.model, plant.qpos, plant.feet, plant.torso, plant.upright)
-    from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos
-
-    model = biped3d_model(params) if model is None else model
-    feet = tuple(f"{side}_foot" for side in SIDES)
-    return _Body(params, model, bent_knee_qpos(model), feet, "torso", "torso")
-
-
-def _stepping_run(body: _Body, impulse: float, azimuth: float, duration: float,
+def _stepping_run(plant: Humanoid3DPlant, impulse: float, azimuth: float, duration: float,
                   swing_time: float | None) -> SteppingRun:  # fmt: skip
     from pushrecovery.control.wbc.controller import WholeBodyController
-    from pushrecovery.control.wbc.observation import HumanoidObservation
     from pushrecovery.control.wbc.stepper.settings import StepSettings
     from pushrecovery.sim.mujoco.humanoid3d.measure import body_origins
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import push_humanoid
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import run_push3d
+    from pushrecovery.sim.push import Push3D
+    from pushrecovery.sim.result import Outcome
 
-    def stepping(observation: HumanoidObservation) -> WholeBodyController:
-        return WholeBodyController(body.model, body.feet, body.upright, observation=observation,
-                                   stepping=True, params=body.params,
-                                   step_settings=StepSettings(swing_time=swing_time))  # fmt: skip
-
-    run = push_humanoid(body.model, body.qpos, stepping, body.feet, body.torso, impulse,
-                        math.radians(azimuth), duration=duration)  # fmt: skip
-    controller = run.controller
-    height = float(run.com[0, 2])
-    down = bool(np.any(run.com[:, 2] < 0.7 * height)) or float(run.torso_tilt.max()) > 1.0
-    xi = run.com[-1, :2] + run.com_velocity[-1, :2] / controller.omega
+    controller = WholeBodyController(plant.model, plant.feet, plant.upright,
+                                     observation=plant.observation, stepping=True,
+                                     params=plant.params,
+                                     step_settings=StepSettings(swing_time=swing_time))  # fmt: skip
+    run = run_push3d(plant, controller, Push3D(impulse, azimuth), duration=duration)
+    assert run.extras is not None
+    down = run.outcome is Outcome.FELL or run.extras.max_torso_tilt > 1.0
+    xi = run.states[-1, :2] + run.states[-1, 3:5] / controller.omega
     assert controller.support is not None
     outside = -float(controller.support.point_signed_distance(float(xi[0]), float(xi[1])))
     stepper = controller.stepper
@@ -170,10 +139,11 @@ def _stepping_run(body: _Body, impulse: float, azimuth: float, duration: float,
     landed = [s for s in stepper.steps if s.landed is not None]
     # Each foothold's distance from the stance foot's (the reach R of (S1)), from where the
     # feet stood (the foot bodies' origins, as ``StepRecord.landed``).
-    where = {foot: xyz[:2] for foot, xyz in body_origins(body.model, body.qpos, body.feet).items()}
+    origins = body_origins(plant.model, plant.qpos, plant.feet)
+    where = {foot: xyz[:2] for foot, xyz in origins.items()}
     reaches = []
     for step in landed:
-        (other,) = (foot for foot in body.feet if foot != step.foot)
+        (other,) = (foot for foot in plant.feet if foot != step.foot)
         assert step.landed is not None
         reaches.append(float(np.linalg.norm(step.landed - where[other])))
         where[step.foot] = step.landed
@@ -291,7 +261,6 @@ def measure_step_critical(
     guess: float,
     rel_tolerance: float = 0.02,
     duration: float = 3.0,
-    model: Any = None,
     swing_time: float | None = None,
     plant: Humanoid3DPlant | None = None,
 ) -> tuple[float, tuple[float, float], int, SteppingRun]:
@@ -299,22 +268,26 @@ def measure_step_critical(
 
     The bracket starts at 0.5 and 1.0 × ``guess`` [N s] (> 0), widens (×0.7 down, ×1.3 up)
     until it holds a stand and a fall, then halves to ``rel_tolerance`` × guess (in [1e-3,
-    0.5]); ``duration`` [s] in (0, 60] after a push at 0.1 s (module docstring); the
+    0.5]); ``duration`` [s] in (0, 59.9] after a push at 0.1 s (module docstring); the
     controller's shortest swing ``swing_time`` [s] (``StepSettings``; None: the body's
     ``min_step_time``). The body: ``plant``'s (a 3-D plant, ``Biped3DPlant`` or ``G1Plant``,
-    of ``params``), else the biped3d of ``params`` (``model``: its compiled
-    ``biped3d_model(params)`` to reuse). Returns the measured impulse, the bracket, the runs
-    made and the run at the measured impulse.
+    of ``params``), else the biped3d of ``params``. Returns the measured impulse, the
+    bracket, the runs made and the run at the measured impulse.
     """
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, Humanoid3DPlant
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical
     from pushrecovery.sim.push import IMPULSE_MAX, Push3D
 
     require_type("params", params, BodyParams)
     guess = bounded_float("guess", guess, 1e-6, IMPULSE_MAX, "N s")
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-3, 0.5)
-    duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
+    duration = bounded_float("duration", duration, 1e-3, 59.9, "s")
     Push3D(0.0, azimuth)  # checks the azimuth
-    body = _body(params, model, plant)
+    if plant is None:
+        plant = Biped3DPlant(params)
+    require_type("plant", plant, Humanoid3DPlant)
+    if plant.params != params:
+        raise InvalidParameterError("plant must be of the body params (plant.params)")
     done: dict[float, SteppingRun] = {}
 
     def stands(impulse: float) -> tuple[bool, str]:
@@ -322,7 +295,7 @@ def measure_step_critical(
             raise InvalidParameterError(
                 f"guess {guess:g} N s: no stand/fall bracket within {MAX_RUNS} runs"
             )
-        done[impulse] = _stepping_run(body, impulse, azimuth, duration, swing_time)
+        done[impulse] = _stepping_run(plant, impulse, azimuth, duration, swing_time)
         return done[impulse].stood, "step" if done[impulse].steps else "ankle"
 
     low, bracket, _ = bisect_critical(stands, 0.5 * guess, guess, rel_tolerance * guess,
@@ -352,7 +325,7 @@ def run_step_validation(
     rel_tolerance : float
         The bisection's width as a fraction of the corrected prediction, in [1e-3, 0.5].
     duration : float
-        Simulated time of each run [s], in (0, 60].
+        Simulated time of each run after its push [s], in (0, 59.9].
     swing_time : float, optional
         The controller's shortest swing [s] (``StepSettings``); default the body's
         ``min_step_time``, the prediction's Δt_s.
@@ -370,7 +343,7 @@ def run_step_validation(
     if params is not None:
         require_type("params", params, BodyParams)
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-3, 0.5)
-    duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
+    duration = bounded_float("duration", duration, 1e-3, 59.9, "s")
     plant = validation_plant(model, params)
     params, origin, height = plant.params, plant.standing_origin, float(plant.standing_height)
     lever = plant.push_lever

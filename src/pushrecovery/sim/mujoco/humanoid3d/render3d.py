@@ -39,7 +39,6 @@ from pushrecovery.ground.polygon import convex_hull
 from pushrecovery.sim.mujoco.humanoid3d.measure import subtree
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 from pushrecovery.sim.mujoco.humanoid3d.runs3d import pushed_rows
-from pushrecovery.sim.mujoco.humanoid3d.wbc_push import WbcRun
 from pushrecovery.sim.mujoco.render.frames import (
     nearest_indices,
     select_indices,
@@ -79,8 +78,7 @@ def default_camera(azimuth: float, elevation: float = 25.0) -> Camera3D:
 class Recording3D:
     """A recorded 3-D run with what it takes to replay it (one row per recorded tick).
 
-    Build it with :meth:`of_plant_run` (``run_push3d(..., record=True)``) or
-    :meth:`of_wbc_run` (``push_humanoid``/``push_biped3d``).
+    Build it with :meth:`of_plant_run` (``run_push3d(..., record=True)``).
 
     Attributes
     ----------
@@ -148,29 +146,6 @@ class Recording3D:
         return cls(plant.model, tuple(plant.feet), plant.omega, plant.floor, extras.push.azimuth,
                    run.time[rows], extras.qpos[rows], extras.qvel[rows], extras.ctrl[rows],
                    states[:, :3], states[:, 3:6])  # fmt: skip
-
-    @classmethod
-    def of_wbc_run(cls, run: WbcRun, azimuth: float) -> Recording3D:
-        """Return the recording of a ``push_humanoid`` run pushed at ``azimuth`` [deg]."""
-        require_type("run", run, WbcRun)
-        controller = run.controller
-        model = controller.model
-        feet = tuple(controller.foot_names)
-        angle = bounded_float("azimuth", azimuth, -360.0, 360.0, "deg")
-        return cls(model, feet, float(controller.omega), _floor(model, feet, run.qpos[0]),
-                   angle, run.time, run.qpos, run.qvel, run.ctrl, run.com,
-                   run.com_velocity)  # fmt: skip
-
-
-def _floor(model: Any, feet: Sequence[str], qpos: FloatArray) -> float:
-    """Return the mean height of the soles at ``qpos`` (standing: the floor) [m]."""
-    import mujoco
-
-    data = mujoco.MjData(model)
-    data.qpos[:] = qpos
-    mujoco.mj_kinematics(model, data)
-    soles = np.vstack([sole_points(model, data, body_id(model, foot)) for foot in feet])
-    return float(soles[:, 2].mean())
 
 
 def _feet_geoms(model: Any, feet: Sequence[str]) -> list[set[int]]:
@@ -338,7 +313,7 @@ def render_recording3d(
     Parameters
     ----------
     recording : Recording3D
-        The run (:meth:`Recording3D.of_plant_run`, :meth:`Recording3D.of_wbc_run`).
+        The run (:meth:`Recording3D.of_plant_run`).
     path : Path
         ``FILE``, ``FILE.png`` or ``FILE.gif``: writes ``FILE.png`` and ``FILE.gif``.
     camera : Camera3D, optional

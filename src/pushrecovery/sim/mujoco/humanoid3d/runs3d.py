@@ -6,13 +6,14 @@
 ``rest_duration``, or ``duration``: the one loop, :func:`~pushrecovery.sim.simulate.simulate`,
 whose :class:`~pushrecovery.sim.result.SimulationResult` carries the run's
 :class:`~pushrecovery.sim.result.Push3DExtras` (:func:`pushed_rows`: the rows a reader of the
-push sees). :func:`critical_push3d`: the largest
-impulse at an azimuth that does not fall. The plants are :mod:`.plant3d`'s.
+push sees); a :class:`WbcTrace` passed to it records the controller's figures tick by tick.
+:func:`critical_push3d`: the largest impulse at an azimuth that does not fall. The plants are
+:mod:`.plant3d`'s.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -20,10 +21,11 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.control.base import Command
+from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.backend import Step
-from pushrecovery.sim.events import ScheduledPush
+from pushrecovery.sim.events import Observer, ScheduledPush
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
     Humanoid3DPlant,
@@ -37,6 +39,7 @@ FloatArray = NDArray[np.float64]
 
 __all__ = [
     "CriticalPush3D",
+    "WbcTrace",
     "bisect_critical",
     "critical_push3d",
     "pushed_rows",
@@ -71,6 +74,7 @@ def run_push3d(
     rest_speed: float = 5e-3,
     rest_duration: float = 0.5,
     record: bool = False,
+    observers: Sequence[Observer] = (),
 ) -> SimulationResult:
     """Stand, push, and run the whole-body controller until a decision (module docstring).
 
@@ -95,6 +99,8 @@ def run_push3d(
         > 0; at least one tick at rest).
     record : bool
         Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (the extras'), for rendering.
+    observers : sequence of Observer
+        Also see every control tick (e.g. a :class:`WbcTrace`); not the push's own steps.
 
     Returns
     -------
@@ -117,7 +123,7 @@ def run_push3d(
         control_period=CONTROL_PERIOD,
         rest=RestCriterion(rest_speed, rest_duration),
         push=ScheduledPush(push_time, push, react=True),
-        observers=(figures,),
+        observers=(figures, *observers),
     )  # fmt: skip
     after = plant.push_row
     assert after is not None  # the push comes before the last tick (ticks > its tick)
@@ -141,6 +147,72 @@ def run_push3d(
         ctrl=None if frames is None else frames[:, nq + nv :],
     )
     return replace(result, extras=extras)
+
+
+class WbcTrace:
+    """Observer of a :func:`run_push3d` run, tick by tick: the body and its controller's QP.
+
+    Row k is control tick k (the push's own 10 ms are no tick): the body at the tick's end,
+    ``time`` [s] (MuJoCo's clock), and the controller's figures of the command held over it,
+    computed at ``time`` − :data:`~.plant3d.CONTROL_PERIOD`.
+
+    Parameters
+    ----------
+    plant : Humanoid3DPlant
+        The run's plant.
+    controller : WholeBodyController
+        Its controller.
+
+    Attributes
+    ----------
+    time : float array, shape (n,)
+        [s].
+    pelvis : float array, shape (n, 3)
+        The upright body's origin [m] (world).
+    torso_tilt : float array, shape (n,)
+        Angle between the upright body's z axis and the vertical [rad].
+    sole_lift : float array, shape (n, len(feet))
+        Each foot's highest sole point above z = 0 [m] (0 on the floor).
+    wrenches : float array, shape (n, len(feet), 6)
+        The QP's wrench per foot (F, T) in its sole frame [N, N m].
+    desired_cop : float array, shape (n, 2)
+        The DCM law's CoP [m] (world xy).
+    cmp_offset : float array, shape (n, 2)
+        The hip law's CMP offset δ from the CoP [m] (0 with the ankles only).
+    ok : bool array, shape (n,)
+        Whether DAQP solved the tick.
+    """
+
+    _FIELDS = ("time", "pelvis", "torso_tilt", "sole_lift", "wrenches", "desired_cop",
+               "cmp_offset", "ok")  # fmt: skip
+
+    def __init__(self, plant: Humanoid3DPlant, controller: WholeBodyController) -> None:
+        require_type("plant", plant, Humanoid3DPlant)
+        require_type("controller", controller, WholeBodyController)
+        self.plant, self.controller = plant, controller
+        self._upright = body_id(plant.model, plant.upright)
+        self._feet = [body_id(plant.model, foot) for foot in plant.feet]
+        self._rows: dict[str, list[object]] = {name: [] for name in self._FIELDS}
+
+    def on_step(self, index: int, step: Step, command: Command) -> None:
+        """Keep the tick's row (class docstring)."""
+        plant, controller, rows, feet = self.plant, self.controller, self._rows, self._feet
+        model, data, solution = plant.model, plant.data, controller.last
+        assert solution is not None  # the tick computed its command
+        rows["time"].append(plant.clock)
+        rows["pelvis"].append(np.array(data.xpos[self._upright]))
+        rows["torso_tilt"].append(plant.torso_tilt())
+        rows["sole_lift"].append([float(sole_points(model, data, f)[:, 2].max()) for f in feet])
+        rows["wrenches"].append(solution.wrenches.copy())
+        rows["desired_cop"].append(controller.desired_cop.copy())
+        rows["cmp_offset"].append(controller.cmp_offset.copy())
+        rows["ok"].append(solution.ok)
+
+    def __getattr__(self, name: str) -> NDArray[np.generic]:
+        """Return the column ``name`` (class docstring) as an array."""
+        if name in WbcTrace._FIELDS:
+            return np.array(self.__dict__["_rows"][name])
+        raise AttributeError(name)
 
 
 class _ControllerFigures:

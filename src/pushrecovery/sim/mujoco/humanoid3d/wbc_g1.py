@@ -4,7 +4,8 @@ The G1 of :func:`~.robots.describe_robot` (torque motors, 1 ms steps, its ``stan
 lowered onto the floor): feet ``left_ankle_roll_link`` and ``right_ankle_roll_link`` (four
 contact spheres each; the sole frame and polygon come from their bottoms, as
 :func:`~.robots.robot_params` measures them), ``torso_link`` held upright and at its height,
-and every other joint (legs, waist, arms) in the posture task. Pushes at ``torso_link``.
+and every other joint (legs, waist, arms) in the posture task. Pushes at ``torso_link``
+(``plant3d.G1Plant``, ``runs3d.run_push3d``).
 """
 
 from __future__ import annotations
@@ -16,10 +17,9 @@ from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.control.wbc.gains import WbcGains
 from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.ground.polygon import convex_hull
-from pushrecovery.sim.mujoco.humanoid3d.robots import RobotDescription, describe_robot
-from pushrecovery.sim.mujoco.humanoid3d.wbc_push import WbcRun, push_humanoid
+from pushrecovery.sim.mujoco.humanoid3d.robots import RobotDescription
 
-__all__ = ["G1_FEET", "G1_TORSO", "g1_ankle_impulse", "g1_controller", "push_g1"]
+__all__ = ["G1_FEET", "G1_TORSO", "g1_ankle_impulse", "g1_controller"]
 
 #: The G1's foot bodies (left, right) and the body the torso task holds upright.
 G1_FEET = ("left_ankle_roll_link", "right_ankle_roll_link")
@@ -58,26 +58,3 @@ def _soles(model: Any, data: Any, feet: list[int]) -> Any:
     import numpy as np
 
     return np.vstack([sole_points(model, data, foot) for foot in feet])
-
-
-def push_g1(
-    impulse: float,
-    azimuth: float = 0.0,
-    *,
-    duration: float = 2.0,
-    push_time: float = 0.1,
-    robot: RobotDescription | None = None,
-    gains: WbcGains | None = None,
-    hip: bool = False,
-) -> WbcRun:
-    """Push the G1 at ``torso_link`` and run the whole-body controller (:func:`push_humanoid`).
-
-    ``robot`` reuses a :func:`~.robots.describe_robot` ("g1"); needs the ``robots`` extra.
-    """
-    robot = describe_robot("g1") if robot is None else robot
-
-    def controller(observation: HumanoidObservation) -> WholeBodyController:
-        return g1_controller(robot, observation, gains, hip=hip)
-
-    return push_humanoid(robot.model, robot.qpos, controller, G1_FEET, G1_TORSO, impulse,
-                         azimuth, duration=duration, push_time=push_time)  # fmt: skip
