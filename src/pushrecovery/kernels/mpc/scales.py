@@ -12,6 +12,16 @@ import numba
 import numpy as np
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _sandwich(b, s, m, r, c):  # type: ignore[no-untyped-def]
+    """(Bᵀ S M)[r, c], summed over q then p as the recursion always has."""
+    acc = 0.0
+    for q in range(4):
+        for p in range(4):
+            acc += b[q, r] * s[q, p] * m[p, c]
+    return acc
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def dual_scales(a, b, wx, wu, bounds, scales, feedback):  # type: ignore[no-untyped-def]
     """Fill ``scales`` (N, 7) and ``feedback`` (N, 2, 4) from the unconstrained problem.
@@ -36,17 +46,9 @@ def dual_scales(a, b, wx, wu, bounds, scales, feedback):  # type: ignore[no-unty
     for i in range(n - 1, -1, -1):
         for r in range(2):
             for c in range(4):
-                acc = 0.0
-                for q in range(4):
-                    for p in range(4):
-                        acc += b[q, r] * s[q, p] * a[p, c]
-                g[r, c] = acc
+                g[r, c] = _sandwich(b, s, a, r, c)
             for c in range(2):
-                acc = 0.0
-                for q in range(4):
-                    for p in range(4):
-                        acc += b[q, r] * s[q, p] * b[p, c]
-                h[r, c] = acc
+                h[r, c] = _sandwich(b, s, b, r, c)
             h[r, r] += 2.0 * wu[i, r]
         det = h[0, 0] * h[1, 1] - h[0, 1] * h[1, 0]
         for c in range(4):
