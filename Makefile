@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 OUT := out
 
-.PHONY: demo test bench lint fuzz docs venv clean
+.PHONY: demo test validate bench lint fuzz docs venv clean
 
 venv: $(STAMP)
 
@@ -24,7 +24,12 @@ demo: $(STAMP)
 	@echo "open $(OUT)/report/index.html"
 
 test: docs
-	$(BIN)/python -m pytest -q -n 2
+	$(BIN)/python -m pytest -q -n 2 -m "not validate"
+
+# The long physics validations (pytest marker `validate`): the full grids and horizons whose
+# short versions run in `make test`.
+validate: $(STAMP)
+	$(BIN)/python -m pytest -q -n 2 -m validate
 
 # The site (Sphinx): guides, topics, the API reference from the docstrings and the CLI reference
 # from click, into out/docs; a warning (a broken reference, a malformed docstring) fails the build.

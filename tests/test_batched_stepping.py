@@ -26,19 +26,36 @@ from pushrecovery.sim.many import COMPILED
 P = load_params()
 
 
-def spec(duration: float = 10.0) -> CampaignSpec:
+#: The full grid (3 stances × 25 pushes × 2 hip limits) and a sixth of it that still takes every
+#: branch of the loop (make test; the full grid runs in make validate).
+FULL = {"x0": (-0.03, 0.09, 0.06), "xdot": (-3.6, 3.6, 0.3)}
+SHORT = {"x0": (0.0, 0.0, 1.0), "xdot": (-3.6, 3.6, 0.6)}
+
+
+def spec(
+    duration: float = 10.0, grid: dict[str, tuple[float, float, float]] = FULL
+) -> CampaignSpec:
     return CampaignSpec(
-        "analytic", "stepping", "recovery", P, x0=(-0.03, 0.09, 0.06), xdot=(-3.6, 3.6, 0.3),
+        "analytic", "stepping", "recovery", P, **grid,
         sweeps={"torque_max": (40.0, 80.0, 40.0)}, duration=duration, batch_size=1000,
     )  # fmt: skip
 
 
-@pytest.mark.parametrize("duration", [10.0, 0.4])
-def test_batched_rows_equal_the_one_push_loop(duration: float) -> None:
-    campaign = spec(duration)
+@pytest.mark.parametrize(
+    "duration, grid, size",
+    [
+        pytest.param(10.0, SHORT, 2 * 13, id="every-branch"),
+        pytest.param(10.0, FULL, 2 * 3 * 25, id="every-branch-full", marks=pytest.mark.validate),
+        pytest.param(0.4, FULL, 2 * 3 * 25, id="undecided"),
+    ],
+)
+def test_batched_rows_equal_the_one_push_loop(
+    duration: float, grid: dict[str, tuple[float, float, float]], size: int
+) -> None:
+    campaign = spec(duration, grid)
     assert ("stepping", "recovery") in COMPILED
     _, rows = run_batch(campaign, 0)  # the compiled loop
-    assert len(rows) == campaign.size == 2 * 3 * 25
+    assert len(rows) == campaign.size == size
     loop = push_rows(campaign, campaign.pushes(0), engine="loop")
     for row, push, expected in zip(rows, campaign.pushes(0), loop, strict=True):
         assert row == expected, push

@@ -83,7 +83,7 @@ def test_a_full_newton_step_solves_the_linearised_kkt_system():
     np.testing.assert_allclose(zu * dsu + su * dzu, target_u, atol=1e-13)
 
 
-@pytest.mark.parametrize("horizon", [50, 100, 200])
+@pytest.mark.parametrize("horizon", [50, 100, pytest.param(200, marks=pytest.mark.validate)])
 def test_the_interior_point_equals_the_sparse_qp(horizon):
     # Random states with the CoP, torque and θ bounds active: the interior point alone (no
     # Riccati verification) gives quadprog's first input of the sparse QP to 1e-6 of the

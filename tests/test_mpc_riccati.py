@@ -12,7 +12,7 @@ from test_mpc import P, sparse_solution
 SCALE = np.array([P.toe - P.heel, P.torque_max])
 
 
-@pytest.mark.parametrize("horizon", [50, 100, 200])
+@pytest.mark.parametrize("horizon", [50, 100, pytest.param(200, marks=pytest.mark.validate)])
 def test_verified_riccati_solutions_equal_the_sparse_qp(horizon):
     # Random states, most with the CoP or torque bounds active: the Riccati passes, started
     # from DAQP's active set, must verify the KKT conditions and give quadprog's first input
@@ -46,7 +46,7 @@ def test_verified_riccati_solutions_equal_the_sparse_qp(horizon):
     assert constrained >= 2
 
 
-@pytest.mark.parametrize("horizon", [50, 200])
+@pytest.mark.parametrize("horizon", [50, pytest.param(200, marks=pytest.mark.validate)])
 def test_closed_loop_ticks_take_the_riccati_route_and_are_exact(horizon):
     # A pushed run: the ticks after the first start from the last active set shifted by a stage
     # and are verified by the passes (DAQP only where they are not); sampled ticks against the
