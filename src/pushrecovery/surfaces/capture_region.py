@@ -1,19 +1,13 @@
 r"""Capture regions of a step: the footholds that capture a state, and the recommended one.
 
 The N-step capturable sets (S1) of :mod:`pushrecovery.surfaces.n_step`, solved for the first
-foothold.
-
-**Footholds.** For a landing at time t (T = e^{ωt}) followed by N − 1 further steps, (S1)
-solved for q_1 gives the first footholds
+foothold: for a landing at time t (T = e^{ωt}) followed by N − 1 further steps,
 
 .. math:: Q_T = T\xi_0 \oplus T(-H) \oplus (T - 1)(-S) \oplus (-V_{N-1}), \qquad (S3)
 
-V_{N−1} the capture points captured, relative to the landing ankle, by the landing foot and
-N − 1 more steps (V_0 = F), intersected with the reach a_0 + R_1. That is the region for a
-touchdown *exactly* at t. For a touchdown at *any* time from t on, Q_T = Q_{T_0} ⊕ (T − T_0) A
-with A = ξ_0 ⊕ (−H) ⊕ (−S), whose union over T >= T_0 is the convex set
-Q_{T_0} ⊕ cone(A) (the whole reach when 0 is inside A: the body is already captured without
-a step and may put its foot anywhere later).
+intersected with the reach; for a touchdown at any time from t on, the union
+Q_{T_0} ⊕ cone(A), A = ξ_0 ⊕ (−H) ⊕ (−S). docs/steps.md, "Footholds: the capture region of a
+step (S3)", derives both and the recommended foothold (the region's Chebyshev centre).
 """
 
 from __future__ import annotations

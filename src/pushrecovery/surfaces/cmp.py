@@ -1,21 +1,14 @@
 r"""CMP-balancing (hip strategy) decision surface, Eq. (15) as corrected (errata E11).
 
-With the ankle saturated (CoP on the toe) and the flywheel driven bang-bang for T = T_max from
-rest (Eqs. 8-12), the capture point obeys ξ̇ = ω (ξ − δ − τ/(m g)), so
-
-.. math:: \xi(2T) = \delta + e^{2\omega T}(\xi_0 - \delta) - a\,(e^{\omega T} - 1)^2,
-          \qquad a = \tau_{max} / (m g).
-
-Requiring ξ(2T) < δ⁺ (Eq. 9) gives Eq. (13), and dividing by e^{2ωT} the bound
+With the ankle saturated and the flywheel driven bang-bang for T = T_max from rest
+(Eqs. 8-12), a state is recoverable when
 
 .. math:: \delta^- - a (1 - e^{-\omega T_{max}})^2 < x + \frac{\dot x}{\omega}
-          < \delta^+ + a (1 - e^{-\omega T_{max}})^2 .
+          < \delta^+ + a (1 - e^{-\omega T_{max}})^2, \qquad a = \tau_{max} / (m g).
 
 The printed Eq. (15) has (e^{ωT} − 1)² in place of (1 − e^{−ωT})², a factor e^{2ωT} (7.2 for
-the paper preset) too optimistic. This bound is also the supremum over *all* flywheel
-controllers that respect abs(τ) ≤ τmax and abs(θ) ≤ θmax from a flywheel at rest (errata E12): the
-bang-bang profile maximises θ(t) at every t, and the capturable capture point is
-δ⁺ + (ω³ I / m g) ∫ e^{−ωs} θ(s) ds.
+the paper preset) too optimistic (docs/errata.md, E11); the bound is also the supremum over
+every flywheel controller within abs(τ) ≤ τmax and abs(θ) ≤ θmax from rest (E12).
 """
 
 from __future__ import annotations
