@@ -42,8 +42,7 @@ MATRIX_RTOL = 1e-9
 #: Relative agreement of the solutions x = (q̈, w) and the commands, both DAQP warm-started
 #: tick to tick: one optimum, reached from two forms of the QP whose rounding differs. The
 #: reference solved cold instead differs from itself warm by up to 5e-9 on these runs, so the
-#: bound is the solver's own spread (1.5e-9 measured on one machine, under 1e-9 on another); a
-#: wrong row or column moves the solution by 1e-3 or more [-].
+#: bound is the solver's own spread (1.5e-9 measured on one machine, under 1e-9 on another) [-].
 SOLUTION_RTOL = 1e-8
 #: WholeBodyQP's default regularisations ε_a and ε_f (its docstring).
 ACC_REG, WRENCH_REG = 1e-6, 1e-8
