@@ -8,20 +8,11 @@ CoP forward). Angular momentum about the ankle gives
 
 .. math:: m L^2 \ddot\theta = m g L \sin\theta - \tau .
 
-Torque limit. Moments on the massless foot give τ = δ F_z with the exact normal force
-F_z = m (g + z̈) = A + τ sinθ / L, A = m g cos²θ − m L cosθ θ̇². Solving for τ,
-
-.. math:: \tau(\delta) = \frac{\delta A}{1 - \delta\sin\theta / L},
-
-which increases with δ while A > 0 and abs(δ) < L. A CoP command is therefore clipped to the foot
-and turned into exactly the torque that puts the CoP there, including the vertical acceleration
-of the CoM that the LIPM neglects. When A ≤ 0 the foot is unloaded and no torque can be
-transmitted (τ = 0). This is how the ankle torque is limited so that the CoP stays on the foot.
-
-With an upper body on a hip joint whose centre of mass is at the hip (the flywheel of Sec. III),
-the hip torque τ_h (positive pitching the upper body forward) reacts on the leg:
-m L² θ̈ = m g L sinθ − τ − τ_h, hence F_z (1 − δ sinθ / L) = A + τ_h sinθ / L and
-τ(δ) = δ (A + τ_h sinθ / L) / (1 − δ sinθ / L) (docs/errata.md, E3).
+A CoP command is clipped to the foot and turned into exactly the torque that puts the CoP
+there, τ(δ) = δ A / (1 − δ sinθ / L), A = m g cos²θ − m L cosθ θ̇² (the exact normal force,
+including the vertical acceleration the LIPM neglects; τ = 0 when A ≤ 0, the foot unloaded).
+docs/errata.md, E3, derives it and its generalisation to a hip torque, an ankle height and a
+foot mass (:func:`ankle_torque_for_cop`).
 """
 
 from __future__ import annotations
