@@ -1,4 +1,4 @@
-r"""The whole-body controller's compiled kernels (numba, cached on disk): its QP, in place.
+"""The whole-body controller's compiled kernels (numba, cached on disk): its QP, in place.
 
 Plain array functions for :mod:`pushrecovery.control.wbc` (the QP's assembly and
 least-distance form, :mod:`~pushrecovery.control.wbc.qp` and
@@ -12,19 +12,13 @@ kernels call one another (``assemble_rows`` runs ``sole_frames``, ``add_rows`` a
 ``constraints``; ``least_distance`` runs ``transform_rows``; ``balance_point`` runs
 ``rotation_vector``): one group, one file.
 
-The QP min ½ xᵀ H x + fᵀ x s.t. l ≤ A x ≤ u is handed to DAQP in the form DAQP itself solves
-(its least-distance problem, Arnström, Bemporad & Axehill 2022): with H = Rᵀ R (R = Lᵀ, L the
-lower Cholesky factor), v = R⁻ᵀ f and u = R x + v,
-
-.. math:: \min_u \tfrac12 \lVert u \rVert^2 \quad\text{s.t.}\quad
-          l + M v \le M u \le u + M v, \qquad M = A R^{-1}, \qquad x = R^{-1} (u - v),
-
-the same problem (the cost differs by the constant ½‖v‖²), so the same solution. DAQP's own
-update of a dense H refactors it and recomputes A R⁻¹ in plain loops (~60 µs at the G1's 47
-unknowns); here H is factored on its *envelope*: row j of H is zero left of its first non-zero
-``first[j]``, a property the Cholesky factor keeps (no fill-in outside the envelope). The
-whole-body QP's H is diagonal outside the floating base, the waist and a swinging leg (the
-posture task), so the factorisation and M cost little more than reading A.
+The QP min ½ xᵀ H x + fᵀ x s.t. l ≤ A x ≤ u reaches DAQP in its least-distance form
+(Arnström, Bemporad & Axehill 2022; docs/humanoid3d_wbc.md, "The QP"): with H = Rᵀ R,
+v = R⁻ᵀ f and u = R x + v, min ½‖u‖² s.t. l + M v ≤ M u ≤ u + M v, M = A R⁻¹,
+x = R⁻¹ (u − v). DAQP's own dense update costs ~60 µs at the G1's 47 unknowns; here H is
+factored on its *envelope* (row j zero left of ``first[j]``, which the Cholesky factor keeps):
+outside the floating base, the waist and a swinging leg H is diagonal, so the factorisation
+and M cost little more than reading A.
 """
 
 from __future__ import annotations
