@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import finite_array, finite_float
+from pushrecovery.arguments import bounded_float, finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN
 
@@ -27,17 +27,6 @@ __all__ = [
 
 #: Largest ω t the closed forms take: e^50 = 5e21, far from float64 overflow (ω t ≈ 710).
 MAX_OMEGA_T = 50.0
-
-
-def _omega(omega: object) -> float:
-    """ω as a float in [OMEGA_MIN, OMEGA_MAX] (sqrt(g/L) of any body), or a named error."""
-    value = finite_float("omega", omega, "1/s")
-    if not OMEGA_MIN <= value <= OMEGA_MAX:
-        raise InvalidParameterError(
-            f"omega must be in [{OMEGA_MIN:g}, {OMEGA_MAX:g}] 1/s (sqrt(g/L) of any body), "
-            f"got omega={value:g}"
-        )
-    return value
 
 
 FloatArray = NDArray[np.float64]
@@ -63,7 +52,7 @@ def lipm_acceleration(x: ArrayLike, cop: ArrayLike, omega: float) -> FloatArray:
     ndarray
         ẍ = ω² (x − δ) [m/s²]; positive accelerates the CoM forward.
     """
-    omega = _omega(omega)
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     return omega**2 * (finite_array("x", x) - finite_array("cop", cop))
 
 
@@ -96,7 +85,7 @@ def lipm_state(
     x, xdot : ndarray
         CoM position [m] and velocity [m/s] at t, broadcast over the inputs.
     """
-    omega = _omega(omega)
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     times = finite_array("t", t)
     if times.size and float(np.max(np.abs(times))) > MAX_OMEGA_T / omega:  # before ω t overflows
         raise InvalidParameterError(
@@ -133,7 +122,7 @@ def lipm_transition(omega: float, dt: float) -> tuple[FloatArray, FloatArray]:
     A : ndarray, shape (2, 2)
     B : ndarray, shape (2,)
     """
-    omega = _omega(omega)
+    omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     dt = finite_float("dt", dt, "s")
     if abs(dt) > MAX_OMEGA_T / omega:
         raise InvalidParameterError(
