@@ -16,12 +16,10 @@ import click
 from pushrecovery.cli.app import example
 from pushrecovery.cli.campaign_options import SCHEDULER, WORKERS, CampaignRun, run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, humanoid_only
-from pushrecovery.cli.options import body_options, emit, out_option, params_from
+from pushrecovery.cli.options import body_options, emit, out_option, params_from, range_option
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
 __all__ = ["campaign", "report"]
-
-_triple: dict[str, Any] = {"nargs": 3, "type": float, "metavar": "START STOP STEP", "default": None}
 
 
 def _refuse_wbc(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
@@ -71,9 +69,9 @@ def _refuse_wbc(ctx: click.Context, param: click.Parameter, value: str | None) -
 @humanoid_only(
     "campaign", "--azimuth", "--azimuths", "--strategy", "--fraction", nargs={"--fraction": 3}
 )
-@click.option("--x0", "x0", **_triple, help="CoM positions before the push [m].")
-@click.option("--xdot", **_triple, help="Pushes as CoM velocities, forward positive [m/s].")
-@click.option("--impulse", **_triple, help="Pushes as impulses at the CoM, forward positive [N s].")
+@range_option("--x0", "x0", help_text="CoM positions before the push [m].")
+@range_option("--xdot", help_text="Pushes as CoM velocities, forward positive [m/s].")
+@range_option("--impulse", help_text="Pushes as impulses at the CoM, forward positive [N s].")
 @run_options(
     param_help="Sweep a body parameter (SI units), repeatable: e.g. torque_max=50:150:25.",
     samples_help="Draw this many pushes uniformly from the ranges (with --seed) instead of the "

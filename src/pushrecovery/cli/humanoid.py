@@ -26,6 +26,7 @@ from pushrecovery.cli.options import (
     echo_confusion,
     emit,
     out_option,
+    range_option,
 )
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
@@ -358,21 +359,11 @@ def validate(
     help="Push directions [deg], START:STOP:STEP (a full turn's STOP, 360, is left out) or a "
     "list A,B,...; 0 forward, 90 left (default 0).",
 )
-@click.option(
-    "--impulse",
-    nargs=3,
-    type=float,
-    default=None,
-    metavar="START STOP STEP",
-    help="Pushes as impulses at the torso [N s], along each azimuth.",
-)
-@click.option(
+@range_option("--impulse", help_text="Pushes as impulses at the torso [N s], along each azimuth.")
+@range_option(
     "--fraction",
-    nargs=3,
-    type=float,
-    default=None,
-    metavar="START STOP STEP",
-    help="Pushes as fractions of the ankle's predicted critical impulse along each azimuth [-].",
+    help_text="Pushes as fractions of the ankle's predicted critical impulse along each "
+    "azimuth [-].",
 )
 @click.option(
     "--strategy",

@@ -118,6 +118,13 @@ def out_option(default: str | None, help_text: str) -> Callable[[F], F]:
     )
 
 
+def range_option(*decls: str, help_text: str) -> Callable[[F], F]:
+    """Return an optional ``START STOP STEP`` option: three floats, None when not given."""
+    return click.option(
+        *decls, nargs=3, type=float, default=None, metavar="START STOP STEP", help=help_text
+    )
+
+
 def duration_option(default: float | None, help_text: str) -> Callable[[F], F]:
     """Return ``--duration`` [s], the longest run, its ``default`` shown unless None."""
     return click.option(

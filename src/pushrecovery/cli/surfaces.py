@@ -11,6 +11,7 @@ from pushrecovery.cli.options import (
     body_options,
     emit,
     params_from,
+    range_option,
     support_from,
     support_options,
     value_range_option,
@@ -118,13 +119,8 @@ def classify(
     multiple=True,
     help="CoM velocity with the CoM above the stance ankle [m/s], > 0 (repeatable).",
 )
-@click.option(
-    "--v0-range",
-    nargs=3,
-    type=float,
-    default=None,
-    metavar="START STOP STEP",
-    help="Velocities START, START+STEP, ... up to STOP (inclusive) [m/s].",
+@range_option(
+    "--v0-range", help_text="Velocities START, START+STEP, ... up to STOP (inclusive) [m/s]."
 )
 @body_options
 def step(
