@@ -173,11 +173,7 @@ class BodyParams:
     def _check_steps(self) -> None:
         """Validate the step timing and limits; derive ``max_steps`` when not given."""
         set_ = object.__setattr__
-        step_time = finite_float("min_step_time", self.min_step_time, "s")
-        if not 0.0 <= step_time <= MAX_STEP_TIME:
-            raise InvalidParameterError(
-                f"min_step_time must be in [0, {MAX_STEP_TIME:g}] s, got {step_time:g}"
-            )
+        step_time = bounded_float("min_step_time", self.min_step_time, 0.0, MAX_STEP_TIME, "s")
         set_(self, "min_step_time", step_time)
         if self.min_step_width is not None:
             width = finite_float("min_step_width", self.min_step_width, "m")

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, require_type
+from pushrecovery.arguments import finite_float, positive_float, require_type
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -138,10 +138,7 @@ class AnkleCapturePoint(Controller):
 
     def __init__(self, params: BodyParams, omega: float | None = None) -> None:
         super().__init__(params)
-        omega = params.omega if omega is None else finite_float("omega", omega, "1/s")
-        if omega <= 0.0:
-            raise InvalidParameterError(f"omega must be > 0 1/s, got {omega:g}")
-        self._omega = omega
+        self._omega = params.omega if omega is None else positive_float("omega", omega, "1/s")
 
     def reset(self, state: NDArray[np.float64]) -> None:
         """Do nothing: the controller has no internal state."""

@@ -142,9 +142,9 @@ def capture_region(
     """
     require_type("params", params, BodyParams)
     require_type("support", support, Support)
-    t = params.min_step_time if swing_time is None else finite_float("swing_time", swing_time, "s")
-    if not 0.0 <= t <= MAX_STEP_TIME:
-        raise InvalidParameterError(f"swing_time must be in [0, {MAX_STEP_TIME:g}] s, got {t:g}")
+    t = params.min_step_time
+    if swing_time is not None:
+        t = bounded_float("swing_time", swing_time, 0.0, MAX_STEP_TIME, "s")
     hip = _checked_plan(steps, timing, hip)
     xi = _capture_point(x, y, xdot, ydot, params)
     if swing is None and support.stance is Stance.DOUBLE:
