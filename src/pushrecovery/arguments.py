@@ -43,6 +43,14 @@ def positive_float(name: str, value: object, unit: str = "") -> float:
     return number
 
 
+def non_negative_float(name: str, value: object, unit: str = "") -> float:
+    """Return ``value`` as a finite float >= 0 or raise naming ``name`` and the range."""
+    number = finite_float(name, value, unit, allowed=">= 0")
+    if number < 0.0:
+        raise InvalidParameterError(f"{name} must be >= 0{_unit(unit)}, got {name}={number:g}")
+    return number
+
+
 def bounded_float(name: str, value: object, low: float, high: float, unit: str = "") -> float:
     """Return ``value`` as a finite float in [``low``, ``high``] or raise naming the range."""
     try:

@@ -25,7 +25,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import bounded_float, finite_float, positive_float
+from pushrecovery.arguments import bounded_float, non_negative_float, positive_float
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import Shape, decompose_unchecked, minkowski_sum_unchecked
@@ -59,9 +59,7 @@ def hip_share(elapsed: float, spin_up: float, omega: float) -> float:
         ``omega`` is outside [0.1, 100] 1/s (:data:`~pushrecovery.params.OMEGA_MIN`,
         :data:`~pushrecovery.params.OMEGA_MAX`).
     """
-    elapsed = finite_float("elapsed", elapsed, "s", allowed=">= 0")
-    if elapsed < 0.0:
-        raise InvalidParameterError(f"elapsed must be >= 0 s, got {elapsed:g}")
+    elapsed = non_negative_float("elapsed", elapsed, "s")
     spin_up = positive_float("spin_up", spin_up, "s")
     omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     return _hip_share(elapsed, spin_up, omega)

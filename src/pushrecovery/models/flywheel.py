@@ -24,6 +24,7 @@ from pushrecovery.arguments import (
     finite_array,
     finite_float,
     float_array,
+    non_negative_float,
     positive_float,
     require_type,
 )
@@ -182,7 +183,7 @@ def bang_bang_torque(t: ArrayLike, switch_time: float, torque_max: float) -> Flo
         ``torque_max`` is outside [0, 1e5] N m (:data:`~pushrecovery.params.LIMITS`).
     """
     t = finite_array("t", t)
-    switch_time = _switch_time(switch_time)
+    switch_time = non_negative_float("switch_time", switch_time, "s")
     torque_max = bounded_float("torque_max", torque_max, *LIMITS["torque_max"])
     return torque_max * np.where(t < switch_time, 1.0, np.where(t < 2.0 * switch_time, -1.0, 0.0))
 
@@ -241,7 +242,7 @@ def bang_bang_end_state(
     require_type("params", params, BodyParams)
     x0 = finite_array("x0", x0)
     xdot0 = finite_array("xdot0", xdot0)
-    switch_time = _switch_time(switch_time)
+    switch_time = non_negative_float("switch_time", switch_time, "s")
     if 2.0 * params.omega * switch_time > MAX_OMEGA_DT:
         raise InvalidParameterError(
             f"switch_time must be in [0, {MAX_OMEGA_DT:g}/(2 omega) = "
@@ -254,13 +255,6 @@ def bang_bang_end_state(
     if not (np.isfinite(x).all() and np.isfinite(xdot).all()):
         raise InvalidParameterError("x0, xdot0 or cop are too large: the end state overflows")
     return x, xdot, theta, rate
-
-
-def _switch_time(value: float) -> float:
-    switch_time = finite_float("switch_time", value, "s", allowed=">= 0")
-    if switch_time < 0.0:
-        raise InvalidParameterError(f"switch_time must be >= 0 s, got {switch_time:g}")
-    return switch_time
 
 
 def _direction(value: float) -> float:

@@ -32,6 +32,7 @@ from pushrecovery.arguments import (
     bounded_float,
     finite_float,
     float_array,
+    non_negative_float,
     require_type,
     whole_number,
 )
@@ -117,21 +118,14 @@ def capturability_distance(
     omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     step_time = bounded_float("step_time", step_time, 0.0, MAX_STEP_TIME, "s")
     reach = bounded_float("reach", reach, 0.0, 2.0 * LIMITS["leg_length"][1], "m")
-    foot_radius = _non_negative("foot_radius", foot_radius)
-    hip = _non_negative("hip", hip)
+    foot_radius = non_negative_float("foot_radius", foot_radius, "m")
+    hip = non_negative_float("hip", hip, "m")
     if count == math.inf and step_time == 0.0:
         raise InvalidParameterError(
             "steps=inf needs step_time > 0 s: infinitely many instantaneous steps reach "
             "infinitely far"
         )
     return _capturability_distance(count, omega, step_time, reach, foot_radius, hip)
-
-
-def _non_negative(name: str, value: float) -> float:
-    number = finite_float(name, value, "m", allowed=">= 0")
-    if number < 0.0:
-        raise InvalidParameterError(f"{name} must be >= 0 m, got {number:g}")
-    return number
 
 
 def _capturability_distance(
