@@ -24,7 +24,6 @@ __all__ = [
     "AnalysisSettings",
     "TrialAnalysis",
     "body_for",
-    "pandas_table",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -140,13 +139,7 @@ class TrialAnalysis:
 
 
 def pandas_table(table: Any) -> Any:
-    """Return a pyarrow table as a pandas DataFrame, or say how to get pandas.
-
-    Raises
-    ------
-    InvalidParameterError
-        Without pandas (the ``tables`` extra).
-    """
+    """Return a pyarrow table as a pandas DataFrame, or say how to get pandas (the tables')."""
     try:
         import pandas  # noqa: F401
     except ImportError:
