@@ -27,8 +27,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import cumulative_trapezoid
 
+from pushrecovery.analysis.events import _non_negative
 from pushrecovery.analysis.signals import _times
-from pushrecovery.arguments import bounded_float, finite_float, sample_array
+from pushrecovery.arguments import bounded_float, sample_array
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import LIMITS
 
@@ -77,13 +78,6 @@ def zero_points(
     tolerance = _non_negative("tolerance", tolerance, "N")
     spacing = _non_negative("spacing", spacing, "s")
     return _zero_points(time, force, tolerance, spacing)
-
-
-def _non_negative(name: str, value: float, unit: str) -> float:
-    number = finite_float(name, value, unit, allowed=">= 0")
-    if number < 0.0:
-        raise InvalidParameterError(f"{name} must be >= 0 [{unit}], got {number:g}")
-    return number
 
 
 def _time_and_force(time: FloatArray, force: FloatArray) -> tuple[FloatArray, FloatArray]:
