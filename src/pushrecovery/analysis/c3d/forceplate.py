@@ -291,13 +291,3 @@ def _threshold(value: float) -> float:
     if not (math.isfinite(number) and number >= 0.0):
         raise InvalidParameterError(f"threshold must be a finite number >= 0 N, got {value!r}")
     return number
-
-
-def _positive(name: str, value: float) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{name} must be a number, got {value!r}") from None
-    if not (math.isfinite(number) and number > 0.0):
-        raise InvalidParameterError(f"{name} must be a finite number > 0, got {value!r}")
-    return number

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.analysis.c3d.forceplate import _channels, _positive, plate_frame
+from pushrecovery.analysis.c3d.forceplate import _channels, plate_frame
+from pushrecovery.arguments import positive_float
 from pushrecovery.errors import InvalidParameterError
 
 FloatArray = NDArray[np.float64]
@@ -55,8 +56,8 @@ def write_c3d(
     InvalidParameterError
         On inconsistent sizes or rates, non-finite forces, degenerate corners.
     """
-    rate = _positive("point_rate", point_rate)
-    a_rate = _positive("analog_rate", analog_rate)
+    rate = positive_float("point_rate", point_rate, "Hz")
+    a_rate = positive_float("analog_rate", analog_rate, "Hz")
     ratio = a_rate / rate
     per_frame = round(ratio)
     if per_frame < 1 or abs(ratio - per_frame) > 1e-9 * ratio:
@@ -85,7 +86,7 @@ def write_c3d(
             f"plates must have {per_frame} samples per marker frame: {n_points * per_frame} "
             f"samples for {n_points} frames, got {samples.pop()}"
         )
-    weight = None if mass is None else _positive("mass", mass)
+    weight = None if mass is None else positive_float("mass", mass, "kg")
     if any(not isinstance(label, str) or not label.strip() for label in labels):
         raise InvalidParameterError("marker labels must be non-empty strings")
 
