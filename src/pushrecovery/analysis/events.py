@@ -24,7 +24,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.analysis.recording import LOADED
 from pushrecovery.analysis.signals import _find_gaps, _times
-from pushrecovery.arguments import finite_float, positive_float, require_type, sample_array
+from pushrecovery.arguments import (
+    finite_float,
+    non_negative_float,
+    positive_float,
+    require_type,
+    sample_array,
+)
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
@@ -122,13 +128,6 @@ def _signal(name: str, value: ArrayLike, time: FloatArray) -> FloatArray:
     return signal
 
 
-def _non_negative(name: str, value: object, unit: str) -> float:
-    number = finite_float(name, value, unit, allowed=">= 0")
-    if number < 0.0:
-        raise InvalidParameterError(f"{name} must be >= 0 [{unit}], got {name}={number:g}")
-    return number
-
-
 def _runs(flags: BoolArray, period: float, min_duration: float) -> list[tuple[int, int]]:
     """Find runs [start, stop) of True, merged across shorter gaps, kept if >= min_duration."""
     runs = _find_gaps(flags)
@@ -181,7 +180,7 @@ def perturbation_onset(
     values = _signal("signal", signal, time)
     start, end = _baseline(baseline, time)
     k = positive_float("k", k)
-    min_duration = _non_negative("min_duration", min_duration, "s")
+    min_duration = non_negative_float("min_duration", min_duration, "s")
     inside = (time >= start) & (time <= end) & np.isfinite(values)
     if np.count_nonzero(inside) < 2:
         raise InvalidParameterError(
@@ -247,7 +246,7 @@ def flight_phases(
     time = _times("time", time)
     force = _signal("vertical_force", vertical_force, time)
     threshold = finite_float("threshold", threshold, "N")
-    min_duration = _non_negative("min_duration", min_duration, "s")
+    min_duration = non_negative_float("min_duration", min_duration, "s")
     with np.errstate(invalid="ignore"):
         unloaded = np.asarray(force < threshold)
     runs = _runs(unloaded, _period(time), min_duration)

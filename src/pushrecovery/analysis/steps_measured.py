@@ -20,14 +20,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.analysis.events import (
     MIN_DURATION,
-    _non_negative,
     _period,
     _runs,
     flight_phases,
 )
 from pushrecovery.analysis.recording import LOADED, Foot, _check_feet
 from pushrecovery.analysis.signals import _find_gaps, _times, smooth_and_differentiate
-from pushrecovery.arguments import finite_float, positive_float, require_type
+from pushrecovery.arguments import finite_float, non_negative_float, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
@@ -220,8 +219,8 @@ def foot_events_from_markers(
         )
     contact_height = positive_float("contact_height", contact_height, "m")
     max_speed = positive_float("max_speed", max_speed, "m/s")
-    cutoff = _non_negative("cutoff", cutoff, "Hz")
-    min_duration = _non_negative("min_duration", min_duration, "s")
+    cutoff = non_negative_float("cutoff", cutoff, "Hz")
+    min_duration = non_negative_float("min_duration", min_duration, "s")
     if np.isinf(foot.heel).any() or np.isinf(foot.toe).any():
         raise InvalidParameterError("foot markers must be finite or NaN (missing)")
     heights = np.column_stack([foot.heel[:, 2], foot.toe[:, 2]]).astype(float)

@@ -27,9 +27,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import cumulative_trapezoid
 
-from pushrecovery.analysis.events import _non_negative
 from pushrecovery.analysis.signals import _times
-from pushrecovery.arguments import bounded_float, sample_array
+from pushrecovery.arguments import bounded_float, non_negative_float, sample_array
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import LIMITS
 
@@ -75,8 +74,8 @@ def zero_points(
         or a negative or non-finite ``tolerance`` or ``spacing``.
     """
     time, force = _time_and_force(time, force)
-    tolerance = _non_negative("tolerance", tolerance, "N")
-    spacing = _non_negative("spacing", spacing, "s")
+    tolerance = non_negative_float("tolerance", tolerance, "N")
+    spacing = non_negative_float("spacing", spacing, "s")
     return _zero_points(time, force, tolerance, spacing)
 
 
@@ -163,8 +162,8 @@ def com_from_force(
         )
     if tolerance is None:
         tolerance = ZERO_FORCE * mass * STANDARD_GRAVITY
-    tolerance = _non_negative("tolerance", tolerance, "N")
-    spacing = _non_negative("spacing", spacing, "s")
+    tolerance = non_negative_float("tolerance", tolerance, "N")
+    spacing = non_negative_float("spacing", spacing, "s")
     pins = _zero_points(time, np.where(np.isfinite(force), force, np.nan), tolerance, spacing)
     pins = pins[np.isfinite(cop[pins])]
     if len(pins) < 2:

@@ -5,11 +5,10 @@ Conventions: docs/c3d.md.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery.arguments import non_negative_float
 from pushrecovery.errors import InvalidParameterError
 
 FloatArray = NDArray[np.float64]
@@ -193,7 +192,7 @@ def plate_cop_in_plate_frame(
         Tz [N m] about the z-down axis (for the force on the plate); NaN where ``cop`` is. For
         the subject about the upward normal this is the same number.
     """
-    limit = _threshold(threshold)
+    limit = non_negative_float("threshold", threshold, "N")
     f = _channels(force, 3, "force")
     m = _channels(moment, 3, "moment")
     if f.shape != m.shape:
@@ -284,10 +283,3 @@ def _vector3(name: str, values: ArrayLike) -> FloatArray:
     if array.shape != (3,) or not np.isfinite(array).all():
         raise InvalidParameterError(f"{name} must be 3 finite numbers, got {values!r}")
     return array
-
-
-def _threshold(value: float) -> float:
-    number = float(value)
-    if not (math.isfinite(number) and number >= 0.0):
-        raise InvalidParameterError(f"threshold must be a finite number >= 0 N, got {value!r}")
-    return number

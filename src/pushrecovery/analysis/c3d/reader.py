@@ -9,7 +9,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.analysis.c3d.content import C3DContent
-from pushrecovery.analysis.c3d.forceplate import _threshold
 from pushrecovery.analysis.c3d.header import _check_header
 from pushrecovery.analysis.c3d.isolated import run_isolated
 from pushrecovery.analysis.c3d.parameters import (
@@ -23,6 +22,7 @@ from pushrecovery.analysis.c3d.parameters import (
 )
 from pushrecovery.analysis.c3d.plates import read_plates
 from pushrecovery.analysis.c3d.structure import check_parameter_section, read_parameter_section
+from pushrecovery.arguments import non_negative_float
 from pushrecovery.errors import InputFileError
 
 FloatArray = NDArray[np.float64]
@@ -51,7 +51,7 @@ def read_c3d(path: str | Path, *, threshold: float = 20.0) -> C3DContent:
     InvalidParameterError
         If ``threshold`` is negative or not finite.
     """
-    limit = _threshold(threshold)
+    limit = non_negative_float("threshold", threshold, "N")
     file = Path(path)
     if not file.exists():
         raise InputFileError(f"{file}: no such file")
