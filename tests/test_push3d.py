@@ -112,6 +112,61 @@ def test_a_push_changes_the_com_velocity_by_j_over_m_at_its_azimuth(azimuth):
     assert back[3] == pytest.approx(-0.1, rel=MOMENTUM_TOLERANCE) and abs(back[4]) < 1e-3
 
 
+def test_a_scheduled_push_acts_over_the_next_steps_under_the_controller():
+    """Push3D(scheduled=True): nothing now, no row; the force on the next 10 ms of physics
+    steps while the WBC commands (its motors change during the push); push_row at its end."""
+    plant = Biped3DPlant(P)
+    before = standing(plant)
+    controller = wbc_for(plant)
+    controller.reset(before)
+    rows = len(plant.run_rows().time)
+    now = plant.apply_push(Push3D(15.0, 90.0, scheduled=True))
+    assert np.array_equal(now, before) and len(plant.run_rows().time) == rows
+    assert plant.push_left == pytest.approx(0.01) and plant.push_row is None
+    motors = []
+    for tick in range(5):  # 10 ms: five 2 ms ticks of four 0.5 ms steps
+        step = plant.step(controller.compute(0.0, plant.state), CONTROL_PERIOD)
+        motors.append(step.applied)
+        assert plant.push_left == pytest.approx(0.01 - (tick + 1) * CONTROL_PERIOD)
+    assert plant.push_row == len(plant.run_rows().time) - 1 and plant.max_torso_tilt >= 0.0
+    assert not np.array_equal(motors[0], motors[-1])  # the controller reacted
+    gained = plant.state[3:5] - before[3:5]
+    assert gained[1] == pytest.approx(15.0 / P.mass, rel=MOMENTUM_TOLERANCE)
+    assert abs(gained[0]) < 0.03 * 15.0 / P.mass
+    plant.step(controller.compute(0.0, plant.state), CONTROL_PERIOD)  # the force is over
+    assert plant.push_left == 0.0 and not np.any(plant.data.xfrc_applied)
+    # In the loop: one row per tick (none of the push's own); push_row where the force ended.
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import run_push3d
+
+    run = run_push3d(plant, wbc_for(plant), Push3D(15.0, 90.0, scheduled=True),
+                     duration=0.02, push_time=2 * CONTROL_PERIOD)  # fmt: skip
+    assert len(run.time) == 2 + 10 + 1 and run.extras.push_row == 2 + 5
+    assert np.diff(run.time) == pytest.approx(CONTROL_PERIOD)
+
+
+def test_a_push_the_3d_plant_cannot_apply_is_refused_naming_the_field():
+    plant = Biped3DPlant(P)
+    plant.reset()
+    with pytest.raises(InvalidParameterError, match="push kind must be 'force'"):
+        plant.apply_push(Push(0.1, "velocity"))
+    with pytest.raises(InvalidParameterError, match=r"push duration must be 0\.01 s"):
+        plant.apply_push(Push(0.1, duration=0.02))
+    with pytest.raises(InvalidParameterError, match="body must be a body of the biped3d"):
+        plant.apply_push(Push(0.1, body="nose"))
+    with pytest.raises(InvalidParameterError, match="scheduled must be a bool"):
+        Push3D(1.0, scheduled="yes")  # type: ignore[arg-type]
+    # A Push's body and scheduling are honoured: the Push3D of J = m Δẋ on the left thigh.
+    ends = []
+    for push in (Push(0.1, body="left_thigh", scheduled=True),
+                 Push3D(0.1 * P.mass, 0.0, "left_thigh", scheduled=True), Push(0.1)):  # fmt: skip
+        state = plant.reset()
+        assert np.array_equal(plant.apply_push(push), state) == push.scheduled
+        for _ in range(5):
+            plant.step(Command(0.0), CONTROL_PERIOD)  # the motors held
+        ends.append(plant.state)
+    assert np.array_equal(ends[0], ends[1]) and not np.allclose(ends[0], ends[2])
+
+
 def run_cli(capsys, *args):
     with pytest.raises(SystemExit) as caught:
         main(list(args))

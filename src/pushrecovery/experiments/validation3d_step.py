@@ -21,12 +21,13 @@ along ψ. Beside the +y edge of C₁ for a left step of a rectangle foot, ρ = w
 
 **Measured.** The largest impulse at ψ the body stands (:func:`~.runs3d.run_push3d` at the
 plant's pushed body, its whole-body controller with ``stepping=True``: ankles and steps, no
-hip task) by ``runs3d.bisect_critical``: a run *falls* when it ends in the plant's fall set
-(under a controller that steps: the CoM below 0.7 z₀, ``plant3d``) or the torso tilted more
-than 1 rad after the push, or ends with ξ more than :data:`FALL_MARGIN` outside the support
-polygon of the feet it stands on then (undecided within ``duration``). Each stood run at the
-measured impulse reports its steps, their longest swing time and its largest foothold
-distance from the stance ankle.
+hip task, reacting through the push's 10 ms as a robot's would: ``Push3D(...,
+scheduled=True)``) by ``runs3d.bisect_critical``: a run *falls* when it ends in the plant's
+fall set (under a controller that steps: the CoM below 0.7 z₀, ``plant3d``) or the torso
+tilted more than 1 rad after the push, or ends with ξ more than :data:`FALL_MARGIN` outside
+the support polygon of the feet it stands on then (undecided within ``duration``). Each stood
+run at the measured impulse reports its steps, their longest swing time and its largest
+foothold distance from the stance ankle.
 
 **Cause** (:meth:`StepRow.cause`), where measured and predicted differ by more than 10 %:
 the simple model takes a touchdown Δt_s after the push and a step as long as
@@ -128,7 +129,8 @@ def _stepping_run(plant: Humanoid3DPlant, impulse: float, azimuth: float, durati
                                      observation=plant.observation, stepping=True,
                                      params=plant.params,
                                      step_settings=StepSettings(swing_time=swing_time))  # fmt: skip
-    run = run_push3d(plant, controller, Push3D(impulse, azimuth), duration=duration)
+    push = Push3D(impulse, azimuth, scheduled=True)  # the controller reacts during it
+    run = run_push3d(plant, controller, push, duration=duration)
     assert run.extras is not None
     down = run.outcome is Outcome.FELL or run.extras.max_torso_tilt > 1.0
     xi = run.states[-1, :2] + run.states[-1, 3:5] / controller.omega

@@ -153,22 +153,30 @@ class Push3D:
     body : str
         The pushed body: ``"torso"`` (the default) is each model's torso (the biped3d's
         ``torso``, the G1's ``torso_link``); any other name is a body of the model.
+    scheduled : bool
+        As :attr:`Push.scheduled`: False (default) pushes now, the motors holding, and
+        ``apply_push`` returns the state after the push (the critical pushes and campaigns);
+        True: the force acts from the plant's next step on, under whatever the controller
+        commands (a robot's controller reacting through the push, as in the stepping runs).
 
     Raises
     ------
     InvalidParameterError
-        If a field is out of its range or ``body`` is not a non-empty name (at most 100
-        characters).
+        If a field is out of its range, ``body`` is not a non-empty name (at most 100
+        characters) or ``scheduled`` is not a bool.
     """
 
     impulse: float
     azimuth: float = 0.0
     body: str = "torso"
+    scheduled: bool = False
 
     def __post_init__(self) -> None:
         impulse = bounded_float("impulse", self.impulse, 0.0, IMPULSE_MAX, "N s")
         azimuth = bounded_float("azimuth", self.azimuth, -AZIMUTH_MAX, AZIMUTH_MAX, "deg")
         _check_body(self.body)
+        if not isinstance(self.scheduled, bool):
+            raise InvalidParameterError(f"scheduled must be a bool, got {self.scheduled!r:.40}")
         object.__setattr__(self, "impulse", impulse)
         object.__setattr__(self, "azimuth", azimuth)
 

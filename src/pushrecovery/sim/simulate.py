@@ -101,8 +101,8 @@ def simulate(
     push : ScheduledPush, optional
         A push during the run (e.g. after quiet standing): the criteria only count from
         its end, when the controller restarts (unless ``push.react``). A
-        :class:`~pushrecovery.sim.push.Push3D` is the plant's own ``apply_push`` (the 3-D
-        humanoids).
+        :class:`~pushrecovery.sim.push.Push3D` (the 3-D humanoids) is applied as given: now,
+        the motors holding, or ``scheduled`` over the following steps.
     plant_step : float, optional
         The plant's step [s] (default: the control period), a whole fraction of it: a
         recorder that samples faster than the controller ticks.
@@ -144,6 +144,7 @@ def simulate(
         push is not None
         and not isinstance(push.push, Push)
         and isinstance(plant, PlantBase | ForcePushing)
+        and "z" not in plant.state_labels  # the 3-D humanoids' force lasts steps too
     ):
         raise InvalidParameterError(
             f"a 3-D push (Push3D) needs a 3-D model, got the {plant.name} model: push with a Push"
@@ -258,7 +259,7 @@ def _start_push(
     """Start ``push`` at plant step k; return the state and the step at which it is over.
 
     A force acts over the plant's following steps (the plant tells how long); a jump (and a
-    3-D humanoid's push, over its own physics steps) is over at once.
+    3-D humanoid's push not scheduled, over its own physics steps) is over at once.
     """
     kick = push.push
     if isinstance(kick, Push) and not kick.scheduled:

@@ -11,11 +11,16 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   the CoM over the feet; a push is :meth:`~Humanoid3DPlant.apply_push`).
 * **begin(state)** starts a run from the plant's own current state only (MuJoCo's state is
   not a function of the CoM's).
-* **apply_push(push)** takes a :class:`~pushrecovery.sim.push.Push3D` (or a sagittal
-  :class:`~pushrecovery.sim.push.Push`, as J = m Δẋ at azimuth 0 or 180 on the torso) and
-  applies the constant force J/Δ (cos ψ, sin ψ, 0) for Δ = :data:`PUSH_DURATION` (10 ms) at
-  the pushed body's centre of mass (``xfrc_applied``), the motors holding their last ``ctrl``
-  meanwhile: the whole body's momentum gains J, minus what the floor's friction takes.
+* **apply_push(push)** takes a :class:`~pushrecovery.sim.push.Push3D` (or a sagittal force
+  :class:`~pushrecovery.sim.push.Push` of the default duration, as J = m Δẋ at azimuth 0 or
+  180 on its body) and applies the constant force J/Δ (cos ψ, sin ψ, 0) for Δ =
+  :data:`PUSH_DURATION` (10 ms, whole physics steps) at the pushed body's centre of mass
+  (``xfrc_applied``): the whole body's momentum gains J, minus what the floor's friction
+  takes. Not ``scheduled``: now, the motors holding their last ``ctrl``, with a row after it.
+  ``scheduled``: on the physics steps of the next :meth:`~Humanoid3DPlant.step` calls, under
+  whatever motor commands they hold (a controller reacting through the push);
+  :attr:`~Humanoid3DPlant.push_left` is how long it still acts
+  (:class:`~pushrecovery.sim.events.ForcePushing`).
 * **step(command, dt)** holds the motor commands of a
   :class:`~pushrecovery.control.wbc.observation.HumanoidCommand` (``motors`` [N m], the
   :class:`~pushrecovery.control.wbc.controller.WholeBodyController`'s output; any other
@@ -34,11 +39,12 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
 * **at_rest(state, speed)**: ‖ċ_xy‖ <= speed and the CoM's ground point strictly inside P
   (the step's ``StepInfo.support`` when the controller steps, and no foot swinging).
 * **Clocked** (:class:`~pushrecovery.sim.backend.Clocked`): ``clock`` is MuJoCo's time and
-  ``run_rows()`` the rows since ``reset``/``begin``: one per step and one after a push (whose
-  10 ms are physics steps of the plant's own), so the loop's result keeps MuJoCo's time and
-  the state on either side of the push. With ``recording`` set, each row also keeps
-  ``qpos``, ``qvel`` and ``ctrl`` (``frames``), and :attr:`~Humanoid3DPlant.max_torso_tilt`
-  is the largest torso tilt since the last push.
+  ``run_rows()`` the rows since ``reset``/``begin``: one per step and one after a push held
+  still (whose 10 ms are physics steps of the plant's own), so the loop's result keeps
+  MuJoCo's time and the state on either side of the push. With ``recording`` set, each row
+  also keeps ``qpos``, ``qvel`` and ``ctrl`` (``frames``). :attr:`~Humanoid3DPlant.push_row`
+  is the row at which the last push's force ended and
+  :attr:`~Humanoid3DPlant.max_torso_tilt` the largest torso tilt since then.
 
 :func:`~pushrecovery.sim.simulate.simulate` is the loop of these plants
 (:func:`~.runs3d.run_push3d`: stand, push, run the whole-body controller).
@@ -158,10 +164,12 @@ class Humanoid3DPlant:
         #: Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (``frames``) from the next reset.
         self.recording = False
         self.frames: list[FloatArray] = []
-        #: The row just after the last push (None: no push since reset/begin).
+        #: The row at which the last push's force ended (None: none since reset/begin).
         self.push_row: int | None = None
-        #: The largest tilt of the upright body since the last push [rad] (0 before one).
+        #: The largest tilt of the upright body since the last push ended [rad] (0 before).
         self.max_torso_tilt = 0.0
+        # A scheduled push: its body, force [N] and the physics steps it still acts.
+        self._push_body, self._push_force, self._push_steps = -1, np.zeros(3), 0
         self._upright_id = body_id(model, upright)
         self._times: list[float] = []
         self._states: list[FloatArray] = []
@@ -198,6 +206,7 @@ class Humanoid3DPlant:
         self.omega = math.sqrt(gravity / self.standing_height)
         self.ctrl = np.zeros(int(model.nu))
         self.info = StepInfo()
+        self._push_steps = 0
         self.state = self._read()
         self.standing_origin = (float(self.state[0]), float(self.state[1]))
         torso = body_id(model, self.torso)
@@ -269,31 +278,60 @@ class Humanoid3DPlant:
             ) from None
 
     def apply_push(self, push: Push3D | Push) -> FloatArray:
-        """Push now: J/Δ for Δ = 10 ms at the body's CoM, the motors holding (contract item 4)."""
+        """Push (contract item 4; module docstring) and return the state after it (scheduled: now).
+
+        A :class:`~pushrecovery.sim.push.Push` is J = m Δẋ [N s] forward (Δẋ >= 0, azimuth 0)
+        or backward (180) on its ``body`` (default the torso), ``scheduled`` as given.
+
+        Raises
+        ------
+        InvalidParameterError
+            If the pushed body is not one of the model, or a ``Push`` is not a force
+            (``kind``) or lasts other than :data:`PUSH_DURATION` (``duration``): the 3-D
+            push is a 10 ms force.
+        """
         import mujoco
 
         if isinstance(push, Push):
-            size = push.impulse(self.params.mass)
-            push = Push3D(abs(size), 0.0 if size >= 0.0 else 180.0)
+            push = self._as_push3d(push)
         require_type("push", push, Push3D)
         body = self.body_of(push.body)
         force = np.array(push.force(PUSH_DURATION))
         model, data = self.model, self.data
         steps = max(1, round(PUSH_DURATION / float(model.opt.timestep)))
+        self._push_body, self._push_force, self._push_steps = body, force, steps
+        if push.scheduled:  # from the next step on (step); push_row, max tilt at its end
+            self.push_row, self.max_torso_tilt = None, 0.0
+            return self.state.copy()
         data.ctrl[:] = self.ctrl
-        data.xfrc_applied[body, :3] = force
-        try:
-            mujoco.mj_step2(model, data)
-            for _ in range(steps - 1):
-                mujoco.mj_step(model, data)
-        finally:
-            data.xfrc_applied[body, :3] = 0.0
+        self._pushed_steps(steps)
         mujoco.mj_step1(model, data)
         self.state = self._read()
         self._inputs.append(tuple(float(v) for v in self.ctrl))  # held during the push
         self._add_row()
         self.push_row, self.max_torso_tilt = len(self._times) - 1, self.torso_tilt()
         return self.state.copy()
+
+    def _as_push3d(self, push: Push) -> Push3D:
+        """Return the sagittal force ``push`` as a Push3D; refuse what a Push3D cannot be."""
+        if push.kind != "force":
+            raise InvalidParameterError(
+                f"push kind must be 'force' on the {self.name} model (a 10 ms force at a body), "
+                f"got {push.kind!r}"
+            )
+        if push.duration != PUSH_DURATION:
+            raise InvalidParameterError(
+                f"push duration must be {PUSH_DURATION:g} s on the {self.name} model, "
+                f"got {push.duration:g}"
+            )
+        size = push.impulse(self.params.mass)
+        body = "torso" if push.body is None else push.body
+        return Push3D(abs(size), 0.0 if size >= 0.0 else 180.0, body, push.scheduled)
+
+    @property
+    def push_left(self) -> float:
+        """How long the force of a scheduled push still acts [s] (0: none)."""
+        return self._push_steps * float(self.model.opt.timestep)
 
     def step(self, command: Command, dt: float) -> Step:
         """Hold ``command``'s motor commands [N m] (clipped) for ``dt`` [s] (item 5).
@@ -326,19 +364,43 @@ class Humanoid3DPlant:
                 info = StepInfo(command.stance, (0.0,), 0, None, (), command.support)
         seconds = bounded_float("dt", dt, 1e-6, 1.0, "s")
         model, data = self.model, self.data
+        steps = max(1, round(seconds / float(model.opt.timestep)))
         data.ctrl[:] = self.ctrl
-        mujoco.mj_step2(model, data)
-        for _ in range(max(1, round(seconds / float(model.opt.timestep))) - 1):
-            mujoco.mj_step(model, data)
+        pushing = self._push_steps > 0
+        if pushing:
+            self._pushed_steps(steps)
+        else:
+            mujoco.mj_step2(model, data)
+            for _ in range(steps - 1):
+                mujoco.mj_step(model, data)
         mujoco.mj_step1(model, data)
         self.state = self._read()
         self.info = info
         applied = tuple(float(v) for v in self.ctrl)
         self._inputs.append(applied)
         self._add_row()
-        if self.push_row is not None:
+        if pushing and self._push_steps == 0:  # the scheduled push's force ended in this step
+            self.push_row, self.max_torso_tilt = len(self._times) - 1, self.torso_tilt()
+        elif self.push_row is not None:
             self.max_torso_tilt = max(self.max_torso_tilt, self.torso_tilt())
         return Step(self.state, applied, info)
+
+    def _pushed_steps(self, steps: int) -> None:
+        """Take ``steps`` physics steps, the scheduled force on those it still acts on."""
+        import mujoco
+
+        model, data = self.model, self.data
+        applied = data.xfrc_applied[self._push_body, :3]
+        try:
+            for sub in range(steps):
+                applied[:] = self._push_force if self._push_steps > 0 else 0.0
+                self._push_steps = max(0, self._push_steps - 1)
+                if sub == 0:  # mj_step1 ended the last step
+                    mujoco.mj_step2(model, data)
+                else:
+                    mujoco.mj_step(model, data)
+        finally:
+            applied[:] = 0.0
 
     def fall_margin(self) -> float:
         """Return 2 max(τmax, τmax_roll)/(m g) [m]: both hips' largest CMP offset."""

@@ -78,9 +78,11 @@ def run_push3d(
 ) -> SimulationResult:
     """Stand, push, and run the whole-body controller until a decision (module docstring).
 
-    The run is :func:`~pushrecovery.sim.simulate.simulate` (the one loop) with the push
-    scheduled at ``push_time`` and the controller reacting through it; its rows are the
-    plant's (MuJoCo's clock, a row on either side of the push).
+    The run is :func:`~pushrecovery.sim.simulate.simulate` (the one loop) with the push at
+    ``push_time`` and the controller running on through it: a push held still (the default
+    ``Push3D``) lasts physics steps of its own, the motors holding, with a row on either
+    side of it; a ``scheduled`` one acts over the next ticks while the controller reacts.
+    The rows are the plant's (MuJoCo's clock).
 
     Parameters
     ----------
@@ -89,7 +91,7 @@ def run_push3d(
     controller : WholeBodyController
         Its controller (:func:`wbc_for`), reset here on the standing state.
     push : Push3D
-        The push, at ``push_time``.
+        The push, at ``push_time`` (``scheduled``: the controller reacts during it).
     duration : float
         Longest simulated time after the push [s], in (0, 60 − ``push_time``].
     push_time : float
@@ -100,7 +102,7 @@ def run_push3d(
     record : bool
         Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (the extras'), for rendering.
     observers : sequence of Observer
-        Also see every control tick (e.g. a :class:`WbcTrace`); not the push's own steps.
+        Also see every control tick (e.g. a :class:`WbcTrace`); not a held push's own steps.
 
     Returns
     -------
@@ -126,8 +128,12 @@ def run_push3d(
         observers=(figures, *observers),
     )  # fmt: skip
     after = plant.push_row
-    assert after is not None  # the push comes before the last tick (ticks > its tick)
-    inputs, held = result.inputs[after - 1 :], result.inputs[after - 1]
+    if after is None:  # the run ended (fell) before the force did
+        after = len(result.time) - 1
+    # The motors from the push on against those held before it (row k: tick k's inputs).
+    first = round(push_time / CONTROL_PERIOD)
+    inputs = result.inputs[first:]
+    held = result.inputs[first - 1] if first else np.zeros(len(plant.input_labels))
     hips = plant.hip_motors
     frames = np.array(plant.frames) if record else None
     nq, nv = int(plant.model.nq), int(plant.model.nv)
@@ -135,7 +141,7 @@ def run_push3d(
         push=push,
         push_row=after,
         peak_hip_torque=figures.peak_hip_torque,
-        peak_hip_motor_torque=max(0.0, float(np.abs(inputs[1:] - held)[:, hips].max()))
+        peak_hip_motor_torque=max(0.0, float(np.abs(inputs - held)[:, hips].max()))
         if hips
         else 0.0,
         max_torso_tilt=plant.max_torso_tilt,
@@ -152,9 +158,10 @@ def run_push3d(
 class WbcTrace:
     """Observer of a :func:`run_push3d` run, tick by tick: the body and its controller's QP.
 
-    Row k is control tick k (the push's own 10 ms are no tick): the body at the tick's end,
-    ``time`` [s] (MuJoCo's clock), and the controller's figures of the command held over it,
-    computed at ``time`` − :data:`~.plant3d.CONTROL_PERIOD`.
+    Row k is control tick k (a push held still lasts 10 ms of no tick; a scheduled one acts
+    during ticks): the body at the tick's end, ``time`` [s] (MuJoCo's clock), and the
+    controller's figures of the command held over it, computed at ``time`` −
+    :data:`~.plant3d.CONTROL_PERIOD`.
 
     Parameters
     ----------
