@@ -174,8 +174,9 @@ class RunRows(NamedTuple):
 class Clocked(Protocol):
     """A plant with its own clock and rows (MuJoCo's time; a push lasting steps of its own).
 
-    Its rows start at ``begin``; each ``step`` and each ``apply_push`` adds one (a push that
-    lasts its own physics steps has a row before it and one after it). The loop reads them
+    Its rows start at ``begin``; each ``step`` adds one, and so does an ``apply_push`` that
+    pushes now (a push that lasts its own physics steps has a row before it and one after
+    it; a scheduled push adds none: its force acts within the following steps). The loop reads them
     once, at the end of a run, in place of its own.
     """
 

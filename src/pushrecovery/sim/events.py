@@ -32,7 +32,8 @@ class ScheduledPush:
         The push the plant's ``apply_push`` applies at ``time``: a :class:`Push`, applied
         scheduled (a velocity jump, or on MuJoCo a force over the following steps,
         :class:`ForcePushing`), or a 3-D push (impulse [N s], azimuth, body) of the 3-D
-        humanoids, whose push lasts physics steps of their own.
+        humanoids, applied as it says: now, the motors holding, over physics steps of its
+        own, or (``scheduled=True``) over the following steps like a planar force push.
     react : bool
         False (default): the body holds still during a force push (CoP under the CoM, no
         hip torque, no step) and the controller restarts on the pushed state as it ends, as
@@ -52,10 +53,11 @@ class ScheduledPush:
 
 @runtime_checkable
 class ForcePushing(Protocol):
-    """A plant whose force push lasts steps of the run (the planar MuJoCo plants).
+    """A plant whose force push lasts steps of the run (the MuJoCo plants, planar and 3-D).
 
-    After a scheduled ``apply_push`` (``Push(..., scheduled=True)``) the force acts over the
-    plant's next steps for ``push_left``.
+    After a scheduled ``apply_push`` (``Push(..., scheduled=True)`` or
+    ``Push3D(..., scheduled=True)``) the force acts over the plant's next steps for
+    ``push_left``.
     """
 
     @property

@@ -85,12 +85,14 @@ class Push3DExtras:
     push : Push3D
         The push.
     push_row : int
-        The row just after the push (``states[push_row - 1]`` is the state as it began).
+        The row just after the push: the row its force ended on (a push now: ``states[push_row
+        - 1]`` is the state as it began; a scheduled push: the first row with its force over).
     peak_hip_torque : float
         Largest flywheel torque the WBC's hip law commanded after the push, m g abs(δ) (δ its
         CMP offset) [N m]: 0 when the ankles sufficed.
     peak_hip_motor_torque : float
-        Largest abs(hip pitch or roll motor command − its value before the push) after it [N m].
+        Largest abs(hip pitch or roll motor command − its value as the push began) after the
+        push began [N m].
     max_torso_tilt : float
         Largest tilt of the upright body from the vertical after the push [rad].
     peak_torque : float
