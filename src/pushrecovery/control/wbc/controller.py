@@ -43,7 +43,7 @@ from pushrecovery.control.wbc.tasks.stack import TaskStack
 from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
-from pushrecovery.kernels.wbc import ankle_targets, balance_point, rotation_vector
+from pushrecovery.kernels.wbc import ankle_targets, balance_point
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cop import capture_point
 
@@ -54,16 +54,6 @@ __all__ = ["WholeBodyController"]
 #: The torso's spin where no hip law reads it (the ankles' kernel computes its own).
 _NO_SPIN = np.zeros(3)
 _NO_SPIN.flags.writeable = False
-
-
-def _rotation_vector(rot: Sequence[float], ref: Sequence[float]) -> FloatArray:
-    """Return the rotation vector (axis × angle) [rad] of R R₀ᵀ, both row-major (9 floats).
-
-    The tick's own kernel (:func:`.kernels.wbc.rotation_vector`, inside ``balance_point``).
-    """
-    out = np.zeros(3)
-    rotation_vector(np.asarray(rot, dtype=float), np.asarray(ref, dtype=float), out)
-    return out
 
 
 class WholeBodyController(Controller):
