@@ -1,19 +1,15 @@
 r"""How high the pelvis may stand while the legs step: the leg's reach (:mod:`.stepper.stepper`).
 
-World frame, x forward, y left, z up, SI units. A leg of thigh a and shank b (hip to knee,
-knee to ankle, the joints' anchors) with its knee bent by κ spans
+World frame, x forward, y left, z up, SI units. A leg of thigh a and shank b with its knee bent
+by κ spans
 
 .. math:: \ell(\kappa) = \sqrt{a^2 + b^2 + 2 a b \cos\kappa}
 
-from hip to ankle (law of cosines; κ = 0 straight). With the ankle at horizontal distance r
-from the hip and height z_a, the hip stands at most z_a + sqrt(ℓ(κ)² − r²) if the knee is to
-stay bent by at least κ. :func:`pelvis_limit` takes the lowest such bound over the legs, each
-at its own hip: a foot on the floor where it is, the swinging foot at its foothold seen from
-where its hip will be at touchdown (moved with the CoM, ``shift``), at the stance ankle's
-height; converted to the pelvis (the hips' parent body) by the hip's height above it. The
-stepper lowers the pelvis task's target to it (a long step, or feet far apart, needs a lower
-pelvis: standing, the biped's hip is 0.99 m above its ankles, ℓ(0.1 rad) = 0.9988 m, so a foot
-reaches 0.14 m from under its hip before the knee straightens onto its stop).
+from hip to ankle, so with the ankle at horizontal distance r from the hip and height z_a the
+hip stands at most z_a + sqrt(ℓ(κ)² − r²) if the knee is to stay bent by κ.
+:func:`pelvis_limit` takes the lowest such bound over the legs (the swinging foot at its
+foothold, seen from where its hip will be at touchdown), converted to the pelvis.
+docs/humanoid3d_stepping.md, "The plan" (pelvis height), gives the rule and the numbers.
 """
 
 from __future__ import annotations
