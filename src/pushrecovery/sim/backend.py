@@ -40,7 +40,7 @@ from typing import ClassVar, NamedTuple, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, float_array, require_type
+from pushrecovery.arguments import finite_float, float_array, non_negative_float, require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -256,10 +256,7 @@ def _rest_arguments(state: object, params: object, speed: object) -> tuple[Float
         )
     finite_float("state x", array[0], "m")
     finite_float("state xdot", array[len(array) // 2], "m/s")
-    number = finite_float("speed", speed, "m/s", allowed=">= 0")
-    if number < 0.0:
-        raise InvalidParameterError(f"speed must be >= 0 m/s, got {number:g}")
-    return array, number
+    return array, non_negative_float("speed", speed, "m/s")
 
 
 class PlantBase:

@@ -9,7 +9,7 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float
+from pushrecovery.arguments import finite_float, non_negative_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.push import Push3D
 from pushrecovery.surfaces.classify import Strategy
@@ -240,8 +240,7 @@ def strategy_used(steps: int, peak_hip_torque: float) -> Strategy:
     """
     if not (isinstance(steps, int | np.integer) and steps >= 0):
         raise InvalidParameterError(f"steps must be an int >= 0, got {steps!r:.40}")
-    if not finite_float("peak_hip_torque", peak_hip_torque, "N m", allowed=">= 0") >= 0.0:
-        raise InvalidParameterError(f"peak_hip_torque must be >= 0 N m, got {peak_hip_torque!r}")
+    non_negative_float("peak_hip_torque", peak_hip_torque, "N m")
     if steps > 0:
         return Strategy.STEP
     if peak_hip_torque > HIP_TORQUE_THRESHOLD:

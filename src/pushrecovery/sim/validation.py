@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, require_type
+from pushrecovery.arguments import finite_float, non_negative_float, require_type
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
@@ -134,9 +134,9 @@ def corrected_critical_velocity(
     direction = finite_float("direction", direction, allowed="+1 or -1")
     if direction not in (1.0, -1.0):
         raise InvalidParameterError(f"direction must be +1 or -1, got {direction!r}")
-    cop_margin = _non_negative("cop_margin", cop_margin, "m")
-    push_duration = _non_negative("push_duration", push_duration, "s")
-    timestep = _non_negative("timestep", timestep, "s")
+    cop_margin = non_negative_float("cop_margin", cop_margin, "m")
+    push_duration = non_negative_float("push_duration", push_duration, "s")
+    timestep = non_negative_float("timestep", timestep, "s")
     shortened = dataclasses.replace(
         params, heel=params.heel + cop_margin, toe=params.toe - cop_margin
     )
@@ -144,13 +144,6 @@ def corrected_critical_velocity(
     edge = region.upper if direction > 0.0 else region.lower
     tangential = 1.0 - (x0 / params.com_height) ** 2  # cos² φ0
     return (edge - x0) / (tangential * (1.0 / params.omega + 0.5 * (push_duration + timestep)))
-
-
-def _non_negative(name: str, value: float, unit: str) -> float:
-    number = finite_float(name, value, unit, allowed=">= 0")
-    if number < 0.0:
-        raise InvalidParameterError(f"{name} must be >= 0 [{unit}], got {number:g}")
-    return number
 
 
 def mujoco_corrected_prediction(

@@ -61,7 +61,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import bounded_float, finite_float, require_type
+from pushrecovery.arguments import bounded_float, finite_float, non_negative_float, require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
@@ -438,9 +438,7 @@ class Humanoid3DPlant:
         foot may swing), else the feet at reset.
         """
         self.check_state(state)
-        limit = finite_float("speed", speed, "m/s", allowed=">= 0")
-        if limit < 0.0:
-            raise InvalidParameterError(f"speed must be >= 0 m/s, got {limit:g}")
+        limit = non_negative_float("speed", speed, "m/s")
         info = self.info
         support = self.support if info.support is None else info.support
         assert support is not None
