@@ -3,7 +3,9 @@
 Implements and verifies the models of Stephens, "Humanoid Push Recovery" [Stephens07]:
 CoP (ankle) balancing, CMP (hip) balancing and stepping. Importing the package is cheap (the
 parameters and numpy load on first use, PEP 562); the plotting and CLI layers import their
-heavy dependencies lazily.
+heavy dependencies lazily. ``pip install pushrecovery`` is the core (models, surfaces, monitor,
+controllers, analytic simulation); MuJoCo, campaigns, trial analysis, figures and the report
+are extras, and a feature missing one says which (:mod:`pushrecovery.extras`).
 
 References
 ----------

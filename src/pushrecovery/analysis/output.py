@@ -10,6 +10,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from pushrecovery.extras import require
+
 if TYPE_CHECKING:  # the trial's summary serialises itself with json_safe
     from pushrecovery.analysis.trial import TrialAnalysis
 
@@ -46,6 +48,7 @@ def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Pa
     dict
         ``frames_parquet``, ``frames_csv`` and ``summary`` paths.
     """
+    require("analysis", "pyarrow", "writing an analysis")
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 

@@ -13,6 +13,7 @@ from pushrecovery.campaign.isolation import BatchRunner, PushRunner
 from pushrecovery.campaign.pushes import error_row, run_batch, run_push
 from pushrecovery.campaign.spec import CampaignError, CampaignSpec
 from pushrecovery.errors import PushRecoveryError
+from pushrecovery.extras import require
 
 __all__ = ["CONNECT_TIMEOUT", "connect", "on_cluster"]
 
@@ -22,6 +23,7 @@ CONNECT_TIMEOUT = 10.0
 
 def connect(scheduler: str) -> Any:
     """Connect to the scheduler at ``scheduler`` (a client that is not made the default)."""
+    require("campaign", "distributed", "a Dask scheduler")
     from distributed import Client
     from distributed.comm import parse_address
 

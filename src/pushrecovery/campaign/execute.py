@@ -32,6 +32,7 @@ from pushrecovery.campaign.pushes import run_batch
 from pushrecovery.campaign.rows import row_schema
 from pushrecovery.campaign.spec import CampaignError, CampaignSpec
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.extras import require_extra
 
 __all__ = ["CampaignError", "CampaignResult", "missing_batches", "read_spec", "run_campaign"]
 
@@ -234,7 +235,12 @@ def run_campaign(
     ------
     CampaignError
         A directory holding another campaign, an unreachable scheduler, a dead worker.
+    MissingExtraError
+        Without the ``campaign`` extra, or the ``sim`` extra for a MuJoCo campaign.
     """
+    require_extra("campaign")
+    if spec.backend == "mujoco":
+        require_extra("sim", "a MuJoCo campaign")
     directory = Path(directory)
     if workers is not None and workers < 1:
         raise InvalidParameterError(f"workers must be >= 1, got {workers}")

@@ -26,6 +26,7 @@ from pushrecovery.campaign.subjects import Subject, subject_for
 from pushrecovery.campaign.trial_events import EVENT_FIELDS, EventRow, trial_events
 from pushrecovery.campaign.trial_rows import TRIAL_FIELDS, TrialRow, failed_rows, trial_rows
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.extras import require
 
 __all__ = [
     "TRIAL_SUFFIXES",
@@ -260,6 +261,7 @@ def run_trials(
         raise InvalidParameterError(f"workers must be an int >= 1, got {workers!r}")
     if not jobs:
         raise InvalidParameterError("no trials to analyse")
+    require("analysis", "pyarrow")
     names = [job.name for job in jobs]
     if len(set(names)) != len(names):
         raise InvalidParameterError("two trials have the same name in the batch")

@@ -1,8 +1,9 @@
 """Command-line interface. ``main`` turns every user error into one stderr line and exit 2.
 
 User errors are the project's own (:class:`~pushrecovery.errors.PushRecoveryError`), click's
-usage errors, files the system cannot open (``OSError``) and memory the machine does not have.
-Any other exception is a bug of the library and keeps its traceback.
+usage errors, files the system cannot open (``OSError``), memory the machine does not have and
+an optional dependency that is not installed (:mod:`pushrecovery.extras`: the line names the
+extra to install). Any other exception is a bug of the library and keeps its traceback.
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ def main(argv: list[str] | None = None) -> None:
         _fail(exc.format_message())
     except click.ClickException as exc:  # e.g. a path that does not exist
         _fail(exc.format_message())
+    except ModuleNotFoundError as exc:  # MissingExtraError, or an extra's module unchecked
+        _fail(str(_missing_extra(exc, args)))
     except PushRecoveryError as exc:
         _fail(str(exc))
     except OSError as exc:  # a file or a device the system refuses
@@ -39,6 +42,34 @@ def main(argv: list[str] | None = None) -> None:
         print("pushrecovery: interrupted", file=sys.stderr)
         sys.exit(130)
     sys.exit(code if isinstance(code, int) else 0)
+
+
+def _missing_extra(exc: ModuleNotFoundError, args: list[str]) -> ModuleNotFoundError:
+    """Return the error naming the extra to install for the command line ``args``.
+
+    The command's own extras (:data:`.app.COMMAND_EXTRAS`) first, so that one install makes
+    it run; else the library's :class:`~pushrecovery.extras.MissingExtraError`; else the
+    extra that brings the missing module. A module no extra brings is a bug: re-raised.
+    """
+    from pushrecovery.cli.app import COMMAND_EXTRAS, COMMANDS
+    from pushrecovery.extras import MissingExtraError, extra_of, missing, require_extra
+
+    words = [*args[:1]] if args[:1] and args[0] in COMMANDS else []
+    if words == ["humanoid"] and args[1:2] and not args[1].startswith("-"):
+        words.append(args[1])
+    command = "'" + " ".join(["pushrecovery", *words]) + "'"
+    own = COMMAND_EXTRAS.get(words[0] if words else "", ())
+    for extra in own:
+        try:
+            require_extra(extra, command)
+        except MissingExtraError as first:
+            return first
+    if isinstance(exc, MissingExtraError):
+        return exc
+    named = extra_of(exc.name or "", own)
+    if named is None:  # not an optional dependency: a bug, with its traceback
+        raise exc
+    return missing(named, exc.name or "", command)
 
 
 def _fail(message: str) -> None:

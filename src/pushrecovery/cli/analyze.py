@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from pushrecovery.cli.app import example
-from pushrecovery.cli.options import PARAM_FLAGS, body_options, emit
+from pushrecovery.cli.options import PARAM_FLAGS, body_options, emit, needs_plots
 
 if TYPE_CHECKING:
     from pushrecovery.analysis.trial import TrialSummary
@@ -139,6 +139,7 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     "--plot/--no-plot",
     default=True,
     show_default=True,
+    callback=needs_plots,
     help="Write time_series.png and phase_portrait.png.",
 )
 @body_options

@@ -12,7 +12,7 @@ import click
 
 from pushrecovery import __version__
 
-__all__ = ["COMMANDS", "EXAMPLE_WIDTH", "cli", "example"]
+__all__ = ["COMMANDS", "COMMAND_EXTRAS", "EXAMPLE_WIDTH", "cli", "example"]
 
 #: Longest line of an example [characters]: with click's indent, an 80-column terminal.
 EXAMPLE_WIDTH = 74
@@ -61,6 +61,17 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "pushrecovery.cli.validate:validate",
         "Critical pushes and a confusion matrix in simulation vs the surfaces.",
     ),
+}
+
+#: Command name -> the extras it needs (``pip install 'pushrecovery[EXTRA]'``); a command not
+#: listed runs on the core install, some of its options needing one (``--plot``: ``plots``;
+#: ``--backend mujoco``: ``sim``). A missing module is named with the first extra bringing it.
+COMMAND_EXTRAS: dict[str, tuple[str, ...]] = {
+    "analyze": ("analysis",),
+    "campaign": ("campaign",),
+    "figures": ("plots",),
+    "humanoid": ("sim",),
+    "report": ("report",),
 }
 
 

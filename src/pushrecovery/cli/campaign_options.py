@@ -16,7 +16,13 @@ from typing import Any, TypeVar
 
 import click
 
-from pushrecovery.cli.options import duration_option, echo_confusion, emit, out_option
+from pushrecovery.cli.options import (
+    duration_option,
+    echo_confusion,
+    emit,
+    needs_plots,
+    out_option,
+)
 from pushrecovery.cli.progress import Progress
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -82,7 +88,13 @@ def run_options(*, param_help: str, samples_help: str, batch_size_help: str) -> 
             is_flag=True,
             help="Complete the campaign in --out, running only the missing batches.",
         ),
-        click.option("--plot/--no-plot", default=True, show_default=True, help="Write the plots."),
+        click.option(
+            "--plot/--no-plot",
+            default=True,
+            show_default=True,
+            callback=needs_plots,
+            help="Write the plots.",
+        ),
     )
 
     def apply(func: F) -> F:

@@ -106,6 +106,43 @@ def _body_options(func: F, only: str | None) -> F:
     )(func)
 
 
+def needs_plots(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
+    """Check the ``plots`` extra when ``--plot`` asks for a figure (a click option callback).
+
+    Before the command's work starts, not after it: a campaign or a simulation without
+    matplotlib ends at once with one line naming the extra (and the ``--no-plot`` flag).
+
+    Parameters
+    ----------
+    ctx : click.Context
+        The command's context: the extras of its command (:data:`.app.COMMAND_EXTRAS`) are
+        checked first.
+    param : click.Parameter
+        The option (``--plot`` with a path, or the flag ``--plot/--no-plot``).
+    value : Any
+        Its value: a path, True or False; None or False draws nothing.
+
+    Returns
+    -------
+    Any
+        ``value``, unchanged.
+
+    Raises
+    ------
+    MissingExtraError
+        If a figure is asked for and matplotlib, or an extra of the command, is missing.
+    """
+    if value:
+        from pushrecovery.cli.app import COMMAND_EXTRAS
+        from pushrecovery.extras import require_extra
+
+        for extra in COMMAND_EXTRAS.get(ctx.info_name or "", ()):  # the command's own first
+            require_extra(extra, f"'{ctx.command_path}'")
+        off = getattr(param, "secondary_opts", None)
+        require_extra("plots", f"{param.opts[0]}" + (f" (else pass {off[0]})" if off else ""))
+    return value
+
+
 def out_option(default: str | None, help_text: str) -> Callable[[F], F]:
     """Return ``--out DIRECTORY``: required without a ``default``, else shown with it."""
     return click.option(

@@ -14,7 +14,7 @@ import click
 
 from pushrecovery.cli.app import example
 from pushrecovery.cli.families import humanoid_only
-from pushrecovery.cli.options import body_options, emit, params_from
+from pushrecovery.cli.options import body_options, emit, needs_plots, params_from
 from pushrecovery.cli.progress import Progress
 from pushrecovery.cli.simulation_options import controller_options, planar_run, timing
 
@@ -70,6 +70,7 @@ __all__ = ["critical_push", "simulate"]
     "--plot",
     type=click.Path(dir_okay=False),
     default=None,
+    callback=needs_plots,
     help="Write a plot of the run (PNG, SVG or PDF by extension).",
 )
 @click.option(

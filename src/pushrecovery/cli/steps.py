@@ -11,6 +11,7 @@ from pushrecovery.cli.app import example
 from pushrecovery.cli.options import (
     body_options,
     emit,
+    needs_plots,
     params_from,
     support_from,
     support_options,
@@ -69,6 +70,7 @@ __all__ = ["capture_region_command"]
     "plot",
     type=click.Path(dir_okay=False, path_type=Path),
     default=None,
+    callback=needs_plots,
     help="Also draw the regions into this PNG, SVG or PDF file.",
 )
 @support_options

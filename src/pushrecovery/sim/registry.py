@@ -12,6 +12,7 @@ import importlib
 from typing import TYPE_CHECKING
 
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
+from pushrecovery.extras import require
 
 if TYPE_CHECKING:  # listing the models must not load numpy (pushrecovery --help)
     from pushrecovery.params import BodyParams
@@ -83,7 +84,8 @@ def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plan
     """Build the plant ``name`` of ``backend``; unknown names raise, naming the choices.
 
     The MuJoCo backend also builds the 3-D models of :data:`PLANTS_3D` (the G1's ``params``
-    must be ``robot_params("g1")``).
+    must be ``robot_params("g1")``); it needs the ``sim`` extra (``MissingExtraError``
+    otherwise, naming it).
     """
     from pushrecovery.arguments import require_type
     from pushrecovery.params import BodyParams as Body  # a runtime check, not an annotation
@@ -100,6 +102,8 @@ def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plan
             f"model must be one of {list(models)} for the {backend} backend, "
             f"got model={name!r}{hint}"
         )
+    if backend == "mujoco":
+        require("sim", "mujoco")
     module, _, attribute = table[name].partition(":")
     plant: Plant = getattr(importlib.import_module(module), attribute)(params)
     return plant

@@ -32,6 +32,7 @@ from pushrecovery.analysis.c3d.parameters import (
     _unit_scale,
 )
 from pushrecovery.errors import InputFileError
+from pushrecovery.extras import require
 
 FloatArray = NDArray[np.float64]
 
@@ -119,6 +120,7 @@ def read_plates(
 
 def _ezc3d_platforms(file: Path) -> list[Any]:
     """ezc3d's force-platform output for every plate of the file (it parses the file again)."""
+    require("analysis", "ezc3d", "reading a C3D file")
     import ezc3d
 
     return list(ezc3d.c3d(str(file), extract_forceplat_data=True)["data"]["platform"])

@@ -24,6 +24,7 @@ from pushrecovery.analysis.c3d.plates import read_plates
 from pushrecovery.analysis.c3d.structure import check_parameter_section, read_parameter_section
 from pushrecovery.arguments import non_negative_float
 from pushrecovery.errors import InputFileError
+from pushrecovery.extras import require
 
 FloatArray = NDArray[np.float64]
 
@@ -63,6 +64,7 @@ def read_c3d(path: str | Path, *, threshold: float = 20.0) -> C3DContent:
         check_parameter_section(file, read_parameter_section(file))
     except OSError as exc:
         raise InputFileError(f"{file}: cannot read ({_one_line(exc)})") from exc
+    require("analysis", "ezc3d", "reading a C3D file")
     content = run_isolated(_read_checked_file, (file, limit), file)
     # A pickle does not keep numpy's read-only flag: the arrays are the file's, not to edit.
     for array in content.markers.values():

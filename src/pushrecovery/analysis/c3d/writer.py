@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.analysis.c3d.forceplate import _channels, plate_frame
 from pushrecovery.arguments import positive_float
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.extras import require
 
 FloatArray = NDArray[np.float64]
 
@@ -90,6 +91,7 @@ def write_c3d(
     if any(not isinstance(label, str) or not label.strip() for label in labels):
         raise InvalidParameterError("marker labels must be non-empty strings")
 
+    require("analysis", "ezc3d", "writing a C3D file")
     import ezc3d
 
     c3d = ezc3d.c3d()

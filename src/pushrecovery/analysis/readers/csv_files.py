@@ -19,6 +19,7 @@ from pushrecovery.analysis.readers.common import (
 )
 from pushrecovery.analysis.recording import AXES, LOADED, Recording
 from pushrecovery.errors import InputFileError
+from pushrecovery.extras import require
 
 __all__ = [
     "CSV_COLUMNS",
@@ -220,6 +221,7 @@ def _vertices(path: Path, data: dict[str, FloatArray]) -> FloatArray | None:
 
 def _read_table(path: Path) -> dict[str, FloatArray]:
     """Numeric columns of a CSV file by lower-case name (pyarrow's parser)."""
+    require("analysis", "pyarrow", "reading a CSV trial")
     import pyarrow as pa
     import pyarrow.csv as pacsv
 

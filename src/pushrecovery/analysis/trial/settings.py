@@ -14,6 +14,7 @@ from pushrecovery.analysis.recording import (
     Recording,
 )
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.extras import require
 from pushrecovery.params import BodyParams
 
 if TYPE_CHECKING:
@@ -121,6 +122,7 @@ class TrialAnalysis:
 
     def to_arrow(self) -> Any:
         """Return the frames as a ``pyarrow.Table`` (NaN as null, as in ``frames.parquet``)."""
+        require("analysis", "pyarrow", "to_arrow")
         import pyarrow as pa
 
         arrays = {}
@@ -140,12 +142,7 @@ class TrialAnalysis:
 
 def pandas_table(table: Any) -> Any:
     """Return a pyarrow table as a pandas DataFrame, or say how to get pandas (the tables')."""
-    try:
-        import pandas  # noqa: F401
-    except ImportError:
-        raise InvalidParameterError(
-            "to_pandas needs pandas: pip install 'pushrecovery[tables]'"
-        ) from None
+    require("tables", "pandas", "to_pandas")
     return table.to_pandas()
 
 
