@@ -75,7 +75,8 @@ def run_push3d(
     azimuth = 0.0 if push.azimuth is None else push.azimuth
     try:
         run = runs3d.run_push3d(
-            plant, controller, Push3D(push.impulse, azimuth), duration=spec.duration,
+            plant, controller, Push3D(push.impulse, azimuth, scheduled=strategy == "step"),
+            duration=spec.duration,
             push_time=PUSH_TIME,
         )  # fmt: skip
     except SimulationDiverged as exc:  # this push only: the others of the batch go on

@@ -212,7 +212,12 @@ def simulate_3d(
     from pushrecovery.sim.registry import make_plant3d
     from pushrecovery.surfaces.classify import classify as classify_state
 
-    push = Push3D(0.0 if impulse is None else impulse, 0.0 if azimuth is None else azimuth)
+    # A stepping controller reacts during the push, as validate's step column measures it.
+    push = Push3D(
+        0.0 if impulse is None else impulse,
+        0.0 if azimuth is None else azimuth,
+        scheduled=stepping,
+    )
     dvx, dvy = push.delta_velocity(params.mass)
     predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
     plant = make_plant3d(model, params)

@@ -86,7 +86,7 @@ def filmstrip_run(
                                   step_settings=StepSettings(swing_time=0.2))  # fmt: skip
     else:
         wbc = wbc_for(plant, hip=controller == "hip")
-    push = Push3D(impulse, azimuth)
+    push = Push3D(impulse, azimuth, scheduled=controller == "step")  # a stepper reacts to it
     duration = max(last_frame, STRIP_DURATION)
     run = run_push3d(plant, wbc, push, duration=duration, push_time=0.1, record=True)
     steps = 0 if run.extras is None else run.extras.steps
