@@ -21,6 +21,7 @@ from scipy.optimize import linprog
 
 from pushrecovery import InvalidParameterError, load_params
 from pushrecovery.errors import ParameterTypeError
+from pushrecovery.ground.support import FootPose, Support
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import (
@@ -32,6 +33,7 @@ from pushrecovery.surfaces.cmp import (
     flywheel_offset,
     flywheel_offsets,
 )
+from pushrecovery.surfaces.plane import cmp_polygon, cmp_polygon_from
 
 P = load_params()
 #: A small robot (the 48 kg body of issue 32 with a light, short-ranged upper body).
@@ -255,3 +257,49 @@ def test_bad_axis_and_params():
         cmp_offset_from("paper", 0.0, 0.0)  # type: ignore[arg-type]
     with pytest.raises(InvalidParameterError, match="omega"):
         flywheel_offsets(100.0, 10.0, 1.0, 700.0, 0.0, 0.0, 0.0)
+
+
+# The plane form: P ⊕ [−Δ⁻_p, Δ⁺_p] × [−Δ⁻_r, Δ⁺_r] in the stance's axes.
+
+PLANE_SUPPORTS = {
+    "double": lambda: Support.from_params(P, "double"),
+    "right-yawed": lambda: Support.from_params(P, "right", right=FootPose(0.0, -0.1, -0.7)),
+}
+
+
+@pytest.mark.parametrize("name", PLANE_SUPPORTS)
+def test_plane_polygon_at_rest_is_cmp_polygon(name):
+    support = PLANE_SUPPORTS[name]()
+    np.testing.assert_allclose(
+        cmp_polygon_from(support, P).vertices, cmp_polygon(support, P).vertices, atol=1e-15
+    )
+
+
+@pytest.mark.parametrize("name", PLANE_SUPPORTS)
+def test_plane_polygon_support_function(name):
+    # h(d) = h_P(d) + Σ_axes Δ⁺ max(d·e, 0) + Δ⁻ max(−d·e, 0), e the body's pitch and roll axes.
+    support = PLANE_SUPPORTS[name]()
+    pitch, roll = (0.4, -1.2), (-0.7, 2.0)
+    region = cmp_polygon_from(support, P, pitch, roll)
+    minus_p, plus_p = cmp_offset_from(P, *pitch)
+    minus_r, plus_r = cmp_offset_from(P, *roll, axis="roll")
+    c, s = math.cos(support.yaw), math.sin(support.yaw)
+    for angle in np.linspace(-math.pi, math.pi, 37):
+        d = np.array([math.cos(angle), math.sin(angle)])
+        along, across = d @ (c, s), d @ (-s, c)
+        want = (
+            support.polygon.support(*d)
+            + plus_p * max(along, 0.0)
+            + minus_p * max(-along, 0.0)
+            + plus_r * max(across, 0.0)
+            + minus_r * max(-across, 0.0)
+        )
+        assert region.support(*d) == pytest.approx(want, abs=1e-14)
+
+
+def test_plane_polygon_bad_input():
+    support = Support.from_params(P, "double")
+    with pytest.raises(InvalidParameterError, match="theta0"):
+        cmp_polygon_from(support, P, roll=(1.5, 0.0))
+    with pytest.raises(InvalidParameterError, match="thetadot0"):
+        cmp_polygon_from(support, P, pitch=(0.0, math.nan))

@@ -39,7 +39,7 @@ from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.kernels.step_scalar import step_line
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
-from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_from, cmp_offset_roll
 from pushrecovery.surfaces.cop import _fusable, capture_point
 from pushrecovery.surfaces.step import StepDecision, plan_step, step_feasible
 
@@ -50,6 +50,7 @@ __all__ = [
     "capture_point_xy",
     "cmp_margin_xy",
     "cmp_polygon",
+    "cmp_polygon_from",
     "cop_margin_xy",
     "direction_thresholds",
     "plan_step_xy",
@@ -104,6 +105,47 @@ def cmp_polygon(support: Support, params: BodyParams) -> ConvexPolygon:
     return _grown(
         vertices.tobytes(), len(vertices), cmp_offset(params), cmp_offset_roll(params), support.yaw
     )
+
+
+def cmp_polygon_from(
+    support: Support,
+    params: BodyParams,
+    pitch: tuple[float, float] = (0.0, 0.0),
+    roll: tuple[float, float] = (0.0, 0.0),
+) -> ConvexPolygon:
+    """:func:`cmp_polygon` from the upper body's current angles and rates [m] (errata E19).
+
+    P ⊕ [−Δ⁻_p, Δ⁺_p] × [−Δ⁻_r, Δ⁺_r] in the stance's axes, with (Δ⁻, Δ⁺) of each axis from
+    :func:`~pushrecovery.surfaces.cmp.cmp_offset_from`: the box of half-sizes (Δ⁻ + Δ⁺)/2
+    (never negative) centred at ((Δ⁺_p − Δ⁻_p)/2, (Δ⁺_r − Δ⁻_r)/2) in those axes. Equals
+    :func:`cmp_polygon` for an upright body at rest (up to rounding, 1e-16 m).
+
+    Parameters
+    ----------
+    support : Support
+        The stance's support (its polygon P and yaw).
+    params : BodyParams
+        Body parameters.
+    pitch, roll : (float, float)
+        Upper-body (angle [rad], rate [rad/s]) about the pitch axis (positive forward) and the
+        roll axis (positive toward the body's left).
+
+    Raises
+    ------
+    InvalidParameterError
+        An angle outside its joint range, a rate from which the flywheel cannot stop inside it,
+        or a non-finite value (the message names ``theta0`` or ``thetadot0``).
+    """
+    require_type("support", support, Support)
+    minus_p, plus_p = cmp_offset_from(params, *pitch)
+    minus_r, plus_r = cmp_offset_from(params, *roll, axis="roll")
+    yaw = support.yaw
+    c, s = math.cos(yaw), math.sin(yaw)
+    shift_p, shift_r = 0.5 * (plus_p - minus_p), 0.5 * (plus_r - minus_r)
+    box = support.polygon.grown(
+        max(0.5 * (plus_p + minus_p), 0.0), max(0.5 * (plus_r + minus_r), 0.0), yaw
+    )
+    return box.transformed(c * shift_p - s * shift_r, s * shift_p + c * shift_r, 0.0)
 
 
 @functools.lru_cache(maxsize=64)
