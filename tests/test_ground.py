@@ -178,9 +178,14 @@ def test_double_support_refuses_overlapping_or_distant_feet():
     Support.from_params(load_params(overrides={"stance_width": 0.1}))
 
 
-def test_pose_limits_and_yaw_wrap():
-    assert FootPose(0.0, 0.0, 7.0).yaw == pytest.approx(7.0 - 2 * math.pi)
+def test_pose_limits_and_yaw_in_radians():
     assert FootPose(0.0, 0.0, -math.pi).yaw == -math.pi
+    assert FootPose(0.0, 0.0, math.pi).yaw == math.pi
+    for degrees in (10.0, -90.0, 7.0, math.pi + 1e-9):  # degrees by mistake, or past ±π
+        with pytest.raises(InvalidParameterError, match=r"yaw must be within \[−π, π\] rad"):
+            FootPose(0.0, 0.09, degrees)
+    with pytest.raises(InvalidParameterError, match=r"yaw must be within \[−π, π\] rad"):
+        FootPose.parse("--left-foot", "0,0.09,10")
     with pytest.raises(InvalidParameterError, match="foot pose x must be within"):
         FootPose(1e300, 0.0)
 

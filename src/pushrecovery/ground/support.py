@@ -44,7 +44,14 @@ class Stance(StrEnum):
 
 @dataclass(frozen=True, slots=True)
 class FootPose:
-    """Where a foot stands: its ankle at (x, y) [m] and its yaw [rad], counter-clockwise."""
+    """Where a foot stands: its ankle at (x, y) [m] and its yaw [rad], counter-clockwise.
+
+    Raises
+    ------
+    InvalidParameterError
+        If x or y is not finite or beyond ±:data:`MAX_POSE` m, or the yaw is not a finite
+        number in [−π, π] rad (a yaw in degrees, such as 10.0, is refused, not wrapped).
+    """
 
     x: float
     y: float
@@ -59,8 +66,10 @@ class FootPose:
                 )
             object.__setattr__(self, name, value)
         yaw = finite_float("foot pose yaw", self.yaw, "rad")
-        if abs(yaw) > math.pi:  # the same heading, within [−π, π]
-            yaw = math.atan2(math.sin(yaw), math.cos(yaw))
+        if abs(yaw) > math.pi:  # most likely degrees: refused rather than wrapped
+            raise InvalidParameterError(
+                f"foot pose yaw must be within [−π, π] rad (radians, not degrees), got {yaw:g}"
+            )
         object.__setattr__(self, "yaw", yaw)
 
     @classmethod

@@ -1,13 +1,14 @@
 """A balance monitor for a 500 Hz – 1 kHz loop: one state in, a verdict out.
 
-:class:`BalanceMonitor` is built once from the body and its support (and rebuilt with
-:meth:`BalanceMonitor.set_support` when a foot lands or lifts). Every query then runs on Python
-floats and tuples prepared at construction (no arrays allocated, no thread pool, no
+:class:`BalanceMonitor` is built once from the body (the N-step regions of a stance foot at
+the origin, :class:`~pushrecovery.surfaces.step_regions.StepRegions`) and told each support
+with :meth:`BalanceMonitor.set_support` when a foot lands or lifts: tens of µs, the regions
+turned and moved to the feet, the CMP region one compiled Minkowski sum. Every query then runs
+on Python floats and tuples prepared for the support (no arrays allocated, no thread pool, no
 compilation) and one call of the compiled N-step region test
-(``kernels.plane_codes.locate_steps`` over the regions of
-:class:`~pushrecovery.surfaces.step_regions.StepRegions`), loaded from numba's on-disk cache
-in the constructor, which calls every path once: the first query of a process pays nothing
-either.
+(``kernels.plane_codes.locate_steps``). The constructor loads every compiled path from numba's
+on-disk cache and calls each once: the first query and the first support change of a process
+pay nothing either.
 
 The verdicts, capture point and margins are those of
 :func:`pushrecovery.surfaces.classify.classify` on the ground plane (tested to 1e-12).
@@ -20,20 +21,37 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import Support
+from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import Strategy
+from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
-from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.step_regions import StepRegions
 
 __all__ = ["BalanceMonitor", "Verdict"]
 
+FloatArray = NDArray[np.float64]
+#: The box's corners (±1, ±1), counter-clockwise, and the sum's weights and offset.
+_CORNERS = ((-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0))
+_UNIT_WEIGHTS = np.ones(2)
+_ORIGIN = np.zeros(2)
+
 _Edges = tuple[tuple[float, float, float, float, float, float, float, float], ...]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _SupportState:
+    """Everything a query needs of one support, built whole and never changed."""
+
+    support: Support
+    cop: _Edges
+    cmp: _Edges
+    regions: tuple[object, ...]  # locate_steps' table, counts, steps, outer
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,23 +84,24 @@ class Verdict:
 
 def _edges(polygon: ConvexPolygon) -> _Edges:
     """Per edge: normal, offset, start vertex, edge vector, 1/‖edge‖² as Python floats."""
-    v, n, b = polygon.vertices, polygon.normals, polygon.offsets
+    v = polygon.vertices.tolist()
     rows = []
-    for i in range(len(v)):
-        j = (i + 1) % len(v)
-        ex, ey = float(v[j, 0] - v[i, 0]), float(v[j, 1] - v[i, 1])
-        rows.append(
-            (
-                float(n[i, 0]),
-                float(n[i, 1]),
-                float(b[i]),
-                float(v[i, 0]),
-                float(v[i, 1]),
-                ex,
-                ey,
-                1.0 / (ex * ex + ey * ey),
-            )
-        )
+    for (nx, ny), b, (x0, y0), (x1, y1) in zip(
+        polygon.normals.tolist(), polygon.offsets.tolist(), v, v[1:] + v[:1], strict=True
+    ):
+        ex, ey = x1 - x0, y1 - y0
+        rows.append((nx, ny, b, x0, y0, ex, ey, 1.0 / (ex * ex + ey * ey)))
+    return tuple(rows)
+
+
+def _loop_edges(loop: list[list[float]]) -> _Edges:
+    """:func:`_edges` of a counter-clockwise vertex loop (normals as ``ConvexPolygon``'s)."""
+    rows = []
+    for (x0, y0), (x1, y1) in zip(loop, loop[1:] + loop[:1], strict=True):
+        ex, ey = x1 - x0, y1 - y0
+        length = math.hypot(ex, ey)
+        nx, ny = ey / length, -ex / length
+        rows.append((nx, ny, nx * x0 + ny * y0, x0, y0, ex, ey, 1.0 / (ex * ex + ey * ey)))
     return tuple(rows)
 
 
@@ -116,6 +135,18 @@ class BalanceMonitor:
     support : Support, optional
         Stance and feet; default double support on the default feet.
 
+    Notes
+    -----
+    Threads: everything :meth:`query` needs of a support lives in one immutable object,
+    which :meth:`set_support` builds whole and then installs with a single attribute
+    assignment; :meth:`query` reads that attribute once. So one thread may call
+    :meth:`set_support` while others call :meth:`query`: each query answers for the old
+    support or the new one, never a mix of both. Two threads calling :meth:`set_support` at
+    once leave the support of whichever assigned last. The compiled kernels hold the GIL
+    (numba releases it only where asked, and these ask nothing), so the threads interleave
+    rather than run in parallel: a monitor per process, not per core. No call allocates
+    arrays on a query; :meth:`set_support` allocates one edge table (tens of kB).
+
     Examples
     --------
     >>> from pushrecovery import load_params
@@ -124,10 +155,11 @@ class BalanceMonitor:
     'hip'
     """
 
-    __slots__ = ("_cmp", "_cop", "_locate", "_omega", "_regions", "params", "support")
+    __slots__ = ("_box", "_locate", "_minkowski", "_omega", "_state", "params")
 
     def __init__(self, params: BodyParams, support: Support | None = None) -> None:
         from pushrecovery.kernels.plane_codes import locate_steps
+        from pushrecovery.kernels.polygons import minkowski_loop
 
         require_type("params", params, BodyParams)
         if support is not None:
@@ -135,17 +167,54 @@ class BalanceMonitor:
         self.params = params
         self._omega = params.omega
         self._locate: Callable[..., tuple[int, float]] = locate_steps
-        self.set_support(Support.from_params(params) if support is None else support)
-        self.query(0.0, 0.0, 10.0, 0.0)  # loads every compiled path before the first tick
+        self._minkowski: Callable[..., FloatArray] = minkowski_loop
+        self._box = (cmp_offset(params), cmp_offset_roll(params))
+        first = Support.from_params(params) if support is None else support
+        for stance in (Stance.LEFT, Stance.DOUBLE):  # loads every compiled path once
+            self.set_support(Support.from_params(params, stance))
+            self.query(0.0, 0.0, 10.0, 0.0)
+        self.set_support(first)
+
+    @property
+    def support(self) -> Support:
+        """The support the queries answer for."""
+        return self._state.support
 
     def set_support(self, support: Support) -> None:
-        """Use another stance or foot placement (tens of µs of set-up; not for every tick)."""
-        self.support = support
-        self._cop = _edges(support.polygon)
-        self._cmp = _edges(cmp_polygon(support, self.params))
+        """Use another stance or foot placement (tens of µs; safe while others query).
+
+        Raises
+        ------
+        ParameterTypeError
+            If ``support`` is not a :class:`~pushrecovery.ground.support.Support`.
+        """
+        require_type("support", support, Support)
         regions = StepRegions.of(self.params, support)
-        steps = np.array(regions.steps, dtype=np.int64)
-        self._regions = (regions.table, regions.counts, steps, regions.outer)
+        self._state = _SupportState(
+            support,
+            _edges(support.polygon),
+            self._cmp_edges(support),
+            (regions.table, regions.counts, regions.steps_array, regions.outer),
+        )
+
+    def _cmp_edges(self, support: Support) -> _Edges:
+        """Return the edges of the CMP region P ⊕ box (``plane.cmp_polygon``), compiled.
+
+        The box's corners as :meth:`~pushrecovery.ground.polygon.ConvexPolygon.grown` places
+        them (turned by the stance's heading); one Minkowski sum of two shapes.
+        """
+        half_x, half_y = self._box
+        if half_x == 0.0 and half_y == 0.0:
+            return _edges(support.polygon)
+        vertices = support.polygon.vertices
+        count = len(vertices)
+        shapes = np.zeros((2, max(count, 4), 2))
+        shapes[0, :count] = vertices
+        c, s = math.cos(support.yaw), math.sin(support.yaw)
+        for k, (sx, sy) in enumerate(_CORNERS):
+            shapes[1, k] = (c * sx * half_x - s * sy * half_y, s * sx * half_x + c * sy * half_y)
+        loop = self._minkowski(shapes, np.array([count, 4]), _UNIT_WEIGHTS, _ORIGIN)
+        return _loop_edges(loop.tolist())
 
     def query(self, x: float, y: float, xdot: float, ydot: float) -> Verdict:
         """Classify one CoM state on the ground plane.
@@ -180,10 +249,11 @@ class BalanceMonitor:
             raise InvalidParameterError(
                 f"x, y, xdot, ydot must be finite, got {x!r}, {y!r}, {xdot!r}, {ydot!r}"
             )
-        cop = _signed_distance(self._cop, px, py)
-        cmp = _signed_distance(self._cmp, px, py)
+        state = self._state  # read once: the old support or the new one, never a mix
+        cop = _signed_distance(state.cop, px, py)
+        cmp = _signed_distance(state.cmp, px, py)
         # The N-step regions (compiled, one call), as StepRegions.locate.
-        steps, step_margin = self._locate(*self._regions, px, py)
+        steps, step_margin = self._locate(*state.regions, px, py)
         if cop > 0.0:
             strategy, steps = Strategy.ANKLE, 0
         elif cmp > 0.0:

@@ -21,9 +21,11 @@ sagittal line s^± = δ^± and q_0 = 0: [δ⁻ − a − l s_N, δ⁺ + a + l s_
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,6 +41,7 @@ from pushrecovery.surfaces.cop import CaptureInterval
 from pushrecovery.surfaces.n_step import (
     StepOption,
     _capturability_distance,
+    landing_foot,
     step_options,
     viable_region,
 )
@@ -270,54 +273,175 @@ def _sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class _Canonical:
+    """The regions of one stance foot at the origin with yaw 0, built once per body and side.
+
+    ``tables`` (2, M, E, 7) and ``counts`` (2, M), ``discs`` (2, M, 4): index 0 the right
+    stance foot (the left one swings), 1 the left, as :func:`step_options` orders them from
+    double support; E the longest of both. ``nested[k]``: every C_N of side k lies in C_{N+1}.
+    """
+
+    polygons: tuple[tuple[ConvexPolygon, ...], tuple[ConvexPolygon, ...]]
+    options: tuple[StepOption, StepOption]
+    tables: FloatArray
+    counts: NDArray[np.int64]
+    discs: FloatArray
+    nested: tuple[bool, bool]
+
+
+#: ``outer`` of one region alone (its margin is the largest).
+_ONE_OUTER = np.ones(1, dtype=np.bool_)
+#: Index of each stance foot in the canonical arrays (:class:`_Canonical`).
+_SIDE = {Stance.RIGHT: 0, Stance.LEFT: 1}
+
+
+@functools.lru_cache(maxsize=16)
+def _canonical(params: BodyParams) -> _Canonical:
+    """Build both stance feet's regions at the origin (the Minkowski sums, once per body)."""
+    times = [
+        tuple(params.min_step_time * (k + 1) for k in range(n))
+        for n in range(1, 1 + params.max_steps)
+    ]
+    polygons, options, nested = [], [], []
+    for stance in (Stance.RIGHT, Stance.LEFT):
+        swing = Stance.LEFT if stance is Stance.RIGHT else Stance.RIGHT
+        option = StepOption(swing, landing_foot(params, stance, 0.0), np.zeros(2), 0.0)
+        side = tuple(viable_region(params, option, t) for t in times)
+        polygons.append(side)
+        options.append(option)
+        nested.append(
+            all(
+                float(outer.signed_distance(*inner.vertices.T).min()) >= -1e-12
+                for inner, outer in itertools.pairwise(side)
+            )
+        )
+    longest = max(len(p.offsets) for side in polygons for p in side)
+    tables = np.empty((2, params.max_steps, longest, 7))
+    counts = np.empty((2, params.max_steps), dtype=np.int64)
+    discs = np.empty((2, params.max_steps, 4))
+    for k, side in enumerate(polygons):
+        for m, polygon in enumerate(side):
+            edges = polygon.edge_table
+            tables[k, m, : len(edges)] = edges
+            tables[k, m, len(edges) :] = edges[-1]
+            counts[k, m] = len(edges)
+            centre = np.array(polygon.centroid)
+            inner = float(np.min(polygon.offsets - polygon.normals @ centre))
+            around = float(np.max(np.hypot(*(polygon.vertices - centre).T)))
+            # Shrunk and grown by 1e-12 relative: rounding never moves a verdict across an edge.
+            discs[k, m] = (*centre, (inner * (1.0 - 1e-12)) ** 2, (around * (1.0 + 1e-12)) ** 2)
+    for array in (tables, counts, discs):
+        array.flags.writeable = False
+    return _Canonical(
+        (polygons[0], polygons[1]),
+        (options[0], options[1]),
+        tables,
+        counts,
+        discs,
+        (nested[0], nested[1]),
+    )
+
+
+@functools.lru_cache(maxsize=16)
+def _levels(
+    params: BodyParams, sides: int, nested: bool
+) -> tuple[tuple[int, ...], NDArray[np.int64], NDArray[np.bool_]]:
+    """N of each row (ascending, ``sides`` rows each), as int64, and the ``outer`` flags."""
+    steps = tuple(n for n in range(1, params.max_steps + 1) for _ in range(sides))
+    array = np.array(steps, dtype=np.int64)
+    outer = np.array([not nested or n == params.max_steps for n in steps])
+    array.flags.writeable = outer.flags.writeable = False
+    return steps, array, outer
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class StepRegions:
     """The N-step regions of one support, N = 1 ... max_steps, ready for verdicts.
+
+    Each single-support region is a rigid transform of the same region for the stance foot
+    at the origin with yaw 0 (rotating every term of (S1) by the stance yaw and moving the
+    ankle rotates and moves the sum): those are built once per body (the Minkowski sums) and
+    a support only rotates and moves their edge tables (``kernels.placement``, tens of µs).
+    From double support the regions are those of both single supports (the first step lifts
+    one foot, the other is the stance). The polygons and options are built when first asked.
 
     Attributes
     ----------
     params : BodyParams
         The body.
-    polygons : tuple of ConvexPolygon
-        C_N, by ascending N; from double support both lifting feet for each N.
+    support : Support
+        The support.
     steps : tuple of int
-        N of each polygon.
-    options : tuple of StepOption
-        The first landing foot of each polygon.
+        N of each region, ascending; from double support both lifting feet for each N (the
+        left foot first).
+    steps_array : ndarray of int64, shape (R,)
+        ``steps`` as an array (compiled tests).
     table : ndarray, shape (R, E, 7)
-        The polygons' edge tables, padded to the longest by repeating a row (compiled tests).
+        The regions' edge tables (rows of ``ConvexPolygon.edge_table``), padded to the
+        longest by repeating a row (compiled tests).
     counts : ndarray of int64, shape (R,)
-        Edges of each polygon.
+        Edges of each region.
     discs : ndarray, shape (R, 4)
-        (c_x, c_y, r_in², r_out²): discs inside and around each polygon about its centroid.
+        (c_x, c_y, r_in², r_out²): discs inside and around each region about its centroid.
     outer : ndarray of bool, shape (R,)
-        Polygons whose union is the union of all: the max_steps ones when every C_N lies in
+        Regions whose union is the union of all: the max_steps ones when every C_N lies in
         C_{N+1} (checked vertex by vertex), else all.
+    polygons : tuple of ConvexPolygon
+        C_N, by row.
+    options : tuple of StepOption
+        The first landing foot of each row.
     """
 
     params: BodyParams
-    polygons: tuple[ConvexPolygon, ...]
+    support: Support
     steps: tuple[int, ...]
-    options: tuple[StepOption, ...]
+    steps_array: NDArray[np.int64]
     table: FloatArray
     counts: NDArray[np.int64]
     discs: FloatArray
     outer: NDArray[np.bool_]
+    _stances: tuple[tuple[Stance, float, float, float], ...]  # (stance, x, y, yaw) per side
+    _built: dict[str, tuple[object, ...]] = field(default_factory=dict, repr=False)
 
     @classmethod
     def of(cls, params: BodyParams, support: Support) -> StepRegions:
         """Return the regions of ``support`` (kept: asking again costs a look-up)."""
         return _regions(params, support)
 
+    @property
+    def polygons(self) -> tuple[ConvexPolygon, ...]:
+        """C_N of each row [m] (built on first use)."""
+        found = self._built.get("polygons")
+        if found is None:
+            canonical = _canonical(self.params)
+            per_side = [
+                [p.transformed(x, y, yaw) for p in canonical.polygons[_SIDE[stance]]]
+                for stance, x, y, yaw in self._stances
+            ]
+            found = self._built["polygons"] = tuple(
+                side[m] for m in range(self.params.max_steps) for side in per_side
+            )
+        return found  # type: ignore[return-value]
+
+    @property
+    def options(self) -> tuple[StepOption, ...]:
+        """The first landing foot of each row (built on first use)."""
+        found = self._built.get("options")
+        if found is None:
+            per_side = step_options(self.params, self.support)
+            found = self._built["options"] = tuple(
+                option for _ in range(self.params.max_steps) for option in per_side
+            )
+        return found  # type: ignore[return-value]
+
     def locate(self, px: float, py: float) -> tuple[int, float]:
         """Return (steps needed, 0 beyond max_steps; step margin [m]) of one capture point."""
-        best = -math.inf
-        found = 0
-        for polygon, steps, outer in zip(self.polygons, self.steps, self.outer, strict=True):
-            margin = float(polygon.signed_distance(px, py))
-            best = max(best, margin) if outer else best
-            if found == 0 and margin > 0.0:
-                found = steps
-        return found, best
+        from pushrecovery.kernels.plane_codes import locate_steps
+
+        found, margin = locate_steps(
+            self.table, self.counts, self.steps_array, self.outer, float(px), float(py)
+        )
+        return int(found), float(margin)
 
     def margins(self, px: FloatArray, py: FloatArray) -> FloatArray:
         """Step margins of many capture points: the largest signed distance to a region [m]."""
@@ -331,56 +455,84 @@ class StepRegions:
         """Return the plan of ``steps`` steps for ξ = (px, py).
 
         From double support the foot on the capture point's side of the other ankle steps
-        when its regions capture ξ (a side step, not a crossover), else the other one.
+        when its regions capture ξ (a side step, not a crossover), else the other one. The
+        plan is made in the stance foot's frame (ankle at the origin, yaw 0: its terms are
+        kept from plan to plan) and turned and moved back.
         """
-        from pushrecovery.kernels.polygons import loop_signed_distance  # compiled, as the plan
+        from pushrecovery.kernels.plane_codes import locate_steps
 
-        rows = [i for i, n in enumerate(self.steps) if n == steps]
-        margins = {i: float(loop_signed_distance(self.polygons[i].vertices, px, py)) for i in rows}
+        sides = len(self._stances)
+        first = (steps - 1) * sides
+        margins = []
+        for k in range(sides):
+            row = slice(first + k, first + k + 1)
+            margins.append(
+                float(
+                    locate_steps(
+                        self.table[row], self.counts[row], self.steps_array[row],
+                        _ONE_OUTER, float(px), float(py),
+                    )[1]
+                )
+            )  # fmt: skip
 
-        def preference(i: int) -> tuple[bool, float]:
-            option = self.options[i]
-            lateral = -math.sin(option.yaw) * (px - option.ankle[0]) + math.cos(option.yaw) * (
-                py - option.ankle[1]
-            )
-            outward = lateral >= 0.0 if option.swing is Stance.LEFT else lateral <= 0.0
-            return margins[i] > 0.0 and outward, margins[i]
+        def preference(k: int) -> tuple[bool, float]:
+            stance, x, y, yaw = self._stances[k]
+            lateral = -math.sin(yaw) * (px - x) + math.cos(yaw) * (py - y)
+            # The swing foot is the other one: a left swing steps to the stance's left.
+            outward = lateral >= 0.0 if stance is Stance.RIGHT else lateral <= 0.0
+            return margins[k] > 0.0 and outward, margins[k]
 
-        row = max(rows, key=preference)
-        margin = margins[row]  # its C_N: known here
-        return capture_plan(
-            np.array([px, py]), self.params, self.options[row], steps, margin=margin
+        k = max(range(sides), key=preference)
+        stance, x, y, yaw = self._stances[k]
+        c, s = math.cos(yaw), math.sin(yaw)
+        dx, dy = px - x, py - y
+        local = np.array([c * dx + s * dy, -s * dx + c * dy])
+        option = _canonical(self.params).options[_SIDE[stance]]
+        plan = capture_plan(local, self.params, option, steps, margin=margins[k])
+        turn = np.array([[c, -s], [s, c]])
+        shift = np.array([x, y])
+        return dataclasses.replace(
+            plan,
+            footholds=plan.footholds @ turn.T + shift,
+            cops=plan.cops @ turn.T + shift,
+            hip=plan.hip @ turn.T,
+            ankle=shift,
         )
 
 
 @functools.lru_cache(maxsize=32)
 def _regions(params: BodyParams, support: Support) -> StepRegions:
-    polygons, steps, options = [], [], []
-    for n in range(1, params.max_steps + 1):
-        times = tuple(params.min_step_time * (k + 1) for k in range(n))
-        for option in step_options(params, support):
-            polygons.append(viable_region(params, option, times))
-            steps.append(n)
-            options.append(option)
-    longest = max(len(p.offsets) for p in polygons)
-    table = np.empty((len(polygons), longest, 7))
-    discs = np.empty((len(polygons), 4))
-    for i, polygon in enumerate(polygons):
-        edges = polygon.edge_table
-        table[i, : len(edges)] = edges
-        table[i, len(edges) :] = edges[-1]
-        centre = np.array(polygon.centroid)
-        inner = float(np.min(polygon.offsets - polygon.normals @ centre))
-        around = float(np.max(np.hypot(*(polygon.vertices - centre).T)))
-        # Shrunk and grown by 1e-12 relative: rounding never moves a verdict across an edge.
-        discs[i] = (*centre, (inner * (1.0 - 1e-12)) ** 2, (around * (1.0 + 1e-12)) ** 2)
-    counts = np.array([len(p.offsets) for p in polygons], dtype=np.int64)
-    sides = len(polygons) // params.max_steps
-    nested = all(
-        float(polygons[i + sides].signed_distance(*polygons[i].vertices.T).min()) >= -1e-12
-        for i in range(len(polygons) - sides)
-    )
-    outer = np.array([not nested or n == params.max_steps for n in steps])
+    """Place both stance feet's canonical regions at the support's feet."""
+    from pushrecovery.kernels.placement import place_tables
+
+    canonical = _canonical(params)
+    stances: tuple[Stance, ...]
+    if support.stance is Stance.DOUBLE:
+        stances = (Stance.RIGHT, Stance.LEFT)  # the left foot lifts first
+        tables, counts, discs = canonical.tables, canonical.counts, canonical.discs
+        nested = canonical.nested[0] and canonical.nested[1]
+    else:
+        stances = (support.stance,)
+        k = _SIDE[support.stance]
+        tables, counts = canonical.tables[k : k + 1], canonical.counts[k : k + 1]
+        discs, nested = canonical.discs[k : k + 1], canonical.nested[k]
+    poses = [support.left if stance is Stance.LEFT else support.right for stance in stances]
+    placed = np.array([(math.cos(p.yaw), math.sin(p.yaw), p.x, p.y) for p in poses])
+    rows = len(stances) * params.max_steps
+    table = np.empty((rows, int(counts.max()), 7))
+    circles = np.empty((rows, 4))
+    place_tables(tables, counts, discs, placed, table, circles)
+    steps, array, outer = _levels(params, len(stances), nested)
     return StepRegions(
-        params, tuple(polygons), tuple(steps), tuple(options), table, counts, discs, outer
+        params,
+        support,
+        steps,
+        array,
+        table,
+        counts.T.reshape(-1),
+        circles,
+        outer,
+        tuple(
+            (stance, pose.x, pose.y, pose.yaw) for stance, pose in zip(stances, poses, strict=True)
+        ),
     )
