@@ -9,6 +9,10 @@ With the ankle saturated and the flywheel driven bang-bang for T = T_max from re
 The printed Eq. (15) has (e^{ωT} − 1)² in place of (1 − e^{−ωT})², a factor e^{2ωT} (7.2 for
 the paper preset) too optimistic (docs/errata.md, E11); the bound is also the supremum over
 every flywheel controller within abs(τ) ≤ τmax and abs(θ) ≤ θmax from rest (E12).
+
+From a flywheel (upper body) at angle θ0 and rate θ̇0 the two sides differ:
+:func:`flywheel_offsets` and :func:`cmp_offset_from` give (Δ⁻, Δ⁺) and :func:`cmp_region_from`
+the interval (heel − Δ⁻, toe + Δ⁺) (docs/errata.md, E19).
 """
 
 from __future__ import annotations

@@ -14,7 +14,9 @@ body's axes. The capturable set of the hip is the Minkowski sum
 
 a_i the corrected Eq. (15) offset of each axis (exact when the constraints on p and on each
 axis are independent, an outer bound otherwise; docs/plane.md, "The CMP (hip) region:
-derivation"). Margins are signed Euclidean distances of ξ to a region, positive inside.
+derivation"). From a moving upper body each axis's interval is [−Δ⁻, Δ⁺] instead
+(:func:`cmp_polygon_from`, errata E19). Margins are signed Euclidean distances of ξ to a
+region, positive inside.
 """
 
 from __future__ import annotations
