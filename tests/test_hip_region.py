@@ -303,3 +303,5 @@ def test_plane_polygon_bad_input():
         cmp_polygon_from(support, P, roll=(1.5, 0.0))
     with pytest.raises(InvalidParameterError, match="thetadot0"):
         cmp_polygon_from(support, P, pitch=(0.0, math.nan))
+    with pytest.raises(InvalidParameterError, match="pitch"):
+        cmp_polygon_from(support, P, pitch=0.1)  # type: ignore[arg-type]

@@ -139,6 +139,11 @@ def cmp_polygon_from(
         or a non-finite value (the message names ``theta0`` or ``thetadot0``).
     """
     require_type("support", support, Support)
+    for name, state in (("pitch", pitch), ("roll", roll)):
+        if not (isinstance(state, tuple | list) and len(state) == 2):
+            raise InvalidParameterError(
+                f"{name} must be an (angle [rad], rate [rad/s]) pair, got {str(state)[:40]!r}"
+            )
     minus_p, plus_p = cmp_offset_from(params, *pitch)
     minus_r, plus_r = cmp_offset_from(params, *roll, axis="roll")
     yaw = support.yaw
