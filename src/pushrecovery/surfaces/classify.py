@@ -12,29 +12,34 @@ the step regions are polygons; on the line, intervals (``docs/steps.md``).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.polygon import following
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.classify_many import classify_states
 from pushrecovery.surfaces.cmp import cmp_region
-from pushrecovery.surfaces.cop import CaptureInterval, capture_point, cop_region
+from pushrecovery.surfaces.cop import CaptureInterval, cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.step_impact import TouchdownImpact, plan_impacts
-from pushrecovery.surfaces.step_regions import (
-    StepRegions,
-    _sagittal_plan,
-)
+from pushrecovery.surfaces.step_regions import StepRegions, _sagittal_plan, line_steps
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
-from pushrecovery.surfaces.verdicts import _steps, _strategy, sagittal_verdicts
+from pushrecovery.surfaces.verdicts import (  # sagittal_verdicts: campaign.pushes imports it here
+    _steps,
+    _strategy,
+    sagittal_verdict,
+    sagittal_verdicts,  # noqa: F401
+)
 
 __all__ = [
     "STRATEGY_CODES",
@@ -72,6 +77,28 @@ def strategy_region(strategy: str, params: BodyParams) -> CaptureInterval:
         ) from None
 
 
+_Details = tuple[dict[str, Any], CapturePlan, tuple[TouchdownImpact, ...]]
+
+
+class _Planned:
+    """A ``step`` verdict's first step, plan and impacts, built on first use and kept.
+
+    Two threads reading at once may both build them (the same values); neither sees a part.
+    """
+
+    __slots__ = ("_build", "_value")
+
+    def __init__(self, build: Callable[[], _Details]) -> None:
+        self._build = build
+        self._value: _Details | None = None
+
+    def get(self) -> _Details:
+        value = self._value
+        if value is None:
+            value = self._value = self._build()
+        return value
+
+
 @dataclass(frozen=True, slots=True)
 class Classification:
     """Strategy needed by one state, with the capture point, the margins [m] and the steps.
@@ -94,18 +121,34 @@ class Classification:
     distances in the plane, and ``step`` adds ``foothold_xy`` [m] and ``direction_xy``, the
     unit vector from the stance ankle to the first foothold, turned to the heading's side
     for a step mostly backward, whose ``step_length`` is then negative (as on the line).
+
+    ``step``, ``plan`` and ``impacts`` are built when first read (a verdict alone costs
+    microseconds; its plan up to a few hundred): the same values as built eagerly.
     """
 
     capture_point: float
     strategy: Strategy
     margins: dict[str, float] = field(default_factory=dict)
-    step: dict[str, object] | None = None
     capture_point_xy: tuple[float, float] | None = None
     support: Support | None = None
     cmp_region: list[list[float]] | None = None
     steps: int | None = None
-    plan: CapturePlan | None = None
-    impacts: tuple[TouchdownImpact, ...] = ()
+    _planned: _Planned | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def step(self) -> dict[str, object] | None:
+        """The first step of a ``step`` verdict's plan (class docstring), else None."""
+        return None if self._planned is None else self._planned.get()[0]
+
+    @property
+    def plan(self) -> CapturePlan | None:
+        """The plan of a ``step`` verdict (footholds, touchdowns, CoPs), else None."""
+        return None if self._planned is None else self._planned.get()[1]
+
+    @property
+    def impacts(self) -> tuple[TouchdownImpact, ...]:
+        """Each touchdown's capture point without and with Sec. IV's impact (a plan's)."""
+        return () if self._planned is None else self._planned.get()[2]
 
     def to_dict(self) -> dict[str, object]:
         """JSON form: ``{"capture_point", "strategy", "margins", "steps"}`` (+ ``"step"``...)."""
@@ -181,21 +224,23 @@ def classify(
     xdot = finite_float("xdot", xdot, "m/s")
     if y is not None or ydot is not None or support is not None:
         return _classify_plane(x, xdot, params, y, ydot, support)
-    verdicts = sagittal_verdicts(np.array([x]), np.array([xdot]), params)
-    cop, cmp = float(verdicts.cop_margin[0]), float(verdicts.cmp_margin[0])
-    capture = float(verdicts.capture_point[0])
-    line = verdicts.line
-    steps, step_margin = int(line.steps[0]), float(line.margin[0])
-    strategy = verdicts.strategies[0]
-    plan = _sagittal_plan(capture, params, steps) if strategy is Strategy.STEP else None
-    step = None
-    if plan is not None:
-        step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)
-        step["step_length_range"] = [float(line.shortest[0]), float(line.longest[0])]
-    margins = {"cop": cop, "cmp": cmp, "step": step_margin}
-    impacts = () if plan is None else tuple(plan_impacts(plan, (x, 0.0), (xdot, 0.0), params))
+    verdict = sagittal_verdict(x, xdot, params)
+    capture, strategy, steps = verdict.capture_point, verdict.strategy, verdict.steps
+    margins = {"cop": verdict.cop_margin, "cmp": verdict.cmp_margin, "step": verdict.step_margin}
+    planned = None
+    if strategy is Strategy.STEP:
+
+        def build() -> _Details:
+            plan = _sagittal_plan(capture, params, steps)
+            step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)
+            line = line_steps(np.array([capture]), params.heel, params.toe, 0.0, params)
+            step["step_length_range"] = [float(line.shortest[0]), float(line.longest[0])]
+            impacts = tuple(plan_impacts(plan, (x, 0.0), (xdot, 0.0), params))
+            return step, plan, impacts
+
+        planned = _Planned(build)
     return Classification(
-        capture, strategy, margins, step, steps=_steps(strategy, steps), plan=plan, impacts=impacts
+        capture, strategy, margins, steps=_steps(strategy, steps), _planned=planned
     )
 
 
@@ -231,6 +276,49 @@ def _first_step(
     }
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class _PlaneTables:
+    """A support's regions for one state's verdict.
+
+    ``table`` stacks the support polygon and the CMP region as
+    :func:`pushrecovery.kernels.single_margins.pair_distances` reads them.
+    """
+
+    inv_omega: float
+    table: NDArray[np.float64]
+    counts: NDArray[np.int64]
+    cmp_region: tuple[tuple[float, ...], ...]
+    regions: StepRegions
+
+
+@functools.lru_cache(maxsize=32)
+def _plane_tables(params: BodyParams, support: Support) -> _PlaneTables:
+    """Return the tables of one support (kept: a loop asks for the same support again)."""
+    from pushrecovery.kernels.single_margins import STRIDE
+
+    hip_region = cmp_polygon(support, params)
+    polygons = (support.polygon, hip_region)
+    table = np.zeros((2, max(len(p.offsets) for p in polygons), STRIDE))
+    for row, polygon in enumerate(polygons):
+        # The operands of ConvexPolygon.signed_distance, computed as it computes them.
+        start = polygon.vertices
+        edge = following(start) - start
+        length2 = np.einsum("ij,ij->i", edge, edge)
+        edges = np.column_stack([polygon.normals, polygon.offsets, start, edge, length2])
+        table[row, : len(edges)] = edges
+    counts = np.array([len(p.offsets) for p in polygons], dtype=np.int64)
+    table.flags.writeable = counts.flags.writeable = False
+    cmp_region = tuple(map(tuple, hip_region.to_list()))
+    regions = StepRegions.of(params, support)
+    return _PlaneTables(1.0 / params.omega, table, counts, cmp_region, regions)
+
+
+@functools.lru_cache(maxsize=32)
+def _default_support(params: BodyParams) -> Support:
+    """Double support on the default feet (kept, as a frozen value)."""
+    return Support.from_params(params)
+
+
 def _classify_plane(
     x: float,
     xdot: float,
@@ -239,56 +327,76 @@ def _classify_plane(
     ydot: float | None,
     support: Support | None,
 ) -> Classification:
-    """:func:`classify` on the ground plane."""
+    """:func:`classify` on the ground plane: the verdict in one compiled call, the plan lazily."""
+    from pushrecovery.kernels.single_margins import pair_distances
+
     y = 0.0 if y is None else finite_float("y", y, "m")
     ydot = 0.0 if ydot is None else finite_float("ydot", ydot, "m/s")
-    support = Support.from_params(params) if support is None else support
-    xi = (capture_point(x, xdot, params.omega), capture_point(y, ydot, params.omega))
-    hip_region = cmp_polygon(support, params)
-    cop = float(support.polygon.signed_distance(*xi))
-    cmp = float(hip_region.signed_distance(*xi))
+    require_type("params", params, BodyParams)
+    if support is None:
+        support = _default_support(params)
+    require_type("support", support, Support)
+    tables = _plane_tables(params, support)
+    # ξ as capture_point computes it: x + ẋ (1/ω).
+    xi = (x + xdot * tables.inv_omega, y + ydot * tables.inv_omega)
+    cop, cmp = pair_distances(tables.table, tables.counts, *xi)
     if not (math.isfinite(cop) and math.isfinite(cmp)):
         raise InvalidParameterError("states are too large: the capture point overflows")
-    regions = StepRegions.of(params, support)
-    steps, step_margin = regions.locate(*xi)
+    steps, step_margin = tables.regions.locate(*xi)
     strategy = _strategy(cop, cmp, steps)
-    plan = regions.plan(*xi, steps) if strategy is Strategy.STEP else None
-    step = None
-    impacts: tuple[TouchdownImpact, ...] = ()
-    if plan is not None:
-        option = next(o for o in regions.options if o.swing is plan.swings[0])
-        ankle = (float(option.ankle[0]), float(option.ankle[1]))
-        step = _first_step(plan, (x, y), (xdot, ydot), ankle, params)
-        foot = plan.footholds[0]
-        gap = (float(foot[0]) - ankle[0], float(foot[1]) - ankle[1])
-        # Signed like the sagittal step: a step mostly backward is negative along the
-        # direction turned to the heading's side; others keep their own direction.
-        heading = (math.cos(support.yaw), math.sin(support.yaw))
-        forward = gap[0] * heading[0] + gap[1] * heading[1]
-        sideways = -gap[0] * heading[1] + gap[1] * heading[0]
-        ahead = -1.0 if forward < 0.0 and abs(forward) >= abs(sideways) else 1.0
-        length = ahead * math.hypot(*gap)
-        step["step_length"] = length
-        # + 0.0 turns the −0.0 of a zero component into 0.0 in the JSON.
-        step["direction_xy"] = [gap[0] / length + 0.0, gap[1] / length + 0.0]
-        step["foothold_xy"] = [float(foot[0]) + 0.0, float(foot[1]) + 0.0]
-        step["step_length_range"] = _plane_range(
-            x, y, xdot, ydot, params, support, plan, ankle, gap
-        )
-        impacts = tuple(plan_impacts(plan, (x, y), (xdot, ydot), params, option.yaw))
+    planned = None
+    if strategy is Strategy.STEP:
+        regions, chosen = tables.regions, support
+
+        def build() -> _Details:
+            return _plane_details(x, y, xdot, ydot, params, chosen, regions, xi, steps)
+
+        planned = _Planned(build)
     margins = {"cop": cop, "cmp": cmp, "step": step_margin}
     return Classification(
         xi[0],
         strategy,
         margins,
-        step,
         xi,
         support,
-        hip_region.to_list(),
+        [list(vertex) for vertex in tables.cmp_region],
         steps=_steps(strategy, steps),
-        plan=plan,
-        impacts=impacts,
+        _planned=planned,
     )
+
+
+def _plane_details(
+    x: float,
+    y: float,
+    xdot: float,
+    ydot: float,
+    params: BodyParams,
+    support: Support,
+    regions: StepRegions,
+    xi: tuple[float, float],
+    steps: int,
+) -> _Details:
+    """Return the first step, plan and impacts of a ``step`` verdict on the ground plane."""
+    plan = regions.plan(*xi, steps)
+    option = next(o for o in regions.options if o.swing is plan.swings[0])
+    ankle = (float(option.ankle[0]), float(option.ankle[1]))
+    step = _first_step(plan, (x, y), (xdot, ydot), ankle, params)
+    foot = plan.footholds[0]
+    gap = (float(foot[0]) - ankle[0], float(foot[1]) - ankle[1])
+    # Signed like the sagittal step: a step mostly backward is negative along the
+    # direction turned to the heading's side; others keep their own direction.
+    heading = (math.cos(support.yaw), math.sin(support.yaw))
+    forward = gap[0] * heading[0] + gap[1] * heading[1]
+    sideways = -gap[0] * heading[1] + gap[1] * heading[0]
+    ahead = -1.0 if forward < 0.0 and abs(forward) >= abs(sideways) else 1.0
+    length = ahead * math.hypot(*gap)
+    step["step_length"] = length
+    # + 0.0 turns the −0.0 of a zero component into 0.0 in the JSON.
+    step["direction_xy"] = [gap[0] / length + 0.0, gap[1] / length + 0.0]
+    step["foothold_xy"] = [float(foot[0]) + 0.0, float(foot[1]) + 0.0]
+    step["step_length_range"] = _plane_range(x, y, xdot, ydot, params, support, plan, ankle, gap)
+    impacts = tuple(plan_impacts(plan, (x, y), (xdot, ydot), params, option.yaw))
+    return step, plan, impacts
 
 
 def _plane_range(

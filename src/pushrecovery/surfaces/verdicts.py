@@ -10,20 +10,22 @@ whole batch, not the plans.
 
 from __future__ import annotations
 
+import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import finite_array, require_type
+from pushrecovery.arguments import finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.cmp import cmp_margin
-from pushrecovery.surfaces.cop import capture_point, cop_margin
-from pushrecovery.surfaces.step_regions import LineSteps, line_steps
+from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
+from pushrecovery.surfaces.cop import capture_point, cop_margin, cop_region
+from pushrecovery.surfaces.step_regions import LineSteps, _growth, line_steps
 from pushrecovery.surfaces.strategy import Strategy
 
-__all__ = ["SagittalVerdicts", "sagittal_verdicts"]
+__all__ = ["SagittalVerdict", "SagittalVerdicts", "sagittal_verdict", "sagittal_verdicts"]
 
 
 def _strategy(cop: float, cmp: float, steps: int) -> Strategy:
@@ -108,3 +110,82 @@ def sagittal_verdicts(x: ArrayLike, xdot: ArrayLike, params: BodyParams) -> Sagi
         for c, m, s in zip(cop.tolist(), cmp.tolist(), line.steps.tolist(), strict=True)
     )
     return SagittalVerdicts(capture, cop, cmp, line, strategies)
+
+
+@dataclass(frozen=True, slots=True)
+class SagittalVerdict:
+    """The verdict of one sagittal state (:func:`sagittal_verdict`).
+
+    Attributes
+    ----------
+    capture_point, cop_margin, cmp_margin : float
+        ξ = x + ẋ/ω and its signed distances to the CoP and CMP regions [m], + inside.
+    steps : int
+        Smallest N <= max_steps whose interval C_N holds ξ strictly; 0 if none.
+    step_margin : float
+        Signed distance of ξ to C_{max_steps} [m].
+    strategy : Strategy
+        The strategy the state needs.
+    """
+
+    capture_point: float
+    cop_margin: float
+    cmp_margin: float
+    steps: int
+    step_margin: float
+    strategy: Strategy
+
+
+@functools.lru_cache(maxsize=64)
+def _line_bounds(
+    params: BodyParams,
+) -> tuple[float, float, float, float, float, tuple[tuple[float, float], ...]]:
+    """1/ω, the CoP and CMP intervals' centres and half widths, C_1 ... C_{max_steps}.
+
+    Each number as the vectorised path computes it (:func:`cop_margin`,
+    :func:`~pushrecovery.surfaces.step_regions.line_steps` with the ankle at 0 and the
+    support [heel, toe]), so that the scalar path agrees to the bit.
+    """
+    cop, cmp = cop_region(params), cmp_region(params)
+    beta, grows = _growth(params, True)
+    base_low = beta * (0.0 + params.heel) + (1.0 - beta) * params.heel
+    base_high = beta * (0.0 + params.toe) + (1.0 - beta) * params.toe
+    levels = tuple((base_low - grow, base_high + grow) for grow in grows[1:].tolist())
+    return 1.0 / params.omega, cop.centre, cop.half_width, cmp.centre, cmp.half_width, levels
+
+
+def sagittal_verdict(x: float, xdot: float, params: BodyParams) -> SagittalVerdict:
+    """Return the verdict of one sagittal state: :func:`sagittal_verdicts` on Python floats.
+
+    The same numbers, to the bit, without building arrays (a single-state call's hot path).
+
+    Parameters
+    ----------
+    x, xdot : float
+        CoM position relative to the ankle [m] and velocity [m/s], finite.
+    params : BodyParams
+        Body parameters.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` is not a :class:`~pushrecovery.params.BodyParams`.
+    InvalidParameterError
+        A state that is not finite or whose capture point overflows.
+    """
+    require_type("params", params, BodyParams)
+    inv, cop_centre, cop_half, cmp_centre, cmp_half, levels = _line_bounds(params)
+    x, xdot = finite_float("x", x, "m"), finite_float("xdot", xdot, "m/s")
+    capture = x + xdot * inv
+    if not math.isfinite(capture):
+        raise InvalidParameterError("states are too large: the margin overflows")
+    cop = cop_half - abs(capture - cop_centre)
+    cmp = cmp_half - abs(capture - cmp_centre)
+    steps = 0
+    for n, (low, high) in enumerate(levels, start=1):
+        if low < capture < high:
+            steps = n
+            break
+    low, high = levels[-1]
+    margin = min(capture - low, high - capture)
+    return SagittalVerdict(capture, cop, cmp, steps, margin, _strategy(cop, cmp, steps))
