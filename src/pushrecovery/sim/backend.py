@@ -12,7 +12,10 @@ simulate` is written against it alone):
 3. ``check_state(state)`` raises :class:`~pushrecovery.errors.InvalidParameterError`, naming
    the entry and its range, for a state the model cannot start from; ``begin(state)`` checks
    it and starts a run from it (as returned by ``reset``/``apply_push``, or any valid state),
-   returning it. A run's records (footholds, stop impacts, measurements) start here.
+   returning it. A run's records (footholds, stop impacts, measurements) start here, and
+   the feet: the ``stepping-plane`` plant starts every run on its ``start_support`` (a
+   stance and foot poses a user may give), which its ``info()`` reports; the loop passes an
+   analytic plant's ``info()`` to the controller's ``observe`` right after its ``reset``.
 4. ``apply_push(push)`` is the one way to push (:class:`~pushrecovery.sim.push.Push`): a jump
    of the CoM velocity on the analytic models; on MuJoCo a jump (``kind="velocity"``) or a
    force on a body over the push's duration, now with the body holding still, or from the

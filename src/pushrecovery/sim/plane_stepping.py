@@ -5,6 +5,11 @@ et al. 2012's 3-D LIPM with a finite foot and a reaction mass), simulated:
 
 - **State** ``[x, y, θp, θr, ẋ, ẏ, θ̇p, θ̇r]`` in the world frame (x forward, y left), as
   :mod:`pushrecovery.models.flywheel_plane`; the feet are the plant's, in :attr:`support`.
+- **Start**: every run (``begin``, ``reset``) starts on :attr:`start_support`: both feet at
+  their default poses unless the user gives a stance and poses (``support=``, e.g. a robot on
+  one foot). Each step's :class:`~pushrecovery.control.base.StepInfo` reports the feet
+  (``support``: the :class:`~pushrecovery.ground.support.Support`, stance and poses), which a
+  controller reads in ``observe``.
 - **Stance**: Eq. (3) in x and y with the hip torques (the planar Eq. 16), advanced exactly
   (zero-order hold, :func:`~pushrecovery.models.flywheel_plane.plane_discrete`) with the
   commanded CoP moved to the nearest point of the support polygon and the torques clipped to
@@ -32,6 +37,7 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import FootPose, Stance, Support
@@ -48,10 +54,18 @@ FloatArray = NDArray[np.float64]
 class PlaneSteppingPlant(PlantBase):
     """The planar LIPM + flywheels with stepping feet (module docstring).
 
+    Parameters
+    ----------
+    params : BodyParams
+        The body.
+    support : Support, optional
+        The stance and foot poses every run starts on (:attr:`start_support`); default both
+        feet at their default poses (:meth:`Support.from_params`).
+
     Attributes
     ----------
     support : Support
-        The feet on the ground now (double support at the start).
+        The feet on the ground now (:attr:`start_support` at the start of a run).
     footholds : list of float
         World x of the stance reference at the start and of every landed ankle [m].
     footholds_xy : list of tuple
@@ -63,8 +77,9 @@ class PlaneSteppingPlant(PlantBase):
     #: Applied inputs per tick: CoP x, y [m], pitch and roll torques [N m].
     input_labels: ClassVar[tuple[str, ...]] = ("cop_x", "cop_y", "pitch_torque", "roll_torque")
 
-    def __init__(self, params: BodyParams) -> None:
+    def __init__(self, params: BodyParams, support: Support | None = None) -> None:
         super().__init__(params)
+        self.start_support = Support.from_params(params) if support is None else support
         self.fall_limits = (params.heel, params.toe)  # along x from the start: reporting only
         self._limits = (
             (params.torque_max, params.flywheel_inertia, params.flywheel_angle_max),
@@ -73,9 +88,33 @@ class PlaneSteppingPlant(PlantBase):
         self._matrices: dict[tuple[float, float], tuple[FloatArray, FloatArray]] = {}
         self._restart_records()
 
+    @property
+    def start_support(self) -> Support:
+        """The stance and foot poses every run starts on (world frame [m], yaw [rad]).
+
+        Set it (or pass ``support`` to the constructor or :meth:`reset`) to start on one foot
+        or on feet placed elsewhere; the soles are this body's (``params``) at the given
+        stance and poses.
+
+        Raises
+        ------
+        ParameterTypeError
+            If the value set is not a :class:`~pushrecovery.ground.support.Support`.
+        InvalidParameterError
+            If its feet overlap or stand farther apart than two legs in double support.
+        """
+        return self._start_support
+
+    @start_support.setter
+    def start_support(self, support: Support) -> None:
+        require_type("support", support, Support)
+        self._start_support = Support.from_params(
+            self.params, support.stance, left=support.left, right=support.right
+        )
+
     def _restart_records(self) -> None:
         self.stop_impacts = 0
-        self.support = Support.from_params(self.params, Stance.DOUBLE)
+        self.support = self._start_support
         self.time = 0.0
         self._swing: tuple[Stance, tuple[float, float], float] | None = None
         ankle = self.support.ankle
@@ -85,8 +124,21 @@ class PlaneSteppingPlant(PlantBase):
     def _start(self, x: float, xdot: float) -> FloatArray:
         return np.array([x, 0.0, 0.0, 0.0, xdot, 0.0, 0.0, 0.0])
 
-    def reset(self, x: float, xdot: float, y: float = 0.0, ydot: float = 0.0) -> FloatArray:
-        """Start on both feet, the CoM at (x, y) [m] moving at (ẋ, ẏ) [m/s] (contract item 2)."""
+    def reset(
+        self,
+        x: float,
+        xdot: float,
+        y: float = 0.0,
+        ydot: float = 0.0,
+        *,
+        support: Support | None = None,
+    ) -> FloatArray:
+        """Start with the CoM at (x, y) [m] moving at (ẋ, ẏ) [m/s] (contract item 2).
+
+        On :attr:`start_support` (both feet by default); a ``support`` given becomes it.
+        """
+        if support is not None:
+            self.start_support = support
         return self.begin(np.array([x, y, 0.0, 0.0, xdot, ydot, 0.0, 0.0]))
 
     def _in_stance(self) -> bool:
@@ -94,20 +146,31 @@ class PlaneSteppingPlant(PlantBase):
         return self._swing is None
 
     def info(self) -> StepInfo:
-        """:meth:`PlantBase.info` with the (x, y) footholds (kept while they stay the same)."""
+        """:meth:`PlantBase.info` with the (x, y) footholds and the feet, ``support``.
+
+        The report is kept while none of it changes.
+        """
         info = super().info()
-        if len(info.footholds_xy) != len(self.footholds_xy):
-            info = self._info = replace(info, footholds_xy=tuple(self.footholds_xy))
+        if info.support is not self.support or len(info.footholds_xy) != len(self.footholds_xy):
+            info = self._info = replace(
+                info,
+                footholds_xy=tuple(self.footholds_xy),
+                support=self.support,  # type: ignore[arg-type]  # the feet (a Support)
+            )
         return info
 
     def check_state(self, state: FloatArray) -> None:
-        """Require a planar state within the model."""
+        """Require a planar state within the model: the CoM within L of the start's ankle."""
         if state.shape != (8,):
             raise InvalidParameterError(
                 f"state must be {list(PLANE_STATE_LABELS)}, got shape {state.shape}"
             )
-        check_com_state(float(state[0]), float(state[4]), self.params)
-        check_com_state(float(state[1]), float(state[5]), self.params, ("y", "ydot"))
+        ax, ay = self._start_support.ankle
+        names = (("x", "xdot"), ("y", "ydot"))
+        if (ax, ay) != (0.0, 0.0):  # the CoM from the start's ankle: say so
+            names = (("x - ankle x", "xdot"), ("y - ankle y", "ydot"))
+        check_com_state(float(state[0]) - ax, float(state[4]), self.params, names[0])
+        check_com_state(float(state[1]) - ay, float(state[5]), self.params, names[1])
         for index, (_, _, limit) in zip((2, 3), self._limits, strict=True):
             if abs(float(state[index])) > limit:
                 raise InvalidParameterError(

@@ -15,6 +15,7 @@ from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.extras import require
 
 if TYPE_CHECKING:  # listing the models must not load numpy (pushrecovery --help)
+    from pushrecovery.ground.support import Support
     from pushrecovery.params import BodyParams
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
     from pushrecovery.sim.plants import Plant
@@ -80,12 +81,16 @@ def available_models(backend: str) -> tuple[str, ...]:
     return tuple(PLANTS[backend])
 
 
-def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plant:
+def make_plant(
+    name: str, params: BodyParams, backend: str = "analytic", *, support: Support | None = None
+) -> Plant:
     """Build the plant ``name`` of ``backend``; unknown names raise, naming the choices.
 
     The MuJoCo backend also builds the 3-D models of :data:`PLANTS_3D` (the G1's ``params``
     must be ``robot_params("g1")``); it needs the ``sim`` extra (``MissingExtraError``
-    otherwise, naming it).
+    otherwise, naming it). ``support`` (the ``stepping-plane`` model only) is the stance and
+    foot poses every run starts on
+    (:attr:`~pushrecovery.sim.plane_stepping.PlaneSteppingPlant.start_support`).
     """
     from pushrecovery.arguments import require_type
     from pushrecovery.params import BodyParams as Body  # a runtime check, not an annotation
@@ -102,10 +107,16 @@ def make_plant(name: str, params: BodyParams, backend: str = "analytic") -> Plan
             f"model must be one of {list(models)} for the {backend} backend, "
             f"got model={name!r}{hint}"
         )
+    if support is not None and (backend, name) != ("analytic", "stepping-plane"):
+        raise InvalidParameterError(
+            f"a support (stance and foot poses) applies to the stepping-plane model only, "
+            f"got model={name!r}"
+        )
     if backend == "mujoco":
         require("sim", "mujoco")
     module, _, attribute = table[name].partition(":")
-    plant: Plant = getattr(importlib.import_module(module), attribute)(params)
+    kind = getattr(importlib.import_module(module), attribute)
+    plant: Plant = kind(params) if support is None else kind(params, support=support)
     return plant
 
 

@@ -77,10 +77,11 @@ def simulate(
 
     The only closed loop of the project. Every ``control_period`` the controller computes a
     command that the plant holds until the next tick, in steps of ``plant_step``; after every
-    step the controller observes the plant's report and every observer sees the step. At the
-    end of each tick the criteria decide: ``fell`` as soon as the state is in the plant's
-    absorbing fall set (beyond the fall limit, moving away), ``recovered`` once the CoM has
-    stayed at rest over the support with an unsaturated command for ``rest.duration``;
+    step the controller observes the plant's report (an analytic plant's report of its start
+    too, right after ``reset``: the stance and feet it starts on) and every observer sees the
+    step. At the end of each tick the criteria decide: ``fell`` as soon as the state is in the
+    plant's absorbing fall set (beyond the fall limit, moving away), ``recovered`` once the CoM
+    has stayed at rest over the support with an unsaturated command for ``rest.duration``;
     ``undecided`` if neither happens within ``duration``.
 
     Parameters
@@ -162,13 +163,17 @@ def simulate(
     states = np.empty((total + 1, len(state)))
     inputs = np.empty((total, len(plant.input_labels)))
     states[0] = state
+    # The controller starts from the plant's report of its start (a user's stance and feet).
+    observing = type(controller).observe is not Controller.observe
+    start_report = plant.info if observing and isinstance(plant, PlantBase) else None
     controller.reset(state)
+    if start_report is not None:
+        controller.observe(start_report())
     outcome, decided, at_rest = Outcome.UNDECIDED, -1, 0
     info = StepInfo()
     command = Command(float(state[0]))
     tick, next_tick, origin, end, k = 0, 0, 0, total, 0
     # The hot loop (a campaign runs it millions of times): skip what a run does not use.
-    observing = type(controller).observe is not Controller.observe
     per_tick = round(dt / h) if abs(dt / h - round(dt / h)) < 1e-9 else 0  # 0: round per tick
     pushing = push is not None
     # Bound once per run: a tick's attribute lookups are a visible share of its Python.
@@ -188,6 +193,8 @@ def simulate(
                 settled = True
                 if not push.react:  # the controller restarts on the pushed state
                     controller.reset(state)
+                    if start_report is not None:
+                        controller.observe(start_report())
                     tick, next_tick, origin = 0, k, k
         if not settled and k >= start >= 0 and push is not None and not push.react:
             command = Command(float(state[0]))  # holding still while the force acts
