@@ -36,8 +36,8 @@ from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
+from pushrecovery.surfaces.monitor import BalanceMonitor
 from pushrecovery.surfaces.n_step import hip_box
-from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.step_regions import StepRegions
 
 __all__ = ["PlaneRecoveryController", "hip_share"]
@@ -113,20 +113,16 @@ class PlaneRecoveryController(Controller):
         self._spin_up = (max_spin_up_time(params), max_spin_up_time(roll_axis(params)))
         self._offsets = (cmp_offset(params), cmp_offset_roll(params))
         self._torques = (params.torque_max, params.torque_max_roll)
-        self._steps: dict[int, tuple[StepRegions, NDArray[np.int64]]] = {}
+        # The support's regions, CMP region and the compiled tests, loaded now rather than in
+        # the loop: a support change then costs tens of µs, any stance, pose or yaw.
+        self._monitor = BalanceMonitor(params)
         self.reset(np.zeros(len(PLANE_STATE_LABELS)))
-        # Build the regions and the plans' terms of every support it can meet, and load the
-        # compiled geometry, now rather than in the loop (0.1-0.5 s here; ms each in a tick).
+        # Plans are made in the stance foot's frame: these are every plan's terms, kept.
         for body in (params, self._without_hip):
-            for stance in Stance:
-                self.support = Support.from_params(params, stance)
-                regions, _ = self._regions(body)
-                cmp_polygon(self._canonical()[0], params)
-                self._locate(regions, 0.0, 0.5)
-                for steps in range(1, body.max_steps + 1):
-                    for side in (0.5, -0.5):  # either foot first
-                        regions.plan(0.0, side, steps)
-        self.reset(np.zeros(len(PLANE_STATE_LABELS)))
+            regions = StepRegions.of(body, self.support)
+            for steps in range(1, body.max_steps + 1):
+                for side in (0.5, -0.5):  # either foot first
+                    regions.plan(0.0, side, steps)
 
     def reset(self, state: NDArray[np.float64]) -> None:
         """Start on both feet (the default poses), hip unused, no step under way."""
@@ -159,11 +155,11 @@ class PlaneRecoveryController(Controller):
             self.mode = "ankle" if self._hip is None else self.mode
             return Command(float(effective[0]), pitch, cop_y=float(effective[1]), roll_torque=roll)
         if self._hip is None:
-            canonical, ankle = self._canonical()
-            inside = cmp_polygon(canonical, self.params).point_signed_distance(
-                float(xi[0] - ankle[0]), float(xi[1] - ankle[1])
-            )
-            if inside > 0.0:
+            # The monitor's CMP margin of ξ (a state at rest at ξ has its capture point at ξ),
+            # told the support only here: a lift-off and a swing need no CMP region.
+            if self._monitor.support is not self.support:
+                self._monitor.set_support(self.support)
+            if self._monitor.query(float(xi[0]), float(xi[1]), 0.0, 0.0).cmp_margin > 0.0:
                 return self._start_hip(t, xi)
         return self._start_step(t, effective)
 
@@ -181,48 +177,13 @@ class PlaneRecoveryController(Controller):
         cop = points[1]
         return Command(float(cop[0]), pitch, cop_y=float(cop[1]), roll_torque=roll)
 
-    def _canonical(self) -> tuple[Support, FloatArray]:
-        """Return the support moved to the origin (on one foot) and the shift [m].
-
-        Its regions and CMP region are built once per side: a touchdown then costs a shift,
-        not a new set of Minkowski sums.
-        """
-        support = self.support
-        if support.stance is Stance.DOUBLE:
-            return support, np.zeros(2)
-        pose = support.left if support.stance is Stance.LEFT else support.right
-        origin = FootPose(0.0, 0.0, pose.yaw)
-        canonical = Support.from_params(self.params, support.stance, left=origin, right=origin)
-        return canonical, np.array([pose.x, pose.y])
-
-    def _regions(self, body: BodyParams) -> tuple[StepRegions, FloatArray]:
-        """Return the current support's step regions and the point they are relative to [m]."""
-        canonical, ankle = self._canonical()
-        return StepRegions.of(body, canonical), ankle
-
-    def _locate(self, regions: StepRegions, px: float, py: float) -> tuple[int, float]:
-        """:meth:`StepRegions.locate`, compiled (as the monitor's; tens of µs saved a call)."""
-        from pushrecovery.kernels.plane_codes import locate_steps
-
-        entry = self._steps.get(id(regions))
-        if entry is None or entry[0] is not regions:
-            entry = self._steps[id(regions)] = (regions, np.array(regions.steps, dtype=np.int64))
-        found, margin = locate_steps(regions.table, regions.counts, entry[1], regions.outer, px, py)
-        return int(found), float(margin)
-
     def _start_step(self, t: float, effective: FloatArray) -> Command:
         """Lift the first foot of the smallest plan that captures ξ_e."""
         body = self.params if self._hip is None else self._without_hip
-        regions, ankle = self._regions(body)
-        px, py = float(effective[0] - ankle[0]), float(effective[1] - ankle[1])
-        steps, _ = self._locate(regions, px, py)
-        relative = regions.plan(px, py, steps if steps else body.max_steps)
-        plan = dataclasses.replace(
-            relative,
-            footholds=relative.footholds + ankle,
-            cops=relative.cops + ankle,
-            ankle=relative.ankle + ankle,
-        )
+        regions = StepRegions.of(body, self.support)
+        px, py = float(effective[0]), float(effective[1])
+        steps, _ = regions.locate(px, py)
+        plan = regions.plan(px, py, steps if steps else body.max_steps)
         if self._hip is None and float(np.abs(plan.hip).max()) > 0.0:
             self._begin_hip(t, plan.hip)
         foothold = (float(plan.footholds[0, 0]), float(plan.footholds[0, 1]))

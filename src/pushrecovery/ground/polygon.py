@@ -332,21 +332,15 @@ def convex_hull(points: ArrayLike) -> ConvexPolygon:
     pts = pts[np.lexsort((pts[:, 1], pts[:, 0]))]
     scale = max(1.0, float(np.abs(pts).max())) if pts.size else 1.0
     eps = 1e-12 * scale * scale
-
-    def chain(sequence: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
-        hull: list[NDArray[np.float64]] = []
-        for p in sequence:
-            while len(hull) >= 2 and _cross(hull[-2], hull[-1], p) <= 0.0:
-                hull.pop()
-            hull.append(p)
-        return hull
-
-    ordered = list(pts)
-    lower, upper = chain(ordered), chain(ordered[::-1])
+    ordered = pts.tolist()  # Python floats: the same arithmetic, without numpy scalars
+    lower, upper = _chain(ordered), _chain(ordered[::-1])
     hull = lower[:-1] + upper[:-1]
     # Vertices closer than MIN_EDGE give edges without a reliable direction: keep one of each.
+    gap = max(MIN_EDGE, 1e-12 * scale)
     hull = [
-        p for i, p in enumerate(hull) if np.hypot(*(p - hull[i - 1])) > max(MIN_EDGE, 1e-12 * scale)
+        p
+        for i, p in enumerate(hull)
+        if math.hypot(p[0] - hull[i - 1][0], p[1] - hull[i - 1][1]) > gap
     ]
     if len(hull) < 3:
         raise InvalidParameterError("support polygon is degenerate (zero area)")
@@ -356,7 +350,16 @@ def convex_hull(points: ArrayLike) -> ConvexPolygon:
     return polygon
 
 
-def _cross(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> float:
+def _chain(points: Sequence[list[float]]) -> list[list[float]]:
+    """One chain of Andrew's monotone chain: left turns kept, collinear points dropped."""
+    hull: list[list[float]] = []
+    for p in points:
+        while len(hull) >= 2 and _cross(hull[-2], hull[-1], p) <= 0.0:
+            hull.pop()
+        hull.append(p)
+    return hull
+
+
+def _cross(a: Sequence[float], b: Sequence[float], c: Sequence[float]) -> float:
     """Return the z of (b − a) × (c − b): > 0 for a left (counter-clockwise) turn at b."""
-    a, b, c = (np.asarray(p, dtype=np.float64) for p in (a, b, c))
-    return float((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]))
+    return (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])

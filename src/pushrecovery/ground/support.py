@@ -153,16 +153,15 @@ class Support:
 
     @classmethod
     def _build(cls, params: BodyParams, stance: Stance, left: FootPose, right: FootPose) -> Support:
-        foot = foot_shape(params)
-        placed = {
-            Stance.LEFT: foot.transformed(left.x, left.y, left.yaw),
-            Stance.RIGHT: foot.mirrored().transformed(right.x, right.y, right.yaw),
-        }
-        if stance is Stance.DOUBLE:
-            _check_double_support(params, left, right, placed[Stance.LEFT], placed[Stance.RIGHT])
-            polygon = convex_hull(np.vstack([p.vertices for p in placed.values()]))
-        else:
-            polygon = placed[stance]
+        foot, mirrored = _feet(params)
+        if stance is Stance.LEFT:
+            return cls(stance, left, right, foot, foot.transformed(left.x, left.y, left.yaw))
+        placed = mirrored.transformed(right.x, right.y, right.yaw)
+        if stance is Stance.RIGHT:
+            return cls(stance, left, right, foot, placed)
+        other = foot.transformed(left.x, left.y, left.yaw)
+        _check_double_support(params, left, right, other, placed)
+        polygon = convex_hull(np.vstack([other.vertices, placed.vertices]))
         return cls(stance, left, right, foot, polygon)
 
     @property
@@ -222,6 +221,13 @@ def _check_double_support(
             f"({left.x:g}, {left.y:g}), right at ({right.x:g}, {right.y:g}); stance_width "
             f"{params.stance_width:g} m, foot_width {params.foot_width:g} m)"
         )
+
+
+@functools.lru_cache(maxsize=16)
+def _feet(params: BodyParams) -> tuple[ConvexPolygon, ConvexPolygon]:
+    """Return the left foot in its own frame and its mirror image, the right foot (kept)."""
+    foot = foot_shape(params)
+    return foot, foot.mirrored()
 
 
 @functools.lru_cache(maxsize=64)

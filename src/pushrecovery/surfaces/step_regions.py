@@ -21,7 +21,6 @@ sagittal line s^± = δ^± and q_0 = 0: [δ⁻ − a − l s_N, δ⁺ + a + l s_
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import itertools
 import math
@@ -289,8 +288,10 @@ class _Canonical:
     nested: tuple[bool, bool]
 
 
-#: ``outer`` of one region alone (its margin is the largest).
+#: ``outer`` of one region alone (its margin is the largest); read-only as every ``outer``
+#: (one compiled signature).
 _ONE_OUTER = np.ones(1, dtype=np.bool_)
+_ONE_OUTER.flags.writeable = False
 #: Index of each stance foot in the canonical arrays (:class:`_Canonical`).
 _SIDE = {Stance.RIGHT: 0, Stance.LEFT: 1}
 
@@ -340,6 +341,13 @@ def _canonical(params: BodyParams) -> _Canonical:
         discs,
         (nested[0], nested[1]),
     )
+
+
+def _row_counts(counts: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Edge counts by row (level m of stance k at row m K + k), read-only."""
+    rows = np.ascontiguousarray(counts.T).reshape(-1)
+    rows.flags.writeable = False
+    return rows
 
 
 @functools.lru_cache(maxsize=16)
@@ -489,14 +497,17 @@ class StepRegions:
         local = np.array([c * dx + s * dy, -s * dx + c * dy])
         option = _canonical(self.params).options[_SIDE[stance]]
         plan = capture_plan(local, self.params, option, steps, margin=margins[k])
-        turn = np.array([[c, -s], [s, c]])
+        turn = np.array([[c, s], [-s, c]])  # row vectors times this: turned by the yaw
         shift = np.array([x, y])
-        return dataclasses.replace(
-            plan,
-            footholds=plan.footholds @ turn.T + shift,
-            cops=plan.cops @ turn.T + shift,
-            hip=plan.hip @ turn.T,
-            ankle=shift,
+        return CapturePlan(
+            plan.steps,
+            plan.swings,
+            plan.footholds @ turn + shift,
+            plan.touchdowns,
+            plan.cops @ turn + shift,
+            plan.hip @ turn,
+            plan.margin,
+            shift,
         )
 
 
@@ -529,7 +540,7 @@ def _regions(params: BodyParams, support: Support) -> StepRegions:
         steps,
         array,
         table,
-        counts.T.reshape(-1),
+        _row_counts(counts),
         circles,
         outer,
         tuple(
