@@ -15,6 +15,8 @@ from types import ModuleType
 
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 
+__all__ = ["EXTRAS", "MissingExtraError", "require", "require_extra"]
+
 #: Extra -> (what needs it, the top-level modules it brings, its own extras' included). An
 #: extra's modules are those of its entry in pyproject.toml (``tests/test_light_install.py``).
 EXTRAS: dict[str, tuple[str, tuple[str, ...]]] = {
