@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command, Controller, register
-from pushrecovery.control.mpc.plan import Plan
+from pushrecovery.control.mpc.plan import Plan, Status
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.control.mpc.qp import CondensedQP
 from pushrecovery.control.mpc.solvers.interior import InteriorPointSolver
@@ -19,6 +19,8 @@ from pushrecovery.models.flywheel import FLYWHEEL_STATE
 from pushrecovery.params import BodyParams
 
 __all__ = ["MPCController"]
+
+_INFEASIBLE = Status.INFEASIBLE  # a module global: an enum member through its class costs ~0.1 µs
 
 
 @register
@@ -31,6 +33,11 @@ class MPCController(Controller):
     CoP at the capture point clipped to the foot, full torque braking the flywheel. It never
     raises inside the loop.
 
+    With ``realtime=True`` each tick's work is bounded by a fixed budget of passes and
+    iterations; a tick it does not solve applies the last verified plan shifted by one stage per
+    tick since (``last_plan.status`` is ``Status.SHIFTED``; ``Status.EXHAUSTED``, the fallback,
+    when there is none). docs/mpc.md, "The real-time mode".
+
     Each tick is solved by :meth:`Route.solve <pushrecovery.control.mpc.solvers.route.Route.solve>`
     of the controller's route (the attribute ``route``: its solvers, the order they are tried
     in); docs/mpc.md describes it, docs/performance.md has its timings.
@@ -40,8 +47,8 @@ class MPCController(Controller):
     params : BodyParams
         Body parameters.
     settings : MPCSettings, optional
-        Horizon, weights, γ, dt and solver; keyword overrides of the defaults may be passed
-        instead (``dt=``, ``horizon=``, ...).
+        Horizon, weights, γ, dt, solver and the real-time mode; keyword overrides of the
+        defaults may be passed instead (``dt=``, ``horizon=``, ``realtime=``, ...).
     """
 
     name = "mpc"
@@ -109,7 +116,8 @@ class MPCController(Controller):
         cop = min(toe, max(heel, cop))
         torque = min(limit, max(-limit, torque))
         at_limit = cop == heel or cop == toe or (limit > 0.0 and abs(torque) >= limit * (1 - 1e-9))
-        return Command(cop, torque, at_limit or not plan.feasible)
+        # Saturated: at a limit, or the fallback of an infeasible QP.
+        return Command(cop, torque, at_limit or plan.status is _INFEASIBLE)
 
     def _check(self, state: NDArray[np.float64]) -> None:
         if np.shape(state) != (4,):

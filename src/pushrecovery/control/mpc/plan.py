@@ -21,8 +21,17 @@ class Status(enum.IntEnum):
     (DAQP, or qpsolvers' back-end) returned it, to its tolerance. ``FAILED``: this solver found
     no plan (the route goes on to the next one). ``INFEASIBLE``: Eq. (17) has no solution; the
     plan is the saturated fallback.
+
+    The real-time mode (``MPCSettings(realtime=True)``) adds two, when a tick's work budget ran
+    out before a plan was verified: ``SHIFTED``, the last plan that solved Eq. (17) (on an
+    earlier tick) shifted by one stage per tick since, its first input applied; ``EXHAUSTED``,
+    no such plan to shift (none since the last reset, or older than the horizon): the inputs of
+    the interior point's unfinished iterate, which the next tick continues, or the saturated
+    fallback where there is none. Neither solves this tick's Eq. (17).
     """
 
+    EXHAUSTED = -3
+    SHIFTED = -2
     INFEASIBLE = -1
     FAILED = 0
     SOLVED = 1

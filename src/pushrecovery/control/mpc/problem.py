@@ -53,6 +53,12 @@ class MPCSettings:
     solver : str
         qpsolvers back-end (default ``daqp``: a dual active-set method, exact to machine
         precision on these small dense problems and the fastest we measured).
+    realtime : bool
+        Bound each tick's work by a fixed budget of Riccati passes and interior-point
+        iterations (scaled by 1/N: docs/mpc.md, "The real-time mode"); when it runs out the tick
+        applies the last verified plan shifted by one stage (``Status.SHIFTED``). Needs
+        ``solver="daqp"`` (the sparse solvers' route); 1 and 0 are read as True and False (the
+        CLI's ``--option realtime=1``). Default False: every tick solved exactly.
     """
 
     dt: float = 0.02
@@ -61,6 +67,7 @@ class MPCSettings:
     input_weights: tuple[float, float] = (1e-2, 1e-5)
     gamma: float = 0.9
     solver: str = "daqp"
+    realtime: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive_float("dt", self.dt, "s"))
@@ -88,6 +95,17 @@ class MPCSettings:
         if not 0.0 < gamma <= 1.0:
             raise InvalidParameterError(f"gamma must be in (0, 1], got {gamma:g}")
         object.__setattr__(self, "gamma", gamma)
+        # 0 and 1 too: the CLI's --option realtime=1 gives a number.
+        if not isinstance(self.realtime, bool | np.bool_ | int) or self.realtime not in (0, 1):
+            raise InvalidParameterError(
+                f"realtime must be True or False (or 1, 0), got {self.realtime!r}"
+            )
+        object.__setattr__(self, "realtime", bool(self.realtime))
+        if self.realtime and self.solver != "daqp":
+            raise InvalidParameterError(
+                f"realtime=True needs solver='daqp' (the sparse solvers' route), "
+                f"got solver={self.solver!r}"
+            )
 
 
 class SparseQP:

@@ -385,6 +385,45 @@ def _start(  # type: ignore[no-untyped-def]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
+def shift_iterate(x0, a, b, feedback, u, x, nu, sl, su, zl, zu):  # type: ignore[no-untyped-def]
+    """Shift an unfinished iterate by one stage (the receding horizon) to continue it from x0.
+
+    The inputs, costates, slacks and bound multipliers of stage i + 1 become stage i's (the
+    last stage keeps its own). The states are simulated from x0, each shifted input corrected
+    by the unconstrained problem's gain on the state's deviation from the shifted iterate's,
+    u_i + K_i (x_i − x̄_{i+1}): open loop, a deviation of x0 would grow as e^{ω t} along the
+    horizon (the reason of the cold start's feedback). The dynamics hold exactly, as the Newton
+    steps need; the slacks' residuals, against the new states, are the iterations' to close.
+    Continue with ``start`` 0.
+    """
+    n = u.shape[0]
+    for i in range(n - 1):
+        for r in range(2):
+            u[i, r] = u[i + 1, r]
+        for r in range(4):
+            nu[i, r] = nu[i + 1, r]
+        for j in range(3):
+            sl[i, j] = sl[i + 1, j]
+            su[i, j] = su[i + 1, j]
+            zl[i, j] = zl[i + 1, j]
+            zu[i, j] = zu[i + 1, j]
+    dev = np.empty(4)
+    for c in range(4):
+        dev[c] = x0[c] - x[1, c]  # x̄_1: stage 0's reference, the old x[1]
+        x[0, c] = x0[c]
+    for i in range(n):
+        for r in range(2):
+            acc = 0.0
+            for c in range(4):
+                acc += feedback[i, r, c] * dev[c]
+            u[i, r] += acc
+        _advance(a, b, x, u, i)  # overwrites the old x[i + 1], read before as stage i's x̄
+        if i + 2 <= n:
+            for c in range(4):
+                dev[c] = x[i + 1, c] - x[i + 2, c]  # the old x[i + 2]: stage i + 1's x̄
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def solve_interior(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, bounds, scale, feedback, tol, dual_tol, max_iter, start, guide,
     u, x, nu, sl, su, zl, zu, work, big_s, gain, hinv, vec_s, sbs, closeds, active,

@@ -46,6 +46,9 @@ class Guess:
         :meth:`~pushrecovery.control.mpc.feasibility.FlywheelFeasibility.forced_braking`).
     budget : int, optional
         Passes or iterations allowed; None: the solver's default.
+    resume : bool
+        The interior point: continue its last solve's unfinished iterate, shifted by one stage
+        (the real-time mode's iterations spread over ticks); ``inputs`` and ``active`` unused.
     """
 
     active: NDArray[np.int8] | None = None
@@ -53,6 +56,7 @@ class Guess:
     inputs: FloatArray | None = None
     forced: tuple[int, int] = (0, 0)
     budget: int | None = None
+    resume: bool = False
 
 
 class Solver(Protocol):

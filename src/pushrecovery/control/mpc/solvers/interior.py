@@ -36,6 +36,7 @@ from pushrecovery.kernels.mpc.interior import (
     GUIDE_CENTRE,
     WARM,
     identify_active,
+    shift_iterate,
     solve_interior,
 )
 from pushrecovery.kernels.mpc.scales import dual_scales
@@ -102,6 +103,9 @@ class InteriorPointSolver:
         The unconstrained problem's time-varying gain (its cold start).
     iterations : int
         Iterations of the last solve (−1: did not converge in :data:`MAX_ITERATIONS`).
+    resumable : bool
+        Whether the last solve ran out of its budget with a finite iterate, which the next
+        solve may continue (``Guess.resume``).
     """
 
     def __init__(
@@ -119,6 +123,7 @@ class InteriorPointSolver:
         dual_scales(problem.a, problem.b, problem.wx, problem.wu, problem.bounds, self.scales,
                     self.feedback)  # fmt: skip
         self.iterations = 0
+        self.resumable = False
         self._u, self._x = np.zeros((n, 2)), np.zeros((n + 1, 4))  # the iterate
         # Iterates and scratch, allocated once.
         self._multipliers = np.zeros((n, 4))
@@ -136,6 +141,16 @@ class InteriorPointSolver:
         self._iterate(np.zeros(4), 0, COLD)
         identify_active(problem.bounds, self.scales, *self._slacks, *self._bound_multipliers,
                         self._active)  # fmt: skip
+        shift_iterate(np.zeros(4), problem.a, problem.b, self.feedback, self._u, self._x,
+                      self._multipliers, *self._slacks, *self._bound_multipliers)  # fmt: skip
+
+    def iterate_inputs(self) -> FloatArray:
+        """Return a copy of the current iterate's inputs (δ [m], τ [N m]), shape (N, 2).
+
+        After an unfinished solve (:attr:`resumable`) not a solution: within the bounds only
+        to the iterate's slack residuals.
+        """
+        return self._u.copy()
 
     def reset(self) -> None:
         """Do nothing: each solve starts from its guess (the interior point keeps no start)."""
@@ -168,9 +183,17 @@ class InteriorPointSolver:
         set is offered to it once it has settled (:data:`SETTLE_ROWS`), and if that one fails,
         once converged to :data:`IDENTIFY_TOL`: its VERIFIED plan ends the solve. Else the
         iterations go on to :data:`TOL` and the plan is the interior point's own (CONVERGED).
+        ``guess.resume``: continue the last solve's iterate (if :attr:`resumable`) shifted by
+        one stage, instead of a start from ``guess.inputs``. At most ``guess.budget``
+        iterations in all (default :data:`MAX_ITERATIONS`), FAILED beyond; each offer costs
+        at most :data:`~pushrecovery.control.mpc.solvers.riccati.POLISH_PASSES` passes.
         """
         start = COLD
-        if guess.inputs is not None:
+        if guess.resume and self.resumable:
+            shift_iterate(x0, self.problem.a, self.problem.b, self.feedback, self._u, self._x,
+                          self._multipliers, *self._slacks, *self._bound_multipliers)  # fmt: skip
+            start = 0
+        elif guess.inputs is not None:
             self._u[:-1] = guess.inputs[1:]
             self._u[-1] = guess.inputs[-1]
             start = WARM
@@ -178,12 +201,14 @@ class InteriorPointSolver:
             self._guide[...] = guess.active
         else:
             self._guide.fill(0)
+        limit = MAX_ITERATIONS if guess.budget is None else min(guess.budget, MAX_ITERATIONS)
+        self.resumable = False
         polish = self.polish
         done, settle = 0, SETTLE_ROWS
-        while polish is not None and done < MAX_ITERATIONS:
+        while polish is not None and done < limit:
             # The settled set first (one offer), then the loosely converged one: verified, the
             # solve ends there.
-            status, count = self._iterate(x0, MAX_ITERATIONS - done, start, True, settle)
+            status, count = self._iterate(x0, limit - done, start, True, settle)
             start, done = 0, done + count
             if status == DIVERGED:
                 self.iterations = -1
@@ -201,15 +226,12 @@ class InteriorPointSolver:
             if status == CONVERGED:
                 break
             settle = -1  # settled, not verified: on to IDENTIFY_TOL
-        status, count = (
-            (EXHAUSTED, 0)
-            if done >= MAX_ITERATIONS
-            else self._iterate(x0, MAX_ITERATIONS - done, start)
-        )
+        status, count = (EXHAUSTED, 0) if done >= limit else self._iterate(x0, limit - done, start)
         if status == CONVERGED:
             self.iterations = done + count
             inputs, states = self._u.copy(), self._x.copy()
             active = self._active.copy()
             return Plan(Status.CONVERGED, inputs[0], inputs, states, active, self.iterations)
         self.iterations = -1
+        self.resumable = status == EXHAUSTED
         return Plan.failed()

@@ -12,6 +12,14 @@ with θmax :data:`RELAXED` larger; the condensed QP in a warm DAQP workspace
 (INFEASIBLE). Other solvers, or ``daqp`` without its workspace, solve the condensed QP through
 ``qpsolvers.solve_qp`` at every tick
 (:class:`~pushrecovery.control.mpc.solvers.solve_qp.SolveQpSolver`), then the fallback.
+
+The real-time mode (``MPCSettings(realtime=True)``) takes the same route within a fixed budget
+of work, counted in passes and iterations (deterministic: the same states give the same plans
+on any machine): at most :data:`REALTIME_PASS_STAGES` / N warm passes and
+:data:`REALTIME_ITERATION_STAGES` / N interior-point iterations, no DAQP. A tick the budget
+does not solve applies the last plan that solved Eq. (17) shifted by one stage per tick since
+(SHIFTED), and the next tick's passes start from its active set, shifted once more; with no such
+plan (none since the last reset, or older than the horizon) the saturated fallback (EXHAUSTED).
 """
 
 from __future__ import annotations
@@ -31,9 +39,18 @@ from pushrecovery.control.mpc.solvers.daqp import DaqpSolver
 from pushrecovery.control.mpc.solvers.interior import InteriorPointSolver
 from pushrecovery.control.mpc.solvers.riccati import MAX_PASSES, POLISH_PASSES, RiccatiSolver
 from pushrecovery.control.mpc.solvers.solve_qp import SolveQpSolver
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
-__all__ = ["INTERIOR_MARGIN", "PASSES_AFTER_FAILURE", "RELAXED", "RELAXED_GUIDE_CENTRE", "Route"]
+__all__ = [
+    "INTERIOR_MARGIN",
+    "PASSES_AFTER_FAILURE",
+    "REALTIME_ITERATION_STAGES",
+    "REALTIME_PASS_STAGES",
+    "RELAXED",
+    "RELAXED_GUIDE_CENTRE",
+    "Route",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -50,9 +67,16 @@ RELAXED_GUIDE_CENTRE = 10.0
 #: boundary's own margin, BOUNDARY): there the feasible set has no interior and its iterates
 #: stall; the passes with full braking held decide, then DAQP.
 INTERIOR_MARGIN = BOUNDARY
+#: The real-time mode's budget of warm Riccati passes, in stages: at most this / N passes
+#: (and at most MAX_PASSES), a pass costing O(N) (docs/mpc.md, "The real-time mode").
+REALTIME_PASS_STAGES = 1500
+#: The real-time mode's budget of interior-point iterations, in stages: at most this / N
+#: iterations (20 at N = 50, 5 at N = 200), each O(N) (docs/mpc.md, "The real-time mode").
+REALTIME_ITERATION_STAGES = 1000
 
 _WARM = Guess()
 _VERIFIED = Status.VERIFIED  # a module global: an enum member through its class costs ~0.1 µs
+_SHIFTED = Status.SHIFTED
 _WARM_PASSES = Guess(budget=MAX_PASSES)
 _PASSES_AFTER_FAILURE = Guess(budget=PASSES_AFTER_FAILURE)
 
@@ -88,6 +112,20 @@ class Route:
         Whether the last tick's warm passes failed.
     boundary : bool
         Whether the last tick was solved on S_N's boundary.
+    held : Plan or None
+        Real-time mode: the last plan that solved Eq. (17), shifted on the ticks since.
+    age : int
+        Real-time mode: the ticks since ``held`` was solved.
+    realtime_passes, realtime_iterations : int
+        Real-time mode: the warm passes (:data:`REALTIME_PASS_STAGES` / N, at most
+        ``MAX_PASSES``) and interior-point iterations (:data:`REALTIME_ITERATION_STAGES` / N)
+        allowed per tick, at least 1.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``settings.realtime`` and the sparse solvers do not apply (a bound without a
+        range, e.g. τmax = 0).
     """
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
@@ -111,6 +149,20 @@ class Route:
         self.feasibility: FlywheelFeasibility | None = None  # built on first need
         self.passes_failed = False
         self.boundary = False
+        self.realtime = settings.realtime
+        self.held: Plan | None = None
+        self.age = 0
+        self._unfinished: InteriorPointSolver | None = None  # the iterate to go on with
+        n = settings.horizon
+        self.realtime_passes = max(1, min(MAX_PASSES, REALTIME_PASS_STAGES // n))
+        self.realtime_iterations = max(1, REALTIME_ITERATION_STAGES // n)
+        if self.realtime:
+            if self.riccati is None or not FlywheelFeasibility.applies(params):
+                raise InvalidParameterError(
+                    "realtime=True needs every bound with a range (heel < toe, torque_max > 0, "
+                    "flywheel_angle_max > 0): the sparse solvers' route"
+                )
+            self.gauge(np.zeros(4))  # build the feasibility test now, not on a tick
 
     @property
     def qp(self) -> CondensedQP:
@@ -151,6 +203,7 @@ class Route:
     def reset(self) -> None:
         """Forget the warm starts: the next tick starts from the empty active set."""
         self.passes_failed = self.boundary = False
+        self.held, self.age, self._unfinished = None, 0, None
         if self._daqp is not None:
             self._daqp.reset()
         if self.riccati is not None:
@@ -170,8 +223,11 @@ class Route:
         -------
         Plan
             The plan; INFEASIBLE (the fallback) if the QP has no solution. Only the solvers' own
-            failures mean "infeasible": any other exception is a bug and propagates.
+            failures mean "infeasible": any other exception is a bug and propagates. Real-time
+            mode: also SHIFTED or EXHAUSTED (module docstring).
         """
+        if self.realtime:
+            return self._solve_realtime(x0, last)
         riccati = self.riccati
         # Whether the previous tick was verified by the passes: DAQP did not solve it, and
         # riccati.active holds its optimal set (kept by a failed solve) to start DAQP from.
@@ -206,7 +262,8 @@ class Route:
                 riccati.reset()
             return self._fallback(x0)
         if riccati is not None:
-            sparse = self._sparse(riccati, x0, gauge, previous_verified, last)
+            inputs = last.inputs if last is not None and last.feasible else None
+            sparse = self._sparse(riccati, x0, gauge, previous_verified, inputs)
             if sparse is not None:
                 return sparse
         daqp = self.daqp
@@ -230,7 +287,8 @@ class Route:
         x0: FloatArray,
         gauge: float,
         previous_verified: bool,
-        last: Plan | None,
+        warm: FloatArray | None,
+        budget: int | None = None,
     ) -> Plan | None:
         """Solve a tick the warm passes did not verify, on the sparse QP; None: DAQP decides.
 
@@ -239,9 +297,11 @@ class Route:
         boundary (γ ≥ 1 − BOUNDARY), where the feasible set has no interior: full braking held
         (:meth:`FlywheelFeasibility.forced_braking`), the passes from the active sets of the
         interior point on the problem with θmax 0.1 % larger (:data:`RELAXED`), which has an
-        interior, then from the last tick's set.
+        interior, then from the last tick's set. ``warm``: the last tick's inputs (the interior
+        point's warm start); ``budget``: its iterations (None: its own maximum).
         """
         interior = self.interior
+        unfinished, self._unfinished = self._unfinished, None  # continued this tick or never
         if gauge < 1.0 - INTERIOR_MARGIN:
             if interior is None:
                 return None
@@ -258,10 +318,12 @@ class Route:
             interior = self.relaxed
         # Warm from the last tick's plan (its inputs computed if they were left lazy) and, if
         # the passes verified it, its active set (the failed warm passes leave it in place).
-        warm = last.inputs if last is not None and last.feasible else None
         start = riccati.active.copy()  # the last tick's set (the failed passes keep it)
         guide = start if warm is not None and previous_verified else None
-        plan = interior.solve(x0, Guess(guide, True, warm, forced))
+        # Real-time mode: the last tick's interior point, out of its budget, goes on.
+        resume = budget is not None and interior is unfinished
+        plan = interior.solve(x0, Guess(guide, True, warm, forced, budget, resume))
+        self._unfinished = interior if budget is not None and interior.resumable else None
         if plan.status is Status.VERIFIED:
             return plan
         if (
@@ -278,8 +340,84 @@ class Route:
         riccati.reset()
         return None
 
-    def _fallback(self, x0: FloatArray) -> Plan:
-        """Return the INFEASIBLE plan from ``x0``: the fallback held, the states on demand."""
+    def _solve_realtime(self, x0: FloatArray, last: Plan | None) -> Plan:
+        """Solve one tick within the real-time budget (module docstring); as :meth:`solve`."""
+        riccati = self.riccati
+        assert riccati is not None  # checked at construction
+        previous_verified = riccati.verified
+        passes = min(PASSES_AFTER_FAILURE, self.realtime_passes) if self.passes_failed else None
+        warm: Guess | None = Guess(budget=self.realtime_passes if passes is None else passes)
+        gauge = -1.0
+        if self.boundary:
+            gauge = self.gauge(x0)
+            if gauge >= 1.0 - INTERIOR_MARGIN:
+                warm = None
+        if warm is not None:
+            plan = riccati.solve(x0, warm)
+            if plan.status is _VERIFIED:
+                self.passes_failed = self.boundary = False
+                self.held, self.age, self._unfinished = plan, 0, None
+                return plan
+        self.passes_failed = True
+        x0 = x0.copy()  # the plan's own: the caller may reuse its array
+        if gauge < 0.0:
+            gauge = self.gauge(x0)
+        self.boundary = gauge >= 1.0 - INTERIOR_MARGIN
+        if gauge > 1.0 + BAND:  # exactly infeasible: the fallback, as the default route
+            riccati.reset()
+            self.held, self.age, self._unfinished = None, 0, None
+            return self._fallback(x0)
+        inputs = (
+            last.inputs if last is not None and (last.feasible or last.status is _SHIFTED) else None
+        )
+        solved = self._sparse(
+            riccati, x0, gauge, previous_verified, inputs, self.realtime_iterations
+        )
+        if solved is not None:
+            self.held, self.age = solved, 0
+            return solved
+        return self._shifted(x0)
+
+    def _shifted(self, x0: FloatArray) -> Plan:
+        """Return the held plan shifted by one more stage (SHIFTED), or EXHAUSTED.
+
+        Its inputs from x0 on (the last stage's repeated), states on demand; the passes of the
+        next tick start from its active set (shifted once more by them). With no plan held (or
+        one older than the horizon), EXHAUSTED: the inputs of the interior point's unfinished
+        iterate, which the next tick continues (the plant then follows the iterate the
+        interior point goes on from), or where there is none the saturated fallback.
+        """
+        held, riccati = self.held, self.riccati
+        assert riccati is not None
+        self.age += 1
+        n = self.settings.horizon
+        if held is None or self.age >= n:
+            self.held, self.age = None, 0
+            riccati.reset()
+            unfinished = self._unfinished
+            if unfinished is None:
+                return self._fallback(x0, Status.EXHAUSTED)
+            iterate = unfinished.iterate_inputs()
+            sparse = self._sparse_qp
+            return Plan(Status.EXHAUSTED, iterate[0], iterate, lambda: sparse.simulate(x0, iterate))
+        age = self.age
+        inputs = np.empty((n, 2))
+        inputs[: n - age] = held.inputs[age:]
+        inputs[n - age :] = held.inputs[-1]
+        active = held.active
+        if active is not None:
+            shifted = np.empty_like(active)
+            shifted[: n - age] = active[age:]
+            shifted[n - age :] = active[-1]
+            riccati.seed(shifted)
+            active = shifted
+        else:
+            riccati.reset()
+        sparse = self._sparse_qp
+        return Plan(_SHIFTED, inputs[0], inputs, lambda: sparse.simulate(x0, inputs), active)
+
+    def _fallback(self, x0: FloatArray, status: Status = Status.INFEASIBLE) -> Plan:
+        """Return the fallback plan from ``x0`` (INFEASIBLE, or EXHAUSTED), states on demand."""
         p = self.params
         cop = p.clip_cop(x0[0] + x0[2] / p.omega)  # the capture point
         rate = x0[3]
@@ -287,4 +425,4 @@ class Route:
         first = np.array([cop, torque])
         inputs = np.tile(first, (self.settings.horizon, 1))
         sparse = self._sparse_qp
-        return Plan(Status.INFEASIBLE, first, inputs, lambda: sparse.simulate(x0, inputs))
+        return Plan(status, first, inputs, lambda: sparse.simulate(x0, inputs))
