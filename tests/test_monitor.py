@@ -1,0 +1,155 @@
+"""The monitor's supports: regions turned and moved from a stance foot's frame, the same as built.
+
+``StepRegions.of`` places regions built once per body (stance ankle at the origin, yaw 0) at
+the feet; here every region is checked against the Minkowski sums of (S1) built directly for
+the placed feet (``viable_region``), on random poses and yaws, for several bodies; the
+monitor's CMP region against ``cmp_polygon``; plans against ``capture_plan`` in the world
+frame.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
+from pushrecovery.ground.support import FootPose, Support
+from pushrecovery.surfaces.capture_plan import capture_plan
+from pushrecovery.surfaces.classify import classify
+from pushrecovery.surfaces.monitor import BalanceMonitor
+from pushrecovery.surfaces.n_step import step_options, viable_region
+from pushrecovery.surfaces.plane import cmp_polygon
+from pushrecovery.surfaces.step_regions import StepRegions
+
+P = load_params()
+SOLE = [
+    [-0.05, -0.04], [0.1, -0.05], [0.18, -0.03], [0.21, 0.0],
+    [0.18, 0.035], [0.1, 0.05], [-0.05, 0.045], [-0.07, 0.0],
+]  # fmt: skip
+BODIES = {
+    "default": P,
+    "min-step-width": dataclasses.replace(P, min_step_width=0.12),
+    "8-vertex sole": load_params(overrides={"foot_polygon": SOLE}),
+    "no roll torque": dataclasses.replace(P, torque_max_roll=0.0),
+}
+
+
+def random_supports(params, count, seed):
+    """Supports of every stance on random poses and yaws (the right foot turned a little)."""
+    rng = np.random.default_rng(seed)
+    supports = []
+    for i in range(count):
+        yaw = 0.0 if i % 4 == 0 else rng.uniform(-math.pi, math.pi)
+        x, y = rng.uniform(-3.0, 3.0, 2)
+        half = rng.uniform(0.1, 0.2)
+        turn = min(math.pi, max(-math.pi, yaw + rng.uniform(-0.3, 0.3)))
+        left = FootPose(x - half * math.sin(yaw), y + half * math.cos(yaw), yaw)
+        right = FootPose(x + half * math.sin(yaw), y - half * math.cos(yaw), turn)
+        stance = ("left", "right", "double")[i % 3]
+        supports.append(Support.from_params(params, stance, left=left, right=right))
+    return supports
+
+
+def built(params, support):
+    """The regions as (S1) builds them for the placed feet: by N, each lifting foot."""
+    polygons = []
+    for n in range(1, params.max_steps + 1):
+        times = tuple(params.min_step_time * (k + 1) for k in range(n))
+        polygons += [viable_region(params, o, times) for o in step_options(params, support)]
+    return polygons
+
+
+def same_loop(a, b, tolerance):
+    """The same counter-clockwise vertex loop, up to where it starts."""
+    assert len(a) == len(b)
+    start = int(np.argmin(np.hypot(*(b - a[0]).T)))
+    assert np.abs(np.roll(b, -start, axis=0) - a).max() <= tolerance
+
+
+@pytest.mark.parametrize("name", list(BODIES))
+def test_placed_regions_are_the_regions_built_for_the_feet(name):
+    params = BODIES[name]
+    for support in random_supports(params, 12, seed=len(name)):
+        regions = StepRegions.of(params, support)
+        expected = built(params, support)
+        scale = max(1.0, abs(support.left.x), abs(support.left.y))
+        assert len(regions.polygons) == len(expected) == len(regions.steps)
+        for polygon, reference, count, edges in zip(
+            regions.polygons, expected, regions.counts, regions.table, strict=True
+        ):
+            same_loop(reference.vertices, polygon.vertices, 1e-12 * scale)
+            assert count == len(reference.vertices)
+            # The table holds the same edges (the same half-planes, in the loop's order).
+            table = edges[:count]
+            order = np.argsort(np.arctan2(table[:, 1], table[:, 0]))
+            own = reference.edge_table[np.argsort(np.arctan2(*reference.normals.T[::-1]))]
+            assert np.abs(table[order] - own).max() <= 1e-12 * scale
+            assert (edges[count:] == edges[count - 1]).all()  # padded by the last edge
+        nested = all(
+            float(expected[i + len(regions.options) // params.max_steps].signed_distance(
+                *expected[i].vertices.T).min()) >= -1e-12
+            for i in range(len(expected) - len(regions.options) // params.max_steps)
+        )  # fmt: skip
+        assert regions.outer.tolist() == [
+            not nested or n == params.max_steps for n in regions.steps
+        ]
+        options = step_options(params, support)
+        for row, option in enumerate(regions.options):
+            mine = options[row % len(options)]
+            assert option.swing is mine.swing and option.yaw == mine.yaw
+            assert np.array_equal(option.ankle, mine.ankle)
+
+
+def test_plans_in_the_stance_frame_are_the_world_plans():
+    params = BODIES["min-step-width"]
+    rng = np.random.default_rng(7)
+    for support in random_supports(params, 6, seed=3):
+        regions = StepRegions.of(params, support)
+        ax, ay = support.ankle
+        for _ in range(4):
+            px, py = ax + rng.uniform(-0.8, 0.8), ay + rng.uniform(-0.8, 0.8)
+            steps, _ = regions.locate(px, py)
+            if not steps:
+                continue
+            plan = regions.plan(px, py, steps)
+            option = next(o for o in step_options(params, support) if o.swing is plan.swings[0])
+            world = capture_plan(np.array([px, py]), params, option, steps)
+            assert plan.swings == world.swings
+            for key in ("footholds", "cops", "hip", "ankle", "touchdowns"):
+                assert np.abs(getattr(plan, key) - getattr(world, key)).max() <= 1e-9, key
+            assert plan.margin == pytest.approx(world.margin, abs=1e-12)
+
+
+@pytest.mark.parametrize("name", list(BODIES))
+def test_the_monitor_on_turned_and_moved_supports_equals_classify(name):
+    params = BODIES[name]
+    monitor = BalanceMonitor(params)
+    rng = np.random.default_rng(11)
+    for support in random_supports(params, 6, seed=5):
+        monitor.set_support(support)
+        assert monitor.support is support
+        hip = cmp_polygon(support, params)
+        ax, ay = support.ankle
+        for _ in range(15):
+            x, y = ax + rng.uniform(-0.1, 0.1), ay + rng.uniform(-0.1, 0.1)
+            xdot, ydot = rng.uniform(-2.5, 2.5, 2)
+            fast = monitor.query(x, y, xdot, ydot)
+            slow = classify(x, xdot, params, y=y, ydot=ydot, support=support)
+            assert fast.strategy == slow.strategy
+            for mine, theirs in ((fast.cop_margin, slow.margins["cop"]),
+                                 (fast.cmp_margin, slow.margins["cmp"]),
+                                 (fast.step_margin, slow.margins["step"])):  # fmt: skip
+                assert abs(mine - theirs) <= 1e-12
+            xi = (fast.capture_point_x, fast.capture_point_y)
+            assert abs(fast.cmp_margin - float(hip.signed_distance(*xi))) <= 1e-12
+
+
+def test_bad_supports_are_refused():
+    monitor = BalanceMonitor(P)
+    with pytest.raises(ParameterTypeError, match="support"):
+        monitor.set_support("double")  # type: ignore[arg-type]
+    with pytest.raises(InvalidParameterError, match="yaw must be within"):
+        FootPose(0.0, 0.09, 10.0)  # degrees by mistake
+    assert monitor.support.stance.value == "double"  # a refused change changes nothing
