@@ -86,7 +86,9 @@ VALID: dict[str, Any] = {
     "region": strategy_region("ankle", P), "strategy": "hip", "backend": "analytic",
     # The hip.
     "switch_time": 0.1, "capture_point": 0.02, "torque_max": 50.0, "inertia": 10.0,
-    "angle_max": 0.5, "weight": 700.0, "speed": 0.01,
+    "angle_max": 0.5, "weight": 700.0, "speed": 0.01, "theta0": 0.1, "thetadot0": 0.2,
+    # The optional dependencies (an installed extra's module).
+    "extra": "sim", "module": "mujoco",
     # Measured data.
     "path": TRIAL, "com": np.array([0.01, 0.02]), "anchor": np.array([0.02]),
     "n": 10, "ankle_ap": 0.0, "ankle_ml": 0.1, "stance_width": 0.2, "contact_height": 0.05,

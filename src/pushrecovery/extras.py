@@ -62,7 +62,7 @@ def missing(extra: str, module: str, feature: str | None = None) -> MissingExtra
     MissingExtraError
         ``FEATURE needs the 'EXTRA' extra (no module MODULE): pip install 'pushrecovery[EXTRA]'``.
     """
-    _check(extra)
+    _check(extra, feature)
     what = feature or EXTRAS[extra][0]
     error = MissingExtraError(
         f"{what} needs the {extra!r} extra (no module {module!r}): "
@@ -95,11 +95,12 @@ def require(extra: str, module: str, feature: str | None = None) -> ModuleType:
     MissingExtraError
         If ``module`` (or a module it imports) is not installed.
     InvalidParameterError
-        If ``extra`` is not a key of :data:`EXTRAS`.
+        If ``extra`` is not a key of :data:`EXTRAS`, ``feature`` not a str or None, or
+        ``module`` not an absolute module name.
     """
-    _check(extra)
+    _check(extra, feature)
     try:
-        return importlib.import_module(module)
+        return importlib.import_module(_check_module(module))
     except ModuleNotFoundError as exc:
         raise missing(extra, exc.name or module, feature) from exc
 
@@ -122,9 +123,10 @@ def require_extra(extra: str, feature: str | None = None) -> None:
     MissingExtraError
         Naming the first module of the extra that is not installed.
     InvalidParameterError
-        If ``extra`` is not a key of :data:`EXTRAS`.
+        If ``extra`` is not a key of :data:`EXTRAS`, ``feature`` not a str or None, or
+        ``module`` not an absolute module name.
     """
-    _check(extra)
+    _check(extra, feature)
     for module in EXTRAS[extra][1]:
         try:
             found = importlib.util.find_spec(module) is not None
@@ -134,9 +136,27 @@ def require_extra(extra: str, feature: str | None = None) -> None:
             raise missing(extra, module, feature)
 
 
-def _check(extra: str) -> None:
-    if extra not in EXTRAS:
-        raise InvalidParameterError(f"extra must be one of {list(EXTRAS)}, got extra={extra!r}")
+def _check(extra: object, feature: object = None) -> None:
+    if not (isinstance(extra, str) and extra in EXTRAS):
+        raise InvalidParameterError(
+            f"extra must be one of {list(EXTRAS)}, got extra={str(extra)[:40]!r}"
+        )
+    if feature is not None and not isinstance(feature, str):
+        raise InvalidParameterError(f"feature must be a str or None, got {type(feature).__name__}")
+
+
+def _check_module(module: object) -> str:
+    """Require an absolute module name (``"pyarrow.parquet"``), at most 200 characters."""
+    if not (
+        isinstance(module, str)
+        and 0 < len(module) <= 200
+        and all(part.isidentifier() for part in module.split("."))
+    ):
+        raise InvalidParameterError(
+            f"module must be an absolute module name such as 'pyarrow.parquet', "
+            f"got {str(module)[:40]!r}"
+        )
+    return module
 
 
 def extra_of(module: str, prefer: tuple[str, ...] = ()) -> str | None:
