@@ -123,8 +123,7 @@ def require_extra(extra: str, feature: str | None = None) -> None:
     MissingExtraError
         Naming the first module of the extra that is not installed.
     InvalidParameterError
-        If ``extra`` is not a key of :data:`EXTRAS`, ``feature`` not a str or None, or
-        ``module`` not an absolute module name.
+        If ``extra`` is not a key of :data:`EXTRAS` or ``feature`` not a str or None.
     """
     _check(extra, feature)
     for module in EXTRAS[extra][1]:
