@@ -2,7 +2,9 @@
 
 :func:`load_params` is the one way a body enters the library from outside (the CLI's
 ``--preset``, ``--params`` and flags); everything it returns is a validated
-:class:`~pushrecovery.params.BodyParams`.
+:class:`~pushrecovery.params.BodyParams`. Where the body stands is not part of it: a file's
+``[feet]`` table (the stance and the foot poses on the ground plane) is read by
+:func:`load_support`, into a :class:`~pushrecovery.ground.support.Support`.
 """
 
 from __future__ import annotations
@@ -10,12 +12,15 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pushrecovery.errors import InputFileError, InvalidParameterError, ParameterTypeError
 from pushrecovery.params import FIELD_NAMES, BodyParams
 
-__all__ = ["PRESETS", "load_params"]
+if TYPE_CHECKING:
+    from pushrecovery.ground.support import FootPose, Support
+
+__all__ = ["PRESETS", "load_params", "load_support"]
 
 
 #: Largest parameter file [bytes]: a body is a few hundred bytes of TOML.
@@ -67,7 +72,8 @@ def load_params(
         top-level ``preset = "..."`` key.
     file : str or Path, optional
         TOML file with any of the field names of :class:`BodyParams` as top-level keys, in SI
-        units (optionally under a ``[body]`` table).
+        units (optionally under a ``[body]`` table). Its ``[feet]`` table is checked here and
+        read by :func:`load_support`.
     overrides : mapping, optional
         Field values that win over the preset and the file; ``None`` values are ignored.
 
@@ -85,6 +91,8 @@ def load_params(
     """
     values: dict[str, Any] = {}
     from_file: dict[str, Any] = _read_toml(Path(file)) if file is not None else {}
+    if "feet" in from_file:  # where the body stands, not the body: load_support's
+        _feet_values(from_file.pop("feet"))
     preset = str(from_file.pop("preset", preset))
     if preset not in PRESETS:
         raise InvalidParameterError(
@@ -133,6 +141,135 @@ def load_params(
         if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)):
             raise InvalidParameterError(f"{name} must be a number, got {value!r}")
     return BodyParams(**values)
+
+
+def load_support(
+    params: BodyParams,
+    file: str | Path | None = None,
+    overrides: Mapping[str, Any] | None = None,
+) -> Support:
+    """Build the feet on the ground from a TOML file's ``[feet]`` table, then overrides.
+
+    The table (every key optional; a file without it: both feet at their default poses)::
+
+        [feet]
+        stance = "left"                      # double (default), left or right
+        left = {x = 0.0, y = 0.1, yaw = 0.0}   # ankle x, y [m]; yaw [rad] in [-pi, pi], default 0
+        right = {x = 0.05, y = -0.1}
+
+    A pose not given is the default one (:meth:`~pushrecovery.ground.support.Support.
+    from_params`: x = 0, y = ±stance_width/2, yaw 0); poses are world frame, x forward, y left.
+
+    Parameters
+    ----------
+    params : BodyParams
+        The body whose feet stand there (its sole, stance width and legs).
+    file : str or Path, optional
+        TOML parameter file (:func:`load_params`' file).
+    overrides : mapping, optional
+        ``stance`` (str), ``left`` and ``right``
+        (:class:`~pushrecovery.ground.support.FootPose`) that win over the file; ``None``
+        values are ignored.
+
+    Returns
+    -------
+    Support
+        The stance and foot poses, with this body's soles.
+
+    Raises
+    ------
+    InvalidParameterError
+        An unknown key, a value of the wrong type or out of range (a yaw outside [−π, π] rad),
+        a pose without x or y, an unknown stance, or feet that overlap or stand farther apart
+        than two legs in double support.
+    InputFileError
+        Missing, unreadable or malformed TOML file.
+    """
+    from pushrecovery.arguments import require_type
+    from pushrecovery.ground.support import FootPose, Support
+
+    require_type("params", params, BodyParams)
+    values = _feet_values(_read_toml(Path(file)).get("feet", {})) if file is not None else {}
+    if overrides is not None and not isinstance(overrides, Mapping):
+        raise ParameterTypeError(
+            f"overrides must be a mapping of stance, left and right, got {type(overrides).__name__}"
+        )
+    for key, value in (overrides or {}).items():
+        if key not in _FEET_KEYS:
+            raise InvalidParameterError(
+                f"unknown support override {key!r}; known: {', '.join(_FEET_KEYS)}"
+            )
+        if value is not None:
+            if key != "stance":
+                require_type(key, value, FootPose)
+            values[key] = value
+    return Support.from_params(
+        params,
+        values.get("stance", "double"),
+        left=values.get("left"),
+        right=values.get("right"),
+    )
+
+
+#: The keys of ``[feet]`` and of each foot's pose in it.
+_FEET_KEYS = ("stance", "left", "right")
+_POSE_KEYS = ("x", "y", "yaw")
+
+
+def _feet_values(table: Any) -> dict[str, Any]:
+    """``[feet]`` as ``stance`` (str) and ``left``/``right`` poses, or a one-line error."""
+    from pushrecovery.ground.support import Stance
+
+    if not isinstance(table, dict):
+        raise InvalidParameterError(
+            f"[feet] must be a table of stance, left and right, got {table!r:.40}"
+        )
+    unknown = sorted(set(table) - set(_FEET_KEYS))
+    if unknown:
+        raise InvalidParameterError(
+            f"unknown key {unknown[0]!r} in [feet]; known keys: {', '.join(_FEET_KEYS)}"
+        )
+    values: dict[str, Any] = {}
+    if "stance" in table:
+        stance = table["stance"]
+        if not isinstance(stance, str) or stance not in {s.value for s in Stance}:
+            raise InvalidParameterError(
+                f"[feet] stance must be one of {[s.value for s in Stance]}, got {stance!r:.40}"
+            )
+        values["stance"] = stance
+    for side in ("left", "right"):
+        if side in table:
+            values[side] = _pose_value(side, table[side])
+    return values
+
+
+def _pose_value(side: str, pose: Any) -> FootPose:
+    """One foot's ``{x, y[, yaw]}`` in ``[feet]`` as a FootPose, or a one-line error."""
+    from pushrecovery.ground.support import FootPose
+
+    name = f"[feet] {side}"
+    if not isinstance(pose, dict):
+        raise InvalidParameterError(
+            f"{name} must be a table {{x = ..., y = ..., yaw = ...}} [m, m, rad], got {pose!r:.40}"
+        )
+    unknown = sorted(set(pose) - set(_POSE_KEYS))
+    if unknown:
+        raise InvalidParameterError(
+            f"unknown key {unknown[0]!r} in {name}; known keys: {', '.join(_POSE_KEYS)}"
+        )
+    missing = [key for key in ("x", "y") if key not in pose]
+    if missing:
+        raise InvalidParameterError(f"{name} needs {missing[0]} [m] (x and y; yaw [rad] optional)")
+    for key, value in pose.items():
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            unit = "rad" if key == "yaw" else "m"
+            raise InvalidParameterError(
+                f"{name}.{key} must be a number [{unit}], got {value!r:.40}"
+            )
+    try:
+        return FootPose(float(pose["x"]), float(pose["y"]), float(pose.get("yaw", 0.0)))
+    except InvalidParameterError as error:
+        raise InvalidParameterError(f"{name}: {error}") from None
 
 
 def _polygon_value(value: Any) -> tuple[tuple[float, float], ...]:

@@ -181,19 +181,28 @@ def support_options(func: F) -> F:
         type=click.Choice(("double", "left", "right")),
         default=None,
         help="Feet on the ground: the support polygon is the hull of both (double, the "
-        "default), or one foot.",
+        "default), or one foot. These three override the --params file's [feet].",
     )(func)
 
 
-def support_from(kwargs: dict[str, Any], params: BodyParams) -> Any:
-    """Pop the support options out of a command's kwargs and build the ``Support``."""
-    from pushrecovery.ground.support import FootPose, Support
+#: The kwargs of :func:`support_options`.
+SUPPORT_KEYS = ("stance", "left_foot", "right_foot")
 
-    poses = {}
+
+def support_from(kwargs: dict[str, Any], params: BodyParams, file: str | None = None) -> Any:
+    """Pop the support options out of a command's kwargs and build the ``Support``.
+
+    The ``[feet]`` of the parameter ``file`` (``--params``), if any, then the flags (later
+    wins), as :func:`~pushrecovery.presets.load_support`.
+    """
+    from pushrecovery.ground.support import FootPose
+    from pushrecovery.presets import load_support
+
+    overrides: dict[str, Any] = {"stance": kwargs.pop("stance")}
     for side in ("left", "right"):
         text = kwargs.pop(f"{side}_foot")
-        poses[side] = None if text is None else FootPose.parse(f"--{side}-foot", text)
-    return Support.from_params(params, kwargs.pop("stance") or "double", **poses)
+        overrides[side] = None if text is None else FootPose.parse(f"--{side}-foot", text)
+    return load_support(params, file, overrides)
 
 
 def params_from(kwargs: dict[str, Any]) -> BodyParams:

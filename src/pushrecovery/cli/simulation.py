@@ -14,7 +14,15 @@ import click
 
 from pushrecovery.cli.app import example
 from pushrecovery.cli.families import humanoid_only
-from pushrecovery.cli.options import body_options, emit, needs_plots, params_from
+from pushrecovery.cli.options import (
+    SUPPORT_KEYS,
+    body_options,
+    emit,
+    needs_plots,
+    params_from,
+    support_from,
+    support_options,
+)
 from pushrecovery.cli.progress import Progress
 from pushrecovery.cli.simulation_options import controller_options, planar_run, timing
 
@@ -28,12 +36,14 @@ __all__ = ["critical_push", "simulate"]
         "pushrecovery simulate --model stepping --controller recovery --impulse 60 "
         "--plot out/step.png",
         "pushrecovery simulate --backend mujoco --model foot --impulse 15 --duration 3 --json",
+        "pushrecovery simulate --model stepping-plane --controller recovery-plane --y 0.1 "
+        "--ydot -0.5 --stance left",
     ),
 )
 @planar_run(
     "simulate",
-    x_help="CoM position before the push, forward from the ankle (stepping-plane: from the "
-    "ankles' midpoint) [m].",
+    x_help="CoM position before the push, forward from the ankle (stepping-plane: world frame, "
+    "the default feet's midpoint at the origin) [m].",
 )
 @click.option(
     "--xdot",
@@ -47,7 +57,7 @@ __all__ = ["critical_push", "simulate"]
     type=float,
     default=0.0,
     show_default=True,
-    help="stepping-plane only: CoM position, left, from the ankles' midpoint [m].",
+    help="stepping-plane only: CoM position, left, world frame as --x [m].",
 )
 @click.option(
     "--ydot",
@@ -80,6 +90,7 @@ __all__ = ["critical_push", "simulate"]
     help="MuJoCo only: write a filmstrip PNG of the run to this file and an animated GIF "
     "beside it (CoM, capture point and CoP drawn).",
 )
+@support_options
 @humanoid_only(
     "simulate", "--azimuth", "--stepping", "--view-azimuth", "--view-elevation", "--frame-times"
 )
@@ -110,8 +121,11 @@ def simulate(
     MuJoCo also the state the push left and the CoP it measured [m]. With --backend mujoco,
     --impulse is a real force at the CoM over 10 ms (the body holding still meanwhile) and the
     run starts as the push ends. With --model stepping-plane (controller recovery-plane) the
-    body stands on both feet of the ground plane and --y, --ydot add the sideways part
-    (--impulse pushes along x). The 3-D humanoids are 'pushrecovery humanoid simulate'.
+    body stands on the feet of the ground plane, both at their default poses unless --stance,
+    --left-foot, --right-foot or the --params file's [feet] place them (poses in the world
+    frame, in which --x and --y are too), and --y, --ydot add the sideways part (--impulse
+    pushes along x); the output then has the support it started on. The 3-D humanoids are
+    'pushrecovery humanoid simulate'.
     """
     from pushrecovery.control.base import make_controller
     from pushrecovery.sim.backend import Measuring, Recording
@@ -120,15 +134,25 @@ def simulate(
     from pushrecovery.sim.simulate import simulate as run
     from pushrecovery.surfaces.classify import classify as classify_state
 
+    file = kwargs["params_file"]
     params = params_from(kwargs)
     velocity = _push_velocity(xdot, impulse, params.mass)
     plane = model == "stepping-plane"
-    if not plane and (y != 0.0 or ydot != 0.0):
+    if not plane:
         from pushrecovery.errors import InvalidParameterError
 
-        raise InvalidParameterError("--y and --ydot need --model stepping-plane")
+        if y != 0.0 or ydot != 0.0:
+            raise InvalidParameterError("--y and --ydot need --model stepping-plane")
+        given = [name for name in SUPPORT_KEYS if kwargs.pop(name) is not None]
+        if given:
+            flag = "--" + given[0].replace("_", "-")
+            raise InvalidParameterError(
+                f"{flag} needs --model stepping-plane (the feet on the ground plane), "
+                f"got --model {model}"
+            )
+    support = support_from(kwargs, params, file) if plane else None
     if plane:
-        predicted = classify_state(x, velocity, params, y=y, ydot=ydot)
+        predicted = classify_state(x, velocity, params, y=y, ydot=ydot, support=support)
     else:
         predicted = classify_state(x, velocity, params)
     if render and backend != "mujoco":
@@ -139,7 +163,7 @@ def simulate(
         from pushrecovery.sim.mujoco.render import require_offscreen_gl
 
         require_offscreen_gl()  # fail before the run, not after it
-    plant = make_plant(model, params, backend)
+    plant = make_plant(model, params, backend, support=support)
     # Frames (an extra forward pass per tick) only for the pictures.
     if render and isinstance(plant, Recording):
         plant.record()
@@ -149,10 +173,13 @@ def simulate(
         # A real force at the CoM, over 10 ms, instead of a velocity jump.
         plant.reset(x, 0.0)
         initial = plant.apply_push(Push.from_impulse(impulse, params.mass))
+    elif plane:
+        from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
+
+        assert isinstance(plant, PlaneSteppingPlant)  # make_plant's for stepping-plane
+        initial = plant.reset(x, velocity, y, ydot)
     else:
         initial = plant.reset(x, velocity)
-        if plane:
-            initial[1], initial[5] = y, ydot  # the planar state's y and ẏ
     result = run(
         plant,
         make_controller(controller, params, **controller_options(controller, kwargs)),
@@ -163,6 +190,8 @@ def simulate(
     data = result.to_dict()
     data["initial_state"] = {"x": x, "xdot": velocity} | ({"y": y, "ydot": ydot} if plane else {})
     data["predicted"] = predicted.to_dict()
+    if support is not None:
+        data["support"] = support.to_dict()
     if isinstance(plant, Measuring):  # MuJoCo: the state the push left, the CoP it measured
         half = len(initial) // 2
         data["after_push"] = {"x": float(initial[0]), "xdot": float(initial[half])}

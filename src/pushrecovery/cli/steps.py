@@ -102,8 +102,9 @@ def capture_region_command(
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.surfaces.capture_region import capture_region
 
+    file = kwargs["params_file"]
     params = params_from(kwargs)
-    support = support_from(kwargs, params)
+    support = support_from(kwargs, params, file)
     if plot is not None and plot.suffix.lower() not in (".png", ".svg", ".pdf"):
         raise InvalidParameterError(f"--plot must end in .png, .svg or .pdf, got {plot.name!r}")
     region = capture_region(

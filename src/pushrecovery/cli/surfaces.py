@@ -42,8 +42,9 @@ def bounds(as_json: bool, **kwargs: Any) -> None:
     """
     from pushrecovery.surfaces.bounds import bounds_data
 
+    file = kwargs["params_file"]
     params = params_from(kwargs)
-    emit(bounds_data(params, support_from(kwargs, params)), as_json)
+    emit(bounds_data(params, support_from(kwargs, params, file)), as_json)
 
 
 @click.command(
@@ -88,6 +89,7 @@ def classify(
     """
     from pushrecovery.surfaces.classify import classify as classify_state
 
+    file = kwargs["params_file"]
     params = params_from(kwargs)
     planar = (
         y is not None
@@ -101,7 +103,7 @@ def classify(
         emit({**result, "state": {"x": x, "xdot": xdot}}, as_json)
         return
     y, ydot = (0.0 if y is None else y), (0.0 if ydot is None else ydot)
-    support = support_from(kwargs, params)
+    support = support_from(kwargs, params, file)
     result = classify_state(x, xdot, params, y=y, ydot=ydot, support=support).to_dict()
     emit({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)
 
