@@ -69,7 +69,7 @@ RELAXED_GUIDE_CENTRE = 10.0
 INTERIOR_MARGIN = BOUNDARY
 #: The real-time mode's budget of warm Riccati passes, in stages: at most this / N passes
 #: (and at most MAX_PASSES), a pass costing O(N) (docs/mpc.md, "The real-time mode").
-REALTIME_PASS_STAGES = 1500
+REALTIME_PASS_STAGES = 1000
 #: The real-time mode's budget of interior-point iterations, in stages: at most this / N
 #: iterations (20 at N = 50, 5 at N = 200), each O(N) (docs/mpc.md, "The real-time mode").
 REALTIME_ITERATION_STAGES = 1000
