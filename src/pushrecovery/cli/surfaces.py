@@ -84,8 +84,9 @@ def classify(
     [s]). Without --y, --ydot, --stance, --left-foot or --right-foot: the paper's sagittal
     model, x relative to the ankle of a foot [heel, toe]. With any of them: the ground plane,
     x forward and y left in the frame of the feet (by default the ankles' midpoint is the
-    origin, in every stance), where the support polygon and the CMP region are 2-D and the
-    margins are signed distances of the capture point to them [m], positive inside.
+    origin, in every stance; the --params file's [feet], then the flags, place them), where
+    the support polygon and the CMP region are 2-D and the margins are signed distances of the
+    capture point to them [m], positive inside.
     """
     from pushrecovery.surfaces.classify import classify as classify_state
 
