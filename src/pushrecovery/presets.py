@@ -157,8 +157,9 @@ def load_support(
         left = {x = 0.0, y = 0.1, yaw = 0.0}   # ankle x, y [m]; yaw [rad] in [-pi, pi], default 0
         right = {x = 0.05, y = -0.1}
 
-    A pose not given is the default one (:meth:`~pushrecovery.ground.support.Support.
-    from_params`: x = 0, y = ±stance_width/2, yaw 0); poses are world frame, x forward, y left.
+    A pose not given is the default one
+    (:meth:`~pushrecovery.ground.support.Support.from_params`: x = 0, y = ±stance_width/2,
+    yaw 0); poses are world frame, x forward, y left.
 
     Parameters
     ----------
