@@ -1,12 +1,14 @@
-"""One state's signed distances to two convex polygons, in one compiled call.
+"""One point's signed distance to a convex polygon, compiled, to the bit of the numpy form.
 
-The single-state path of :func:`pushrecovery.surfaces.classify.classify` on the ground plane:
-the support polygon and the CMP region of one support, each distance the
-same floating-point operations as
-:meth:`pushrecovery.ground.polygon.ConvexPolygon.signed_distance` (numpy), so that the margins
-agree to the bit: inside, −max_i(n_i · p − b_i); outside, −min_i hypot(d − t_i e_i), with d
-the point minus vertex i, e_i edge i, t_i = clip((d · e_i) / (e_i · e_i), 0, 1); a NaN
-propagates as numpy's max and min propagate it.
+The single-state paths of :func:`pushrecovery.surfaces.classify.classify` (the support
+polygon and the CMP region) and :func:`pushrecovery.surfaces.step_impact.plan_impacts` (the
+landing foot's region) call it on Python floats instead of building arrays. Each distance is
+the same floating-point operations as
+:meth:`pushrecovery.ground.polygon.ConvexPolygon.signed_distance` (numpy), so that it agrees
+to the bit: inside, −max_i(n_i · p − b_i); outside, −min_i hypot(d_i − t_i e_i), with d_i
+the point minus vertex i, e_i edge i, t_i = clip((d_i · e_i) / (e_i · e_i), 0, 1); a NaN
+propagates as numpy's max and min propagate it. The operands that numpy computes with a
+reduction (e_i · e_i) come from numpy too (:func:`edge_rows`).
 """
 
 from __future__ import annotations
@@ -16,28 +18,41 @@ import math
 import numba
 import numpy as np
 
-__all__ = ["STRIDE", "pair_distances"]
-
-#: Values per edge row of a table: n_x, n_y, b, v_x, v_y, e_x, e_y, e · e.
-STRIDE = 8
+__all__ = ["edge_rows", "signed_distance"]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
-def _signed_distance(table, row, count, px, py):  # type: ignore[no-untyped-def]
-    """Signed distance of p to the polygon of ``table[row, :count]`` [m], + inside."""
+def edge_rows(vertices, normals, offsets):  # type: ignore[no-untyped-def]
+    """Return the rows :func:`signed_distance` reads, one per edge (E, 8).
+
+    n_x, n_y, b, v_x, v_y, e_x, e_y, e · e of a convex polygon's counter-clockwise
+    ``vertices`` (E, 2), outward unit ``normals`` (E, 2) and ``offsets`` (E,), computed as
+    the numpy signed distance computes them.
+    """
+    edges = np.concatenate((vertices[1:], vertices[:1])) - vertices
+    length2 = np.einsum("ij,ij->i", edges, edges)
+    return np.ascontiguousarray(np.column_stack([normals, offsets, vertices, edges, length2]))
+
+
+@numba.njit(cache=True, nogil=True)
+def signed_distance(rows, px, py):  # type: ignore[no-untyped-def]
+    """Signed distance of p = (px, py) to the polygon of ``rows`` (:func:`edge_rows`) [m].
+
+    Positive inside.
+    """
+    count = rows.shape[0]
     excess = -np.inf
     for k in range(count):
-        e = table[row, k, 0] * px + table[row, k, 1] * py - table[row, k, 2]
+        e = rows[k, 0] * px + rows[k, 1] * py - rows[k, 2]
         if e > excess or e != e:  # a NaN stays, as in numpy's max
             excess = e
     if not excess > 0.0:
         return -excess
     best = np.inf
     for k in range(count):
-        dx = px - table[row, k, 3]
-        dy = py - table[row, k, 4]
-        ex, ey = table[row, k, 5], table[row, k, 6]
-        along = (dx * ex + dy * ey) / table[row, k, 7]
+        dx = px - rows[k, 3]
+        dy = py - rows[k, 4]
+        ex, ey = rows[k, 5], rows[k, 6]
+        along = (dx * ex + dy * ey) / rows[k, 7]
         if along < 0.0:
             along = 0.0
         if along > 1.0:
@@ -46,15 +61,3 @@ def _signed_distance(table, row, count, px, py):  # type: ignore[no-untyped-def]
         if gap < best or gap != gap:
             best = gap
     return -best
-
-
-@numba.njit(cache=True, nogil=True)
-def pair_distances(table, counts, px, py):  # type: ignore[no-untyped-def]
-    """Return the signed distances of p = (px, py) to the polygons of rows 0 and 1 [m].
-
-    ``table`` of shape (2, E, :data:`STRIDE`), row r's first ``counts[r]`` edges; + inside.
-    """
-    return (
-        _signed_distance(table, 0, counts[0], px, py),
-        _signed_distance(table, 1, counts[1], px, py),
-    )

@@ -23,7 +23,6 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.polygon import following
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
@@ -32,9 +31,10 @@ from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.step_impact import TouchdownImpact, plan_impacts
-from pushrecovery.surfaces.step_regions import StepRegions, _sagittal_plan, line_steps
+from pushrecovery.surfaces.step_regions import StepRegions, _sagittal_plan
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 from pushrecovery.surfaces.verdicts import (  # sagittal_verdicts: campaign.pushes imports it here
+    _first_step_range,
     _steps,
     _strategy,
     sagittal_verdict,
@@ -233,8 +233,7 @@ def classify(
         def build() -> _Details:
             plan = _sagittal_plan(capture, params, steps)
             step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)
-            line = line_steps(np.array([capture]), params.heel, params.toe, 0.0, params)
-            step["step_length_range"] = [float(line.shortest[0]), float(line.longest[0])]
+            step["step_length_range"] = list(_first_step_range(capture, steps, params))
             impacts = tuple(plan_impacts(plan, (x, 0.0), (xdot, 0.0), params))
             return step, plan, impacts
 
@@ -280,13 +279,13 @@ def _first_step(
 class _PlaneTables:
     """A support's regions for one state's verdict.
 
-    ``table`` stacks the support polygon and the CMP region as
-    :func:`pushrecovery.kernels.single_margins.pair_distances` reads them.
+    ``cop`` and ``cmp``: the support polygon's and the CMP region's edges as
+    :func:`pushrecovery.kernels.single_margins.signed_distance` reads them.
     """
 
     inv_omega: float
-    table: NDArray[np.float64]
-    counts: NDArray[np.int64]
+    cop: NDArray[np.float64]
+    cmp: NDArray[np.float64]
     cmp_region: tuple[tuple[float, ...], ...]
     regions: StepRegions
 
@@ -294,23 +293,14 @@ class _PlaneTables:
 @functools.lru_cache(maxsize=32)
 def _plane_tables(params: BodyParams, support: Support) -> _PlaneTables:
     """Return the tables of one support (kept: a loop asks for the same support again)."""
-    from pushrecovery.kernels.single_margins import STRIDE
+    from pushrecovery.kernels.single_margins import edge_rows
 
     hip_region = cmp_polygon(support, params)
-    polygons = (support.polygon, hip_region)
-    table = np.zeros((2, max(len(p.offsets) for p in polygons), STRIDE))
-    for row, polygon in enumerate(polygons):
-        # The operands of ConvexPolygon.signed_distance, computed as it computes them.
-        start = polygon.vertices
-        edge = following(start) - start
-        length2 = np.einsum("ij,ij->i", edge, edge)
-        edges = np.column_stack([polygon.normals, polygon.offsets, start, edge, length2])
-        table[row, : len(edges)] = edges
-    counts = np.array([len(p.offsets) for p in polygons], dtype=np.int64)
-    table.flags.writeable = counts.flags.writeable = False
+    cop, cmp = (edge_rows(p.vertices, p.normals, p.offsets) for p in (support.polygon, hip_region))
+    cop.flags.writeable = cmp.flags.writeable = False
     cmp_region = tuple(map(tuple, hip_region.to_list()))
     regions = StepRegions.of(params, support)
-    return _PlaneTables(1.0 / params.omega, table, counts, cmp_region, regions)
+    return _PlaneTables(1.0 / params.omega, cop, cmp, cmp_region, regions)
 
 
 @functools.lru_cache(maxsize=32)
@@ -328,7 +318,7 @@ def _classify_plane(
     support: Support | None,
 ) -> Classification:
     """:func:`classify` on the ground plane: the verdict in one compiled call, the plan lazily."""
-    from pushrecovery.kernels.single_margins import pair_distances
+    from pushrecovery.kernels.single_margins import signed_distance
 
     y = 0.0 if y is None else finite_float("y", y, "m")
     ydot = 0.0 if ydot is None else finite_float("ydot", ydot, "m/s")
@@ -339,7 +329,7 @@ def _classify_plane(
     tables = _plane_tables(params, support)
     # ξ as capture_point computes it: x + ẋ (1/ω).
     xi = (x + xdot * tables.inv_omega, y + ydot * tables.inv_omega)
-    cop, cmp = pair_distances(tables.table, tables.counts, *xi)
+    cop, cmp = signed_distance(tables.cop, *xi), signed_distance(tables.cmp, *xi)
     if not (math.isfinite(cop) and math.isfinite(cmp)):
         raise InvalidParameterError("states are too large: the capture point overflows")
     steps, step_margin = tables.regions.locate(*xi)

@@ -35,7 +35,6 @@ from pushrecovery.arguments import finite_float, finite_vector, require_type
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
-from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.n_step import landing_viable
 
 __all__ = ["TouchdownImpact", "plan_impacts"]
@@ -118,41 +117,55 @@ def plan_impacts(
         :func:`~pushrecovery.surfaces.capture_region.capture_region` (±1000 m, ±100 m/s), or
         a non-finite ``yaw``.
     """
+    from pushrecovery.kernels.single_margins import edge_rows, signed_distance
+
     require_type("plan", plan, CapturePlan)
     r = finite_vector("position", position, 2, MAX_POSITION, "m")
     v = finite_vector("velocity", velocity, 2, MAX_SPEED, "m/s")
     require_type("params", params, BodyParams)
     yaw = finite_float("yaw", yaw, "rad")
     omega, height = params.omega, params.com_height
-    ankle = np.array(plan.ankle, dtype=np.float64)
+    # Component by component on floats: the operations of the 2-vector form, the same bits
+    # (the dot product stays numpy's, whose summation the floats need not match).
+    (rx, ry), (vx, vy) = r.tolist(), v.tolist()
+    ax, ay = (float(a) for a in plan.ankle)
+    cops, footholds, touchdowns = plan.cops.tolist(), plan.footholds.tolist(), plan.touchdowns
     start = 0.0
     found = []
-    first = math.exp(-omega * float(plan.touchdowns[0]))
-    hip = plan.hip / (1.0 - first) if first < 1.0 else np.zeros(2)
+    first = math.exp(-omega * float(touchdowns[0]))
+    hx, hy = (h / (1.0 - first) for h in plan.hip.tolist()) if first < 1.0 else (0.0, 0.0)
+    inv = 1.0 / omega  # as capture_point
     for k in range(plan.steps):
-        t = float(plan.touchdowns[k])
-        p = plan.cops[k] + (hip if k == 0 else 0.0)
+        t = float(touchdowns[k])
+        px, py = cops[k][0] + (hx if k == 0 else 0.0), cops[k][1] + (hy if k == 0 else 0.0)
         c, s = math.cosh(omega * (t - start)), math.sinh(omega * (t - start))
-        r, v = p + (r - p) * c + v / omega * s, (r - p) * omega * s + v * c
+        rx, ry, vx, vy = (
+            px + (rx - px) * c + vx / omega * s,
+            py + (ry - py) * c + vy / omega * s,
+            (rx - px) * omega * s + vx * c,
+            (ry - py) * omega * s + vy * c,
+        )
         start = t
-        q = plan.footholds[k]
-        after = v + (v @ (r - ankle)) / height**2 * (r - q)
-        xi = capture_point(r, v, omega)
-        xi_impact = capture_point(r, after, omega)
+        qx, qy = footholds[k]
+        lean = float(np.array((vx, vy)) @ np.array((rx - ax, ry - ay))) / height**2
+        after = (vx + lean * (rx - qx), vy + lean * (ry - qy))
+        xi = (rx + vx * inv, ry + vy * inv)
+        xi_impact = (rx + after[0] * inv, ry + after[1] * inv)
         remaining = landing_viable(params, plan.swings[k], yaw, plan.steps - 1 - k)
-        region = remaining.transformed(float(q[0]), float(q[1]), 0.0)
-        speed = float(np.hypot(*v))
+        region = remaining.transformed(qx, qy, 0.0)
+        rows = edge_rows(region.vertices, region.normals, region.offsets)
+        speed = float(np.hypot(vx, vy))
         found.append(
             TouchdownImpact(
                 t,
-                (float(r[0]), float(r[1])),
-                (float(v[0]), float(v[1])),
-                (float(xi[0]), float(xi[1])),
-                (float(xi_impact[0]), float(xi_impact[1])),
-                float(region.signed_distance(*xi)),
-                float(region.signed_distance(*xi_impact)),
+                (rx, ry),
+                (vx, vy),
+                xi,
+                xi_impact,
+                signed_distance(rows, *xi),  # region.signed_distance's bits, compiled
+                signed_distance(rows, *xi_impact),
                 float(np.hypot(*after)) / speed if speed > 0.0 else 1.0,
             )
         )
-        ankle = np.array(q, dtype=np.float64)
+        ax, ay = qx, qy
     return found

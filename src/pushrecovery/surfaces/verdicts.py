@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.arguments import finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
+from pushrecovery.surfaces.cmp import cmp_margin, cmp_offset, cmp_region
 from pushrecovery.surfaces.cop import capture_point, cop_margin, cop_region
 from pushrecovery.surfaces.step_regions import LineSteps, _growth, line_steps
 from pushrecovery.surfaces.strategy import Strategy
@@ -189,3 +189,22 @@ def sagittal_verdict(x: float, xdot: float, params: BodyParams) -> SagittalVerdi
     low, high = levels[-1]
     margin = min(capture - low, high - capture)
     return SagittalVerdict(capture, cop, cmp, steps, margin, _strategy(cop, cmp, steps))
+
+
+def _first_step_range(capture: float, steps: int, params: BodyParams) -> tuple[float, float]:
+    """``(shortest, longest)`` of :func:`line_steps` for one capture point [m], on floats.
+
+    The first steps along the recommended one's direction that still capture with ``steps``
+    steps (>= 1), the stance foot [heel, toe] about the ankle at 0: the same operations as
+    the vectorised path, so the same bits.
+    """
+    reach, hip = params.max_step_length, cmp_offset(params)
+    scale = math.exp(params.omega * params.min_step_time)
+    _, without_hip = _growth(params, False)
+    more = float(without_hip[steps - 1])
+    first = scale * capture - scale * hip - (scale - 1.0) * params.toe - params.toe - more
+    last = scale * capture + scale * hip - (scale - 1.0) * params.heel - params.heel + more
+    first, last = max(first - 0.0, -reach), min(last - 0.0, reach)
+    if 0.5 * (first + last) >= 0.0:
+        return max(first, 0.0), last
+    return max(-last, 0.0), -first
