@@ -251,10 +251,12 @@ def _numpy_foothold(  # pragma: no cover - only when the compiled simplex fails
     hip: bool,
 ) -> FloatArray | None:
     """Return the recommended foothold relative to the ankle, from the numpy region."""
-    from pushrecovery.surfaces.capture_region import _foothold_and_centre
+    from pushrecovery.surfaces.capture_region import _region_loop
 
     option = _world_option(swing, yaw, stance_key, np.zeros(2))
-    _, foothold = _foothold_and_centre(relative, params, option, touchdown, steps, hip)
+    _, foothold = _region_loop(
+        relative, params, option, np.zeros(2), stance_key, touchdown, steps, hip
+    )
     return foothold
 
 

@@ -64,7 +64,8 @@ class CaptureRegion:
     Attributes
     ----------
     polygon : ConvexPolygon or None
-        The region of ankle positions of the landing foot [m]; None when empty.
+        The region of ankle positions of the landing foot [m]; None when empty. Built when
+        first read (a loop that needs the foothold alone does not pay for it).
     swing : Stance
         The landing foot.
     touchdown : float
@@ -78,23 +79,34 @@ class CaptureRegion:
         its boundary (the largest margin for a misplaced foot) [m].
     """
 
-    polygon: ConvexPolygon | None
     swing: Stance
     touchdown: float
     timing: str
     steps: int
     foothold: FloatArray | None = field(default=None)
+    # The polygon, or its counter-clockwise vertices until first read.
+    _polygon: ConvexPolygon | None = field(default=None, repr=False)
+    _vertices: FloatArray | None = field(default=None, repr=False)
+
+    @property
+    def polygon(self) -> ConvexPolygon | None:
+        """The region of ankle positions of the landing foot [m]; None when empty."""
+        if self._polygon is None and self._vertices is not None:
+            object.__setattr__(self, "_polygon", ConvexPolygon._from_ccw(self._vertices))
+        return self._polygon
 
     @property
     def area(self) -> float:
         """Area of the region [m²] (0 when empty)."""
-        return 0.0 if self.polygon is None else self.polygon.area
+        polygon = self.polygon
+        return 0.0 if polygon is None else polygon.area
 
     def margin(self, x: NDArray[np.float64] | float, y: NDArray[np.float64] | float) -> FloatArray:
         """Signed distance of footholds (x, y) to the region [m], + inside, −inf if empty."""
-        if self.polygon is None:
+        polygon = self.polygon
+        if polygon is None:
             return np.full(np.broadcast(np.asarray(x), np.asarray(y)).shape, -np.inf)
-        return self.polygon.signed_distance(x, y)
+        return polygon.signed_distance(x, y)
 
 
 def capture_region(
@@ -153,13 +165,26 @@ def capture_region(
             xi[1] - centre[1]
         )
         swing = Stance.LEFT if lateral >= 0.0 else Stance.RIGHT
-    option = step_options(params, support, swing)[0]
+    option, ankle, key = _first_option(params, support, swing)
     if timing == "exact":  # the compiled pipeline: a balance loop asks at every tick
-        polygon, foothold = _foothold_and_centre(xi, params, option, t, steps, hip)
-        return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
+        region, foothold = _region_loop(xi, params, option, ankle, key, t, steps, hip)
+        if isinstance(region, ConvexPolygon):  # pragma: no cover - the numpy path's polygon
+            return CaptureRegion(option.swing, t, timing, steps, foothold, _polygon=region)
+        return CaptureRegion(option.swing, t, timing, steps, foothold, _vertices=region)
     polygon = foothold_region(xi, params, option, t, steps, timing=timing, hip=hip)
     foothold = None if polygon is None else chebyshev_centre_unchecked(polygon)
-    return CaptureRegion(polygon, option.swing, t, timing, steps, foothold)
+    return CaptureRegion(option.swing, t, timing, steps, foothold, _polygon=polygon)
+
+
+@functools.lru_cache(maxsize=64)
+def _first_option(
+    params: BodyParams, support: Support, swing: Stance | str | None
+) -> tuple[StepOption, FloatArray, bytes]:
+    """Return the step option, its stance ankle and its :func:`step_terms` key (kept)."""
+    option = step_options(params, support, swing)[0]
+    ankle = np.asarray(option.ankle, dtype=np.float64)
+    ankle.flags.writeable = False
+    return option, ankle, (option.stance.vertices - ankle).tobytes()
 
 
 ORIGIN = np.zeros(2)
@@ -188,6 +213,49 @@ class StepTerms:
     split_total: FloatArray
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class _StepShapes:
+    """The touchdown-free part of :class:`StepTerms`: the stacked shapes and the window."""
+
+    has_box: bool
+    foot_shapes: FloatArray
+    foot_counts: NDArray[np.int64]
+    window_normals: FloatArray
+    window_offsets: FloatArray
+    split_shapes: FloatArray
+    split_counts: NDArray[np.int64]
+
+
+@functools.lru_cache(maxsize=256)
+def _step_shapes(
+    params: BodyParams, swing: Stance, yaw: float, steps: int, hip: bool, stance_key: bytes
+) -> _StepShapes:
+    """Return the shapes of :func:`step_terms`, the same for every touchdown (kept)."""
+    stance = np.frombuffer(stance_key, dtype=np.float64).reshape(-1, 2)
+    landing = landing_viable(params, swing, yaw, steps - 1)
+    box = hip_box(params, yaw) if hip else None
+    foot: list[tuple[float, Shape]] = [(1.0, stance), (-1.0, landing)]
+    if box is not None:
+        foot.append((-1.0, box))
+    split: list[tuple[float, Shape]] = [
+        (1.0, box if box is not None else np.zeros((1, 2))),
+        (1.0, stance),
+        (1.0, landing),
+    ]
+    foot_shapes, foot_counts, _ = stacked_shapes(foot)
+    split_shapes, split_counts, _ = stacked_shapes(split)
+    window = reach_polygon(params, swing, yaw)
+    return _StepShapes(
+        box is not None,
+        foot_shapes,
+        foot_counts,
+        window.normals,
+        window.offsets,
+        split_shapes,
+        split_counts,
+    )
+
+
 @functools.lru_cache(maxsize=256)
 def step_terms(
     params: BodyParams,
@@ -201,60 +269,51 @@ def step_terms(
     """Return the terms of one step, the stance given by its vertices relative to its ankle.
 
     Kept (the plans and the regions ask for the same few again and again): ``stance_key`` is
-    the float64 bytes of the stance's vertices minus its ankle.
+    the float64 bytes of the stance's vertices minus its ankle. A new touchdown costs the
+    weights and one compiled sum: the shapes are kept apart, for every touchdown.
     """
     from pushrecovery.kernels.polygons import minkowski_loop
 
-    stance = np.frombuffer(stance_key, dtype=np.float64).reshape(-1, 2)
-    landing = landing_viable(params, swing, yaw, steps - 1)
-    box = hip_box(params, yaw) if hip else None
+    shapes = _step_shapes(params, swing, yaw, steps, hip, stance_key)
     scale = math.exp(params.omega * touchdown)
-    foot: list[tuple[float, Shape]] = [(1.0 - scale, stance), (-1.0, landing)]
-    if box is not None:
-        foot.append((-scale, box))
-    split: list[tuple[float, Shape]] = [
-        (scale, box if box is not None else np.zeros((1, 2))),
-        (scale - 1.0, stance),
-        (1.0, landing),
-    ]
-    foot_shapes, foot_counts, foot_weights = stacked_shapes(foot)
-    split_shapes, split_counts, split_weights = stacked_shapes(split)
-    window = reach_polygon(params, swing, yaw)
+    foot = (1.0 - scale, -1.0, -scale) if shapes.has_box else (1.0 - scale, -1.0)
+    foot_weights = np.array(foot, dtype=np.float64)
+    split_weights = np.array((scale, scale - 1.0, 1.0), dtype=np.float64)
+    if not math.isfinite(float(foot_weights.sum() + split_weights.sum())):
+        raise InvalidParameterError(f"Minkowski weights must be finite, got {list(foot)}")
     return StepTerms(
         scale,
-        box is not None,
-        foot_shapes,
-        foot_counts,
+        shapes.has_box,
+        shapes.foot_shapes,
+        shapes.foot_counts,
         foot_weights,
-        window.normals,
-        window.offsets,
-        split_shapes,
-        split_counts,
+        shapes.window_normals,
+        shapes.window_offsets,
+        shapes.split_shapes,
+        shapes.split_counts,
         split_weights,
-        minkowski_loop(split_shapes, split_counts, split_weights, ORIGIN),
+        minkowski_loop(shapes.split_shapes, shapes.split_counts, split_weights, ORIGIN),
     )
 
 
-def _foothold_and_centre(
+def _region_loop(
     xi: FloatArray,
     params: BodyParams,
     option: StepOption,
+    ankle: FloatArray,
+    key: bytes,
     t: float,
     steps: int,
     hip: bool,
-    *,
-    polygon: bool = True,
-) -> tuple[ConvexPolygon | None, FloatArray | None]:
+) -> tuple[FloatArray | ConvexPolygon | None, FloatArray | None]:
     """(S3) exactly at t and its recommended foothold, in one compiled call [m].
 
-    :func:`foothold_region` and :func:`chebyshev_centre` (the numpy path, taken when the
-    compiled simplex fails); (None, None) when no foothold captures. Without ``polygon`` the
-    region is not built (None) and only the foothold is returned.
+    The region as its counter-clockwise vertices (the polygon left unbuilt), or as the
+    polygon of :func:`foothold_region` and the foothold its :func:`chebyshev_centre` when the
+    compiled simplex fails; (None, None) when no foothold captures.
     """
     from pushrecovery.kernels.polygons import foothold_kernel
 
-    ankle = np.asarray(option.ankle, dtype=np.float64)
-    key = (option.stance.vertices - ankle).tobytes()
     terms = step_terms(params, option.swing, option.yaw, steps, t, hip, key)
     vertices, qx, qy, ok = foothold_kernel(
         terms.foot_shapes,
@@ -269,8 +328,7 @@ def _foothold_and_centre(
         return region, None if region is None else chebyshev_centre_unchecked(region)
     if len(vertices) < 3:
         return None, None
-    region = ConvexPolygon._from_ccw(vertices + ankle) if polygon else None
-    return region, np.array([qx + ankle[0], qy + ankle[1]])
+    return vertices + ankle, np.array([qx + ankle[0], qy + ankle[1]])
 
 
 def foothold_region(
