@@ -17,6 +17,7 @@ from pushrecovery import load_params
 from pushrecovery.control.base import Command, make_controller
 from pushrecovery.control.recovery_plane import PlaneRecoveryController, hip_share
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.support import FootPose, Support
 from pushrecovery.models.flywheel_plane import plane_discrete
 from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 from pushrecovery.sim.registry import make_plant
@@ -92,6 +93,40 @@ def test_plans_are_followed_and_kept_within_reach_and_step_time():
     # The CoP always on the support of its tick: on the foot under it at the end.
     final = result.final_state
     assert math.hypot(final[0] - feet[-1, 0], final[1] - feet[-1, 1]) < params.toe
+
+
+def test_a_turned_and_moved_stance_gets_the_turned_and_moved_command(monkeypatch):
+    """Any stance yaw and place re-plans from the regions and terms built at construction."""
+    import pushrecovery.kernels.polygons as polygons
+    import pushrecovery.surfaces.capture_plan as plans
+    import pushrecovery.surfaces.n_step as n_step
+
+    params = load_params()
+    controller = PlaneRecoveryController(params)
+
+    def built(*_, **__):
+        raise AssertionError("a Minkowski sum built in the loop")
+
+    for module, name in ((n_step, "minkowski_sum_unchecked"), (plans, "minkowski_sum_unchecked"),
+                         (plans, "minkowski_sum_loop"), (polygons, "minkowski_loop")):  # fmt: skip
+        monkeypatch.setattr(module, name, built)
+    push = np.array([0.9, 0.5])  # CoM velocity in the stance foot's frame [m/s]
+    commands = {}
+    for yaw, x, y in ((0.0, 0.0, 0.0), (0.7, 1.3, -0.4), (-2.9, -0.8, 2.1), (math.pi, 0.2, 0.3)):
+        turn = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+        stance = FootPose(x, y, yaw)
+        support = Support.from_params(params, "left", left=stance, right=stance)
+        velocity = turn @ push
+        state = np.array([x, y, 0.0, 0.0, velocity[0], velocity[1], 0.0, 0.0])
+        controller.reset(state)
+        controller.support = support
+        command = controller.compute(0.0, state)
+        assert controller.mode == "step" and command.swing == "right"
+        local = turn.T @ (np.array(command.foothold) - (x, y))
+        cop = turn.T @ (np.array([command.cop, command.cop_y]) - (x, y))
+        commands[yaw] = np.concatenate([local, cop])
+    for found in commands.values():
+        assert np.abs(found - commands[0.0]).max() <= 1e-12
 
 
 def test_the_hip_share_is_the_integral_of_the_bang_bang_profile():
