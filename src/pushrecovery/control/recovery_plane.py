@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, non_negative_float, positive_float
-from pushrecovery.control.base import Command, Controller, register
+from pushrecovery.control.base import Command, Controller, StepInfo, register
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import Shape, decompose_unchecked, minkowski_sum_unchecked
 from pushrecovery.ground.support import FootPose, Stance, Support
@@ -136,6 +136,18 @@ class PlaneRecoveryController(Controller):
         self.plan: CapturePlan | None = None
         self._hip: _HipManoeuvre | None = None
         self._swing: tuple[Stance, tuple[float, float], float] | None = None
+
+    def observe(self, info: StepInfo) -> None:
+        """Take the feet a plant reports (``info.support``, a Support) when no step is under way.
+
+        ``stepping-plane`` reports the stance and feet a run starts on right after
+        :meth:`reset` and after every tick: between steps the next plan starts from them (a
+        run from one foot plans from that foot). While a step is under way the controller
+        keeps its own feet (the commanded foothold lands at the commanded time).
+        """
+        support = info.support
+        if isinstance(support, Support) and info.stance and self.plan is None:
+            self.support = support
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """Return the command of the current phase (module docstring)."""
