@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 from pushrecovery.cli import main
 from pushrecovery.cli.app import cli
-from pushrecovery.control.base import StepInfo
+from pushrecovery.control.base import Controller
 from pushrecovery.control.recovery_plane import PlaneRecoveryController
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.support import FootPose, Stance, Support
@@ -27,18 +27,15 @@ P = load_params()
 ONE_STEP = (0.0, 0.1, 0.0, -0.5)  # x, y [m], xdot, ydot [m/s]
 
 
-class AdoptingController(PlaneRecoveryController):
-    """recovery-plane with the hook its observe needs: the plant's feet while neither steps."""
+class BlindController(PlaneRecoveryController):
+    """recovery-plane without its observe: the feet it commands, never the plant's."""
 
-    def observe(self, info: StepInfo) -> None:
-        support = info.support
-        if isinstance(support, Support) and info.stance and self.plan is None:
-            self.support = support
+    observe = Controller.observe
 
 
 @pytest.fixture(scope="module")
-def adopting() -> AdoptingController:
-    return AdoptingController(P)
+def blind() -> BlindController:
+    return BlindController(P)
 
 
 @pytest.fixture(scope="module")
@@ -107,13 +104,13 @@ def test_a_bad_support_is_refused(call: object, error: type[Exception], match: s
         call()  # type: ignore[operator]
 
 
-def test_the_start_report_changes_no_default_run(
-    adopting: AdoptingController, controller: PlaneRecoveryController
+def test_the_reported_feet_change_no_default_run(
+    controller: PlaneRecoveryController, blind: BlindController
 ) -> None:
-    """A controller that adopts the reported feet runs bit for bit as one that does not."""
+    """Runs from both feet: bit for bit with and without the plant's reports of the feet."""
     for x, y, xdot, ydot in [(0.02, 0.01, 0.9, 0.2), (0.0, 0.0, 1.6, -0.5), (0.0, 0.0, 0.2, 1.2)]:
         runs = []
-        for each in (adopting, controller):
+        for each in (controller, blind):
             plant = make_plant("stepping-plane", P)
             runs.append(simulate(plant, each, plant.reset(x, xdot, y, ydot), duration=2.0))
         assert np.array_equal(runs[0].states, runs[1].states)
@@ -132,13 +129,6 @@ def _one_foot_run(controller: PlaneRecoveryController) -> tuple[int, str]:
 
 
 def test_a_run_from_one_foot_takes_the_step_the_verdict_promises(
-    adopting: AdoptingController,
-) -> None:
-    assert _one_foot_run(adopting) == (1, "recovered")
-
-
-@pytest.mark.xfail(strict=True, reason="needs the controller hook (observe adopts info.support)")
-def test_recovery_plane_from_one_foot_takes_the_promised_step(
     controller: PlaneRecoveryController,
 ) -> None:
     assert _one_foot_run(controller) == (1, "recovered")
