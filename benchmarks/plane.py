@@ -14,6 +14,13 @@
    memory per state: the growth of the peak RSS (VmHWM, reset just before the call) of a
    subprocess over its RSS before the call, the result included. Targets: <= 10x and <= 100
    bytes per state. A quiet-standing distribution is printed for information.
+5. Single-state ``classify`` (issue 32), sagittal and on the plane, the verdict and margins
+   alone and with the full plan (its first step, plan and impacts read), over 4000 states
+   (x ~ N(0.05, 0.05) m, y ~ N(0, 0.05) m, ẋ, ẏ ~ N(0, 0.8) m/s): median, p99 and max over
+   every call, each beside a 100x100 mat-vec timed in the same loop. Targets: median <= 20 µs
+   for the verdict, <= 200 µs with the plan.
+6. ``pushrecovery classify --y 0.05 --json`` (the planar CLI) in a fresh process vs ``python
+   -c "import numpy"``, after a first run (information; target <= 2x, issue 32).
 """
 
 from __future__ import annotations
@@ -78,6 +85,98 @@ def monitor_query() -> tuple[float, float]:
         f"{median / base_median:.0f}"
     )
     return median, p99
+
+
+def _every_call(func, states, baseline) -> tuple[np.ndarray, np.ndarray]:
+    """Time func(*state) and baseline() for each state, alternately [µs]."""
+    clock = time.perf_counter_ns
+    own, base = np.empty(len(states)), np.empty(len(states))
+    for i, state in enumerate(states):
+        start = clock()
+        func(*state)
+        middle = clock()
+        baseline()
+        end = clock()
+        own[i], base[i] = middle - start, end - middle
+    return own / 1e3, base / 1e3
+
+
+def _planned(result):
+    result.step, result.plan, result.impacts  # noqa: B018 - built on first read
+    return result
+
+
+def classify_single() -> bool:
+    """Single-state classify, sagittal and plane, verdict alone and with the plan (item 5)."""
+    from pushrecovery.surfaces.classify import classify
+
+    params = load_params()
+    rng = np.random.default_rng(5)
+    n = 4000
+    states = np.column_stack(
+        [
+            rng.normal(0.05, 0.05, n),
+            rng.normal(0.0, 0.05, n),
+            rng.normal(0.0, 0.8, n),
+            rng.normal(0.0, 0.8, n),
+        ]
+    ).tolist()
+    matrix, vector = rng.normal(size=(100, 100)), rng.normal(size=100)
+
+    def matvec():
+        return matrix @ vector
+
+    cases = {
+        "sagittal, verdict": (lambda x, y, xd, yd: classify(x, xd, params), 20.0),
+        "sagittal, with the plan": (lambda x, y, xd, yd: _planned(classify(x, xd, params)), 200.0),
+        "plane, verdict": (lambda x, y, xd, yd: classify(x, xd, params, y=y, ydot=yd), 20.0),
+        "plane, with the plan": (
+            lambda x, y, xd, yd: _planned(classify(x, xd, params, y=y, ydot=yd)),
+            200.0,
+        ),
+    }
+    counts = {s.value: 0 for s in STRATEGY_CODES}
+    for x, y, xdot, ydot in states:
+        counts[classify(x, xdot, params, y=y, ydot=ydot).strategy.value] += 1
+    failed = False
+    for name, (func, target) in cases.items():
+        for state in states[:50]:  # the support's tables and the compiled paths, once
+            func(*state)
+        own, base = _every_call(func, states, matvec)
+        median, p99, worst = np.median(own), np.percentile(own, 99), own.max()
+        base_median = np.median(base)
+        failed |= median > target
+        print(
+            f"classify ({name}), {n} calls: median {median:.1f} µs, p99 {p99:.1f} µs, max "
+            f"{worst:.0f} µs (target median <= {target:g}); 100x100 mat-vec {base_median:.2f} "
+            f"µs; ratios {median / base_median:.1f} / {p99 / base_median:.1f} / "
+            f"{worst / base_median:.0f}"
+        )
+    print(f"  (plane states: {counts})")
+    return failed
+
+
+def classify_startup() -> float:
+    """The planar CLI classify --json in a fresh process vs import numpy (item 6)."""
+    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+    exe = Path(sys.executable).with_name("pushrecovery")
+    command = [str(exe), "classify", "--x", "0.0", "--xdot", "0.3", "--y", "0.05", "--json"]
+
+    def run(cmd):
+        return lambda: subprocess.run(cmd, check=True, capture_output=True, env=env)
+
+    run(command)()  # a first run on this machine fills the caches
+    numpy_import = min(
+        timeit.repeat(run([sys.executable, "-c", "import numpy"]), number=1, repeat=REPEAT)
+    )
+    wall = min(timeit.repeat(run(command), number=1, repeat=REPEAT))
+    ratio = wall / numpy_import
+    print(
+        f"  (information) pushrecovery classify --y 0.05 --json in a fresh process: "
+        f"{wall * 1e3:.0f} ms; python -c 'import numpy' {numpy_import * 1e3:.0f} ms; ratio "
+        f"{ratio:.1f} (issue 32's target <= 2{'' if ratio <= 2.0 else ': not met'})"
+    )
+    return ratio
 
 
 def bounds_startup() -> float:
@@ -200,7 +299,9 @@ def main() -> int:
     startup = bounds_startup()
     margins = plane_margins()
     ratio, per_state = classify_many()
-    failed = (
+    single_failed = classify_single()
+    classify_startup()
+    failed = single_failed or (
         median > 20.0
         or p99 > 200.0
         or startup > 2.0
