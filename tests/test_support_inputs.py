@@ -117,7 +117,10 @@ def test_the_reported_feet_change_no_default_run(
         assert runs[0].footholds_xy == runs[1].footholds_xy and len(runs[0].footholds_xy) > 1
 
 
-def _one_foot_run(controller: PlaneRecoveryController) -> tuple[int, str]:
+def test_a_run_from_one_foot_takes_the_step_the_verdict_promises(
+    controller: PlaneRecoveryController,
+) -> None:
+    """On the left foot pushed right: the verdict's one step, landed where its plan puts it."""
     x, y, xdot, ydot = ONE_STEP
     left = Support.from_params(P, "left")
     verdict = classify(x, xdot, P, y=y, ydot=ydot, support=left)
@@ -125,13 +128,10 @@ def _one_foot_run(controller: PlaneRecoveryController) -> tuple[int, str]:
     assert classify(x, xdot, P, y=y, ydot=ydot).strategy == "ankle"  # on both feet
     plant = make_plant("stepping-plane", P, support=left)
     result = simulate(plant, controller, plant.reset(x, xdot, y, ydot), duration=3.0)
-    return len(result.footholds_xy) - 1, result.outcome.value
-
-
-def test_a_run_from_one_foot_takes_the_step_the_verdict_promises(
-    controller: PlaneRecoveryController,
-) -> None:
-    assert _one_foot_run(controller) == (1, "recovered")
+    assert result.outcome.value == "recovered"
+    assert result.footholds_xy[0] == left.ankle and len(result.footholds_xy) == 2
+    planned = verdict.to_dict()["plan"]["footholds"][0]
+    assert result.footholds_xy[1] == pytest.approx(tuple(planned), abs=1e-9)
 
 
 def invoke(*args: str) -> str:
