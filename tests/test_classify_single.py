@@ -281,3 +281,15 @@ def test_bad_single_plane_arguments_are_refused(params):
         classify(0.0, 0.0, params, ydot=math.nan)
     with pytest.raises(InvalidParameterError, match="capture point overflows"):
         classify(1.7e308, 1.7e308, params, y=0.0)
+
+
+def test_a_classification_pickles_with_its_plan(params):
+    import copy
+    import json
+    import pickle
+
+    for kw in ({}, {"y": 0.05, "ydot": 0.4}, {"y": 0.0, "ydot": 0.0}):
+        found = classify(0.0, 1.2 if kw.get("ydot") else 0.1, params, **kw)
+        for again in (pickle.loads(pickle.dumps(found)), copy.deepcopy(found)):
+            assert json.dumps(again.to_dict()) == json.dumps(found.to_dict())
+            assert repr(again.plan) == repr(found.plan)

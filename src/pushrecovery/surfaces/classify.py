@@ -98,6 +98,17 @@ class _Planned:
             value = self._value = self._build()
         return value
 
+    def __reduce__(self) -> tuple[Callable[[_Details], _Planned], tuple[_Details]]:
+        """Pickle (and deep-copy) the built values, not the closure that builds them."""
+        return _built, (self.get(),)
+
+
+def _built(value: _Details) -> _Planned:
+    """Return a :class:`_Planned` holding ``value`` (unpickling)."""
+    planned = _Planned(lambda: value)
+    planned._value = value
+    return planned
+
 
 @dataclass(frozen=True, slots=True)
 class Classification:
@@ -412,7 +423,7 @@ def _plane_range(
     u = (gap[0] / length, gap[1] / length)
     # The chord of the convex region along the ray ankle + s u: each half-plane bounds s.
     low, high = 0.0, math.inf
-    for (nx, ny), b in zip(region.normals, region.offsets, strict=True):
+    for (nx, ny), b in zip(region.normals.tolist(), region.offsets.tolist(), strict=True):
         rate = nx * u[0] + ny * u[1]
         room = b - nx * ankle[0] - ny * ankle[1]
         if rate > 0.0:
