@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from pushrecovery.arguments import bounded_float, non_negative_float, positive_float
 from pushrecovery.control.base import Command, Controller, StepInfo, register
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.minkowski import Shape, decompose_unchecked, minkowski_sum_unchecked
+from pushrecovery.ground.minkowski import stacked_shapes
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, roll_axis
@@ -123,6 +123,9 @@ class PlaneRecoveryController(Controller):
             for steps in range(1, body.max_steps + 1):
                 for side in (0.5, -0.5):  # either foot first
                     regions.plan(0.0, side, steps)
+        if hip_box(params, 0.0) is not None:
+            self._start_hip(0.0, np.array([0.0, 0.2]))  # the hip's split, compiled
+            self.reset(np.zeros(len(PLANE_STATE_LABELS)))
 
     def reset(self, state: NDArray[np.float64]) -> None:
         """Start on both feet (the default poses), hip unused, no step under way."""
@@ -180,9 +183,14 @@ class PlaneRecoveryController(Controller):
         box = hip_box(self.params, self.support.yaw)
         if box is None:  # pragma: no cover - the CMP region is the support without a box
             raise InvalidParameterError("no hip torque: the CMP region is the support")
-        terms: list[tuple[float, Shape]] = [(1.0, box), (1.0, self.support.polygon)]
+        from pushrecovery.kernels.polygons import decompose_loop, minkowski_loop
+
+        # decompose (ground.minkowski) compiled: one sum and one split, µs for any yaw.
+        shapes, counts, weights = stacked_shapes([(1.0, box), (1.0, self.support.polygon)])
         origin = np.zeros(2)
-        points, _ = decompose_unchecked(xi, terms, origin, minkowski_sum_unchecked(terms, origin))
+        total = minkowski_loop(shapes, counts, weights, origin)
+        points, _ = decompose_loop(np.asarray(xi, dtype=np.float64), shapes, counts, weights,
+                                   origin, total)  # fmt: skip
         self._begin_hip(t, points[0])
         self.mode = "hip"
         pitch, roll = self._hip_torques(t)
