@@ -212,9 +212,10 @@ class PlaneRecoveryController(Controller):
         self.plan, self.mode = plan, "step"
         self._swing = (side, foothold, touchdown)
         stance = Stance.RIGHT if side is Stance.LEFT else Stance.LEFT
-        self.support = Support.from_params(
-            self.params, stance, left=self.support.left, right=self.support.right
-        )
+        if self.support.stance is not stance:  # from double support: the other foot lifts
+            self.support = Support.from_params(
+                self.params, stance, left=self.support.left, right=self.support.right
+            )
         pitch, roll = self._hip_torques(t)
         cop = plan.cops[0]
         return Command(
