@@ -22,7 +22,7 @@ __all__ = ["edge_rows", "signed_distance"]
 
 
 def edge_rows(vertices, normals, offsets):  # type: ignore[no-untyped-def]
-    """Return the rows :func:`signed_distance` reads, one per edge (E, 8).
+    """Return the rows :func:`signed_distance` reads, one per edge (E, 8), read-only.
 
     n_x, n_y, b, v_x, v_y, e_x, e_y, e · e of a convex polygon's counter-clockwise
     ``vertices`` (E, 2), outward unit ``normals`` (E, 2) and ``offsets`` (E,), computed as
@@ -30,7 +30,9 @@ def edge_rows(vertices, normals, offsets):  # type: ignore[no-untyped-def]
     """
     edges = np.concatenate((vertices[1:], vertices[:1])) - vertices
     length2 = np.einsum("ij,ij->i", edges, edges)
-    return np.ascontiguousarray(np.column_stack([normals, offsets, vertices, edges, length2]))
+    rows = np.ascontiguousarray(np.column_stack([normals, offsets, vertices, edges, length2]))
+    rows.flags.writeable = False  # read-only, always: one compiled signature
+    return rows
 
 
 @numba.njit(cache=True, nogil=True)

@@ -308,7 +308,6 @@ def _plane_tables(params: BodyParams, support: Support) -> _PlaneTables:
 
     hip_region = cmp_polygon(support, params)
     cop, cmp = (edge_rows(p.vertices, p.normals, p.offsets) for p in (support.polygon, hip_region))
-    cop.flags.writeable = cmp.flags.writeable = False
     cmp_region = tuple(map(tuple, hip_region.to_list()))
     regions = StepRegions.of(params, support)
     return _PlaneTables(1.0 / params.omega, cop, cmp, cmp_region, regions)
