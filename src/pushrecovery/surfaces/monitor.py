@@ -142,10 +142,11 @@ class BalanceMonitor:
     assignment; :meth:`query` reads that attribute once. So one thread may call
     :meth:`set_support` while others call :meth:`query`: each query answers for the old
     support or the new one, never a mix of both. Two threads calling :meth:`set_support` at
-    once leave the support of whichever assigned last. The compiled kernels hold the GIL
-    (numba releases it only where asked, and these ask nothing), so the threads interleave
-    rather than run in parallel: a monitor per process, not per core. No call allocates
-    arrays on a query; :meth:`set_support` allocates one edge table (tens of kB).
+    once leave the support of whichever assigned last. The compiled kernels (numba,
+    ``nogil``) release the GIL only while they run, a few µs of a call, and read arrays that
+    nothing writes after :meth:`set_support` built them; the rest of a call is Python, which
+    holds the GIL, so threads take turns rather than run in parallel. A query allocates no
+    arrays; :meth:`set_support` allocates one edge table (tens of kB).
 
     Examples
     --------
