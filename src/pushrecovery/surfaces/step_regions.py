@@ -2,7 +2,9 @@ r"""The ``step`` verdict: a state is captured by at most ``max_steps`` steps.
 
 A support's regions C_1 ... C_{max_steps} of :mod:`pushrecovery.surfaces.n_step`
 ((S1): touchdowns every ``min_step_time`` from ``min_step_time`` on, the hip's box included;
-from double support, one set per foot that may lift first) are built once and kept. A state
+from double support, one set per foot that may lift first) are those of its stance feet: each
+is built once per body for the stance ankle at the origin with yaw 0 and turned and moved to
+the feet (:class:`StepRegions`), so a new support costs tens of µs at any pose and yaw. A state
 needs the smallest N whose region holds its capture point ξ strictly; its step margin is the
 largest signed distance of ξ to any of them (positive exactly when some plan of at most
 ``max_steps`` steps captures it: the margin agrees with the verdict everywhere).
@@ -17,6 +19,9 @@ with the support [s⁻, s⁺] before the first step, the stance ankle q_0, landi
 
 β = a_1 = e^{−ωΔt_s}, a the corrected Eq. (15) offset and l = ``max_step_length``; on the
 sagittal line s^± = δ^± and q_0 = 0: [δ⁻ − a − l s_N, δ⁺ + a + l s_N].
+
+Over 400 lines on purpose: one concept, the step verdict and its plan, on the line and on the
+plane; the regions themselves are :mod:`pushrecovery.surfaces.n_step`'s.
 """
 
 from __future__ import annotations
