@@ -274,6 +274,8 @@ def test_bad_step_parameters_are_refused(overrides, match):
         ({"timing": "later"}, "timing must be"),
         ({"swing": "double"}, "swing must be"),
         ({"swing": "left"}, "swing must be the free foot"),
+        ({"swing": ["right"]}, "swing must be 'left' or 'right'"),
+        ({"swing": 3}, "swing must be 'left' or 'right'"),
     ],
 )
 def test_bad_region_arguments_are_refused(kwargs, match):

@@ -165,6 +165,8 @@ def capture_region(
             xi[1] - centre[1]
         )
         swing = Stance.LEFT if lateral >= 0.0 else Stance.RIGHT
+    if swing is not None and not isinstance(swing, str):  # refused by step_options, by name
+        step_options(params, support, swing)
     option, ankle, key = _first_option(params, support, swing)
     if timing == "exact":  # the compiled pipeline: a balance loop asks at every tick
         region, foothold = _region_loop(xi, params, option, ankle, key, t, steps, hip)
