@@ -293,3 +293,21 @@ def test_a_classification_pickles_with_its_plan(params):
         for again in (pickle.loads(pickle.dumps(found)), copy.deepcopy(found)):
             assert json.dumps(again.to_dict()) == json.dumps(found.to_dict())
             assert repr(again.plan) == repr(found.plan)
+
+
+@pytest.mark.parametrize(
+    ("x", "y", "speed", "plane", "match"),
+    [
+        (1500.0, 0.0, 0.0, False, "position must have entries in"),
+        (50.0, 0.0, 0.0, False, "velocity must have entries in"),
+        (1500.0, 0.0, 0.0, True, "x must be in"),
+        (50.0, 0.1, 0.0, True, "xdot must be in"),
+    ],
+)
+def test_a_step_state_beyond_the_plans_range_is_refused_by_classify_itself(
+    params, x, y, speed, plane, match
+):
+    """The plan is built lazily, but its state check is not deferred (as when built eagerly)."""
+    xdot = -(x - 0.3) * params.omega  # ξ 0.3 m ahead: a step verdict
+    with pytest.raises(InvalidParameterError, match=match):
+        classify(x, xdot, params, **({"y": y, "ydot": speed} if plane else {}))

@@ -26,6 +26,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
+from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
 from pushrecovery.surfaces.classify_many import classify_states
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, cop_region
@@ -248,10 +249,24 @@ def classify(
             impacts = tuple(plan_impacts(plan, (x, 0.0), (xdot, 0.0), params))
             return step, plan, impacts
 
-        planned = _Planned(build)
+        planned = _eager_if_out_of_range(_Planned(build), x, 0.0, xdot, 0.0)
     return Classification(
         capture, strategy, margins, steps=_steps(strategy, steps), _planned=planned
     )
+
+
+def _eager_if_out_of_range(
+    planned: _Planned, x: float, y: float, xdot: float, ydot: float
+) -> _Planned:
+    """Build now a plan that would refuse its state (beyond the ranges of capture_region).
+
+    A step verdict's plan takes positions within ±MAX_POSITION and speeds within ±MAX_SPEED;
+    beyond them classify raises its InvalidParameterError itself, as when it built every plan.
+    """
+    positions, speeds = max(abs(x), abs(y)), max(abs(xdot), abs(ydot))
+    if not (positions <= MAX_POSITION and speeds <= MAX_SPEED):
+        planned.get()  # raises
+    return planned
 
 
 def _first_step(
@@ -351,7 +366,7 @@ def _classify_plane(
         def build() -> _Details:
             return _plane_details(x, y, xdot, ydot, params, chosen, regions, xi, steps)
 
-        planned = _Planned(build)
+        planned = _eager_if_out_of_range(_Planned(build), x, y, xdot, ydot)
     margins = {"cop": cop, "cmp": cmp, "step": step_margin}
     return Classification(
         xi[0],
