@@ -311,3 +311,20 @@ def test_a_step_state_beyond_the_plans_range_is_refused_by_classify_itself(
     xdot = -(x - 0.3) * params.omega  # ξ 0.3 m ahead: a step verdict
     with pytest.raises(InvalidParameterError, match=match):
         classify(x, xdot, params, **({"y": y, "ydot": speed} if plane else {}))
+
+
+@pytest.mark.parametrize(
+    ("position", "velocity", "match"),
+    [
+        ((1500.0, 0.0), (0.0, 0.0), r"position must have entries in \[-1000, 1000\]"),
+        ((0.0, math.nan), (0.0, 0.0), "position must be finite"),
+        ((0.0,), (1.0, 0.0), r"position must be 2 numbers \(shape \(2,\)\)"),
+        ((0.0, 0.0), (200.0, 0.0), r"velocity must have entries in \[-100, 100\]"),
+        ((0.0, 0.0), (math.inf, 0.0), "velocity must be finite"),
+    ],
+)
+def test_plan_impacts_refuse_bad_states_by_name(params, position, velocity, match):
+    plan = classify(0.0, 1.0, params).plan
+    assert plan is not None
+    with pytest.raises(InvalidParameterError, match=match):
+        plan_impacts(plan, position, velocity, params)

@@ -120,14 +120,13 @@ def plan_impacts(
     from pushrecovery.kernels.single_margins import edge_rows, signed_distance
 
     require_type("plan", plan, CapturePlan)
-    r = finite_vector("position", position, 2, MAX_POSITION, "m")
-    v = finite_vector("velocity", velocity, 2, MAX_SPEED, "m/s")
+    rx, ry = _pair("position", position, MAX_POSITION, "m")
+    vx, vy = _pair("velocity", velocity, MAX_SPEED, "m/s")
     require_type("params", params, BodyParams)
     yaw = finite_float("yaw", yaw, "rad")
     omega, height = params.omega, params.com_height
     # Component by component on floats: the operations of the 2-vector form, the same bits
     # (the dot product stays numpy's, whose summation the floats need not match).
-    (rx, ry), (vx, vy) = r.tolist(), v.tolist()
     ax, ay = (float(a) for a in plan.ankle)
     cops, footholds, touchdowns = plan.cops.tolist(), plan.footholds.tolist(), plan.touchdowns
     start = 0.0
@@ -169,3 +168,13 @@ def plan_impacts(
         )
         ax, ay = qx, qy
     return found
+
+
+def _pair(name: str, value: object, bound: float, unit: str) -> tuple[float, float]:
+    """``finite_vector(name, value, 2, bound, unit)`` as two floats; a float pair skips numpy."""
+    if type(value) is tuple and len(value) == 2 and all(type(v) is float for v in value):
+        a, b = value
+        if abs(a) <= bound and abs(b) <= bound:  # False for NaN: checked below, by name
+            return a, b
+    a, b = finite_vector(name, value, 2, bound, unit).tolist()  # type: ignore[arg-type]
+    return a, b
