@@ -50,12 +50,12 @@ def test_every_run_starts_on_the_support_given() -> None:
         plant.reset(0.0, 0.0, 0.1, 0.0)
         assert plant.support.stance is Stance.LEFT
         info = plant.info()
-        assert info.support is plant.support
+        assert info.feet is plant.support
         assert info.footholds_xy == (left.ankle,) and info.footholds == (left.ankle[0],)
     right = Support.from_params(P, "right", right=FootPose(0.3, -0.2, 0.2))
     plant.reset(0.3, 0.0, -0.2, 0.0, support=right)
     assert plant.start_support.right == FootPose(0.3, -0.2, 0.2)
-    assert plant.info().support is plant.support and plant.support.stance is Stance.RIGHT
+    assert plant.info().feet is plant.support and plant.support.stance is Stance.RIGHT
     assert make_plant("stepping-plane", P, support=left).start_support.stance is Stance.LEFT
 
 

@@ -41,6 +41,7 @@ from pushrecovery.params import BodyParams
 
 if TYPE_CHECKING:
     from pushrecovery.ground.polygon import ConvexPolygon
+    from pushrecovery.ground.support import Support
 
 __all__ = [
     "CONTROLLERS",
@@ -117,6 +118,11 @@ class StepInfo:
         The support polygon (world xy [m]) of a controller that steps, as its last command
         gave it (the feet it keeps on the floor): the 3-D plants' fall set and rest read it
         (a capture point beyond it is what a step answers); None: the plant's own support.
+    feet : Support or None
+        On the ground plane: the feet on the ground now, as the plant (or a robot's contact
+        detection) measures them: the stance and both foot poses
+        (:class:`~pushrecovery.ground.support.Support`); a controller that steps adopts them in
+        ``observe``. None: not reported.
     """
 
     stance: bool = True
@@ -125,6 +131,7 @@ class StepInfo:
     measured_cop: float | None = None
     footholds_xy: tuple[tuple[float, float], ...] = ()
     support: ConvexPolygon | None = None
+    feet: Support | None = None
 
 
 class Controller(ABC):

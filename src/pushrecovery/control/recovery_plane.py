@@ -141,16 +141,15 @@ class PlaneRecoveryController(Controller):
         self._swing: tuple[Stance, tuple[float, float], float] | None = None
 
     def observe(self, info: StepInfo) -> None:
-        """Take the feet a plant reports (``info.support``, a Support) when no step is under way.
+        """Take the feet a plant reports (``info.feet``) when no step is under way.
 
         ``stepping-plane`` reports the stance and feet a run starts on right after
         :meth:`reset` and after every tick: between steps the next plan starts from them (a
         run from one foot plans from that foot). While a step is under way the controller
         keeps its own feet (the commanded foothold lands at the commanded time).
         """
-        support = info.support
-        if isinstance(support, Support) and info.stance and self.plan is None:
-            self.support = support
+        if info.feet is not None and info.stance and self.plan is None:
+            self.support = info.feet
 
     def compute(self, t: float, state: NDArray[np.float64]) -> Command:
         """Return the command of the current phase (module docstring)."""

@@ -8,7 +8,7 @@ et al. 2012's 3-D LIPM with a finite foot and a reaction mass), simulated:
 - **Start**: every run (``begin``, ``reset``) starts on :attr:`start_support`: both feet at
   their default poses unless the user gives a stance and poses (``support=``, e.g. a robot on
   one foot). Each step's :class:`~pushrecovery.control.base.StepInfo` reports the feet
-  (``support``: the :class:`~pushrecovery.ground.support.Support`, stance and poses), which a
+  (``feet``: the :class:`~pushrecovery.ground.support.Support`, stance and poses), which a
   controller reads in ``observe``.
 - **Stance**: Eq. (3) in x and y with the hip torques (the planar Eq. 16), advanced exactly
   (zero-order hold, :func:`~pushrecovery.models.flywheel_plane.plane_discrete`) with the
@@ -146,16 +146,14 @@ class PlaneSteppingPlant(PlantBase):
         return self._swing is None
 
     def info(self) -> StepInfo:
-        """:meth:`PlantBase.info` with the (x, y) footholds and the feet, ``support``.
+        """:meth:`PlantBase.info` with the (x, y) footholds and the feet, ``feet``.
 
         The report is kept while none of it changes.
         """
         info = super().info()
-        if info.support is not self.support or len(info.footholds_xy) != len(self.footholds_xy):
+        if info.feet is not self.support or len(info.footholds_xy) != len(self.footholds_xy):
             info = self._info = replace(
-                info,
-                footholds_xy=tuple(self.footholds_xy),
-                support=self.support,  # type: ignore[arg-type]  # the feet (a Support)
+                info, footholds_xy=tuple(self.footholds_xy), feet=self.support
             )
         return info
 
