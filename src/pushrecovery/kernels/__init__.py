@@ -27,6 +27,8 @@ wbc
     the whole-body controller's QP assembly, least-distance form, ankle and joint-guard rows.
 hull
     the convex hull of every frame's points.
+placement
+    regions built once in a stance foot's frame, turned and moved onto a support.
 threads
     numba's thread count, held at one while a worker runs pushes.
 """
