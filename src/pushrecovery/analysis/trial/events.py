@@ -8,6 +8,9 @@ markers), the steps they make; each event with the verdicts of its frame, each s
 the recommended one (:class:`StepComparison`) and the capture region at its foot-off
 (:class:`CaptureRegionCheck`). docs/events.md, "How the trial analysis uses them", has the
 details.
+
+Over 400 lines on purpose: one concept, a trial's typed events as ``summary.json`` writes them
+(the records and the one function that fills them).
 """
 
 from __future__ import annotations

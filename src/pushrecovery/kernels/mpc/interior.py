@@ -22,6 +22,9 @@ A and B have the flywheel's structure
 (checked by :class:`~pushrecovery.control.mpc.problem.SparseQP`): the CoM (x, ẋ) and the flywheel
 (θ, θ̇) evolve apart, A block-diagonal in that split, and the CoP moves the CoM only (B's δ
 column zero on θ, θ̇). The products skip those zeros, term by term the same sums.
+
+Over 400 lines on purpose: one kernel (the interior point), its start, Newton step, line search
+and shift of an iterate sharing one iterate layout.
 """
 
 from __future__ import annotations

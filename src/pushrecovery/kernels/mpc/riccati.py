@@ -32,6 +32,10 @@ same sums in the same order as plain loops, so the same results (a skipped term 
 leaves a nonzero sum as it is; a sum the loops started from 0.0 keeps that start, ``0.0 + …``,
 so that an all-zero one stays +0). A solve's scratch is allocated once (:func:`scratch`), not
 per pass.
+
+Over 400 lines on purpose: one kernel (the active-set passes), whose backward recursion,
+elimination of the held θ rows and multiplier check share the per-stage scalars above; split,
+they would pass a dozen arrays between modules for nothing.
 """
 
 from __future__ import annotations

@@ -19,7 +19,12 @@ on any machine): at most :data:`REALTIME_PASS_STAGES` / N warm passes and
 :data:`REALTIME_ITERATION_STAGES` / N interior-point iterations, no DAQP. A tick the budget
 does not solve applies the last plan that solved Eq. (17) shifted by one stage per tick since
 (SHIFTED), and the next tick's passes start from its active set, shifted once more; with no such
-plan (none since the last reset, or older than the horizon) the saturated fallback (EXHAUSTED).
+plan (none since the last reset, or older than the horizon) the first input of the interior
+point's unfinished iterate, which the next tick continues, or the saturated fallback where there
+is none (EXHAUSTED).
+
+Over 400 lines on purpose: the route is one decision (which solver ends a tick), its default and
+real-time budgets two settings of it.
 """
 
 from __future__ import annotations
