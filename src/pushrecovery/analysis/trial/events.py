@@ -10,7 +10,7 @@ the recommended one (:class:`StepComparison`) and the capture region at its foot
 details.
 
 Over 400 lines on purpose: one concept, a trial's typed events as ``summary.json`` writes them
-(the records, and `trial_events` with the helpers that fill them).
+(the records, and ``trial_events`` with the helpers that fill them).
 """
 
 from __future__ import annotations
