@@ -29,6 +29,8 @@ hull
     the convex hull of every frame's points.
 placement
     regions built once in a stance foot's frame, turned and moved onto a support.
+single_margins
+    one state's signed distances to a support polygon and its CMP region (single-state ``classify``).
 threads
     numba's thread count, held at one while a worker runs pushes.
 """
