@@ -30,7 +30,7 @@ hull
 placement
     regions built once in a stance foot's frame, turned and moved onto a support.
 single_margins
-    one state's signed distances to a support polygon and its CMP region (single-state ``classify``).
+    one state's signed distances to a support polygon and its CMP region (single ``classify``).
 threads
     numba's thread count, held at one while a worker runs pushes.
 """
