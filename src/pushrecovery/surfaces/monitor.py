@@ -12,6 +12,13 @@ pay nothing either.
 
 The verdicts, capture point and margins are those of
 :func:`pushrecovery.surfaces.classify.classify` on the ground plane (tested to 1e-12).
+
+A query may also give the upper body's current pitch and roll, each (angle [rad], rate
+[rad/s]): the CMP margin is then that of the region the hip strategy reaches from that state
+(docs/errata.md, E19; :func:`pushrecovery.surfaces.plane.cmp_polygon_from`, tested to 1e-12),
+P ⊕ an off-centre box in the support's axes. The sum's edges are ordered per support (P's
+edges and the box's four, merged by direction), so a query only moves the box's corners: a
+few µs more, no hull built.
 """
 
 from __future__ import annotations
@@ -29,7 +36,7 @@ from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import Strategy
-from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
+from pushrecovery.surfaces.cmp import _flywheel_offsets, cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.step_regions import StepRegions
 
@@ -42,6 +49,10 @@ _UNIT_WEIGHTS = np.ones(2)
 _ORIGIN = np.zeros(2)
 
 _Edges = tuple[tuple[float, float, float, float, float, float, float, float], ...]
+#: Per edge of P ⊕ box, CCW: outward normal, the vertex of P it starts from, the box corner.
+_SumEdges = tuple[tuple[float, float, float, float, int], ...]
+#: An upper-body axis's (angle [rad], rate [rad/s]).
+Axis = tuple[float, float]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -51,6 +62,7 @@ class _SupportState:
     support: Support
     cop: _Edges
     cmp: _Edges
+    torso: tuple[_SumEdges, float, float]  # P ⊕ box's edges, cos and sin of the yaw
     regions: tuple[object, ...]  # locate_steps' table, counts, steps, outer
 
 
@@ -125,6 +137,78 @@ def _signed_distance(edges: _Edges, px: float, py: float) -> float:
     return -best
 
 
+def _sum_edges(support: Support) -> tuple[_SumEdges, float, float]:
+    """Return the edges of P ⊕ box for any box [lo_x, hi_x] × [lo_y, hi_y] in the stance axes.
+
+    The sum of a convex polygon and a box has P's edges, each moved by the box corner whose
+    normal cone holds the edge's normal, and the box's four edges, each moved by the vertex of
+    P where P's normals cross the box's normal: an order that depends on the directions alone,
+    so it is fixed per support and only the box's corners change per query. Box corners
+    k = 0…3, counter-clockwise: (lo_x, lo_y), (hi_x, lo_y), (hi_x, hi_y), (lo_x, hi_y); an edge
+    of P whose normal has stance components (u, w) takes corner 2 if u > 0 < w, 3 if u <= 0 < w,
+    0 if u, w <= 0 and 1 if w <= 0 < u (a partition of the directions, turning with them, so
+    each box edge is inserted once; a tie gives two collinear edges, one possibly of length 0).
+    """
+    yaw = support.yaw
+    c, s = math.cos(yaw), math.sin(yaw)
+    # The box edge from corner k to k + 1: its outward normal in the world frame.
+    box = ((s, -c), (c, s), (-s, c), (-c, -s))
+    vertices = support.polygon.vertices.tolist()
+    corners = []
+    for nx, ny in support.polygon.normals.tolist():
+        u, w = c * nx + s * ny, c * ny - s * nx
+        corners.append((2 if u > 0.0 else 3) if w > 0.0 else (1 if u > 0.0 else 0))
+    rows = []
+    k = corners[-1]
+    for (vx, vy), (nx, ny), corner in zip(
+        vertices, support.polygon.normals.tolist(), corners, strict=True
+    ):
+        while k != corner:  # the box's edges between the last edge's corner and this one's
+            rows.append((*box[k], vx, vy, k))
+            k = (k + 1) % 4
+        rows.append((nx, ny, vx, vy, corner))
+    return tuple(rows), c, s
+
+
+def _sum_distance(
+    torso: tuple[_SumEdges, float, float],
+    box: tuple[float, float, float, float],
+    px: float,
+    py: float,
+) -> float:
+    """Signed distance of (px, py) to P ⊕ [lo_x, hi_x] × [lo_y, hi_y] (stance axes), + inside.
+
+    ``box`` is (lo_x, hi_x, lo_y, hi_y) [m], lo <= hi; the edges from :func:`_sum_edges`.
+    """
+    rows, c, s = torso
+    lo_x, hi_x, lo_y, hi_y = box
+    # The box's corners in the world frame, counter-clockwise from (lo_x, lo_y).
+    cx = (c * lo_x - s * lo_y, c * hi_x - s * lo_y, c * hi_x - s * hi_y, c * lo_x - s * hi_y)
+    cy = (s * lo_x + c * lo_y, s * hi_x + c * lo_y, s * hi_x + c * hi_y, s * lo_x + c * hi_y)
+    excess = -math.inf
+    for nx, ny, vx, vy, k in rows:
+        e = nx * (px - (vx + cx[k])) + ny * (py - (vy + cy[k]))
+        if e > excess:
+            excess = e
+    if excess <= 0.0:
+        return -excess
+    # Outside: the nearest of the sum's edges, from each vertex to the next.
+    _, _, vx, vy, k = rows[-1]
+    x1, y1 = vx + cx[k], vy + cy[k]
+    best = math.inf
+    for _, _, vx, vy, k in rows:
+        x0, y0, x1, y1 = x1, y1, vx + cx[k], vy + cy[k]
+        ex, ey = x1 - x0, y1 - y0
+        dx, dy = px - x0, py - y0
+        length2 = ex * ex + ey * ey
+        t = (dx * ex + dy * ey) / length2 if length2 > 0.0 else 0.0
+        t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+        gap = math.hypot(dx - t * ex, dy - t * ey)
+        if gap < best:
+            best = gap
+    return -best
+
+
 class BalanceMonitor:
     """Real-time balance verdicts for one body on one support.
 
@@ -146,7 +230,8 @@ class BalanceMonitor:
     ``nogil``) release the GIL only while they run, a few µs of a call, and read arrays that
     nothing writes after :meth:`set_support` built them; the rest of a call is Python, which
     holds the GIL, so threads take turns rather than run in parallel. A query allocates no
-    arrays; :meth:`set_support` allocates one edge table (tens of kB).
+    arrays (an upper-body state is the caller's, read once); :meth:`set_support` allocates one
+    edge table (tens of kB).
 
     Examples
     --------
@@ -154,9 +239,11 @@ class BalanceMonitor:
     >>> monitor = BalanceMonitor(load_params())
     >>> monitor.query(0.0, 0.0, 0.0, 0.6).strategy.value
     'hip'
+    >>> monitor.query(0.0, 0.0, 0.0, 0.6, roll=(0.9, 0.0)).strategy.value  # leaning left
+    'step'
     """
 
-    __slots__ = ("_box", "_locate", "_minkowski", "_omega", "_state", "params")
+    __slots__ = ("_axes", "_box", "_locate", "_minkowski", "_omega", "_state", "params")
 
     def __init__(self, params: BodyParams, support: Support | None = None) -> None:
         from pushrecovery.kernels.plane_codes import locate_steps
@@ -170,10 +257,18 @@ class BalanceMonitor:
         self._locate: Callable[..., tuple[int, float]] = locate_steps
         self._minkowski: Callable[..., FloatArray] = minkowski_loop
         self._box = (cmp_offset(params), cmp_offset_roll(params))
+        # Each upper-body axis's τmax, I, θmax, m g and ω, for the offsets from θ0, θ̇0 (E19).
+        self._axes = (
+            (params.torque_max, params.flywheel_inertia, params.flywheel_angle_max,
+             params.weight, params.omega),
+            (params.torque_max_roll, params.flywheel_inertia_roll,
+             params.flywheel_angle_max_roll, params.weight, params.omega),
+        )  # fmt: skip
         first = Support.from_params(params) if support is None else support
         for stance in (Stance.LEFT, Stance.DOUBLE):  # loads every compiled path once
             self.set_support(Support.from_params(params, stance))
             self.query(0.0, 0.0, 10.0, 0.0)
+            self.query(0.0, 0.0, 10.0, 0.0, pitch=(0.0, 0.1), roll=(0.0, -0.1))
         self.set_support(first)
 
     @property
@@ -195,6 +290,7 @@ class BalanceMonitor:
             support,
             _edges(support.polygon),
             self._cmp_edges(support),
+            _sum_edges(support),
             (regions.table, regions.counts, regions.steps_array, regions.outer),
         )
 
@@ -217,8 +313,16 @@ class BalanceMonitor:
         loop = self._minkowski(shapes, np.array([count, 4]), _UNIT_WEIGHTS, _ORIGIN)
         return _loop_edges(loop.tolist())
 
-    def query(self, x: float, y: float, xdot: float, ydot: float) -> Verdict:
-        """Classify one CoM state on the ground plane.
+    def query(
+        self,
+        x: float,
+        y: float,
+        xdot: float,
+        ydot: float,
+        pitch: Axis | None = None,
+        roll: Axis | None = None,
+    ) -> Verdict:
+        r"""Classify one CoM state on the ground plane, the upper body upright or as given.
 
         Parameters
         ----------
@@ -226,15 +330,38 @@ class BalanceMonitor:
             CoM position in the world frame [m].
         xdot, ydot : float
             CoM velocity [m/s].
+        pitch, roll : (float, float), optional
+            The upper body's current (angle [rad], rate [rad/s]) about its pitch axis
+            (positive forward: toward the support's heading e_p = (cos ψ, sin ψ), ψ =
+            ``support.yaw``, the direction in which a positive pitch torque moves the CMP) and
+            about its roll axis (positive toward the body's left, e_r = (−sin ψ, cos ψ)): the
+            flywheel states of :mod:`pushrecovery.models.flywheel_plane` and
+            :func:`~pushrecovery.surfaces.cmp.cmp_offset_from`. None is (0, 0) for that axis;
+            both None, or every value 0, answer for the upright body at rest (the same
+            verdict, bit for bit, as without them).
 
         Returns
         -------
         Verdict
+            With a torso state, ``cmp_margin`` is the signed distance of ξ to
+            P ⊕ [−Δ⁻_p, Δ⁺_p] × [−Δ⁻_r, Δ⁺_r], the box in the support's axes (e_p, e_r) with
+            (Δ⁻, Δ⁺) of each axis from
+            :func:`~pushrecovery.surfaces.cmp.cmp_offset_from` (docs/errata.md, E19):
+            :func:`~pushrecovery.surfaces.plane.cmp_polygon_from`'s region (tested to 1e-12),
+            without building it. A side's Δ is smaller when the upper body already leans or
+            turns toward it (less room, or a rate to brake first) and negative when it must
+            first be braked against the push: the region can then end inside the support
+            polygon, so ``ankle`` needs ξ inside both (ξ in P outside the region is not
+            balanced without a step). The CoP margin and the step regions do not depend on
+            the upper body (they assume it upright and at rest).
 
         Raises
         ------
         InvalidParameterError
-            If a value is NaN or infinite.
+            If a value is NaN or infinite; if ``pitch`` or ``roll`` is not a pair, an angle is
+            outside its joint range [−θmax, θmax] or a rate is one from which no torque within
+            τmax stops the upper body inside that range (the message names the axis and
+            ``theta0`` or ``thetadot0``, as :func:`~pushrecovery.surfaces.cmp.cmp_offset_from`).
         """
         try:
             px = capture_point(x, xdot, self._omega)
@@ -250,12 +377,16 @@ class BalanceMonitor:
             raise InvalidParameterError(
                 f"x, y, xdot, ydot must be finite, got {x!r}, {y!r}, {xdot!r}, {ydot!r}"
             )
+        box = None if pitch is None and roll is None else self._torso_box(pitch, roll)
         state = self._state  # read once: the old support or the new one, never a mix
         cop = _signed_distance(state.cop, px, py)
-        cmp = _signed_distance(state.cmp, px, py)
+        if box is None:
+            cmp = _signed_distance(state.cmp, px, py)
+        else:
+            cmp = _sum_distance(state.torso, box, px, py)
         # The N-step regions (compiled, one call), as StepRegions.locate.
         steps, step_margin = self._locate(*state.regions, px, py)
-        if cop > 0.0:
+        if cop > 0.0 and (box is None or cmp > 0.0):
             strategy, steps = Strategy.ANKLE, 0
         elif cmp > 0.0:
             strategy, steps = Strategy.HIP, 0
@@ -264,3 +395,32 @@ class BalanceMonitor:
         else:
             strategy, steps = Strategy.FALL, -1
         return Verdict(strategy, px, py, cop, cmp, step_margin, steps)
+
+    def _torso_box(
+        self, pitch: Axis | None, roll: Axis | None
+    ) -> tuple[float, float, float, float] | None:
+        """(−Δ⁻_p, Δ⁺_p, −Δ⁻_r, Δ⁺_r) [m] of the upper body's state; None if every value is 0."""
+        box: list[float] = []
+        resting = True
+        for name, value, axis in (("pitch", pitch, self._axes[0]), ("roll", roll, self._axes[1])):
+            angle, rate = (0.0, 0.0) if value is None else _pair(name, value)
+            try:
+                minus, plus = _flywheel_offsets(*axis, angle, rate)
+            except InvalidParameterError as error:
+                raise InvalidParameterError(f"{name}: {error}") from None
+            resting = resting and angle == 0.0 and rate == 0.0
+            box += (-minus, plus)
+        if resting:  # the at-rest region, as without a torso state
+            return None
+        return box[0], box[1], box[2], box[3]
+
+
+def _pair(name: str, value: Axis) -> Axis:
+    """Return an axis's (angle, rate) or raise naming ``name`` (values checked by the caller)."""
+    try:
+        angle, rate = value
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            f"{name} must be an (angle [rad], rate [rad/s]) pair, got {str(value)[:40]!r}"
+        ) from None
+    return angle, rate
