@@ -18,9 +18,10 @@ from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.support import FootPose, Support
 from pushrecovery.surfaces.capture_plan import capture_plan
 from pushrecovery.surfaces.classify import classify
+from pushrecovery.surfaces.cmp import cmp_offset_from
 from pushrecovery.surfaces.monitor import BalanceMonitor
 from pushrecovery.surfaces.n_step import step_options, viable_region
-from pushrecovery.surfaces.plane import cmp_polygon
+from pushrecovery.surfaces.plane import cmp_polygon, cmp_polygon_from
 from pushrecovery.surfaces.step_regions import StepRegions
 
 P = load_params()
@@ -163,3 +164,144 @@ def test_bad_supports_are_refused():
     with pytest.raises(InvalidParameterError, match="yaw must be within"):
         FootPose(0.0, 0.09, 10.0)  # degrees by mistake
     assert monitor.support.stance.value == "double"  # a refused change changes nothing
+
+
+def torso_states(params, count, rng):
+    """Upper-body (pitch, roll) states across each axis's range: angles in [−θmax, θmax], rates
+    up to those the flywheel can still stop, the range's corners among them."""
+    states = []
+    for i in range(count):
+        pair = []
+        for torque, inertia, angle_max in (
+            (params.torque_max, params.flywheel_inertia, params.flywheel_angle_max),
+            (params.torque_max_roll, params.flywheel_inertia_roll, params.flywheel_angle_max_roll),
+        ):
+            angle = (angle_max, -angle_max, 0.0)[i] if i < 3 else rng.uniform(-1, 1) * angle_max
+            accel = torque / inertia
+            low = -math.sqrt(2.0 * accel * (angle_max + angle))
+            high = math.sqrt(2.0 * accel * (angle_max - angle))
+            rate = (low, high)[i % 2] if i < 6 else rng.uniform(low, high)
+            pair.append((angle, rate))
+        states.append(tuple(pair))
+    return states
+
+
+@pytest.mark.parametrize("name", ["default", "8-vertex sole", "no roll torque", "16-vertex sole"])
+def test_the_torso_state_margin_is_the_distance_to_cmp_polygon_from(name):
+    params = BODIES[name]
+    monitor = BalanceMonitor(params)
+    rng = np.random.default_rng(13)
+    for support in random_supports(params, 9, seed=17):
+        monitor.set_support(support)
+        ax, ay = support.ankle
+        for pitch, roll in torso_states(params, 8, rng):
+            region = cmp_polygon_from(support, params, pitch, roll)
+            for _ in range(12):
+                x, y = ax + rng.uniform(-0.35, 0.35), ay + rng.uniform(-0.35, 0.35)
+                xdot, ydot = rng.uniform(-0.5, 0.5, 2)
+                verdict = monitor.query(x, y, xdot, ydot, pitch=pitch, roll=roll)
+                at_rest = monitor.query(x, y, xdot, ydot)
+                xi = (verdict.capture_point_x, verdict.capture_point_y)
+                assert abs(verdict.cmp_margin - float(region.signed_distance(*xi))) <= 1e-12
+                # The CoP margin and the steps do not depend on the upper body.
+                assert xi == (at_rest.capture_point_x, at_rest.capture_point_y)
+                assert verdict.cop_margin == at_rest.cop_margin
+                assert verdict.step_margin == at_rest.step_margin
+                cop, cmp = verdict.cop_margin, verdict.cmp_margin
+                expected = (
+                    "ankle" if cop > 0.0 and cmp > 0.0 else "hip" if cmp > 0.0
+                    else "step" if at_rest.step_margin > 0.0 else "fall"
+                )  # fmt: skip
+                assert verdict.strategy.value == expected
+
+
+def test_an_upright_resting_torso_gives_the_verdict_without_one():
+    monitor = BalanceMonitor(P)
+    rng = np.random.default_rng(19)
+    for support in random_supports(P, 6, seed=23):
+        monitor.set_support(support)
+        ax, ay = support.ankle
+        for _ in range(20):
+            state = (ax + rng.uniform(-0.2, 0.2), ay + rng.uniform(-0.2, 0.2),
+                     *rng.uniform(-1.5, 1.5, 2))  # fmt: skip
+            verdict = monitor.query(*state)
+            for torso in (
+                {"pitch": None, "roll": None},
+                {"pitch": (0.0, 0.0)},
+                {"roll": (0, 0.0)},
+                {"pitch": (0.0, 0.0), "roll": (0.0, 0.0)},
+            ):
+                assert monitor.query(*state, **torso) == verdict
+
+
+def crossing(monitor, support, direction, torso):
+    """Distances d along ``direction`` (stance axes) from the ankle at which ξ = ankle + d e
+    is ``hip`` for the body at rest and not with ``torso``, and the reverse."""
+    c, s = math.cos(support.yaw), math.sin(support.yaw)
+    ex, ey = c * direction[0] - s * direction[1], s * direction[0] + c * direction[1]
+    ax, ay = support.ankle
+    lost, gained = [], []
+    for d in np.arange(0.0, 0.6, 0.002):
+        x, y = ax + d * ex, ay + d * ey
+        rest, moved = monitor.query(x, y, 0.0, 0.0), monitor.query(x, y, 0.0, 0.0, **torso)
+        if rest.strategy.value == "hip" and moved.strategy.value == "step":
+            lost.append(d)
+        if rest.strategy.value == "step" and moved.strategy.value == "hip":
+            gained.append(d)
+    return lost, gained
+
+
+@pytest.mark.parametrize("stance", ["double", "left"])
+def test_a_torso_leaning_or_turning_toward_the_push_needs_a_step_sooner(stance):
+    monitor = BalanceMonitor(P)
+    feet = {"left": FootPose(0.3, 0.5, 0.6), "right": FootPose(0.4, 0.32, 0.5)}
+    support = Support.from_params(P, stance, **feet)
+    monitor.set_support(support)
+    lean, roll_max = 0.9 * P.flywheel_angle_max, 0.9 * P.flywheel_angle_max_roll
+    rate = 0.5 * math.sqrt(2.0 * P.torque_max / P.flywheel_inertia * P.flywheel_angle_max)
+    for direction, toward, away in (
+        ((1.0, 0.0), {"pitch": (lean, 0.0)}, {"pitch": (-lean, 0.0)}),  # pushed forward
+        ((1.0, 0.0), {"pitch": (0.0, rate)}, {"pitch": (0.0, -rate)}),  # turning forward
+        ((-1.0, 0.0), {"pitch": (-lean, 0.0)}, {"pitch": (lean, 0.0)}),  # pushed backward
+        ((0.0, 1.0), {"roll": (roll_max, 0.0)}, {"roll": (-roll_max, 0.0)}),  # to the left
+    ):
+        lost, gained = crossing(monitor, support, direction, toward)
+        assert lost and not gained  # hip at rest, step leaning toward the push
+        lost, gained = crossing(monitor, support, direction, away)
+        assert gained and not lost  # step at rest, hip leaning away from it
+
+
+def test_a_torso_to_be_braked_against_the_push_shrinks_the_region_inside_the_foot():
+    monitor = BalanceMonitor(P)  # default double support, yaw 0: the toe at x = P.toe
+    rate = math.sqrt(2.0 * P.torque_max / P.flywheel_inertia * P.flywheel_angle_max)
+    _, plus = cmp_offset_from(P, 0.0, rate)
+    assert plus < 0.0  # full speed forward: it must be braked, the CMP moves back first
+    x = P.toe + 0.5 * plus  # on the foot, beyond what the braked torso leaves
+    at_rest, moving = monitor.query(x, 0.0, 0.0, 0.0), monitor.query(x, 0, 0, 0, pitch=(0, rate))
+    assert at_rest.strategy.value == "ankle" and moving.cop_margin > 0.0
+    assert moving.cmp_margin == pytest.approx(0.5 * plus, abs=1e-12)
+    assert moving.strategy.value == "step"
+
+
+def test_bad_torso_states_are_refused_naming_the_axis_and_the_value():
+    monitor = BalanceMonitor(P)
+    fast = math.sqrt(2.0 * P.torque_max / P.flywheel_inertia * P.flywheel_angle_max) * 1.01
+    for torso, words in (
+        ({"pitch": (math.nan, 0.0)}, "pitch: theta0"),
+        ({"roll": (0.0, math.inf)}, "roll: thetadot0"),
+        ({"pitch": (1.01 * P.flywheel_angle_max, 0.0)}, "pitch: theta0 must be in"),
+        ({"roll": (-1.01 * P.flywheel_angle_max_roll, 0.0)}, "roll: theta0 must be in"),
+        ({"pitch": (0.0, fast)}, "pitch: thetadot0 must be in"),
+        ({"pitch": (0.0, "fast")}, "pitch: thetadot0"),
+        ({"pitch": 0.1}, "pitch must be an"),
+        ({"roll": (0.1, 0.0, 0.0)}, "roll must be an"),
+    ):
+        with pytest.raises(InvalidParameterError, match=words.replace("(", r"\(")):
+            monitor.query(0.0, 0.0, 0.1, 0.0, **torso)
+    assert monitor.query(0.0, 0.0, 0.1, 0.0, pitch=(0.1, 0.0)).strategy.value == "ankle"
+    # Without roll torque the roll rate is not used: any finite rate is accepted.
+    still = BalanceMonitor(BODIES["no roll torque"])
+    spinning = still.query(0.3, 0.0, 0.1, 0.0, roll=(0.0, 1e3))
+    upright = still.query(0.3, 0.0, 0.1, 0.0)
+    assert spinning.strategy == upright.strategy
+    assert spinning.cmp_margin == pytest.approx(upright.cmp_margin, abs=1e-12)
