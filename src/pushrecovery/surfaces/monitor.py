@@ -49,8 +49,9 @@ _UNIT_WEIGHTS = np.ones(2)
 _ORIGIN = np.zeros(2)
 
 _Edges = tuple[tuple[float, float, float, float, float, float, float, float], ...]
-#: Per edge of P ⊕ box, CCW: outward normal, the vertex of P it starts from, the box corner.
-_SumEdges = tuple[tuple[float, float, float, float, int], ...]
+#: Per edge of P ⊕ box, CCW: outward normal, the vertex of P and the box corner it starts from,
+#: those it ends at (stance axes).
+_SumEdges = tuple[tuple[float, float, float, float, int, float, float, int], ...]
 #: An upper-body axis's (angle [rad], rate [rad/s]).
 Axis = tuple[float, float]
 
@@ -148,26 +149,35 @@ def _sum_edges(support: Support) -> tuple[_SumEdges, float, float]:
     of P whose normal has stance components (u, w) takes corner 2 if u > 0 < w, 3 if u <= 0 < w,
     0 if u, w <= 0 and 1 if w <= 0 < u (a partition of the directions, turning with them, so
     each box edge is inserted once; a tie gives two collinear edges, one possibly of length 0).
+
+    Each row: the edge's outward normal, its start (a vertex of P and a corner) and its end,
+    all in the stance's axes (turned by −yaw about the world origin), then cos and sin of yaw.
     """
     yaw = support.yaw
     c, s = math.cos(yaw), math.sin(yaw)
-    # The box edge from corner k to k + 1: its outward normal in the world frame.
-    box = ((s, -c), (c, s), (-s, c), (-c, -s))
-    vertices = support.polygon.vertices.tolist()
-    corners = []
-    for nx, ny in support.polygon.normals.tolist():
-        u, w = c * nx + s * ny, c * ny - s * nx
-        corners.append((2 if u > 0.0 else 3) if w > 0.0 else (1 if u > 0.0 else 0))
-    rows = []
-    k = corners[-1]
-    for (vx, vy), (nx, ny), corner in zip(
-        vertices, support.polygon.normals.tolist(), corners, strict=True
-    ):
+    # The box edge from corner k to k + 1: its outward normal in the stance's axes.
+    box = ((0.0, -1.0), (1.0, 0.0), (0.0, 1.0), (-1.0, 0.0))
+    vertices = [(c * x + s * y, c * y - s * x) for x, y in support.polygon.vertices.tolist()]
+    normals = [(c * x + s * y, c * y - s * x) for x, y in support.polygon.normals.tolist()]
+    starts = []  # (normal, start vertex, start corner) of each edge, in order
+    k = -1
+    for (vx, vy), (u, w) in zip(vertices, normals, strict=True):
+        corner = (2 if u > 0.0 else 3) if w > 0.0 else (1 if u > 0.0 else 0)
+        if k < 0:  # the first vertex: its box edges come at the end, from the last corner
+            first, k = corner, corner
         while k != corner:  # the box's edges between the last edge's corner and this one's
-            rows.append((*box[k], vx, vy, k))
+            starts.append((*box[k], vx, vy, k))
             k = (k + 1) % 4
-        rows.append((nx, ny, vx, vy, corner))
-    return tuple(rows), c, s
+        starts.append((u, w, vx, vy, corner))
+    vx, vy = vertices[0]
+    while k != first:  # the box's edges at the first vertex, closing the loop
+        starts.append((*box[k], vx, vy, k))
+        k = (k + 1) % 4
+    rows = tuple(
+        (*row, *following[2:])
+        for row, following in zip(starts, starts[1:] + starts[:1], strict=True)
+    )
+    return rows, c, s
 
 
 def _sum_distance(
@@ -179,27 +189,27 @@ def _sum_distance(
     """Signed distance of (px, py) to P ⊕ [lo_x, hi_x] × [lo_y, hi_y] (stance axes), + inside.
 
     ``box`` is (lo_x, hi_x, lo_y, hi_y) [m], lo <= hi; the edges from :func:`_sum_edges`.
+    Outside, the nearest point is on an edge whose line ξ is beyond (positive excess): only
+    those are measured.
     """
     rows, c, s = torso
     lo_x, hi_x, lo_y, hi_y = box
-    # The box's corners in the world frame, counter-clockwise from (lo_x, lo_y).
-    cx = (c * lo_x - s * lo_y, c * hi_x - s * lo_y, c * hi_x - s * hi_y, c * lo_x - s * hi_y)
-    cy = (s * lo_x + c * lo_y, s * hi_x + c * lo_y, s * hi_x + c * hi_y, s * lo_x + c * hi_y)
+    cx, cy = (lo_x, hi_x, hi_x, lo_x), (lo_y, lo_y, hi_y, hi_y)  # the corners, CCW
+    qx, qy = c * px + s * py, c * py - s * px  # ξ in the stance's axes
     excess = -math.inf
-    for nx, ny, vx, vy, k in rows:
-        e = nx * (px - (vx + cx[k])) + ny * (py - (vy + cy[k]))
+    for nx, ny, vx, vy, k, _, _, _ in rows:
+        e = nx * (qx - (vx + cx[k])) + ny * (qy - (vy + cy[k]))
         if e > excess:
             excess = e
     if excess <= 0.0:
         return -excess
-    # Outside: the nearest of the sum's edges, from each vertex to the next.
-    _, _, vx, vy, k = rows[-1]
-    x1, y1 = vx + cx[k], vy + cy[k]
     best = math.inf
-    for _, _, vx, vy, k in rows:
-        x0, y0, x1, y1 = x1, y1, vx + cx[k], vy + cy[k]
-        ex, ey = x1 - x0, y1 - y0
-        dx, dy = px - x0, py - y0
+    for nx, ny, vx, vy, k, wx, wy, j in rows:
+        x0, y0 = vx + cx[k], vy + cy[k]
+        dx, dy = qx - x0, qy - y0
+        if nx * dx + ny * dy <= 0.0:
+            continue
+        ex, ey = wx + cx[j] - x0, wy + cy[j] - y0
         length2 = ex * ex + ey * ey
         t = (dx * ex + dy * ey) / length2 if length2 > 0.0 else 0.0
         t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
@@ -363,6 +373,8 @@ class BalanceMonitor:
             τmax stops the upper body inside that range (the message names the axis and
             ``theta0`` or ``thetadot0``, as :func:`~pushrecovery.surfaces.cmp.cmp_offset_from`).
         """
+        if not (type(x) is type(y) is type(xdot) is type(ydot) is float):
+            x, y, xdot, ydot = _floats(x, y, xdot, ydot)  # numpy scalars: 5x slower otherwise
         try:
             px = capture_point(x, xdot, self._omega)
             py = capture_point(y, ydot, self._omega)
@@ -413,6 +425,15 @@ class BalanceMonitor:
         if resting:  # the at-rest region, as without a torso state
             return None
         return box[0], box[1], box[2], box[3]
+
+
+def _floats(*values: float) -> tuple[float, ...]:
+    """Return numbers (numpy scalars, ints) as Python floats, anything else as it is.
+
+    The same values (IEEE doubles either way); Python floats keep a query's arithmetic off
+    numpy's scalar path. Arrays, text and None go on to :meth:`BalanceMonitor.query`'s check.
+    """
+    return tuple(float(v) if isinstance(v, int | np.floating | np.integer) else v for v in values)
 
 
 def _pair(name: str, value: Axis) -> Axis:
