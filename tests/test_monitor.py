@@ -305,3 +305,15 @@ def test_bad_torso_states_are_refused_naming_the_axis_and_the_value():
     upright = still.query(0.3, 0.0, 0.1, 0.0)
     assert spinning.strategy == upright.strategy
     assert spinning.cmp_margin == pytest.approx(upright.cmp_margin, abs=1e-12)
+
+
+def test_numpy_scalars_and_ints_give_the_verdict_of_python_floats():
+    monitor = BalanceMonitor(P)
+    rng = np.random.default_rng(29)
+    for state in rng.uniform(-0.5, 0.5, (20, 4)):
+        verdict = monitor.query(*(float(v) for v in state))
+        assert monitor.query(*state) == verdict  # numpy float64
+        assert type(monitor.query(*state).capture_point_x) is float
+    assert monitor.query(0, 0, 1, 0) == monitor.query(0.0, 0.0, 1.0, 0.0)
+    with pytest.raises(ParameterTypeError, match="must be numbers"):
+        monitor.query(np.array([0.1]), 0.0, 0.0, 0.0)

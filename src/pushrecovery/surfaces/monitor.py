@@ -49,9 +49,8 @@ _UNIT_WEIGHTS = np.ones(2)
 _ORIGIN = np.zeros(2)
 
 _Edges = tuple[tuple[float, float, float, float, float, float, float, float], ...]
-#: Per edge of P ⊕ box, CCW: outward normal, the vertex of P and the box corner it starts from,
-#: those it ends at (stance axes).
-_SumEdges = tuple[tuple[float, float, float, float, int, float, float, int], ...]
+#: Per edge of P ⊕ box, CCW: outward normal, the vertex of P and the box corner it starts from.
+_SumEdges = tuple[tuple[float, float, float, float, int], ...]
 #: An upper-body axis's (angle [rad], rate [rad/s]).
 Axis = tuple[float, float]
 
@@ -138,7 +137,7 @@ def _signed_distance(edges: _Edges, px: float, py: float) -> float:
     return -best
 
 
-def _sum_edges(support: Support) -> tuple[_SumEdges, float, float]:
+def _sum_edges(polygon: _Edges, yaw: float) -> tuple[_SumEdges, float, float]:
     """Return the edges of P ⊕ box for any box [lo_x, hi_x] × [lo_y, hi_y] in the stance axes.
 
     The sum of a convex polygon and a box has P's edges, each moved by the box corner whose
@@ -150,34 +149,31 @@ def _sum_edges(support: Support) -> tuple[_SumEdges, float, float]:
     0 if u, w <= 0 and 1 if w <= 0 < u (a partition of the directions, turning with them, so
     each box edge is inserted once; a tie gives two collinear edges, one possibly of length 0).
 
-    Each row: the edge's outward normal, its start (a vertex of P and a corner) and its end,
-    all in the stance's axes (turned by −yaw about the world origin), then cos and sin of yaw.
+    ``polygon`` is P's :func:`_edges`, ``yaw`` the stance's heading [rad]. Each row: the edge's
+    outward normal and its start (a vertex of P and a corner), in the world frame; each edge
+    ends where the next starts. Then cos and sin of the yaw.
     """
-    yaw = support.yaw
     c, s = math.cos(yaw), math.sin(yaw)
-    # The box edge from corner k to k + 1: its outward normal in the stance's axes.
-    box = ((0.0, -1.0), (1.0, 0.0), (0.0, 1.0), (-1.0, 0.0))
-    vertices = [(c * x + s * y, c * y - s * x) for x, y in support.polygon.vertices.tolist()]
-    normals = [(c * x + s * y, c * y - s * x) for x, y in support.polygon.normals.tolist()]
-    starts = []  # (normal, start vertex, start corner) of each edge, in order
-    k = -1
-    for (vx, vy), (u, w) in zip(vertices, normals, strict=True):
+    # The box edge from corner k to k + 1: its outward normal in the world frame.
+    box = ((s, -c), (c, s), (-s, c), (-c, -s))
+    starts: list[tuple[float, float, float, float, int]] = []
+    k = first = -1
+    for nx, ny, _, vx, vy, _, _, _ in polygon:
+        u, w = c * nx + s * ny, c * ny - s * nx
         corner = (2 if u > 0.0 else 3) if w > 0.0 else (1 if u > 0.0 else 0)
-        if k < 0:  # the first vertex: its box edges come at the end, from the last corner
-            first, k = corner, corner
+        if k < 0:  # the first vertex: its box edges come last, from the last edge's corner
+            first = k = corner
         while k != corner:  # the box's edges between the last edge's corner and this one's
-            starts.append((*box[k], vx, vy, k))
-            k = (k + 1) % 4
-        starts.append((u, w, vx, vy, corner))
-    vx, vy = vertices[0]
+            bx, by = box[k]
+            starts.append((bx, by, vx, vy, k))
+            k = (k + 1) & 3
+        starts.append((nx, ny, vx, vy, corner))
+    _, _, _, vx, vy, _, _, _ = polygon[0]
     while k != first:  # the box's edges at the first vertex, closing the loop
-        starts.append((*box[k], vx, vy, k))
-        k = (k + 1) % 4
-    rows = tuple(
-        (*row, *following[2:])
-        for row, following in zip(starts, starts[1:] + starts[:1], strict=True)
-    )
-    return rows, c, s
+        bx, by = box[k]
+        starts.append((bx, by, vx, vy, k))
+        k = (k + 1) & 3
+    return tuple(starts), c, s
 
 
 def _sum_distance(
@@ -194,28 +190,31 @@ def _sum_distance(
     """
     rows, c, s = torso
     lo_x, hi_x, lo_y, hi_y = box
-    cx, cy = (lo_x, hi_x, hi_x, lo_x), (lo_y, lo_y, hi_y, hi_y)  # the corners, CCW
-    qx, qy = c * px + s * py, c * py - s * px  # ξ in the stance's axes
+    # The box's corners in the world frame, counter-clockwise from (lo_x, lo_y).
+    cx = (c * lo_x - s * lo_y, c * hi_x - s * lo_y, c * hi_x - s * hi_y, c * lo_x - s * hi_y)
+    cy = (s * lo_x + c * lo_y, s * hi_x + c * lo_y, s * hi_x + c * hi_y, s * lo_x + c * hi_y)
     excess = -math.inf
-    for nx, ny, vx, vy, k, _, _, _ in rows:
-        e = nx * (qx - (vx + cx[k])) + ny * (qy - (vy + cy[k]))
+    for nx, ny, vx, vy, k in rows:
+        e = nx * (px - (vx + cx[k])) + ny * (py - (vy + cy[k]))
         if e > excess:
             excess = e
     if excess <= 0.0:
         return -excess
     best = math.inf
-    for nx, ny, vx, vy, k, wx, wy, j in rows:
-        x0, y0 = vx + cx[k], vy + cy[k]
-        dx, dy = qx - x0, qy - y0
-        if nx * dx + ny * dy <= 0.0:
-            continue
-        ex, ey = wx + cx[j] - x0, wy + cy[j] - y0
-        length2 = ex * ex + ey * ey
-        t = (dx * ex + dy * ey) / length2 if length2 > 0.0 else 0.0
-        t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
-        gap = math.hypot(dx - t * ex, dy - t * ey)
-        if gap < best:
-            best = gap
+    nx, ny, vx, vy, k = rows[-1]  # the last edge: it ends where the first starts
+    x0, y0 = vx + cx[k], vy + cy[k]
+    for next_nx, next_ny, vx, vy, k in rows:  # the edge (nx, ny) from (x0, y0) to (x1, y1)
+        x1, y1 = vx + cx[k], vy + cy[k]
+        dx, dy = px - x0, py - y0
+        if nx * dx + ny * dy > 0.0:  # ξ is beyond this edge's line
+            ex, ey = x1 - x0, y1 - y0
+            length2 = ex * ex + ey * ey
+            t = (dx * ex + dy * ey) / length2 if length2 > 0.0 else 0.0
+            t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+            gap = math.hypot(dx - t * ex, dy - t * ey)
+            if gap < best:
+                best = gap
+        nx, ny, x0, y0 = next_nx, next_ny, x1, y1
     return -best
 
 
@@ -296,11 +295,12 @@ class BalanceMonitor:
         """
         require_type("support", support, Support)
         regions = StepRegions.of(self.params, support)
+        cop = _edges(support.polygon)
         self._state = _SupportState(
             support,
-            _edges(support.polygon),
+            cop,
             self._cmp_edges(support),
-            _sum_edges(support),
+            _sum_edges(cop, support.yaw),
             (regions.table, regions.counts, regions.steps_array, regions.outer),
         )
 
