@@ -267,12 +267,17 @@ class BalanceMonitor:
         self._minkowski: Callable[..., FloatArray] = minkowski_loop
         self._box = (cmp_offset(params), cmp_offset_roll(params))
         # Each upper-body axis's τmax, I, θmax, m g and ω, for the offsets from θ0, θ̇0 (E19).
-        self._axes = (
+        limits = (
             (params.torque_max, params.flywheel_inertia, params.flywheel_angle_max,
              params.weight, params.omega),
             (params.torque_max_roll, params.flywheel_inertia_roll,
              params.flywheel_angle_max_roll, params.weight, params.omega),
         )  # fmt: skip
+        # Per axis: those values and (−Δ⁻, Δ⁺) of the upright body at rest.
+        rest = [_flywheel_offsets(*axis, 0.0, 0.0) for axis in limits]
+        self._axes = tuple(
+            (axis, (-minus, plus)) for axis, (minus, plus) in zip(limits, rest, strict=True)
+        )
         first = Support.from_params(params) if support is None else support
         for stance in (Stance.LEFT, Stance.DOUBLE):  # loads every compiled path once
             self.set_support(Support.from_params(params, stance))
@@ -415,9 +420,12 @@ class BalanceMonitor:
         box: list[float] = []
         resting = True
         for name, value, axis in (("pitch", pitch, self._axes[0]), ("roll", roll, self._axes[1])):
-            angle, rate = (0.0, 0.0) if value is None else _pair(name, value)
+            if value is None:  # upright and at rest: (Δ⁻, Δ⁺) computed once, the same numbers
+                box += axis[1]
+                continue
+            angle, rate = _pair(name, value)
             try:
-                minus, plus = _flywheel_offsets(*axis, angle, rate)
+                minus, plus = _flywheel_offsets(*axis[0], angle, rate)
             except InvalidParameterError as error:
                 raise InvalidParameterError(f"{name}: {error}") from None
             resting = resting and angle == 0.0 and rate == 0.0
