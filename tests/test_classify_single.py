@@ -21,6 +21,7 @@ from pushrecovery.ground.minkowski import stacked_shapes
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.kernels.polygons import minkowski_loop
 from pushrecovery.kernels.single_margins import edge_rows, signed_distance
+from pushrecovery.surfaces.capture_plan import plan_loads
 from pushrecovery.surfaces.capture_region import (
     ORIGIN,
     _region_loop,
@@ -88,7 +89,8 @@ def test_sagittal_classify_builds_the_plan_the_full_functions_build(params):
             continue
         assert found.steps is not None
         plan = _sagittal_plan(found.capture_point, params, found.steps)
-        assert repr(found.plan) == repr(plan)
+        loads = plan_loads(plan, params, (x, 0.0), (xdot, 0.0))
+        assert repr(found.plan) == repr(dataclasses.replace(plan, loads=loads))
         line = line_steps(np.array([found.capture_point]), params.heel, params.toe, 0.0, params)
         assert found.step is not None
         low, high = found.step["step_length_range"]  # type: ignore[misc]
@@ -122,7 +124,8 @@ def test_plane_classify_margins_are_the_polygons_distances(sole):
             if found.strategy is Strategy.STEP:
                 assert found.steps == steps
                 plan = regions.plan(*xi, steps)
-                assert repr(found.plan) == repr(plan)
+                loads = plan_loads(plan, params, (x, y), (xdot, ydot))
+                assert repr(found.plan) == repr(dataclasses.replace(plan, loads=loads))
                 option = next(o for o in regions.options if o.swing is plan.swings[0])
                 impacts = plan_impacts(plan, (x, y), (xdot, ydot), params, option.yaw)
                 assert found.impacts == tuple(impacts)

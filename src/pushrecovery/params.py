@@ -27,6 +27,8 @@ MIN_FOOT_WIDTH = 1e-3
 #: Longest step time [s] (e^{-ω Δt_s} is then far below any margin) and most steps.
 MAX_STEP_TIME = 5.0
 MAX_STEPS = 50
+#: Largest friction coefficient μ (dimensionless): above it a ground holds any LIPM force.
+MAX_FRICTION = 10.0
 #: The physical parameters' ranges (name: low, high, unit), docs/reliability.md: wide enough
 #: for a 10 g toy and a 10 t machine, on the Moon or at 10 g, and narrow enough that no
 #: formula of the project leaves float64 (a gravity of 1e15 m/s^2 or a leg of 1e300 m is
@@ -105,6 +107,16 @@ class BodyParams:
         leg), in [0, max_step_length); ``None`` (preset): no limit, the reach is a disc and
         crossover steps count (people take them after sideways pushes; 0 keeps the landing
         ankle on its own side of the stance foot's line).
+    ankle_torque_max : float or None
+        Ankle torque limit [N m], in [0, 1e5]: the magnitude of the horizontal torque vector
+        m g (p − a) × ẑ the support's vertical force m g exerts about the ankle a through a
+        CoP p, |τ| = m g ‖p − a‖ (a plan's ``ankle_torque_ok``,
+        :class:`~pushrecovery.surfaces.capture_plan.CapturePlan`); ``None`` (preset): not
+        limited (the foot's edges are then the only bound on the CoP).
+    friction : float or None
+        Static friction coefficient μ of the ground, dimensionless, in (0, 10]: a plan's
+        horizontal ground force m ω² ‖r − p‖ must stay within μ m g (``friction_ok``);
+        ``None`` (preset): not limited.
 
     Raises
     ------
@@ -131,6 +143,8 @@ class BodyParams:
     min_step_time: float = 0.2
     max_steps: int = field(default=None)  # type: ignore[assignment]
     min_step_width: float | None = None
+    ankle_torque_max: float | None = None
+    friction: float | None = None
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -169,6 +183,17 @@ class BodyParams:
         set_(self, "max_step_length", reach)
         self._check_ground_plane(leg)
         self._check_steps()
+        if self.ankle_torque_max is not None:
+            limit = bounded_float("ankle_torque_max", self.ankle_torque_max, *LIMITS["torque_max"])
+            set_(self, "ankle_torque_max", limit)
+        if self.friction is not None:
+            mu = finite_float("friction", self.friction, "")
+            if not 0.0 < mu <= MAX_FRICTION:
+                raise InvalidParameterError(
+                    f"friction must be in (0, {MAX_FRICTION:g}] (a dimensionless coefficient), "
+                    f"got {mu:g}"
+                )
+            set_(self, "friction", mu)
 
     def _check_steps(self) -> None:
         """Validate the step timing and limits; derive ``max_steps`` when not given."""

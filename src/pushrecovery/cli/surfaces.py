@@ -71,10 +71,23 @@ def bounds(as_json: bool, **kwargs: Any) -> None:
     default=None,
     help="CoM velocity, left [m/s] (default 0); puts the state on the ground plane.",
 )
+@click.option(
+    "--landing-yaw",
+    type=float,
+    default=None,
+    help="Yaw of the plan's landing feet [rad], in [-pi, pi] (default: the stance foot's); "
+    "puts the state on the ground plane.",
+)
 @support_options
 @body_options
 def classify(
-    x: float, xdot: float, y: float | None, ydot: float | None, as_json: bool, **kwargs: Any
+    x: float,
+    xdot: float,
+    y: float | None,
+    ydot: float | None,
+    landing_yaw: float | None,
+    as_json: bool,
+    **kwargs: Any,
 ) -> None:
     """Which strategy the CoM state needs: ankle, hip, step or fall.
 
@@ -86,7 +99,10 @@ def classify(
     x forward and y left in the frame of the feet (by default the ankles' midpoint is the
     origin, in every stance; the --params file's [feet], then the flags, place them), where
     the support polygon and the CMP region are 2-D and the margins are signed distances of the
-    capture point to them [m], positive inside.
+    capture point to them [m], positive inside. A plan also says whether a step crosses over
+    (lands across the stance foot's midline; a note in the table), the landing feet's yaw
+    [rad], its peak ankle torque [N m] and horizontal ground force [N], and, when the body
+    sets ankle_torque_max and friction (--params file), whether they hold (docs/steps.md).
     """
     from pushrecovery.surfaces.classify import classify as classify_state
 
@@ -95,18 +111,32 @@ def classify(
     planar = (
         y is not None
         or ydot is not None
+        or landing_yaw is not None
         or any(kwargs[name] is not None for name in ("stance", "left_foot", "right_foot"))
     )
     if not planar:
         for name in ("stance", "left_foot", "right_foot"):
             kwargs.pop(name)
         result = classify_state(x, xdot, params).to_dict()
-        emit({**result, "state": {"x": x, "xdot": xdot}}, as_json)
+        _emit_classified({**result, "state": {"x": x, "xdot": xdot}}, as_json)
         return
     y, ydot = (0.0 if y is None else y), (0.0 if ydot is None else ydot)
     support = support_from(kwargs, params, file)
-    result = classify_state(x, xdot, params, y=y, ydot=ydot, support=support).to_dict()
-    emit({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)
+    result = classify_state(
+        x, xdot, params, y=y, ydot=ydot, support=support, landing_yaw=landing_yaw
+    ).to_dict()
+    _emit_classified({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)
+
+
+def _emit_classified(data: dict[str, Any], as_json: bool) -> None:
+    """Print a classification; the table notes a plan that crosses over."""
+    plan = data.get("plan")
+    if not as_json and isinstance(plan, dict) and plan.get("crossover"):
+        data["note"] = (
+            "the plan crosses over: a foot lands across the stance foot's midline "
+            "(a robot that cannot cross its legs sets min_step_width)"
+        )
+    emit(data, as_json)
 
 
 @click.command(

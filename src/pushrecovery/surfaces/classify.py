@@ -15,17 +15,17 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, require_type
+from pushrecovery.arguments import bounded_float, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_plan import CapturePlan
+from pushrecovery.surfaces.capture_plan import CapturePlan, plan_loads
 from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
 from pushrecovery.surfaces.classify_many import classify_states
 from pushrecovery.surfaces.cmp import cmp_region
@@ -198,6 +198,7 @@ def classify(
     y: float | None = None,
     ydot: float | None = None,
     support: Support | None = None,
+    landing_yaw: float | None = None,
 ) -> Classification:
     """Classify one CoM state (upper body upright and at rest, as the surfaces assume).
 
@@ -223,6 +224,11 @@ def classify(
         Lateral CoM velocity [m/s] (default 0).
     support : Support, optional
         Stance and feet on the ground plane.
+    landing_yaw : float, optional
+        Yaw of the plan's landing feet [rad], in [−π, π] (ground plane; default: the stance
+        foot's yaw). The verdict keeps the regions of the stance's yaw; the plan and its
+        margin are those of the landing yaw
+        (:meth:`~pushrecovery.surfaces.step_regions.StepRegions.plan`).
 
     Returns
     -------
@@ -230,12 +236,16 @@ def classify(
         ``ankle`` when the capture point is strictly inside the foot or support polygon
         (Eq. 4), ``hip`` when it is inside the CMP region (corrected Eq. 15, in the plane:
         the polygon grown by each axis's offset), ``step`` when at most ``max_steps`` steps
-        capture it (with the plan), else ``fall``.
+        capture it (with the plan), else ``fall``. The plan says whether it crosses over and
+        what its CoPs ask of the ankle and the ground
+        (:class:`~pushrecovery.surfaces.capture_plan.CapturePlan`).
     """
     x = finite_float("x", x, "m")
     xdot = finite_float("xdot", xdot, "m/s")
-    if y is not None or ydot is not None or support is not None:
-        return _classify_plane(x, xdot, params, y, ydot, support)
+    if landing_yaw is not None:
+        landing_yaw = bounded_float("landing_yaw", landing_yaw, -math.pi, math.pi, "rad")
+    if y is not None or ydot is not None or support is not None or landing_yaw is not None:
+        return _classify_plane(x, xdot, params, y, ydot, support, landing_yaw)
     verdict = sagittal_verdict(x, xdot, params)
     capture, strategy, steps = verdict.capture_point, verdict.strategy, verdict.steps
     margins = {"cop": verdict.cop_margin, "cmp": verdict.cmp_margin, "step": verdict.step_margin}
@@ -247,7 +257,8 @@ def classify(
             step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)
             step["step_length_range"] = list(_first_step_range(capture, steps, params))
             impacts = tuple(plan_impacts(plan, (x, 0.0), (xdot, 0.0), params))
-            return step, plan, impacts
+            loads = plan_loads(plan, params, (x, 0.0), (xdot, 0.0))
+            return step, replace(plan, loads=loads), impacts
 
         planned = _eager_if_out_of_range(_Planned(build), x, 0.0, xdot, 0.0)
     return Classification(
@@ -341,6 +352,7 @@ def _classify_plane(
     y: float | None,
     ydot: float | None,
     support: Support | None,
+    landing_yaw: float | None = None,
 ) -> Classification:
     """:func:`classify` on the ground plane: the verdict in one compiled call, the plan lazily."""
     from pushrecovery.kernels.single_margins import signed_distance
@@ -364,7 +376,7 @@ def _classify_plane(
         regions, chosen = tables.regions, support
 
         def build() -> _Details:
-            return _plane_details(x, y, xdot, ydot, params, chosen, regions, xi, steps)
+            return _plane_details(x, y, xdot, ydot, params, chosen, regions, xi, steps, landing_yaw)
 
         planned = _eager_if_out_of_range(_Planned(build), x, y, xdot, ydot)
     margins = {"cop": cop, "cmp": cmp, "step": step_margin}
@@ -390,9 +402,10 @@ def _plane_details(
     regions: StepRegions,
     xi: tuple[float, float],
     steps: int,
+    landing_yaw: float | None = None,
 ) -> _Details:
     """Return the first step, plan and impacts of a ``step`` verdict on the ground plane."""
-    plan = regions.plan(*xi, steps)
+    plan = regions.plan(*xi, steps, landing_yaw=landing_yaw)
     option = next(o for o in regions.options if o.swing is plan.swings[0])
     ankle = (float(option.ankle[0]), float(option.ankle[1]))
     step = _first_step(plan, (x, y), (xdot, ydot), ankle, params)
@@ -410,8 +423,9 @@ def _plane_details(
     step["direction_xy"] = [gap[0] / length + 0.0, gap[1] / length + 0.0]
     step["foothold_xy"] = [float(foot[0]) + 0.0, float(foot[1]) + 0.0]
     step["step_length_range"] = _plane_range(x, y, xdot, ydot, params, support, plan, ankle, gap)
-    impacts = tuple(plan_impacts(plan, (x, y), (xdot, ydot), params, option.yaw))
-    return step, plan, impacts
+    impacts = tuple(plan_impacts(plan, (x, y), (xdot, ydot), params, plan.landing_yaw))
+    loads = plan_loads(plan, params, (x, y), (xdot, ydot))
+    return step, replace(plan, loads=loads), impacts
 
 
 def _plane_range(

@@ -210,7 +210,8 @@ class StepOption:
     ankle : ndarray, shape (2,)
         The stance ankle q_0 [m].
     yaw : float
-        The stance foot's yaw, kept by every landing foot [rad].
+        The stance foot's yaw [rad], kept by every landing foot unless a plan chooses a
+        landing yaw (:func:`~pushrecovery.surfaces.capture_plan.capture_plan`).
     """
 
     swing: Stance
@@ -253,12 +254,19 @@ def step_options(
 
 
 def _sum_terms(
-    params: BodyParams, option: StepOption, touchdowns: tuple[float, ...], hip: bool
+    params: BodyParams,
+    option: StepOption,
+    touchdowns: tuple[float, ...],
+    hip: bool,
+    landing_yaw: float | None = None,
 ) -> tuple[list[tuple[float, Shape]], FloatArray, list[Stance]]:
     """Return the weighted shapes and the offset of (S1), and the landing sides.
 
-    Terms in order: the hip's box, the stance, the landing feet, the reach polygons.
+    Terms in order: the hip's box, the stance, the landing feet, the reach polygons. The
+    landing feet and the reach about each landed foot turn with ``landing_yaw`` (default: the
+    stance's yaw); the first reach and the hip's box keep the stance's yaw.
     """
+    landing = option.yaw if landing_yaw is None else landing_yaw
     omega = params.omega
     a = [math.exp(-omega * t) for t in touchdowns] + [0.0]
     terms: list[tuple[float, Shape]] = []
@@ -269,10 +277,10 @@ def _sum_terms(
     side = option.swing
     for k in range(len(touchdowns)):
         sides.append(side)
-        terms.append((a[k] - a[k + 1], landing_foot(params, side, option.yaw)))
+        terms.append((a[k] - a[k + 1], landing_foot(params, side, landing)))
         side = _other(side)
     for k in range(len(touchdowns)):
-        terms.append((a[k], reach_polygon(params, sides[k], option.yaw)))
+        terms.append((a[k], reach_polygon(params, sides[k], option.yaw if k == 0 else landing)))
     return terms, a[0] * option.ankle, sides
 
 
@@ -296,6 +304,7 @@ def viable_region(
     touchdowns: tuple[float, ...],
     *,
     hip: bool = True,
+    landing_yaw: float | None = None,
 ) -> ConvexPolygon:
     """C_N of (S1): the capture points that N steps at these touchdown times capture [m].
 
@@ -309,6 +318,11 @@ def viable_region(
         t_1 < ... < t_N [s] from now, at least ``min_step_time`` apart; () gives S ⊕ H.
     hip : bool
         Include the upper body's box H.
+    landing_yaw : float, optional
+        Yaw of every landing foot [rad], in [−π, π] (default: the stance's, ``option.yaw``).
+        The landing feet F_k and the reach about each landed foot turn with it; the first
+        reach and H keep the stance's frame. The feet are not rotationally symmetric, so C_N
+        depends on it.
 
     Raises
     ------
@@ -316,7 +330,7 @@ def viable_region(
         If ``params``, ``option`` or ``hip`` has the wrong type.
     InvalidParameterError
         Touchdown times that are not a one-dimensional sequence of finite numbers at least
-        ``min_step_time`` apart (the first >= 0).
+        ``min_step_time`` apart (the first >= 0), or a ``landing_yaw`` outside [−π, π] rad.
     """
     require_type("params", params, BodyParams)
     require_type("option", option, StepOption)
@@ -328,7 +342,9 @@ def viable_region(
         )
     touchdowns = tuple(float(t) for t in times)
     _check_touchdowns(params, touchdowns)
-    terms, offset, _ = _sum_terms(params, option, touchdowns, bool(hip))
+    if landing_yaw is not None:
+        landing_yaw = bounded_float("landing_yaw", landing_yaw, -math.pi, math.pi, "rad")
+    terms, offset, _ = _sum_terms(params, option, touchdowns, bool(hip), landing_yaw)
     return minkowski_sum_unchecked(terms, offset)
 
 

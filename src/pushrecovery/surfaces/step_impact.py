@@ -101,7 +101,7 @@ def plan_impacts(
     params : BodyParams
         The body (L, ω, feet, reach, Δt_s).
     yaw : float
-        The stance's yaw, kept by the landing feet [rad].
+        The landing feet's yaw [rad]: a plan's ``landing_yaw`` (by default the stance's).
 
     Returns
     -------

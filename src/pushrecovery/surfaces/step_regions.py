@@ -29,17 +29,17 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import finite_array, require_type
+from pushrecovery.arguments import bounded_float, finite_array, finite_vector, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_plan import CapturePlan, capture_plan
+from pushrecovery.surfaces.capture_plan import CapturePlan, capture_plan, plan_loads
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.cop import CaptureInterval
 from pushrecovery.surfaces.n_step import (
@@ -228,14 +228,17 @@ def sagittal_step_interval(params: BodyParams, steps: int | None = None) -> Capt
     return CaptureInterval(float(low), float(high))
 
 
-def _sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
+def _sagittal_plan(
+    xi: float, params: BodyParams, steps: int, com: float | None = None
+) -> CapturePlan:
     """Return the plan of :func:`~.capture_plan.capture_plan` on the sagittal line.
 
     Step by step: the first foothold is the middle of the interval of first footholds ((S3)
     on the line: T ξ − T[−a, a] − (T − 1)(q_0 + [δ⁻, δ⁺]) − V_{N−1}, within q_0 ± l), the most
     robust one; the CoP and the hip's share put every term of T ξ − q_1 at the same fraction of
     its half-width from its centre, which gives the capture point at touchdown; then the same
-    from the new foot, N − 1 steps, without the hip. Footholds (x, 0), touchdowns every Δt_s.
+    from the new foot, N − 1 steps, without the hip. Footholds (x, 0), touchdowns every Δt_s;
+    with the CoM position ``com`` [m] the loads include the ground forces (:func:`plan_loads`).
     """
     interval = sagittal_step_interval(params, steps)
     margin = interval.half_width - abs(xi - interval.centre)
@@ -265,7 +268,7 @@ def _sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
         capture = foothold + middle + share * (half + more)
         ankle, hip = foothold, 0.0
     cops[steps, 0] = capture  # the last CoP holds the capture point, in the last foot
-    return CapturePlan(
+    plan = CapturePlan(
         steps,
         tuple(Stance.LEFT if k % 2 == 0 else Stance.RIGHT for k in range(steps)),
         footholds,
@@ -274,6 +277,10 @@ def _sagittal_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
         np.array([share_hip, 0.0]),
         margin,
     )
+    if com is None:
+        return replace(plan, loads=plan_loads(plan, params))
+    velocity = (params.omega * (xi - com), 0.0)
+    return replace(plan, loads=plan_loads(plan, params, (com, 0.0), velocity))
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -464,15 +471,35 @@ class StepRegions:
                 np.maximum(best, polygon.signed_distance(px, py), out=best)
         return best
 
-    def plan(self, px: float, py: float, steps: int) -> CapturePlan:
+    def plan(
+        self,
+        px: float,
+        py: float,
+        steps: int,
+        *,
+        landing_yaw: float | None = None,
+        com: tuple[float, float] | FloatArray | None = None,
+    ) -> CapturePlan:
         """Return the plan of ``steps`` steps for ξ = (px, py).
 
         From double support the foot on the capture point's side of the other ankle steps
         when its regions capture ξ (a side step, not a crossover), else the other one. The
         plan is made in the stance foot's frame (ankle at the origin, yaw 0: its terms are
-        kept from plan to plan) and turned and moved back.
+        kept from plan to plan) and turned and moved back. The plan says whether it crosses
+        over (``crossover``, :class:`~pushrecovery.surfaces.capture_plan.CapturePlan`).
+
+        ``landing_yaw`` [rad], in [−π, π], is the world yaw of every landing foot (default:
+        the stance foot's); the foot is chosen, and ``steps`` given, by the regions of the
+        stance's yaw, while the plan and its ``margin`` are those of the landing yaw
+        (:func:`~pushrecovery.surfaces.capture_plan.capture_plan`). With the CoM position
+        ``com`` [m], world frame, the plan's loads include the ground forces.
         """
         from pushrecovery.kernels.plane_codes import locate_steps
+
+        if landing_yaw is not None:
+            landing_yaw = bounded_float("landing_yaw", landing_yaw, -math.pi, math.pi, "rad")
+        if com is not None:
+            com = finite_vector("com", com, 2, unit="m")
 
         sides = len(self._stances)
         first = (steps - 1) * sides
@@ -501,7 +528,20 @@ class StepRegions:
         dx, dy = px - x, py - y
         local = np.array([c * dx + s * dy, -s * dx + c * dy])
         option = _canonical(self.params).options[_SIDE[stance]]
-        plan = capture_plan(local, self.params, option, steps, margin=margins[k])
+        turned = None if landing_yaw is None else math.remainder(landing_yaw - yaw, math.tau)
+        local_com = None
+        if com is not None:
+            gx, gy = float(com[0]) - x, float(com[1]) - y
+            local_com = (c * gx + s * gy, -s * gx + c * gy)
+        plan = capture_plan(
+            local,
+            self.params,
+            option,
+            steps,
+            margin=margins[k] if not turned else None,
+            landing_yaw=turned,
+            com=local_com,
+        )
         turn = np.array([[c, s], [-s, c]])  # row vectors times this: turned by the yaw
         shift = np.array([x, y])
         return CapturePlan(
@@ -513,6 +553,9 @@ class StepRegions:
             plan.hip @ turn,
             plan.margin,
             shift,
+            yaw,
+            yaw if landing_yaw is None else landing_yaw,
+            plan.loads,
         )
 
 
