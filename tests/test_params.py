@@ -46,11 +46,27 @@ def test_params_are_frozen(params):
         ("torque_max", -1.0, r"torque_max must be in \[0,"),
         ("flywheel_angle_max", 0.0, "flywheel_angle_max must be in"),
         ("leg_length", -1.0, "leg_length must be in"),
+        ("ankle_torque_max", -1.0, r"ankle_torque_max must be in \[0, 100000\] \[N m\]"),
+        ("ankle_torque_max", 1e6, r"ankle_torque_max must be in \[0, 100000\]"),
+        ("ankle_torque_max", math.nan, "ankle_torque_max must be a finite number"),
+        ("friction", 0.0, r"friction must be in \(0, 10\] \(a dimensionless coefficient\)"),
+        ("friction", -0.5, r"friction must be in \(0, 10\]"),
+        ("friction", 11.0, r"friction must be in \(0, 10\]"),
+        ("friction", math.inf, "friction must be a finite number"),
     ],
 )
 def test_bad_values_name_the_parameter(field, value, words):
     with pytest.raises(InvalidParameterError, match=words):
         load_params(overrides={field: value})
+
+
+def test_ankle_torque_and_friction_limits_are_optional(tmp_path):
+    assert (load_params().ankle_torque_max, load_params().friction) == (None, None)
+    path = tmp_path / "robot.toml"
+    path.write_text("ankle_torque_max = 60\nfriction = 0.7\n")
+    p = load_params(file=path)
+    assert (p.ankle_torque_max, p.friction) == (60.0, 0.7)
+    assert p.to_dict()["ankle_torque_max"] == 60.0 and p.to_dict()["friction"] == 0.7
 
 
 def test_error_is_a_value_error():
