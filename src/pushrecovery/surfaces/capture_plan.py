@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,6 +50,7 @@ from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_region import (
     MAX_CAPTURE_POINT,
     MAX_POSITION,
+    MAX_SPEED,
     ORIGIN,
     StepTerms,
     step_terms,
@@ -155,6 +156,22 @@ class CapturePlan:
     landing_yaw: float = 0.0
     loads: PlanLoads | None = None
 
+    def with_loads(self, loads: PlanLoads | None) -> CapturePlan:
+        """Return the same plan with ``loads`` (:func:`plan_loads`)."""
+        return CapturePlan(
+            self.steps,
+            self.swings,
+            self.footholds,
+            self.touchdowns,
+            self.cops,
+            self.hip,
+            self.margin,
+            self.ankle,
+            self.yaw,
+            self.landing_yaw,
+            loads,
+        )
+
     @property
     def ankles(self) -> FloatArray:
         """The stance ankle of each phase, shape (N + 1, 2): ``ankle``, then the footholds [m]."""
@@ -229,41 +246,60 @@ def plan_loads(
     ParameterTypeError
         If ``plan`` or ``params`` has the wrong type.
     InvalidParameterError
-        Only one of ``position`` and ``velocity``, or either not a finite (x, y) within
-        ±1000 m (m/s).
+        Only one of ``position`` and ``velocity``, or a position (velocity) that is not a
+        finite (x, y) within ±1000 m (±100 m/s).
     """
     require_type("plan", plan, CapturePlan)
     require_type("params", params, BodyParams)
-    offsets = np.asarray(plan.cops, dtype=np.float64) - plan.ankles
-    torques = tuple(params.weight * float(math.hypot(*row)) for row in offsets.tolist())
+    # On Python floats: a plan has a few phases, and numpy's per-call cost would dominate.
+    cops = plan.cops.tolist()
+    ankles = [plan.ankle.tolist(), *plan.footholds.tolist()]
+    weight = params.weight
+    torques = tuple(
+        weight * math.hypot(p[0] - a[0], p[1] - a[1]) for p, a in zip(cops, ankles, strict=True)
+    )
     peak = max(torques)
     limit = params.ankle_torque_max
-    torque_ok = None if limit is None else bool(peak <= limit)
+    torque_ok = None if limit is None else peak <= limit
     if (position is None) != (velocity is None):
         raise InvalidParameterError("give both position and velocity (the CoM state), or neither")
     if position is None or velocity is None:
         return PlanLoads(torques, peak, torque_ok)
-    r = finite_vector("position", position, 2, MAX_POSITION, "m")
-    v = finite_vector("velocity", velocity, 2, MAX_POSITION, "m/s")
+    rx, ry = _point("position", position, MAX_POSITION, "m")
+    vx, vy = _point("velocity", velocity, MAX_SPEED, "m/s")
     omega = params.omega
     first = math.exp(-omega * float(plan.touchdowns[0]))
-    offset = plan.hip / (1.0 - first) if first < 1.0 else np.zeros(2)
+    hx, hy = (h / (1.0 - first) for h in plan.hip.tolist()) if first < 1.0 else (0.0, 0.0)
     start, farthest = 0.0, 0.0
-    for k in range(plan.steps + 1):
-        cmp = plan.cops[k] + (offset if k == 0 else 0.0)
-        farthest = max(farthest, float(np.hypot(*(r - cmp))))
-        if k == plan.steps:  # the last CoP holds the capture point: ‖r − p‖ decays
+    for k, t in enumerate([*plan.touchdowns.tolist(), None]):
+        px, py = cops[k][0] + (hx if k == 0 else 0.0), cops[k][1] + (hy if k == 0 else 0.0)
+        farthest = max(farthest, math.hypot(rx - px, ry - py))
+        if t is None:  # the last CoP holds the capture point: ‖r − p‖ decays
             break
-        t = float(plan.touchdowns[k])
         c, s = math.cosh(omega * (t - start)), math.sinh(omega * (t - start))
-        r, v = cmp + (r - cmp) * c + v / omega * s, (r - cmp) * omega * s + v * c
-        farthest = max(farthest, float(np.hypot(*(r - cmp))))
+        rx, ry, vx, vy = (
+            px + (rx - px) * c + vx / omega * s,
+            py + (ry - py) * c + vy / omega * s,
+            (rx - px) * omega * s + vx * c,
+            (ry - py) * omega * s + vy * c,
+        )
+        farthest = max(farthest, math.hypot(rx - px, ry - py))
         start = t
     force = params.mass * omega**2 * farthest
     if params.friction is None:
         return PlanLoads(torques, peak, torque_ok, force)
-    ratio = force / (params.friction * params.weight)
-    return PlanLoads(torques, peak, torque_ok, force, ratio, bool(ratio <= 1.0))
+    ratio = force / (params.friction * weight)
+    return PlanLoads(torques, peak, torque_ok, force, ratio, ratio <= 1.0)
+
+
+def _point(name: str, value: object, bound: float, unit: str) -> tuple[float, float]:
+    """Return a finite (x, y) within ±``bound`` as two floats (a float pair skips numpy)."""
+    if type(value) is tuple and len(value) == 2 and all(type(v) is float for v in value):
+        a, b = value
+        if abs(a) <= bound and abs(b) <= bound:  # False for NaN: refused below, by name
+            return a, b
+    a, b = finite_vector(name, value, 2, bound, unit).tolist()  # type: ignore[arg-type]
+    return a, b
 
 
 def capture_plan(
@@ -339,7 +375,7 @@ def capture_plan(
     _check_touchdowns(params, times)
     plan = _plan(xi, params, option, steps, times, hip, margin, landing)
     velocity = None if com is None else params.omega * (xi - com)
-    return replace(plan, loads=plan_loads(plan, params, com, velocity))
+    return plan.with_loads(plan_loads(plan, params, com, velocity))
 
 
 def _plan(

@@ -15,7 +15,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -32,7 +32,7 @@ from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.step_impact import TouchdownImpact, plan_impacts
-from pushrecovery.surfaces.step_regions import StepRegions, _sagittal_plan
+from pushrecovery.surfaces.step_regions import StepRegions, _line_plan
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 from pushrecovery.surfaces.verdicts import (  # sagittal_verdicts: campaign.pushes imports it here
     _first_step_range,
@@ -253,12 +253,12 @@ def classify(
     if strategy is Strategy.STEP:
 
         def build() -> _Details:
-            plan = _sagittal_plan(capture, params, steps)
+            plan = _line_plan(capture, params, steps)
             step = _first_step(plan, (x, 0.0), (xdot, 0.0), (0.0, 0.0), params)
             step["step_length_range"] = list(_first_step_range(capture, steps, params))
             impacts = tuple(plan_impacts(plan, (x, 0.0), (xdot, 0.0), params))
             loads = plan_loads(plan, params, (x, 0.0), (xdot, 0.0))
-            return step, replace(plan, loads=loads), impacts
+            return step, plan.with_loads(loads), impacts
 
         planned = _eager_if_out_of_range(_Planned(build), x, 0.0, xdot, 0.0)
     return Classification(
@@ -425,7 +425,7 @@ def _plane_details(
     step["step_length_range"] = _plane_range(x, y, xdot, ydot, params, support, plan, ankle, gap)
     impacts = tuple(plan_impacts(plan, (x, y), (xdot, ydot), params, plan.landing_yaw))
     loads = plan_loads(plan, params, (x, y), (xdot, ydot))
-    return step, replace(plan, loads=loads), impacts
+    return step, plan.with_loads(loads), impacts
 
 
 def _plane_range(

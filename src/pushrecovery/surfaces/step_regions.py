@@ -29,7 +29,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -231,14 +231,22 @@ def sagittal_step_interval(params: BodyParams, steps: int | None = None) -> Capt
 def _sagittal_plan(
     xi: float, params: BodyParams, steps: int, com: float | None = None
 ) -> CapturePlan:
+    """Return :func:`_line_plan` with its loads (:func:`plan_loads`; the CoM at ``com`` [m])."""
+    plan = _line_plan(xi, params, steps)
+    if com is None:
+        return plan.with_loads(plan_loads(plan, params))
+    velocity = (params.omega * (xi - com), 0.0)
+    return plan.with_loads(plan_loads(plan, params, (com, 0.0), velocity))
+
+
+def _line_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
     """Return the plan of :func:`~.capture_plan.capture_plan` on the sagittal line.
 
     Step by step: the first foothold is the middle of the interval of first footholds ((S3)
     on the line: T ξ − T[−a, a] − (T − 1)(q_0 + [δ⁻, δ⁺]) − V_{N−1}, within q_0 ± l), the most
     robust one; the CoP and the hip's share put every term of T ξ − q_1 at the same fraction of
     its half-width from its centre, which gives the capture point at touchdown; then the same
-    from the new foot, N − 1 steps, without the hip. Footholds (x, 0), touchdowns every Δt_s;
-    with the CoM position ``com`` [m] the loads include the ground forces (:func:`plan_loads`).
+    from the new foot, N − 1 steps, without the hip. Footholds (x, 0), touchdowns every Δt_s.
     """
     interval = sagittal_step_interval(params, steps)
     margin = interval.half_width - abs(xi - interval.centre)
@@ -268,7 +276,7 @@ def _sagittal_plan(
         capture = foothold + middle + share * (half + more)
         ankle, hip = foothold, 0.0
     cops[steps, 0] = capture  # the last CoP holds the capture point, in the last foot
-    plan = CapturePlan(
+    return CapturePlan(
         steps,
         tuple(Stance.LEFT if k % 2 == 0 else Stance.RIGHT for k in range(steps)),
         footholds,
@@ -277,10 +285,6 @@ def _sagittal_plan(
         np.array([share_hip, 0.0]),
         margin,
     )
-    if com is None:
-        return replace(plan, loads=plan_loads(plan, params))
-    velocity = (params.omega * (xi - com), 0.0)
-    return replace(plan, loads=plan_loads(plan, params, (com, 0.0), velocity))
 
 
 @dataclass(frozen=True, slots=True, eq=False)
