@@ -311,3 +311,15 @@ def test_cli_landing_yaw_out_of_range_is_one_line_exit_2(capsys):
     assert exit_info.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "landing_yaw" in err and "rad" in err
+
+
+def test_cli_capture_region_says_whether_its_foothold_crosses_over():
+    base = ["capture-region", "--x", "0", "--xdot", "0.3", "--stance", "right", "--json"]
+    across = json.loads(CliRunner().invoke(cli, [*base, "--ydot", "-0.9"]).output)
+    assert across["swing"] == "left" and across["crossover"] is True
+    assert across["foothold"][1] < -0.1  # the left foot lands right of the right ankle
+    outward = json.loads(CliRunner().invoke(cli, [*base, "--ydot", "0.6"]).output)
+    assert outward["crossover"] is False
+    narrow = [*base, "--ydot", "-0.9", "--min-step-width", "0.12"]
+    empty = json.loads(CliRunner().invoke(cli, narrow).output)
+    assert empty["foothold"] is None and empty["crossover"] is None

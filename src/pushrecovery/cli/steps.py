@@ -96,8 +96,9 @@ def capture_region_command(
     the reach (max_step_length about the stance ankle), touchdowns min_step_time apart and the
     hip's box (docs/steps.md). Prints the landing foot, the touchdown time [s], the region's
     vertices [m] and area [m^2], and the recommended foothold [m]: the region's Chebyshev
-    centre, the one farthest from its edges; then the capture point [m], the support and the
-    state. An empty region has no vertices (null in JSON).
+    centre, the one farthest from its edges, and whether it crosses over (lands across the
+    stance foot's midline; min_step_width forbids it); then the capture point [m], the support
+    and the state. An empty region has no vertices (null in JSON).
     """
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.surfaces.capture_region import capture_region
@@ -128,6 +129,7 @@ def capture_region_command(
         "area": region.area,
         "vertices": None if region.polygon is None else region.polygon.to_list(),
         "foothold": None if region.foothold is None else [float(v) for v in region.foothold],
+        "crossover": None if region.foothold is None else _crosses(region, support),
         "capture_point_xy": [
             capture_point(x, xdot, params.omega),
             capture_point(y, ydot, params.omega),
@@ -145,3 +147,17 @@ def capture_region_command(
         (path,) = save_figure(figure, plot.with_suffix(""), (plot.suffix[1:].lower(),))
         data["plot"] = str(path)
     emit(data, as_json)
+
+
+def _crosses(region: Any, support: Any) -> bool:
+    """Whether the recommended foothold lands across the stance foot's midline (docs/steps.md)."""
+    import math
+
+    from pushrecovery.ground.support import Stance
+    from pushrecovery.surfaces.capture_plan import CROSSOVER_TOLERANCE
+
+    stance = support.right if region.swing is Stance.LEFT else support.left
+    dx, dy = float(region.foothold[0]) - stance.x, float(region.foothold[1]) - stance.y
+    lateral = -math.sin(stance.yaw) * dx + math.cos(stance.yaw) * dy
+    outward = lateral if region.swing is Stance.LEFT else -lateral
+    return outward < -CROSSOVER_TOLERANCE
