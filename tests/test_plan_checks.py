@@ -323,3 +323,26 @@ def test_cli_capture_region_says_whether_its_foothold_crosses_over():
     narrow = [*base, "--ydot", "-0.9", "--min-step-width", "0.12"]
     empty = json.loads(CliRunner().invoke(cli, narrow).output)
     assert empty["foothold"] is None and empty["crossover"] is None
+
+
+def test_turned_terms_of_the_stance_yaw_are_step_terms(params):
+    from pushrecovery.surfaces.capture_plan import _turned_terms
+    from pushrecovery.surfaces.capture_region import step_terms
+
+    option = step_options(params, Support.from_params(params, Stance.RIGHT))[0]
+    key = (option.stance.vertices - option.ankle).tobytes()
+    for steps, hip in ((1, True), (3, False)):
+        same = step_terms(params, Stance.LEFT, 0.0, steps, 0.2, hip, key)
+        turned = _turned_terms(params, Stance.LEFT, 0.0, 0.0, steps, 0.2, hip, key)
+        for name in ("foot_shapes", "foot_weights", "window_offsets", "split_total"):
+            np.testing.assert_array_equal(getattr(turned, name), getattr(same, name))
+
+
+def test_capture_plan_with_the_com_reports_the_forces_of_that_state(params):
+    option = step_options(params, Support.from_params(params, Stance.RIGHT))[0]
+    xi, com = np.array([0.45, -0.1]), (0.05, -0.08)
+    plan = capture_plan(xi, params, option, 1, com=com)
+    velocity = params.omega * (xi - np.array(com))
+    again = plan_loads(plan, params, com, tuple(velocity.tolist()))
+    assert plan.loads == again and plan.loads.horizontal_force_peak is not None
+    assert capture_plan(xi, params, option, 1).loads.horizontal_force_peak is None

@@ -121,7 +121,9 @@ class Classification:
     and null in JSON otherwise. ``steps`` is the number of steps needed (0: ankle or hip,
     None: more than ``max_steps``) and ``plan`` the plan of a ``step`` verdict (footholds,
     touchdown times, CoPs; ``impact``: each touchdown's capture point without and with Sec.
-    IV's impact, :mod:`pushrecovery.surfaces.step_impact`). ``step`` describes its first
+    IV's impact, :mod:`pushrecovery.surfaces.step_impact`; whether a step crosses over and the
+    ankle torques and ground forces of its CoPs from this state,
+    :class:`~pushrecovery.surfaces.capture_plan.CapturePlan`). ``step`` describes its first
     step: ``step_length`` (stance ankle to landing ankle, signed like the step on the line),
     ``com_to_foot`` (landing ankle minus CoM at touchdown), ``theta`` (the stance leg's lean
     at touchdown, atan of the CoM's distance ahead of the stance ankle over L) and the
