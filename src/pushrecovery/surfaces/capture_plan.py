@@ -24,7 +24,12 @@ asks of the legs and the ground:
   so its peak over a phase lies at an end: the touchdowns. The CoM follows the plan's CoPs
   with the hip's share delivered as a constant CMP offset until the first touchdown, as
   :func:`~pushrecovery.surfaces.step_impact.plan_impacts` does; the last CoP holds the
-  capture point, where ‖r − p‖ decays as e^{−ωt}.
+  capture point of a plan that captures (``margin`` > 0), where ‖r − p‖ decays as e^{−ωt}
+  (a plan with ``margin`` < 0 does not come to rest: its peak covers the touchdowns only).
+
+Over 400 lines on purpose: one concept, a plan, how it is made and what it asks of the robot;
+the landing yaw's terms (:func:`_turned_terms`) would shrink to a call if
+:func:`~pushrecovery.surfaces.capture_region.step_terms` took a landing yaw.
 """
 
 from __future__ import annotations
