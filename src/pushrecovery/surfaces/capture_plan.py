@@ -28,7 +28,7 @@ asks of the legs and the ground:
   (a plan with ``margin`` < 0 does not come to rest: its peak covers the touchdowns only).
 
 Over 400 lines on purpose: one concept, a plan, how it is made and what it asks of the robot;
-the landing yaw's terms (:func:`_turned_terms`) would shrink to a call if
+the landing yaw's terms (``_turned_terms``) would shrink to a call if
 :func:`~pushrecovery.surfaces.capture_region.step_terms` took a landing yaw.
 """
 
