@@ -110,7 +110,7 @@ class BodyParams:
     ankle_torque_max : float or None
         Ankle torque limit [N m], in [0, 1e5]: the magnitude of the horizontal torque vector
         m g (p − a) × ẑ the support's vertical force m g exerts about the ankle a through a
-        CoP p, |τ| = m g ‖p − a‖ (a plan's ``ankle_torque_ok``,
+        CoP p, ‖τ‖ = m g ‖p − a‖ (a plan's ``ankle_torque_ok``,
         :class:`~pushrecovery.surfaces.capture_plan.CapturePlan`); ``None`` (preset): not
         limited (the foot's edges are then the only bound on the CoP).
     friction : float or None
