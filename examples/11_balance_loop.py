@@ -4,10 +4,11 @@ A body stands on feet placed as a robot would measure them (turned, not at the d
 and is pushed forward and to the left. Every millisecond the loop thread asks the plane
 recovery controller for a command, advances the plant (the exact planar model with stepping
 feet) and, when a foot lifts or lands, tells the monitor the new support; a second thread
-reads the monitor's verdict at 100 Hz, as a logger or a safety supervisor would, while the
-loop changes the support under it (docs/realtime.md gives the thread rules). Everything that
-builds regions or loads compiled code happens before the loop; the loop prints what each
-kind of call cost against the 1 ms period.
+reads the monitor's verdict at 100 Hz, with the upper body's current pitch and roll, as a
+logger or a safety supervisor would, while the loop changes the support under it
+(docs/realtime.md gives the thread rules). Everything that builds regions or loads compiled
+code happens before the loop; the loop prints what each kind of call cost against the 1 ms
+period.
 """
 
 import threading
@@ -44,10 +45,14 @@ done = threading.Event()
 
 
 def supervise() -> None:
-    """Read the monitor at 100 Hz while the loop runs (queries are safe beside set_support)."""
+    """Read the monitor at 100 Hz while the loop runs (queries are safe beside set_support).
+
+    The verdict takes the upper body's current pitch and roll (angle, rate) too: the hip
+    strategy has less room on the side the upper body already leans or turns toward.
+    """
     while not done.is_set():
-        x, y, _, _, xdot, ydot, _, _ = latest[0]
-        verdict = monitor.query(float(x), float(y), float(xdot), float(ydot))
+        x, y, pitch, roll, xdot, ydot, pitch_rate, roll_rate = latest[0].tolist()
+        verdict = monitor.query(x, y, xdot, ydot, pitch=(pitch, pitch_rate), roll=(roll, roll_rate))
         seen[verdict.strategy.value] = seen.get(verdict.strategy.value, 0) + 1
         time.sleep(0.01)
 
