@@ -19,6 +19,9 @@ A query may also give the upper body's current pitch and roll, each (angle [rad]
 P ⊕ an off-centre box in the support's axes. The sum's edges are ordered per support (P's
 edges and the box's four, merged by direction), so a query only moves the box's corners: a
 few µs more, no hull built.
+
+Over 400 lines on purpose: one concept, a query's verdict for one support, with the
+per-support tables it reads and the distance routines it runs on them in Python floats.
 """
 
 from __future__ import annotations
