@@ -230,7 +230,8 @@ def classify(
         Yaw of the plan's landing feet [rad], in [−π, π] (ground plane; default: the stance
         foot's yaw). The verdict keeps the regions of the stance's yaw; the plan and its
         margin are those of the landing yaw
-        (:meth:`~pushrecovery.surfaces.step_regions.StepRegions.plan`).
+        (:meth:`~pushrecovery.surfaces.step_regions.StepRegions.plan`), while the first
+        step's ``step_length_range`` stays that of the stance's yaw.
 
     Returns
     -------
