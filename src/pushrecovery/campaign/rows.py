@@ -180,7 +180,7 @@ PARAM_UNITS: Mapping[str, str] = {
     "leg_length": "m", "max_step_length": "m", "foot_width": "m", "stance_width": "m",
     "flywheel_inertia_roll": "kg m^2", "torque_max_roll": "N m",
     "flywheel_angle_max_roll": "rad", "min_step_time": "s", "max_steps": "-",
-    "min_step_width": "m",
+    "min_step_width": "m", "ankle_torque_max": "N m", "friction": "-",
 }  # fmt: skip
 
 
