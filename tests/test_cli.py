@@ -305,6 +305,8 @@ def test_table_output_is_readable():
             "has no option 'bogus'",
         ),
         (["simulate", "--controller", "ankle-saturated", "--kp", "2000"], "apply to ankle-pd"),
+        (["classify", "--x", "0", "--xdot", "1.2", "--friction", "0"], "friction must be in"),
+        (["classify", "--x", "0", "--xdot", "1.2", "--ankle-torque-max", "-1"], "ankle_torque_max"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(capsys, args, words):

@@ -49,6 +49,16 @@ PARAM_FLAGS: tuple[tuple[str, str, str], ...] = (
         "min_step_width",
         "Narrowest lateral stance-to-landing ankle distance [m] (default: none, crossovers).",
     ),
+    (
+        "--ankle-torque-max",
+        "ankle_torque_max",
+        "Ankle torque limit [N m] the plans' CoPs are checked against (default: none).",
+    ),
+    (
+        "--friction",
+        "friction",
+        "Friction coefficient μ the plans are checked against (default: none).",
+    ),
 )
 
 
