@@ -13,7 +13,8 @@ to the foremost supporting toe marker; along ml it spans the supporting feet's m
 by half the foot width on each side (heel and toe markers sit on the foot's midline; the ankle
 marker, on the lateral malleolus, is left out). The stance ankle of the stepping model is the
 supporting ankle nearest the capture point (across: the foot's midline). A frame in which any
-foot's markers are missing has no known base.
+foot's heel or toe marker is missing has no known base (the markers left would give a smaller
+one).
 """
 
 from __future__ import annotations
@@ -175,8 +176,9 @@ def support_from_feet(
         floor = np.nanmin(low, axis=0)
     with np.errstate(invalid="ignore"):
         supporting = low <= floor + contact_height
-    # A foot whose markers are missing may be on the floor or not: the base is unknown.
-    unknown = ~np.isfinite(low).all(axis=1)
+    # A missing heel or toe marker may be an edge of the base (and its foot may be on the
+    # floor or not): the base is unknown, not the smaller base of the markers left.
+    unknown = ~(np.isfinite(heel).all(axis=(1, 2)) & np.isfinite(toe).all(axis=(1, 2)))
     ap = (heel[..., 0], toe[..., 0])
     # Across, heel and toe only: Plug-in Gait's ankle marker sits on the lateral malleolus.
     ml = np.stack([heel[..., 1], toe[..., 1]], axis=-1)

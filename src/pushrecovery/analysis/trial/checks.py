@@ -16,7 +16,7 @@ the base as a whole is rejected and the trial is not classified: no frame gets a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -55,6 +55,9 @@ class DataChecks:
     base_rejected : bool
         The CoP contradicts the base in more than :data:`MAX_CONTRADICTED` of the loaded
         frames: the trial is not classified.
+    marker_gaps : dict of str to ndarray of bool
+        Per base marker (``"left heel"``, ...), the frames it is missing in: the base is
+        unknown there (never filled: a spline through the gap would invent its edge).
     """
 
     flights: tuple[tuple[float, float], ...]
@@ -63,6 +66,15 @@ class DataChecks:
     loaded_frames: int
     tolerance: float
     base_rejected: bool
+    marker_gaps: dict[str, BoolArray] = field(default_factory=dict)
+
+    @property
+    def marker_gap(self) -> BoolArray:
+        """Frames in which a base marker (a heel or toe marker) is missing."""
+        missing = np.zeros_like(self.flight)
+        for frames in self.marker_gaps.values():
+            missing |= frames
+        return missing
 
     @property
     def contradicted(self) -> BoolArray:
@@ -74,7 +86,7 @@ class DataChecks:
         """Frames that get no verdict: all of them if the base is rejected."""
         if self.base_rejected:
             return np.ones_like(self.flight)
-        return self.flight | self.contradicted
+        return self.flight | self.contradicted | self.marker_gap
 
     def reasons(self) -> dict[str, int]:
         """Frames withheld, per reason (a frame may have both)."""
@@ -83,6 +95,7 @@ class DataChecks:
             f"CoP beyond the computed base by more than {self.tolerance * 100:g} cm": int(
                 self.contradicted.sum()
             ),
+            "a heel or toe marker missing (base unknown)": int(self.marker_gap.sum()),
         }
         if self.base_rejected:
             reasons["base of support contradicted by the CoP: trial not classified"] = len(
@@ -100,6 +113,8 @@ class DataChecks:
             "cop_outside_base_frames": {axis: int(v.sum()) for axis, v in self.cop_outside.items()},
             "base_rejected": self.base_rejected,
             "max_contradicted_share": MAX_CONTRADICTED,
+            "excluded_frames_markers": int(self.marker_gap.sum()),
+            "marker_gap_frames": {name: int(v.sum()) for name, v in self.marker_gaps.items()},
         }
 
 
@@ -110,12 +125,14 @@ def check_frames(
     cop: FloatArray | None,
     lower: dict[str, FloatArray],
     upper: dict[str, FloatArray],
+    marker_gaps: dict[str, BoolArray] | None = None,
 ) -> DataChecks:
     """Check the frames at ``time`` [s] (module docstring); the pipeline's, unchecked.
 
     ``force`` is the ground reaction force (m, 3) [N] at ``force_time`` [s] (None without
     plates), ``cop`` the CoP (n, 2) [m] at the frames (NaN where unloaded), ``lower`` and
-    ``upper`` the base per axis at the frames [m].
+    ``upper`` the base per axis at the frames [m], ``marker_gaps`` per base marker the frames
+    it is missing in.
     """
     n = len(time)
     flight = np.zeros(n, dtype=bool)
@@ -140,4 +157,5 @@ def check_frames(
             outside[axis] &= measured
     contradicted = outside[AXES[0]] | outside[AXES[1]]
     rejected = loaded > 0 and contradicted.sum() > MAX_CONTRADICTED * loaded
-    return DataChecks(flights, flight, outside, loaded, COP_TOLERANCE, bool(rejected))
+    gaps = {name: frames for name, frames in (marker_gaps or {}).items() if frames.any()}
+    return DataChecks(flights, flight, outside, loaded, COP_TOLERANCE, bool(rejected), gaps)

@@ -130,9 +130,11 @@ def analyze(
         force = resample(force_time, force, time)
     if cop is not None and force_time is not None:
         cop = resample(force_time, cop, time)
-    support, base, support_source, found = _support(recording, time, com, cop, params, settings)
+    support, base, support_source, found, missing = _support(
+        recording, time, com, cop, params, settings
+    )
     gaps += found
-    checks = check_frames(time, force_time, plate_force, cop, support.lower, support.upper)
+    checks = check_frames(time, force_time, plate_force, cop, support.lower, support.upper, missing)
     if checks.base_rejected:
         notes.append(
             f"the measured CoP lies beyond the computed base of support ({support_source}) "
@@ -227,7 +229,7 @@ def analyze(
         support_source=support_source,
         notes=notes,
         reasons={
-            **_exclusions(com, velocity, support, invalid & ~checks.withheld),
+            **_exclusions(com, velocity, support, invalid & ~checks.withheld, checks.marker_gap),
             **checks.reasons(),
         },
         checks=checks,

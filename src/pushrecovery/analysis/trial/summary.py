@@ -340,15 +340,24 @@ def _interpolated(time: FloatArray, gaps: list[Gap]) -> NDArray[np.bool_]:
 
 
 def _exclusions(
-    com: FloatArray, velocity: FloatArray, support: Support, invalid: NDArray[np.bool_]
+    com: FloatArray,
+    velocity: FloatArray,
+    support: Support,
+    invalid: NDArray[np.bool_],
+    marker_gap: NDArray[np.bool_],
 ) -> dict[str, int]:
-    """Why frames were excluded (a frame may have several reasons)."""
+    """Why frames were excluded (a frame may have several reasons).
+
+    A frame whose base is unknown because a base marker is missing (``marker_gap``) is the
+    data checks' to count, not a frame without a supporting foot.
+    """
+    no_base = ~np.isfinite(support.lower["ap"] + support.lower["ml"]) & ~marker_gap
     reasons = {
         "no CoM": int((~np.isfinite(com).all(axis=1)).sum()),
         "no CoM velocity (segment shorter than 3 frames)": int(
             (np.isfinite(com).all(axis=1) & ~np.isfinite(velocity).all(axis=1)).sum()
         ),
-        "no supporting foot": int((~np.isfinite(support.lower["ap"] + support.lower["ml"])).sum()),
+        "no supporting foot": int(no_base.sum()),
     }
     reasons = {k: v for k, v in reasons.items() if v}
     if invalid.any() and not reasons:  # pragma: no cover - every invalid frame has a reason

@@ -43,6 +43,10 @@ def _repair_loaded(
     return repaired, gaps
 
 
+#: The foot markers the base of support is built from: their gaps are never filled.
+BASE_MARKERS = ("heel", "toe")
+
+
 def _support(
     recording: Recording,
     time: FloatArray,
@@ -50,23 +54,32 @@ def _support(
     cop: FloatArray | None,
     params: BodyParams,
     settings: AnalysisSettings,
-) -> tuple[Support, BasePolygons, str, list[Gap]]:
+) -> tuple[Support, BasePolygons, str, list[Gap], dict[str, NDArray[np.bool_]]]:
     """Build the base of support from the feet, CSV columns, or two assumed fixed feet.
 
     Per axis (the intervals of :class:`Support`) and in the plane (the polygon of the
     supporting soles, :mod:`pushrecovery.analysis.base_polygon`, the foot model's width the
-    settings' foot width).
+    settings' foot width). The last item: per base marker (``"<foot> heel"``, ``"<foot>
+    toe"``), the frames it is missing in. Those markers are not gap-filled: a spline through a
+    gap would invent the base's edge, so the frames a base marker misses have no known base
+    (docs/analysis.md, "Data checks"); the ankle marker (the stepping model's stance ankle,
+    not an edge of the base) is filled up to ``max_gap`` as before.
     """
     model = FootModel(width=settings.widths(params)[0])
     gaps: list[Gap] = []
+    missing: dict[str, NDArray[np.bool_]] = {}
     if recording.feet:
         measured: list[Foot] = []
         for foot in recording.feet:
             parts = []
             for part in ("heel", "toe", "ankle"):
+                name = f"{foot.name} {part}"
                 values = resample(recording.time, getattr(foot, part), time)
-                values, found = repair_gaps(time, values, settings.max_gap, f"{foot.name} {part}")
+                longest = 0.0 if part in BASE_MARKERS else settings.max_gap
+                values, found = repair_gaps(time, values, longest, name)
                 gaps += found
+                if part in BASE_MARKERS:
+                    missing[name] = np.asarray(~np.isfinite(values).all(axis=1), dtype=bool)
                 parts.append(values)
             measured.append(Foot(foot.name, *parts))
         support = support_from_feet(
@@ -75,16 +88,16 @@ def _support(
             foot_width=settings.widths(params)[0],
         )
         plane = base_from_feet(measured, model, contact_height=settings.contact_height)
-        return support, plane, "foot markers", gaps
+        return support, plane, "foot markers", gaps, missing
     if recording.base_vertices is not None:
         plane = base_from_vertices(_resampled(recording.time, recording.base_vertices, time))
         low_ap, high_ap, low_ml, high_ml = plane.extents()
         edges = {"ap": np.column_stack([low_ap, high_ap]), "ml": np.column_stack([low_ml, high_ml])}
         support = _explicit_support(recording, time, params, settings, edges)
-        return support, plane, "base polygon columns", gaps
+        return support, plane, "base polygon columns", gaps, missing
     if recording.base:
         support = _explicit_support(recording, time, params, settings)
-        return support, _rectangles(support), "base columns", gaps
+        return support, _rectangles(support), "base columns", gaps, missing
     centre = cop if cop is not None and np.isfinite(cop).any() else com
     if not np.isfinite(centre).any():
         raise InvalidParameterError(
@@ -108,7 +121,7 @@ def _support(
     source = "fixed feet (heel/toe flags, --stance-width)"
     if assumed:
         source += ": " + ", ".join(assumed)
-    return support, plane, source, gaps
+    return support, plane, source, gaps, missing
 
 
 def _rectangles(support: Support) -> BasePolygons:

@@ -1,0 +1,110 @@
+"""Files made to carry the faults real labs record (issue 34, item 1), each flagged as documented.
+
+Every file is a C3D written by the project's own writer: Plug-in Gait feet (heel, toe and ankle
+markers), a ``CentreOfMass`` marker swaying over the feet, and force plates where the fault
+needs them. docs/analysis.md, "Data checks", has the thresholds these tests check.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.analysis.c3d.writer import write_c3d
+from pushrecovery.analysis.readers import read_recording
+from pushrecovery.analysis.trial import analyze
+
+RATE = 100.0  # marker rate [Hz]
+SECONDS = 4.0
+P = load_params(overrides={"mass": 70.0, "com_height": 0.95})
+
+
+def _feet(n: int, forward: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Both feet standing still, 20 cm apart, heel 5 cm behind and toe 15 cm ahead of the
+    ankle (lab x forward, y to the subject's left, z up) [m]."""
+    markers = {}
+    for side, ml in (("L", 0.10), ("R", -0.10)):
+        lateral = 0.03 if side == "L" else -0.03
+        markers[f"{side}HEE"] = np.tile([-0.05, ml, 0.03], (n, 1))
+        markers[f"{side}TOE"] = np.tile([0.15, ml, 0.03], (n, 1))
+        markers[f"{side}ANK"] = np.tile([0.0, ml + lateral, 0.08], (n, 1))
+    return markers
+
+
+def _com(n: int) -> np.ndarray:
+    """A CoM swaying 3 cm sideways at 0.5 Hz and 1 cm forward at 0.3 Hz [m]."""
+    t = np.arange(n) / RATE
+    return np.column_stack(
+        [
+            0.04 + 0.01 * np.sin(2 * np.pi * 0.3 * t),
+            0.03 * np.sin(2 * np.pi * 0.5 * t),
+            np.full(n, 0.95),
+        ]
+    )
+
+
+def _write(path, markers, plates=(), analog_rate=RATE):
+    write_c3d(path, point_rate=RATE, markers=markers, analog_rate=analog_rate, plates=plates)
+    return read_recording(path)
+
+
+# --- (a) marker gaps ------------------------------------------------------------------------
+HEEL_GAP = slice(200, 230)  # 300 ms of the left heel marker
+TOE_GAP = slice(300, 310)  # 100 ms of the left toe marker
+
+
+def _gapped(tmp_path):
+    n = int(SECONDS * RATE)
+    markers = {**_feet(n), "CentreOfMass": _com(n)}
+    clean = _write(tmp_path / "clean.c3d", markers)
+    markers["LHEE"] = markers["LHEE"].copy()
+    markers["LTOE"] = markers["LTOE"].copy()
+    markers["LHEE"][HEEL_GAP] = np.nan
+    markers["LTOE"][TOE_GAP] = np.nan
+    return clean, _write(tmp_path / "gapped.c3d", markers)
+
+
+def test_missing_base_markers_exclude_their_frames_counted_per_marker(tmp_path):
+    clean, gapped = _gapped(tmp_path)
+    before, after = analyze(clean, P), analyze(gapped, P)
+    gap = np.zeros(len(after.time), dtype=bool)
+    gap[HEEL_GAP] = gap[TOE_GAP] = True
+    checks = after.summary.checks
+    assert checks.to_dict()["marker_gap_frames"] == {"left heel": 30, "left toe": 10}
+    assert checks.to_dict()["excluded_frames_markers"] == 40
+    assert after.summary.excluded["a heel or toe marker missing (base unknown)"] == 40
+    assert "no supporting foot" not in after.summary.excluded
+    # No verdict and no base in those frames: not the smaller base of the markers left.
+    assert not after.columns["valid"][gap].any()
+    assert np.isnan(after.columns["ml_base_min"][gap]).all()
+    assert np.isnan(after.columns["mos"][gap]).all()
+    assert after.columns["valid"][~gap].all()
+    assert after.summary.excluded_frames == 40
+    # Elsewhere everything is the un-gapped trial's, and the smallest margins are those of the
+    # un-gapped recording restricted to the same frames (the hand value).
+    for name in ("mos", "ap_margin_cop", "ml_margin_cop", "ml_base_min", "ml_base_max"):
+        np.testing.assert_array_equal(after.columns[name][~gap], before.columns[name][~gap])
+    hand = float(np.min(before.columns["mos"][~gap]))
+    assert after.summary.plane.min_mos.value == hand
+    assert before.summary.plane.min_mos.value < hand  # the gaps hid the smallest margin
+    hand_ml = float(np.min(before.columns["ml_margin_cop"][~gap]))
+    assert after.summary.directions["ml"].min_cop_margin.value == hand_ml
+
+
+def test_a_trial_without_gaps_reports_none(tmp_path):
+    clean, _ = _gapped(tmp_path)
+    checks = analyze(clean, P).summary.checks.to_dict()
+    assert checks["marker_gap_frames"] == {}
+    assert checks["excluded_frames_markers"] == 0
+
+
+@pytest.mark.parametrize("part", ["LHEE", "RTOE"])
+def test_one_missing_sample_is_not_filled(tmp_path, part):
+    n = int(SECONDS * RATE)
+    markers = {**_feet(n), "CentreOfMass": _com(n)}
+    markers[part] = markers[part].copy()
+    markers[part][200] = np.nan
+    result = analyze(_write(tmp_path / "one.c3d", markers), P)
+    assert result.summary.checks.to_dict()["excluded_frames_markers"] == 1
+    assert not result.columns["valid"][200]
