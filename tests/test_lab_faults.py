@@ -108,3 +108,73 @@ def test_one_missing_sample_is_not_filled(tmp_path, part):
     result = analyze(_write(tmp_path / "one.c3d", markers), P)
     assert result.summary.checks.to_dict()["excluded_frames_markers"] == 1
     assert not result.columns["valid"][200]
+
+
+# --- (b) a loaded plate under no foot -------------------------------------------------------
+ANALOG = 1000.0
+WEIGHT = 70.0 * 9.81
+
+
+def _plate(n, vertical, cop_xy, corners):
+    force = np.zeros((n, 3))
+    force[:, 2] = vertical
+    cop = np.column_stack([cop_xy, np.zeros(n)])
+    cop[vertical <= 0.0] = np.nan
+    return force, cop, np.zeros(n), np.asarray(corners, dtype=float)
+
+
+def _rectangle(x0, x1, y0, y1):
+    return [[x1, y1, 0.0], [x0, y1, 0.0], [x0, y0, 0.0], [x1, y0, 0.0]]
+
+
+def _standing_plates(n_points, stray_load=None, stray_at=(0.05, 0.30)):
+    """Each foot on its own plate, the load shifting with the CoM sideways (the combined CoP
+    under the CoM); optionally a third plate left of the left foot loaded ``stray_load`` [N]
+    for 80 ms from 2 s."""
+    n = int(n_points * ANALOG / RATE)
+    t = np.arange(n) / ANALOG
+    com = _com(n_points)
+    ml = np.interp(t, np.arange(n_points) / RATE, com[:, 1])
+    ap = np.interp(t, np.arange(n_points) / RATE, com[:, 0])
+    left = 0.5 * WEIGHT * (1.0 + ml / 0.10)
+    plates = [
+        _plate(n, left, np.column_stack([ap, np.full(n, 0.10)]), _rectangle(-0.2, 0.3, 0.0, 0.25)),
+        _plate(n, WEIGHT - left, np.column_stack([ap, np.full(n, -0.10)]),
+               _rectangle(-0.2, 0.3, -0.25, 0.0)),
+    ]  # fmt: skip
+    if stray_load is not None:
+        load = np.where((t >= 2.0) & (t < 2.08), stray_load, 0.0)
+        where = np.tile(stray_at, (n, 1))
+        plates.append(_plate(n, load, where, _rectangle(-0.2, 0.3, 0.26, 0.51)))
+    return plates
+
+
+def _plated(path, **options):
+    n = int(SECONDS * RATE)
+    markers = {**_feet(n), "CentreOfMass": _com(n)}
+    plates = _standing_plates(n, **options)
+    return _write(path, markers, plates, analog_rate=ANALOG)
+
+
+def test_a_light_plate_under_no_foot_makes_no_foot_events_and_is_flagged(tmp_path):
+    clean = analyze(_plated(tmp_path / "two.c3d"), P)
+    stray = analyze(_plated(tmp_path / "three.c3d", stray_load=66.0), P)
+    checks = stray.summary.checks.to_dict()
+    assert checks["stray_plates"] == ["plate 3"]
+    assert checks["plate_feet"] == {"plate 1": "left", "plate 2": "right"}
+    # 20 cm from the left foot's markers, 15 cm from its sole (5 cm half width).
+    assert checks["plate_foot_distance"]["plate 3"] == pytest.approx(0.15, abs=1e-6)
+    assert stray.summary.events.foot_events == ()
+    assert any("plate 3" in note for note in stray.summary.notes)
+    # The combined CoP and vertical force are the two feet's: no 15 cm jump sideways.
+    for name in ("ml_cop", "ap_cop", "ml_margin_cop", "mos"):
+        np.testing.assert_allclose(stray.columns[name], clean.columns[name], atol=1e-9)
+    assert clean.summary.checks.to_dict()["stray_plates"] == []
+
+
+def test_a_plate_loaded_beyond_a_quarter_of_the_weight_is_a_foots_contact(tmp_path):
+    heavy = analyze(_plated(tmp_path / "heavy.c3d", stray_load=0.3 * WEIGHT), P)
+    checks = heavy.summary.checks.to_dict()
+    assert checks["stray_plates"] == []
+    assert len(checks["plate_feet"]) == 3
+    assert {e.event.kind for e in heavy.summary.events.foot_events} >= {"foot-contact"}

@@ -22,10 +22,20 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.analysis.base_polygon import FootModel, foot_soles
 from pushrecovery.analysis.events import flight_phases
-from pushrecovery.analysis.recording import AXES, LOADED
+from pushrecovery.analysis.recording import AXES, LOADED, Foot, Recording
+from pushrecovery.analysis.signals import resample
 
-__all__ = ["COP_TOLERANCE", "MAX_CONTRADICTED", "DataChecks"]
+__all__ = [
+    "COP_TOLERANCE",
+    "MAX_CONTRADICTED",
+    "PLATE_FOOT_TOLERANCE",
+    "PLATE_LOAD_SHARE",
+    "DataChecks",
+    "PlateFeet",
+    "plate_feet",
+]
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -34,6 +44,128 @@ BoolArray = NDArray[np.bool_]
 COP_TOLERANCE = 0.02
 #: Share of the loaded frames beyond which a contradicted base is rejected for the trial.
 MAX_CONTRADICTED = 0.2
+#: How far a plate's CoP may lie outside a foot's sole (from its markers) and still be that
+#: foot's contact [m]: Plug-in Gait's TOE marker sits on the 2nd metatarsal head with the toes'
+#: tips 4-6 cm ahead of it, and a lightly loaded plate's CoP errs by up to about 1 cm.
+PLATE_FOOT_TOLERANCE = 0.05
+#: A plate whose peak vertical force exceeds this share of the body weight is a foot's
+#: contact even with its CoP away from every sole (then the markers are off, not the load): a
+#: foot bearing weight carries about half of it in double stance, all of it in single stance.
+PLATE_LOAD_SHARE = 0.25
+
+
+@dataclass(frozen=True, slots=True)
+class PlateFeet:
+    """Which foot stands on each force plate (:func:`plate_feet`).
+
+    Attributes
+    ----------
+    owners : dict of int to str
+        Plate index -> the foot whose contact it is (``plate k`` without foot markers, or when
+        two plates would go to one foot); stray plates are not in it.
+    distance : dict of int to float
+        Plate index -> median distance of its loaded CoP to the nearest foot's sole [m]
+        (0 inside), NaN without foot markers.
+    peak : dict of int to float
+        Plate index -> its largest vertical force [N].
+    stray : tuple of int
+        Plates loaded with their CoP under no foot (beyond :data:`PLATE_FOOT_TOLERANCE`) and
+        never beyond :data:`PLATE_LOAD_SHARE` of the body weight: no foot's contact, no foot
+        events, left out of the combined CoP.
+    """
+
+    owners: dict[int, str]
+    distance: dict[int, float]
+    peak: dict[int, float]
+    stray: tuple[int, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return the summary's ``checks`` entries of the plates (plates named from 1)."""
+        return {
+            "plate_foot_tolerance": PLATE_FOOT_TOLERANCE,
+            "plate_load_share": PLATE_LOAD_SHARE,
+            "plate_feet": {f"plate {k + 1}": name for k, name in self.owners.items()},
+            "plate_foot_distance": {f"plate {k + 1}": v for k, v in self.distance.items()},
+            "stray_plates": [f"plate {k + 1}" for k in self.stray],
+        }
+
+
+def plate_feet(recording: Recording, foot_width: float, weight: float) -> PlateFeet:
+    """Return the foot standing on each force plate of ``recording`` (multi-plate C3D files).
+
+    A plate is a foot's contact when its CoP, at the samples it is loaded, lies within
+    :data:`PLATE_FOOT_TOLERANCE` of that foot's sole (median distance over those samples; the
+    sole is :func:`~pushrecovery.analysis.base_polygon.foot_soles` of the foot's markers at
+    the plate's samples, ``foot_width`` [m] wide): the nearest such foot. A plate whose CoP
+    lies under no foot is still the nearest foot's when its peak vertical force exceeds
+    :data:`PLATE_LOAD_SHARE` of ``weight`` [N]; else it is **stray** (issue 34: a plate 17-23
+    cm from a foot loaded to 66 N for 80 ms made that foot's contact and foot-off). Without
+    foot markers every loaded plate keeps its name (``plate k``). Two plates that would go
+    to one foot keep their names.
+    """
+    owners: dict[int, str] = {}
+    distance: dict[int, float] = {}
+    peak: dict[int, float] = {}
+    stray: list[int] = []
+    if recording.force_time is None or not recording.plates:
+        return PlateFeet(owners, distance, peak, ())
+    model = FootModel(width=foot_width)
+    soles = {
+        foot.name: foot_soles(
+            Foot(
+                foot.name,
+                *(
+                    resample(recording.time, getattr(foot, part), recording.force_time)
+                    for part in ("heel", "toe", "ankle")
+                ),
+            ),
+            model,
+        )
+        for foot in recording.feet
+    }
+    for k, (vertical, cop) in enumerate(recording.plates):
+        loaded = np.isfinite(cop).all(axis=1)
+        if not loaded.any():
+            continue
+        peak[k] = float(np.nanmax(vertical))
+        owners[k] = f"plate {k + 1}"
+        distances = {
+            name: _median_distance(cop[loaded], sole[loaded]) for name, sole in soles.items()
+        }
+        known = {name: d for name, d in distances.items() if np.isfinite(d)}
+        distance[k] = min(known.values()) if known else float("nan")
+        if not known:
+            continue
+        nearest = min(known, key=lambda name: known[name])
+        if known[nearest] <= PLATE_FOOT_TOLERANCE or peak[k] > PLATE_LOAD_SHARE * weight:
+            owners[k] = nearest
+        else:
+            del owners[k]
+            stray.append(k)
+    if len(set(owners.values())) != len(owners):  # two plates under one foot: by plate
+        owners = {k: f"plate {k + 1}" for k in owners}
+    return PlateFeet(owners, distance, peak, tuple(stray))
+
+
+def _median_distance(points: FloatArray, soles: FloatArray) -> float:
+    """Return the median distance of ``points`` (m, 2) to the rectangles ``soles`` [m].
+
+    ``soles`` (m, 4, 2): corners back-right, front-right, front-left, back-left (those of
+    :func:`~pushrecovery.analysis.base_polygon.foot_soles`); 0 inside, NaN if unknown.
+    """
+    origin = soles[:, 0]
+    along = soles[:, 1] - origin
+    across = soles[:, 3] - origin
+    length = np.linalg.norm(along, axis=1)
+    width = np.linalg.norm(across, axis=1)
+    d = points - origin
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.einsum("ij,ij->i", d, along) / length
+        t = np.einsum("ij,ij->i", d, across) / width
+    ds = np.maximum(0.0, np.maximum(-s, s - length))
+    dt = np.maximum(0.0, np.maximum(-t, t - width))
+    gap = np.hypot(ds, dt)
+    return float(np.median(gap[np.isfinite(gap)])) if np.isfinite(gap).any() else float("nan")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -58,6 +190,8 @@ class DataChecks:
     marker_gaps : dict of str to ndarray of bool
         Per base marker (``"left heel"``, ...), the frames it is missing in: the base is
         unknown there (never filled: a spline through the gap would invent its edge).
+    plates : PlateFeet
+        Which foot stands on each force plate, and the stray plates.
     """
 
     flights: tuple[tuple[float, float], ...]
@@ -67,6 +201,7 @@ class DataChecks:
     tolerance: float
     base_rejected: bool
     marker_gaps: dict[str, BoolArray] = field(default_factory=dict)
+    plates: PlateFeet = field(default_factory=lambda: PlateFeet({}, {}, {}, ()))
 
     @property
     def marker_gap(self) -> BoolArray:
@@ -115,6 +250,7 @@ class DataChecks:
             "max_contradicted_share": MAX_CONTRADICTED,
             "excluded_frames_markers": int(self.marker_gap.sum()),
             "marker_gap_frames": {name: int(v.sum()) for name, v in self.marker_gaps.items()},
+            **self.plates.to_dict(),
         }
 
 
@@ -126,13 +262,14 @@ def check_frames(
     lower: dict[str, FloatArray],
     upper: dict[str, FloatArray],
     marker_gaps: dict[str, BoolArray] | None = None,
+    plates: PlateFeet | None = None,
 ) -> DataChecks:
     """Check the frames at ``time`` [s] (module docstring); the pipeline's, unchecked.
 
     ``force`` is the ground reaction force (m, 3) [N] at ``force_time`` [s] (None without
     plates), ``cop`` the CoP (n, 2) [m] at the frames (NaN where unloaded), ``lower`` and
     ``upper`` the base per axis at the frames [m], ``marker_gaps`` per base marker the frames
-    it is missing in.
+    it is missing in, ``plates`` the plates' feet (:func:`plate_feet`).
     """
     n = len(time)
     flight = np.zeros(n, dtype=bool)
@@ -158,4 +295,5 @@ def check_frames(
     contradicted = outside[AXES[0]] | outside[AXES[1]]
     rejected = loaded > 0 and contradicted.sum() > MAX_CONTRADICTED * loaded
     gaps = {name: frames for name, frames in (marker_gaps or {}).items() if frames.any()}
-    return DataChecks(flights, flight, outside, loaded, COP_TOLERANCE, bool(rejected), gaps)
+    owners = PlateFeet({}, {}, {}, ()) if plates is None else plates
+    return DataChecks(flights, flight, outside, loaded, COP_TOLERANCE, bool(rejected), gaps, owners)

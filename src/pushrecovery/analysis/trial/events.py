@@ -33,6 +33,7 @@ from pushrecovery.analysis.steps_measured import (
     foot_events_from_markers,
     measured_steps,
 )
+from pushrecovery.analysis.trial.checks import PlateFeet
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_region import capture_region
@@ -304,37 +305,13 @@ def _compared(
     return result
 
 
-def _plate_feet(recording: Recording) -> dict[int, str]:
-    """Return plate number -> the foot standing on it (``plate k`` without one).
+def _foot_events(recording: Recording, owners: dict[int, str]) -> list[FootEvent]:
+    """Foot events from each foot's own plate where it has one, else from its markers.
 
-    The foot whose heel-toe midpoint lies nearest the plate's median loaded CoP; when two
-    plates would go to one foot, the plates keep their own names.
+    ``owners``: plate index -> its foot (:func:`~pushrecovery.analysis.trial.checks.plate_feet`);
+    a plate not in it (stray: under no foot) makes no events.
     """
-    if recording.force_time is None or not recording.plates:
-        return {}
-    centres = {}
-    for foot in recording.feet:
-        middle = 0.5 * (foot.heel[:, :2] + foot.toe[:, :2])
-        centres[foot.name] = np.nanmedian(middle, axis=0)
-    owners: dict[int, str] = {}
-    for k, (_, cop) in enumerate(recording.plates):
-        loaded = np.isfinite(cop).all(axis=1)
-        if not loaded.any():
-            continue
-        where = np.median(cop[loaded], axis=0)
-        owners[k] = f"plate {k + 1}"
-        if centres:
-            distance = {name: float(np.hypot(*(where - c))) for name, c in centres.items()}
-            owners[k] = min(distance, key=lambda name: distance[name])
-    if len(set(owners.values())) != len(owners):  # two plates under one foot: by plate
-        owners = {k: f"plate {k + 1}" for k in owners}
-    return owners
-
-
-def _foot_events(recording: Recording) -> list[FootEvent]:
-    """Foot events from each foot's own plate where it has one, else from its markers."""
     events: list[FootEvent] = []
-    owners = _plate_feet(recording)
     for k, name in owners.items():
         vertical = recording.plates[k][0]
         assert recording.force_time is not None
@@ -414,16 +391,18 @@ def trial_events(
     *,
     com: FloatArray | None = None,
     plane: tuple[Any, BodyParams] | None = None,
+    plates: PlateFeet,
 ) -> TrialEvents:
     """Return the trial's onset, foot events and steps with their margins.
 
     ``time`` [s] and ``velocity`` (n, 2) [m/s] are the analysis' frames, ``per_axis`` their
     margins, ``mass`` the subject's [kg]; with ``com`` (n, 2) [m] and ``plane`` (the base
     polygons and the body), each step is also judged against the 2-D capture region at its
-    foot-off (``capture_region``).
+    foot-off (``capture_region``). ``plates``: which foot stands on each plate
+    (:func:`~pushrecovery.analysis.trial.checks.plate_feet`).
     """
     onset, onset_source = _onset(recording, time, velocity, mass)
-    events = _foot_events(recording)
+    events = _foot_events(recording, plates.owners)
     steps = (
         measured_steps(recording.time, recording.feet, events, onset=onset)
         if events and recording.feet

@@ -23,7 +23,7 @@ from pushrecovery.analysis.signals import (
     resample,
     smooth_and_differentiate,
 )
-from pushrecovery.analysis.trial.checks import check_frames
+from pushrecovery.analysis.trial.checks import PlateFeet, check_frames, plate_feet
 from pushrecovery.analysis.trial.events import Onset, trial_events
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
 from pushrecovery.analysis.trial.summary import (
@@ -80,6 +80,10 @@ def analyze(
     settings = settings or AnalysisSettings()
     gaps: list[Gap] = []
     notes = list(recording.notes)
+    plates = plate_feet(recording, settings.widths(params)[0], params.weight)
+    if plates.stray:
+        recording, note = _without_plates(recording, plates)
+        notes.append(note)
     force_time = recording.force_time
     force = cop = None
     if recording.force is not None and force_time is not None:
@@ -134,7 +138,9 @@ def analyze(
         recording, time, com, cop, params, settings
     )
     gaps += found
-    checks = check_frames(time, force_time, plate_force, cop, support.lower, support.upper, missing)
+    checks = check_frames(
+        time, force_time, plate_force, cop, support.lower, support.upper, missing, plates
+    )
     if checks.base_rejected:
         notes.append(
             f"the measured CoP lies beyond the computed base of support ({support_source}) "
@@ -207,7 +213,14 @@ def analyze(
     columns["cop_outside_base"] = checks.contradicted
 
     events = trial_events(
-        recording, time, velocity, per_axis, params.mass, com=com, plane=(base, params)
+        recording,
+        time,
+        velocity,
+        per_axis,
+        params.mass,
+        com=com,
+        plane=(base, params),
+        plates=checks.plates,
     )
     sway = _posturography(force_time, plate_cop, plate_force)
     if sway is not None and events.onset.time is not None:
@@ -280,6 +293,39 @@ def _plane(
             values[withheld] = np.nan
     plane.strategy[withheld] = -1
     return plane
+
+
+def _without_plates(recording: Recording, plates: PlateFeet) -> tuple[Recording, str]:
+    """Return the recording without its stray plates' vertical force and CoP, and a note.
+
+    The combined CoP is again the vertical-force-weighted mean of the other plates' CoPs and
+    the stray plates' vertical force is taken off the total; their horizontal force, which
+    the recording does not keep per plate, stays in the total (the note says so).
+    """
+    assert recording.force is not None and recording.cop is not None
+    kept = [k for k in range(len(recording.plates)) if k not in plates.stray]
+    weights = np.zeros(len(recording.cop))
+    moments = np.zeros_like(recording.cop)
+    for k in kept:
+        vertical, cop = recording.plates[k]
+        loaded = np.isfinite(cop).all(axis=1) & (vertical > 0.0)
+        weights += np.where(loaded, vertical, 0.0)
+        moments += np.where(loaded[:, None], vertical[:, None] * cop, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cop = np.where((weights > 0.0)[:, None], moments / weights[:, None], np.nan)
+    force = recording.force.copy()
+    for k in plates.stray:
+        force[:, 2] -= np.nan_to_num(recording.plates[k][0], nan=0.0)
+    names = ", ".join(
+        f"plate {k + 1} (peak {plates.peak[k]:.0f} N, {plates.distance[k] * 100:.0f} cm from "
+        "the nearest sole)"
+        for k in plates.stray
+    )
+    note = (
+        f"loaded under no foot: {names}: no foot's contact, left out of the combined CoP and the "
+        "vertical force (its horizontal force stays in the total)"
+    )
+    return replace(recording, force=force, cop=cop), note
 
 
 def _withhold(margins: DirectionMargins, frames: NDArray[np.bool_]) -> None:
