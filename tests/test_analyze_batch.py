@@ -180,7 +180,8 @@ def test_the_batch_tables_are_typed_and_read_by_pandas(study, tmp_path):
     from pushrecovery.campaign.trial_rows import TrialRow
 
     trials, root = find_trials([study / "s01"])
-    result = run_trials(trial_jobs(trials, root), tmp_path / "t", workers=1)
+    jobs = trial_jobs(trials, root, flags={"mass": P.mass})  # no silent preset mass (issue 34)
+    result = run_trials(jobs, tmp_path / "t", workers=1)
     rows = result.trial_rows()
     assert all(isinstance(row, TrialRow) for row in rows) and len(rows) == 16
     frame = result.to_pandas("trials")

@@ -68,7 +68,7 @@ def test_choices_match_the_readers():
 def test_analyze_csv_writes_frames_summary_and_plots(tmp_path):
     trial = _trial(tmp_path / "trial.csv")
     out = tmp_path / "out"
-    args = ["analyze", str(trial), "--units", "mm", "--out", str(out), "--json"]
+    args = ["analyze", str(trial), "--units", "mm", "--mass", "72", "--out", str(out), "--json"]
     result = CliRunner().invoke(cli, args, catch_exceptions=False)
     assert result.exit_code == 0, result.output
     data = json.loads(result.output)
@@ -76,7 +76,7 @@ def test_analyze_csv_writes_frames_summary_and_plots(tmp_path):
     for axis in ("ap", "ml"):
         assert set(data["directions"][axis]) >= DIRECTION_KEYS
     assert data["strategy"]["most_demanding"] == "ankle"
-    assert data["body"]["mass_source"] == "preset"
+    assert data["body"]["mass_source"] == "flag"
     for name in ("frames.parquet", "frames.csv", "summary.json", "time_series.png"):
         assert (out / name).stat().st_size > 0
     assert json.loads((out / "summary.json").read_text())["frames"] == 250
@@ -108,7 +108,8 @@ def test_gaps_reach_the_json_and_the_files(tmp_path):
         lines[i] = ",".join(cells)
     trial.write_text("\n".join(lines) + "\n")
     out = tmp_path / "out"
-    args = ["analyze", str(trial), "--units", "mm", "--out", str(out), "--json", "--no-plot"]
+    args = ["analyze", str(trial), "--units", "mm", "--mass", "72", "--out", str(out), "--json"]
+    args.append("--no-plot")
     result = CliRunner().invoke(cli, args, catch_exceptions=False)
     assert result.exit_code == 0, result.output
 
@@ -125,7 +126,8 @@ def test_gaps_reach_the_json_and_the_files(tmp_path):
 
 def test_analyze_table_output(tmp_path):
     trial = _trial(tmp_path / "trial.csv", push=0.8)
-    args = ["analyze", str(trial), "--units", "mm", "--out", str(tmp_path / "o"), "--no-plot"]
+    args = ["analyze", str(trial), "--units", "mm", "--mass", "72", "--out", str(tmp_path / "o")]
+    args.append("--no-plot")
     result = CliRunner().invoke(cli, args, catch_exceptions=False)
     assert result.exit_code == 0, result.output
     assert "needs" in result.output and "step_events" in result.output
@@ -153,9 +155,10 @@ def test_bad_inputs_are_one_line(tmp_path, capsys):
     text = tmp_path / "trial.txt"
     text.write_text("hello")
     assert "expected .csv or .c3d" in _fail(capsys, "analyze", str(text), "--out", out)
-    err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--cutoff", "-1", "--out", out)
+    mm = ("--units", "mm", "--mass", "72")
+    err = _fail(capsys, "analyze", str(trial), *mm, "--cutoff", "-1", "--out", out)
     assert "cutoff" in err
-    err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--cutoff", "80", "--out", out)
+    err = _fail(capsys, "analyze", str(trial), *mm, "--cutoff", "80", "--out", out)
     assert "cutoff must be in (0, 50)" in err
     err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--mass", "-3", "--out", out)
     assert "mass" in err
@@ -171,6 +174,56 @@ def test_bad_inputs_are_one_line(tmp_path, capsys):
     assert "'C7'" in err
     err = _fail(capsys, "analyze", str(kistler), "--foot", "left=LHEE", "--out", out)
     assert "NAME=HEEL,TOE,ANKLE" in err
+
+
+def test_no_mass_is_refused_not_guessed(tmp_path, capsys):
+    """A CSV without a mass, plates or --mass: refused in one line, no silent 72 kg preset."""
+    trial = _trial(tmp_path / "trial.csv")
+    err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--out", str(tmp_path / "o"))
+    assert "no body mass for trial.csv" in err and "--mass" in err
+
+
+def test_height_and_sex_scale_the_body_to_the_person(tmp_path):
+    """A 14.5 kg, 1.0 m child: de Leva's geometry, not the 72 kg, 1 m-CoM preset."""
+    from pushrecovery.anthropometry import person_params
+
+    trial = _trial(tmp_path / "trial.csv")
+    out = tmp_path / "out"
+    args = ["analyze", str(trial), "--units", "mm", "--mass", "14.5", "--height", "1.0"]
+    args += ["--sex", "female", "--out", str(out), "--json", "--no-plot"]
+    result = CliRunner().invoke(cli, args, catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    child = person_params(14.5, 1.0, "female").params
+    assert data["body"]["mass"] == 14.5 and data["body"]["mass_source"] == "flag"
+    assert data["body"]["com_height"] == child.com_height
+    assert data["body"]["com_height_source"].startswith("de Leva 1996 Table 4")
+    for name in ("leg_length", "heel", "toe", "foot_width", "flywheel_inertia"):
+        assert data["params"][name] == getattr(child, name), name
+    # a flag wins over the table
+    args += ["--foot-width", "0.07"]
+    result = CliRunner().invoke(cli, args, catch_exceptions=False)
+    assert json.loads(result.output)["params"]["foot_width"] == 0.07
+    # the table's line in the brief output
+    brief = ["analyze", str(trial), "--units", "mm", "--mass", "14.5", "--height", "1.0"]
+    brief += ["--sex", "female", "--out", str(out), "--no-plot"]
+    result = CliRunner().invoke(cli, brief, catch_exceptions=False)
+    assert "EXTRAPOLATED" in result.output
+
+
+def test_bad_height_and_sex_are_one_line(tmp_path, capsys):
+    trial = str(_trial(tmp_path / "trial.csv"))
+    base = ("analyze", trial, "--units", "mm", "--mass", "60", "--out", str(tmp_path / "o"))
+    assert "height" in _fail(capsys, *base, "--height", "3", "--sex", "male")
+    assert "height" in _fail(capsys, *base, "--height", "0.4", "--sex", "male")
+    assert "'other'" in _fail(capsys, *base, "--height", "1.7", "--sex", "other")
+    assert "height and sex go together" in _fail(capsys, *base, "--height", "1.7")
+    assert "height and sex go together" in _fail(capsys, *base, "--sex", "male")
+    folder = tmp_path / "many"
+    folder.mkdir()
+    _trial(folder / "a.csv")
+    err = _fail(capsys, "analyze", str(folder), "--height", "1.7", "--sex", "male", "--out", "o")
+    assert "--height and --sex apply to one trial" in err
 
 
 def _kistler():

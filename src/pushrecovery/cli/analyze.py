@@ -18,6 +18,7 @@ __all__ = ["analyze"]
 # Literal so that --help imports nothing heavy; a test checks them against the readers.
 _UNITS = ("m", "cm", "mm")
 _AP_AXES = ("x", "-x", "y", "-y", "z", "-z")
+_SEXES = ("female", "male")
 
 
 #: (flag, default, help) of the AnalysisSettings fields named by the flags (SI units).
@@ -128,6 +129,20 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     metavar="NAME=HEEL,TOE,ANKLE",
     help="C3D foot markers (default the Plug-in Gait LHEE,LTOE,LANK and RHEE,RTOE,RANK).",
 )
+@click.option(
+    "--height",
+    type=float,
+    default=None,
+    metavar="M",
+    help="Stature [m], with --sex: the body's geometry and upper-body inertia from de Leva "
+    "1996 Table 4 (docs/analysis.md, The body of a person).",
+)
+@click.option(
+    "--sex",
+    type=click.Choice(_SEXES),
+    default=None,
+    help="Column of de Leva's table, with --height.",
+)
 @_settings_options
 @click.option(
     "--normalise",
@@ -174,9 +189,17 @@ def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) ->
     )
     single = len(inputs) == 1 and Path(inputs[0]).is_file()
     batch = {name: kwargs.pop(name) for name in ("subjects", "workers", "scheduler", "resume")}
+    person = {name: kwargs.pop(name) for name in ("height", "sex")}
     if single and batch["subjects"] is None:
-        _single(Path(inputs[0]), out, as_json, reader, settings, **kwargs)
+        _single(Path(inputs[0]), out, as_json, reader, settings, person, **kwargs)
     else:
+        if any(value is not None for value in person.values()):
+            from pushrecovery.errors import InvalidParameterError
+
+            raise InvalidParameterError(
+                "--height and --sex apply to one trial; a batch of trials is not scaled to "
+                "people yet (give each trial's --mass and body flags, or analyse one file)"
+            )
         _batch(inputs, out, as_json, reader, settings, batch, **kwargs)
 
 
@@ -186,6 +209,7 @@ def _single(
     as_json: bool,
     reader: dict[str, dict[str, Any]],
     settings: Any,
+    person: dict[str, Any],
     **kwargs: Any,
 ) -> None:
     """One trial, its outputs straight into ``out`` (the first releases' contract)."""
@@ -193,6 +217,7 @@ def _single(
     from pushrecovery.analysis.readers import read_recording
     from pushrecovery.analysis.trial import analyze as analyze_trial
     from pushrecovery.analysis.trial import body_for
+    from pushrecovery.analysis.trial.settings import PRESET_BODY
     from pushrecovery.presets import load_params
 
     plot = kwargs.pop("plot")
@@ -204,6 +229,9 @@ def _single(
         mass=overrides["mass"],
         com_height=overrides["com_height"],
         gravity=preset.gravity,
+        height=person["height"],
+        sex=person["sex"],
+        keep={name for name, value in overrides.items() if value is not None},
     )
     params = load_params(kwargs["preset"], kwargs["params_file"], {**overrides, **found})
     result = analyze_trial(recording, params, settings, sources=sources)
@@ -213,7 +241,7 @@ def _single(
     if as_json:
         emit({**result.summary.to_dict(), "files": files}, True)
         return
-    emit(_brief(result.summary, files), False)
+    emit(_brief(result.summary, files, sources.get("body", PRESET_BODY)), False)
 
 
 def plot_trial(result: Any, out: Path) -> dict[str, str]:
@@ -281,13 +309,14 @@ def _batch(
     )
 
 
-def _brief(summary: TrialSummary, files: dict[str, str]) -> dict[str, Any]:
+def _brief(summary: TrialSummary, files: dict[str, str], body_source: str) -> dict[str, Any]:
     """Pick the lines a person reads first; everything else is in summary.json."""
     brief: dict[str, Any] = {
         "frames": f"{summary.valid_frames} of {summary.frames} analysed "
         f"({summary.rate:.6g} Hz, {summary.duration:.6g} s)",
         "mass": f"{summary.params.mass:.4g} kg ({summary.mass_source})",
         "com_height": f"{summary.params.com_height:.4g} m ({summary.com_height_source})",
+        "body": body_source,
         "com": summary.com_source,
         "support": summary.support_source,
         "needs": summary.most_demanding,

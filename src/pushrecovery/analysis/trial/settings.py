@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -22,6 +24,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "COP_AHEAD_OF_ANKLE",
+    "PERSON_FIELDS",
+    "PRESET_BODY",
     "AnalysisSettings",
     "TrialAnalysis",
     "body_for",
@@ -146,31 +150,64 @@ def pandas_table(table: Any) -> Any:
     return table.to_pandas()
 
 
+#: Where the body came from without --height and --sex.
+PRESET_BODY = "preset (not scaled to the person: give --height and --sex)"
+#: The fields a person's body (:func:`pushrecovery.anthropometry.person_params`) gives the
+#: analysis, unless a flag, the subjects table or the file gives them.
+PERSON_FIELDS = (
+    "com_height",
+    "leg_length",
+    "heel",
+    "toe",
+    "foot_width",
+    "flywheel_inertia",
+    "flywheel_inertia_roll",
+)
+
+
 def body_for(
     recording: Recording,
     *,
     mass: float | None,
     com_height: float | None,
     gravity: float,
+    height: float | None = None,
+    sex: str | None = None,
+    keep: Collection[str] = (),
 ) -> tuple[dict[str, float], dict[str, str]]:
-    """Subject mass and CoM height: a flag, else the file, else the force plates.
+    """Subject mass and body: a flag, else the file, else the force plates; refused if none.
 
     Parameters
     ----------
     recording : Recording
         The trial.
     mass, com_height : float or None
-        Values given as flags [kg, m].
+        Values given as flags or by the subjects table [kg, m].
     gravity : float
         g [m/s^2], to weigh the subject on the force plates.
+    height : float or None
+        Stature [m], in [0.5, 2.5]: with ``sex``, the body's geometry and upper-body inertia
+        come from de Leva's table (:func:`pushrecovery.anthropometry.person_params`).
+    sex : {"female", "male"} or None
+        The table's column; given together with ``height``.
+    keep : collection of str
+        Fields given otherwise (flags, the subjects table) that the person's body leaves alone.
 
     Returns
     -------
     (values, sources)
-        ``mass`` and ``com_height`` found (to override the preset with, see
-        :func:`pushrecovery.presets.load_params`; a quantity the file does not give is left
-        out), and where each came from: ``flag``, ``file``, ``force plates`` (mean vertical
-        force / g while loaded) or ``preset``.
+        ``mass``, ``com_height`` and (with ``height`` and ``sex``) the fields of
+        :data:`PERSON_FIELDS` found (to override the preset with, see
+        :func:`pushrecovery.presets.load_params`; a quantity nothing gives is left out), and
+        where each came from: ``flag``, ``file``, ``force plates`` (mean vertical force / g
+        while loaded), the anthropometric table, or ``preset``; with ``height`` and ``sex``,
+        ``body``: the person's table (without, the body is the preset's: :data:`PRESET_BODY`).
+
+    Raises
+    ------
+    InvalidParameterError
+        No mass (neither given, in the file, nor weighed on its force plates): no body is
+        guessed. ``height`` without ``sex`` or the reverse, or either out of its range.
     """
     values: dict[str, float] = {}
     sources = {"mass": "preset", "com_height": "preset"}
@@ -182,10 +219,34 @@ def body_for(
         mass, source = _weighed(recording.force_time, recording.force[:, 2], gravity)
         if mass is not None:
             values["mass"], sources["mass"] = mass, source
+    if "mass" not in values:
+        raise InvalidParameterError(
+            f"no body mass for {Path(recording.source).name or 'the trial'}: the file has none "
+            "and no loaded force plate to weigh the subject on; give --mass KG (or a subjects "
+            "table's mass)"
+        )
     if com_height is not None:
         values["com_height"], sources["com_height"] = com_height, "flag"
     elif recording.com_height is not None:
         values["com_height"], sources["com_height"] = recording.com_height, "file"
+    if height is None and sex is None:
+        return values, sources
+    if height is None or sex is None:
+        raise InvalidParameterError(
+            "height and sex go together (de Leva's table has one column per sex): give both "
+            f"--height M and --sex female|male, got height={height}, sex={sex}"
+        )
+    from pushrecovery.anthropometry import person_params
+
+    person = person_params(values["mass"], height, sex)
+    for name in PERSON_FIELDS:
+        if name not in values and name not in keep:
+            values[name] = getattr(person.params, name)
+            sources[name] = person.sources[name]
+    sources["body"] = (
+        f"{person.sources['model']}, stature {height:g} m; hip torque and range, stance and "
+        "step timing: preset (not a person's)"
+    )
     return values, sources
 
 
