@@ -178,3 +178,54 @@ def test_a_plate_loaded_beyond_a_quarter_of_the_weight_is_a_foots_contact(tmp_pa
     assert checks["stray_plates"] == []
     assert len(checks["plate_feet"]) == 3
     assert {e.event.kind for e in heavy.summary.events.foot_events} >= {"foot-contact"}
+
+
+# --- (c) saturation and zero offset ---------------------------------------------------------
+def _push(n_points, peak=-195.0, clip=None):
+    """A backward horizontal force of ``peak`` [N] on the left plate, a 200 ms half sine from
+    1.5 s, clipped at ``clip`` [N] (the issue's -120 N of a -195 N peak)."""
+    n = int(n_points * ANALOG / RATE)
+    t = np.arange(n) / ANALOG
+    push = np.where((t >= 1.5) & (t < 1.7), peak * np.sin(np.pi * (t - 1.5) / 0.2), 0.0)
+    return push if clip is None else np.maximum(push, clip)
+
+
+def _pushed(path, clip=None, offset=None):
+    n = int(SECONDS * RATE)
+    markers = {**_feet(n), "CentreOfMass": _com(n)}
+    plates = _standing_plates(n)
+    force = plates[0][0].copy()
+    force[:, 0] = _push(n, clip=clip)
+    plates[0] = (force, *plates[0][1:])
+    if offset is not None:  # a third plate, never stepped on, reading ``offset`` [N]
+        samples = len(force)
+        plates.append(
+            _plate(samples, np.full(samples, offset), np.tile([0.05, 0.40], (samples, 1)),
+                   _rectangle(-0.2, 0.3, 0.26, 0.51))
+        )  # fmt: skip
+    return _write(path, markers, plates, analog_rate=ANALOG)
+
+
+def test_a_clipped_channel_is_flagged_saturated(tmp_path):
+    clipped = analyze(_pushed(tmp_path / "clipped.c3d", clip=-120.0), P)
+    checks = clipped.summary.checks.to_dict()
+    assert checks["saturated_channels"] == ["force ap"]
+    flat = next(c for c in checks["channels"] if c["channel"] == "force ap")["flat_samples"]
+    # -195 sin(pi t / 0.2 s) < -120 N for 0.2 (1 - 2 asin(120/195)/pi) s = 116 ms at 1 kHz.
+    expected = 0.2 * (1 - 2 * np.arcsin(120 / 195) / np.pi) * ANALOG
+    assert abs(flat - expected) <= 2
+    assert any("saturated" in note and "force ap" in note for note in clipped.summary.notes)
+    whole = analyze(_pushed(tmp_path / "whole.c3d"), P).summary.checks.to_dict()
+    assert whole["saturated_channels"] == []
+    assert all(c["flat_samples"] < 5 for c in whole["channels"])
+
+
+def test_an_offset_plate_is_flagged(tmp_path):
+    offset = analyze(_pushed(tmp_path / "offset.c3d", offset=12.0), P)
+    checks = offset.summary.checks.to_dict()
+    assert checks["zero_offset_channels"] == ["plate 3 vertical"]
+    plate = next(c for c in checks["channels"] if c["channel"] == "plate 3 vertical")
+    assert plate["offset"] == pytest.approx(12.0, abs=1e-3)
+    assert checks["saturated_channels"] == []  # a constant 12 N is no clipped peak
+    fine = analyze(_pushed(tmp_path / "fine.c3d", offset=2.0), P).summary.checks.to_dict()
+    assert fine["zero_offset_channels"] == []

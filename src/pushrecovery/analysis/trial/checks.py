@@ -16,7 +16,7 @@ the base as a whole is rejected and the trial is not classified: no frame gets a
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -32,14 +32,20 @@ __all__ = [
     "MAX_CONTRADICTED",
     "PLATE_FOOT_TOLERANCE",
     "PLATE_LOAD_SHARE",
+    "SATURATION_SAMPLES",
+    "ZERO_OFFSET",
+    "ChannelCheck",
     "DataChecks",
     "PlateFeet",
+    "channel_checks",
     "plate_feet",
 ]
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
+#: The force components in body axes, in the recording's order.
+AXES_3D = ("ap", "ml", "up")
 #: How far the measured CoP may lie beyond the computed base before it contradicts it [m].
 COP_TOLERANCE = 0.02
 #: Share of the loaded frames beyond which a contradicted base is rejected for the trial.
@@ -52,6 +58,94 @@ PLATE_FOOT_TOLERANCE = 0.05
 #: contact even with its CoP away from every sole (then the markers are off, not the load): a
 #: foot bearing weight carries about half of it in double stance, all of it in single stance.
 PLATE_LOAD_SHARE = 0.25
+
+#: Consecutive identical samples at a force channel's largest or smallest value that make a
+#: flat top, the mark of a clipped (saturated) amplifier or converter: a real peak sampled with
+#: converter noise repeats its exact extreme for 1-2 samples (biomdp's Kistler and Vicon plate
+#: files: at most 2), a clipped one for as long as the true force stays beyond the range.
+SATURATION_SAMPLES = 5
+#: Largest mean force a channel may read while its plate is unloaded [N]: a quarter of
+#: :data:`~pushrecovery.analysis.recording.LOADED`; 5 N moves the CoP of half a 70 kg body
+#: 20 cm from the plate's centre by 3 mm.
+ZERO_OFFSET = 5.0
+#: Fewest unloaded seconds that give a channel's zero offset (else it is not checked).
+MIN_UNLOADED = 0.1
+
+
+@dataclass(frozen=True, slots=True)
+class ChannelCheck:
+    """Saturation and zero offset of one force channel (:func:`channel_checks`).
+
+    Attributes
+    ----------
+    channel : str
+        ``plate k vertical`` (per plate, files with several), or ``force ap``, ``force ml``,
+        ``force up``: the total ground reaction force (with one plate: that plate's channels
+        in body axes).
+    flat_samples : int
+        Longest run of identical consecutive samples at the channel's largest or smallest
+        value, counted when that value is at least :data:`~pushrecovery.analysis.recording.LOADED`
+        in size (a flat zero is an unloaded plate, not a clipped one) and the channel spans at
+        least ``LOADED`` (a constant channel is no clipped peak); else 0.
+    saturated : bool
+        ``flat_samples`` >= :data:`SATURATION_SAMPLES`.
+    offset : float or None
+        Mean of the channel while its plate is unloaded (vertical force below ``LOADED``) [N];
+        None with fewer than :data:`MIN_UNLOADED` s unloaded.
+    offset_flag : bool
+        ``|offset|`` > :data:`ZERO_OFFSET`.
+    """
+
+    channel: str
+    flat_samples: int
+    saturated: bool
+    offset: float | None
+    offset_flag: bool
+
+
+def channel_checks(recording: Recording) -> tuple[ChannelCheck, ...]:
+    """Check the force channels of ``recording`` for saturation and zero offset.
+
+    The channels the recording keeps: the total force's three components, and each plate's
+    vertical force when there are several plates (module docstring of
+    :class:`ChannelCheck`); none without force plates.
+    """
+    if recording.force is None or recording.force_time is None:
+        return ()
+    time = recording.force_time
+    period = float(time[-1] - time[0]) / max(len(time) - 1, 1)
+    fewest = max(1, int(np.ceil(MIN_UNLOADED / period))) if period > 0 else 1
+    total = recording.force
+    channels = [(f"force {name}", total[:, i], total[:, 2]) for i, name in enumerate(AXES_3D)]
+    if len(recording.plates) > 1:
+        channels += [
+            (f"plate {k + 1} vertical", vertical, vertical)
+            for k, (vertical, _) in enumerate(recording.plates)
+        ]
+    return tuple(_channel(name, x, v, fewest) for name, x, v in channels)
+
+
+def _channel(name: str, values: FloatArray, vertical: FloatArray, fewest: int) -> ChannelCheck:
+    """One channel's :class:`ChannelCheck`; ``vertical`` is its plate's vertical force."""
+    finite = values[np.isfinite(values)]
+    flat = 0
+    if len(finite) and float(finite.max() - finite.min()) >= LOADED:
+        for extreme in {float(finite.max()), float(finite.min())}:
+            if abs(extreme) >= LOADED:
+                flat = max(flat, _longest_run(values == extreme))
+    with np.errstate(invalid="ignore"):
+        unloaded = (vertical < LOADED) & np.isfinite(values)
+    offset = float(np.mean(values[unloaded])) if unloaded.sum() >= fewest else None
+    flagged = offset is not None and abs(offset) > ZERO_OFFSET
+    return ChannelCheck(name, flat, flat >= SATURATION_SAMPLES, offset, flagged)
+
+
+def _longest_run(flags: BoolArray) -> int:
+    """Longest run of True in ``flags``."""
+    if not flags.any():
+        return 0
+    edges = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
+    return int((np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)).max())
 
 
 @dataclass(frozen=True, slots=True)
@@ -192,6 +286,8 @@ class DataChecks:
         unknown there (never filled: a spline through the gap would invent its edge).
     plates : PlateFeet
         Which foot stands on each force plate, and the stray plates.
+    channels : tuple of ChannelCheck
+        Saturation and zero offset of each force channel the recording keeps.
     """
 
     flights: tuple[tuple[float, float], ...]
@@ -202,6 +298,7 @@ class DataChecks:
     base_rejected: bool
     marker_gaps: dict[str, BoolArray] = field(default_factory=dict)
     plates: PlateFeet = field(default_factory=lambda: PlateFeet({}, {}, {}, ()))
+    channels: tuple[ChannelCheck, ...] = ()
 
     @property
     def marker_gap(self) -> BoolArray:
@@ -251,6 +348,11 @@ class DataChecks:
             "excluded_frames_markers": int(self.marker_gap.sum()),
             "marker_gap_frames": {name: int(v.sum()) for name, v in self.marker_gaps.items()},
             **self.plates.to_dict(),
+            "saturation_samples": SATURATION_SAMPLES,
+            "zero_offset_threshold": ZERO_OFFSET,
+            "saturated_channels": [c.channel for c in self.channels if c.saturated],
+            "zero_offset_channels": [c.channel for c in self.channels if c.offset_flag],
+            "channels": [asdict(c) for c in self.channels],
         }
 
 
@@ -263,13 +365,15 @@ def check_frames(
     upper: dict[str, FloatArray],
     marker_gaps: dict[str, BoolArray] | None = None,
     plates: PlateFeet | None = None,
+    channels: tuple[ChannelCheck, ...] = (),
 ) -> DataChecks:
     """Check the frames at ``time`` [s] (module docstring); the pipeline's, unchecked.
 
     ``force`` is the ground reaction force (m, 3) [N] at ``force_time`` [s] (None without
     plates), ``cop`` the CoP (n, 2) [m] at the frames (NaN where unloaded), ``lower`` and
     ``upper`` the base per axis at the frames [m], ``marker_gaps`` per base marker the frames
-    it is missing in, ``plates`` the plates' feet (:func:`plate_feet`).
+    it is missing in, ``plates`` the plates' feet (:func:`plate_feet`), ``channels`` the
+    force channels' checks (:func:`channel_checks`).
     """
     n = len(time)
     flight = np.zeros(n, dtype=bool)
@@ -296,4 +400,6 @@ def check_frames(
     rejected = loaded > 0 and contradicted.sum() > MAX_CONTRADICTED * loaded
     gaps = {name: frames for name, frames in (marker_gaps or {}).items() if frames.any()}
     owners = PlateFeet({}, {}, {}, ()) if plates is None else plates
-    return DataChecks(flights, flight, outside, loaded, COP_TOLERANCE, bool(rejected), gaps, owners)
+    return DataChecks(
+        flights, flight, outside, loaded, COP_TOLERANCE, bool(rejected), gaps, owners, channels
+    )

@@ -23,7 +23,12 @@ from pushrecovery.analysis.signals import (
     resample,
     smooth_and_differentiate,
 )
-from pushrecovery.analysis.trial.checks import PlateFeet, check_frames, plate_feet
+from pushrecovery.analysis.trial.checks import (
+    PlateFeet,
+    channel_checks,
+    check_frames,
+    plate_feet,
+)
 from pushrecovery.analysis.trial.events import Onset, trial_events
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
 from pushrecovery.analysis.trial.summary import (
@@ -81,6 +86,13 @@ def analyze(
     gaps: list[Gap] = []
     notes = list(recording.notes)
     plates = plate_feet(recording, settings.widths(params)[0], params.weight)
+    channels = channel_checks(recording)  # the channels as recorded, stray plates and all
+    for flagged, what in (
+        ([c.channel for c in channels if c.saturated], "saturated (a flat top at its extreme)"),
+        ([c.channel for c in channels if c.offset_flag], "offset from zero while unloaded"),
+    ):
+        if flagged:
+            notes.append(f"force channel {what}: {', '.join(flagged)}")
     if plates.stray:
         recording, note = _without_plates(recording, plates)
         notes.append(note)
@@ -139,7 +151,7 @@ def analyze(
     )
     gaps += found
     checks = check_frames(
-        time, force_time, plate_force, cop, support.lower, support.upper, missing, plates
+        time, force_time, plate_force, cop, support.lower, support.upper, missing, plates, channels
     )
     if checks.base_rejected:
         notes.append(
