@@ -117,7 +117,7 @@ def test_a_resumed_batch_keeps_finished_trials(study, tmp_path):
 def test_bad_subjects_tables(tmp_path):
     cases = {
         "pattern,mass\nx,70\n": "needs the columns pattern and subject",
-        "pattern,subject,height\nx,a,1\n": "unknown columns height",
+        "pattern,subject,shoe_size\nx,a,1\n": "unknown columns shoe_size",
         "pattern,subject,mass\nx,a,heavy\n": "line 2: mass must be a number",
         "pattern,subject,mass\nx,a,-3\n": "line 2: mass must be in",
         "pattern,subject\n,a\n": "line 2: pattern and subject must not be empty",
