@@ -7,6 +7,8 @@ needs them. docs/analysis.md, "Data checks", has the thresholds these tests chec
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -14,6 +16,8 @@ from pushrecovery import load_params
 from pushrecovery.analysis.c3d.writer import write_c3d
 from pushrecovery.analysis.readers import read_recording
 from pushrecovery.analysis.trial import analyze
+from pushrecovery.campaign.trials import find_trials, run_trials, trial_jobs
+from pushrecovery.errors import InvalidParameterError
 
 RATE = 100.0  # marker rate [Hz]
 SECONDS = 4.0
@@ -229,3 +233,75 @@ def test_an_offset_plate_is_flagged(tmp_path):
     assert checks["saturated_channels"] == []  # a constant 12 N is no clipped peak
     fine = analyze(_pushed(tmp_path / "fine.c3d", offset=2.0), P).summary.checks.to_dict()
     assert fine["zero_offset_channels"] == []
+
+
+# --- (d) the forward axis against the feet --------------------------------------------------
+def _turned(values):
+    """Body (ap, ml, up) -> the lab of a lab whose forward is -y: (ml, -ap, up)."""
+    values = np.asarray(values, dtype=float)
+    return np.stack([values[..., 1], -values[..., 0], values[..., 2]], axis=-1)
+
+
+def _minus_y_lab(path):
+    n = int(SECONDS * RATE)
+    markers = {name: _turned(v) for name, v in {**_feet(n), "CentreOfMass": _com(n)}.items()}
+    plates = [
+        (_turned(force), _turned(cop), moment, _turned(corners))
+        for force, cop, moment, corners in _standing_plates(n)
+    ]
+    write_c3d(path, point_rate=RATE, markers=markers, analog_rate=ANALOG, plates=plates)
+    return path
+
+
+def test_a_lab_whose_forward_is_minus_y_is_refused_with_the_default_axis(tmp_path):
+    path = _minus_y_lab(tmp_path / "minus_y.c3d")
+    with pytest.raises(
+        InvalidParameterError, match=r"feet point 90 degrees to the right.*--ap-axis"
+    ):
+        analyze(read_recording(path), P)
+    right = analyze(read_recording(path, ap_axis="-y"), P)
+    same = analyze(_plated(tmp_path / "x.c3d"), P)
+    assert right.summary.checks.forward_angle == pytest.approx(0.0, abs=1e-9)
+    assert same.summary.checks.to_dict()["forward_angle"] == pytest.approx(0.0, abs=1e-9)
+    np.testing.assert_allclose(right.columns["mos"], same.columns["mos"], atol=1e-9)
+
+
+def test_feet_turned_out_pass(tmp_path):
+    """Feet turned out 20 degrees each (toe-out): their mean points forward."""
+    n = int(SECONDS * RATE)
+    markers = {**_feet(n), "CentreOfMass": _com(n)}
+    for side, sign in (("L", 1.0), ("R", -1.0)):
+        turn = np.radians(20.0) * sign
+        heel, toe = markers[f"{side}HEE"].copy(), markers[f"{side}TOE"].copy()
+        length = toe[0, 0] - heel[0, 0]
+        toe[:, 0] = heel[:, 0] + length * np.cos(turn)
+        toe[:, 1] = heel[:, 1] + length * np.sin(turn)
+        markers[f"{side}TOE"] = toe
+    result = analyze(_write(tmp_path / "out.c3d", markers), P)
+    assert result.summary.checks.forward_angle == pytest.approx(0.0, abs=1e-6)
+
+
+# --- a batch: the faulty trials flagged or failed, the rest intact -----------------------------
+def test_a_batch_with_faulty_trials_keeps_the_clean_ones(tmp_path):
+    folder = tmp_path / "trials"
+    folder.mkdir()
+    _plated(folder / "a_clean.c3d")
+    _minus_y_lab(folder / "b_minus_y.c3d")
+    _pushed(folder / "c_clipped.c3d", clip=-120.0)
+    trials, root = find_trials([folder])
+    batch = run_trials(trial_jobs(trials, root), tmp_path / "out", workers=1)
+    status = {row["trial"]: (row["status"], row["error"]) for row in batch.trials}
+    assert status["a_clean.c3d"] == ("analysed", None)
+    assert status["c_clipped.c3d"] == ("analysed", None)
+    assert status["b_minus_y.c3d"][0] == "failed"
+    assert "--ap-axis" in status["b_minus_y.c3d"][1] and "\n" not in status["b_minus_y.c3d"][1]
+    alone = analyze(read_recording(folder / "a_clean.c3d"), P).summary
+    rows = [r for r in batch.trials if r["trial"] == "a_clean.c3d"]
+    for row in rows:
+        assert row["excluded_frames"] == alone.excluded_frames == 0
+    summaries = {
+        name: json.loads((tmp_path / "out" / "trials" / name / "summary.json").read_text())
+        for name in ("a_clean.c3d", "c_clipped.c3d")
+    }
+    assert summaries["a_clean.c3d"]["checks"]["saturated_channels"] == []
+    assert summaries["c_clipped.c3d"]["checks"]["saturated_channels"] == ["force ap"]

@@ -26,9 +26,11 @@ from pushrecovery.analysis.base_polygon import FootModel, foot_soles
 from pushrecovery.analysis.events import flight_phases
 from pushrecovery.analysis.recording import AXES, LOADED, Foot, Recording
 from pushrecovery.analysis.signals import resample
+from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
     "COP_TOLERANCE",
+    "FORWARD_TOLERANCE",
     "MAX_CONTRADICTED",
     "PLATE_FOOT_TOLERANCE",
     "PLATE_LOAD_SHARE",
@@ -38,6 +40,7 @@ __all__ = [
     "DataChecks",
     "PlateFeet",
     "channel_checks",
+    "check_forward",
     "plate_feet",
 ]
 
@@ -70,6 +73,43 @@ SATURATION_SAMPLES = 5
 ZERO_OFFSET = 5.0
 #: Fewest unloaded seconds that give a channel's zero offset (else it is not checked).
 MIN_UNLOADED = 0.1
+#: Largest angle between the feet's heel -> toe direction and the declared forward axis [deg]:
+#: feet turn out some 5-15 degrees each, symmetrically (their mean points forward); beyond 45
+#: degrees the declared axis is nearer another lab axis than the feet's forward.
+FORWARD_TOLERANCE = 45.0
+
+
+def check_forward(feet: tuple[Foot, ...]) -> float | None:
+    """Return the angle of the feet's forward from the declared ap axis [deg], + to the left.
+
+    The feet's forward is the sum over feet of each foot's mean unit heel -> toe direction
+    on the floor (the frames where both markers are present). None without foot markers.
+
+    Raises
+    ------
+    InvalidParameterError
+        If the angle exceeds :data:`FORWARD_TOLERANCE` in size: the file's forward is another
+        axis than the one declared (``ap_axis``, ``--ap-axis``).
+    """
+    total = np.zeros(2)
+    for foot in feet:
+        d = foot.toe[:, :2] - foot.heel[:, :2]
+        length = np.hypot(d[:, 0], d[:, 1])
+        known = np.isfinite(length) & (length > 0.0)
+        if known.any():
+            mean = np.mean(d[known] / length[known, None], axis=0)
+            total += mean / max(float(np.hypot(*mean)), 1e-12)
+    if not total.any():
+        return None
+    angle = float(np.degrees(np.arctan2(total[1], total[0])))
+    if abs(angle) > FORWARD_TOLERANCE:
+        side = "left" if angle > 0 else "right"
+        raise InvalidParameterError(
+            f"the feet point {abs(angle):.0f} degrees to the {side} of the declared forward "
+            f"axis (heel -> toe markers; more than {FORWARD_TOLERANCE:g} degrees): the file's "
+            "forward is another lab axis; give it with --ap-axis (ap_axis)"
+        )
+    return angle
 
 
 @dataclass(frozen=True, slots=True)
@@ -288,6 +328,9 @@ class DataChecks:
         Which foot stands on each force plate, and the stray plates.
     channels : tuple of ChannelCheck
         Saturation and zero offset of each force channel the recording keeps.
+    forward_angle : float or None
+        Angle of the feet's heel -> toe direction from the ap axis [deg] (:func:`check_forward`),
+        None without foot markers.
     """
 
     flights: tuple[tuple[float, float], ...]
@@ -299,6 +342,7 @@ class DataChecks:
     marker_gaps: dict[str, BoolArray] = field(default_factory=dict)
     plates: PlateFeet = field(default_factory=lambda: PlateFeet({}, {}, {}, ()))
     channels: tuple[ChannelCheck, ...] = ()
+    forward_angle: float | None = None
 
     @property
     def marker_gap(self) -> BoolArray:
@@ -353,6 +397,8 @@ class DataChecks:
             "saturated_channels": [c.channel for c in self.channels if c.saturated],
             "zero_offset_channels": [c.channel for c in self.channels if c.offset_flag],
             "channels": [asdict(c) for c in self.channels],
+            "forward_angle": self.forward_angle,
+            "forward_tolerance": FORWARD_TOLERANCE,
         }
 
 
@@ -366,6 +412,7 @@ def check_frames(
     marker_gaps: dict[str, BoolArray] | None = None,
     plates: PlateFeet | None = None,
     channels: tuple[ChannelCheck, ...] = (),
+    forward_angle: float | None = None,
 ) -> DataChecks:
     """Check the frames at ``time`` [s] (module docstring); the pipeline's, unchecked.
 
@@ -373,7 +420,8 @@ def check_frames(
     plates), ``cop`` the CoP (n, 2) [m] at the frames (NaN where unloaded), ``lower`` and
     ``upper`` the base per axis at the frames [m], ``marker_gaps`` per base marker the frames
     it is missing in, ``plates`` the plates' feet (:func:`plate_feet`), ``channels`` the
-    force channels' checks (:func:`channel_checks`).
+    force channels' checks (:func:`channel_checks`), ``forward_angle`` that of
+    :func:`check_forward`.
     """
     n = len(time)
     flight = np.zeros(n, dtype=bool)
@@ -401,5 +449,14 @@ def check_frames(
     gaps = {name: frames for name, frames in (marker_gaps or {}).items() if frames.any()}
     owners = PlateFeet({}, {}, {}, ()) if plates is None else plates
     return DataChecks(
-        flights, flight, outside, loaded, COP_TOLERANCE, bool(rejected), gaps, owners, channels
+        flights,
+        flight,
+        outside,
+        loaded,
+        COP_TOLERANCE,
+        bool(rejected),
+        marker_gaps=gaps,
+        plates=owners,
+        channels=channels,
+        forward_angle=forward_angle,
     )

@@ -26,6 +26,7 @@ from pushrecovery.analysis.signals import (
 from pushrecovery.analysis.trial.checks import (
     PlateFeet,
     channel_checks,
+    check_forward,
     check_frames,
     plate_feet,
 )
@@ -85,6 +86,7 @@ def analyze(
     settings = settings or AnalysisSettings()
     gaps: list[Gap] = []
     notes = list(recording.notes)
+    forward = check_forward(recording.feet)  # a wrong --ap-axis: refused
     plates = plate_feet(recording, settings.widths(params)[0], params.weight)
     channels = channel_checks(recording)  # the channels as recorded, stray plates and all
     for flagged, what in (
@@ -151,7 +153,16 @@ def analyze(
     )
     gaps += found
     checks = check_frames(
-        time, force_time, plate_force, cop, support.lower, support.upper, missing, plates, channels
+        time,
+        force_time,
+        plate_force,
+        cop,
+        support.lower,
+        support.upper,
+        missing,
+        plates,
+        channels,
+        forward,
     )
     if checks.base_rejected:
         notes.append(
