@@ -247,7 +247,10 @@ def csv_case(rng: random.Random, folder: Path, index: int) -> Case:
     """``analyze FILE`` with a mutated CSV trial."""
     path = folder / f"case{index}.csv"
     path.write_text(mutate_text(rng, csv_text(rng)), encoding="latin-1")
-    return Case("file:csv", ["analyze", str(path), "--out", str(folder / f"out{index}"), "--json"])
+    return Case(
+        "file:csv",
+        ["analyze", str(path), "--mass", "70", "--out", str(folder / f"out{index}"), "--json"],
+    )
 
 
 def c3d_case(rng: random.Random, folder: Path, index: int, sources: list[Path]) -> Case:

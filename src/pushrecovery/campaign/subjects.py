@@ -13,6 +13,9 @@ preset, in that order: docs/analysis.md, "Many trials"):
 ``com_height``     CoM height above the ankle [m]
 ``foot_length``    foot length, heel to toe [m]
 ``foot_width``     foot width [m]
+``height``         stature [m], in [0.5, 2.5]: with ``sex``, the body from de Leva's
+                   table (:func:`pushrecovery.anthropometry.person_params`)
+``sex``            ``female`` or ``male`` (de Leva's column), with ``height``
 =================  ===================================================================
 
 The first row whose pattern matches a trial applies to it. A malformed table (a missing
@@ -42,10 +45,13 @@ SUBJECT_COLUMNS = (
     "com_height",
     "foot_length",
     "foot_width",
+    "height",
+    "sex",
 )
-_NUMBERS = SUBJECT_COLUMNS[2:]
+_NUMBERS = SUBJECT_COLUMNS[2:-1]
 #: Ranges of the columns that are no field of BodyParams' LIMITS [m].
 _FOOT_RANGE = (0.01, 1.0)
+_RANGES = {"height": (0.5, 2.5)}
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,6 +65,8 @@ class Subject:
     com_height: float | None = None
     foot_length: float | None = None
     foot_width: float | None = None
+    height: float | None = None
+    sex: str | None = None
 
     def matches(self, relative: str) -> bool:
         """Whether the pattern matches the trial's relative path or its file name."""
@@ -132,13 +140,18 @@ def _subject(row: dict[str, str], where: str) -> Subject:
             value = float(text)
         except ValueError:
             raise InvalidParameterError(f"{where}: {name} must be a number, got {text!r}") from None
-        low, high = LIMITS.get(name, _FOOT_RANGE)[:2]
+        low, high = LIMITS.get(name, _RANGES.get(name, _FOOT_RANGE))[:2]
         if not (math.isfinite(value) and low <= value <= high):
             raise InvalidParameterError(
                 f"{where}: {name} must be in [{low:g}, {high:g}], got {text}"
             )
         numbers[name] = value
-    return Subject(row["pattern"], row["subject"], **numbers)
+    sex = row.get("sex", "").lower() or None
+    if sex not in (None, "female", "male"):
+        raise InvalidParameterError(f"{where}: sex must be female or male, got {row['sex']!r}")
+    if (numbers["height"] is None) != (sex is None):
+        raise InvalidParameterError(f"{where}: height and sex go together: give both or neither")
+    return Subject(row["pattern"], row["subject"], **numbers, sex=sex)
 
 
 def subject_for(relative: str, subjects: tuple[Subject, ...]) -> Subject | None:

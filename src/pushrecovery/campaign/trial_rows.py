@@ -100,6 +100,9 @@ class TrialRow:
     sway_ellipse_area, sway_mean_velocity_total : float
         The 95 % prediction ellipse [m²] and the resultant mean speed [m/s] (the same on both
         axes' rows).
+    body_source : str
+        Where the body's geometry and upper-body inertia came from: de Leva's table (the
+        subjects table's ``height`` and ``sex``), or the preset (not scaled to the person).
     """
 
     trial: str
@@ -159,6 +162,7 @@ class TrialRow:
     sway_f95: float | None = None
     sway_ellipse_area: float | None = None
     sway_mean_velocity_total: float | None = None
+    body_source: str | None = None
 
 
 #: Arrow types of the columns, in order.
@@ -177,6 +181,8 @@ def trial_rows(
 
     The values are the summary's own (NaN, not yet None: ``json_safe`` them for a JSON file).
     """
+    from pushrecovery.analysis.trial.settings import PRESET_BODY
+
     checks, plane = summary.checks, summary.plane
     rows = []
     for axis, data in summary.directions.items():
@@ -201,6 +207,7 @@ def trial_rows(
             com_height_source=summary.com_height_source,
             leg_length=params.leg_length,
             leg_length_source=sources.get("leg_length", "preset"),
+            body_source=sources.get("body", PRESET_BODY),
             com_source=summary.com_source,
             support_source=summary.support_source,
             heel=data.heel,

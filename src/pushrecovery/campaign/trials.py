@@ -180,15 +180,20 @@ def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict
             for name, value in _subject_body(job.subject, job.preset, job.params_file).items():
                 given[name], sources[name] = value, "subjects table"
         preset = load_params(job.preset, job.params_file, given)
+        person = job.subject if job.subject is not None else None
         found, found_sources = body_for(
             recording,
             mass=given.get("mass"),
             com_height=given.get("com_height"),
             gravity=preset.gravity,
+            height=None if person is None else person.height,
+            sex=None if person is None else person.sex,
+            keep=set(given),
         )
         for name in ("mass", "com_height"):
             if sources.get(name) == "subjects table":
                 found_sources[name] = "subjects table"
+        sources.update({k: v for k, v in found_sources.items() if k not in sources})
         params = load_params(job.preset, job.params_file, {**given, **found})
         analysis = analyze(recording, params, job.settings, sources=found_sources)
         files = {name: str(path) for name, path in write_analysis(analysis, directory).items()}
