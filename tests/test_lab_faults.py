@@ -133,21 +133,25 @@ def _rectangle(x0, x1, y0, y1):
 
 def _standing_plates(n_points, stray_load=None, stray_at=(0.05, 0.30)):
     """Each foot on its own plate, the load shifting with the CoM sideways (the combined CoP
-    under the CoM); optionally a third plate left of the left foot loaded ``stray_load`` [N]
-    for 80 ms from 2 s."""
+    under the CoM) and 0.3 N of noise on each (a noise-free total would be constant: a flat
+    top at its extreme); optionally a third plate left of the left foot loaded to ``stray_load``
+    [N] for 80 ms from 2 s (a half sine)."""
     n = int(n_points * ANALOG / RATE)
     t = np.arange(n) / ANALOG
     com = _com(n_points)
     ml = np.interp(t, np.arange(n_points) / RATE, com[:, 1])
     ap = np.interp(t, np.arange(n_points) / RATE, com[:, 0])
     left = 0.5 * WEIGHT * (1.0 + ml / 0.10)
+    noise = np.random.default_rng(34).normal(0.0, 0.3, (2, n))  # a real plate's, ~0.3 N
     plates = [
-        _plate(n, left, np.column_stack([ap, np.full(n, 0.10)]), _rectangle(-0.2, 0.3, 0.0, 0.25)),
-        _plate(n, WEIGHT - left, np.column_stack([ap, np.full(n, -0.10)]),
+        _plate(n, left + noise[0], np.column_stack([ap, np.full(n, 0.10)]),
+               _rectangle(-0.2, 0.3, 0.0, 0.25)),
+        _plate(n, WEIGHT - left + noise[1], np.column_stack([ap, np.full(n, -0.10)]),
                _rectangle(-0.2, 0.3, -0.25, 0.0)),
     ]  # fmt: skip
     if stray_load is not None:
-        load = np.where((t >= 2.0) & (t < 2.08), stray_load, 0.0)
+        pulse = np.sin(np.pi * (t - 2.0) / 0.08)
+        load = np.where((t > 2.0) & (t < 2.08), stray_load * pulse, 0.0)
         where = np.tile(stray_at, (n, 1))
         plates.append(_plate(n, load, where, _rectangle(-0.2, 0.3, 0.26, 0.51)))
     return plates
@@ -305,3 +309,36 @@ def test_a_batch_with_faulty_trials_keeps_the_clean_ones(tmp_path):
     }
     assert summaries["a_clean.c3d"]["checks"]["saturated_channels"] == []
     assert summaries["c_clipped.c3d"]["checks"]["saturated_channels"] == ["force ap"]
+
+
+# --- the data-quality table -------------------------------------------------------------------
+def test_the_data_quality_table_names_every_check_and_what_it_flagged(tmp_path):
+    import pyarrow.parquet as pq
+
+    from pushrecovery.analysis.output import write_analysis
+
+    _, gapped = _gapped(tmp_path)
+    paths = write_analysis(analyze(gapped, P), tmp_path / "gapped")
+    table = pq.read_table(paths["quality_parquet"]).to_pylist()
+    flagged = {(row["check"], row["target"]): row for row in table if row["flagged"]}
+    assert set(flagged) == {("marker_gap", "left heel"), ("marker_gap", "left toe")}
+    assert flagged["marker_gap", "left heel"]["frames"] == 30
+    assert flagged["marker_gap", "left toe"]["frames"] == 10
+    checks = {row["check"] for row in table}
+    assert checks == {"flight", "cop_outside_base", "base_rejected", "marker_gap", "forward_axis"}
+    assert paths["quality_csv"].read_text().splitlines()[0] == (
+        '"check","target","flagged","frames","value","threshold","unit"'
+    )
+    stray = analyze(_plated(tmp_path / "three.c3d", stray_load=66.0), P).summary.checks
+    rows = {(r["check"], r["target"]): r for r in stray.quality_rows()}
+    assert rows["plate_under_no_foot", "plate 3"]["flagged"]
+    assert not rows["plate_under_no_foot", "plate 1"]["flagged"]
+    assert not rows["saturation", "force up"]["flagged"]
+    assert stray.row_flags() == {
+        "excluded_frames_markers": 0,
+        "marker_gap_frames": "",
+        "stray_plates": "plate 3",
+        "saturated_channels": "",
+        "zero_offset_channels": "",
+        "forward_angle": pytest.approx(0.0, abs=1e-9),
+    }

@@ -1,4 +1,4 @@
-"""Write an analysed trial: ``frames.parquet``, ``frames.csv`` and ``summary.json``."""
+"""Write an analysed trial: the frames, the data-quality table and ``summary.json``."""
 
 from __future__ import annotations
 
@@ -15,10 +15,12 @@ from pushrecovery.extras import require
 if TYPE_CHECKING:  # the trial's summary serialises itself with json_safe
     from pushrecovery.analysis.trial import TrialAnalysis
 
-__all__ = ["FRAME_FILES", "SUMMARY_FILE", "json_safe", "write_analysis"]
+__all__ = ["FRAME_FILES", "QUALITY_FILES", "SUMMARY_FILE", "json_safe", "write_analysis"]
 
 #: Per-frame tables written into the output directory.
 FRAME_FILES = ("frames.parquet", "frames.csv")
+#: The data-quality table written into the output directory (docs/analysis.md, "Data checks").
+QUALITY_FILES = ("quality.parquet", "quality.csv")
 #: The summary written into the output directory.
 SUMMARY_FILE = "summary.json"
 
@@ -37,16 +39,19 @@ def json_safe(value: Any) -> Any:
 
 
 def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Path]:
-    """Write the frames (Parquet and CSV) and the summary (JSON) into ``out_dir``.
+    """Write the frames and the data-quality table (Parquet and CSV) and the summary (JSON).
 
     Columns of the frame tables are those of :attr:`TrialAnalysis.columns` (docs/analysis.md):
     lengths in m, velocities in m/s, times in s; missing values are empty in the CSV and null
-    in Parquet; a time to leave of +inf (never) is written as ``inf``.
+    in Parquet; a time to leave of +inf (never) is written as ``inf``. The data-quality table
+    has one row per check and what it checked
+    (:meth:`~pushrecovery.analysis.trial.checks.DataChecks.quality_rows`).
 
     Returns
     -------
     dict
-        ``frames_parquet``, ``frames_csv`` and ``summary`` paths.
+        ``frames_parquet``, ``frames_csv``, ``quality_parquet``, ``quality_csv`` and
+        ``summary`` paths.
     """
     require("analysis", "pyarrow", "writing an analysis")
     import pyarrow.csv as pacsv
@@ -62,9 +67,26 @@ def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Pa
     }
     _atomic(paths["frames_parquet"], lambda p: pq.write_table(table, p))
     _atomic(paths["frames_csv"], lambda p: pacsv.write_csv(table, p))
+    quality = _quality_table(analysis)
+    paths["quality_parquet"] = out / QUALITY_FILES[0]
+    paths["quality_csv"] = out / QUALITY_FILES[1]
+    _atomic(paths["quality_parquet"], lambda p: pq.write_table(quality, p))
+    _atomic(paths["quality_csv"], lambda p: pacsv.write_csv(quality, p))
     text = json.dumps(analysis.summary.to_dict(), indent=2, allow_nan=False)
     _atomic(paths["summary"], lambda p: p.write_text(text + "\n"))
     return paths
+
+
+def _quality_table(analysis: TrialAnalysis) -> Any:
+    """Return the data-quality rows as a typed Arrow table (QUALITY_FIELDS)."""
+    import pyarrow as pa
+
+    from pushrecovery.analysis.trial.checks import QUALITY_FIELDS
+
+    types = {"str": pa.string(), "int": pa.int64(), "float": pa.float64(), "bool": pa.bool_()}
+    schema = pa.schema([(name, types[kind.split(" ")[0]]) for name, kind in QUALITY_FIELDS])
+    rows = json_safe(analysis.summary.checks.quality_rows())
+    return pa.Table.from_pylist(rows, schema=schema)
 
 
 def _atomic(path: Path, write: Any) -> None:

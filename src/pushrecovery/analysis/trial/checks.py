@@ -34,6 +34,7 @@ __all__ = [
     "MAX_CONTRADICTED",
     "PLATE_FOOT_TOLERANCE",
     "PLATE_LOAD_SHARE",
+    "QUALITY_FIELDS",
     "SATURATION_SAMPLES",
     "ZERO_OFFSET",
     "ChannelCheck",
@@ -47,6 +48,16 @@ __all__ = [
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
+#: Columns of the data-quality table (:meth:`DataChecks.quality_rows`) and their types.
+QUALITY_FIELDS: tuple[tuple[str, str], ...] = (
+    ("check", "str"),
+    ("target", "str"),
+    ("flagged", "bool"),
+    ("frames", "int | None"),
+    ("value", "float | None"),
+    ("threshold", "float"),
+    ("unit", "str"),
+)
 #: The force components in body axes, in the recording's order.
 AXES_3D = ("ap", "ml", "up")
 #: How far the measured CoP may lie beyond the computed base before it contradicts it [m].
@@ -379,6 +390,69 @@ class DataChecks:
             )
         return {key: value for key, value in reasons.items() if value}
 
+    def quality_rows(self) -> list[dict[str, Any]]:
+        """Return the data-quality table: one row per check and what it checked.
+
+        Columns (:data:`QUALITY_FIELDS`): ``check`` (``flight``, ``cop_outside_base``,
+        ``base_rejected``, ``marker_gap``, ``plate_under_no_foot``, ``saturation``,
+        ``zero_offset``, ``forward_axis``), ``target`` (the trial, an axis, a marker, a plate
+        or a force channel), ``flagged``, ``frames`` (frames concerned, where it counts
+        frames), ``value`` (the measure compared with the threshold: a share, a distance [m],
+        a run of samples, a force [N], an angle [deg]), ``threshold`` and its ``unit``
+        (docs/analysis.md, "Data checks").
+        """
+        rows = [_row("flight", "trial", int(self.flight.sum()), None, LOADED, "N")]
+        for axis, frames in self.cop_outside.items():
+            rows.append(
+                _row("cop_outside_base", axis, int(frames.sum()), None, self.tolerance, "m")
+            )
+        share = self.contradicted.sum() / self.loaded_frames if self.loaded_frames else None
+        rows.append(
+            _row("base_rejected", "trial", int(self.contradicted.sum()), share,
+                 MAX_CONTRADICTED, "share", flagged=self.base_rejected)
+        )  # fmt: skip
+        gaps = {name: int(frames.sum()) for name, frames in self.marker_gaps.items()}
+        for name, count in (gaps or {"heel and toe markers": 0}).items():
+            rows.append(_row("marker_gap", name, count, None, 0.0, "frames"))
+        for k, distance in self.plates.distance.items():
+            rows.append(
+                _row("plate_under_no_foot", f"plate {k + 1}", None, distance,
+                     PLATE_FOOT_TOLERANCE, "m", flagged=k in self.plates.stray)
+            )  # fmt: skip
+        for channel in self.channels:
+            rows.append(
+                _row("saturation", channel.channel, None, float(channel.flat_samples),
+                     SATURATION_SAMPLES, "samples", flagged=channel.saturated)
+            )  # fmt: skip
+            rows.append(
+                _row("zero_offset", channel.channel, None, channel.offset, ZERO_OFFSET, "N",
+                     flagged=channel.offset_flag)
+            )  # fmt: skip
+        if self.forward_angle is not None:
+            rows.append(
+                _row("forward_axis", "feet", None, self.forward_angle, FORWARD_TOLERANCE, "deg",
+                     flagged=False)
+            )  # fmt: skip
+        return rows
+
+    def row_flags(self) -> dict[str, Any]:
+        """Return the trial row's columns of the newer checks (docs/analysis.md).
+
+        ``excluded_frames_markers`` (int), ``marker_gap_frames`` (``"left heel=30; left
+        toe=10"``), ``stray_plates``, ``saturated_channels``, ``zero_offset_channels`` (names
+        joined by ``"; "``, empty when none) and ``forward_angle`` [deg] (None without feet).
+        """
+        return {
+            "excluded_frames_markers": int(self.marker_gap.sum()),
+            "marker_gap_frames": "; ".join(
+                f"{name}={int(v.sum())}" for name, v in self.marker_gaps.items()
+            ),
+            "stray_plates": "; ".join(f"plate {k + 1}" for k in self.plates.stray),
+            "saturated_channels": "; ".join(c.channel for c in self.channels if c.saturated),
+            "zero_offset_channels": "; ".join(c.channel for c in self.channels if c.offset_flag),
+            "forward_angle": self.forward_angle,
+        }
+
     def to_dict(self) -> dict[str, Any]:
         """Return the summary's ``checks``."""
         return {
@@ -400,6 +474,28 @@ class DataChecks:
             "forward_angle": self.forward_angle,
             "forward_tolerance": FORWARD_TOLERANCE,
         }
+
+
+def _row(
+    check: str,
+    target: str,
+    frames: int | None,
+    value: float | None,
+    threshold: float,
+    unit: str,
+    *,
+    flagged: bool | None = None,
+) -> dict[str, Any]:
+    """One row of the data-quality table; flagged, unless given, when it counts frames."""
+    return {
+        "check": check,
+        "target": target,
+        "flagged": bool(frames) if flagged is None else bool(flagged),
+        "frames": frames,
+        "value": value,
+        "threshold": float(threshold),
+        "unit": unit,
+    }
 
 
 def check_frames(
