@@ -49,7 +49,9 @@ def _com(n: int) -> np.ndarray:
 
 
 def _write(path, markers, plates=(), analog_rate=RATE):
-    write_c3d(path, point_rate=RATE, markers=markers, analog_rate=analog_rate, plates=plates)
+    write_c3d(
+        path, point_rate=RATE, markers=markers, analog_rate=analog_rate, plates=plates, mass=70.0
+    )
     return read_recording(path)
 
 
