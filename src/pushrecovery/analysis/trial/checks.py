@@ -1,4 +1,4 @@
-"""A trial's data checked before its verdicts: flight phases, and a CoP outside the base.
+"""A trial's data checked before its verdicts: what real labs record wrong (issues 18 and 34).
 
 Verdicts assume a body standing on the base of support the analysis computed. Two things in the
 data contradict that, and the frames where they do get no verdict (issue 18, item 5):
@@ -12,6 +12,20 @@ data contradict that, and the frames where they do get no verdict (issue 18, ite
 
 When the CoP contradicts the base in more than :data:`MAX_CONTRADICTED` of the loaded frames,
 the base as a whole is rejected and the trial is not classified: no frame gets a verdict.
+
+Issue 34 adds the faults of a lab's recording (docs/analysis.md, "Data checks", has the table
+of checks, thresholds and reasons):
+
+- **a heel or toe marker missing**: the base is unknown in that frame (``marker_gaps``; the
+  frames get no verdict);
+- **a plate under no foot** (:func:`plate_feet`): a loaded plate whose CoP lies under no
+  foot's sole and whose load stays light is no foot's contact;
+- **saturation and zero offset** of the force channels (:func:`channel_checks`): flags;
+- **the forward axis against the feet** (:func:`check_forward`): a trial whose feet point
+  elsewhere than the declared ap axis is refused.
+
+:meth:`DataChecks.quality_rows` is the data-quality table, one row per check and target.
+Over 400 lines on purpose: one concept, the checks of a trial's data.
 """
 
 from __future__ import annotations
