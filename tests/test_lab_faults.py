@@ -344,3 +344,25 @@ def test_the_data_quality_table_names_every_check_and_what_it_flagged(tmp_path):
         "zero_offset_channels": "",
         "forward_angle": pytest.approx(0.0, abs=1e-9),
     }
+
+
+def test_a_batch_has_the_checks_in_its_rows_and_a_quality_table(tmp_path):
+    # The flags reach the trials table (one column each) and the study's quality table.
+    import pyarrow.parquet as pq
+
+    folder = tmp_path / "trials"
+    folder.mkdir()
+    _gapped(folder)
+    _plated(folder / "stray.c3d", stray_load=66.0)
+    trials, root = find_trials([folder])
+    batch = run_trials(trial_jobs(trials, root), tmp_path / "out", workers=1)
+    rows = {(r["trial"], r["axis"]): r for r in batch.trials}
+    assert rows["gapped.c3d", "ap"]["marker_gap_frames"] == "left heel=30; left toe=10"
+    assert rows["gapped.c3d", "ml"]["excluded_frames_markers"] == 40
+    assert rows["stray.c3d", "ap"]["stray_plates"] == "plate 3"
+    q = pq.read_table(tmp_path / "out" / "quality.parquet").to_pylist()
+    assert {(r["trial"], r["check"], r["target"]) for r in q if r["flagged"]} == {
+        ("gapped.c3d", "marker_gap", "left heel"),
+        ("gapped.c3d", "marker_gap", "left toe"),
+        ("stray.c3d", "plate_under_no_foot", "plate 3"),
+    }

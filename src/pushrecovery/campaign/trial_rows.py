@@ -103,6 +103,17 @@ class TrialRow:
     body_source : str
         Where the body's geometry and upper-body inertia came from: de Leva's table (the
         subjects table's ``height`` and ``sex``), or the preset (not scaled to the person).
+    excluded_frames_markers : int
+        Frames without a verdict because a heel or toe marker is missing (docs/analysis.md,
+        "Data checks").
+    marker_gap_frames : str
+        Those frames per marker, ``"left heel=30; left toe=10"`` ("" when none).
+    stray_plates, saturated_channels, zero_offset_channels : str
+        Plates loaded under no foot, force channels with a flat top at their extreme, and
+        channels offset from zero while unloaded, joined by ``"; "`` ("" when none).
+    forward_angle : float
+        Angle of the feet's heel -> toe direction from the ap axis [deg], + to the left
+        (null without foot markers).
     """
 
     trial: str
@@ -163,6 +174,12 @@ class TrialRow:
     sway_ellipse_area: float | None = None
     sway_mean_velocity_total: float | None = None
     body_source: str | None = None
+    excluded_frames_markers: int | None = None
+    marker_gap_frames: str | None = None
+    stray_plates: str | None = None
+    saturated_channels: str | None = None
+    zero_offset_channels: str | None = None
+    forward_angle: float | None = None
 
 
 #: Arrow types of the columns, in order.
@@ -240,6 +257,7 @@ def trial_rows(
             min_time_to_boundary_xcom=plane.min_time_to_boundary_xcom.value,
             most_demanding_2d=plane.most_demanding,
             **_sway(summary.sway, axis),
+            **checks.row_flags(),
         )
         if row.base_rejected:
             row = replace(

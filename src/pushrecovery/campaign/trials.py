@@ -199,13 +199,15 @@ def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict
         files = {name: str(path) for name, path in write_analysis(analysis, directory).items()}
         if after is not None:
             files.update(after(analysis, directory))
+        quality = [{"trial": job.name, **row} for row in analysis.summary.checks.quality_rows()]
         record = {
             "trials": json_safe(trial_rows(job, analysis.summary, params, sources)),
             "events": json_safe(trial_events(job, analysis.summary)),
+            "quality": json_safe(quality),
             "files": files,
         }
     except PushRecoveryError as exc:
-        record = {"trials": failed_rows(job, str(exc)), "events": [], "files": {}}
+        record = {"trials": failed_rows(job, str(exc)), "events": [], "quality": [], "files": {}}
     _write_json(directory / ROW_FILE, record)
     return record
 
@@ -328,17 +330,21 @@ def _on_cluster(
 
 def _join(jobs: list[TrialJob], out: Path, ran: int) -> TrialsResult:
     """Read every trial's rows (in job order) and write the batch's tables and summary."""
+    from pushrecovery.analysis.trial.checks import QUALITY_FIELDS
     from pushrecovery.campaign.trial_rows import batch_summary, write_table
 
     trials: list[dict[str, Any]] = []
     events: list[dict[str, Any]] = []
+    quality: list[dict[str, Any]] = []
     for job in jobs:
         record = json.loads((out / TRIALS_DIR / job.name / ROW_FILE).read_text())
         trials += record["trials"]
         events += record["events"]
+        quality += record.get("quality", [])  # trials finished before the table existed
     files = {
         **write_table(trials, TRIAL_FIELDS, out / "trials"),
         **write_table(events, EVENT_FIELDS, out / "events"),
+        **write_table(quality, (("trial", "str"), *QUALITY_FIELDS), out / "quality"),
     }
     summary = batch_summary(trials)
     _write_json(out / "summary.json", summary)
