@@ -64,7 +64,7 @@ def _foot(text: str) -> tuple[str, str, str, str]:
 
 @click.command(
     short_help="Per-frame margins and strategies of measured trials (CSV, C3D).",
-    epilog=example("pushrecovery analyze trial.csv --units mm --out out/trial"),
+    epilog=example("pushrecovery analyze trial.csv --mass 72 --units mm --out out/trial"),
 )
 @click.argument("inputs", nargs=-1, required=True, metavar="FILE|FOLDER|GLOB...")
 @click.option(
@@ -135,7 +135,7 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     default=None,
     metavar="M",
     help="Stature [m], with --sex: the body's geometry and upper-body inertia from de Leva "
-    "1996 Table 4 (docs/analysis.md, The body of a person).",
+    "1996 Table 4 (docs/anthropometry.md).",
 )
 @click.option(
     "--sex",
