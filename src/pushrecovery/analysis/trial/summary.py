@@ -31,6 +31,7 @@ from pushrecovery.analysis.signals import (
 )
 from pushrecovery.analysis.trial.checks import DataChecks
 from pushrecovery.analysis.trial.events import TrialEvents, _events_dict
+from pushrecovery.analysis.trial.settings import PRESET_BODY
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy
 
@@ -177,6 +178,9 @@ class TrialSummary:
         The body assumed (mass [kg], CoM height [m], ω [1/s], ...).
     mass_source, com_height_source : str
         Where mass and CoM height came from (``given`` without ``sources``).
+    body_source : str
+        Where the body's geometry and upper-body inertia came from: the person's segment
+        table (docs/anthropometry.md) or the preset (``given`` without ``sources``).
     com_source, support_source : str
         How the CoM and the base of support were obtained.
     cutoff, force_cutoff : float
@@ -233,6 +237,7 @@ class TrialSummary:
     events: TrialEvents
     sway: SwayMeasures | None = None
     sway_rate: float | None = None
+    body_source: str = "given"
 
     @property
     def excluded_frames(self) -> int:
@@ -261,6 +266,7 @@ class TrialSummary:
                     "com_height": params.com_height,
                     "com_height_source": self.com_height_source,
                     "omega": params.omega,
+                    "body_source": self.body_source,
                 },
                 "params": params.to_dict(),
                 "com_source": self.com_source,
@@ -474,6 +480,8 @@ def _summary(
         params=params,
         mass_source=sources.get("mass", "given"),
         com_height_source=sources.get("com_height", "given"),
+        # With sources (the CLI, a batch) the body is the preset unless a person's table gave it.
+        body_source=sources.get("body", PRESET_BODY) if sources else "given",
         com_source=com_source,
         support_source=support_source,
         cutoff=settings.cutoff,
