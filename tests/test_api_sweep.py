@@ -27,6 +27,7 @@ import pushrecovery
 from pushrecovery import load_params
 from pushrecovery.analysis.base_polygon import FootModel, base_from_params
 from pushrecovery.analysis.c3d import write_c3d
+from pushrecovery.analysis.readers import read_recording
 from pushrecovery.analysis.recording import fixed_feet
 from pushrecovery.control.mpc import MPCSettings
 from pushrecovery.errors import PushRecoveryError
@@ -89,6 +90,8 @@ VALID: dict[str, Any] = {
     "angle_max": 0.5, "weight": 700.0, "speed": 0.01, "theta0": 0.1, "thetadot0": 0.2,
     # The optional dependencies (an installed extra's module).
     "extra": "sim", "module": "mujoco",
+    # A person's body (de Leva), and a recording's checks.
+    "height": 1.75, "sex": "female", "recording": read_recording(TRIAL),
     # Measured data.
     "path": TRIAL, "com": np.array([0.01, 0.02]), "anchor": np.array([0.02]),
     "n": 10, "ankle_ap": 0.0, "ankle_ml": 0.1, "stance_width": 0.2, "contact_height": 0.05,

@@ -23,7 +23,7 @@ from dataclasses import asdict, dataclass
 from types import MappingProxyType
 from typing import Literal, NamedTuple
 
-from pushrecovery.arguments import bounded_float, finite_float
+from pushrecovery.arguments import bounded_float, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
@@ -216,11 +216,13 @@ def person_params(
     if not 0.0 < mass <= 500.0:
         raise InvalidParameterError(f"mass must be in (0, 500] kg, got {mass:g}")
     height = bounded_float("height", height, 0.5, 2.5, "m")
-    if sex not in SEXES:
+    if not (isinstance(sex, str) and sex in SEXES):
         raise InvalidParameterError(f"sex must be 'female' or 'male', got {str(sex)[:20]!r}")
     ankle_from_heel = finite_float("ankle_from_heel", ankle_from_heel)
     if not 0.0 < ankle_from_heel < 1.0:
         raise InvalidParameterError(f"ankle_from_heel must be in (0, 1), got {ankle_from_heel:g}")
+    if base is not None:
+        require_type("base", base, BodyParams)
     if base is None:
         from pushrecovery.presets import load_params
 

@@ -40,7 +40,8 @@ from pushrecovery.analysis.base_polygon import FootModel, foot_soles
 from pushrecovery.analysis.events import flight_phases
 from pushrecovery.analysis.recording import AXES, LOADED, Foot, Recording
 from pushrecovery.analysis.signals import resample
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import positive_float, require_type
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 __all__ = [
     "COP_TOLERANCE",
@@ -116,6 +117,10 @@ def check_forward(feet: tuple[Foot, ...]) -> float | None:
         If the angle exceeds :data:`FORWARD_TOLERANCE` in size: the file's forward is another
         axis than the one declared (``ap_axis``, ``--ap-axis``).
     """
+    if not (isinstance(feet, tuple | list) and all(isinstance(f, Foot) for f in feet)):
+        raise ParameterTypeError(
+            f"feet must be a tuple of Foot (a recording's feet), got {type(feet).__name__}"
+        )
     total = np.zeros(2)
     for foot in feet:
         d = foot.toe[:, :2] - foot.heel[:, :2]
@@ -175,6 +180,7 @@ def channel_checks(recording: Recording) -> tuple[ChannelCheck, ...]:
     vertical force when there are several plates (module docstring of
     :class:`ChannelCheck`); none without force plates.
     """
+    require_type("recording", recording, Recording)
     if recording.force is None or recording.force_time is None:
         return ()
     time = recording.force_time
@@ -262,6 +268,9 @@ def plate_feet(recording: Recording, foot_width: float, weight: float) -> PlateF
     foot markers every loaded plate keeps its name (``plate k``). Two plates that would go
     to one foot keep their names.
     """
+    require_type("recording", recording, Recording)
+    foot_width = positive_float("foot_width", foot_width, "m")
+    weight = positive_float("weight", weight, "N")
     owners: dict[int, str] = {}
     distance: dict[int, float] = {}
     peak: dict[int, float] = {}
