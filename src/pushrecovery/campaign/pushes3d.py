@@ -82,8 +82,8 @@ def run_push3d(
     except SimulationDiverged as exc:  # this push only: the others of the batch go on
         del cache[push.params]
         return error_row3d(spec, push, f"the physics diverged: {exc}")
-    extras = run.extras
-    assert extras is not None  # run_push3d's result
+    extras, physics = run.extras, run.physics
+    assert extras is not None and physics is not None  # run_push3d's result
     row = predict3d(spec, push)
     stepper = controller.stepper
     row.update(
@@ -103,6 +103,11 @@ def run_push3d(
         # The motor commands held from the push on (the push's, then each tick's).
         peak_torque_ratio=_torque_ratio(run.inputs[extras.push_row - 1 :], plant.ctrl_range),
         failed_ticks=extras.failed_ticks,
+        foot_slip=physics.foot_slip,
+        peak_ground_force=physics.peak_force_ratio,
+        max_penetration=physics.max_penetration,
+        friction_use=physics.friction_use,
+        joint_limit_steps=physics.joint_limit_steps,
     )
     return row
 

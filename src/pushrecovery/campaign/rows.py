@@ -90,7 +90,8 @@ _PLANAR: tuple[Column, ...] = (
            "steps the surfaces predict: 0 for ankle and hip, N for step, -1 for fall"),
     Column("predicted_recovers", "bool", "-",
            "the predicted strategy is within the controller's (ankle < hip < step)"),
-    Column("outcome", "string", "-", "recovered, fell, undecided, or error"),
+    Column("outcome", "string", "-",
+           "recovered, fell, undecided, slipped (at rest, a loaded foot slid), or error"),
     Column("used", "string", "-",
            "strategy the run used: ankle (CoP only), hip (hip torque), step, fall or error"),
     Column("steps", "int64", "-", "steps taken"),
@@ -118,6 +119,16 @@ _PLANAR: tuple[Column, ...] = (
     Column("peak_torque_ratio", "float64", "-",
            f"largest |motor command| / its limit (3-D); {_NULL_PLANAR}"),
     Column("failed_ticks", "int64", "-", f"ticks the QP did not solve (3-D); {_NULL_PLANAR}"),
+    Column("foot_slip", "float64", "m",
+           f"largest slip of a foot carrying >= 10% of m g (3-D); {_NULL_PLANAR}"),
+    Column("peak_ground_force", "float64", "-",
+           f"largest vertical floor force / (m g) in one physics step (3-D); {_NULL_PLANAR}"),
+    Column("max_penetration", "float64", "m",
+           f"deepest floor contact (3-D); {_NULL_PLANAR}"),
+    Column("friction_use", "float64", "-",
+           f"largest |f_t| / (mu f_n) of a loaded floor contact, 1: sliding (3-D); {_NULL_PLANAR}"),
+    Column("joint_limit_steps", "int64", "-",
+           f"physics steps with a joint on its range limit (3-D); {_NULL_PLANAR}"),
 )  # fmt: skip
 
 #: How the 3-D models read the columns whose meaning differs (the others read as planar).
@@ -170,7 +181,9 @@ ERROR_OUTCOME: Mapping[str, Any] = {
 #: What a 3-D error row adds to :data:`ERROR_OUTCOME`.
 ERROR_OUTCOME_3D: Mapping[str, Any] = {
     "lift_offs": 0, "peak_hip_motor_torque": math.nan, "max_torso_tilt": math.nan,
-    "peak_torque_ratio": math.nan, "failed_ticks": 0,
+    "peak_torque_ratio": math.nan, "failed_ticks": 0, "foot_slip": math.nan,
+    "peak_ground_force": math.nan, "max_penetration": math.nan, "friction_use": math.nan,
+    "joint_limit_steps": 0,
 }  # fmt: skip
 
 #: Units of the sweepable body parameters (``param_<name>`` columns; ``BodyParams``).

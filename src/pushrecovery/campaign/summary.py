@@ -115,7 +115,7 @@ class SummaryTally:
     def __init__(self, spec: CampaignSpec) -> None:
         self.spec = spec
         self.total = self.judged = self.agree = 0
-        self.outcomes = dict.fromkeys(("recovered", "fell", "undecided", "error"), 0)
+        self.outcomes = dict.fromkeys(("recovered", "fell", "undecided", "slipped", "error"), 0)
         self.predicted = dict.fromkeys(LABELS, 0)
         self.used = dict.fromkeys(LABELS, 0)
         self.counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)

@@ -250,6 +250,7 @@ class CampaignRun:
             f"{summary['pushes']} pushes ({result.ran} of {result.spec.batches} batches run "
             f"now): {outcomes['recovered']} recovered, {outcomes['fell']} fell, "
             f"{outcomes['undecided']} undecided"
+            + (f", {outcomes['slipped']} slipped" if outcomes.get("slipped") else "")
             + (f", {outcomes['error']} without an outcome" if outcomes.get("error") else "")
             + "; prediction accuracy "
             + ("n/a" if summary["accuracy"] is None else f"{summary['accuracy']:.3f}")

@@ -110,6 +110,14 @@ def humanoid() -> None:
     help="The whole-body controller may step (docs/humanoid3d_stepping.md).",
 )
 @click.option(
+    "--slip-limit",
+    type=float,
+    default=0.01,
+    show_default=True,
+    help="Largest slip of a loaded foot [m] of a run that counts as recovered; more is "
+    "'slipped' (docs/physical_checks.md).",
+)
+@click.option(
     "--render",
     type=click.Path(dir_okay=False),
     default=None,
@@ -143,6 +151,7 @@ def simulate(
     impulse: float,
     duration: float,
     stepping: bool,
+    slip_limit: float,
     render: str | None,
     view_azimuth: float | None,
     view_elevation: float | None,
@@ -154,9 +163,11 @@ def simulate(
 
     The body starts standing still on both feet; the push is --impulse [N s] at the torso
     along --azimuth, and the run goes on for --duration (it stops early once the body falls or
-    has stood still). Prints the outcome (recovered, fell or undecided: not at rest yet), the
-    strategy used (ankle, hip or step) and the steps, the ground plane's predicted strategy
-    for the push, the peak torques [N m] and the torso's largest tilt [rad]. The body flags
+    has stood still). Prints the outcome (recovered; slipped: at rest, but a loaded foot slid
+    more than --slip-limit; fell; or undecided: not at rest yet), the strategy used (ankle,
+    hip or step) and the steps, the ground plane's predicted strategy for the push, the peak
+    torques [N m], the torso's largest tilt [rad] and the physical checks (foot slip, peak
+    ground force, penetration, friction and torque use, joint limits). The body flags
     (--preset, --params, --mass, ...) build biped3d; g1 has the robot's own body and refuses
     them.
     """
@@ -170,7 +181,10 @@ def simulate(
         from pushrecovery.sim.mujoco.render import require_offscreen_gl
 
         require_offscreen_gl()  # fail before the run, not after it
-    emit(simulate_3d(model, body, impulse, azimuth, duration, render, pictures, stepping), as_json)
+    run = simulate_3d(
+        model, body, impulse, azimuth, duration, render, pictures, stepping, slip_limit
+    )
+    emit(run, as_json)
 
 
 @humanoid.command(

@@ -179,6 +179,7 @@ def simulate_3d(
     render: str | None = None,
     pictures: dict[str, Any] | None = None,
     stepping: bool = False,
+    slip_limit: float = 0.01,
 ) -> dict[str, Any]:
     """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON).
 
@@ -198,11 +199,14 @@ def simulate_3d(
         The camera and frame times of ``render`` (:func:`render_options`).
     stepping : bool
         Whether the controller may step (``wbc_for(plant, stepping=True)``).
+    slip_limit : float
+        Largest loaded-foot slip of a recovered run [m] (more: ``slipped``).
 
     Returns
     -------
     dict
-        The run's JSON (a public contract: keys, order and values).
+        The run's JSON (a public contract: keys, order and values); ``physics`` is the run's
+        :class:`~pushrecovery.sim.physical_checks.PhysicalChecks`.
     """
     import numpy as np
 
@@ -222,7 +226,9 @@ def simulate_3d(
     predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
     plant = make_plant3d(model, params)
     wbc = wbc_for(plant, stepping=stepping)
-    run = run_push3d(plant, wbc, push, duration=duration, record=bool(render))
+    run = run_push3d(
+        plant, wbc, push, duration=duration, record=bool(render), slip_limit=slip_limit
+    )
     extras = run.extras
     assert extras is not None  # a pushed run's
     states = run.states[pushed_rows(run)]
@@ -263,6 +269,7 @@ def simulate_3d(
         "max_torso_tilt": extras.max_torso_tilt,
         "failed_ticks": extras.failed_ticks,
         "hip_task": plant.hip_task,
+        "physics": run.physics.to_dict() if run.physics is not None else None,
     } | (_render_3d(plant, run, render, pictures or {}) if render else {})
 
 
@@ -310,4 +317,5 @@ def critical_3d(
         "backend": "mujoco",
         "strategy": found.strategy,
         "hip_task": plant.hip_task,
+        "foot_slip": found.foot_slip,
     }

@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import finite_float, non_negative_float
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.push import Push3D
 from pushrecovery.surfaces.classify import Strategy
 
@@ -20,6 +21,7 @@ __all__ = [
     "Push3DExtras",
     "SimulationResult",
     "is_falling",
+    "judge",
     "strategy_used",
 ]
 
@@ -35,6 +37,9 @@ class Outcome(StrEnum):
     RECOVERED = "recovered"
     FELL = "fell"
     UNDECIDED = "undecided"
+    #: Came to rest, but a loaded foot slid (or a torque passed its limit): not a recovery
+    #: (:mod:`pushrecovery.sim.physical_checks`).
+    SLIPPED = "slipped"
 
 
 def is_falling(x: float, xdot: float, lower: float, upper: float) -> bool:
@@ -135,7 +140,8 @@ class SimulationResult:
         CoP [m] and hip (flywheel) torque [N m] applied over each control period; on the
         ground plane CoP x, y, pitch and roll torques.
     outcome : Outcome
-        ``recovered``, ``fell`` or ``undecided`` (neither within the duration).
+        ``recovered``, ``fell``, ``undecided`` (neither within the duration) or ``slipped``
+        (at rest, but the physical checks failed: :func:`judge`).
     model, controller : str
         Registry names of the plant and the controller.
     stop_impacts : int
@@ -150,6 +156,9 @@ class SimulationResult:
         When the outcome was decided [s] (None: undecided).
     extras : Push3DExtras or None
         A 3-D humanoid's pushed run: the push, its peaks, steps and recorded frames.
+    physics : PhysicalChecks or None
+        A MuJoCo run's physical checks (loaded-foot slip, ground force, penetration, friction
+        and torque use, joint limits); None for the analytic models.
     """
 
     time: NDArray[np.float64]
@@ -164,6 +173,7 @@ class SimulationResult:
     state_labels: tuple[str, ...] = ()
     decided_time: float | None = None
     extras: Push3DExtras | None = None
+    physics: PhysicalChecks | None = None
 
     @property
     def cops(self) -> NDArray[np.float64]:
@@ -211,20 +221,30 @@ class SimulationResult:
         order = [key for key in _FIRST_KEYS if key in values]
         order += [key for key in labels if key not in order]
         final_state = {key: values[key] for key in order}
-        return {
-            "recovered": self.recovered,
-            "outcome": self.outcome.value,
-            "model": self.model,
-            "controller": self.controller,
-            "duration": float(self.time[-1]),
-            "final_state": final_state,
-            # simulate() always runs at least one control tick, so cops is never empty.
-            "peak_cop": {"min": float(self.cops.min()), "max": float(self.cops.max())},
-            "max_excursion": float(np.abs(self.states[:, 0]).max()),
-            "peak_torque": float(np.abs(self.torques).max()),
-            "stop_impacts": self.stop_impacts,
-            "footholds": list(self.footholds),
-        } | ({"footholds_xy": [list(p) for p in self.footholds_xy]} if self.footholds_xy else {})
+        xy: dict[str, object] = (
+            {"footholds_xy": [list(p) for p in self.footholds_xy]} if self.footholds_xy else {}
+        )
+        physics: dict[str, object] = (
+            {} if self.physics is None else {"physics": self.physics.to_dict()}
+        )
+        return (
+            {
+                "recovered": self.recovered,
+                "outcome": self.outcome.value,
+                "model": self.model,
+                "controller": self.controller,
+                "duration": float(self.time[-1]),
+                "final_state": final_state,
+                # simulate() always runs at least one control tick, so cops is never empty.
+                "peak_cop": {"min": float(self.cops.min()), "max": float(self.cops.max())},
+                "max_excursion": float(np.abs(self.states[:, 0]).max()),
+                "peak_torque": float(np.abs(self.torques).max()),
+                "stop_impacts": self.stop_impacts,
+                "footholds": list(self.footholds),
+            }
+            | xy
+            | physics
+        )
 
 
 def strategy_used(steps: int, peak_hip_torque: float) -> Strategy:
@@ -246,3 +266,15 @@ def strategy_used(steps: int, peak_hip_torque: float) -> Strategy:
     if peak_hip_torque > HIP_TORQUE_THRESHOLD:
         return Strategy.HIP
     return Strategy.ANKLE
+
+
+def judge(outcome: Outcome, checks: PhysicalChecks | None) -> Outcome:
+    """Return ``outcome``, or ``slipped`` for a recovered run whose checks it violated.
+
+    A run that came to rest while a loaded foot slid farther than the checks' ``slip_limit``,
+    or with a torque above its limit, did not recover as the model claims it would: it is
+    ``slipped`` (a fall or an undecided run stays what it is).
+    """
+    if outcome is Outcome.RECOVERED and checks is not None and checks.violations():
+        return Outcome.SLIPPED
+    return outcome

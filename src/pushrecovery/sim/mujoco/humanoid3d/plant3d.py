@@ -74,6 +74,7 @@ from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import RunRows, Step
+from pushrecovery.sim.mujoco.contact_audit import ContactAudit
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
 from pushrecovery.sim.push import Push, Push3D
@@ -171,6 +172,10 @@ class Humanoid3DPlant:
         # A scheduled push: its body, force [N] and the physics steps it still acts.
         self._push_body, self._push_force, self._push_steps = -1, np.zeros(3), 0
         self._upright_id = body_id(model, upright)
+        #: The physical checks of the run since reset/begin (every physics step).
+        gravity = float(np.linalg.norm(model.opt.gravity))
+        weight = float(np.sum(model.body_mass)) * gravity
+        self.audit = ContactAudit(model, self.data, feet, self.qpos, weight)
         self._times: list[float] = []
         self._states: list[FloatArray] = []
         self._inputs: list[tuple[float, ...]] = []
@@ -255,6 +260,7 @@ class Humanoid3DPlant:
         """Start the rows at the current state (no push yet)."""
         self._times, self._states, self._inputs = [], [], []
         self.frames, self.push_row, self.max_torso_tilt = [], None, 0.0
+        self.audit.reset()
         self._add_row()
 
     def _add_row(self) -> None:
@@ -370,9 +376,12 @@ class Humanoid3DPlant:
         if pushing:
             self._pushed_steps(steps)
         else:
+            audit = self.audit.after_step
             mujoco.mj_step2(model, data)
+            audit()
             for _ in range(steps - 1):
                 mujoco.mj_step(model, data)
+                audit()
         mujoco.mj_step1(model, data)
         self.state = self._read()
         self.info = info
@@ -399,6 +408,7 @@ class Humanoid3DPlant:
                     mujoco.mj_step2(model, data)
                 else:
                     mujoco.mj_step(model, data)
+                self.audit.after_step()
         finally:
             applied[:] = 0.0
 

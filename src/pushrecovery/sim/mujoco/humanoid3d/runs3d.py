@@ -31,8 +31,9 @@ from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     Humanoid3DPlant,
     wbc_for,
 )
+from pushrecovery.sim.physical_checks import DEFAULT_SLIP_LIMIT
 from pushrecovery.sim.push import Push3D
-from pushrecovery.sim.result import Outcome, Push3DExtras, SimulationResult
+from pushrecovery.sim.result import Outcome, Push3DExtras, SimulationResult, judge
 from pushrecovery.sim.simulate import MAX_DURATION, RestCriterion, simulate
 
 FloatArray = NDArray[np.float64]
@@ -75,6 +76,7 @@ def run_push3d(
     rest_duration: float = 0.5,
     record: bool = False,
     observers: Sequence[Observer] = (),
+    slip_limit: float = DEFAULT_SLIP_LIMIT,
 ) -> SimulationResult:
     """Stand, push, and run the whole-body controller until a decision (module docstring).
 
@@ -103,11 +105,15 @@ def run_push3d(
         Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (the extras'), for rendering.
     observers : sequence of Observer
         Also see every control tick (e.g. a :class:`WbcTrace`); not a held push's own steps.
+    slip_limit : float
+        Largest loaded-foot slip of a run that may count as recovered [m], in [1e-6, 1].
 
     Returns
     -------
     SimulationResult
-        The run, its ``extras`` a :class:`~pushrecovery.sim.result.Push3DExtras`.
+        The run, its ``extras`` a :class:`~pushrecovery.sim.result.Push3DExtras`, its
+        ``physics`` the plant's :class:`~pushrecovery.sim.physical_checks.PhysicalChecks` of
+        the run (a run at rest that slid is ``slipped``, not ``recovered``).
     """
     require_type("plant", plant, Humanoid3DPlant)
     require_type("controller", controller, WholeBodyController)
@@ -116,6 +122,7 @@ def run_push3d(
     duration = bounded_float("duration", duration, 1e-3, MAX_DURATION - push_time, "s")
     rest_speed = bounded_float("rest_speed", rest_speed, 1e-6, 10.0, "m/s")
     rest_duration = bounded_float("rest_duration", rest_duration, 0.0, 60.0, "s")
+    plant.audit.slip_limit = bounded_float("slip_limit", slip_limit, 1e-6, 1.0, "m")
     plant.recording = bool(record)
     ticks = round(push_time / CONTROL_PERIOD) + max(1, round(duration / CONTROL_PERIOD))
     figures = _ControllerFigures(controller, plant, round(push_time / CONTROL_PERIOD))
@@ -152,7 +159,8 @@ def run_push3d(
         qvel=None if frames is None else frames[:, nq : nq + nv],
         ctrl=None if frames is None else frames[:, nq + nv :],
     )
-    return replace(result, extras=extras)
+    physics = plant.audit.result()
+    return replace(result, extras=extras, physics=physics, outcome=judge(result.outcome, physics))
 
 
 class WbcTrace:
@@ -274,12 +282,17 @@ class CriticalPush3D:
         Runs made.
     strategy : str
         The strategy of the run at ``impulse``.
+    foot_slip : float
+        The largest loaded-foot slip of the run at ``impulse`` [m] (0 when no run stood): a
+        run that slid stands for the bisection (it did not fall) but is ``slipped``, not
+        ``recovered`` (:mod:`pushrecovery.sim.physical_checks`).
     """
 
     impulse: float
     bracket: tuple[float, float]
     simulations: int
     strategy: str
+    foot_slip: float = 0.0
 
 
 def critical_push3d(
@@ -304,17 +317,16 @@ def critical_push3d(
     tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
     Push3D(0.0, azimuth, body)  # checks azimuth and body
 
-    runs = 0
+    slips: dict[float, float] = {}
 
     def recovers(impulse: float) -> tuple[bool, str]:
-        nonlocal runs
-        runs += 1
         run = run_push3d(plant, wbc_for(plant), Push3D(impulse, azimuth, body),
                          duration=duration)  # fmt: skip
+        slips[impulse] = 0.0 if run.physics is None else run.physics.foot_slip
         return run.outcome is not Outcome.FELL, run.strategy_used().value
 
     low, bracket, strategy = bisect_critical(recovers, 0.0, 0.25 * plant.params.mass, tolerance)
-    return CriticalPush3D(low, bracket, runs, strategy)
+    return CriticalPush3D(low, bracket, len(slips), strategy, slips.get(low, 0.0))
 
 
 def bisect_critical(
