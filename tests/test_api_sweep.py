@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 import pushrecovery
+from pushrecovery.sim.result import Outcome
 from pushrecovery import load_params
 from pushrecovery.analysis.base_polygon import FootModel, base_from_params
 from pushrecovery.analysis.c3d import write_c3d
@@ -174,6 +175,8 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         "cop_margin": 0.0, "push_duration": 0.01
     },
     "pushrecovery.sim.critical.find_critical_velocity": {"direction": "forward"},
+    "pushrecovery.sim.physical_checks.joint_group": {"name": "left_knee_joint"},
+    "pushrecovery.sim.result.judge": {"outcome": Outcome.RECOVERED, "checks": None},
     # Posturography: 10 s of CoP (ap, ml) [m] at 100 Hz (the spectrum needs >= 1 / 0.15 Hz).
     **{f"pushrecovery.analysis.posturography.{name}": {
         "cop": 0.01 * np.column_stack([np.sin(np.arange(1000) / 20), np.cos(np.arange(1000) / 13)]),

@@ -19,10 +19,11 @@ SIMULATE_KEYS = [
     "peak_torque", "stop_impacts", "initial_state", "predicted", "after_push", "backend",
     "azimuth", "impulse", "push_body", "delta_velocity", "steps", "stepping", "strategy",
     "peak_hip_torque", "peak_hip_motor_torque", "max_torso_tilt", "failed_ticks", "hip_task",
+    "physics",
 ]  # fmt: skip
 CRITICAL_KEYS = [
     "velocity", "impulse", "bracket", "impulse_bracket", "simulations", "model", "controller",
-    "x", "azimuth", "backend", "strategy", "hip_task",
+    "x", "azimuth", "backend", "strategy", "hip_task", "foot_slip",
 ]  # fmt: skip
 
 

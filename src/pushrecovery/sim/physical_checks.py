@@ -39,6 +39,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from pushrecovery.arguments import require_type
+
 __all__ = [
     "DEFAULT_SLIP_LIMIT",
     "JOINT_GROUPS",
@@ -68,7 +70,14 @@ _OVER = 1e-9
 
 
 def joint_group(name: str) -> str:
-    """Return the joint group (:data:`JOINT_GROUPS`) of an actuator called ``name``."""
+    """Return the joint group (:data:`JOINT_GROUPS`) of an actuator called ``name``.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``name`` is not a str.
+    """
+    require_type("name", name, str)
     lowered = name.lower()
     for group, words in JOINT_GROUPS:
         if any(word in lowered for word in words):

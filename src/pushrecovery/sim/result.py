@@ -9,7 +9,7 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, non_negative_float
+from pushrecovery.arguments import finite_float, non_negative_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.push import Push3D
@@ -274,7 +274,15 @@ def judge(outcome: Outcome, checks: PhysicalChecks | None) -> Outcome:
     A run that came to rest while a loaded foot slid farther than the checks' ``slip_limit``,
     or with a torque above its limit, did not recover as the model claims it would: it is
     ``slipped`` (a fall or an undecided run stays what it is).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``outcome`` is not an Outcome or ``checks`` neither PhysicalChecks nor None.
     """
+    require_type("outcome", outcome, Outcome)
+    if checks is not None:
+        require_type("checks", checks, PhysicalChecks)
     if outcome is Outcome.RECOVERED and checks is not None and checks.violations():
         return Outcome.SLIPPED
     return outcome

@@ -39,8 +39,9 @@ class ContactAudit:
     feet : sequence of str
         The foot bodies; a geom of a foot's subtree belongs to the foot.
     qpos : float array
-        A pose with the soles flat on the floor (the standing posture), in MuJoCo's units: the
-        sole points are found there.
+        A pose with the soles flat on the floor (the standing posture), where the sole points
+        are found: [m] for slide and free-joint positions, [-] for the free joint's unit
+        quaternion, [rad] for hinges.
     weight : float
         The body weight m g [N], > 0.
     slip_limit : float
