@@ -24,7 +24,6 @@ import numpy as np
 import pytest
 
 import pushrecovery
-from pushrecovery.sim.result import Outcome
 from pushrecovery import load_params
 from pushrecovery.analysis.base_polygon import FootModel, base_from_params
 from pushrecovery.analysis.c3d import write_c3d

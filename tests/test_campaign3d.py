@@ -131,7 +131,12 @@ def test_cli_validate_on_the_biped3d(capsys, tmp_path):
     # the side, bisected to 20 % of the corrected prediction: below the plain 2-D prediction
     # (docs/validation3d.md: −14 %), above the bracket's widest miss
     assert 0.6 * critical["predicted"] < critical["measured"] < critical["predicted"]
-    assert sum(map(sum, data["confusion"]["counts"])) == 1
+    found = data["confusion"]
+    apart = found["apart"]
+    assert sum(map(sum, found["counts"])) + sum(map(sum, apart.values())) == 1
+    # 1 s is too short to come to rest: the run is undecided, and no agreement is claimed.
+    assert apart["undecided"] == [1, 0, 0, 0] and found["judged"] == 0
+    assert found["accuracy"] is None
     assert (tmp_path / "validation3d_biped3d.png").exists()
     assert (tmp_path / "confusion_biped3d" / "confusion3d.csv").exists()
 

@@ -69,26 +69,31 @@ def test_rows_to_matrix_causes_and_accuracy():
         row("hip", "step"),  # the hip law fell short, a step saved it
         row("step", "fall", outcome="fell", lift_offs=1),  # stepped, fell
         row("step", "fall", outcome="fell"),  # never lifted a foot
-        row("ankle", "ankle", outcome="undecided"),  # still moving: used = fall
+        row("ankle", "ankle", outcome="undecided"),  # still moving: used = undecided
         row("hip", "fall", outcome="fell", ratio=1.0, failed=FAILED_TICKS),  # saturated
         row("step", "fall", outcome="fell", lift_offs=1, ratio=1.0, failed=FAILED_TICKS - 1),
         row("ankle", "ankle", outcome="error"),  # no outcome: left out
+        row("step", "step", outcome="slipped"),  # at rest on feet that slid: used = slipped
     ]
     result = confusion_from_rows(rows, "biped3d")
-    assert len(result.pushes) == 9 and result.errors == 1
+    assert len(result.pushes) == 10 and result.errors == 1
     assert [p.cause for p in result.pushes] == [
         "agree", "torso lever", "lesser sufficed", "hip shortfall", "step failed", "no step",
-        "undecided", "saturation", "step failed",
+        "undecided", "saturation", "step failed", "slipped",
     ]  # fmt: skip
-    assert result.pushes[6].used == "fall"
+    assert result.pushes[6].used == "undecided" and result.pushes[9].used == "slipped"
     counts = result.counts
-    assert counts[LABELS.index("ankle"), LABELS.index("fall")] == 1
+    assert counts.sum() == 8  # the runs that recovered or fell
+    assert counts[LABELS.index("ankle"), LABELS.index("fall")] == 0
     assert counts[LABELS.index("step"), LABELS.index("fall")] == 3
+    assert result.apart() == {"undecided": [1, 0, 0, 0], "slipped": [0, 0, 1, 0]}
+    # The undecided run is left out; the slipped one did not recover: it disagrees.
+    assert result.judged == 9
     assert result.accuracy == pytest.approx(1 / 9)
     # against the corrected verdict the second row agrees as well
     assert result.accuracy_corrected == pytest.approx(2 / 9)
     causes = result.causes()
-    assert set(causes) == set(CAUSES) and sum(causes.values()) == 9 and causes["agree"] == 1
+    assert set(causes) == set(CAUSES) and sum(causes.values()) == 10 and causes["agree"] == 1
 
 
 def test_write_tables(tmp_path):
@@ -97,17 +102,23 @@ def test_write_tables(tmp_path):
     table = pq.read_table(parquet)
     assert table.num_rows == 2 and table.column("cause").to_pylist() == ["agree", "hip shortfall"]
     assert csv.read_text().splitlines()[0].startswith('"azimuth"')
-    assert "| ankle | 1 | 0 | 0 | 0 |" in result.to_markdown()
+    assert "| ankle | 1 | 0 | 0 | 0 | 0 | 0 |" in result.to_markdown()
+    assert "| predicted \\ used | ankle | hip | step | fall | undecided | slipped |" in (
+        result.to_markdown()
+    )
 
 
 def test_figure_annotates_the_counts():
     from pushrecovery.plots.confusion3d import confusion3d_figure
 
     rows = [row("ankle", "ankle", azimuth=a) for a in (0.0, 90.0)] + [row("hip", "step")]
+    rows.append(row("hip", "hip", outcome="undecided"))
     fig = confusion3d_figure(confusion_from_rows(rows, "biped3d"))
     matrix = fig.axes[0]
     texts = [t.get_text() for t in matrix.texts]
-    assert len(texts) == 16 and texts[0] == "2" and texts[LABELS.index("hip") * 4 + 2] == "1"
+    # 4 rows x (4 used + undecided + slipped), row by row.
+    assert len(texts) == 24 and texts[0] == "2" and texts[LABELS.index("hip") * 6 + 2] == "1"
+    assert texts[LABELS.index("hip") * 6 + 4] == "1"  # the undecided column
 
 
 @pytest.mark.parametrize(

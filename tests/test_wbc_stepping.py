@@ -131,7 +131,7 @@ def direction_runs(params, plant):
         heading = math.radians(azimuth)
         impulse = OUTSIDE * params.mass * params.omega * polygon.ray_distance(0.0, 0.0, heading)
         for stepping in (False, True):
-            runs[azimuth, stepping] = push(plant, impulse, heading, duration=1.9,
+            runs[azimuth, stepping] = push(plant, impulse, heading, duration=2.2,
                                            stepping=stepping)  # fmt: skip
     return runs
 

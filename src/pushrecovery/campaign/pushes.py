@@ -20,7 +20,13 @@ from typing import Any
 
 from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.pushes3d import error_row3d, run_push3d
-from pushrecovery.campaign.rows import COLUMNS, COLUMNS_3D, ERROR_OUTCOME, verdict_columns
+from pushrecovery.campaign.rows import (
+    COLUMNS,
+    COLUMNS_3D,
+    ERROR_OUTCOME,
+    used_label,
+    verdict_columns,
+)
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.many import COMPILED, LOOP_UP_TO, PushRuns, run_many
@@ -79,7 +85,7 @@ class _Simulated:
     """What a run gives a row (either loop: one push, or the compiled batch)."""
 
     outcome: Outcome
-    used: Strategy
+    used: str  # a Strategy's value, or the outcome of a run that is neither recovered nor fell
     steps: int
     peak_hip_torque: float
     cop_min: float
@@ -130,7 +136,7 @@ def _row(
     row = _inputs_and_prediction(spec, push, found or _predictions([push])[0])
     row.update(
         outcome=run.outcome.value,
-        used=run.used.value,
+        used=run.used,
         steps=run.steps,
         peak_hip_torque=run.peak_hip_torque,
         peak_ankle_torque=push.params.weight * peak_cop if math.isfinite(peak_cop) else 0.0,
@@ -171,7 +177,7 @@ def _rows_of_runs(spec: CampaignSpec, pushes: list[Push], runs: PushRuns) -> lis
             rows.append(error_row(spec, push, error))
             continue
         outcome = runs.outcomes[k]
-        used = strategy_used(steps[k], peaks[k]) if outcome is Outcome.RECOVERED else Strategy.FALL
+        used = used_label(outcome, strategy_used(steps[k], peaks[k]))
         run = _Simulated(outcome, used, steps[k], peaks[k], lows[k], highs[k], times[k], impacts[k])
         rows.append(_row(spec, push, run, predictions[k]))
     return rows

@@ -17,12 +17,11 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery.campaign.rows import ERROR_OUTCOME, ERROR_OUTCOME_3D, verdict_columns
+from pushrecovery.campaign.rows import ERROR_OUTCOME, ERROR_OUTCOME_3D, used_label, verdict_columns
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.campaign.spec3d import critical_impulse, predict_push, push_geometry
 from pushrecovery.errors import SimulationDiverged
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.strategy import Strategy
 
 __all__ = ["PUSH_TIME", "error_row3d", "predict3d", "run_push3d"]
 
@@ -88,7 +87,7 @@ def run_push3d(
     stepper = controller.stepper
     row.update(
         outcome=run.outcome.value,
-        used=run.strategy_used().value if run.recovered else Strategy.FALL.value,
+        used=used_label(run.outcome, run.strategy_used()),
         steps=extras.steps,
         peak_hip_torque=extras.peak_hip_torque,
         peak_ankle_torque=math.nan,

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal, cast
 
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.result import Outcome
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
 if TYPE_CHECKING:
@@ -39,6 +40,7 @@ __all__ = [
     "Family",
     "columns",
     "row_schema",
+    "used_label",
     "verdict_columns",
 ]
 
@@ -93,7 +95,8 @@ _PLANAR: tuple[Column, ...] = (
     Column("outcome", "string", "-",
            "recovered, fell, undecided, slipped (at rest, a loaded foot slid), or error"),
     Column("used", "string", "-",
-           "strategy the run used: ankle (CoP only), hip (hip torque), step, fall or error"),
+           "strategy the run used: ankle (CoP only), hip (hip torque), step, fall, error, or the "
+           "outcome of a run neither recovered nor fallen (undecided, slipped)"),
     Column("steps", "int64", "-", "steps taken"),
     Column("peak_hip_torque", "float64", "N m", "largest |hip torque| applied"),
     Column("peak_ankle_torque", "float64", "N m",
@@ -142,7 +145,7 @@ _READ_3D: Mapping[str, tuple[str, str]] = {
     "cmp_margin": ("m", "signed distance of the capture point inside the CMP region"),
     "step_margin": ("m", "the plane's signed step margin (> 0: captured)"),
     "used": ("-", "step if a step landed, hip if m g |delta| passed 1 N m, else ankle; "
-                  "fall, error"),
+                  "fall, error, undecided, slipped"),
     "steps": ("-", "steps that landed"),
     "peak_hip_torque": ("N m", "the hip law's largest m g |delta|"),
     "peak_ankle_torque": ("N m", "NaN (the whole-body controller's CoP is not recorded)"),
@@ -195,6 +198,17 @@ PARAM_UNITS: Mapping[str, str] = {
     "flywheel_angle_max_roll": "rad", "min_step_time": "s", "max_steps": "-",
     "min_step_width": "m", "ankle_torque_max": "N m", "friction": "-",
 }  # fmt: skip
+
+
+def used_label(outcome: Outcome, strategy: Strategy) -> str:
+    """Return a row's ``used``: the strategy of a recovered run, ``fall``, or the outcome.
+
+    A run that neither recovered nor fell (``undecided``: not at rest yet; ``slipped``: at
+    rest, but a loaded foot slid) is labelled by its outcome: it is not a fall.
+    """
+    if outcome is Outcome.RECOVERED:
+        return strategy.value
+    return Strategy.FALL.value if outcome is Outcome.FELL else outcome.value
 
 
 def _family(family: str) -> Family:

@@ -27,10 +27,12 @@ from pushrecovery.campaign.spec import CampaignSpec
 from pushrecovery.sim.critical import predicted_critical_velocity
 from pushrecovery.sim.validation import LABELS as VALIDATION_LABELS
 
-__all__ = ["LABELS", "SummaryTally", "boundary", "summarize"]
+__all__ = ["APART", "LABELS", "SummaryTally", "boundary", "summarize"]
 
 #: Rows and columns of the confusion matrix: the strategies, escalating (as ``validate``'s).
 LABELS = VALIDATION_LABELS
+#: Outcomes counted in columns of their own beside the matrix: neither a strategy nor a fall.
+APART = ("undecided", "slipped")
 
 
 def _clean(value: float) -> float | None:
@@ -117,8 +119,9 @@ class SummaryTally:
         self.total = self.judged = self.agree = 0
         self.outcomes = dict.fromkeys(("recovered", "fell", "undecided", "slipped", "error"), 0)
         self.predicted = dict.fromkeys(LABELS, 0)
-        self.used = dict.fromkeys(LABELS, 0)
+        self.used = dict.fromkeys((*LABELS, *APART), 0)
         self.counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)
+        self.apart = {name: np.zeros(len(LABELS), dtype=np.int64) for name in APART}
         self.steps_predicted: dict[int, int] = defaultdict(int)
         self.steps_taken: dict[int, int] = defaultdict(int)
         self.stepping = self.exact = 0
@@ -136,17 +139,25 @@ class SummaryTally:
         # A push without an outcome (its physics diverged, its worker died) is counted apart
         # and left out of the confusion matrix, the accuracy and the critical pushes.
         decided = outcome != "error"
-        for p, u in zip(predicted[decided], used[decided], strict=True):
+        undecided = outcome == "undecided"
+        apart = undecided | (outcome == "slipped")
+        for p, u in zip(predicted[decided & ~apart], used[decided & ~apart], strict=True):
             self.counts[LABELS.index(p), LABELS.index(u)] += 1
+        for name, counts in self.apart.items():
+            for p in predicted[outcome == name]:
+                counts[LABELS.index(p)] += 1
         recovered = outcome == "recovered"
+        judged = decided & ~undecided
         self.total += len(outcome)
-        self.judged += int(np.sum(decided))
-        self.agree += int(np.sum((columns["predicted_recovers"] == recovered) & decided))
+        self.judged += int(np.sum(judged))
+        self.agree += int(np.sum((columns["predicted_recovers"] == recovered) & judged))
         for name in self.outcomes:
             self.outcomes[name] += int(np.sum(outcome == name))
         for name in LABELS:
             self.predicted[name] += int(np.sum(predicted == name))
-            self.used[name] += int(np.sum(used == name))
+            self.used[name] += int(np.sum((used == name) & ~apart))
+        for name in APART:  # tables written before these runs had their own `used`
+            self.used[name] += int(np.sum(outcome == name))
         self._add_steps(columns, recovered)
         if self.spec.samples is None:
             part = {name: columns[name] for name in self.boundary_names}
@@ -185,9 +196,11 @@ class SummaryTally:
                 "rows": "predicted",
                 "columns": "used",
                 "counts": self.counts.tolist(),
+                "apart": {name: counts.tolist() for name, counts in self.apart.items()},
             },
             "boundary": found,
             "steps": self._steps(),
+            "judged": self.judged,
         }
 
     def _steps(self) -> dict[str, Any]:

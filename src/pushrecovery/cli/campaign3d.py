@@ -105,6 +105,7 @@ def echo_causes(result: Any) -> None:
         f"corrected for the push's height (rows), agreement {result.accuracy_corrected:.3f}:",
         LABELS,
         result.counts_corrected.tolist(),
+        result.apart(corrected=True),
     )
     causes = {k: v for k, v in result.causes().items() if v and k != "agree"}
     click.echo(

@@ -257,7 +257,10 @@ class CampaignRun:
         )
         confusion = summary["confusion"]
         echo_confusion(
-            "confusion (rows predicted, columns used):", confusion["labels"], confusion["counts"]
+            "confusion (rows predicted, columns used):",
+            confusion["labels"],
+            confusion["counts"],
+            confusion.get("apart"),
         )
         for echo in more:
             echo()

@@ -460,16 +460,22 @@ def _echo_validation(data: dict[str, Any]) -> None:
         )
     if "confusion" in data:
         found = data["confusion"]
+
+        def agreement(value: float | None) -> str:
+            return "n/a (every run undecided)" if value is None else f"{value:.3f}"
+
         echo_confusion(
-            f"confusion (rows predicted, columns used), agreement {found['accuracy']:.3f}",
+            f"confusion (rows predicted, columns used), agreement {agreement(found['accuracy'])}",
             found["labels"],
             found["counts"],
+            found.get("apart"),
         )
         echo_confusion(
             f"against the verdict corrected for the push's height, agreement "
-            f"{found['accuracy_corrected']:.3f}",
+            f"{agreement(found['accuracy_corrected'])}",
             found["labels"],
             found["counts_corrected"],
+            found.get("apart_corrected"),
         )
         causes = ", ".join(f"{k} {v}" for k, v in found["causes"].items() if v and k != "agree")
         click.echo(f"where they differ: {causes or 'nowhere'}")

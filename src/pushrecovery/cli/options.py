@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import click
@@ -232,12 +232,25 @@ def emit(data: dict[str, Any], as_json: bool) -> None:
         click.echo(line)
 
 
-def echo_confusion(title: str, labels: Sequence[str], counts: Sequence[Sequence[int]]) -> None:
-    """Print a confusion matrix under ``title``: one row and one column per label."""
+def echo_confusion(
+    title: str,
+    labels: Sequence[str],
+    counts: Sequence[Sequence[int]],
+    apart: Mapping[str, Sequence[int]] | None = None,
+) -> None:
+    """Print a confusion matrix under ``title``: one row and one column per label.
+
+    ``apart``: columns of their own after a bar (the runs neither recovered nor fallen, per
+    row), e.g. ``{"undecided": [...], "slipped": [...]}``.
+    """
+    apart = apart or {}
     click.echo(title)
-    click.echo(" " * 10 + "".join(f"{label:>7}" for label in labels))
-    for label, row in zip(labels, counts, strict=True):
-        click.echo(f"{label:<10}" + "".join(f"{count:>7}" for count in row))
+    bar = " |" if apart else ""
+    header = "".join(f"{label:>7}" for label in labels) + bar
+    click.echo(" " * 10 + header + "".join(f"{name:>10}" for name in apart))
+    for i, (label, row) in enumerate(zip(labels, counts, strict=True)):
+        extra = "".join(f"{column[i]:>10}" for column in apart.values())
+        click.echo(f"{label:<10}" + "".join(f"{count:>7}" for count in row) + bar + extra)
 
 
 def _table(data: dict[str, Any], indent: str = "") -> list[str]:

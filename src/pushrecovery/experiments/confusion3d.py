@@ -23,12 +23,14 @@ from numpy.typing import NDArray
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
+    "APART",
     "CAUSES",
     "DEFAULT_AZIMUTHS",
     "DEFAULT_FRACTIONS",
     "FAILED_TICKS",
     "LABELS",
     "SATURATED",
+    "USED",
     "Confusion3D",
     "ConfusionPush",
     "classify_cause",
@@ -38,6 +40,10 @@ __all__ = [
 
 #: Rows (predicted) and columns (used) of the matrix, escalating.
 LABELS: tuple[str, ...] = ("ankle", "hip", "step", "fall")
+#: Runs neither recovered nor fallen, in columns of their own beside the matrix.
+APART: tuple[str, ...] = ("undecided", "slipped")
+#: Every value of a push's ``used``: a strategy, a fall, or apart.
+USED: tuple[str, ...] = LABELS + APART
 #: The grid of the documented matrix: every 30°, and fractions of the ankle's critical push.
 DEFAULT_AZIMUTHS: tuple[float, ...] = tuple(float(a) for a in range(0, 360, 30))
 DEFAULT_FRACTIONS: tuple[float, ...] = (0.5, 0.9, 1.1, 1.5, 2.0)
@@ -54,7 +60,9 @@ CAUSES: Mapping[str, str] = {
     "× (1 + d/z₀)",
     "lesser sufficed": "recovered with a lesser strategy than predicted (the prediction is "
     "conservative there)",
-    "undecided": "the run neither came to rest nor fell within its duration (counted as fall)",
+    "undecided": "the run neither came to rest nor fell within its duration (a column apart)",
+    "slipped": "the run came to rest, but a loaded foot slid more than the slip limit (a "
+    "column apart: docs/physical_checks.md)",
     "hip shortfall": "predicted hip (plain or corrected), the hip law did not recover it: it "
     "stepped or fell (the hip law's band is narrower than the CMP region)",
     "step failed": "predicted step, a step was begun but the body did not come to rest",
@@ -78,9 +86,10 @@ class ConfusionPush:
     impulse : float
         J [N s].
     predicted, predicted_corrected, used : str
-        Labels of :data:`LABELS`: predicted, predicted for the push's height, used.
+        Labels of :data:`LABELS`: predicted, predicted for the push's height; used, of
+        :data:`USED` (a run undecided or slipped is labelled so).
     outcome : str
-        recovered, fell or undecided.
+        recovered, fell, undecided or slipped.
     steps, lift_offs : int
         Steps that landed, steps begun.
     peak_torque_ratio : float
@@ -102,10 +111,11 @@ class ConfusionPush:
     failed_ticks: int
 
     def __post_init__(self) -> None:
-        for name in ("predicted", "predicted_corrected", "used"):
-            if getattr(self, name) not in LABELS:
+        for name, allowed in (("predicted", LABELS), ("predicted_corrected", LABELS),
+                              ("used", USED)):  # fmt: skip
+            if getattr(self, name) not in allowed:
                 raise InvalidParameterError(
-                    f"{name} must be one of {list(LABELS)}, got {getattr(self, name)!r}"
+                    f"{name} must be one of {list(allowed)}, got {getattr(self, name)!r}"
                 )
 
     @property
@@ -126,9 +136,10 @@ def classify_cause(push: ConfusionPush) -> str:
     """Return the key of :data:`CAUSES` for ``push``, tried in this order.
 
     1. ``agree``: used = predicted.
-    2. ``lesser sufficed``: it recovered with a strategy below the predicted one.
-    3. ``torso lever``: used = the corrected verdict.
-    4. ``undecided``: the run neither came to rest nor fell.
+    2. ``undecided``, ``slipped``: the run neither came to rest nor fell, or came to rest on
+       feet that slid.
+    3. ``lesser sufficed``: it recovered with a strategy below the predicted one.
+    4. ``torso lever``: used = the corrected verdict.
     5. ``saturation``: it fell, a motor at :data:`SATURATED` of its limit and DAQP failed on
        at least :data:`FAILED_TICKS` ticks.
     6. ``hip shortfall``: the plain or corrected verdict is hip, the run stepped or fell.
@@ -139,12 +150,12 @@ def classify_cause(push: ConfusionPush) -> str:
     predicted, corrected, used = push.predicted, push.predicted_corrected, push.used
     if used == predicted:
         return "agree"
+    if used in APART:
+        return used
     if used != "fall" and _rank(used) < _rank(predicted):
         return "lesser sufficed"
     if used == corrected:
         return "torso lever"
-    if push.outcome == "undecided":
-        return "undecided"
     saturated = push.peak_torque_ratio >= SATURATED and push.failed_ticks >= FAILED_TICKS
     if used == "fall" and saturated:
         return "saturation"
@@ -198,26 +209,43 @@ class Confusion3D:
 
     @property
     def counts(self) -> NDArray[np.int64]:
-        """Predicted (rows) × used (columns), :data:`LABELS`."""
-        return confusion_counts([p.predicted for p in self.pushes], [p.used for p in self.pushes])
+        """Predicted (rows) × used (columns), :data:`LABELS`: the runs that recovered or fell."""
+        decided = [p for p in self.pushes if p.used in LABELS]
+        return confusion_counts([p.predicted for p in decided], [p.used for p in decided])
 
     @property
     def counts_corrected(self) -> NDArray[np.int64]:
         """The same with the verdict corrected for the push's height as rows."""
-        return confusion_counts(
-            [p.predicted_corrected for p in self.pushes], [p.used for p in self.pushes]
-        )
+        decided = [p for p in self.pushes if p.used in LABELS]
+        return confusion_counts([p.predicted_corrected for p in decided], [p.used for p in decided])
+
+    def apart(self, *, corrected: bool = False) -> dict[str, list[int]]:
+        """Return the runs of each :data:`APART` outcome per predicted (or corrected) row."""
+        found = {name: [0] * len(LABELS) for name in APART}
+        for p in self.pushes:
+            if p.used in found:
+                found[p.used][_rank(p.predicted_corrected if corrected else p.predicted)] += 1
+        return found
+
+    @property
+    def judged(self) -> int:
+        """Pushes with a decided outcome: every push but the undecided ones."""
+        return sum(1 for p in self.pushes if p.used != "undecided")
 
     @property
     def accuracy(self) -> float:
-        """Share of pushes whose used strategy is the predicted one (NaN without pushes)."""
-        total = len(self.pushes)
+        """Share of the judged pushes whose used strategy is the predicted one (NaN: none).
+
+        A slipped run counts as a disagreement (it did not recover); an undecided one is left
+        out.
+        """
+        total = self.judged
         return float(np.trace(self.counts)) / total if total else float("nan")
 
     @property
     def accuracy_corrected(self) -> float:
         """The same against the corrected verdict."""
-        total = len(self.pushes)
+        total = self.judged
         return float(np.trace(self.counts_corrected)) / total if total else float("nan")
 
     def causes(self) -> dict[str, int]:
@@ -234,10 +262,12 @@ class Confusion3D:
     def to_markdown(self, *, corrected: bool = False) -> str:
         """Return the matrix as a markdown table (rows predicted, columns used)."""
         counts = self.counts_corrected if corrected else self.counts
+        apart = self.apart(corrected=corrected)
         name = "predicted (corrected)" if corrected else "predicted"
-        lines = [f"| {name} \\ used | " + " | ".join(LABELS) + " |", "|---" * 5 + "|"]
-        for label, row in zip(LABELS, counts.tolist(), strict=True):
-            lines.append(f"| {label} | " + " | ".join(str(v) for v in row) + " |")
+        lines = [f"| {name} \\ used | " + " | ".join(USED) + " |", "|---" * (len(USED) + 1) + "|"]
+        for i, (label, row) in enumerate(zip(LABELS, counts.tolist(), strict=True)):
+            cells = [*row, *(apart[n][i] for n in APART)]
+            lines.append(f"| {label} | " + " | ".join(str(v) for v in cells) + " |")
         return "\n".join(lines)
 
     def write(self, stem: Path | str) -> tuple[Path, Path]:
@@ -278,7 +308,7 @@ def confusion_from_rows(rows: Iterable[Mapping[str, Any]], model: str) -> Confus
                 f"rows must be a 3-D campaign's: missing {', '.join(missing)}"
             )
         values = {name: row[name] for name in COLUMNS}
-        if values["outcome"] != "recovered":
-            values["used"] = "fall"
+        if values["outcome"] != "recovered":  # tables written before `used` said so too
+            values["used"] = values["outcome"] if values["outcome"] in APART else "fall"
         pushes.append(ConfusionPush(**values))
     return Confusion3D(model, tuple(pushes), errors)

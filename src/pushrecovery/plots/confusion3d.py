@@ -13,7 +13,9 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, cast
 
-from pushrecovery.experiments.confusion3d import LABELS, Confusion3D
+import numpy as np
+
+from pushrecovery.experiments.confusion3d import APART, LABELS, USED, Confusion3D
 from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR
 
 if TYPE_CHECKING:
@@ -23,7 +25,8 @@ if TYPE_CHECKING:
 __all__ = ["USED_COLOURS", "confusion3d_figure"]
 
 #: One colour per used strategy.
-USED_COLOURS = {"ankle": RECOVER_COLOUR, "hip": HIP_COLOUR, "step": "#1565c0", "fall": FALL_COLOUR}
+USED_COLOURS = {"ankle": RECOVER_COLOUR, "hip": HIP_COLOUR, "step": "#1565c0", "fall": FALL_COLOUR,
+                "undecided": "#9e9e9e", "slipped": "#8e24aa"}  # fmt: skip
 
 
 def confusion3d_figure(result: Confusion3D, *, corrected: bool = False) -> Figure:
@@ -37,22 +40,26 @@ def confusion3d_figure(result: Confusion3D, *, corrected: bool = False) -> Figur
     fig = Figure(figsize=(11.0, 5.2))
     grid = fig.add_gridspec(1, 2, width_ratios=(1.0, 1.2))
     ax = fig.add_subplot(grid[0, 0])
-    counts = result.counts_corrected if corrected else result.counts
+    apart = result.apart(corrected=corrected)
+    matrix = result.counts_corrected if corrected else result.counts
+    # The runs neither recovered nor fallen in columns of their own, right of a line.
+    counts = np.column_stack([matrix, *(apart[name] for name in APART)])
     ax.imshow(counts, cmap="Blues")
+    ax.axvline(len(LABELS) - 0.5, color="black", linewidth=1.5)
     peak = max(1, int(counts.max()))
     for i in range(len(LABELS)):
-        for j in range(len(LABELS)):
+        for j in range(len(USED)):
             value = int(counts[i, j])
             ax.text(j, i, str(value), ha="center", va="center",
                     color="white" if value > peak / 2 else "black")  # fmt: skip
-    ax.set_xticks(range(len(LABELS)), LABELS)
+    ax.set_xticks(range(len(USED)), USED, rotation=30)
     ax.set_yticks(range(len(LABELS)), LABELS)
     ax.set_xlabel("used (whole-body controller)")
     ax.set_ylabel("predicted (corrected)" if corrected else "predicted (ground plane)")
     accuracy = result.accuracy_corrected if corrected else result.accuracy
     ax.set_title(f"{result.model}: {len(result.pushes)} pushes, agreement {accuracy:.2f}")
     polar = cast("PolarAxes", fig.add_subplot(grid[0, 1], projection="polar"))
-    for label in LABELS:
+    for label in USED:
         for agree in (True, False):
             picked = [
                 p

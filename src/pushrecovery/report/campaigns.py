@@ -28,10 +28,15 @@ DATA_FILES = ("pushes.parquet", "summary.json", "spec.json")
 
 def _confusion(summary: Mapping[str, Any], ident: str) -> ConfusionMatrix:
     """Predicted strategy (rows) against the strategy used (columns)."""
+    confusion = summary["confusion"]
     return ConfusionMatrix(
-        labels=tuple(summary["confusion"]["labels"]),
-        counts=tuple(tuple(int(c) for c in row) for row in summary["confusion"]["counts"]),
+        labels=tuple(confusion["labels"]),
+        counts=tuple(tuple(int(c) for c in row) for row in confusion["counts"]),
         ident=ident,
+        apart=tuple(
+            (name, tuple(int(c) for c in column))
+            for name, column in confusion.get("apart", {}).items()
+        ),
     )
 
 
@@ -73,7 +78,8 @@ def _column(pushes: Any, name: str) -> np.ndarray:
 
 def _verdict_counts(pushes: Any, ident: str) -> VerdictCounts:
     """Count the surfaces' verdict (recovers or not) against the outcome, by push."""
-    decided = _column(pushes, "outcome") != "error"  # as the accuracy: pushes with an outcome
+    # As the accuracy: pushes with a decided outcome (neither an error nor undecided).
+    decided = ~np.isin(_column(pushes, "outcome"), ("error", "undecided"))
     verdict = _column(pushes, "predicted_recovers").astype(bool)[decided]
     recovered = (_column(pushes, "outcome") == "recovered")[decided]
     return VerdictCounts(
@@ -181,6 +187,7 @@ def campaign_section(ctx: _Context, key: str) -> CampaignSection:
         recovered=int(outcomes["recovered"]),
         fell=int(outcomes["fell"]),
         undecided=int(outcomes["undecided"]),
+        slipped=int(outcomes.get("slipped", 0)),
         errors=int(outcomes.get("error", 0)),
         accuracy=accuracy(summary),
         verdicts=_verdict_counts(result.table, f"verdicts-{key}"),

@@ -61,21 +61,30 @@ class Picture:
 
 @dataclass(frozen=True)
 class ConfusionMatrix:
-    """Predicted strategy (rows) against the strategy used (columns) of a campaign."""
+    """Predicted strategy (rows) against the strategy used (columns) of a campaign.
+
+    ``apart``: columns of their own beside the matrix, per predicted row: the runs neither
+    recovered nor fallen (``undecided``, ``slipped``).
+    """
 
     labels: tuple[str, ...]
     counts: tuple[tuple[int, ...], ...]
     ident: str
+    apart: tuple[tuple[str, tuple[int, ...]], ...] = ()
 
     @property
     def row_totals(self) -> tuple[int, ...]:
-        """Pushes per predicted strategy."""
-        return tuple(sum(row) for row in self.counts)
+        """Pushes per predicted strategy (the columns apart included)."""
+        extra = [column for _, column in self.apart]
+        return tuple(
+            sum(row) + sum(column[i] for column in extra) for i, row in enumerate(self.counts)
+        )
 
     @property
     def column_totals(self) -> tuple[int, ...]:
-        """Pushes per strategy used."""
-        return tuple(sum(column) for column in zip(*self.counts, strict=True))
+        """Pushes per strategy used, then per column apart."""
+        columns = [*zip(*self.counts, strict=True), *(column for _, column in self.apart)]
+        return tuple(sum(column) for column in columns)
 
     @property
     def total(self) -> int:
@@ -226,6 +235,7 @@ class CampaignSection(Section):
     boundary: Table | None  # the grid's critical pushes; None when the grid has no boundary
     irregular: int  # boundary rows that are not monotone
     data_files: tuple[str, ...]  # relative to the page
+    slipped: int = 0  # at rest on feet that slid (3-D): not recovered
 
 
 @dataclass(frozen=True)

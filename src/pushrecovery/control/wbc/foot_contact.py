@@ -1,10 +1,17 @@
-r"""The feet of the whole-body QP: each sole frame and its wrench constraints.
+r"""The feet of the whole-body QP: each sole frame and its contact wrench cone.
 
 A foot's wrench w = (F, T) is the force and moment the floor exerts on it at its *sole frame*
 (the foot body's axes, its origin on the sole plane under the ankle; F_z > 0 pushes the foot
-up). Its linear constraints G w ≤ 0: unilateral contact, the friction pyramid inscribed in
-Coulomb's cone, the CoP inside the sole polygon and the yaw friction (the docstring of
-:mod:`~pushrecovery.control.wbc.qp`, the QP).
+up). Its linear constraints G w ≤ 0 are the **contact wrench cone** (CWC) of the sole polygon
+(:func:`contact_wrench_cone`): exactly the wrenches that point forces at the polygon's vertices,
+each in the friction pyramid inscribed in Coulomb's cone, can sum to. They imply unilateral
+contact, the friction pyramid on F, the CoP inside the polygon, and couple the yaw moment with
+the CoP and the tangential force: a foot loaded on its toe edge cannot take the yaw moment it
+could with its whole sole (Caron, Pham and Nakamura 2015, "Stability of surface contacts for
+humanoid robots: closed-form formulae of the contact wrench cone for rectangular support
+areas", ICRA; here computed for any convex sole). Independent bounds on F, the CoP and T_z, as
+this QP had before, admit wrenches the floor cannot give: MuJoCo then turns the foot about its
+loaded corner (docs/physical_checks.md: the G1 slid 12 cm at 8 N s).
 """
 
 from __future__ import annotations
@@ -22,7 +29,58 @@ from pushrecovery.ground.polygon import convex_hull
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["FootContact", "foot_contact"]
+__all__ = ["FootContact", "contact_wrench_cone", "foot_contact"]
+
+
+def contact_wrench_cone(vertices: FloatArray, mu: float) -> FloatArray:
+    r"""Return G with G w ≤ 0 exactly for the wrenches of a sole polygon's point contacts.
+
+    Span form: every vertex p_i = (x_i, y_i, 0) of the sole polygon (sole frame) carries a
+    force f_i in the friction pyramid, f_i = Σ_j λ_ij d_j, λ ≥ 0, d_j = (±μ, 0, 1), (0, ±μ, 1);
+    the wrench is w = Σ_i (f_i, p_i × f_i) with p × f = (y f_z, −x f_z, x f_y − y f_x). The
+    cone is pointed (F_z > 0 but at w = 0), so its face form is the facets of the convex hull of
+    its 4k generators cut at F_z = 1 (Qhull through scipy): a·(F_x, F_y, T_x, T_y, T_z)/F_z + b
+    ≤ 0 becomes a row (a_1, a_2, b, a_3, a_4, a_5), scaled to unit length; duplicate facets of
+    the triangulation are merged, and −F_z ≤ 0 closes the cone.
+
+    Parameters
+    ----------
+    vertices : float array, shape (k, 2)
+        The sole polygon's vertices in the sole frame [m], k >= 3, with area.
+    mu : float
+        The pyramid's friction coefficient μ [-], > 0: its edges are those of MuJoCo's
+        pyramidal cone of friction μ (:func:`foot_contact` passes the floor's μ/√2, a margin).
+
+    Returns
+    -------
+    float array, shape (r, 6)
+        Rows of G [-, -, -, 1/m, 1/m, 1/m] up to each row's scale.
+
+    Raises
+    ------
+    InvalidParameterError
+        If the vertices are not k >= 3 finite points with area, or mu is not > 0.
+    """
+    from scipy.spatial import ConvexHull, QhullError
+
+    points = np.asarray(vertices, dtype=float)
+    if points.ndim != 2 or points.shape[0] < 3 or points.shape[1] != 2:
+        raise InvalidParameterError(f"vertices must be k >= 3 points (x, y), got {points.shape}")
+    if not np.isfinite(points).all() or not (math.isfinite(mu) and mu > 0.0):
+        raise InvalidParameterError(f"vertices must be finite and mu > 0, got mu={mu!r}")
+    generators = [
+        (fx, fy, y, -x, x * fy - y * fx)
+        for x, y in points
+        for fx, fy in ((mu, 0.0), (-mu, 0.0), (0.0, mu), (0.0, -mu))
+    ]
+    try:
+        equations = ConvexHull(np.array(generators)).equations
+    except QhullError:
+        raise InvalidParameterError("vertices must span a polygon with area") from None
+    rows = equations[:, [0, 1, 5, 2, 3, 4]]
+    rows /= np.linalg.norm(rows, axis=1)[:, None]
+    rows = np.unique(np.round(rows, 12), axis=0)
+    return np.vstack([[0.0, 0.0, -1.0, 0.0, 0.0, 0.0], rows])
 
 
 @dataclass(frozen=True)
@@ -36,37 +94,25 @@ class FootContact:
     origin : float array, shape (3,)
         The sole frame's origin in the foot body's frame [m]: under the body origin, on the
         sole plane.
-    edges : float array, shape (k, 3)
-        Rows (n_x, n_y, d) with n·p ≤ d for a CoP p inside the sole polygon, in the sole frame
-        [-, -, m] (n a unit outward normal).
+    vertices : float array, shape (k, 2)
+        The sole polygon's vertices in the sole frame [m], counter-clockwise.
     mu : float
-        Friction coefficient of the pyramid, μ' = μ/√2 [-].
-    yaw_radius : float
-        Inscribed radius r of the sole polygon about the frame's origin [m] (abs(T_z) ≤ μ' r F_z).
+        Friction coefficient of the pyramid, μ' = μ/√2 [-]: the floor's μ with a margin (the
+        pyramid's edges (±μ', 0, 1), (0, ±μ', 1) lie inside MuJoCo's for μ).
+    cone : float array, shape (r, 6)
+        G of the contact wrench cone, G w ≤ 0 (:func:`contact_wrench_cone`).
     """
 
     name: str
     body: int
     origin: FloatArray
-    edges: FloatArray
+    vertices: FloatArray
     mu: float
-    yaw_radius: float
+    cone: FloatArray
 
     def constraint_rows(self) -> FloatArray:
-        """Return G with G w ≤ 0 for this foot's wrench w = (F, T) [rows, 6].
-
-        Rows: −F_z ≤ 0; ±F_x − μ' F_z ≤ 0; ±F_y − μ' F_z ≤ 0; per edge
-        n_y T_x − n_x T_y − d F_z ≤ 0; ±T_z − μ' r F_z ≤ 0.
-        """
-        mu, rows = self.mu, [[0.0, 0.0, -1.0, 0.0, 0.0, 0.0]]
-        for sign in (1.0, -1.0):
-            rows.append([sign, 0.0, -mu, 0.0, 0.0, 0.0])
-            rows.append([0.0, sign, -mu, 0.0, 0.0, 0.0])
-        for nx, ny, d in self.edges:
-            rows.append([0.0, 0.0, -d, ny, -nx, 0.0])
-        for sign in (1.0, -1.0):
-            rows.append([0.0, 0.0, -mu * self.yaw_radius, 0.0, 0.0, sign])
-        return np.array(rows, dtype=float)
+        """Return G with G w ≤ 0 for this foot's wrench w = (F, T) [rows, 6]: its cone."""
+        return self.cone
 
 
 def foot_contact(model: Any, data: Any, name: str) -> FootContact:
@@ -82,7 +128,7 @@ def foot_contact(model: Any, data: Any, name: str) -> FootContact:
     ------
     InvalidParameterError
         If ``name`` is not a body of ``model`` with colliding geoms, or its sole polygon does
-        not contain the sole frame's origin (the yaw bound needs it inside).
+        not contain the sole frame's origin (the point under the ankle).
     """
     try:
         body = body_id(model, name)
@@ -97,7 +143,6 @@ def foot_contact(model: Any, data: Any, name: str) -> FootContact:
     vertices, following = polygon.vertices, np.roll(polygon.vertices, -1, axis=0)
     direction = following - vertices
     normal = np.column_stack([direction[:, 1], -direction[:, 0]])
-    normal /= np.linalg.norm(normal, axis=1)[:, None]
     offset = np.einsum("ij,ij->i", normal, vertices)
     if np.any(offset <= 0.0):
         raise InvalidParameterError(
@@ -107,12 +152,12 @@ def foot_contact(model: Any, data: Any, name: str) -> FootContact:
         g for g in range(model.ngeom) if int(model.geom_bodyid[g]) != body
         and int(model.geom_conaffinity[g]) & int(model.geom_contype[geoms[0]])
     ]  # fmt: skip
-    mu = max(float(model.geom_friction[g, 0]) for g in geoms + others)
+    mu = max(float(model.geom_friction[g, 0]) for g in geoms + others) / math.sqrt(2.0)
     return FootContact(
         name=name,
         body=body,
         origin=np.array([0.0, 0.0, float(local[:, 2].mean())]),
-        edges=np.column_stack([normal, offset]),
-        mu=mu / math.sqrt(2.0),
-        yaw_radius=float(offset.min()),
+        vertices=np.array(vertices, dtype=float),
+        mu=mu,
+        cone=contact_wrench_cone(vertices, mu),
     )

@@ -10,9 +10,9 @@ al., "TSID"; Wensing & Orin, ICRA 2013)
 
 subject to the floating-base rows of the dynamics M_u q̈ + h_u = J_{c,u}^T w, each foot on the
 floor fixed, J_i q̈ + J̇_i q̇ = −k_c J_i q̇ (:data:`CONTACT_DAMPING` k_c [1/s]; a swinging foot
-has w_i = 0 instead, :meth:`WholeBodyQP.set_contacts`), unilateral contact and a friction
-pyramid abs(F_x), abs(F_y) ≤ μ' F_z (μ' = μ/√2), each foot's CoP (−T_y, T_x)/F_z inside its
-sole polygon, yaw friction abs(T_z) ≤ μ' r F_z and the motor limits; the tasks A_k x = b_k come
+has w_i = 0 instead, :meth:`WholeBodyQP.set_contacts`), each foot's contact wrench cone (the
+wrenches that friction pyramids at its sole's vertices can give, μ' = μ/√2:
+:func:`~.foot_contact.contact_wrench_cone`) and the motor limits; the tasks A_k x = b_k come
 from :mod:`~pushrecovery.control.wbc.controller`. Solved with DAQP, its model kept between
 ticks, first without the motor rows; :mod:`.kernels.wbc` assembles each tick in place and hands
 DAQP its least-distance form. MuJoCo's types appear as ``Any``.
