@@ -93,7 +93,7 @@ def test_run_validation3d_refuses(kwargs, name):
 
 
 def test_table_of_a_synthetic_result():
-    row = ValidationRow(0.0, "ankle", 30.0, 25.0, 27.0, (27.0, 27.5), 6, "ankle")
+    row = ValidationRow(0.0, "ankle", 30.0, 25.0, 27.0, (27.0, 27.5), 6, "ankle", 0.0042, 1.6)
     assert row.relative_error == pytest.approx(-0.1)
     assert row.corrected_error == pytest.approx(0.08)
     result = Validation3D("biped3d", (row,), 72.0, 3.1, (0.0, 0.0), 0.2, 1.0, 0.01, 3.0,
@@ -101,6 +101,7 @@ def test_table_of_a_synthetic_result():
     table = result.to_table().splitlines()
     assert len(table) == 3 and table[2].startswith("| 0 | ankle | 30.0 | 27.0 (fell 27.5) |")
     assert "-10.0 %" in table[2] and "+8.0 %" in table[2]
+    assert table[2].endswith("| ankle | 4.2 | 1.60 |")  # the critical run's slip and force
     assert result.worst_error("ankle") == pytest.approx(0.1)
     with pytest.raises(InvalidParameterError, match="hip"):
         result.worst_error("hip")

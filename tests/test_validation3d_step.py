@@ -56,6 +56,8 @@ def test_measured_step_critical_is_beyond_the_ankle_and_below_the_prediction(par
     assert 1.2 * ankle < measured < predicted_step_critical(params, 90.0)
     assert run.stood and run.steps >= 1 and run.step_length > 0.2
     assert runs <= 12
+    # The run's physical checks travel with it (the landing's strike above m g).
+    assert run.foot_slip >= 0.0 and run.peak_force > 1.0
 
 
 def test_row_errors_and_cause(params):

@@ -135,7 +135,14 @@ def _row(row: Any) -> dict[str, Any]:
         "strategy": row.strategy,
         **_critical(row),
         "strategy_used": row.strategy_used,
+        "foot_slip": _finite(row.foot_slip),
+        "peak_force": _finite(row.peak_force),
     }
+
+
+def _finite(value: float) -> float | None:
+    """Return ``value``, or None where it is NaN (JSON has no NaN)."""
+    return None if math.isnan(value) else value
 
 
 def _step_row(row: Any, step: Any) -> dict[str, Any]:
@@ -147,6 +154,8 @@ def _step_row(row: Any, step: Any) -> dict[str, Any]:
         "step_length": row.step_length,
         "refit": None if math.isnan(row.refit) else row.refit,  # no step landed: JSON null
         "cause": row.cause(step.params),
+        "foot_slip": _finite(row.foot_slip),
+        "peak_force": _finite(row.peak_force),
     }
 
 

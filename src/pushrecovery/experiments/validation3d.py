@@ -12,6 +12,7 @@ numbers.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -67,12 +68,18 @@ class MeasuredCritical:
         Simulations made.
     strategy_used : str
         The strategy of the run at ``impulse`` (``sim.result.strategy_used``).
+    foot_slip : float
+        The run at ``impulse``: its largest loaded-foot slip [m] (NaN: no run stood).
+    peak_force : float
+        The run at ``impulse``: its largest vertical ground force / (m g) [-] (NaN: none).
     """
 
     impulse: float
     bracket: tuple[float, float]
     runs: int
     strategy_used: str
+    foot_slip: float = math.nan
+    peak_force: float = math.nan
 
 
 def measure_critical_impulse(
@@ -122,6 +129,7 @@ def measure_critical_impulse(
     duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
     Push3D(0.0, azimuth)  # checks the azimuth
     runs = 0
+    checks: dict[float, tuple[float, float]] = {}  # impulse -> (foot slip, peak force)
 
     def stands(impulse: float) -> tuple[bool, str]:
         nonlocal runs
@@ -133,13 +141,16 @@ def measure_critical_impulse(
         run = run_push3d(
             plant, wbc_for(plant, hip=hip), Push3D(impulse, azimuth), duration=duration
         )
+        if run.physics is not None:
+            checks[impulse] = (run.physics.foot_slip, run.physics.peak_force_ratio)
         return run.outcome is not Outcome.FELL, run.strategy_used().value
 
     low, bracket, used = bisect_critical(
         stands, 0.8 * guess, min(1.2 * guess, IMPULSE_MAX), rel_tolerance * guess,
         grow=1.3, shrink=0.7,
     )  # fmt: skip
-    return MeasuredCritical(low, bracket, runs, used)
+    slip, peak = checks.get(low, (math.nan, math.nan))
+    return MeasuredCritical(low, bracket, runs, used, slip, peak)
 
 
 @dataclass(frozen=True)
@@ -164,6 +175,10 @@ class ValidationRow(CriticalErrors):
         Simulations of the bisection.
     strategy_used : str
         The strategy of the run at ``measured``.
+    foot_slip : float
+        That run's largest loaded-foot slip [m] (docs/physical_checks.md; NaN: unknown).
+    peak_force : float
+        That run's largest vertical ground force / (m g) [-] (NaN: unknown).
     """
 
     azimuth: float
@@ -174,6 +189,8 @@ class ValidationRow(CriticalErrors):
     bracket: tuple[float, float]
     runs: int
     strategy_used: str
+    foot_slip: float = math.nan
+    peak_force: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -226,15 +243,16 @@ class Validation3D:
         """Return the rows as a markdown table (impulses [N s], errors in %)."""
         lines = [
             "| azimuth [deg] | strategy | predicted [N s] | measured [N s] | error | "
-            "corrected [N s] | error vs corrected | used |",
-            "|---:|---|---:|---:|---:|---:|---:|---|",
+            "corrected [N s] | error vs corrected | used | foot slip [mm] | peak force [m g] |",
+            "|---:|---|---:|---:|---:|---:|---:|---|---:|---:|",
         ]
         for row in self.rows:
             lines.append(
                 f"| {row.azimuth:g} | {row.strategy} | {row.predicted:.1f} | "
                 f"{row.measured:.1f} (fell {row.bracket[1]:.1f}) | "
                 f"{100 * row.relative_error:+.1f} % | {row.corrected:.1f} | "
-                f"{100 * row.corrected_error:+.1f} % | {row.strategy_used} |"
+                f"{100 * row.corrected_error:+.1f} % | {row.strategy_used} | "
+                f"{1e3 * row.foot_slip:.1f} | {row.peak_force:.2f} |"
             )
         return "\n".join(lines)
 
@@ -344,6 +362,7 @@ def run_validation3d(
                 duration=duration,
             )  # fmt: skip
             rows.append(ValidationRow(angle, strategy, predicted[strategy], guess, found.impulse,
-                                      found.bracket, found.runs, found.strategy_used))  # fmt: skip
+                                      found.bracket, found.runs, found.strategy_used,
+                                      found.foot_slip, found.peak_force))  # fmt: skip
     return Validation3D(model, tuple(rows), body.mass, body.omega, origin, lever,
                         float(plant.standing_height), rel_tolerance, duration, chosen)  # fmt: skip

@@ -107,13 +107,17 @@ def predicted_step_critical(
 class SteppingRun:
     """What one stepping run did: whether it stood, its steps, longest swing [s] and reach [m].
 
-    The reach is the largest distance of a landed ankle from the stance ankle [m].
+    The reach is the largest distance of a landed ankle from the stance ankle [m]; the foot
+    slip [m] and peak vertical ground force [m g] are the run's physical checks
+    (docs/physical_checks.md; NaN: no run).
     """
 
     stood: bool
     steps: int
     swing_time: float
     step_length: float
+    foot_slip: float = math.nan
+    peak_force: float = math.nan
 
 
 def _stepping_run(plant: Humanoid3DPlant, impulse: float, azimuth: float, duration: float,
@@ -150,11 +154,14 @@ def _stepping_run(plant: Humanoid3DPlant, impulse: float, azimuth: float, durati
         reaches.append(float(np.linalg.norm(step.landed - where[other])))
         where[step.foot] = step.landed
     swings = [s.touchdown - s.liftoff for s in landed if s.touchdown is not None]
+    assert run.physics is not None  # run_push3d's
     return SteppingRun(
         stood=not down and outside <= FALL_MARGIN,
         steps=len(stepper.steps),
         swing_time=max(swings, default=0.0),
         step_length=max(reaches, default=0.0),
+        foot_slip=run.physics.foot_slip,
+        peak_force=run.physics.peak_force_ratio,
     )
 
 
@@ -182,6 +189,9 @@ class StepRow(CriticalErrors):
     refit : float
         The corrected prediction with that swing as Δt_s and that step as the reach [N s]
         (nan when no step landed): the simple model given the biped's own step.
+    foot_slip, peak_force : float
+        That run's largest loaded-foot slip [m] and vertical ground force / (m g) [-] (a
+        landing's strike; NaN: unknown).
     """
 
     azimuth: float
@@ -194,6 +204,8 @@ class StepRow(CriticalErrors):
     swing_time: float
     step_length: float
     refit: float = math.nan
+    foot_slip: float = math.nan
+    peak_force: float = math.nan
 
     def cause(self, params: BodyParams) -> str:
         """Name the simple model's assumptions the run broke (module docstring), or ``""``."""
@@ -242,8 +254,9 @@ class StepValidation:
         """Return the rows as a markdown table (impulses [N s], errors in %)."""
         lines = [
             "| azimuth [deg] | predicted [N s] | corrected [N s] | measured [N s] | error | "
-            "error vs corrected | steps | swing [s] | step [m] | refit [N s] | cause |",
-            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|",
+            "error vs corrected | steps | swing [s] | step [m] | refit [N s] | foot slip [mm] | "
+            "peak force [m g] | cause |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|",
         ]
         for row in self.rows:
             lines.append(
@@ -251,7 +264,8 @@ class StepValidation:
                 f"{row.measured:.1f} (fell {row.bracket[1]:.1f}) | "
                 f"{100 * row.relative_error:+.1f} % | {100 * row.corrected_error:+.1f} % | "
                 f"{row.steps} | {row.swing_time:.2f} | {row.step_length:.2f} | "
-                f"{row.refit:.1f} | {row.cause(self.params)} |"
+                f"{row.refit:.1f} | {1e3 * row.foot_slip:.1f} | {row.peak_force:.1f} | "
+                f"{row.cause(self.params)} |"
             )
         return "\n".join(lines)
 
@@ -363,6 +377,7 @@ def run_step_validation(
             refit = factor * predicted_step_critical(own, angle, origin=origin,
                                                      step_time=run.swing_time)  # fmt: skip
         rows.append(StepRow(angle, predicted, factor * predicted, measured, bracket, runs,
-                            run.steps, run.swing_time, run.step_length, refit))  # fmt: skip
+                            run.steps, run.swing_time, run.step_length, refit,
+                            run.foot_slip, run.peak_force))  # fmt: skip
     return StepValidation(params, tuple(rows), origin, lever, height, rel_tolerance, duration,
                           model)  # fmt: skip
