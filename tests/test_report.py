@@ -24,6 +24,7 @@ from pushrecovery.plots.campaign import (
 from pushrecovery.report import SECTIONS, PushGrid, write_report
 from pushrecovery.report.build import build_report
 from pushrecovery.report.data import (
+    BoundsSection,
     CampaignSection,
     FailedSection,
     FiguresSection,
@@ -287,3 +288,44 @@ def test_a_campaign_with_no_outcome_has_no_accuracy(
     skip = ("bounds", "map", "plane", "figures", "sweep", "planar")
     write_report(params, tmp_path, mujoco=False, skip=skip, workers=1, **TINY)
     assert "<strong>Accuracy —</strong>" in (tmp_path / "index.html").read_text()
+
+
+def test_a_section_that_could_not_be_computed_is_named_in_the_verdict(
+    params: BodyParams, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from pushrecovery.report import build
+
+    def broken(ctx: Any) -> Any:
+        raise InvalidParameterError("leg_length must equal com_height here")
+
+    monkeypatch.setitem(build._BUILDERS, "plane", broken)
+    skip = [key for key in SECTIONS if key not in ("bounds", "plane")]
+    report = build_report(params, tmp_path, mujoco=False, skip=skip, workers=1)
+    assert report.verdict.missing == (
+        ("plane", SECTIONS["plane"], "InvalidParameterError: leg_length must equal com_height here"),
+    )
+    html = render_report(report)
+    verdict = html[html.index('<p class="verdict">') : html.index("</p>", html.index('"verdict"'))]
+    assert "Not computed (1 section):" in verdict and '<a href="#plane">' in verdict
+    assert "leg_length must equal com_height here" in verdict
+    # A page whose sections all computed says nothing of the kind.
+    whole = build_report(params, tmp_path, mujoco=False, skip=[*skip, "plane"], workers=1)
+    assert whole.verdict.missing == () and "Not computed" not in render_report(whole)
+
+
+def test_the_step_thresholds_say_how_many_steps(report: tuple[Report, Path, list[str]]) -> None:
+    # One step, the paper's single step and max_steps steps are three different pushes: each
+    # row says which it is (the N-step limit once stood in a row labelled one step, Sec. IV).
+    data, _, _ = report
+    section = data.section("bounds")
+    assert isinstance(section, BoundsSection)
+    rows = {row[0]: row for row in section.bounds.rows}
+    th = bounds_data(load_params())["thresholds"]
+    n = load_params().max_steps
+    assert float(rows["one-step threshold"][2]) == pytest.approx(th["steps"]["1"][1], rel=1e-5)
+    assert float(rows["Sec. IV single-step threshold"][2]) == pytest.approx(
+        th["step_sec4"][1], rel=1e-5
+    )
+    assert float(rows[f"{n}-step threshold"][2]) == pytest.approx(th["step"][1], rel=1e-5)
+    units = {row[0]: row[2] for row in section.parameters.rows}
+    assert all(units.values()), [name for name, unit in units.items() if not unit]

@@ -18,6 +18,7 @@ __all__ = [
     "LIMITS",
     "OMEGA_MAX",
     "OMEGA_MIN",
+    "UNITS",
     "BodyParams",
     "default_max_steps",
 ]
@@ -42,6 +43,15 @@ LIMITS: dict[str, tuple[float, float, str]] = {
     "flywheel_angle_max": (1e-3, math.pi, "rad"),
     "leg_length": (1e-2, 10.0, "m"),
 }
+#: The unit of every field of :class:`BodyParams` (``foot_polygon``: its vertices).
+UNITS: dict[str, str] = {
+    "mass": "kg", "com_height": "m", "gravity": "m/s^2", "heel": "m", "toe": "m",
+    "flywheel_inertia": "kg m^2", "torque_max": "N m", "flywheel_angle_max": "rad",
+    "leg_length": "m", "max_step_length": "m", "foot_width": "m", "stance_width": "m",
+    "foot_polygon": "m", "flywheel_inertia_roll": "kg m^2", "torque_max_roll": "N m",
+    "flywheel_angle_max_roll": "rad", "min_step_time": "s", "max_steps": "-",
+    "min_step_width": "m", "ankle_torque_max": "N m", "friction": "-",
+}  # fmt: skip
 #: sqrt(g/L) over the bodies :data:`LIMITS` admits [1/s]: 0.1 to 100 (for functions that take
 #: ω itself rather than a body).
 OMEGA_MIN = math.sqrt(LIMITS["gravity"][0] / LIMITS["com_height"][1])

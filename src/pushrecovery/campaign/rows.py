@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal, cast
 
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import UNITS
 from pushrecovery.sim.result import Outcome
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
@@ -190,14 +191,7 @@ ERROR_OUTCOME_3D: Mapping[str, Any] = {
 }  # fmt: skip
 
 #: Units of the sweepable body parameters (``param_<name>`` columns; ``BodyParams``).
-PARAM_UNITS: Mapping[str, str] = {
-    "mass": "kg", "com_height": "m", "gravity": "m/s^2", "heel": "m", "toe": "m",
-    "flywheel_inertia": "kg m^2", "torque_max": "N m", "flywheel_angle_max": "rad",
-    "leg_length": "m", "max_step_length": "m", "foot_width": "m", "stance_width": "m",
-    "flywheel_inertia_roll": "kg m^2", "torque_max_roll": "N m",
-    "flywheel_angle_max_roll": "rad", "min_step_time": "s", "max_steps": "-",
-    "min_step_width": "m", "ankle_torque_max": "N m", "friction": "-",
-}  # fmt: skip
+PARAM_UNITS: Mapping[str, str] = {k: v for k, v in UNITS.items() if k != "foot_polygon"}
 
 
 def used_label(outcome: Outcome, strategy: Strategy) -> str:

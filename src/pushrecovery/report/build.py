@@ -135,7 +135,14 @@ def build_report(
     )
     return Report(
         size=size,
-        verdict=_verdict(params, ctx),
+        verdict=replace(
+            _verdict(params, ctx),
+            missing=tuple(
+                (key, SECTIONS[key], f"{section.error}: {section.message}")
+                for key, section in sections.items()
+                if isinstance(section, FailedSection)
+            ),
+        ),
         sections=tuple((key, SECTIONS[key], sections[key]) for key in SECTIONS if key in sections),
         notes={key: tuple(texts) for key, texts in ctx.notes.items()},
         footer=Footer(

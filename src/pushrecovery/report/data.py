@@ -305,6 +305,8 @@ class Verdict:
     hip: float  # [m/s], corrected Eq. (15)
     step: float  # [m/s], the N-step verdict
     scores: tuple[tuple[str, float | None, int], ...]  # (section title, accuracy, pushes)
+    #: Sections that could not be computed: (key, title, why), named where the reader looks first.
+    missing: tuple[tuple[str, str, str], ...] = ()
 
 
 @dataclass(frozen=True)

@@ -64,11 +64,26 @@ def _bounds(ctx: _Context) -> BoundsSection:
             "largest push from x = 0, corrected Eq. (15)",
         ],
         [
-            "step threshold",
+            "one-step threshold",
+            num(th["steps"]["1"][0], 6),
+            num(th["steps"]["1"][1], 6),
+            "m/s",
+            "largest push from x = 0 one step recovers (the 1-step capture region)",
+        ],
+        [
+            "Sec. IV single-step threshold",
+            num(th["step_sec4"][0], 6),
+            num(th["step_sec4"][1], 6),
+            "m/s",
+            "the same by the paper's single-step model, Sec. IV (Eq. 21)",
+        ],
+        [
+            f"{ctx.params.max_steps}-step threshold",
             num(th["step"][0], 6),
             num(th["step"][1], 6),
             "m/s",
-            "largest push from x = 0 one step recovers, Sec. IV",
+            f"largest push from x = 0 that {ctx.params.max_steps} steps recover "
+            "(max_steps: the N-step capture regions)",
         ],
     ]
     return BoundsSection(

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import UNITS as PARAMS_UNITS
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR
 from pushrecovery.surfaces.cmp import cmp_region
@@ -40,18 +41,7 @@ STRATEGY_COLOURS: Mapping[str, str] = {
 
 
 #: SI unit of each body parameter, for axis labels.
-UNITS: Mapping[str, str] = {
-    "mass": "kg",
-    "com_height": "m",
-    "gravity": "m/s²",
-    "heel": "m",
-    "toe": "m",
-    "flywheel_inertia": "kg m²",
-    "torque_max": "N m",
-    "flywheel_angle_max": "rad",
-    "leg_length": "m",
-    "max_step_length": "m",
-}
+UNITS: Mapping[str, str] = {name: unit.replace("^2", "²") for name, unit in PARAMS_UNITS.items()}
 
 
 #: At most this many panels (swept values) in an outcome map.

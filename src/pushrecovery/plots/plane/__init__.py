@@ -7,9 +7,8 @@ and roll flywheels' offsets, corrected Eq. 15: hip) and sample states: pushes of
 and speeds from a CoM at rest above the stance's reference point (``support.ankle``), each
 drawn at its capture point ξ = r + ṙ/ω and coloured by
 :func:`~pushrecovery.surfaces.classify.classify_states` (ankle, hip, step, fall). The dashed
-blue curve is the largest push some strategy recovers along each heading: the single-step
-limit (Sec. IV applied along the capture point's excursion), found by bisection on the same
-classifier (it matches :func:`~pushrecovery.surfaces.plane.step_threshold_xy`).
+blue curve is the largest push some strategy recovers along each heading: the limit of
+``max_steps`` steps (the N-step capture regions), found by bisection on the same classifier.
 
 :func:`capture_plane_figure` draws one stance, whole and close to the feet;
 :func:`capture_plane_panels` draws double, left and right support side by side on one scale.

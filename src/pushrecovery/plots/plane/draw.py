@@ -146,7 +146,7 @@ def draw_capture_plane(
         ls="--",
         lw=1.0,
         zorder=3,
-        label="largest push one step recovers (Sec. IV)",
+        label=f"largest push {params.max_steps} steps recover (N-step regions)",
     )
     feet = _feet(support)
     for outline, carries in feet:
