@@ -301,9 +301,8 @@ def test_a_section_that_could_not_be_computed_is_named_in_the_verdict(
     monkeypatch.setitem(build._BUILDERS, "plane", broken)
     skip = [key for key in SECTIONS if key not in ("bounds", "plane")]
     report = build_report(params, tmp_path, mujoco=False, skip=skip, workers=1)
-    assert report.verdict.missing == (
-        ("plane", SECTIONS["plane"], "InvalidParameterError: leg_length must equal com_height here"),
-    )
+    why = "InvalidParameterError: leg_length must equal com_height here"
+    assert report.verdict.missing == (("plane", SECTIONS["plane"], why),)
     html = render_report(report)
     verdict = html[html.index('<p class="verdict">') : html.index("</p>", html.index('"verdict"'))]
     assert "Not computed (1 section):" in verdict and '<a href="#plane">' in verdict
