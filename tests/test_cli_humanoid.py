@@ -23,7 +23,8 @@ SIMULATE_KEYS = [
 ]  # fmt: skip
 CRITICAL_KEYS = [
     "velocity", "impulse", "bracket", "impulse_bracket", "simulations", "model", "controller",
-    "x", "azimuth", "backend", "strategy", "hip_task", "foot_slip",
+    "x", "azimuth", "backend", "strategy", "hip_task", "foot_slip", "predicted",
+    "predicted_corrected", "compared_with", "relative_error", "corrected_error", "stepping",
 ]  # fmt: skip
 
 
@@ -53,6 +54,24 @@ def test_humanoid_critical_push_runs_and_keeps_its_json(capsys) -> None:
     data = json.loads(out)
     assert list(data) == CRITICAL_KEYS
     assert data["azimuth"] == 90.0 and data["impulse"] > 0.0
+    # The prediction it is compared with: the biped3d's own controller has the hip task.
+    assert data["compared_with"] == "hip" and set(data["predicted"]) == {"ankle", "hip", "step"}
+    ratio = data["predicted_corrected"]["hip"] / data["predicted"]["hip"]
+    assert 0.7 < ratio < 1.0  # 1 / (1 + d/z0), the push 0.2 m above the CoM
+    expected = data["impulse"] / data["predicted"]["hip"] - 1.0
+    assert data["relative_error"] == pytest.approx(expected)
+
+
+def test_humanoid_critical_push_measures_the_strategy_asked(capsys) -> None:
+    code, out, err = run_cli(capsys, "humanoid", "critical-push", "--model", "biped3d",
+                             "--azimuth", "0", "--duration", "0.3", "--tolerance", "0.5",
+                             "--strategy", "ankle", "--json")  # fmt: skip
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["compared_with"] == "ankle" and data["hip_task"] is False
+    assert data["stepping"] is False and data["strategy"] == "ankle"
+    code, out, err = run_cli(capsys, "humanoid", "critical-push", "--strategy", "jump")
+    assert code == 2 and "jump" in err
 
 
 def test_humanoid_validate_runs(capsys, tmp_path) -> None:

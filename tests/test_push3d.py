@@ -195,11 +195,11 @@ def test_simulate_with_stepping_steps_where_the_balance_strategies_fall(capsys):
     # recovered, or slipped while its feet slide: tests/test_physical_checks.py).
     args = ("humanoid", "simulate", "--model", "biped3d", "--azimuth", "90", "--push", "50",
             "--duration", "6", "--json")  # fmt: skip
-    code, out, err = run_cli(capsys, *args)
+    code, out, err = run_cli(capsys, *args, "--no-stepping")
     assert code == 0, err
     still = json.loads(out)
     assert still["outcome"] == "fell" and still["steps"] == 0 and still["stepping"] is False
-    code, out, err = run_cli(capsys, *args, "--stepping")
+    code, out, err = run_cli(capsys, *args)  # stepping is the default
     assert code == 0, err
     stepped = json.loads(out)
     assert stepped["outcome"] in ("recovered", "slipped") and stepped["steps"] >= 1

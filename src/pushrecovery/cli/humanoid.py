@@ -104,10 +104,11 @@ def humanoid() -> None:
 )
 @duration_option(10.0, "Longest simulated time [s].")
 @click.option(
-    "--stepping",
-    is_flag=True,
-    default=False,
-    help="The whole-body controller may step (docs/humanoid3d_stepping.md).",
+    "--stepping/--no-stepping",
+    default=True,
+    show_default=True,
+    help="The whole-body controller may step when its ankles and hip cannot hold the push "
+    "(docs/humanoid3d_stepping.md); --no-stepping measures the ankle or hip alone.",
 )
 @click.option(
     "--slip-limit",
@@ -209,23 +210,39 @@ def simulate(
     "Longest simulated time per push [s]; keep it short (every push of the bisection runs the "
     "whole-body controller this long at most).",
 )
+@click.option(
+    "--strategy",
+    type=click.Choice(["ankle", "hip", "step"]),
+    default=None,
+    help="The controller measured: ankle (no hip task), hip (with it), step (stepping, "
+    "reacting during the push); default the model's own without stepping (biped3d: hip, "
+    "g1: ankle).",
+)
 @_body_options
 def critical_push(
-    model: str, azimuth: float, tolerance: float, duration: float, as_json: bool, **kwargs: Any
+    model: str,
+    azimuth: float,
+    tolerance: float,
+    duration: float,
+    strategy: str | None,
+    as_json: bool,
+    **kwargs: Any,
 ) -> None:
     """Largest push at the torso along --azimuth that the whole-body controller recovers.
 
     The impulse is bisected between a run that stands and one that falls within --duration
     (keep it short: every push of the bisection is a run of the whole-body controller), to
     --tolerance times the mass. Prints the critical impulse [N s] and velocity [m/s], their
-    bracket, the number of simulations and the strategy used just below it. The body flags
-    (--preset, --params, --mass, ...) build biped3d; g1 has the robot's own body and refuses
-    them.
+    bracket, the number of simulations, the strategy used just below it and that run's foot
+    slip [m]; then the ground plane's predicted critical impulse of each strategy [N s] (ankle,
+    hip, one step), plain and corrected for the push's height, and the measured push's error
+    against the prediction of the strategy measured. The body flags (--preset, --params,
+    --mass, ...) build biped3d; g1 has the robot's own body and refuses them.
     """
     from pushrecovery.cli.simulation3d import critical_3d, params_3d
 
     params = params_3d(model, kwargs)
-    emit(critical_3d(model, params, azimuth, tolerance, duration), as_json)
+    emit(critical_3d(model, params, azimuth, tolerance, duration, strategy), as_json)
 
 
 @humanoid.command(

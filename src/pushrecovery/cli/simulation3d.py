@@ -211,7 +211,7 @@ def simulate_3d(
     import numpy as np
 
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import STATE_LABELS, wbc_for
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import pushed_rows, run_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import PUSH_TIME, pushed_rows, run_push3d
     from pushrecovery.sim.push import Push3D
     from pushrecovery.sim.registry import make_plant3d
     from pushrecovery.surfaces.classify import classify as classify_state
@@ -232,7 +232,10 @@ def simulate_3d(
     extras = run.extras
     assert extras is not None  # a pushed run's
     states = run.states[pushed_rows(run)]
-    before, after = run.states[extras.push_row - 1], run.states[extras.push_row]
+    # The state as the push began (the row at its start: a scheduled push lasts several rows)
+    # and as its force ended.
+    began = int(np.searchsorted(run.time, PUSH_TIME + 1e-9)) - 1
+    before, after = run.states[began], run.states[extras.push_row]
     return {
         "recovered": run.recovered,
         "outcome": run.outcome.value,
@@ -274,9 +277,14 @@ def simulate_3d(
 
 
 def critical_3d(
-    model: str, params: Any, azimuth: float | None, tolerance: float, duration: float
+    model: str,
+    params: Any,
+    azimuth: float | None,
+    tolerance: float,
+    duration: float,
+    strategy: str | None = None,
 ) -> dict[str, Any]:
-    """Bisect the impulse at ``azimuth`` on a 3-D model (the JSON).
+    """Bisect the impulse at ``azimuth`` on a 3-D model against the predictions (the JSON).
 
     Parameters
     ----------
@@ -288,22 +296,40 @@ def critical_3d(
         The final bracket's width as a velocity [m/s] (times the mass: an impulse).
     duration : float
         Longest simulated time per push [s].
+    strategy : str or None
+        ``ankle`` (the WBC without its hip task), ``hip`` (with it), ``step`` (with stepping,
+        reacting during the push), or None: the model's own controller without stepping
+        (the biped3d's with its hip task, the G1's without).
 
     Returns
     -------
     dict
-        The search's JSON (a public contract: keys, order and values).
+        The search's JSON (a public contract: keys, order and values): the measured critical
+        push, then ``predicted`` and ``predicted_corrected``, the ground plane's critical
+        impulse of each strategy [N s] (ankle and hip: m ω ρ_R(r₀, ψ), step: the one-step
+        region's; corrected: over 1 + d/z₀, the push at the torso's height), ``compared_with``
+        (the strategy measured) and the measured push's ``relative_error`` and
+        ``corrected_error`` against it.
     """
     from pushrecovery.arguments import positive_float
+    from pushrecovery.experiments.validation3d_predict import predicted_critical_impulses
+    from pushrecovery.experiments.validation3d_step import predicted_step_critical
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d
     from pushrecovery.sim.registry import make_plant3d
 
     width = positive_float("tolerance", tolerance, "m/s") * params.mass
+    angle = 0.0 if azimuth is None else azimuth
     plant = make_plant3d(model, params)
+    hip = {"ankle": False, "hip": True}.get(strategy or "")
     found = critical_push3d(
-        plant, 0.0 if azimuth is None else azimuth, tolerance=width, duration=duration
+        plant, angle, tolerance=width, duration=duration, hip=hip, stepping=strategy == "step"
     )
     low, high = found.bracket
+    origin = plant.standing_origin
+    predicted = predicted_critical_impulses(params, angle, origin=origin)
+    predicted["step"] = predicted_step_critical(params, angle, origin=origin)
+    factor = 1.0 / (1.0 + plant.push_lever / plant.standing_height)
+    compared = strategy or ("hip" if plant.hip_task else "ankle")
     return {
         "velocity": found.impulse / params.mass,
         "impulse": found.impulse,
@@ -313,9 +339,16 @@ def critical_3d(
         "model": model,
         "controller": "wbc",
         "x": 0.0,
-        "azimuth": 0.0 if azimuth is None else azimuth,
+        "azimuth": angle,
         "backend": "mujoco",
         "strategy": found.strategy,
-        "hip_task": plant.hip_task,
+        "hip_task": plant.hip_task if hip is None else hip,
         "foot_slip": found.foot_slip,
+        "predicted": predicted,
+        "predicted_corrected": {name: factor * value for name, value in predicted.items()},
+        "compared_with": compared,
+        "relative_error": (found.impulse - predicted[compared]) / predicted[compared],
+        "corrected_error": (found.impulse - factor * predicted[compared])
+        / (factor * predicted[compared]),
+        "stepping": strategy == "step",
     }

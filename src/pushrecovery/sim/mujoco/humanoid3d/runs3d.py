@@ -39,6 +39,7 @@ from pushrecovery.sim.simulate import MAX_DURATION, RestCriterion, simulate
 FloatArray = NDArray[np.float64]
 
 __all__ = [
+    "PUSH_TIME",
     "CriticalPush3D",
     "WbcTrace",
     "bisect_critical",
@@ -46,6 +47,10 @@ __all__ = [
     "pushed_rows",
     "run_push3d",
 ]
+
+
+#: When :func:`run_push3d` pushes, after quiet standing, unless told [s].
+PUSH_TIME = 0.1
 
 
 def pushed_rows(result: SimulationResult) -> NDArray[np.intp]:
@@ -71,7 +76,7 @@ def run_push3d(
     push: Push3D,
     *,
     duration: float = 3.0,
-    push_time: float = 0.1,
+    push_time: float = PUSH_TIME,
     rest_speed: float = 5e-3,
     rest_duration: float = 0.5,
     record: bool = False,
@@ -302,25 +307,30 @@ def critical_push3d(
     tolerance: float = 0.5,
     duration: float = 3.0,
     body: str = "torso",
+    hip: bool | None = None,
+    stepping: bool = False,
 ) -> CriticalPush3D:
     """Bisect the impulse at ``azimuth`` [deg] between a run that stands and one that falls.
 
     The upper end starts at m · 0.25 m/s and doubles while the body recovers (up to the
     push's largest impulse); then the bracket halves until it is at most ``tolerance`` [N s]
-    wide (in (0, 1e3]). Each run is :func:`run_push3d` with the plant's own WBC
-    (:func:`~.plant3d.wbc_for`: the hip task on the biped3d, not on the G1, whose critical
-    pushes it lowers), ``duration`` [s] after the push; a run that has not fallen by then
-    (recovered or still undecided) counts as standing: falls are decided within a second,
-    rest takes seconds.
+    wide (in (0, 1e3]). Each run is :func:`run_push3d` with the plant's WBC
+    (:func:`~.plant3d.wbc_for` with ``hip``, None: the plant's own choice, the hip task on the
+    biped3d, not on the G1, whose critical pushes it lowers; with ``stepping`` the stepping
+    task, reacting during the push, ``Push3D(scheduled=True)``), ``duration`` [s] after the
+    push; a run that has not fallen by then (recovered, slipped or still undecided) counts as
+    standing: falls are decided within a second, rest takes seconds.
     """
     require_type("plant", plant, Humanoid3DPlant)
     tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
     Push3D(0.0, azimuth, body)  # checks azimuth and body
-
+    stepping = bool(stepping)
+    wbc_for(plant, hip=hip, stepping=stepping)  # checks hip before any run
     slips: dict[float, float] = {}
 
     def recovers(impulse: float) -> tuple[bool, str]:
-        run = run_push3d(plant, wbc_for(plant), Push3D(impulse, azimuth, body),
+        run = run_push3d(plant, wbc_for(plant, hip=hip, stepping=stepping),
+                         Push3D(impulse, azimuth, body, scheduled=stepping),
                          duration=duration)  # fmt: skip
         slips[impulse] = 0.0 if run.physics is None else run.physics.foot_slip
         return run.outcome is not Outcome.FELL, run.strategy_used().value
