@@ -21,21 +21,29 @@ MASS = 2.0
 BOX = """<mujoco><option timestep="0.0005" cone="{cone}"/>
 <worldbody><geom name="floor" type="plane" size="5 5 0.1" friction="{mu} 0.005 0.0001"/>
 <body name="box" pos="0 0 {hz}"><freejoint/>
-<geom type="box" size="{hx} {hy} {hz}" mass="2" friction="{mu} 0.005 0.0001"/></body>
+<geom type="box" size="{hx} {hy} {hz}" mass="2" friction="{mu} 0.005 0.0001" condim="{condim}"/>
+</body>
 </worldbody></mujoco>"""
 
 
 def _box(mu: float = 0.5, half: tuple[float, float, float] = (0.1, 0.1, 0.05),
-         cone: str = "pyramidal") -> tuple[object, object, ContactAudit]:  # fmt: skip
+         cone: str = "pyramidal", condim: int = 3) -> tuple[object, object, ContactAudit]:  # fmt: skip
     """A box resting on the floor (settled 1 s) and an audit of it as the one foot."""
     hx, hy, hz = half
-    model = mujoco.MjModel.from_xml_string(BOX.format(mu=mu, hx=hx, hy=hy, hz=hz, cone=cone))
+    xml = BOX.format(mu=mu, hx=hx, hy=hy, hz=hz, cone=cone, condim=condim)
+    model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     audit = ContactAudit(model, data, ["box"], data.qpos.copy(), MASS * GRAVITY)
     mujoco.mj_step(model, data, nstep=2000)
     audit.reset()
     return model, data, audit
+
+
+def _normal(model: object, data: object, index: int) -> float:
+    force = np.zeros(6)
+    mujoco.mj_contactForce(model, data, index, force)
+    return float(force[0])
 
 
 def _run(model: object, data: object, audit: ContactAudit, steps: int) -> None:
@@ -64,13 +72,19 @@ def test_a_sliding_box_slips_the_distance_coulomb_friction_allows(cone: str, spe
     assert checks.violations() == (("slip",) if expected > 0.011 else ())  # 9 or 102 mm
 
 
-def test_a_box_at_rest_carries_its_weight_without_slipping() -> None:
-    model, data, audit = _box()
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+@pytest.mark.parametrize("condim", [1, 3, 4, 6])
+def test_a_box_at_rest_carries_its_weight_without_slipping(cone: str, condim: int) -> None:
+    # Every contact dimension and cone: the forces are decoded from MuJoCo's constraint forces.
+    model, data, audit = _box(cone=cone, condim=condim)
     _run(model, data, audit, 200)
     checks = audit.result()
     assert checks.peak_force_ratio == pytest.approx(1.0, abs=1e-6)
     assert checks.peak_ground_force == pytest.approx(MASS * GRAVITY, rel=1e-6)
     assert checks.foot_slip < 1e-9 and checks.friction_use < 1e-6
+    # MuJoCo's own contact forces carry the weight as the audit's decoding of them does.
+    total = sum(_normal(model, data, i) for i in range(data.ncon))
+    assert total == pytest.approx(MASS * GRAVITY, rel=1e-6)
     assert 0.0 < checks.max_penetration < 1e-3  # soft contacts sink a little
     assert checks.physics_steps == 200 and checks.joint_limit_steps == 0
     assert checks.violations() == ()

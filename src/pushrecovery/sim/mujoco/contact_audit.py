@@ -9,7 +9,6 @@ check).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -17,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, positive_float
+from pushrecovery.kernels.contact_audit import audit_step
 from pushrecovery.sim.physical_checks import (
     DEFAULT_SLIP_LIMIT,
     JOINT_GROUPS,
@@ -73,15 +73,26 @@ class ContactAudit:
         self.slip_limit = bounded_float("slip_limit", slip_limit, 1e-6, 1.0, "m")
         self.feet = tuple(feet)
         foot_ids = [model.body(name).id for name in self.feet]
-        self._foot_ids = foot_ids
+        self._foot_ids = np.array(foot_ids, dtype=np.int64)
         pose = mujoco.MjData(model)
         pose.qpos[:] = qpos
         mujoco.mj_kinematics(model, pose)
-        # Each foot's sole points in its body frame: R^T (c - o) in the standing pose.
-        self._soles = [
+        # Each foot's sole points in its body frame, R^T (c - o) in the standing pose, padded
+        # to the most points of a foot.
+        soles = [
             (sole_points(model, pose, body) - pose.xpos[body]) @ pose.xmat[body].reshape(3, 3)
             for body in foot_ids
         ]
+        most = max(len(sole) for sole in soles)
+        self._soles = np.zeros((len(soles), most, 3))
+        for index, sole in enumerate(soles):
+            self._soles[index, : len(sole)] = sole
+        self._sole_counts = np.array([len(sole) for sole in soles], dtype=np.int64)
+        self._slip = np.zeros((len(soles), most, 2))
+        self._pending = np.zeros((len(soles), most, 2))
+        self._cop = np.zeros((len(soles), 2))
+        self._unloaded = np.zeros(len(soles), dtype=np.int64)
+        self._loads, self._moments = np.zeros(len(soles)), np.zeros((len(soles), 2))
         # Each geom's foot (index into feet) or -1; floor geoms are the world body's.
         owner = np.full(model.nbody, -1, dtype=np.intp)
         for index, body in enumerate(foot_ids):
@@ -90,9 +101,10 @@ class ContactAudit:
             if owner[body] < 0:
                 owner[body] = owner[model.body_parentid[body]]
         bodies = np.asarray(model.geom_bodyid)
-        self._geom_foot = owner[bodies].tolist()
-        self._floor = (bodies == 0).tolist()
+        self._geom_foot = np.ascontiguousarray(owner[bodies], dtype=np.int64)
+        self._floor = np.ascontiguousarray(bodies == 0)
         self._limits = _torque_limits(model)
+        self._torque_use = np.zeros(model.nu)
         groups = [joint_group(model.actuator(i).name) for i in range(model.nu)]
         order = [group for group, _ in JOINT_GROUPS] + ["other"]
         self._groups = [
@@ -101,114 +113,60 @@ class ContactAudit:
             if group in groups
         ]
         self._limit_type = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
-        self._xbody = int(mujoco.mjtObj.mjOBJ_XBODY)
-        self._contact_force = mujoco.mj_contactForce
-        self._object_velocity = mujoco.mj_objectVelocity
-        self._force, self._velocity = np.zeros(6), np.zeros(6)
+        self._pyramidal = int(model.opt.cone) == int(mujoco.mjtCone.mjCONE_PYRAMIDAL)
+        self._roots = np.asarray(model.body_rootid, dtype=np.int64)
+        self._h = float(model.opt.timestep)
+        self._light = 1e-3 * LOAD_FRACTION * self.weight
+        self._threshold = LOAD_FRACTION * self.weight
         self._lift_steps = max(1, round(LIFT_TIME / float(model.opt.timestep)))
         self.reset()
+        # The kernel's arguments after the step's contacts and constraints: MuJoCo's arrays of
+        # fixed size (views of ``data``'s arena, valid while it lives) and the audit's state.
+        self._kernel_arguments = (
+            data.xpos, data.xmat, data.cvel, data.subtree_com, data.actuator_force,
+            self._pyramidal, self._floor, self._geom_foot, self._light, self._threshold,
+            self._lift_steps, self._h, self._foot_ids, self._roots, self._soles,
+            self._sole_counts, self._slip, self._pending, self._unloaded, self._cop,
+            self._loads, self._moments, self._limits, self._torque_use, self._limit_type,
+        )  # fmt: skip
 
     def reset(self) -> None:
         """Start a new run's audit."""
-        count = len(self.feet)
-        # The current loaded interval's displacement of each sole point.
-        self._slip = [np.zeros((len(sole), 2)) for sole in self._soles]
-        self._pending = [np.zeros((len(sole), 2)) for sole in self._soles]
-        self._cop = [(0.0, 0.0)] * count  # each foot's last CoP (world xy) [m]
+        # The current stance interval's travel of each sole point, and a bounce's (pending).
+        self._slip[:] = 0.0
+        self._pending[:] = 0.0
+        self._cop[:] = 0.0  # each foot's last CoP (world xy) [m]
         # Physics steps each foot has carried less than the load threshold (a new interval
         # starts at the next load only after LIFT_TIME of them: a bounce is not a step).
-        self._unloaded = [self._lift_steps] * count
+        self._unloaded[:] = self._lift_steps
         self.foot_slip, self.slip_foot = 0.0, ""
         self.peak_ground_force = self.max_penetration = self.friction_use = 0.0
-        self._torque_use = np.zeros(self.model.nu)
+        self._torque_use[:] = 0.0
         self.joint_limit_steps = self.physics_steps = 0
 
     def after_step(self) -> None:
-        """Audit the physics step MuJoCo just took (its contacts, forces and velocities)."""
-        model, data, force = self.model, self.data, self._force
-        floor, geom_foot = self._floor, self._geom_foot
-        count = len(self.feet)
-        loads = [0.0] * count
-        moments = [[0.0, 0.0] for _ in range(count)]
-        total = 0.0
-        light = 1e-3 * LOAD_FRACTION * self.weight
-        for i in range(data.ncon):
-            contact = data.contact[i]
-            g1, g2 = int(contact.geom1), int(contact.geom2)
-            if floor[g1] == floor[g2]:
-                continue  # not a contact of the body with the floor
-            self._contact_force(model, data, i, force)
-            frame = contact.frame
-            # The force of geom1 on geom2 along the normal (geom1 → geom2): on the body as is
-            # when the floor is geom1, reversed when it is geom2.
-            sign = 1.0 if floor[g1] else -1.0
-            fz = sign * (force[0] * frame[2] + force[1] * frame[5] + force[2] * frame[8])
-            total += fz
-            depth = -float(contact.dist)
-            if depth > self.max_penetration:
-                self.max_penetration = depth
-            if force[0] > light and contact.friction[0] > 0.0:
-                use = math.hypot(force[1], force[2]) / (contact.friction[0] * force[0])
-                if use > self.friction_use:
-                    self.friction_use = use
-            foot = geom_foot[g2 if floor[g1] else g1]
-            if foot >= 0:
-                loads[foot] += fz
-                moments[foot][0] += fz * contact.pos[0]
-                moments[foot][1] += fz * contact.pos[1]
+        """Audit the physics step MuJoCo just took (its contacts, forces and velocities).
+
+        It runs at every physics step: one compiled kernel on MuJoCo's arrays
+        (:func:`~pushrecovery.kernels.contact_audit.audit_step`).
+        """
+        data = self.data
+        contact = data.contact
+        total, depth, use, moved, foot, on_limit = audit_step(
+            contact.geom, contact.dist, contact.frame, contact.pos, contact.friction,
+            contact.efc_address, contact.dim, data.efc_force, data.efc_type, data.nefc,
+            *self._kernel_arguments,
+        )  # fmt: skip
         if total > self.peak_ground_force:
             self.peak_ground_force = total
-        self._slide(loads, moments)
-        np.maximum(self._torque_use, np.abs(data.actuator_force) / self._limits,
-                   out=self._torque_use)  # fmt: skip
-        if data.nefc and np.any(data.efc_type[: data.nefc] == self._limit_type):
-            self.joint_limit_steps += 1
+        if depth > self.max_penetration:
+            self.max_penetration = depth
+        if use > self.friction_use:
+            self.friction_use = use
+        if moved > self.foot_slip:
+            self.foot_slip, self.slip_foot = moved, self.feet[foot]
+        self.joint_limit_steps += on_limit
         self.physics_steps += 1
-
-    def _slide(self, loads: list[float], moments: list[list[float]]) -> None:
-        """Integrate each foot's sole travel over this step (module docstring).
-
-        A foot below the load threshold for less than ``LIFT_TIME`` (a bounce) keeps its
-        interval: its travel meanwhile, about its last CoP, is kept aside and counts once the
-        foot is loaded again (a foot that chatters while it slides); a lift drops it.
-        """
-        threshold = LOAD_FRACTION * self.weight
-        for foot, body in enumerate(self._foot_ids):
-            load = loads[foot]
-            slip, pending = self._slip[foot], self._pending[foot]
-            if load < threshold:
-                self._unloaded[foot] += 1
-                if self._unloaded[foot] < self._lift_steps:
-                    self._travel(body, foot, pending)
-                continue
-            if self._unloaded[foot] >= self._lift_steps:
-                slip[:] = 0.0  # a new stance: its slip counts from here
-            else:
-                slip += pending  # a bounce: the travel while unloaded counts
-            pending[:] = 0.0
-            self._unloaded[foot] = 0
-            self._cop[foot] = (moments[foot][0] / load, moments[foot][1] / load)
-            self._travel(body, foot, slip)
-            moved = float(np.sqrt((slip * slip).sum(axis=1)).max())
-            if moved > self.foot_slip:
-                self.foot_slip, self.slip_foot = moved, self.feet[foot]
-
-    def _travel(self, body: int, foot: int, into: NDArray[np.float64]) -> None:
-        """Add this step's horizontal travel of the foot's sole points to ``into`` [m]."""
-        model, data, velocity = self.model, self.data, self._velocity
-        h = float(model.opt.timestep)
-        cop_x, cop_y = self._cop[foot]
-        self._object_velocity(model, data, self._xbody, body, velocity, 0)
-        origin = data.xpos[body]
-        rx, ry, rz = cop_x - origin[0], cop_y - origin[1], -origin[2]
-        wx, wy, wz = velocity[0], velocity[1], velocity[2]
-        # v_p = v_o + ω × (p − o), horizontal part, p on the floor (z = 0).
-        vx = velocity[3] + wy * rz - wz * ry
-        vy = velocity[4] + wz * rx - wx * rz
-        # The sole points now (world xy) relative to the CoP, turned by ω_z about it.
-        points = origin[:2] + self._soles[foot] @ data.xmat[body].reshape(3, 3)[:2].T
-        into[:, 0] += (vx - wz * (points[:, 1] - cop_y)) * h
-        into[:, 1] += (vy + wz * (points[:, 0] - cop_x)) * h
 
     def result(self) -> PhysicalChecks:
         """Return the checks of the run so far."""
