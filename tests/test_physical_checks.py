@@ -26,8 +26,12 @@ BOX = """<mujoco><option timestep="0.0005" cone="{cone}"/>
 </worldbody></mujoco>"""
 
 
-def _box(mu: float = 0.5, half: tuple[float, float, float] = (0.1, 0.1, 0.05),
-         cone: str = "pyramidal", condim: int = 3) -> tuple[object, object, ContactAudit]:  # fmt: skip
+def _box(
+    mu: float = 0.5,
+    half: tuple[float, float, float] = (0.1, 0.1, 0.05),
+    cone: str = "pyramidal",
+    condim: int = 3,
+) -> tuple[object, object, ContactAudit]:
     """A box resting on the floor (settled 1 s) and an audit of it as the one foot."""
     hx, hy, hz = half
     xml = BOX.format(mu=mu, hx=hx, hy=hy, hz=hz, cone=cone, condim=condim)
