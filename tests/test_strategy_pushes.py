@@ -74,3 +74,13 @@ def test_percentages_are_no_finer_than_their_resolution():
     assert percent_within(-0.0587, 0.005) == "−5.9 % ± 0.5 %"
     assert percent_within(0.01234, 0.0004) == "+1.23 % ± 0.04 %"
     assert percent_within(0.1, None) == "+10.0 %"
+
+
+def test_a_bisected_push_has_an_interval_of_errors():
+    from pushrecovery.report.markup import percent_interval
+
+    # A push bracketed in [10.8, 10.9] N s against 10.3 N s: +4.9 to +5.8 %, not "+4.9 %".
+    assert percent_interval(10.8, 10.9, 10.3) == "+4.9 … +5.8 %"
+    assert percent_interval(27.0, 27.1, 31.5) == "−14.3 … −14.0 %"
+    assert percent_interval(1.0, 2.0, 0.0) == "—"
+    assert percent_interval(-0.45, -0.46, -0.47) == "−4.3 … −2.1 %"  # backward, as magnitudes

@@ -27,7 +27,7 @@ from pushrecovery.experiments.filmstrip3d import STRIP_DURATION, filmstrip_run
 from pushrecovery.report.config import HUMANOID3D_STRIPS
 from pushrecovery.report.context import _Context
 from pushrecovery.report.data import Filmstrip, Humanoid3DSection, Picture, Table
-from pushrecovery.report.markup import num, percent
+from pushrecovery.report.markup import num, percent_interval
 
 __all__ = ["HINT", "humanoid3d_section"]
 
@@ -175,15 +175,18 @@ def _table(result: Any) -> Table:
             num(row.corrected, 3),
             num(row.measured, 3),
             f"[{num(row.bracket[0], 3)}, {num(row.bracket[1], 3)}]",
-            percent(row.relative_error),
-            percent(row.corrected_error),
+            percent_interval(row.bracket[0], row.bracket[1], row.predicted),
+            percent_interval(row.bracket[0], row.bracket[1], row.corrected),
             row.strategy_used,
+            num(1e3 * row.foot_slip, 2),
+            num(row.peak_force, 3),
         )
         for row in result.rows
     )
     header = (
         *("azimuth [deg]", "strategy", "predicted [N s]", "corrected [N s]", "measured [N s]"),
-        *("bracket [N s]", "vs predicted", "vs corrected", "used"),
+        *("bracket [N s]", "vs predicted", "vs corrected", "used", "foot slip [mm]"),
+        "peak ground force [m g]",
     )
     return Table(header, rows, text_columns=2, ident=f"validation3d-{result.model}")
 

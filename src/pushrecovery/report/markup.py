@@ -28,6 +28,19 @@ def percent(value: float | None, digits: int = 1) -> str:
     return f"{100.0 * value:+.{digits}f} %".replace("-", "−")
 
 
+def percent_interval(low: float, high: float, reference: float) -> str:
+    """Format the interval of errors (low/reference − 1, high/reference − 1) as percentages.
+
+    A bisected critical push is known to lie in its bracket [low, high]: its error against a
+    prediction is an interval, ``−14.3 … −13.9 %`` (smaller first; a backward push's negative
+    velocities over a negative reference read as magnitudes); an em dash without a reference.
+    """
+    if not (reference and math.isfinite(reference)):
+        return "—"
+    first, last = sorted((low / reference - 1.0, high / reference - 1.0))
+    return f"{percent(first).removesuffix(' %')} … {percent(last)}"
+
+
 def percent_within(value: float | None, resolution: float | None) -> str:
     """Format a fraction as a percentage no finer than ``resolution`` (a fraction), with it.
 

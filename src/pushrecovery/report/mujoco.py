@@ -6,7 +6,7 @@ from pushrecovery.errors import PushRecoveryError
 from pushrecovery.report.config import FILMSTRIPS
 from pushrecovery.report.context import _Context
 from pushrecovery.report.data import CriticalSection, Filmstrip, FilmstripsSection, Picture, Table
-from pushrecovery.report.markup import num, percent
+from pushrecovery.report.markup import num, percent_interval
 
 
 def _critical(ctx: _Context) -> CriticalSection:
@@ -33,8 +33,8 @@ def _critical(ctx: _Context) -> CriticalSection:
                     num(row.corrected),
                     num(row.measured),
                     f"[{num(row.bracket[0])}, {num(row.bracket[1])}]",
-                    percent(row.relative_error),
-                    percent(row.corrected_error),
+                    percent_interval(row.bracket[0], row.bracket[1], row.predicted),
+                    percent_interval(row.bracket[0], row.bracket[1], row.corrected),
                     str(row.simulations),
                 )
             )
