@@ -9,6 +9,7 @@ is 11-15 % high (docs/validation3d.md, "The critical push from every direction")
 """
 
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -119,6 +120,29 @@ def test_polar_figure_draws_a_synthetic_result():
     assert fig.axes[0].name == "polar"
     assert len(fig.axes[0].get_lines()) >= 2
     assert fig.axes[0].get_title().startswith("biped3d:")
+    # With the dense prediction the lines follow it every 2°, the corrected one scaled by the
+    # rows' own corrected / predicted; not straight lines between the measured azimuths.
+    from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS
+
+    curve = tuple(30.0 + 0.01 * a for a in CURVE_AZIMUTHS)
+    dense = validation3d_figure(replace(result, curves=(("ankle", curve),)))
+    plain, corrected = dense.axes[0].get_lines()[:2]
+    assert len(plain.get_ydata()) == len(CURVE_AZIMUTHS) == 181
+    assert list(plain.get_ydata()) == list(curve)
+    assert corrected.get_ydata()[10] == pytest.approx(curve[10] * 25.0 / 30.0)
+
+
+def test_the_validation_has_the_dense_prediction_of_the_ground_plane():
+    from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS
+    from pushrecovery.experiments.validation3d_predict import predicted_critical_impulses
+
+    params = load_params()
+    result = run_validation3d("biped3d", (0.0,), ("ankle",), rel_tolerance=0.3, duration=0.3)
+    ((name, curve),) = result.curves
+    assert name == "ankle" and len(curve) == len(CURVE_AZIMUTHS)
+    at_45 = predicted_critical_impulses(params, 44.0, origin=result.origin)["ankle"]
+    assert curve[CURVE_AZIMUTHS.index(44.0)] == pytest.approx(at_45)
+    assert result.rows[0].predicted == pytest.approx(curve[0])
 
 
 def test_polar_figure_of_a_step_column_alone_is_titled_by_its_model():

@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
 
 __all__ = [
+    "CURVE_AZIMUTHS",
     "DEFAULT_AZIMUTHS",
     "MODELS",
     "STRATEGIES",
@@ -46,6 +47,9 @@ __all__ = [
 
 #: Push azimuths of the validation [deg]: every 30°.
 DEFAULT_AZIMUTHS: tuple[float, ...] = tuple(float(a) for a in range(0, 360, 30))
+#: Where the prediction is drawn as a curve, every 2° [deg]: the regions' edges are polygons,
+#: whose ray distance is not a straight line between the measured azimuths.
+CURVE_AZIMUTHS: tuple[float, ...] = tuple(float(a) for a in range(0, 361, 2))
 #: Strategies with a 2-D prediction and a WBC that uses only them (no stepping task yet).
 STRATEGIES: tuple[str, ...] = ("ankle", "hip")
 #: The 3-D models (``sim.registry.PLANTS_3D``).
@@ -212,6 +216,12 @@ class Validation3D:
     rel_tolerance, duration : float
         The bisection's width (fraction of the prediction) and each run's time after the push
         [s].
+    strategies : tuple of str
+        The strategies measured.
+    curves : tuple of (str, tuple of float)
+        Per strategy, the predicted critical impulse m ω ρ_R(r₀, ψ) [N s] at every azimuth of
+        :data:`CURVE_AZIMUTHS` (the corrected one is it over 1 + d/z₀); empty for a result
+        made without it.
     """
 
     model: str
@@ -224,6 +234,7 @@ class Validation3D:
     rel_tolerance: float
     duration: float
     strategies: tuple[str, ...] = field(default=STRATEGIES)
+    curves: tuple[tuple[str, tuple[float, ...]], ...] = ()
 
     def rows_for(self, strategy: str) -> tuple[ValidationRow, ...]:
         """Return the rows of ``strategy``, by azimuth."""
@@ -364,5 +375,8 @@ def run_validation3d(
             rows.append(ValidationRow(angle, strategy, predicted[strategy], guess, found.impulse,
                                       found.bracket, found.runs, found.strategy_used,
                                       found.foot_slip, found.peak_force))  # fmt: skip
+    dense = [predicted_critical_impulses(body, angle, origin=origin) for angle in CURVE_AZIMUTHS]
+    curves = tuple((strategy, tuple(p[strategy] for p in dense)) for strategy in chosen)
     return Validation3D(model, tuple(rows), body.mass, body.omega, origin, lever,
-                        float(plant.standing_height), rel_tolerance, duration, chosen)  # fmt: skip
+                        float(plant.standing_height), rel_tolerance, duration, chosen,
+                        curves)  # fmt: skip

@@ -49,7 +49,7 @@ import numpy as np
 
 from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.experiments.validation3d import DEFAULT_AZIMUTHS, MAX_RUNS
+from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS, DEFAULT_AZIMUTHS, MAX_RUNS
 from pushrecovery.experiments.validation3d_predict import CriticalErrors, critical_impulse_along
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
@@ -239,6 +239,9 @@ class StepValidation:
         The bisection's width (fraction of the corrected prediction) and each run's time [s].
     model : str
         The 3-D model measured (``biped3d`` or ``g1``).
+    curve : tuple of float
+        The one-step critical impulse m ω ρ_{C_1}(r₀, ψ) [N s] at every azimuth of
+        ``validation3d.CURVE_AZIMUTHS`` (empty for a result made without it).
     """
 
     params: BodyParams
@@ -249,6 +252,7 @@ class StepValidation:
     rel_tolerance: float
     duration: float
     model: str = "biped3d"
+    curve: tuple[float, ...] = ()
 
     def to_table(self) -> str:
         """Return the rows as a markdown table (impulses [N s], errors in %)."""
@@ -379,5 +383,6 @@ def run_step_validation(
         rows.append(StepRow(angle, predicted, factor * predicted, measured, bracket, runs,
                             run.steps, run.swing_time, run.step_length, refit,
                             run.foot_slip, run.peak_force))  # fmt: skip
+    curve = tuple(predicted_step_critical(params, a, origin=origin) for a in CURVE_AZIMUTHS)
     return StepValidation(params, tuple(rows), origin, lever, height, rel_tolerance, duration,
-                          model)  # fmt: skip
+                          model, curve)  # fmt: skip

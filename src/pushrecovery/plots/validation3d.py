@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any, cast
 
-from pushrecovery.experiments.validation3d import Validation3D
+from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS, Validation3D
 from pushrecovery.experiments.validation3d_step import StepValidation
 from pushrecovery.plots.common import HIP_COLOUR, RECOVER_COLOUR
 
@@ -45,17 +45,30 @@ def validation3d_figure(result: Validation3D | None, step: StepValidation | None
         columns += [(s, list(result.rows_for(s))) for s in result.strategies]
     if step is not None:
         columns.append(("step", list(step.rows)))
+    # The predictions as dense curves (every 2°) where the result has them.
+    curves = dict(result.curves) if result is not None else {}
+    if step is not None and step.curve:
+        curves["step"] = step.curve
+    dense = [math.radians(a) for a in CURVE_AZIMUTHS]
     for strategy, unsorted in columns:
         rows = sorted(unsorted, key=lambda row: row.azimuth % 360.0)
         if not rows:
             continue
         colour = STRATEGY_COLOURS.get(strategy, "0.3")
         angles = [math.radians(row.azimuth) for row in rows]
-        closed = len(rows) > 2
-        loop = (lambda values: [*values, values[0]]) if closed else (lambda values: values)
-        ax.plot(loop(angles), loop([row.predicted for row in rows]), "-", color=colour,
-                label=f"{strategy}: 2-D prediction")  # fmt: skip
-        ax.plot(loop(angles), loop([row.corrected for row in rows]), "--", color=colour,
+        # The measured rows' own ratio corrected / predicted (1 / (1 + d/z0)).
+        factor = rows[0].corrected / rows[0].predicted if rows[0].predicted else 1.0
+        if strategy in curves:
+            line_angles, predicted = dense, list(curves[strategy])
+            corrected = [factor * value for value in predicted]
+        else:  # a result without curves: straight lines between the measured azimuths
+            closed = len(rows) > 2
+            loop = (lambda values: [*values, values[0]]) if closed else (lambda values: values)
+            line_angles = loop(angles)
+            predicted = loop([row.predicted for row in rows])
+            corrected = loop([row.corrected for row in rows])
+        ax.plot(line_angles, predicted, "-", color=colour, label=f"{strategy}: 2-D prediction")
+        ax.plot(line_angles, corrected, "--", color=colour,
                 label=f"{strategy}: corrected (push height)")  # fmt: skip
         ax.errorbar(
             angles,

@@ -155,8 +155,10 @@ def _validation(ctx: _Context, model: str, strategies: tuple[str, ...]) -> Any:
                 ValidationRow(**(row | {"bracket": tuple(row["bracket"])}))
                 for row in cached["rows"]
             )
+            curves = tuple((name, tuple(values)) for name, values in cached.get("curves", ()))
             fields = cached | {"rows": rows, "origin": tuple(cached["origin"]),
-                               "strategies": tuple(cached["strategies"])}  # fmt: skip
+                               "strategies": tuple(cached["strategies"]),
+                               "curves": curves}  # fmt: skip
             ctx.note("humanoid3d", f"Reused the {model} validation in {path.name}.")
             return Validation3D(**fields)
         except (KeyError, TypeError, ValueError):
@@ -200,7 +202,7 @@ def _polar(ctx: _Context, result: Any) -> Picture:
     caption = (
         f"{result.model}: the critical push [N s] at each azimuth (0° forward, 90° left) under "
         "the whole-body controller (markers; bar: up to the push that fell) against the 2-D "
-        f"prediction m ω ρ (solid) and its push-height correction (dashed); bisected to "
+        f"prediction m ω ρ (solid, every 2°) and its push-height correction (dashed); bisected to "
         f"{100 * result.rel_tolerance:g} % of the prediction, {result.duration:g} s per run."
     )
     return Picture(path, caption, "experiments.validation3d.run_validation3d")
