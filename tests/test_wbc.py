@@ -494,3 +494,23 @@ def test_the_torso_error_is_the_rotation_vector_of_r_r0_transposed():
             got = np.zeros(3)
             rotation_vector(rot.ravel(), ref.ravel(), got)
             assert got == pytest.approx(expected, abs=1e-9)
+
+
+@needs_robots
+def test_the_h1_stands_and_recovers_a_forward_push_with_its_contact_wrench_cones():
+    # With independent bounds on force, CoP and yaw moment DAQP found the H1's QP infeasible
+    # from the second tick and it fell unpushed; each foot's contact wrench cone (its
+    # triangular sole: a heel point and a toe bar) makes it stand and take a push.
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
+    from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
+
+    h1 = describe_robot("h1")
+    feet = tuple(h1.model.body(body).name for body in h1.feet)
+    plant = Humanoid3DPlant(h1.params, h1.model, h1.qpos, feet, "torso_link", "torso_link")
+    result, run = push(plant, 0.0, duration=1.9, **WHOLE_RUN)
+    assert result.time[-1] > 1.99 and result.outcome is not Outcome.FELL  # 2 s unpushed
+    assert np.abs(run.pelvis - run.pelvis[0]).max() < 0.01  # settles 5.6 mm (a fall: dm)
+    assert result.physics is not None and result.physics.foot_slip < 3e-3
+    pushed, _ = push(plant, 10.0, duration=3.0)  # forward, 60 % of the corrected ankle limit
+    assert pushed.outcome is Outcome.RECOVERED
+    assert pushed.physics is not None and pushed.physics.foot_slip < 5e-3
