@@ -97,6 +97,9 @@ class ModelChoice(ListedChoice):
         What the ``elsewhere`` models are, for the message (``"a 3-D humanoid"``).
     unlisted : sequence of str, optional
         Models of this family that the command refuses itself (:class:`ListedChoice`).
+    files : bool
+        Whether an MJCF file (a value ending in ``.xml``) is a model too (its path is
+        returned; the command reads it).
     """
 
     def __init__(
@@ -105,10 +108,12 @@ class ModelChoice(ListedChoice):
         elsewhere: Mapping[str, str],
         family: str,
         unlisted: tuple[str, ...] = (),
+        files: bool = False,
     ) -> None:
         super().__init__(choices, unlisted)
         self.elsewhere = dict(elsewhere)
         self.family = family
+        self.files = files
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """Return ``value`` if it is a choice; refuse another family's model by its command."""
@@ -118,6 +123,8 @@ class ModelChoice(ListedChoice):
             raise InvalidParameterError(
                 f"--model {value} is {self.family}: use 'pushrecovery {self.elsewhere[value]}'"
             )
+        if self.files and isinstance(value, str) and value.lower().endswith(".xml"):
+            return value
         return super().convert(value, param, ctx)
 
 

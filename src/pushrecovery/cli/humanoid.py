@@ -38,20 +38,40 @@ _PLANAR = (*MODELS, *MUJOCO_MODELS)
 _PLANAR_OPTIONS = ("--backend", "--controller", "--kp", "--kd", "--option", "--control-period")
 
 
-def _model(command: str) -> Any:
-    """``--model biped3d|g1``; a planar model is refused naming the planar ``command``."""
+def _model(command: str, files: bool = False) -> Any:
+    """``--model biped3d|g1`` (``files``: or an MJCF file); a planar model is refused."""
     if command == "validate":  # the planar validate picks its models by --strategy
         elsewhere = dict.fromkeys(_PLANAR, "validate --strategy ankle|hip|step")
     else:
         elsewhere = {model: f"{command} --model {model}" for model in _PLANAR}
+    mjcf = (
+        ", or your own robot's MJCF file PATH.xml (its own body; name its feet and torso with "
+        "--left-foot-body, --right-foot-body, --torso-body; docs/your_robot.md)"
+        if files
+        else ""
+    )
     return click.option(
         "--model",
-        type=ModelChoice(HUMANOID_MODELS, elsewhere=elsewhere, family="a planar model"),
+        type=ModelChoice(
+            HUMANOID_MODELS, elsewhere=elsewhere, family="a planar model", files=files
+        ),
         default="biped3d",
         show_default=True,
         help="The humanoid: biped3d (built from the body flags) or g1 (the Unitree G1, its own "
-        "body; the robots extra).",
+        f"body; the robots extra){mjcf}.",
     )
+
+
+def _mjcf_options(command: Any) -> Any:
+    """Add the options of ``--model PATH.xml``: its feet, torso and standing keyframe."""
+    for flag, what in (
+        ("--keyframe", "--model PATH.xml: the keyframe of the standing pose (default qpos0)."),
+        ("--torso-body", "--model PATH.xml: the upper body held upright and pushed."),
+        ("--right-foot-body", "--model PATH.xml: the right foot's body."),
+        ("--left-foot-body", "--model PATH.xml: the left foot's body."),
+    ):
+        command = click.option(flag, default=None, metavar="NAME", help=what)(command)
+    return command
 
 
 #: The push's direction of a single run (simulate, critical-push).
@@ -90,7 +110,8 @@ def humanoid() -> None:
     short_help="Push a 3-D humanoid; report recovered or fell.",
     epilog=example("pushrecovery humanoid simulate --azimuth 90 --push 50 --stepping --duration 5"),
 )
-@_model("simulate")
+@_model("simulate", files=True)
+@_mjcf_options
 @planar_only("simulate", *_PLANAR_OPTIONS, "--x", "--xdot", "--y", "--ydot", "--plot")
 @_azimuth
 @click.option(
@@ -172,18 +193,26 @@ def simulate(
     (--preset, --params, --mass, ...) build biped3d; g1 has the robot's own body and refuses
     them.
     """
-    from pushrecovery.cli.simulation3d import check_views, params_3d, render_options, simulate_3d
+    from pushrecovery.cli.simulation3d import (
+        check_views,
+        is_mjcf,
+        mjcf_plant,
+        params_3d,
+        render_options,
+        simulate_3d,
+    )
 
     if not render:
         check_views(view_azimuth, view_elevation, frame_times)
     pictures = render_options(azimuth, view_azimuth, view_elevation, frame_times)
-    body = params_3d(model, kwargs)
+    plant = mjcf_plant(model, kwargs) if is_mjcf(model) else None
+    body = plant.params if plant is not None else params_3d(model, kwargs)
     if render:
         from pushrecovery.sim.mujoco.render import require_offscreen_gl
 
         require_offscreen_gl()  # fail before the run, not after it
     run = simulate_3d(
-        model, body, impulse, azimuth, duration, render, pictures, stepping, slip_limit
+        model, body, impulse, azimuth, duration, render, pictures, stepping, slip_limit, plant
     )
     emit(run, as_json)
 
@@ -195,7 +224,8 @@ def simulate(
         "pushrecovery humanoid critical-push --azimuth 90 --duration 1 --tolerance 0.05"
     ),
 )
-@_model("critical-push")
+@_model("critical-push", files=True)
+@_mjcf_options
 @planar_only("critical-push", *_PLANAR_OPTIONS, "--x", "--direction")
 @_azimuth
 @click.option(
@@ -239,10 +269,11 @@ def critical_push(
     against the prediction of the strategy measured. The body flags (--preset, --params,
     --mass, ...) build biped3d; g1 has the robot's own body and refuses them.
     """
-    from pushrecovery.cli.simulation3d import critical_3d, params_3d
+    from pushrecovery.cli.simulation3d import critical_3d, is_mjcf, mjcf_plant, params_3d
 
-    params = params_3d(model, kwargs)
-    emit(critical_3d(model, params, azimuth, tolerance, duration, strategy), as_json)
+    plant = mjcf_plant(model, kwargs) if is_mjcf(model) else None
+    params = plant.params if plant is not None else params_3d(model, kwargs)
+    emit(critical_3d(model, params, azimuth, tolerance, duration, strategy, plant), as_json)
 
 
 @humanoid.command(

@@ -16,7 +16,43 @@ if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
     from pushrecovery.sim.result import SimulationResult
 
-__all__ = ["check_views", "critical_3d", "params_3d", "render_options", "simulate_3d"]
+__all__ = [
+    "check_views",
+    "critical_3d",
+    "is_mjcf",
+    "mjcf_plant",
+    "params_3d",
+    "render_options",
+    "simulate_3d",
+]
+
+
+def is_mjcf(model: str) -> bool:
+    """Whether ``--model`` names an MJCF file (``*.xml``) rather than a built-in humanoid."""
+    return model.lower().endswith(".xml")
+
+
+def mjcf_plant(model: str, kwargs: dict[str, Any]) -> Any:
+    """Return the plant of ``--model PATH.xml`` from the foot and torso options (popped).
+
+    Raises
+    ------
+    InvalidParameterError
+        If a body flag is given (the model has its own body) or the file, a body or a leg's
+        joints are missing (:func:`~pushrecovery.sim.mujoco.humanoid3d.mjcf.describe_mjcf`).
+    """
+    from pushrecovery.cli.options import PARAM_FLAGS
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant
+
+    given = [flag for flag, field, _ in PARAM_FLAGS if kwargs.get(field) is not None]
+    if given or kwargs.get("params_file") or kwargs.get("preset", "paper") != "paper":
+        raise InvalidParameterError(
+            f"--model {model} has the model's own body: no --preset, --params or body flags "
+            f"(got {(given or ['--preset/--params'])[0]})"
+        )
+    feet = (kwargs.pop("left_foot_body"), kwargs.pop("right_foot_body"))
+    return MjcfPlant(model, feet, kwargs.pop("torso_body"), kwargs.pop("keyframe"))
 
 
 def params_3d(model: str, kwargs: dict[str, Any]) -> Any:
@@ -37,12 +73,18 @@ def params_3d(model: str, kwargs: dict[str, Any]) -> Any:
     Raises
     ------
     InvalidParameterError
-        If ``g1`` is given a preset, a parameter file or a body flag.
+        If ``g1`` is given a preset, a parameter file or a body flag, or a built-in model the
+        options of an MJCF file (``--left-foot-body``, ...).
     """
+    from pushrecovery.errors import InvalidParameterError
+
+    for option in ("left_foot_body", "right_foot_body", "torso_body", "keyframe"):
+        if kwargs.pop(option, None) is not None:
+            flag = "--" + option.replace("_", "-")
+            raise InvalidParameterError(f"{flag} needs --model PATH.xml (got --model {model})")
     if model != "g1":
         return params_from(kwargs)
     from pushrecovery.cli.options import PARAM_FLAGS
-    from pushrecovery.errors import InvalidParameterError
 
     given = [flag for flag, field, _ in PARAM_FLAGS if kwargs.get(field) is not None]
     if given or kwargs.get("params_file") or kwargs.get("preset", "paper") != "paper":
@@ -180,6 +222,7 @@ def simulate_3d(
     pictures: dict[str, Any] | None = None,
     stepping: bool = False,
     slip_limit: float = 0.01,
+    plant: Any = None,
 ) -> dict[str, Any]:
     """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON).
 
@@ -201,6 +244,8 @@ def simulate_3d(
         Whether the controller may step (``wbc_for(plant, stepping=True)``).
     slip_limit : float
         Largest loaded-foot slip of a recovered run [m] (more: ``slipped``).
+    plant : Humanoid3DPlant, optional
+        The plant (an MJCF file's, :func:`mjcf_plant`); default the built-in ``model``'s.
 
     Returns
     -------
@@ -224,7 +269,7 @@ def simulate_3d(
     )
     dvx, dvy = push.delta_velocity(params.mass)
     predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
-    plant = make_plant3d(model, params)
+    plant = make_plant3d(model, params) if plant is None else plant
     wbc = wbc_for(plant, stepping=stepping)
     run = run_push3d(
         plant, wbc, push, duration=duration, record=bool(render), slip_limit=slip_limit
@@ -283,6 +328,7 @@ def critical_3d(
     tolerance: float,
     duration: float,
     strategy: str | None = None,
+    plant: Any = None,
 ) -> dict[str, Any]:
     """Bisect the impulse at ``azimuth`` on a 3-D model against the predictions (the JSON).
 
@@ -299,7 +345,9 @@ def critical_3d(
     strategy : str or None
         ``ankle`` (the WBC without its hip task), ``hip`` (with it), ``step`` (with stepping,
         reacting during the push), or None: the model's own controller without stepping
-        (the biped3d's with its hip task, the G1's without).
+        (the biped3d's with its hip task, the G1's and an MJCF model's without).
+    plant : Humanoid3DPlant, optional
+        The plant (an MJCF file's, :func:`mjcf_plant`); default the built-in ``model``'s.
 
     Returns
     -------
@@ -319,7 +367,7 @@ def critical_3d(
 
     width = positive_float("tolerance", tolerance, "m/s") * params.mass
     angle = 0.0 if azimuth is None else azimuth
-    plant = make_plant3d(model, params)
+    plant = make_plant3d(model, params) if plant is None else plant
     hip = {"ankle": False, "hip": True}.get(strategy or "")
     found = critical_push3d(
         plant, angle, tolerance=width, duration=duration, hip=hip, stepping=strategy == "step"

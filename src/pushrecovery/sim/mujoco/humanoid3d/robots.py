@@ -38,14 +38,17 @@ __all__ = [
     "ASSETS_VERSION",
     "ROBOTS",
     "TIMESTEP",
+    "LegJoints",
     "Robot",
     "RobotDescription",
     "RobotsExtraMissing",
+    "derive_description",
     "describe_robot",
     "load_robot",
     "robot_licence",
     "robot_params",
     "robot_path",
+    "torque_motors",
 ]
 
 #: The wheel holding the models, and the version the derived parameters were checked on.
@@ -156,6 +159,17 @@ def load_robot(name: str) -> Any:
 
     spec = mujoco.MjSpec.from_file(str(robot_path(name)))
     spec.option.timestep = TIMESTEP
+    return torque_motors(spec)
+
+
+def torque_motors(spec: Any) -> Any:
+    """Turn every actuator of ``spec`` into a torque motor (gear 1) and return ``spec``.
+
+    Its limit [N m] is its joint's actuator force range, else the actuator's own control range
+    times its gear (unlimited without either): the whole-body controller commands torques.
+    """
+    import mujoco
+
     for actuator in spec.actuators:
         joint = spec.joint(actuator.target)
         limit = None
@@ -235,22 +249,48 @@ def describe_robot(name: str) -> RobotDescription:
     RobotsExtraMissing
         If the ``robots`` extra is not installed.
     """
-    import mujoco
-
     robot = _robot(name)
     model = load_robot(name).compile()
     legs = [body_id(model, robot.leg_root.format(side=s)) for s in SIDES]
     feet = [body_id(model, robot.foot.format(side=s)) for s in SIDES]
     start = model.qpos0 if robot.keyframe is None else model.key(robot.keyframe).qpos
+
+    def joints(pattern: str) -> list[int]:
+        return [joint_id(model, pattern.format(side=s)) for s in SIDES]
+
+    roll = None if robot.ankle_roll is None else joints(robot.ankle_roll)
+    found = LegJoints(joints(robot.hip_pitch), joints(robot.hip_roll), joints(robot.ankle_pitch),
+                      roll)  # fmt: skip
+    return derive_description(name.lower(), model, np.array(start, dtype=float), legs, feet,
+                              found)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class LegJoints:
+    """The joints of both legs (left, right) the body parameters are measured at (ids)."""
+
+    hip_pitch: list[int]
+    hip_roll: list[int]
+    ankle_pitch: list[int]
+    ankle_roll: list[int] | None
+
+
+def derive_description(
+    name: str, model: Any, start: Any, legs: list[int], feet: list[int], found: LegJoints
+) -> RobotDescription:
+    """Measure a humanoid at its standing pose and derive its body parameters.
+
+    The pose is ``start`` (a keyframe or ``qpos0``) lowered until the soles touch the floor
+    (:func:`~.measure.standing_qpos`); ``legs`` and ``feet`` are the bodies at the top of each
+    leg and each foot (left, right); docs/humanoid3d.md defines every derived parameter.
+    """
+    import mujoco
+
     qpos = standing_qpos(model, np.array(start, dtype=float), feet)
     data = mujoco.MjData(model)
     data.qpos[:] = qpos
     mujoco.mj_forward(model, data)
-
-    def joint(pattern: str, side: str) -> int:
-        return joint_id(model, pattern.format(side=side))
-
-    ankles = [data.xanchor[joint(robot.ankle_pitch, s)] for s in SIDES]
+    ankles = [data.xanchor[j] for j in found.ankle_pitch]
     ankle = 0.5 * (ankles[0] + ankles[1])
     # The left sole in the left foot's frame (ankle pitch anchor as origin, foot axes).
     rot = np.array(data.xmat[feet[0]]).reshape(3, 3)
@@ -259,25 +299,30 @@ def describe_robot(name: str) -> RobotDescription:
     root = 1 if model.body_parentid[1] == 0 else 0
     upper = sorted(set(subtree(model, root)) - {b for leg in legs for b in subtree(model, leg)})
     hips = {
-        axis: 0.5 * sum(data.xanchor[joint(pattern, s)] for s in SIDES)
-        for axis, pattern in (("pitch", robot.hip_pitch), ("roll", robot.hip_roll))
+        axis: 0.5 * sum(data.xanchor[j] for j in pair)
+        for axis, pair in (("pitch", found.hip_pitch), ("roll", found.hip_roll))
     }
     ranges, limits = {}, {}
-    for pattern in (robot.hip_pitch, robot.hip_roll, robot.ankle_pitch, robot.ankle_roll):
-        for side in SIDES if pattern is not None else ():
-            j = joint(pattern, side)  # type: ignore[arg-type]
+    for pair in (found.hip_pitch, found.hip_roll, found.ankle_pitch, found.ankle_roll or []):
+        for j in pair:
+            limited = bool(model.jnt_limited[j])  # an unlimited hinge turns all the way
             ranges[model.joint(j).name] = (
-                float(model.jnt_range[j, 0]),
-                float(model.jnt_range[j, 1]),
+                float(model.jnt_range[j, 0]) if limited else -math.pi,
+                float(model.jnt_range[j, 1]) if limited else math.pi,
             )
             motors = [a for a in range(model.nu) if int(model.actuator_trnid[a, 0]) == j]
+            if not motors:
+                raise InvalidParameterError(
+                    f"model: joint {model.joint(j).name!r} has no actuator (the hips and ankles "
+                    "need motors)"
+                )
             limits[model.joint(j).name] = float(np.min(np.abs(model.actuator_ctrlrange[motors])))
 
-    def sided(pattern: str, table: dict[str, Any]) -> list[Any]:
-        return [table[pattern.format(side=s)] for s in SIDES]
+    def values(pair: list[int], table: dict[str, Any]) -> list[Any]:
+        return [table[model.joint(j).name] for j in pair]
 
-    def angle(pattern: str) -> float:
-        return min(math.pi, min(min(-lo, hi) for lo, hi in sided(pattern, ranges)))
+    def angle(pair: list[int]) -> float:
+        return min(math.pi, min(min(-lo, hi) for lo, hi in values(pair, ranges)))
 
     height = float(data.subtree_com[root][2] - ankle[2])
     params = BodyParams(
@@ -290,15 +335,15 @@ def describe_robot(name: str) -> RobotDescription:
         foot_polygon=polygon,
         flywheel_inertia=inertia_about_axis(model, data, upper, hips["pitch"], Y_AXIS),
         flywheel_inertia_roll=inertia_about_axis(model, data, upper, hips["roll"], X_AXIS),
-        torque_max=min(sided(robot.hip_pitch, limits)),
-        torque_max_roll=min(sided(robot.hip_roll, limits)),
-        flywheel_angle_max=angle(robot.hip_pitch),
-        flywheel_angle_max_roll=angle(robot.hip_roll),
+        torque_max=min(values(found.hip_pitch, limits)),
+        torque_max_roll=min(values(found.hip_roll, limits)),
+        flywheel_angle_max=angle(found.hip_pitch),
+        flywheel_angle_max_roll=angle(found.hip_roll),
         leg_length=float(hips["pitch"][2] - ankle[2]),
         stance_width=float(abs(ankles[0][1] - ankles[1][1])),
     )  # fmt: skip
     return RobotDescription(
-        name=name.lower(), model=model, qpos=qpos, legs=legs, feet=feet, params=params,
+        name=name, model=model, qpos=qpos, legs=legs, feet=feet, params=params,
         joint_ranges=ranges, torque_limits=limits,
     )  # fmt: skip
 

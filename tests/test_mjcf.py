@@ -1,0 +1,126 @@
+"""Your own robot from an MJCF file (issue 33, item 3, first part): parameters, runs, refusals."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from pushrecovery import load_params
+from pushrecovery.cli import main
+from pushrecovery.errors import InvalidParameterError
+
+mujoco = pytest.importorskip("mujoco")
+
+from pushrecovery.sim.mujoco.humanoid3d.biped3d import build_biped3d  # noqa: E402
+from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant, describe_mjcf  # noqa: E402
+from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant  # noqa: E402
+from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d  # noqa: E402
+from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos  # noqa: E402
+
+FEET = ("left_foot", "right_foot")
+#: The body parameters an MJCF file gives back (the rest are the planner's, not the body's).
+MEASURED = ("mass", "com_height", "gravity", "heel", "toe", "foot_width", "stance_width",
+            "flywheel_inertia", "flywheel_inertia_roll", "torque_max", "torque_max_roll",
+            "flywheel_angle_max", "flywheel_angle_max_roll", "leg_length")  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def biped_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The generated biped3d written to an MJCF file, with its bent-knee stance as a keyframe."""
+    spec = build_biped3d(load_params())
+    spec.add_key(name="bent", qpos=list(bent_knee_qpos(spec.compile())))
+    path = tmp_path_factory.mktemp("mjcf") / "biped3d.xml"
+    path.write_text(spec.to_xml())
+    return path
+
+
+def test_the_biped_written_to_mjcf_gives_back_its_body(biped_file: Path) -> None:
+    # Straight-legged ("stand"), the measured body is the one the model was generated from.
+    params = load_params()
+    found = describe_mjcf(biped_file, feet=FEET, torso="torso", keyframe="stand").params
+    for name in MEASURED:
+        assert getattr(found, name) == pytest.approx(getattr(params, name), rel=1e-6), name
+
+
+def test_the_biped_written_to_mjcf_has_the_built_in_critical_push(biped_file: Path) -> None:
+    built_in = Biped3DPlant(load_params())
+    mine = MjcfPlant(biped_file, FEET, "torso", keyframe="bent")
+    assert mine.qpos == pytest.approx(built_in.qpos, abs=1e-12)
+    pushes = [critical_push3d(plant, 0.0, tolerance=1.0, duration=1.0, hip=False)
+              for plant in (built_in, mine)]  # fmt: skip
+    assert pushes[0].impulse == pushes[1].impulse and pushes[0].bracket == pushes[1].bracket
+
+
+def run_cli(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    with pytest.raises(SystemExit) as caught:
+        main(list(args))
+    out, err = capsys.readouterr()
+    code = caught.value.code
+    return (0 if code is None else int(code)), out, err
+
+
+def test_humanoid_simulate_runs_an_mjcf_file(biped_file: Path, capsys) -> None:
+    code, out, err = run_cli(
+        capsys, "humanoid", "simulate", "--model", str(biped_file), "--left-foot-body",
+        "left_foot", "--right-foot-body", "right_foot", "--torso-body", "torso", "--keyframe",
+        "bent", "--push", "10", "--duration", "4", "--no-stepping", "--json",
+    )  # fmt: skip
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["model"] == str(biped_file) and data["outcome"] == "recovered"
+    assert data["hip_task"] is False and data["physics"]["violations"] == []
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        ((), "left foot must be a body of the model, got 'None'; candidates: left_foot, "
+             "right_foot"),
+        (("--left-foot-body", "left_foot", "--right-foot-body", "right_foot", "--torso-body",
+          "head"), "torso must be a body of the model, got 'head'; candidates: torso"),
+        (("--left-foot-body", "left_foot", "--right-foot-body", "right_foot", "--torso-body",
+          "torso", "--keyframe", "sit"), "keyframe must be one of the model's ['stand', 'bent']"),
+        (("--left-foot-body", "left_foot", "--right-foot-body", "right_foot", "--torso-body",
+          "torso", "--mass", "50"), "has the model's own body"),
+    ],
+)  # fmt: skip
+def test_an_mjcf_model_is_refused_in_one_line(biped_file: Path, capsys, extra, words) -> None:
+    code, _, err = run_cli(capsys, "humanoid", "simulate", "--model", str(biped_file), *extra)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1
+
+
+def test_bad_files_and_misplaced_options_are_refused(
+    biped_file: Path, tmp_path: Path, capsys
+) -> None:
+    ball = tmp_path / "ball.xml"
+    ball.write_text("<mujoco><worldbody><body><geom size='0.1'/></body></worldbody></mujoco>")
+    broken = tmp_path / "broken.xml"
+    broken.write_text("<mujoco><worldbody><body>")
+    cases = ((tmp_path / "none.xml", "must be an MJCF file"),
+             (ball, "must have a free joint first"), (broken, "broken.xml"))  # fmt: skip
+    for path, words in cases:
+        code, _, err = run_cli(capsys, "humanoid", "simulate", "--model", str(path))
+        assert code == 2 and words in err and len(err.strip().splitlines()) == 1
+    code, _, err = run_cli(capsys, "humanoid", "simulate", "--torso-body", "torso")
+    assert code == 2 and "--torso-body needs --model PATH.xml" in err
+    with pytest.raises(InvalidParameterError, match="feet"):
+        describe_mjcf(biped_file, feet=("left_foot",), torso="torso")  # type: ignore[arg-type]
+
+
+def test_the_g1_from_its_mjcf_file_has_the_robots_parameters() -> None:
+    from pushrecovery.sim.mujoco.humanoid3d import robots
+
+    try:
+        path = robots.robot_path("g1")
+    except robots.RobotsExtraMissing:
+        pytest.skip("the robots extra is not installed")
+    found = describe_mjcf(path, feet=("left_ankle_roll_link", "right_ankle_roll_link"),
+                          torso="torso_link", keyframe="stand").params  # fmt: skip
+    known = robots.robot_params("g1")
+    for name in MEASURED:
+        assert getattr(found, name) == pytest.approx(getattr(known, name), rel=1e-9), name
+    assert found.foot_polygon == known.foot_polygon
+    assert not math.isnan(found.com_height)
