@@ -124,3 +124,22 @@ def test_the_g1_from_its_mjcf_file_has_the_robots_parameters() -> None:
         assert getattr(found, name) == pytest.approx(getattr(known, name), rel=1e-9), name
     assert found.foot_polygon == known.foot_polygon
     assert not math.isnan(found.com_height)
+
+
+def test_bounds_of_an_mjcf_file_are_those_of_its_body(biped_file: Path, capsys) -> None:
+    code, out, err = run_cli(
+        capsys, "bounds", "--model", str(biped_file), "--left-foot-body", "left_foot",
+        "--right-foot-body", "right_foot", "--torso-body", "torso", "--keyframe", "stand",
+        "--json",
+    )  # fmt: skip
+    assert code == 0, err
+    mine = json.loads(out)
+    code, out, err = run_cli(capsys, "bounds", "--json")  # the preset it was generated from
+    preset = json.loads(out)
+    for name in ("ankle", "hip"):
+        assert mine["thresholds"][name] == pytest.approx(preset["thresholds"][name], rel=1e-6)
+    assert mine["params"]["mass"] == preset["params"]["mass"]
+    for args, words in ((("--keyframe", "stand"), "--keyframe needs --model PATH.xml"),
+                        (("--model", "robot.urdf"), "must be an MJCF file PATH.xml")):  # fmt: skip
+        code, _, err = run_cli(capsys, "bounds", *args)
+        assert code == 2 and words in err

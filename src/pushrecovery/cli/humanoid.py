@@ -25,6 +25,7 @@ from pushrecovery.cli.options import (
     duration_option,
     echo_confusion,
     emit,
+    mjcf_options,
     out_option,
     range_option,
 )
@@ -60,18 +61,6 @@ def _model(command: str, files: bool = False) -> Any:
         help="The humanoid: biped3d (built from the body flags) or g1 (the Unitree G1, its own "
         f"body; the robots extra){mjcf}.",
     )
-
-
-def _mjcf_options(command: Any) -> Any:
-    """Add the options of ``--model PATH.xml``: its feet, torso and standing keyframe."""
-    for flag, what in (
-        ("--keyframe", "--model PATH.xml: the keyframe of the standing pose (default qpos0)."),
-        ("--torso-body", "--model PATH.xml: the upper body held upright and pushed."),
-        ("--right-foot-body", "--model PATH.xml: the right foot's body."),
-        ("--left-foot-body", "--model PATH.xml: the left foot's body."),
-    ):
-        command = click.option(flag, default=None, metavar="NAME", help=what)(command)
-    return command
 
 
 #: The push's direction of a single run (simulate, critical-push).
@@ -111,7 +100,7 @@ def humanoid() -> None:
     epilog=example("pushrecovery humanoid simulate --azimuth 90 --push 50 --stepping --duration 5"),
 )
 @_model("simulate", files=True)
-@_mjcf_options
+@mjcf_options
 @planar_only("simulate", *_PLANAR_OPTIONS, "--x", "--xdot", "--y", "--ydot", "--plot")
 @_azimuth
 @click.option(
@@ -225,7 +214,7 @@ def simulate(
     ),
 )
 @_model("critical-push", files=True)
-@_mjcf_options
+@mjcf_options
 @planar_only("critical-push", *_PLANAR_OPTIONS, "--x", "--direction")
 @_azimuth
 @click.option(

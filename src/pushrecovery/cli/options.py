@@ -278,3 +278,15 @@ def value_range_option(option: str, triple: tuple[float, float, float], limit: i
     from pushrecovery.campaign.spec import value_range
 
     return value_range(option, triple, limit)
+
+
+def mjcf_options(command: Any) -> Any:
+    """Add the options of ``--model PATH.xml``: its feet, torso and standing keyframe."""
+    for flag, what in (
+        ("--keyframe", "--model PATH.xml: the keyframe of the standing pose (default qpos0)."),
+        ("--torso-body", "--model PATH.xml: the upper body held upright and pushed."),
+        ("--right-foot-body", "--model PATH.xml: the right foot's body."),
+        ("--left-foot-body", "--model PATH.xml: the left foot's body."),
+    ):
+        command = click.option(flag, default=None, metavar="NAME", help=what)(command)
+    return command

@@ -32,18 +32,23 @@ def is_mjcf(model: str) -> bool:
     return model.lower().endswith(".xml")
 
 
-def mjcf_plant(model: str, kwargs: dict[str, Any]) -> Any:
+def mjcf_plant(model: str, kwargs: dict[str, Any], *, plant: bool = True) -> Any:
     """Return the plant of ``--model PATH.xml`` from the foot and torso options (popped).
+
+    With ``plant`` False, its :func:`~pushrecovery.sim.mujoco.humanoid3d.mjcf.describe_mjcf`
+    description only (the model and body, no controller's plant).
 
     Raises
     ------
     InvalidParameterError
         If a body flag is given (the model has its own body) or the file, a body or a leg's
         joints are missing (:func:`~pushrecovery.sim.mujoco.humanoid3d.mjcf.describe_mjcf`).
+    MissingExtraError
+        Without the ``sim`` extra (MuJoCo).
     """
     from pushrecovery.cli.options import PARAM_FLAGS
     from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant
+    from pushrecovery.extras import require_extra
 
     given = [flag for flag, field, _ in PARAM_FLAGS if kwargs.get(field) is not None]
     if given or kwargs.get("params_file") or kwargs.get("preset", "paper") != "paper":
@@ -51,8 +56,14 @@ def mjcf_plant(model: str, kwargs: dict[str, Any]) -> Any:
             f"--model {model} has the model's own body: no --preset, --params or body flags "
             f"(got {(given or ['--preset/--params'])[0]})"
         )
+    require_extra("sim", f"--model {model}")
+    from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant, describe_mjcf
+
     feet = (kwargs.pop("left_foot_body"), kwargs.pop("right_foot_body"))
-    return MjcfPlant(model, feet, kwargs.pop("torso_body"), kwargs.pop("keyframe"))
+    torso, keyframe = kwargs.pop("torso_body"), kwargs.pop("keyframe")
+    if not plant:
+        return describe_mjcf(model, feet=feet, torso=torso, keyframe=keyframe)
+    return MjcfPlant(model, feet, torso, keyframe)
 
 
 def params_3d(model: str, kwargs: dict[str, Any]) -> Any:

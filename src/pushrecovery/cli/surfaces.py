@@ -10,6 +10,7 @@ from pushrecovery.cli.app import example
 from pushrecovery.cli.options import (
     body_options,
     emit,
+    mjcf_options,
     params_from,
     range_option,
     support_from,
@@ -28,7 +29,16 @@ __all__ = ["bounds", "classify", "step"]
 )
 @support_options
 @body_options
-def bounds(as_json: bool, **kwargs: Any) -> None:
+@click.option(
+    "--model",
+    default=None,
+    metavar="PATH.xml",
+    help="Your own robot's MJCF file: its body parameters derived from the model (name its "
+    "feet and torso with --left-foot-body, --right-foot-body, --torso-body; "
+    "docs/your_robot.md) instead of the body flags.",
+)
+@mjcf_options
+def bounds(as_json: bool, model: str | None, **kwargs: Any) -> None:
     """Capture-point bounds of each balance strategy (Eq. 4, corrected Eq. 15).
 
     Prints the body (params), omega = sqrt(g/L) [1/s] and, on the sagittal line, the
@@ -38,12 +48,25 @@ def bounds(as_json: bool, **kwargs: Any) -> None:
     CoM velocity from x = 0 that each strategy recovers, [backward, forward] [m/s] (steps: for
     each number of steps, and inf, the limit); and on the ground plane (plane) the support
     polygon and the CMP region [m, from the ankles' midpoint, x forward, y left] and the
-    thresholds forward, backward, left and right [m/s] for the chosen --stance.
+    thresholds forward, backward, left and right [m/s] for the chosen --stance. With --model
+    PATH.xml the body is the MJCF file's, measured at its standing pose.
     """
+    from pushrecovery.errors import InvalidParameterError
     from pushrecovery.surfaces.bounds import bounds_data
 
     file = kwargs["params_file"]
-    params = params_from(kwargs)
+    if model is not None:
+        if not model.lower().endswith(".xml"):
+            raise InvalidParameterError(f"--model must be an MJCF file PATH.xml, got {model!r}")
+        from pushrecovery.cli.simulation3d import mjcf_plant
+
+        params = mjcf_plant(model, kwargs, plant=False).params
+    else:
+        for option in ("left_foot_body", "right_foot_body", "torso_body", "keyframe"):
+            if kwargs.pop(option) is not None:
+                flag = "--" + option.replace("_", "-")
+                raise InvalidParameterError(f"{flag} needs --model PATH.xml")
+        params = params_from(kwargs)
     emit(bounds_data(params, support_from(kwargs, params, file)), as_json)
 
 
