@@ -19,7 +19,7 @@ SIMULATE_KEYS = [
     "peak_torque", "stop_impacts", "initial_state", "predicted", "after_push", "backend",
     "azimuth", "impulse", "push_body", "delta_velocity", "steps", "stepping", "strategy",
     "peak_hip_torque", "peak_hip_motor_torque", "max_torso_tilt", "failed_ticks", "hip_task",
-    "physics",
+    "physics", "predicted_corrected",
 ]  # fmt: skip
 CRITICAL_KEYS = [
     "velocity", "impulse", "bracket", "impulse_bracket", "simulations", "model", "controller",

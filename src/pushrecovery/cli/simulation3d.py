@@ -262,7 +262,8 @@ def simulate_3d(
     -------
     dict
         The run's JSON (a public contract: keys, order and values); ``physics`` is the run's
-        :class:`~pushrecovery.sim.physical_checks.PhysicalChecks`.
+        :class:`~pushrecovery.sim.physical_checks.PhysicalChecks`; ``predicted_corrected`` the
+        ground plane's verdict for the push at the torso's height (velocity × (1 + d/z₀)).
     """
     import numpy as np
 
@@ -281,6 +282,10 @@ def simulate_3d(
     dvx, dvy = push.delta_velocity(params.mass)
     predicted = classify_state(0.0, dvx, params, y=0.0, ydot=dvy)  # the ground plane's verdict
     plant = make_plant3d(model, params) if plant is None else plant
+    # The verdict for the push at the torso's height: its velocity × (1 + d/z0)
+    # (docs/validation3d.md), a push the ankles cannot hold though J/m alone is inside.
+    lever = 1.0 + plant.push_lever / plant.standing_height
+    corrected = classify_state(0.0, lever * dvx, params, y=0.0, ydot=lever * dvy)
     wbc = wbc_for(plant, stepping=stepping)
     run = run_push3d(
         plant, wbc, push, duration=duration, record=bool(render), slip_limit=slip_limit
@@ -329,6 +334,7 @@ def simulate_3d(
         "failed_ticks": extras.failed_ticks,
         "hip_task": plant.hip_task,
         "physics": run.physics.to_dict() if run.physics is not None else None,
+        "predicted_corrected": corrected.to_dict(),
     } | (_render_3d(plant, run, render, pictures or {}) if render else {})
 
 
