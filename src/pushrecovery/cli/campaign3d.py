@@ -25,7 +25,7 @@ def spec_3d(model: str, params: Any, strategy: str | None, **options: Any) -> An
     model : str
         ``biped3d`` or ``g1``.
     params : BodyParams
-        The body (:func:`pushrecovery.cli.simulation3d.params_3d`).
+        The body (:func:`pushrecovery.cli.bodies3d.params_3d`).
     strategy : str or None
         ``--strategy``: the controller ``wbc-STRATEGY`` (None: ``wbc-step``).
     **options

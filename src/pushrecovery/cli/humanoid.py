@@ -182,20 +182,13 @@ def simulate(
     (--preset, --params, --mass, ...) build biped3d; g1 has the robot's own body and refuses
     them.
     """
-    from pushrecovery.cli.simulation3d import (
-        check_views,
-        is_mjcf,
-        mjcf_plant,
-        params_3d,
-        render_options,
-        simulate_3d,
-    )
+    from pushrecovery.cli.bodies3d import body_3d
+    from pushrecovery.cli.simulation3d import check_views, render_options, simulate_3d
 
     if not render:
         check_views(view_azimuth, view_elevation, frame_times)
     pictures = render_options(azimuth, view_azimuth, view_elevation, frame_times)
-    plant = mjcf_plant(model, kwargs) if is_mjcf(model) else None
-    body = plant.params if plant is not None else params_3d(model, kwargs)
+    body, plant = body_3d(model, kwargs)
     if render:
         from pushrecovery.sim.mujoco.render import require_offscreen_gl
 
@@ -258,10 +251,10 @@ def critical_push(
     against the prediction of the strategy measured. The body flags (--preset, --params,
     --mass, ...) build biped3d; g1 has the robot's own body and refuses them.
     """
-    from pushrecovery.cli.simulation3d import critical_3d, is_mjcf, mjcf_plant, params_3d
+    from pushrecovery.cli.bodies3d import body_3d
+    from pushrecovery.cli.simulation3d import critical_3d
 
-    plant = mjcf_plant(model, kwargs) if is_mjcf(model) else None
-    params = plant.params if plant is not None else params_3d(model, kwargs)
+    params, plant = body_3d(model, kwargs)
     emit(critical_3d(model, params, azimuth, tolerance, duration, strategy, plant), as_json)
 
 
@@ -359,7 +352,7 @@ def validate(
     from pathlib import Path
 
     from pushrecovery.cli.azimuths import azimuths_from
-    from pushrecovery.cli.simulation3d import params_3d
+    from pushrecovery.cli.bodies3d import params_3d
     from pushrecovery.cli.validate3d import QUICK, Validate3DOptions, fraction_list, validate_3d
     from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
 
@@ -453,8 +446,8 @@ def campaign(
     --mass, ...) build biped3d; g1 has the robot's own body and refuses them and --param.
     """
     from pushrecovery.cli.azimuths import azimuths_from
+    from pushrecovery.cli.bodies3d import params_3d
     from pushrecovery.cli.campaign3d import echo_causes, spec_3d, write_confusion
-    from pushrecovery.cli.simulation3d import params_3d
     from pushrecovery.errors import InvalidParameterError
 
     run = CampaignRun.pop(kwargs)

@@ -1,111 +1,20 @@
-"""The runs of ``pushrecovery humanoid simulate`` and ``critical-push``: body, camera, runs.
+"""The runs of ``pushrecovery humanoid simulate`` and ``critical-push``: camera and runs.
 
-``humanoid simulate --model biped3d|g1 --azimuth DEG``: the whole-body controller after a
-push from any direction (:mod:`pushrecovery.sim.mujoco.humanoid3d.runs3d`); the commands are
-in :mod:`pushrecovery.cli.humanoid`. :func:`params_3d` is also the body of the 3-D
-``validate`` and ``campaign``.
+``humanoid simulate --model biped3d|g1|PATH.xml --azimuth DEG``: the whole-body controller
+after a push from any direction (:mod:`pushrecovery.sim.mujoco.humanoid3d.runs3d`); the
+commands are in :mod:`pushrecovery.cli.humanoid`, the body and plant of ``--model`` in
+:mod:`pushrecovery.cli.bodies3d`.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from pushrecovery.cli.options import params_from
-
 if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
     from pushrecovery.sim.result import SimulationResult
 
-__all__ = [
-    "check_views",
-    "critical_3d",
-    "is_mjcf",
-    "mjcf_plant",
-    "params_3d",
-    "render_options",
-    "simulate_3d",
-]
-
-
-def is_mjcf(model: str) -> bool:
-    """Whether ``--model`` names an MJCF file (``*.xml``) rather than a built-in humanoid."""
-    return model.lower().endswith(".xml")
-
-
-def mjcf_plant(model: str, kwargs: dict[str, Any], *, plant: bool = True) -> Any:
-    """Return the plant of ``--model PATH.xml`` from the foot and torso options (popped).
-
-    With ``plant`` False, its :func:`~pushrecovery.sim.mujoco.humanoid3d.mjcf.describe_mjcf`
-    description only (the model and body, no controller's plant).
-
-    Raises
-    ------
-    InvalidParameterError
-        If a body flag is given (the model has its own body) or the file, a body or a leg's
-        joints are missing (:func:`~pushrecovery.sim.mujoco.humanoid3d.mjcf.describe_mjcf`).
-    MissingExtraError
-        Without the ``sim`` extra (MuJoCo).
-    """
-    from pushrecovery.cli.options import PARAM_FLAGS
-    from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.extras import require_extra
-
-    given = [flag for flag, field, _ in PARAM_FLAGS if kwargs.get(field) is not None]
-    if given or kwargs.get("params_file") or kwargs.get("preset", "paper") != "paper":
-        raise InvalidParameterError(
-            f"--model {model} has the model's own body: no --preset, --params or body flags "
-            f"(got {(given or ['--preset/--params'])[0]})"
-        )
-    require_extra("sim", f"--model {model}")
-    from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant, describe_mjcf
-
-    feet = (kwargs.pop("left_foot_body"), kwargs.pop("right_foot_body"))
-    torso, keyframe = kwargs.pop("torso_body"), kwargs.pop("keyframe")
-    if not plant:
-        return describe_mjcf(model, feet=feet, torso=torso, keyframe=keyframe)
-    return MjcfPlant(model, feet, torso, keyframe)
-
-
-def params_3d(model: str, kwargs: dict[str, Any]) -> Any:
-    """Return the body of a 3-D model: the options' (biped3d) or the robot's own (g1).
-
-    Parameters
-    ----------
-    model : str
-        ``biped3d`` or ``g1``.
-    kwargs : dict
-        The command's keyword arguments; the body options are popped out of it (biped3d).
-
-    Returns
-    -------
-    BodyParams
-        The body the plant is built from.
-
-    Raises
-    ------
-    InvalidParameterError
-        If ``g1`` is given a preset, a parameter file or a body flag, or a built-in model the
-        options of an MJCF file (``--left-foot-body``, ...).
-    """
-    from pushrecovery.errors import InvalidParameterError
-
-    for option in ("left_foot_body", "right_foot_body", "torso_body", "keyframe"):
-        if kwargs.pop(option, None) is not None:
-            flag = "--" + option.replace("_", "-")
-            raise InvalidParameterError(f"{flag} needs --model PATH.xml (got --model {model})")
-    if model != "g1":
-        return params_from(kwargs)
-    from pushrecovery.cli.options import PARAM_FLAGS
-
-    given = [flag for flag, field, _ in PARAM_FLAGS if kwargs.get(field) is not None]
-    if given or kwargs.get("params_file") or kwargs.get("preset", "paper") != "paper":
-        raise InvalidParameterError(
-            "--model g1 has the robot's own body: no --preset, --params or body flags "
-            f"(got {(given or ['--preset/--params'])[0]})"
-        )
-    from pushrecovery.sim.mujoco.humanoid3d.robots import robot_params
-
-    return robot_params("g1")
+__all__ = ["check_views", "critical_3d", "render_options", "simulate_3d"]
 
 
 def check_views(
@@ -256,7 +165,8 @@ def simulate_3d(
     slip_limit : float
         Largest loaded-foot slip of a recovered run [m] (more: ``slipped``).
     plant : Humanoid3DPlant, optional
-        The plant (an MJCF file's, :func:`mjcf_plant`); default the built-in ``model``'s.
+        The plant (an MJCF file's, :func:`~pushrecovery.cli.bodies3d.body_3d`); default the
+        built-in ``model``'s.
 
     Returns
     -------
@@ -364,7 +274,8 @@ def critical_3d(
         reacting during the push), or None: the model's own controller without stepping
         (the biped3d's with its hip task, the G1's and an MJCF model's without).
     plant : Humanoid3DPlant, optional
-        The plant (an MJCF file's, :func:`mjcf_plant`); default the built-in ``model``'s.
+        The plant (an MJCF file's, :func:`~pushrecovery.cli.bodies3d.body_3d`); default the
+        built-in ``model``'s.
 
     Returns
     -------
