@@ -11,7 +11,7 @@ and sums it up as :class:`PhysicalChecks`:
   moves by d_c = ∫ (v_p + ω_z ẑ × (c − p))_xy dt, with p the foot's CoP
   Σ F_z,i p_i / Σ F_z,i over its floor contacts, v_p = v_o + ω × (p − o) the velocity of the
   foot's material point at p (o the foot body's origin, v_o and ω its linear and angular
-  velocity, ``mj_objectVelocity``, world frame). A foot rolling about its toe or heel edge
+  velocity, from MuJoCo's ``cvel``, world frame). A foot rolling about its toe or heel edge
   (ω_x, ω_y about the CoP) does not count; a foot spinning about a point (ω_z: MuJoCo's
   point contacts without torsional friction let a foot yaw on one toe corner) does, as a
   real sole would slide. A foot below the load threshold for at least :data:`LIFT_TIME`
