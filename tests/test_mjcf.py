@@ -108,6 +108,9 @@ def test_bad_files_and_misplaced_options_are_refused(
     assert code == 2 and "--torso-body needs --model PATH.xml" in err
     with pytest.raises(InvalidParameterError, match="feet"):
         describe_mjcf(biped_file, feet=("left_foot",), torso="torso")  # type: ignore[arg-type]
+    # A "foot" whose chain holds only the hip's joints: no ankle pitch, refused naming it.
+    with pytest.raises(InvalidParameterError, match="left foot: its leg needs a hip and an ankle"):
+        describe_mjcf(biped_file, feet=("left_thigh", "right_thigh"), torso="torso")
 
 
 def test_the_g1_from_its_mjcf_file_has_the_robots_parameters() -> None:

@@ -99,7 +99,7 @@ def _body(model: Any, name: object, role: str) -> int:
     )
 
 
-def _leg_joints(model: Any, data: Any, foot: int, role: str) -> tuple[int, list[int]]:
+def _leg_joints(model: Any, foot: int, role: str) -> tuple[int, list[int]]:
     """Return the leg's top body and its hinges from the hip down to ``foot`` (ids)."""
     import mujoco
 
@@ -185,7 +185,7 @@ def describe_mjcf(
     mujoco.mj_kinematics(model, data)
     legs, found = [], []
     for foot, side in zip(foot_ids, ("left", "right"), strict=True):
-        top, hinges = _leg_joints(model, data, foot, f"{side} foot")
+        top, hinges = _leg_joints(model, foot, f"{side} foot")
         legs.append(top)
         found.append(_axis_joints(data, hinges, f"{side} foot"))
     rolls = [f[3] for f in found]
