@@ -146,3 +146,19 @@ def test_bounds_of_an_mjcf_file_are_those_of_its_body(biped_file: Path, capsys) 
                         (("--model", "robot.urdf"), "must be an MJCF file PATH.xml")):  # fmt: skip
         code, _, err = run_cli(capsys, "bounds", *args)
         assert code == 2 and words in err
+
+
+def test_humanoid_validate_measures_an_mjcf_file(biped_file: Path, tmp_path: Path, capsys) -> None:
+    body = ("--model", str(biped_file), "--left-foot-body", "left_foot", "--right-foot-body",
+            "right_foot", "--torso-body", "torso", "--keyframe", "bent")  # fmt: skip
+    code, out, err = run_cli(
+        capsys, "humanoid", "validate", *body, "--azimuth", "0", "--strategy", "ankle",
+        "--rel-tolerance", "0.2", "--duration", "1", "--no-confusion", "--out", str(tmp_path),
+        "--json",
+    )  # fmt: skip
+    assert code == 0, err
+    (row,) = json.loads(out)["critical"]
+    assert row["strategy"] == "ankle" and 0.5 * row["predicted"] < row["measured"]
+    assert (tmp_path / "validation3d_biped3d.md").exists()
+    code, _, err = run_cli(capsys, "humanoid", "validate", *body, "--out", str(tmp_path))
+    assert code == 2 and "pass --no-confusion" in err

@@ -265,7 +265,8 @@ def critical_push(
         "--duration 1 --no-confusion --out out/validate3d"
     ),
 )
-@_model("validate")
+@_model("validate", files=True)
+@mjcf_options
 @planar_only("validate", "--backend", "--x0", "--tolerance", "--grid")
 @click.option(
     "--strategy",
@@ -347,20 +348,27 @@ def validate(
     measured critical impulse [N s] with the errors, then the confusion matrices and the
     files: tables, CSV, the polar plot and the campaign, under --out (the campaign resumes if
     interrupted); --quick is a shorter first look. The body flags (--preset, --params, --mass,
-    ...) build biped3d; g1 has the robot's own body and refuses them.
+    ...) build biped3d; g1 has the robot's own body and refuses them. An MJCF file (--model
+    PATH.xml) runs the critical pushes, not the confusion campaign (--no-confusion).
     """
     from pathlib import Path
 
     from pushrecovery.cli.azimuths import azimuths_from
-    from pushrecovery.cli.bodies3d import params_3d
+    from pushrecovery.cli.bodies3d import body_3d, is_mjcf
     from pushrecovery.cli.validate3d import QUICK, Validate3DOptions, fraction_list, validate_3d
+    from pushrecovery.errors import InvalidParameterError
     from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
 
+    if is_mjcf(model) and confusion:
+        raise InvalidParameterError(
+            f"--model {model}: the confusion campaign runs the built-in humanoids only; "
+            "pass --no-confusion"
+        )
     quick_values: dict[str, Any] = QUICK if quick else {}
     directions = azimuths_from(azimuth, azimuths) or quick_values.get("azimuths", DEFAULT_AZIMUTHS)
     # The G1's hip task recovers nothing (docs/validation3d.md, "G1: no hip strategy"): its
     # ankle and step by default.
-    usual = ("ankle", "step") if model == "g1" else ("ankle", "hip", "step")
+    usual = ("ankle", "step") if model == "g1" or is_mjcf(model) else ("ankle", "hip", "step")
     chosen = strategies or quick_values.get("strategies", usual)
     chosen = chosen if critical else ()
     options = Validate3DOptions(
@@ -375,7 +383,8 @@ def validate(
         out=Path(out),
         workers=workers,
     )
-    data = validate_3d(options, params_3d(model, kwargs))
+    params, plant = body_3d(model, kwargs)
+    data = validate_3d(options, params, plant)
     if as_json:
         emit(data, True)
         return

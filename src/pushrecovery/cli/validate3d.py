@@ -69,8 +69,12 @@ def fraction_list(text: str | None, default: tuple[float, ...]) -> tuple[float, 
     return values
 
 
-def validate_3d(options: Validate3DOptions, params: Any) -> dict[str, Any]:
-    """Run the 3-D validation and confusion matrix; write them under ``options.out``; JSON."""
+def validate_3d(options: Validate3DOptions, params: Any, plant: Any = None) -> dict[str, Any]:
+    """Run the 3-D validation and confusion matrix; write them under ``options.out``; JSON.
+
+    ``plant``: an MJCF file's plant (its tables are named after the file's stem); default the
+    built-in ``options.model``'s.
+    """
     from pushrecovery.experiments.validation3d import run_validation3d
     from pushrecovery.plots.common import save_figure
     from pushrecovery.plots.validation3d import validation3d_figure
@@ -79,7 +83,8 @@ def validate_3d(options: Validate3DOptions, params: Any) -> dict[str, Any]:
     out.mkdir(parents=True, exist_ok=True)
     data: dict[str, Any] = {"backend": "mujoco", "model": options.model}
     result = step = None
-    stem = out / f"validation3d_{options.model}"
+    name = Path(options.model).stem if plant is not None else options.model
+    stem = out / f"validation3d_{name}"
     files: dict[str, str] = {}
     balance = tuple(s for s in options.strategies if s != "step")
     if balance:
@@ -90,6 +95,7 @@ def validate_3d(options: Validate3DOptions, params: Any) -> dict[str, Any]:
             params=params,
             rel_tolerance=options.rel_tolerance,
             duration=options.duration,
+            plant=plant,
         )
         stem.with_suffix(".md").write_text(result.to_table() + "\n")
         _write_csv(result, stem.with_suffix(".csv"))
@@ -104,8 +110,9 @@ def validate_3d(options: Validate3DOptions, params: Any) -> dict[str, Any]:
             params=params,
             rel_tolerance=max(options.rel_tolerance, 0.02),
             duration=options.duration,
+            plant=plant,
         )
-        step_stem = out / f"validation3d_{options.model}_step"
+        step_stem = out / f"validation3d_{name}_step"
         step_stem.with_suffix(".md").write_text(step.to_table() + "\n")
         data["step_critical"] = [_step_row(row, step) for row in step.rows]
         files["step_table"] = str(step_stem.with_suffix(".md"))

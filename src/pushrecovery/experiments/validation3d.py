@@ -325,6 +325,7 @@ def run_validation3d(
     params: BodyParams | None = None,
     rel_tolerance: float = 0.01,
     duration: float = 3.0,
+    plant: Humanoid3DPlant | None = None,
 ) -> Validation3D:
     """Predict and measure each strategy's critical impulse at each azimuth (module doc).
 
@@ -342,13 +343,16 @@ def run_validation3d(
         The bisection's final width as a fraction of the prediction, in [1e-4, 0.5].
     duration : float
         Simulated time after each push, in (0, 60] s (a run not fallen by then stands).
+    plant : Humanoid3DPlant, optional
+        The plant to validate (an MJCF file's, :mod:`~pushrecovery.sim.mujoco.humanoid3d.mjcf`;
+        ``model`` then only names it); default the built-in ``model``'s.
 
     Raises
     ------
     InvalidParameterError
         Naming the bad argument.
     """
-    if model not in MODELS:
+    if plant is None and model not in MODELS:
         raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
     angles = azimuth_list(azimuths)
     if isinstance(strategies, str) or not isinstance(strategies, Sequence):
@@ -360,7 +364,7 @@ def run_validation3d(
         )
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-4, 0.5)
     duration = bounded_float("duration", duration, 1e-3, 60.0, "s")
-    plant = validation_plant(model, params)
+    plant = validation_plant(model, params) if plant is None else plant
     body, origin, lever = plant.params, plant.standing_origin, plant.push_lever
     factor = 1.0 / (1.0 + lever / float(plant.standing_height))
     rows = []

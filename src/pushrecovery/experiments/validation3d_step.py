@@ -331,6 +331,7 @@ def run_step_validation(
     rel_tolerance: float = 0.02,
     duration: float = 3.0,
     swing_time: float | None = None,
+    plant: Humanoid3DPlant | None = None,
 ) -> StepValidation:
     """Predict and measure the step critical impulse of a 3-D model at each azimuth.
 
@@ -349,6 +350,9 @@ def run_step_validation(
     swing_time : float, optional
         The controller's shortest swing [s] (``StepSettings``); default the body's
         ``min_step_time``, the prediction's Δt_s.
+    plant : Humanoid3DPlant, optional
+        The plant to validate (an MJCF file's; ``model`` then only names it); default the
+        built-in ``model``'s.
 
     Raises
     ------
@@ -357,14 +361,14 @@ def run_step_validation(
     """
     from pushrecovery.experiments.validation3d import MODELS, azimuth_list, validation_plant
 
-    if model not in MODELS:
+    if plant is None and model not in MODELS:
         raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
     angles = azimuth_list(azimuths)
     if params is not None:
         require_type("params", params, BodyParams)
     rel_tolerance = bounded_float("rel_tolerance", rel_tolerance, 1e-3, 0.5)
     duration = bounded_float("duration", duration, 1e-3, 59.9, "s")
-    plant = validation_plant(model, params)
+    plant = validation_plant(model, params) if plant is None else plant
     params, origin, height = plant.params, plant.standing_origin, float(plant.standing_height)
     lever = plant.push_lever
     factor = 1.0 / (1.0 + lever / height)
