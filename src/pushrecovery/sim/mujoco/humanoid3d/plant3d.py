@@ -46,6 +46,10 @@ their state in MuJoCo and report the contract's (docs/architecture.md) where it 
   is the row at which the last push's force ended and
   :attr:`~Humanoid3DPlant.max_torso_tilt` the largest torso tilt since then.
 
+* **audit**: a :class:`~pushrecovery.sim.mujoco.contact_audit.ContactAudit` watches every
+  physics step since reset/begin (loaded-foot slip, ground force, penetration, friction and
+  torque use, joint limits; :mod:`pushrecovery.sim.physical_checks`).
+
 :func:`~pushrecovery.sim.simulate.simulate` is the loop of these plants
 (:func:`~.runs3d.run_push3d`: stand, push, run the whole-body controller).
 
