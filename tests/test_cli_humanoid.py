@@ -217,3 +217,11 @@ def test_each_help_lists_only_its_familys_models_and_options(capsys, command) ->
     assert "[biped3d|g1]" in humanoid and "Example:" in humanoid
     example = humanoid.split("Example:")[1].split()
     assert example[:3] == ["pushrecovery", "humanoid", command]
+
+
+@pytest.mark.parametrize("limit", ["0", "-0.01", "2", "nan"])
+def test_humanoid_simulate_refuses_a_slip_limit_out_of_range(capsys, limit: str) -> None:
+    code, _, err = run_cli(capsys, "humanoid", "simulate", "--push", "5", "--duration", "0.2",
+                           "--slip-limit", limit)  # fmt: skip
+    assert code == 2 and "slip_limit must be" in err and "[1e-06, 1]" in err
+    assert len(err.strip().splitlines()) == 1
