@@ -71,8 +71,65 @@ def test_model_maps_the_paper_parameters():
     for leg in ("left", "right"):
         ankle = data.xanchor[model.joint(f"{leg}_ankle").id]
         assert data.xpos[torso.id][2] - ankle[2] == pytest.approx(P.com_height)
-    with pytest.raises(InvalidParameterError, match="leg_length must equal com_height"):
-        biped_model(load_params(overrides={"leg_length": 0.9}))
+
+
+# Bodies whose leg is not as long as the CoM is high: the report's non-default body and
+# the preset with legs 10 % shorter and longer.
+UNEQUAL = [
+    {"mass": 45.0, "com_height": 0.7, "leg_length": 0.72},
+    {"leg_length": 0.9},
+    {"leg_length": 1.1},
+]
+
+
+@pytest.mark.parametrize("overrides", [{}, *UNEQUAL])
+def test_legs_of_any_length_keep_the_com_height(overrides):
+    # Legs ℓ long put the hip ℓ above the ankles, and the torso's CoM c above the hip with
+    # m_u c = m (L − ℓ): the whole body's CoM stands at L − Σ m_i d_i / m, d_i the depth of
+    # each leg segment's CoM below the hip (by hand from the segments' shapes: thigh capsule
+    # ℓ/2 long from the hip, shank capsule ℓ/2 − 4 cm long from the knee, foot box under the
+    # ankle), against MuJoCo's subtree CoM.
+    from pushrecovery.sim.mujoco.models import FOOT_HALF_THICKNESS
+
+    params = load_params(overrides=overrides)
+    leg, mass = params.leg_length, params.mass
+    model = biped_model(params).compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    ankle = data.xanchor[model.joint("left_ankle").id][2]
+    assert data.xpos[model.body("torso").id][2] - ankle == pytest.approx(leg, abs=1e-12)
+    depths = 0.5 * leg / 2, 0.5 * leg + (0.5 * leg - 0.04) / 2, leg + FOOT_HALF_THICKNESS
+    lowering = 2.0 * sum(m * d for m, d in zip((0.5, 0.3, 0.2), depths, strict=True)) / mass
+    com = data.subtree_com[0][2] - ankle
+    assert com == pytest.approx(params.com_height - lowering, abs=1e-12)
+    # c itself, by hand for the first body: 45 (0.70 − 0.72) / (45 − 2 kg of legs) m.
+    if overrides.get("mass") == 45.0:
+        assert model.body("torso").ipos[2] == pytest.approx(45.0 * -0.02 / 43.0, rel=1e-12)
+
+
+def test_legs_too_short_or_long_for_the_com_are_refused():
+    for leg in (0.4, 2.0):
+        with pytest.raises(InvalidParameterError, match="within ±leg_length/2 of its hip"):
+            biped_model(load_params(overrides={"leg_length": leg}))
+
+
+@pytest.mark.parametrize("overrides", UNEQUAL)
+@pytest.mark.parametrize("v", [0.3, 1.2])
+def test_unequal_legs_recover_as_predicted(overrides, v):
+    # The ankle alone at 0.3 m/s; at 1.2 m/s (past the hip region of all three) one step.
+    from pushrecovery.surfaces.classify import classify
+
+    params = load_params(overrides=overrides)
+    plant = MujocoBipedPlant(params)
+    state = plant.reset(0.0, v)
+    controller = recovery(params)
+    result = simulate(plant, controller, state, duration=5.0)
+    predicted = classify(0.0, v, params)
+    assert result.recovered
+    assert len(controller.steps) == predicted.steps == (0 if v < 1.0 else 1)
+    if controller.steps:
+        landed = result.footholds[1] - result.footholds[0]
+        assert landed == pytest.approx(controller.steps[0], abs=LANDING_TOLERANCE)
 
 
 def test_stands_still_for_two_seconds():
@@ -159,11 +216,13 @@ def test_forward_pushes_from_ahead_of_the_ankle_recover(v):
     assert landed == pytest.approx(controller.steps[0], abs=LANDING_TOLERANCE)
 
 
-def test_biped_kinematics_match_subtree_com():
+@pytest.mark.parametrize("overrides", [{}, *UNEQUAL])
+def test_biped_kinematics_match_subtree_com(overrides):
     # The plant's own CoM kinematics (the state it reports) against MuJoCo's subtree_com and
     # subtree_linvel of the same model, over random configurations: a change of a segment's
-    # mass or length in the model that the plant does not follow fails here.
-    plant = MujocoBipedPlant(P)
+    # mass or length in the model that the plant does not follow fails here (with unequal
+    # legs, the torso's CoM off the hip too).
+    plant = MujocoBipedPlant(load_params(overrides=overrides))
     model, data = plant.model, plant.data
     rng = np.random.default_rng(42)
     worst_x = worst_v = 0.0

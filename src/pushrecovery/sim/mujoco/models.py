@@ -142,17 +142,19 @@ def add_motor(spec: Any, joint: str) -> None:
     motor.set_to_motor()
 
 
-def add_upper_body(parent: Any, params: BodyParams, mass: float, pos: list[float]) -> Any:
-    """Add the upper body ``torso`` at ``pos``: ``mass`` [kg] at its origin, inertia I.
+def add_upper_body(
+    parent: Any, params: BodyParams, mass: float, pos: list[float], com: float = 0.0
+) -> Any:
+    """Add the upper body ``torso`` at ``pos``: ``mass`` [kg] ``com`` [m] above its origin.
 
-    Drawn as a pelvis sphere and a trunk; its joint (the hip of ``torso``, the floating base of
-    ``biped``) is the caller's.
+    Its inertia about its CoM is I (``params.flywheel_inertia``). Drawn as a pelvis sphere and
+    a trunk; its joint (the hip of ``torso``, the floating base of ``biped``) is the caller's.
     """
     import mujoco
 
     torso = parent.add_body(name="torso", pos=pos)
     torso.explicitinertial = True
-    torso.mass, torso.ipos = mass, [0.0, 0.0, 0.0]
+    torso.mass, torso.ipos = mass, [0.0, 0.0, com]
     torso.inertia = [params.flywheel_inertia] * 3
     torso.add_geom(
         name="pelvis",

@@ -27,6 +27,7 @@ class BipedKinematics:
     _segment: float
     _base_z: float
     _fractions: tuple[float, float, float]
+    _torso: tuple[float, float]
     _thigh_w: tuple[float, float]
     _shank_w: tuple[float, float]
     _foot_w: tuple[float, float, float]
@@ -52,7 +53,11 @@ class BipedKinematics:
         (ft, fs, ff), seg = self._fractions, self._segment
         ct, cs = self._thigh_w[1], self._shank_w[1]
         _, fx, fz = self._foot_w
-        dx = dz = dvx = dvz = 0.0
+        # The torso's CoM, c above the hip along its pitch (0 when leg_length = com_height).
+        fu, c = self._torso
+        sp, cp, wp = math.sin(q[_PITCH]), math.cos(q[_PITCH]), v[_PITCH]
+        dx, dz = fu * c * sp, fu * c * cp
+        dvx, dvz = fu * c * cp * wp, -fu * c * sp * wp
         for k in (3, 6):
             a1 = q[_PITCH] + q[k]
             a2 = a1 + q[k + 1]

@@ -20,7 +20,7 @@ from pushrecovery.sim.mujoco.models import (
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["LEGS", "LEG_MASS", "biped_model"]
+__all__ = ["LEGS", "LEG_MASS", "biped_model", "torso_com"]
 
 # --- model -------------------------------------------------------------------------------------
 #: Thigh and shank masses [kg]; with the foot's, one leg's.
@@ -42,34 +42,55 @@ KNEE_ARMATURE = 0.05
 ANKLE_ARMATURE = 0.01
 
 
-def biped_model(params: BodyParams) -> Any:
-    """Return the ``MjSpec`` of the planar ``biped`` for ``params`` (module docstring).
+def torso_com(params: BodyParams) -> tuple[float, float]:
+    """Return the torso's mass m_u [kg] and its CoM height c above the hip [m].
+
+    m_u c = m (L − ℓ) (L = ``com_height``, ℓ = ``leg_length``): the legs are ℓ long and the
+    torso's CoM moves the whole body's by L − ℓ, so the body stands at L plus the legs' own
+    lowering, as with ℓ = L (c = 0, the paper's flywheel centred on the hip).
 
     Raises
     ------
     InvalidParameterError
-        If ``leg_length != com_height`` (the straight legs carry the hip at the CoM height L)
-        or the mass does not exceed the legs'.
+        If the mass does not exceed the legs' or c is outside (−ℓ/2, ℓ/2).
     """
-    import mujoco
-
-    if params.leg_length != params.com_height:
-        raise InvalidParameterError(
-            "the biped's straight legs carry the hip at the CoM height: leg_length must equal "
-            f"com_height, got {params.leg_length:g} m and {params.com_height:g} m"
-        )
     torso_mass = params.mass - 2.0 * LEG_MASS
     if torso_mass <= 0.0:
         raise InvalidParameterError(
             f"mass must exceed the legs' {2.0 * LEG_MASS:g} kg, got {params.mass:g} kg"
         )
+    leg = params.leg_length
+    height = params.mass * (params.com_height - leg) / torso_mass
+    if not -0.5 * leg < height < 0.5 * leg:
+        raise InvalidParameterError(
+            "com_height must put the biped's torso CoM within ±leg_length/2 of its hip: "
+            f"com_height={params.com_height:g} m, leg_length={leg:g} m puts it {height:.4g} m "
+            "above it"
+        )
+    return torso_mass, height
+
+
+def biped_model(params: BodyParams) -> Any:
+    """Return the ``MjSpec`` of the planar ``biped`` for ``params`` (module docstring).
+
+    The legs are ``leg_length`` long; the torso's CoM sits where :func:`torso_com` puts it.
+
+    Raises
+    ------
+    InvalidParameterError
+        As :func:`torso_com`.
+    """
+    import mujoco
+
+    torso_mass, torso_height = torso_com(params)
     hinge, capsule = mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtGeom.mjGEOM_CAPSULE
     y_axis, leg_colour = [0.0, 1.0, 0.0], [0.4, 0.5, 0.8, 1.0]
-    length = params.com_height
+    length = params.leg_length
     segment = 0.5 * length
     limit = params.flywheel_angle_max
     spec = model_spec("biped", params)
-    torso = add_upper_body(spec.worldbody, params, torso_mass, [0.0, 0.0, length + ANKLE_HEIGHT])
+    hip = [0.0, 0.0, length + ANKLE_HEIGHT]
+    torso = add_upper_body(spec.worldbody, params, torso_mass, hip, torso_height)
     torso.add_joint(name="x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0])
     torso.add_joint(name="z", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0.0, 0.0, 1.0])
     torso.add_joint(

@@ -76,9 +76,9 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
         # As SteppingPlant: beyond δ± ± τmax/(m g) no CMP stops an outgoing CoM.
         self.fall_limits = params.hip_fall_limits
         self.footholds: list[float] = [0.0]
-        self._length = params.com_height
-        self._segment = 0.5 * params.com_height
-        self._base_z = params.com_height + ANKLE_HEIGHT  # hip above the floor at qpos z = 0
+        self._length = params.leg_length
+        self._segment = 0.5 * params.leg_length
+        self._base_z = params.leg_length + ANKLE_HEIGHT  # hip above the floor at qpos z = 0
         # Mass distribution of a leg: weight [N] and CoM offsets in the segment frames [m].
         g, total = params.gravity, params.mass
         thigh, shank, foot = (model.body(f"{LEGS[0]}_{b}") for b in ("thigh", "shank", "foot"))
@@ -91,6 +91,8 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
             float(shank.mass[0]) / total,
             float(foot.mass[0]) / total,
         )
+        torso = model.body("torso")
+        self._torso = (float(torso.mass[0]) / total, float(torso.ipos[2]))
         self._sole_ids = tuple(model.geom(f"{leg}_sole").id for leg in LEGS)
         self._reset_phase()
 
