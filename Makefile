@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 OUT := out
 
-.PHONY: demo test validate bench lint fuzz docs venv clean
+.PHONY: demo test validate report-check bench lint fuzz docs venv clean
 
 venv: $(STAMP)
 
@@ -24,12 +24,18 @@ demo: $(STAMP)
 	@echo "open $(OUT)/report/index.html"
 
 test: docs
-	$(BIN)/python -m pytest -q -n 2 -m "not validate"
+	$(BIN)/python -m pytest -q -n 2 -m "not validate and not browser"
 
 # The long physics validations (pytest marker `validate`): the full grids and horizons whose
 # short versions run in `make test`.
 validate: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 -m validate
+
+# The report of a non-default body as a reader sees it: headless Chromium (Debian's package,
+# installed here when missing) takes a screenshot (out/report-check/screenshot.png) and the DOM.
+report-check: $(STAMP)
+	@command -v chromium >/dev/null || (apt-get update -qq && apt-get install -y -qq chromium)
+	$(BIN)/python -m pytest -q -m browser tests/test_report_browser.py
 
 # The site (Sphinx): guides, topics, the API reference from the docstrings and the CLI reference
 # from click, into out/docs; a warning (a broken reference, a malformed docstring) fails the build.
