@@ -117,3 +117,35 @@ def test_the_parquet_file_explains_its_columns(tmp_path: Path) -> None:
     again = finish(spec, tmp_path / "c")
     assert pq.read_schema(again.pushes_file).field("x0").metadata[b"unit"] == b"m"
     assert pq.read_table(again.pushes_file).equals(before)
+
+
+def test_planar_mujoco_rows_carry_the_physical_checks(tmp_path: Path) -> None:
+    # The same pushes on the analytic flywheel and the MuJoCo torso (the loop engine audits
+    # every physics step): the MuJoCo rows have the checks, the analytic ones nulls; each
+    # row's checks are those of the same push simulated alone.
+    from pushrecovery.campaign.rows import COLUMNS_PHYSICS
+    from pushrecovery.control import make_controller
+    from pushrecovery.sim.critical import pushed_state
+    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.simulate import simulate
+
+    tables = {}
+    for backend, model in (("analytic", "flywheel"), ("mujoco", "torso")):
+        spec = CampaignSpec(
+            backend, model, "mpc", P, x0=(0.0, 0.0, 0.1), xdot=(0.2, 0.6, 0.4), duration=4.0
+        )
+        result = run_campaign(spec, tmp_path / backend, workers=1, isolated=False)
+        assert result is not None
+        tables[backend] = pq.read_table(result.pushes_file).to_pylist()
+    for row in tables["analytic"]:
+        assert all(row[name] is None for name in COLUMNS_PHYSICS)
+    for row in tables["mujoco"]:
+        plant = make_plant("torso", P, "mujoco")
+        alone = simulate(
+            plant, make_controller("mpc", P), pushed_state(plant, row["x0"], row["xdot"], force=True),
+            duration=4.0,
+        )  # fmt: skip
+        assert row["outcome"] == alone.outcome.value
+        assert row["foot_slip"] == alone.physics.foot_slip > 0.0
+        assert row["peak_ground_force"] == alone.physics.peak_force_ratio > 0.9
+        assert row["joint_limit_steps"] == alone.physics.joint_limit_steps

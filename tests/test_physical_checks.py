@@ -193,3 +193,51 @@ def test_the_audit_refuses_a_slip_limit_out_of_range(limit: float) -> None:
     model = mujoco.MjModel.from_xml_string(ARM)
     with pytest.raises(InvalidParameterError, match="slip_limit"):
         ContactAudit(model, mujoco.MjData(model), ["thigh"], model.qpos0, 10.0, limit)
+
+
+# --- the planar MuJoCo plants ---------------------------------------------------------------
+
+
+def test_planar_plants_audit_every_physics_step():
+    # The torso plant holds its torques for 10 ms but the audit sees each 1 ms step: a
+    # 1 s quiet stance is 1000 audited steps carrying m g (the soft contact's
+    # penetration settles within 0.3 %), with no slip.
+    from pushrecovery import load_params
+    from pushrecovery.control import make_controller
+    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.simulate import RestCriterion, simulate
+
+    params = load_params()
+    plant = make_plant("torso", params, "mujoco")
+    state = plant.reset(0.0, 0.0)
+    rest = RestCriterion(duration=1.0)
+    result = simulate(plant, make_controller("ankle-pd", params), state, duration=1.5, rest=rest)
+    checks = result.physics
+    assert result.recovered and checks is not None
+    assert checks.physics_steps == round(result.time[-1] / 1e-3) == 1000
+    assert checks.peak_force_ratio == pytest.approx(1.0, abs=3e-3)
+    assert checks.foot_slip < 1e-5 and checks.slip_foot == "foot"
+
+
+def test_a_planar_run_whose_foot_slides_is_slipped():
+    # The same 0.5 m/s force push on the torso + MPC: on μ = 1 it recovers with the foot
+    # creeping a few mm (MuJoCo's soft friction); on μ = 0.25 the push's 10 ms force and the
+    # hip's torque slide the foot a decimetre before the body comes to rest: not recovered.
+    from pushrecovery import load_params
+    from pushrecovery.control import make_controller
+    from pushrecovery.sim.critical import pushed_state
+    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.simulate import simulate
+
+    outcomes = {}
+    for mu in (1.0, 0.25):
+        params = load_params(overrides={"friction": mu})
+        plant = make_plant("torso", params, "mujoco")
+        assert plant.model.geom("floor").friction[0] == mu
+        state = pushed_state(plant, 0.0, 0.5, force=True)
+        result = simulate(plant, make_controller("mpc", params), state, duration=4.0)
+        outcomes[mu] = (result.outcome.value, result.physics.foot_slip)
+        # The push's own 10 ms are audited too.
+        assert result.physics.physics_steps == round(result.time[-1] / 1e-3) + 10
+    assert outcomes[1.0][0] == "recovered" and outcomes[1.0][1] < 0.01
+    assert outcomes[0.25][0] == "slipped" and outcomes[0.25][1] > 0.05

@@ -126,7 +126,8 @@ class BodyParams:
     friction : float or None
         Static friction coefficient μ of the ground, dimensionless, in (0, 10]: a plan's
         horizontal ground force m ω² ‖r − p‖ must stay within μ m g (``friction_ok``);
-        ``None`` (preset): not limited.
+        ``None`` (preset): not limited. The generated MuJoCo models (``foot``, ``torso``,
+        ``biped``, ``biped3d``) take it as their contacts' sliding friction (else 1).
 
     Raises
     ------

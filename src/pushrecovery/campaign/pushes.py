@@ -23,13 +23,16 @@ from pushrecovery.campaign.pushes3d import error_row3d, run_push3d
 from pushrecovery.campaign.rows import (
     COLUMNS,
     COLUMNS_3D,
+    COLUMNS_PHYSICS,
     ERROR_OUTCOME,
+    physics_columns,
     used_label,
     verdict_columns,
 )
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.many import COMPILED, LOOP_UP_TO, PushRuns, run_many
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.result import Outcome, strategy_used
 from pushrecovery.surfaces.classify import (
     Strategy,
@@ -92,6 +95,7 @@ class _Simulated:
     cop_max: float
     time: float
     stop_impacts: int
+    physics: PhysicalChecks | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -145,6 +149,7 @@ def _row(
         time=run.time,
         stop_impacts=run.stop_impacts,
         error=None,
+        **physics_columns(run.physics),
     )
     return row
 
@@ -159,8 +164,8 @@ def _inputs_and_prediction(spec: CampaignSpec, push: Push, found: _Prediction) -
     return row
 
 
-#: The 3-D columns of a planar row: null.
-_NULL_3D: dict[str, Any] = dict.fromkeys(COLUMNS_3D)
+#: The 3-D columns of a planar row, and the physical checks until a MuJoCo run fills them: null.
+_NULL_3D: dict[str, Any] = dict.fromkeys(COLUMNS_3D + COLUMNS_PHYSICS)
 
 
 def _rows_of_runs(spec: CampaignSpec, pushes: list[Push], runs: PushRuns) -> list[dict[str, Any]]:
@@ -178,7 +183,10 @@ def _rows_of_runs(spec: CampaignSpec, pushes: list[Push], runs: PushRuns) -> lis
             continue
         outcome = runs.outcomes[k]
         used = used_label(outcome, strategy_used(steps[k], peaks[k]))
-        run = _Simulated(outcome, used, steps[k], peaks[k], lows[k], highs[k], times[k], impacts[k])
+        run = _Simulated(
+            outcome, used, steps[k], peaks[k], lows[k], highs[k], times[k], impacts[k],
+            runs.checks(k),
+        )  # fmt: skip
         rows.append(_row(spec, push, run, predictions[k]))
     return rows
 

@@ -17,7 +17,13 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery.campaign.rows import ERROR_OUTCOME, ERROR_OUTCOME_3D, used_label, verdict_columns
+from pushrecovery.campaign.rows import (
+    ERROR_OUTCOME,
+    ERROR_OUTCOME_3D,
+    physics_columns,
+    used_label,
+    verdict_columns,
+)
 from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.campaign.spec3d import critical_impulse, predict_push, push_geometry
 from pushrecovery.errors import SimulationDiverged
@@ -102,11 +108,7 @@ def run_push3d(
         # The motor commands held from the push on (the push's, then each tick's).
         peak_torque_ratio=_torque_ratio(run.inputs[extras.push_row - 1 :], plant.ctrl_range),
         failed_ticks=extras.failed_ticks,
-        foot_slip=physics.foot_slip,
-        peak_ground_force=physics.peak_force_ratio,
-        max_penetration=physics.max_penetration,
-        friction_use=physics.friction_use,
-        joint_limit_steps=physics.joint_limit_steps,
+        **physics_columns(physics),
     )
     return row
 

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any, Literal, cast
 
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import UNITS
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.result import Outcome
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
@@ -33,6 +34,7 @@ if TYPE_CHECKING:
 __all__ = [
     "COLUMNS",
     "COLUMNS_3D",
+    "COLUMNS_PHYSICS",
     "ERROR_OUTCOME",
     "ERROR_OUTCOME_3D",
     "FAMILIES",
@@ -40,6 +42,7 @@ __all__ = [
     "Column",
     "Family",
     "columns",
+    "physics_columns",
     "row_schema",
     "used_label",
     "verdict_columns",
@@ -73,6 +76,8 @@ class Column:
 
 
 _NULL_PLANAR = "null on the planar models"
+_MUJOCO = "MuJoCo, every physics step"
+_NULL_ANALYTIC = "null on the analytic models and in the compiled and rollout engines"
 
 #: The columns after ``index`` and the ``param_<name>`` ones, in order, as the planar models
 #: read them (positions relative to the stance ankle).
@@ -124,15 +129,17 @@ _PLANAR: tuple[Column, ...] = (
            f"largest |motor command| / its limit (3-D); {_NULL_PLANAR}"),
     Column("failed_ticks", "int64", "-", f"ticks the QP did not solve (3-D); {_NULL_PLANAR}"),
     Column("foot_slip", "float64", "m",
-           f"largest slip of a foot carrying >= 10% of m g (3-D); {_NULL_PLANAR}"),
+           f"largest slip of a foot carrying >= 10% of m g ({_MUJOCO}); {_NULL_ANALYTIC}"),
     Column("peak_ground_force", "float64", "-",
-           f"largest vertical floor force / (m g) in one physics step (3-D); {_NULL_PLANAR}"),
+           f"largest vertical floor force / (m g) in one physics step ({_MUJOCO}); "
+           f"{_NULL_ANALYTIC}"),
     Column("max_penetration", "float64", "m",
-           f"deepest floor contact (3-D); {_NULL_PLANAR}"),
+           f"deepest floor contact ({_MUJOCO}); {_NULL_ANALYTIC}"),
     Column("friction_use", "float64", "-",
-           f"largest |f_t| / (mu f_n) of a loaded floor contact, 1: sliding (3-D); {_NULL_PLANAR}"),
+           f"largest |f_t| / (mu f_n) of a loaded floor contact, 1: sliding ({_MUJOCO}); "
+           f"{_NULL_ANALYTIC}"),
     Column("joint_limit_steps", "int64", "-",
-           f"physics steps with a joint on its range limit (3-D); {_NULL_PLANAR}"),
+           f"physics steps with a joint on its range limit ({_MUJOCO}); {_NULL_ANALYTIC}"),
 )  # fmt: skip
 
 #: How the 3-D models read the columns whose meaning differs (the others read as planar).
@@ -171,9 +178,16 @@ _READ_3D: Mapping[str, tuple[str, str]] = {
 #: The fixed columns after the ``param_<name>`` ones, with their Arrow type names (both
 #: families: the same names, types and order).
 COLUMNS: tuple[tuple[str, str], ...] = tuple((c.name, c.kind) for c in _PLANAR)
+#: The physical checks of a MuJoCo run (:class:`~pushrecovery.sim.physical_checks.PhysicalChecks`):
+#: null (None) in the rows of runs that were not audited.
+COLUMNS_PHYSICS: tuple[str, ...] = (
+    "foot_slip", "peak_ground_force", "max_penetration", "friction_use", "joint_limit_steps",
+)  # fmt: skip
 #: The columns of the 3-D models only: null (None) in the other models' rows.
 COLUMNS_3D: tuple[str, ...] = tuple(
-    name for name, _ in COLUMNS[[n for n, _ in COLUMNS].index("azimuth") :]
+    name
+    for name, _ in COLUMNS[[n for n, _ in COLUMNS].index("azimuth") :]
+    if name not in COLUMNS_PHYSICS
 )
 
 #: The outcome columns of a push that raised, or whose worker died (both families).
@@ -192,6 +206,22 @@ ERROR_OUTCOME_3D: Mapping[str, Any] = {
 
 #: Units of the sweepable body parameters (``param_<name>`` columns; ``BodyParams``).
 PARAM_UNITS: Mapping[str, str] = {k: v for k, v in UNITS.items() if k != "foot_polygon"}
+
+
+def physics_columns(checks: PhysicalChecks | None) -> dict[str, Any]:
+    """Return a row's :data:`COLUMNS_PHYSICS` for ``checks`` (None: a run not audited, nulls).
+
+    ``peak_ground_force`` is in body weights (``PhysicalChecks.peak_force_ratio``).
+    """
+    if checks is None:
+        return dict.fromkeys(COLUMNS_PHYSICS)
+    return {
+        "foot_slip": checks.foot_slip,
+        "peak_ground_force": checks.peak_force_ratio,
+        "max_penetration": checks.max_penetration,
+        "friction_use": checks.friction_use,
+        "joint_limit_steps": checks.joint_limit_steps,
+    }
 
 
 def used_label(outcome: Outcome, strategy: Strategy) -> str:

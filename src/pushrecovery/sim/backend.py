@@ -30,8 +30,9 @@ simulate` is written against it alone):
    (docs/conventions.md); ``at_rest(state, speed)`` whether the CoM moves at most ``speed``
    [m/s] over the support.
 7. Optional capabilities are their own protocols: :class:`Recording` (frames for rendering),
-   :class:`Measuring` (the CoP measured from contact forces) and :class:`Clocked` (the plant's
-   own clock and rows: MuJoCo's time, a push lasting steps of its own). Check them with
+   :class:`Measuring` (the CoP measured from contact forces), :class:`Clocked` (the plant's
+   own clock and rows: MuJoCo's time, a push lasting steps of its own) and :class:`Audited`
+   (the physical checks of every physics step since ``reset``: MuJoCo). Check them with
    ``isinstance``; nothing else is looked up by name.
 """
 
@@ -47,9 +48,11 @@ from pushrecovery.arguments import finite_float, float_array, non_negative_float
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.push import Push
 
 __all__ = [
+    "Audited",
     "Backend",
     "Clocked",
     "Measuring",
@@ -190,6 +193,19 @@ class Clocked(Protocol):
 
     def run_rows(self) -> RunRows:
         """Return the rows of the run since ``begin``."""
+        ...
+
+
+@runtime_checkable
+class Audited(Protocol):
+    """A plant whose physics steps are audited (MuJoCo): the run's physical checks.
+
+    The loop puts them in the result and judges its outcome by them
+    (:func:`~pushrecovery.sim.result.judge`: a run at rest that slid is ``slipped``).
+    """
+
+    def physical_checks(self) -> PhysicalChecks:
+        """Return the checks of every physics step since ``reset`` (a force push's included)."""
         ...
 
 

@@ -27,6 +27,7 @@ from pushrecovery.errors import (
     SimulationTimeout,
 )
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.result import Outcome
 
 __all__ = ["COMPILED", "DIVERGED", "ENGINES", "LOOP_UP_TO", "ROLLOUT", "PushRuns", "run_many"]
@@ -69,6 +70,10 @@ class PushRuns:
         a run that has one. The other entries of such a run are not to be used.
     engine : str
         The engine that ran the pushes (one of :data:`ENGINES` but ``auto``).
+    physics : tuple of PhysicalChecks or None
+        Each MuJoCo run's physical checks (``SimulationResult.physics``; its outcome judged
+        by them); None on the analytic models, in the ``compiled`` and ``rollout`` engines
+        (which do not audit contacts) and for a run with an error. Empty: all None.
     """
 
     outcomes: tuple[Outcome, ...]
@@ -80,6 +85,11 @@ class PushRuns:
     stop_impacts: NDArray[np.int64]
     errors: tuple[str | None, ...]
     engine: str
+    physics: tuple[PhysicalChecks | None, ...] = ()
+
+    def checks(self, k: int) -> PhysicalChecks | None:
+        """Return push k's physical checks (None: not audited)."""
+        return self.physics[k] if self.physics else None
 
 
 def run_many(
@@ -240,6 +250,7 @@ def _loop(
     steps, stops = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
     peaks = np.zeros(count)
     errors: list[str | None] = [None] * count
+    physics: list[PhysicalChecks | None] = [None] * count
     cache: dict[BodyParams, tuple[Any, Any]] = {}
     for k, body in enumerate(bodies):
         if on_start is not None:
@@ -264,6 +275,8 @@ def _loop(
         cop_min[k] = float(cops.min()) if cops.size else math.nan
         cop_max[k] = float(cops.max()) if cops.size else math.nan
         steps[k], peaks[k], stops[k] = len(run.footholds) - 1, run.peak_hip_torque, run.stop_impacts
+        physics[k] = run.physics
     return PushRuns(
-        tuple(outcomes), times, cop_min, cop_max, steps, peaks, stops, tuple(errors), "loop"
-    )
+        tuple(outcomes), times, cop_min, cop_max, steps, peaks, stops, tuple(errors), "loop",
+        tuple(physics),
+    )  # fmt: skip

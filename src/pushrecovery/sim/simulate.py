@@ -13,11 +13,11 @@ from pushrecovery.arguments import finite_array, positive_float
 from pushrecovery.control.base import Command, Controller, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged, SimulationTimeout
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS
-from pushrecovery.sim.backend import Clocked, PlantBase
+from pushrecovery.sim.backend import Audited, Clocked, PlantBase
 from pushrecovery.sim.events import ForcePushing, Observer, ScheduledPush
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.push import Push
-from pushrecovery.sim.result import Outcome, SimulationResult
+from pushrecovery.sim.result import Outcome, SimulationResult, judge
 
 __all__ = ["DEFAULT_CONTROL_PERIOD", "RestCriterion", "check_run", "simulate"]
 
@@ -248,10 +248,14 @@ def simulate(
         times, states, inputs = plant.run_rows()  # type: ignore[attr-defined]
     else:
         times, states, inputs = np.arange(k + 1, dtype=np.float64) * h, states[: k + 1], inputs[:k]
+    # MuJoCo's runs: what every physics step did (a run at rest that slid is slipped).
+    physics = None
+    if not isinstance(plant, PlantBase) and isinstance(plant, Audited):
+        physics = plant.physical_checks()
     return SimulationResult(
-        times, states, inputs, outcome, plant.name, controller.name, info.stop_impacts,
-        info.footholds, info.footholds_xy, plant.state_labels,
-        decided_time=None if decided < 0 else decided_clock,
+        times, states, inputs, judge(outcome, physics), plant.name, controller.name,
+        info.stop_impacts, info.footholds, info.footholds_xy, plant.state_labels,
+        decided_time=None if decided < 0 else decided_clock, physics=physics,
     )  # fmt: skip
 
 

@@ -59,7 +59,8 @@ CONTACT_TIME = 2e-3
 def model_spec(name: str, params: BodyParams) -> Any:
     """Return a new ``mujoco.MjSpec``: options, contact defaults, the light and the floor.
 
-    The shared part of every model (the ``<mujoco>`` header of an MJCF file).
+    The shared part of every model (the ``<mujoco>`` header of an MJCF file). Every contact's
+    sliding friction is ``params.friction`` when given, else 1.
     """
     import mujoco
 
@@ -74,7 +75,7 @@ def model_spec(name: str, params: BodyParams) -> Any:
     spec.visual.global_.offheight = 480
     geom = spec.default.geom
     geom.contype, geom.conaffinity = 1, 1
-    geom.friction = [1.0, 0.005, 0.0001]
+    geom.friction = [1.0 if params.friction is None else params.friction, 0.005, 0.0001]
     geom.solref = [CONTACT_TIME, 1.0]
     geom.solimp[:3] = [0.95, 0.99, 0.001]
     spec.worldbody.add_light(

@@ -34,6 +34,7 @@ from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import RecordedFrame, Step, check_com_state, over_foot_at_rest
+from pushrecovery.sim.mujoco.contact_audit import ContactAudit
 from pushrecovery.sim.mujoco.engine import (
     floor_cop_world,
     settle,
@@ -41,6 +42,7 @@ from pushrecovery.sim.mujoco.engine import (
     unstable_warnings,
 )
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, MODEL_BUILDERS, TIMESTEP
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.push import PUSH_DURATION, Push
 
 __all__ = [
@@ -87,6 +89,8 @@ class MujocoPlant(ABC):
     model_name: ClassVar[str]
     #: Body the push force acts on (at its centre of mass).
     pushed_body: ClassVar[str]
+    #: The foot bodies whose contacts the audit checks (:meth:`physical_checks`).
+    feet: ClassVar[tuple[str, ...]] = ("foot",)
     #: Longest time the joint torques are held between two refreshes [s]; they are also
     #: refreshed at every control tick and at every step of a push. One physics step (the
     #: default) for plants with joint servos; longer for open-loop torque maps of a slowly
@@ -146,6 +150,9 @@ class MujocoPlant(ABC):
         # a memoryview, read after every step).
         self._warnings = memoryview(self.data.warning.number)
         self._unstable = unstable_warnings()
+        #: The physical checks of every physics step since :meth:`reset` (the model's pose
+        #: qpos0 stands on flat soles).
+        self.audit = ContactAudit(model, self.data, self.feet, model.qpos0, params.weight)
         #: The state after settling (:meth:`reset`), kept: settling is the same every time.
         self._settled: FloatArray | None = None
         self._info_key: tuple[int, float] | None = None
@@ -272,6 +279,7 @@ class MujocoPlant(ABC):
         mj.mj_forward(self.model, d)
         self._start_clock()
         self._restart_records()
+        self.audit.reset()
         return self.read_state()
 
     def check_state(self, state: FloatArray) -> None:
@@ -307,6 +315,10 @@ class MujocoPlant(ABC):
             self._info_key, self._info = key, StepInfo(True, (key[1],), key[0], None)
         return self._info
 
+    def physical_checks(self) -> PhysicalChecks:
+        """Return the checks of every physics step since :meth:`reset` (contact_audit)."""
+        return self.audit.result()
+
     def at_rest(self, state: FloatArray, speed: float) -> bool:
         """:func:`~pushrecovery.sim.plants.over_foot_at_rest` on the stance foot."""
         return over_foot_at_rest(state, self.params, speed)
@@ -336,7 +348,7 @@ class MujocoPlant(ABC):
             raise InvalidParameterError(
                 f"control_period must be >= half the MuJoCo step, {0.5 * h:g} s, got {dt:g}"
             )
-        actuate, torque = self.actuate, 0.0
+        actuate, audit, torque = self.actuate, self.audit.after_step, 0.0
         # Whole physics steps that keep the physics clock on the control clock (a period
         # that is not a multiple of the step, e.g. bang-bang's, is rounded per tick).
         self.time += dt
@@ -348,18 +360,20 @@ class MujocoPlant(ABC):
             self.push_now = self._push_force if self._push_target == self._pushed else 0.0
             torque = actuate(cop, command)
             mj_step(model, d)
+            audit()
             self._push_steps -= 1
             steps -= 1
         if self._push_target >= 0 and not self._push_steps:
             self.push_now = self._xfrc[self._push_target, 0] = 0.0
             self._push_target = -1
         # The hot loop: the torques are refreshed every `torque_hold` steps (about 1 µs of
-        # Python each), MuJoCo steps in between without leaving C (nstep by position: the
-        # keyword cost 0.12 µs a call).
+        # Python each); the audit sees every physics step.
         hold = self._hold_steps
         while steps > 0:
             torque = actuate(cop, command)
-            mj_step(model, d, min(hold, steps))
+            for _ in range(min(hold, steps)):
+                mj_step(model, d)
+                audit()
             steps -= hold
         counts, (a, b, c) = self._warnings, self._unstable
         if counts[a] or counts[b] or counts[c]:

@@ -59,6 +59,7 @@ class MujocoBipedPlant(BipedKinematics, BipedServos, MujocoPlant):
     state_labels: ClassVar[tuple[str, ...]] = STEPPING_STATE
     model_name: ClassVar[str] = "biped"
     pushed_body: ClassVar[str] = "torso"
+    feet: ClassVar[tuple[str, ...]] = tuple(f"{leg}_foot" for leg in LEGS)
 
     @classmethod
     def build(cls, params: BodyParams) -> Any:

@@ -81,6 +81,7 @@ from pushrecovery.sim.backend import RunRows, Step
 from pushrecovery.sim.mujoco.contact_audit import ContactAudit
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.push import Push, Push3D
 
 FloatArray = NDArray[np.float64]
@@ -259,6 +260,10 @@ class Humanoid3DPlant:
         """Return the rows since reset/begin: one per step, one after each push."""
         inputs = np.array(self._inputs, dtype=float).reshape(len(self._inputs), len(self.ctrl))
         return RunRows(np.array(self._times), np.array(self._states), inputs)
+
+    def physical_checks(self) -> PhysicalChecks:
+        """Return the checks of every physics step since reset/begin (the :attr:`audit`'s)."""
+        return self.audit.result()
 
     def _restart_rows(self) -> None:
         """Start the rows at the current state (no push yet)."""

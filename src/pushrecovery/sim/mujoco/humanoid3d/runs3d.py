@@ -33,7 +33,7 @@ from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
 )
 from pushrecovery.sim.physical_checks import DEFAULT_SLIP_LIMIT
 from pushrecovery.sim.push import Push3D
-from pushrecovery.sim.result import Outcome, Push3DExtras, SimulationResult, judge
+from pushrecovery.sim.result import Outcome, Push3DExtras, SimulationResult
 from pushrecovery.sim.simulate import MAX_DURATION, RestCriterion, simulate
 
 FloatArray = NDArray[np.float64]
@@ -164,8 +164,7 @@ def run_push3d(
         qvel=None if frames is None else frames[:, nq : nq + nv],
         ctrl=None if frames is None else frames[:, nq + nv :],
     )
-    physics = plant.audit.result()
-    return replace(result, extras=extras, physics=physics, outcome=judge(result.outcome, physics))
+    return replace(result, extras=extras)  # the loop judged the outcome by the audit
 
 
 class WbcTrace:
