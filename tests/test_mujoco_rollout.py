@@ -110,8 +110,10 @@ def test_params_must_be_a_body():
 def test_a_campaign_batch_of_foot_and_ankle_pd_runs_in_lockstep():
     # run_batch takes the lockstep rollout for MuJoCo's foot + ankle-pd; its rows are the
     # one-push loop's: the same verdicts, times within one tick, CoP excursions within 1 µm.
+    # The rollout does not audit contacts: its physical checks are null, the loop's not.
     from pushrecovery.campaign import CampaignSpec
     from pushrecovery.campaign.pushes import push_rows, run_batch
+    from pushrecovery.campaign.rows import COLUMNS_PHYSICS
     from pushrecovery.sim.many import ROLLOUT
 
     assert ("foot", "ankle-pd") in ROLLOUT
@@ -124,8 +126,10 @@ def test_a_campaign_batch_of_foot_and_ankle_pd_runs_in_lockstep():
     loops = push_rows(campaign, campaign.pushes(0), engine="loop")
     for row, push, loop in zip(rows, campaign.pushes(0), loops, strict=True):
         outcomes.add(loop["outcome"])
-        close = ("time", "cop_min", "cop_max", "peak_ankle_torque")
+        close = ("time", "cop_min", "cop_max", "peak_ankle_torque", *COLUMNS_PHYSICS)
         exact = {k: v for k, v in loop.items() if k not in close}
+        assert all(row[k] is None for k in COLUMNS_PHYSICS)
+        assert loop["foot_slip"] >= 0.0 and loop["peak_ground_force"] > 0.9
         assert {k: row[k] for k in exact} == exact, push
         assert abs(row["peak_ankle_torque"] - loop["peak_ankle_torque"]) < P.weight * 1e-6
         assert abs(row["time"] - loop["time"]) <= 1e-3 + 1e-12
