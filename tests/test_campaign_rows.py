@@ -141,10 +141,8 @@ def test_planar_mujoco_rows_carry_the_physical_checks(tmp_path: Path) -> None:
         assert all(row[name] is None for name in COLUMNS_PHYSICS)
     for row in tables["mujoco"]:
         plant = make_plant("torso", P, "mujoco")
-        alone = simulate(
-            plant, make_controller("mpc", P), pushed_state(plant, row["x0"], row["xdot"], force=True),
-            duration=4.0,
-        )  # fmt: skip
+        state = pushed_state(plant, row["x0"], row["xdot"], force=True)
+        alone = simulate(plant, make_controller("mpc", P), state, duration=4.0)
         assert row["outcome"] == alone.outcome.value
         assert row["foot_slip"] == alone.physics.foot_slip > 0.0
         assert row["peak_ground_force"] == alone.physics.peak_force_ratio > 0.9

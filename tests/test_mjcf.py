@@ -160,5 +160,72 @@ def test_humanoid_validate_measures_an_mjcf_file(biped_file: Path, tmp_path: Pat
     (row,) = json.loads(out)["critical"]
     assert row["strategy"] == "ankle" and 0.5 * row["predicted"] < row["measured"]
     assert (tmp_path / "validation3d_biped3d.md").exists()
-    code, _, err = run_cli(capsys, "humanoid", "validate", *body, "--out", str(tmp_path))
-    assert code == 2 and "pass --no-confusion" in err
+
+
+def test_a_campaign_on_an_mjcf_file_is_the_built_in_campaign(biped_file: Path, tmp_path) -> None:
+    # The same pushes on the biped3d and on its MJCF file (the same standing pose): the same
+    # outcomes and strategies (the file's body is measured in its bent-knee pose, so its
+    # predictions and the controller's gains differ in the last digits); the spec keeps the
+    # file and its bodies, so that the workers build it and a resumed campaign is the same.
+    import pyarrow.parquet as pq
+
+    from pushrecovery.campaign import CampaignSpec, run_campaign
+    from pushrecovery.sim.mjcf_source import MjcfSource
+
+    source = MjcfSource(str(biped_file), FEET, "torso", "bent")
+    mine = source.plant()
+    grid = dict(backend="mujoco", controller="wbc-ankle", x0=(0.0, 0.0, 1.0),
+                fraction=(0.6, 1.4, 0.8), azimuths=(0.0, 90.0), duration=3.0)  # fmt: skip
+    specs = {
+        "built-in": CampaignSpec(model="biped3d", params=load_params(), **grid),
+        "mjcf": CampaignSpec(model="mjcf", mjcf=source, params=mine.params, **grid),
+    }
+    assert specs["mjcf"].model_name == "biped3d"
+    stored = specs["mjcf"].to_dict()
+    assert CampaignSpec.from_dict(stored).to_dict() == stored and stored["mjcf"]["feet"] == list(
+        FEET
+    )
+    rows = {}
+    for name, spec in specs.items():
+        result = run_campaign(spec, tmp_path / name, workers=1, isolated=False)
+        assert result is not None
+        rows[name] = pq.read_table(result.pushes_file).to_pylist()
+    assert len(rows["mjcf"]) == 4
+    keys = ("azimuth", "fraction", "predicted", "outcome", "used", "steps")
+    for built_in, file in zip(rows["built-in"], rows["mjcf"], strict=True):
+        assert {k: file[k] for k in keys} == {k: built_in[k] for k in keys}
+        assert file["impulse"] == pytest.approx(built_in["impulse"], rel=0.02)
+    assert {row["outcome"] for row in rows["mjcf"]} == {"recovered", "fell"}
+    with pytest.raises(InvalidParameterError, match="needs its file"):
+        CampaignSpec(model="mjcf", params=mine.params, **grid)
+    with pytest.raises(InvalidParameterError, match="an MJCF model has the robot's own body"):
+        CampaignSpec(model="mjcf", mjcf=source, params=mine.params, sweeps={"mass": (60, 70, 10)},
+                     **grid)  # fmt: skip
+
+
+def test_humanoid_campaign_and_validate_take_an_mjcf_file(
+    biped_file: Path, tmp_path: Path, capsys
+) -> None:
+    body = ("--model", str(biped_file), "--left-foot-body", "left_foot", "--right-foot-body",
+            "right_foot", "--torso-body", "torso", "--keyframe", "bent")  # fmt: skip
+    code, out, err = run_cli(
+        capsys, "humanoid", "campaign", *body, "--azimuth", "0", "--fraction", "0.5", "1.5",
+        "1.0", "--strategy", "ankle", "--duration", "1", "--workers", "1", "--out",
+        str(tmp_path / "c"), "--json",
+    )  # fmt: skip
+    assert code == 0, err
+    assert json.loads(out)["pushes"] == 2 and (tmp_path / "c" / "confusion3d.csv").exists()
+    code, out, err = run_cli(
+        capsys, "humanoid", "validate", *body, "--azimuth", "0", "--no-critical",
+        "--fractions", "0.5,1.5", "--duration", "1", "--out", str(tmp_path / "v"), "--json",
+    )  # fmt: skip
+    assert code == 0, err
+    confusion = json.loads(out)["confusion"]
+    apart = sum(map(sum, confusion["apart"].values()))
+    assert sum(map(sum, confusion["counts"])) + apart == 2
+    assert (tmp_path / "v" / "confusion_biped3d").is_dir()
+    code, _, err = run_cli(
+        capsys, "humanoid", "campaign", *body, "--param", "mass=60:70:10", "--fraction", "0.5",
+        "1.5", "1.0", "--out", str(tmp_path / "d"),
+    )  # fmt: skip
+    assert code == 2 and "an MJCF model has the robot's own body" in err

@@ -39,7 +39,7 @@ def predict3d(spec: CampaignSpec, push: Push) -> dict[str, Any]:
     """Return the columns of a 3-D push that do not depend on the run: the push and its verdict."""
     params = push.params
     azimuth = 0.0 if push.azimuth is None else push.azimuth
-    (x0, y0), ratio = push_geometry(spec.model, params)
+    (x0, y0), ratio = push_geometry(spec.source, params)
     found, corrected = predict_push(params, (x0, y0), push.impulse, azimuth, ratio)
     xi = found.capture_point_xy or (math.nan, math.nan)
     ankle = critical_impulse(params, (x0, y0), azimuth)
@@ -66,11 +66,11 @@ def run_push3d(
     from pushrecovery.sim.mujoco.humanoid3d import runs3d
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import PUSH_DURATION, wbc_for
     from pushrecovery.sim.push import Push3D
-    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.registry import make_plant3d
 
     cache = {} if cache is None else cache
     if push.params not in cache:
-        cache[push.params] = make_plant(spec.model, push.params, "mujoco")
+        cache[push.params] = make_plant3d(spec.source, push.params)
     plant = cache[push.params]
     strategy = spec.strategy
     # wbc-hip: the hip task; wbc-step: the plant's own controller (its default hip task,

@@ -42,6 +42,7 @@ from pushrecovery.campaign.spec3d import (
 from pushrecovery.control.base import controller_class
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.mjcf_source import MjcfSource
 
 __all__ = [
     "BACKENDS",
@@ -111,7 +112,7 @@ class CampaignSpec:
         Physics: velocity jumps on the analytic models, real forces at the CoM on MuJoCo.
     model, controller : str
         Plant (``BACKENDS[backend]``) and controller registry names; on the 3-D models
-        (``biped3d``, ``g1``) the controller is one of ``WBC_CONTROLLERS``.
+        (``biped3d``, ``g1``, ``mjcf``) the controller is one of ``WBC_CONTROLLERS``.
     params : BodyParams
         The body; swept parameters replace their field.
     x0 : (start, stop, step)
@@ -142,6 +143,9 @@ class CampaignSpec:
     azimuths : tuple of float or None
         3-D models only: the pushes' directions [deg], 0 forward, 90 left (default (0,));
         1 to 360 angles in [−360, 360], distinct modulo 360.
+    mjcf : MjcfSource or None
+        Model ``mjcf`` only (and then required): the user's MJCF humanoid, its file and bodies;
+        ``params`` is its derived body (``MjcfPlant(...).params``) and cannot be swept.
     """
 
     backend: str
@@ -159,6 +163,7 @@ class CampaignSpec:
     push_timeout: float = DEFAULT_PUSH_TIMEOUT
     azimuths: tuple[float, ...] | None = None
     fraction: Range | None = None
+    mjcf: MjcfSource | None = None
 
     def __post_init__(self) -> None:
         if self.backend not in BACKENDS:
@@ -234,6 +239,16 @@ class CampaignSpec:
         """Whether the model is a 3-D humanoid (the whole-body controller, azimuths)."""
         return self.model in MODELS_3D
 
+    @property
+    def source(self) -> str | MjcfSource:
+        """What builds the model's plant: its name, or the MJCF file (``model`` ``mjcf``)."""
+        return self.model if self.mjcf is None else self.mjcf
+
+    @property
+    def model_name(self) -> str:
+        """The model's name in tables and figures: its name, or the MJCF file's stem."""
+        return self.model if self.mjcf is None else self.mjcf.name
+
     @functools.cached_property
     def strategy(self) -> str:
         """The highest strategy the controller has: ankle, hip or step."""
@@ -244,7 +259,7 @@ class CampaignSpec:
     def _check_setup(self) -> None:
         """Check that the model, controller and duration work together (:func:`check_run`)."""
         if self.is_3d:  # the plant builds (the G1's extra is there, its params its own)
-            standing_origin(self.model, self.push(0).params)
+            standing_origin(self.source, self.push(0).params)
             return
         from pushrecovery.control.base import make_controller
         from pushrecovery.sim.registry import make_plant
@@ -345,7 +360,7 @@ class CampaignSpec:
         values = tuple(float(v) for v in swept)
         if self.fraction is not None and azimuth is not None:  # J = f J*_ankle(ψ)
             impulse = float(push) * critical_impulse(
-                body, standing_origin(self.model, body), float(azimuth)
+                body, standing_origin(self.source, body), float(azimuth)
             )
             return Push(index, body, values, float(x0), impulse / body.mass, float(azimuth),
                         float(push))  # fmt: skip
@@ -392,12 +407,18 @@ class CampaignSpec:
 
     # --- storage ---------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """JSON form (``from_dict`` reads it back); ``azimuths``, ``fraction``: 3-D only."""
-        extra = {
+        """JSON form (``from_dict`` reads it back).
+
+        ``azimuths``, ``fraction``: 3-D only; ``mjcf`` (the file and its bodies): model
+        ``mjcf`` only.
+        """
+        extra: dict[str, Any] = {
             name: list(value)
             for name, value in (("azimuths", self.azimuths), ("fraction", self.fraction))
             if value is not None
         }
+        if self.mjcf is not None:
+            extra["mjcf"] = self.mjcf.to_dict()
         return extra | {
             "backend": self.backend,
             "model": self.model,
@@ -436,6 +457,7 @@ class CampaignSpec:
                 push_timeout=data.get("push_timeout", DEFAULT_PUSH_TIMEOUT),
                 azimuths=None if data.get("azimuths") is None else tuple(data["azimuths"]),
                 fraction=None if data.get("fraction") is None else tuple(data["fraction"]),
+                mjcf=None if data.get("mjcf") is None else MjcfSource.from_dict(data["mjcf"]),
             )
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InvalidParameterError(f"malformed campaign spec: {exc}") from None

@@ -19,6 +19,7 @@ from typing import Any
 from pushrecovery.campaign.ranges import value_range
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.mjcf_source import MjcfSource
 
 __all__ = [
     "AZIMUTH_LIMIT",
@@ -34,8 +35,9 @@ __all__ = [
     "standing_origin",
 ]
 
-#: The 3-D models a campaign runs (``sim.registry.PLANTS_3D``).
-MODELS_3D: tuple[str, ...] = ("biped3d", "g1")
+#: The 3-D models a campaign runs (``sim.registry.PLANTS_3D``, and ``mjcf``: the spec's
+#: :class:`~pushrecovery.sim.mjcf_source.MjcfSource`).
+MODELS_3D: tuple[str, ...] = ("biped3d", "g1", "mjcf")
 #: The whole-body controller's strategy sets, by campaign controller name: the highest
 #: strategy it may use (ankle only; + the hip task; + the hip and the stepping task).
 WBC_CONTROLLERS: Mapping[str, str] = {"wbc-ankle": "ankle", "wbc-hip": "hip", "wbc-step": "step"}
@@ -120,11 +122,15 @@ def check_spec3d(spec: Any) -> tuple[float, ...] | None:
     """
     from pushrecovery.control.base import controller_class
 
+    if (spec.model == "mjcf") != (spec.mjcf is not None):
+        raise InvalidParameterError(
+            "model 'mjcf' needs its file (mjcf, an MjcfSource), and mjcf needs model 'mjcf'"
+        )
     if spec.model not in MODELS_3D:
         controller_class(spec.controller)  # raises, naming the controllers
         if spec.azimuths is not None or spec.fraction is not None:
             raise InvalidParameterError(
-                "azimuths and fraction apply to the 3-D models (biped3d, g1) only"
+                "azimuths and fraction apply to the 3-D models (biped3d, g1, mjcf) only"
             )
         return None
     pushes = [p for p in (spec.xdot, spec.impulse, spec.fraction) if p is not None]
@@ -140,8 +146,9 @@ def check_spec3d(spec: Any) -> tuple[float, ...] | None:
         raise InvalidParameterError(
             f"x0 must be 0 on the 3-D model {spec.model} (it stands in its own posture), got {x0!r}"
         )
-    if spec.model == "g1" and spec.sweeps:
-        raise InvalidParameterError("the g1 has the robot's own body: no --param sweeps")
+    if spec.model in ("g1", "mjcf") and spec.sweeps:
+        robot = "the g1" if spec.model == "g1" else "an MJCF model"
+        raise InvalidParameterError(f"{robot} has the robot's own body: no --param sweeps")
     if not spec.duration <= 60.0:
         raise InvalidParameterError(
             f"duration must be at most 60 s on the 3-D models, got {spec.duration:g}"
@@ -155,7 +162,7 @@ def check_spec3d(spec: Any) -> tuple[float, ...] | None:
 
 
 @functools.lru_cache(maxsize=32)
-def push_geometry(model: str, params: BodyParams) -> tuple[tuple[float, float], float]:
+def push_geometry(model: str | MjcfSource, params: BodyParams) -> tuple[tuple[float, float], float]:
     """Return r₀ [m] and d/z₀ [-] of 3-D ``model`` with body ``params``, standing.
 
     r₀ is the standing CoM's ground point (the plant's reset state's x, y, in the frame of
@@ -165,13 +172,15 @@ def push_geometry(model: str, params: BodyParams) -> tuple[tuple[float, float], 
     """
     from pushrecovery.sim.registry import make_plant3d
 
-    if model not in MODELS_3D:
-        raise InvalidParameterError(f"model must be one of {list(MODELS_3D)}, got {model!r}")
+    if not isinstance(model, MjcfSource) and model not in MODELS_3D[:-1]:
+        raise InvalidParameterError(
+            f"model must be one of {list(MODELS_3D[:-1])} or an MjcfSource, got {model!r}"
+        )
     plant = make_plant3d(model, params)
     return plant.standing_origin, plant.push_lever / float(plant.standing_height)
 
 
-def standing_origin(model: str, params: BodyParams) -> tuple[float, float]:
+def standing_origin(model: str | MjcfSource, params: BodyParams) -> tuple[float, float]:
     """Return the standing CoM's ground point r₀ [m] (:func:`push_geometry`)."""
     return push_geometry(model, params)[0]
 

@@ -45,7 +45,7 @@ def _analytic3d(spec: CampaignSpec, params: Any, azimuth: float) -> float:
 
     if spec.strategy not in ("ankle", "hip"):
         return math.nan
-    origin = standing_origin(spec.model, params)
+    origin = standing_origin(spec.source, params)
     return critical_impulse(params, origin, azimuth, spec.strategy) / params.mass
 
 

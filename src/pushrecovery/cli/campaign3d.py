@@ -23,14 +23,14 @@ def spec_3d(model: str, params: Any, strategy: str | None, **options: Any) -> An
     Parameters
     ----------
     model : str
-        ``biped3d`` or ``g1``.
+        ``biped3d``, ``g1`` or ``mjcf`` (with ``mjcf=`` the file's MjcfSource in ``options``).
     params : BodyParams
-        The body (:func:`pushrecovery.cli.bodies3d.params_3d`).
+        The body (:func:`pushrecovery.cli.bodies3d.body_3d`).
     strategy : str or None
         ``--strategy``: the controller ``wbc-STRATEGY`` (None: ``wbc-step``).
     **options
         The rest of the spec: ``impulse``, ``fraction``, ``azimuths``, ``sweeps``,
-        ``samples``, ``seed``, ``duration``, ``batch_size``, ``push_timeout``.
+        ``samples``, ``seed``, ``duration``, ``batch_size``, ``push_timeout``, ``mjcf``.
 
     Returns
     -------
@@ -65,7 +65,7 @@ def write_confusion(
     table : pyarrow.Table
         The campaign's pushes.
     model : str
-        ``biped3d`` or ``g1``.
+        The model's name in the figure (``CampaignSpec.model_name``).
     directory : Path
         Where ``confusion3d.*`` go.
     plot : bool

@@ -348,22 +348,16 @@ def validate(
     measured critical impulse [N s] with the errors, then the confusion matrices and the
     files: tables, CSV, the polar plot and the campaign, under --out (the campaign resumes if
     interrupted); --quick is a shorter first look. The body flags (--preset, --params, --mass,
-    ...) build biped3d; g1 has the robot's own body and refuses them. An MJCF file (--model
-    PATH.xml) runs the critical pushes, not the confusion campaign (--no-confusion).
+    ...) build biped3d; g1 and an MJCF file (--model PATH.xml, its feet and torso named) have
+    the robot's own body and refuse them.
     """
     from pathlib import Path
 
     from pushrecovery.cli.azimuths import azimuths_from
     from pushrecovery.cli.bodies3d import body_3d, is_mjcf
     from pushrecovery.cli.validate3d import QUICK, Validate3DOptions, fraction_list, validate_3d
-    from pushrecovery.errors import InvalidParameterError
     from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
 
-    if is_mjcf(model) and confusion:
-        raise InvalidParameterError(
-            f"--model {model}: the confusion campaign runs the built-in humanoids only; "
-            "pass --no-confusion"
-        )
     quick_values: dict[str, Any] = QUICK if quick else {}
     directions = azimuths_from(azimuth, azimuths) or quick_values.get("azimuths", DEFAULT_AZIMUTHS)
     # The G1's hip task recovers nothing (docs/validation3d.md, "G1: no hip strategy"): its
@@ -398,7 +392,8 @@ def validate(
         "--workers 1 --out out/c3d"
     ),
 )
-@_model("campaign")
+@_model("campaign", files=True)
+@mjcf_options
 @planar_only(
     "campaign", "--backend", "--controller", "--x0", "--xdot", nargs={"--x0": 3, "--xdot": 3}
 )
@@ -452,10 +447,11 @@ def campaign(
     predicted against used strategy. Prints the counts of outcomes, the accuracy, the
     confusion matrix, where prediction and run differ, and the files. Finished batches are
     kept: an interrupted campaign continues with --resume. The body flags (--preset, --params,
-    --mass, ...) build biped3d; g1 has the robot's own body and refuses them and --param.
+    --mass, ...) build biped3d; g1 and an MJCF file (--model PATH.xml, its feet and torso
+    named) have the robot's own body and refuse them and --param.
     """
     from pushrecovery.cli.azimuths import azimuths_from
-    from pushrecovery.cli.bodies3d import params_3d
+    from pushrecovery.cli.bodies3d import body_3d
     from pushrecovery.cli.campaign3d import echo_causes, spec_3d, write_confusion
     from pushrecovery.errors import InvalidParameterError
 
@@ -474,17 +470,19 @@ def campaign(
                 if impulse is None
                 else "give --impulse or --fraction, not both"
             )
+        params, plant = body_3d(model, kwargs)
         spec = spec_3d(
-            model,
-            params_3d(model, kwargs),
+            "mjcf" if plant is not None else model,
+            params,
             strategy,
             impulse=impulse,
             fraction=fraction,
             azimuths=directions,
+            mjcf=None if plant is None else plant.source,
             **run.spec_options(),
         )
     result = run.run(spec)
-    confusion, files = write_confusion(result.table, spec.model, result.directory, run.plot)
+    confusion, files = write_confusion(result.table, spec.model_name, result.directory, run.plot)
     run.show(result, files, as_json, lambda: echo_causes(confusion))
 
 

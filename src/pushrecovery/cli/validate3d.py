@@ -120,7 +120,7 @@ def validate_3d(options: Validate3DOptions, params: Any, plant: Any = None) -> d
         (figure,) = save_figure(validation3d_figure(result, step), stem, ["png"])
         data["files"] = files | {"polar": str(figure)}
     if options.confusion:
-        data["confusion"] = _confusion(options, params)
+        data["confusion"] = _confusion(options, params, plant)
     return data
 
 
@@ -177,19 +177,24 @@ def _write_csv(result: Any, path: Path) -> None:
             writer.writerow({**row, "fell": fell})
 
 
-def _confusion(options: Validate3DOptions, params: Any) -> dict[str, Any]:
-    """Run the confusion campaigns (resumable) and write the matrix; return its JSON."""
+def _confusion(options: Validate3DOptions, params: Any, plant: Any = None) -> dict[str, Any]:
+    """Run the confusion campaigns (resumable) and write the matrix; return its JSON.
+
+    ``plant``: an MJCF file's plant, whose source the campaigns' workers build.
+    """
     from pushrecovery.campaign import CampaignError, CampaignSpec, run_campaign
     from pushrecovery.cli.campaign3d import write_confusion
     from pushrecovery.cli.progress import Progress
 
     # One campaign per push size (the sizes need not be evenly spaced: a campaign's range is),
     # each resumable in its own directory.
-    directory = options.out / f"confusion_{options.model}"
+    source = None if plant is None else plant.source
+    directory = options.out / f"confusion_{options.model if source is None else source.name}"
     specs = [
         CampaignSpec(
             backend="mujoco",
-            model=options.model,
+            model=options.model if source is None else "mjcf",
+            mjcf=source,
             controller="wbc-step",
             params=params,
             x0=(0.0, 0.0, 1.0),
@@ -223,7 +228,7 @@ def _confusion(options: Validate3DOptions, params: Any) -> dict[str, Any]:
     import pyarrow as pa
 
     table = pa.concat_tables(tables)
-    matrix, files = write_confusion(table, options.model, directory)
+    matrix, files = write_confusion(table, specs[0].model_name, directory)
     click.echo(f"confusion campaign in {directory}", err=True)
     return {
         "labels": ["ankle", "hip", "step", "fall"],

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.extras import require
+from pushrecovery.sim.mjcf_source import MjcfSource
 
 if TYPE_CHECKING:  # listing the models must not load numpy (pushrecovery --help)
     from pushrecovery.ground.support import Support
@@ -120,19 +121,24 @@ def make_plant(
     return plant
 
 
-def make_plant3d(name: str, params: BodyParams) -> Humanoid3DPlant:
+def make_plant3d(name: str | MjcfSource, params: BodyParams) -> Humanoid3DPlant:
     """Build the 3-D humanoid ``name`` of :data:`PLANTS_3D` (a MuJoCo plant) with its own type.
 
     :func:`make_plant` with the MuJoCo backend, for callers that use what only the 3-D plants
-    have (the whole-body controller, pushes from any azimuth).
+    have (the whole-body controller, pushes from any azimuth). An
+    :class:`~pushrecovery.sim.mjcf_source.MjcfSource` builds its file's plant, with the
+    file's own body (``params`` is not used).
 
     Raises
     ------
     InvalidParameterError
-        If ``name`` is not one of :data:`MUJOCO_3D_MODELS`.
+        If ``name`` is not one of :data:`MUJOCO_3D_MODELS`, or the MJCF file's plant does not
+        build (:meth:`MjcfSource.plant <pushrecovery.sim.mjcf_source.MjcfSource.plant>`).
     """
     from pushrecovery.arguments import require_type
 
+    if isinstance(name, MjcfSource):
+        return name.plant()
     require_type("name", name, str)
     if name not in MUJOCO_3D_MODELS:
         raise InvalidParameterError(

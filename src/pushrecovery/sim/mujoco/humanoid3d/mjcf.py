@@ -29,6 +29,7 @@ import numpy as np
 
 from pushrecovery.control.wbc.bodies import body_id
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.sim.mjcf_source import MjcfSource
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import CONTROL_PERIOD, Humanoid3DPlant
 from pushrecovery.sim.mujoco.humanoid3d.robots import (
     LegJoints,
@@ -222,5 +223,7 @@ class MjcfPlant(Humanoid3DPlant):
     ) -> None:
         described = describe_mjcf(path, feet=feet, torso=torso, keyframe=keyframe)
         self.description = described
+        #: What names this plant for a campaign's workers.
+        self.source = MjcfSource(str(path), (feet[0], feet[1]), torso, keyframe)
         super().__init__(described.params, described.model, described.qpos, tuple(feet),
                          torso=torso, upright=torso)  # fmt: skip
