@@ -101,3 +101,43 @@ def test_the_page_shows_the_section(tiny: None, tmp_path: Path, monkeypatch) -> 
     monkeypatch.setattr(robots, "robot_path", no_extra)
     html = write_report(load_params(), tmp_path, skip=ONLY_3D).read_text()
     assert '<section id="humanoid3d">' in html and "<h2>3-D humanoid</h2>" in html
+
+
+def test_a_report_on_an_mjcf_robot_validates_and_films_it(
+    tiny: None, tmp_path: Path, capsys
+) -> None:
+    # The user's robot (the biped3d written to an MJCF file, its bent-knee keyframe) in place
+    # of the biped3d: its table and filmstrip are named after the file, its body is the file's.
+    pytest.importorskip("mujoco")
+    from pushrecovery.sim.mjcf_source import MjcfSource
+    from pushrecovery.sim.mujoco.humanoid3d.biped3d import build_biped3d
+    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos
+
+    spec = build_biped3d(load_params())
+    spec.add_key(name="bent", qpos=list(bent_knee_qpos(spec.compile())))
+    path = tmp_path / "my_robot.xml"
+    path.write_text(spec.to_xml())
+    robot = MjcfSource(str(path), ("left_foot", "right_foot"), "torso", "bent")
+    grids = replace(SIZES["small"], azimuths3d=(90.0,), tolerance3d=0.2, duration3d=1.5)
+    ctx = _Context(robot.plant().params, tmp_path, grids, workers=1, scheduler=None, robot=robot)
+    section = section3d.humanoid3d_section(ctx)
+    (table,) = section.tables
+    assert table.ident == "validation3d-my_robot"
+    assert [row[:2] for row in table.rows] == [("90", "ankle")]
+    assert (tmp_path / "humanoid3d" / "validation3d-my_robot.json").is_file()
+    if section.rendering is None:
+        (strip,) = section.strips
+        assert strip.model == "my_robot" and "my_robot" in strip.caption
+    # The command line: --model PATH.xml with its bodies; body flags are refused in one line.
+    from pushrecovery.cli import main
+
+    body = ["--model", str(path), "--left-foot-body", "left_foot", "--right-foot-body",
+            "right_foot", "--torso-body", "torso", "--keyframe", "bent"]  # fmt: skip
+    with pytest.raises(SystemExit) as caught:
+        main(["report", *body, "--mass", "60", "--out", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert caught.value.code == 2 and "has the model's own body" in err
+    with pytest.raises(SystemExit) as caught:
+        main(["report", "--torso-body", "torso", "--out", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert caught.value.code == 2 and "--torso-body needs --model PATH.xml" in err

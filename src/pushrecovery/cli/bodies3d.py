@@ -12,7 +12,7 @@ from typing import Any
 
 from pushrecovery.cli.options import params_from
 
-__all__ = ["body_3d", "is_mjcf", "mjcf_plant", "params_3d"]
+__all__ = ["body_3d", "is_mjcf", "mjcf_body", "mjcf_plant", "params_3d"]
 
 
 def body_3d(model: str, kwargs: dict[str, Any]) -> tuple[Any, Any]:
@@ -66,6 +66,26 @@ def mjcf_plant(model: str, kwargs: dict[str, Any], *, plant: bool = True) -> Any
     if not plant:
         return describe_mjcf(model, feet=feet, torso=torso, keyframe=keyframe)
     return MjcfPlant(model, feet, torso, keyframe)
+
+
+def mjcf_body(model: str, kwargs: dict[str, Any]) -> tuple[Any, Any]:
+    """Return the body of ``--model PATH.xml`` and the file's MjcfSource (options popped).
+
+    Raises
+    ------
+    InvalidParameterError
+        As :func:`mjcf_plant`, or if ``model`` is not an MJCF file (``*.xml``).
+    """
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.sim.mjcf_source import MjcfSource
+
+    if not is_mjcf(model):
+        raise InvalidParameterError(f"--model must be an MJCF file PATH.xml, got {model!r}")
+    left, right = kwargs.get("left_foot_body"), kwargs.get("right_foot_body")
+    torso, keyframe = kwargs.get("torso_body"), kwargs.get("keyframe")
+    described = mjcf_plant(model, kwargs, plant=False)  # refuses missing bodies, by name
+    source = MjcfSource(model, (str(left), str(right)), str(torso), keyframe)
+    return described.params, source
 
 
 def params_3d(model: str, kwargs: dict[str, Any]) -> Any:

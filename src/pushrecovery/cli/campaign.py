@@ -16,7 +16,14 @@ import click
 from pushrecovery.cli.app import example
 from pushrecovery.cli.campaign_options import SCHEDULER, WORKERS, CampaignRun, run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, humanoid_only
-from pushrecovery.cli.options import body_options, emit, out_option, params_from, range_option
+from pushrecovery.cli.options import (
+    body_options,
+    emit,
+    mjcf_options,
+    out_option,
+    params_from,
+    range_option,
+)
 from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 
 __all__ = ["campaign", "report"]
@@ -151,6 +158,15 @@ def campaign(
 )
 @WORKERS
 @SCHEDULER
+@click.option(
+    "--model",
+    "robot",
+    default=None,
+    metavar="PATH.xml",
+    help="Your own humanoid's MJCF file: the report's body is derived from it and its 3-D "
+    "section validates and films it (name its feet and torso; docs/your_robot.md).",
+)
+@mjcf_options
 @body_options
 def report(
     out: str,
@@ -158,6 +174,7 @@ def report(
     workers: int | None,
     scheduler: str | None,
     as_json: bool,
+    robot: str | None,
     **kwargs: Any,
 ) -> None:
     """Write one self-contained HTML page about a parameter set.
@@ -167,14 +184,21 @@ def report(
     MuJoCo with their accuracy and confusion matrices, the MuJoCo critical pushes, a filmstrip
     per strategy and the 3-D humanoid; SI units throughout. Prints the page's path
     (OUT/index.html); the campaigns are kept in OUT and reused by a rerun with the same body
-    and grids.
+    and grids. With --model PATH.xml the body is your robot's, derived from its MJCF file
+    (body flags refused), and the 3-D section validates and films it beside the G1.
     """
+    from pushrecovery.cli.bodies3d import mjcf_body, params_3d
     from pushrecovery.report import write_report
 
-    params = params_from(kwargs)
+    source = None
+    if robot is None:
+        params = params_3d("biped3d", kwargs)  # refuses the MJCF options without --model
+    else:
+        params, source = mjcf_body(robot, kwargs)
     # Each section's start and end on a terminal only: a piped stderr keeps its one-line errors.
     progress = (lambda line: click.echo(line, err=True)) if sys.stderr.isatty() else None
     path = write_report(
-        params, Path(out), full=full, workers=workers, scheduler=scheduler, progress=progress
-    )
+        params, Path(out), full=full, workers=workers, scheduler=scheduler, progress=progress,
+        robot=source,
+    )  # fmt: skip
     emit({"report": str(path)}, as_json)

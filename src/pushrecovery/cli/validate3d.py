@@ -83,7 +83,7 @@ def validate_3d(options: Validate3DOptions, params: Any, plant: Any = None) -> d
     out.mkdir(parents=True, exist_ok=True)
     data: dict[str, Any] = {"backend": "mujoco", "model": options.model}
     result = step = None
-    name = Path(options.model).stem if plant is not None else options.model
+    name = options.model if plant is None else plant.source.name
     stem = out / f"validation3d_{name}"
     files: dict[str, str] = {}
     balance = tuple(s for s in options.strategies if s != "step")

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from pushrecovery.arguments import bounded_float, positive_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.mjcf_source import MjcfSource
 
 if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.render3d import Recording3D
@@ -27,7 +28,7 @@ STRIP_CONTROLLERS = ("ankle", "hip", "step")
 
 def filmstrip_run(
     params: BodyParams,
-    model: str,
+    model: str | MjcfSource,
     azimuth: float,
     fraction: float,
     controller: str,
@@ -39,8 +40,8 @@ def filmstrip_run(
     ----------
     params : BodyParams
         The biped3d's body (the G1 has its own, ``robot_params("g1")``).
-    model : str
-        ``biped3d`` or ``g1``.
+    model : str or MjcfSource
+        ``biped3d``, ``g1`` or an MJCF file's humanoid (its own body).
     azimuth : float
         The push's direction [deg], 0 forward (+x), 90 left (+y).
     fraction : float

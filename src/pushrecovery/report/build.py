@@ -33,6 +33,7 @@ from pushrecovery.report.data import FailedSection, Footer, Report, Section, Ver
 from pushrecovery.report.humanoid3d import humanoid3d_section
 from pushrecovery.report.mujoco import _critical, _filmstrips
 from pushrecovery.report.sections import _bounds, _figures, _map, _plane, _steps
+from pushrecovery.sim.mjcf_source import MjcfSource
 from pushrecovery.surfaces.bounds import bounds_data
 
 __all__ = ["build_report"]
@@ -67,6 +68,7 @@ def build_report(
     workers: int | None = None,
     scheduler: str | None = None,
     progress: Callable[[str], None] | None = None,
+    robot: MjcfSource | None = None,
 ) -> Report:
     """Compute every section of the report; return them as data.
 
@@ -108,7 +110,7 @@ def build_report(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     skipped = set(skip) | (set(MUJOCO_SECTIONS) if not mujoco else set())
-    ctx = _Context(params, out, grids, workers, scheduler)
+    ctx = _Context(params, out, grids, workers, scheduler, robot=robot)
     sections: dict[str, Section] = {}
     times: dict[str, float] = {}
     start = time.perf_counter()

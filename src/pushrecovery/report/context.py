@@ -10,6 +10,7 @@ from typing import Any
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.report.config import PushGrid, Range, ReportGrids
+from pushrecovery.sim.mjcf_source import MjcfSource
 
 
 @dataclass
@@ -21,6 +22,8 @@ class _Context:
     scheduler: str | None
     notes: dict[str, list[str]] = field(default_factory=dict)
     summaries: dict[str, dict[str, Any]] = field(default_factory=dict)
+    #: The user's MJCF humanoid whose body ``params`` is (None: the body flags').
+    robot: MjcfSource | None = None
 
     def note(self, key: str, text: str) -> None:
         self.notes.setdefault(key, []).append(text)

@@ -88,6 +88,9 @@ def write_report(
         Address of a ``dask.distributed`` scheduler to run the campaigns on.
     progress : callable, optional
         Called with one line of text as each section starts and ends.
+    robot : MjcfSource, optional
+        The user's MJCF humanoid whose derived body ``params`` is: the "3-D humanoid" section
+        validates it (ankle) beside the G1, and films it in place of the biped3d.
 
     Returns
     -------

@@ -2,7 +2,8 @@
 
 Computed only when MuJoCo and the ``robots`` extra are installed; otherwise the section is one
 line saying how to get it (:data:`HINT`). For the biped3d of the report's body (ankle and hip)
-and the G1 (ankle), the critical push at each azimuth of the grids (``azimuths3d``,
+and the G1 (ankle) (a report on the user's MJCF humanoid, ``robot``: that robot in place of the
+biped3d, ankle), the critical push at each azimuth of the grids (``azimuths3d``,
 ``tolerance3d``, ``duration3d``) against the 2-D prediction
 (:func:`~pushrecovery.experiments.validation3d.run_validation3d`, the azimuths shared over
 the report's worker processes); then the filmstrips of :data:`~.config.HUMANOID3D_STRIPS`
@@ -28,6 +29,7 @@ from pushrecovery.report.config import HUMANOID3D_STRIPS
 from pushrecovery.report.context import _Context
 from pushrecovery.report.data import Filmstrip, Humanoid3DSection, Picture, Table
 from pushrecovery.report.markup import num, percent_interval
+from pushrecovery.sim.mjcf_source import MjcfSource
 
 __all__ = ["HINT", "humanoid3d_section"]
 
@@ -42,6 +44,8 @@ VALIDATIONS: tuple[tuple[str, tuple[str, ...]], ...] = (
 )
 #: One filmstrip (:data:`~.config.HUMANOID3D_STRIPS`).
 Strip = tuple[str, float, float, str, str, tuple[float, ...]]
+#: A validated or filmed model: a built-in's name, or the user's MJCF humanoid.
+Model = str | MjcfSource
 #: Bumped when what a cached file holds changes meaning.
 _CACHE_VERSION = 1
 
@@ -100,25 +104,34 @@ def _code_fingerprint() -> str:
     return digest.hexdigest()[:16]
 
 
-def _settings(ctx: _Context, model: str, **extra: Any) -> dict[str, Any]:
+def _name(model: Model) -> str:
+    """Return the model's name in files and captions (an MJCF file's stem)."""
+    return model if isinstance(model, str) else model.name
+
+
+def _settings(ctx: _Context, model: Model, **extra: Any) -> dict[str, Any]:
     """Return the settings a cached file must match: the body, the grid, ``extra``, the code."""
     from pushrecovery import __version__
 
-    body = ctx.params.to_dict() if model == "biped3d" else "robot"
+    body: Any = ctx.params.to_dict() if model == "biped3d" else "robot"
+    if isinstance(model, MjcfSource):
+        body = model.to_dict()
     return {"cache": _CACHE_VERSION, "version": __version__, "code": _code_fingerprint(),
-            "model": model, "body": body, **extra}  # fmt: skip
+            "model": _name(model), "body": body, **extra}  # fmt: skip
 
 
-def _validate_one(model: str, azimuth: float, strategies: tuple[str, ...], params: Any,
+def _validate_one(model: Model, azimuth: float, strategies: tuple[str, ...], params: Any,
                   tolerance: float, duration: float) -> Any:  # fmt: skip
     """One azimuth of the validation (a worker process's job)."""
     from pushrecovery.experiments.validation3d import run_validation3d
 
-    return run_validation3d(model, [azimuth], strategies, params=params,
-                            rel_tolerance=tolerance, duration=duration)  # fmt: skip
+    plant = None if isinstance(model, str) else model.plant()
+    return run_validation3d(_name(model), [azimuth], strategies, params=params,
+                            rel_tolerance=tolerance, duration=duration,
+                            plant=plant)  # fmt: skip
 
 
-def _run_validation(ctx: _Context, model: str, strategies: tuple[str, ...]) -> Any:
+def _run_validation(ctx: _Context, model: Model, strategies: tuple[str, ...]) -> Any:
     """Run the validation, one azimuth per job over the report's worker processes."""
     grids = ctx.grids
     params = ctx.params if model == "biped3d" else None
@@ -139,7 +152,7 @@ def _run_validation(ctx: _Context, model: str, strategies: tuple[str, ...]) -> A
     return replace(parts[0], rows=tuple(row for part in parts for row in part.rows))
 
 
-def _validation(ctx: _Context, model: str, strategies: tuple[str, ...]) -> Any:
+def _validation(ctx: _Context, model: Model, strategies: tuple[str, ...]) -> Any:
     """Return the validation of ``model``, from ``OUT/humanoid3d`` when computed alike."""
     from pushrecovery.experiments.validation3d import Validation3D, ValidationRow
 
@@ -147,7 +160,7 @@ def _validation(ctx: _Context, model: str, strategies: tuple[str, ...]) -> Any:
     settings = _settings(ctx, model, strategies=list(strategies),
                          azimuths=list(grids.azimuths3d), tolerance=grids.tolerance3d,
                          duration=grids.duration3d)  # fmt: skip
-    path = ctx.out / "humanoid3d" / f"validation3d-{model}.json"
+    path = ctx.out / "humanoid3d" / f"validation3d-{_name(model)}.json"
     cached = _read(path, settings)
     if cached is not None:
         try:
@@ -159,7 +172,7 @@ def _validation(ctx: _Context, model: str, strategies: tuple[str, ...]) -> Any:
             fields = cached | {"rows": rows, "origin": tuple(cached["origin"]),
                                "strategies": tuple(cached["strategies"]),
                                "curves": curves}  # fmt: skip
-            ctx.note("humanoid3d", f"Reused the {model} validation in {path.name}.")
+            ctx.note("humanoid3d", f"Reused the {_name(model)} validation in {path.name}.")
             return Validation3D(**fields)
         except (KeyError, TypeError, ValueError):
             pass  # another layout: compute afresh
@@ -209,12 +222,19 @@ def _polar(ctx: _Context, result: Any) -> Picture:
 
 
 def _strip(ctx: _Context, key: str, spec: Strip) -> Filmstrip:
-    """Render (or reuse) one filmstrip of :data:`HUMANOID3D_STRIPS`."""
+    """Render (or reuse) one filmstrip of :data:`HUMANOID3D_STRIPS`.
+
+    A report on the user's robot films it in place of the biped3d.
+    """
     import shutil
 
     from pushrecovery.sim.mujoco.humanoid3d.render3d import render_recording3d
 
-    model, azimuth, fraction, controller, caption, times = spec
+    name, azimuth, fraction, controller, caption, times = spec
+    model: Model = name
+    if name == "biped3d" and ctx.robot is not None:
+        model, caption = ctx.robot, caption.replace("biped3d", ctx.robot.name)
+        key = key.replace("biped3d", ctx.robot.name)
     folder = ctx.out / "humanoid3d"
     png, stamp = folder / f"{key}.png", folder / f"{key}.json"
     settings = _settings(ctx, model, azimuth=azimuth, fraction=fraction, controller=controller,
@@ -234,14 +254,14 @@ def _strip(ctx: _Context, key: str, spec: Strip) -> Filmstrip:
         from pushrecovery.sim.mujoco.humanoid3d.robots import robot_licence
 
         shutil.copyfile(robot_licence("g1"), folder / "g1-LICENSE")
-    mass = _mass(ctx, model)
+    mass = ctx.params.mass if isinstance(model, MjcfSource) else _mass(ctx, model)
     text = (
         f"{caption}: {impulse:.1f} N s ({fraction:g} × the 2-D ankle limit at {azimuth:g}°), "
         f"{outcome}. Red: CoM and its ground point; blue: capture point; green: CoP measured "
         "from the contact forces; magenta: the support polygon of the soles in contact."
         + (" The G1 model: Unitree, BSD-3-Clause (g1-LICENSE)." if model == "g1" else "")
     )
-    return Filmstrip(key, model, caption, impulse, impulse / mass, outcome,
+    return Filmstrip(key, _name(model), caption, impulse, impulse / mass, outcome,
                      Picture(png, text, "sim.mujoco.humanoid3d.render3d"))  # fmt: skip
 
 
@@ -260,7 +280,10 @@ def humanoid3d_section(ctx: _Context) -> Humanoid3DSection:
     from pushrecovery.sim.mujoco.render import require_offscreen_gl
 
     polar, tables = [], []
-    for model, strategies in VALIDATIONS:
+    validations: list[tuple[Model, tuple[str, ...]]] = list(VALIDATIONS)
+    if ctx.robot is not None:  # the user's robot (its own body) in place of the biped3d
+        validations[0] = (ctx.robot, ("ankle",))
+    for model, strategies in validations:
         result = _validation(ctx, model, strategies)
         polar.append(_polar(ctx, result))
         tables.append(_table(result))

@@ -18,7 +18,17 @@ from pushrecovery.errors import InvalidParameterError
 if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant
 
-__all__ = ["MjcfSource"]
+__all__ = ["MjcfSource", "model_name"]
+
+
+def model_name(path: str | Path) -> str:
+    """Return the name of MJCF file ``path``'s humanoid: its stem, or a scene's folder's name.
+
+    A ``scene.xml`` (robot and floor, as MuJoCo Menagerie's ``unitree_h1/scene.xml``) takes the
+    name of its folder.
+    """
+    file = Path(path)
+    return file.parent.name if file.stem == "scene" and file.parent.name else file.stem
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,8 +73,8 @@ class MjcfSource:
 
     @property
     def name(self) -> str:
-        """The file's stem, which names the campaign's tables and figures."""
-        return Path(self.path).stem
+        """The name of the campaign's tables and figures (:func:`model_name`)."""
+        return model_name(self.path)
 
     def plant(self) -> MjcfPlant:
         """Build the file's 3-D plant (MuJoCo, the ``sim`` extra).

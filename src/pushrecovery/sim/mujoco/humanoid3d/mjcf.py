@@ -29,7 +29,7 @@ import numpy as np
 
 from pushrecovery.control.wbc.bodies import body_id
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.sim.mjcf_source import MjcfSource
+from pushrecovery.sim.mjcf_source import MjcfSource, model_name
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import CONTROL_PERIOD, Humanoid3DPlant
 from pushrecovery.sim.mujoco.humanoid3d.robots import (
     LegJoints,
@@ -196,7 +196,7 @@ def describe_mjcf(
         ankle_pitch=[f[2] for f in found],
         ankle_roll=None if None in rolls else [int(r) for r in rolls if r is not None],
     )
-    return derive_description(Path(path).stem, model, start, legs, foot_ids, joints)
+    return derive_description(model_name(path), model, start, legs, foot_ids, joints)
 
 
 class MjcfPlant(Humanoid3DPlant):
