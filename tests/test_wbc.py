@@ -514,3 +514,22 @@ def test_the_h1_stands_and_recovers_a_forward_push_with_its_contact_wrench_cones
     pushed, _ = push(plant, 10.0, duration=3.0)  # forward, 60 % of the corrected ankle limit
     assert pushed.outcome is Outcome.RECOVERED
     assert pushed.physics is not None and pushed.physics.foot_slip < 5e-3
+
+
+def test_a_light_body_pushed_inside_its_ankle_region_recovers_with_the_ankles_within_limits():
+    # Issue 33's case: 48 kg, CoM 0.78 m, upper body ±60 N m, ±0.6 rad, 0.6 m/s (28.8 N s)
+    # toward −45°: the ground plane says ankle (capture point 30 mm inside the polygon, 6 mm
+    # with the push-height correction). It once used the hip past its limits and fell; with
+    # the contact wrench cones it recovers with the ankles, every motor within its limit and
+    # the feet still.
+    params = load_params(overrides={
+        "mass": 48.0, "com_height": 0.78, "torque_max": 60.0, "flywheel_angle_max": 0.6,
+        "torque_max_roll": 60.0, "flywheel_angle_max_roll": 0.6,
+    })  # fmt: skip
+    plant = Biped3DPlant(params)
+    run = run_push3d(plant, wbc_for(plant), Push3D(28.8, -45.0), duration=6.0)
+    assert run.outcome is Outcome.RECOVERED
+    assert run.extras.steps == 0 and run.extras.peak_hip_torque < 1.0  # the ankles only
+    assert run.extras.max_torso_tilt < 0.05
+    assert all(use <= 1.0 for _, use in run.physics.torque_use)
+    assert run.physics.foot_slip < 0.005
