@@ -77,8 +77,10 @@ def test_humanoid_simulate_runs_an_mjcf_file(biped_file: Path, capsys) -> None:
 @pytest.mark.parametrize(
     ("extra", "words"),
     [
-        ((), "left foot must be a body of the model, got 'None'; candidates: left_foot, "
-             "right_foot"),
+        (("--left-foot-body", "left_foot"), "give both --left-foot-body and --right-foot-body"),
+        (("--left-foot-body", "torso_x", "--right-foot-body", "right_foot"),
+         "left foot must be a body of the model, got 'torso_x'; candidates: left_foot, "
+         "right_foot"),
         (("--left-foot-body", "left_foot", "--right-foot-body", "right_foot", "--torso-body",
           "head"), "torso must be a body of the model, got 'head'; candidates: torso"),
         (("--left-foot-body", "left_foot", "--right-foot-body", "right_foot", "--torso-body",
@@ -229,3 +231,52 @@ def test_humanoid_campaign_and_validate_take_an_mjcf_file(
         "1.5", "1.0", "--out", str(tmp_path / "d"),
     )  # fmt: skip
     assert code == 2 and "an MJCF model has the robot's own body" in err
+
+
+def test_feet_and_torso_are_found_by_their_names(biped_file: Path, tmp_path: Path) -> None:
+    # The rules (mjcf module docstring) find what the options would name, on the biped's file
+    # and on the robots' own files (the G1's ankle roll link, below its ankle pitch link).
+    named = describe_mjcf(biped_file, feet=FEET, torso="torso", keyframe="stand")
+    found = describe_mjcf(biped_file, keyframe="stand")
+    assert found.feet == named.feet and found.torso == "torso" and found.params == named.params
+    from pushrecovery.sim.mujoco.humanoid3d import robots
+
+    try:
+        paths = {name: robots.robot_path(name) for name in ("g1", "h1")}
+    except robots.RobotsExtraMissing:
+        paths = {}
+    expected = {"g1": ("left_ankle_roll_link", "right_ankle_roll_link"),
+                "h1": ("left_ankle_link", "right_ankle_link")}  # fmt: skip
+    for name, path in paths.items():
+        robot = describe_mjcf(path)
+        assert tuple(robot.model.body(i).name for i in robot.feet) == expected[name]
+        assert robot.torso == "torso_link"
+
+
+def test_bodies_the_rules_cannot_decide_are_refused_listing_the_candidates(
+    tmp_path: Path,
+) -> None:
+    def variant(edit) -> Path:
+        spec = build_biped3d(load_params())
+        edit(spec)
+        path = tmp_path / "variant.xml"
+        path.write_text(spec.to_xml())
+        return path
+
+    def camera(spec) -> None:  # a second body whose name holds "torso"
+        spec.body("torso").add_body(name="torso_camera", pos=[0, 0, 0.3]).add_geom(size=[0.02])
+
+    def hand(spec) -> None:  # a second left "foot": a hand with a sole
+        spec.body("torso").add_body(name="left_hand_sole", pos=[0, 0.3, 0.3]).add_geom(size=[0.02])
+
+    def rename(spec) -> None:
+        spec.body("torso").name = "upper"
+
+    cases = ((camera, "torso could not be found by its name: torso, torso_camera"),
+             (hand, "feet could not be found by their names (left: ['left_foot', "
+                    "'left_hand_sole'], right: ['right_foot'])"),
+             (rename, "torso could not be found by its name (none holds"))  # fmt: skip
+    for edit, words in cases:
+        with pytest.raises(InvalidParameterError) as caught:
+            describe_mjcf(variant(edit))
+        assert words in str(caught.value)

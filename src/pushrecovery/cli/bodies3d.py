@@ -61,7 +61,12 @@ def mjcf_plant(model: str, kwargs: dict[str, Any], *, plant: bool = True) -> Any
     require_extra("sim", f"--model {model}")
     from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant, describe_mjcf
 
-    feet = (kwargs.pop("left_foot_body"), kwargs.pop("right_foot_body"))
+    left, right = kwargs.pop("left_foot_body"), kwargs.pop("right_foot_body")
+    if (left is None) != (right is None):
+        raise InvalidParameterError(
+            "give both --left-foot-body and --right-foot-body, or neither (found by their names)"
+        )
+    feet = None if left is None else (left, right)
     torso, keyframe = kwargs.pop("torso_body"), kwargs.pop("keyframe")
     if not plant:
         return describe_mjcf(model, feet=feet, torso=torso, keyframe=keyframe)
@@ -81,10 +86,10 @@ def mjcf_body(model: str, kwargs: dict[str, Any]) -> tuple[Any, Any]:
 
     if not is_mjcf(model):
         raise InvalidParameterError(f"--model must be an MJCF file PATH.xml, got {model!r}")
-    left, right = kwargs.get("left_foot_body"), kwargs.get("right_foot_body")
-    torso, keyframe = kwargs.get("torso_body"), kwargs.get("keyframe")
-    described = mjcf_plant(model, kwargs, plant=False)  # refuses missing bodies, by name
-    source = MjcfSource(model, (str(left), str(right)), str(torso), keyframe)
+    keyframe = kwargs.get("keyframe")
+    described = mjcf_plant(model, kwargs, plant=False)  # the bodies given or found
+    left, right = (described.model.body(i).name for i in described.feet)
+    source = MjcfSource(model, (left, right), str(described.torso), keyframe)
     return described.params, source
 
 

@@ -284,9 +284,19 @@ def mjcf_options(command: Any) -> Any:
     """Add the options of ``--model PATH.xml``: its feet, torso and standing keyframe."""
     for flag, what in (
         ("--keyframe", "--model PATH.xml: the keyframe of the standing pose (default qpos0)."),
-        ("--torso-body", "--model PATH.xml: the upper body held upright and pushed."),
-        ("--right-foot-body", "--model PATH.xml: the right foot's body."),
-        ("--left-foot-body", "--model PATH.xml: the left foot's body."),
+        (
+            "--torso-body",
+            "--model PATH.xml: the upper body held upright and pushed (default: "
+            "found by its name, docs/your_robot.md).",
+        ),
+        (
+            "--right-foot-body",
+            "--model PATH.xml: the right foot's body (default: found by its name).",
+        ),
+        (
+            "--left-foot-body",
+            "--model PATH.xml: the left foot's body (default: found by its name).",
+        ),
     ):
         command = click.option(flag, default=None, metavar="NAME", help=what)(command)
     return command

@@ -14,14 +14,27 @@ chains hold, found by their axes at that pose (world frame, x forward, y left, z
   within 25° of ±y after the hip pitch, the **ankle roll** the last within 25° of ±x after the
   hip roll (none: an ankle that only pitches).
 
-A foot or torso that is not a body of the model, or a leg without those joints, is refused in
-one line naming it (and, for a missing body, the model's bodies that could be meant).
+Feet and torso not named are found by their names (:func:`find_bodies`):
+
+* a **foot** is a body whose name holds ``foot``, ``ankle``, ``toe`` or ``sole`` and none of
+  whose descendants does (the last such body of its chain: the G1's ``left_ankle_roll_link``,
+  not its ``left_ankle_pitch_link``); it is left if its name holds ``left`` (or starts with
+  ``l_``, or ends with ``_l``), right likewise, else by the side of the standing pose it is on
+  (y > 0: left);
+* the **torso** is the one body whose name holds the first of ``torso``, ``trunk``, ``chest``,
+  ``waist``, ``pelvis``, ``base`` that any body's name holds.
+
+Where the rules find no foot for a side, two or more, or several torsos, the error lists the
+candidates in one line. A foot or torso that is not a body of the model, or a leg without those
+joints, is refused in one line naming it (and, for a missing body, the model's bodies that
+could be meant).
 :class:`MjcfPlant` is the 3-D plant of such a model (:mod:`.plant3d`).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -38,14 +51,14 @@ from pushrecovery.sim.mujoco.humanoid3d.robots import (
     torque_motors,
 )
 
-__all__ = ["AXIS_TOLERANCE", "MjcfPlant", "describe_mjcf", "load_mjcf"]
+__all__ = ["AXIS_TOLERANCE", "MjcfPlant", "describe_mjcf", "find_bodies", "load_mjcf"]
 
 #: A hinge is a pitch (roll) joint when its axis is within this angle of ±y (±x) [deg].
 AXIS_TOLERANCE = 25.0
-#: Words that name a foot or an upper body, for the candidates of a missing body's error.
+#: Words that name a foot or an upper body (the torso's in the order the rules try them).
 _HINTS = {
     "foot": ("foot", "ankle", "toe", "sole"),
-    "torso": ("torso", "pelvis", "trunk", "base", "waist", "chest"),
+    "torso": ("torso", "trunk", "chest", "waist", "pelvis", "base"),
 }
 
 
@@ -100,6 +113,72 @@ def _body(model: Any, name: object, role: str) -> int:
     )
 
 
+def _side(name: str) -> str | None:
+    """Return ``left`` or ``right`` where a body's name says which, else None."""
+    low = name.lower()
+    for side, short in (("left", "l"), ("right", "r")):
+        if side in low or low.startswith(f"{short}_") or low.endswith(f"_{short}"):
+            return side
+    return None
+
+
+def find_bodies(
+    model: Any, data: Any, feet: tuple[str, str] | None, torso: str | None
+) -> tuple[tuple[str, str], str]:
+    """Return the feet (left, right) and torso: those given, else found by the module's rules.
+
+    ``data`` holds the standing pose's kinematics (the side of a foot whose name says none).
+
+    Raises
+    ------
+    InvalidParameterError
+        Where the rules find no body or several for a role, listing the candidates.
+    """
+    names = [model.body(i).name for i in range(model.nbody)]
+    if feet is None:
+        words = _HINTS["foot"]
+        marked = {i for i in range(1, model.nbody) if any(w in names[i].lower() for w in words)}
+        # The last marked body of each chain: no marked body below it.
+        ends = [i for i in sorted(marked) if not any(_ancestor(model, i, j) for j in marked)]
+        sides: dict[str, list[str]] = {"left": [], "right": []}
+        for i in ends:
+            side = _side(names[i]) or ("left" if float(data.xpos[i][1]) > 0.0 else "right")
+            sides[side].append(names[i])
+        if len(sides["left"]) != 1 or len(sides["right"]) != 1:
+            raise InvalidParameterError(
+                f"feet could not be found by their names (left: {sides['left'] or 'none'}, "
+                f"right: {sides['right'] or 'none'}): name them with --left-foot-body and "
+                "--right-foot-body"
+            )
+        feet = (sides["left"][0], sides["right"][0])
+    if torso is None:
+        for word in _HINTS["torso"]:
+            found = [n for n in names[1:] if word in n.lower()]
+            if len(found) == 1:
+                torso = found[0]
+                break
+            if found:
+                raise InvalidParameterError(
+                    f"torso could not be found by its name: {', '.join(found[:12])} all hold "
+                    f"{word!r}; name it with --torso-body"
+                )
+        else:
+            raise InvalidParameterError(
+                "torso could not be found by its name (none holds "
+                f"{', '.join(_HINTS['torso'])}); name it with --torso-body"
+            )
+    return (feet[0], feet[1]), torso
+
+
+def _ancestor(model: Any, ancestor: int, body: int) -> bool:
+    """Whether ``ancestor`` is above ``body`` in the kinematic tree."""
+    while body > 0:
+        body = int(model.body_parentid[body])
+        if body == ancestor:
+            return True
+    return False
+
+
 def _leg_joints(model: Any, foot: int, role: str) -> tuple[int, list[int]]:
     """Return the leg's top body and its hinges from the hip down to ``foot`` (ids)."""
     import mujoco
@@ -141,8 +220,8 @@ def _axis_joints(data: Any, hinges: list[int], role: str) -> tuple[int, int, int
 def describe_mjcf(
     path: str | Path,
     *,
-    feet: tuple[str, str],
-    torso: str,
+    feet: tuple[str, str] | None = None,
+    torso: str | None = None,
     keyframe: str | None = None,
 ) -> RobotDescription:
     """Return the humanoid of MJCF file ``path``: model, standing pose, body parameters.
@@ -151,11 +230,11 @@ def describe_mjcf(
     ----------
     path : str or Path
         The MJCF file (robot and floor; a free joint first).
-    feet : (str, str)
-        The left and right foot bodies.
-    torso : str
+    feet : (str, str), optional
+        The left and right foot bodies (default: found by the module's rules).
+    torso : str, optional
         The upper body the whole-body controller holds upright and a push named ``"torso"``
-        acts on.
+        acts on (default: found by the module's rules).
     keyframe : str, optional
         The keyframe of the standing pose (default ``qpos0``).
 
@@ -167,11 +246,8 @@ def describe_mjcf(
     import mujoco
 
     model = load_mjcf(path)
-    if not (isinstance(feet, tuple | list) and len(feet) == 2):
+    if feet is not None and not (isinstance(feet, tuple | list) and len(feet) == 2):
         raise InvalidParameterError(f"feet must be two body names (left, right), got {feet!r}")
-    sides = ("left", "right")
-    foot_ids = [_body(model, name, f"{side} foot") for name, side in zip(feet, sides, strict=True)]
-    _body(model, torso, "torso")
     if keyframe is None:
         start = np.array(model.qpos0, dtype=float)
     else:
@@ -184,6 +260,10 @@ def describe_mjcf(
     data = mujoco.MjData(model)
     data.qpos[:] = start
     mujoco.mj_kinematics(model, data)
+    feet, torso = find_bodies(model, data, feet, torso)
+    sides = ("left", "right")
+    foot_ids = [_body(model, name, f"{side} foot") for name, side in zip(feet, sides, strict=True)]
+    _body(model, torso, "torso")
     legs, found = [], []
     for foot, side in zip(foot_ids, ("left", "right"), strict=True):
         top, hinges = _leg_joints(model, foot, f"{side} foot")
@@ -196,7 +276,8 @@ def describe_mjcf(
         ankle_pitch=[f[2] for f in found],
         ankle_roll=None if None in rolls else [int(r) for r in rolls if r is not None],
     )
-    return derive_description(model_name(path), model, start, legs, foot_ids, joints)
+    described = derive_description(model_name(path), model, start, legs, foot_ids, joints)
+    return replace(described, torso=torso)
 
 
 class MjcfPlant(Humanoid3DPlant):
@@ -206,10 +287,11 @@ class MjcfPlant(Humanoid3DPlant):
     ----------
     path : str or Path
         The MJCF file.
-    feet : (str, str)
-        The left and right foot bodies.
-    torso : str
-        The upper body (held upright; a push named ``"torso"`` acts on it).
+    feet : (str, str), optional
+        The left and right foot bodies (default: found by their names, module docstring).
+    torso : str, optional
+        The upper body (held upright; a push named ``"torso"`` acts on it; default: found by
+        its name).
     keyframe : str, optional
         The standing pose's keyframe (default ``qpos0``).
     """
@@ -219,11 +301,17 @@ class MjcfPlant(Humanoid3DPlant):
     hip_task: ClassVar[bool] = False
 
     def __init__(
-        self, path: str | Path, feet: tuple[str, str], torso: str, keyframe: str | None = None
+        self,
+        path: str | Path,
+        feet: tuple[str, str] | None = None,
+        torso: str | None = None,
+        keyframe: str | None = None,
     ) -> None:
         described = describe_mjcf(path, feet=feet, torso=torso, keyframe=keyframe)
         self.description = described
-        #: What names this plant for a campaign's workers.
-        self.source = MjcfSource(str(path), (feet[0], feet[1]), torso, keyframe)
-        super().__init__(described.params, described.model, described.qpos, tuple(feet),
-                         torso=torso, upright=torso)  # fmt: skip
+        model, upper = described.model, str(described.torso)
+        left, right = (model.body(i).name for i in described.feet)
+        #: What names this plant for a campaign's workers (the bodies found, if not given).
+        self.source = MjcfSource(str(path), (left, right), upper, keyframe)
+        super().__init__(described.params, model, described.qpos, (left, right),
+                         torso=upper, upright=upper)  # fmt: skip

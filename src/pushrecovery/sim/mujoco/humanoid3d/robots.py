@@ -208,6 +208,8 @@ class RobotDescription:
         Joint name -> (low, high) [rad] of the hips and ankles.
     torque_limits : dict
         Joint name -> motor torque limit [N m] of the hips and ankles.
+    torso : str or None
+        The upper body's name, where it was found (an MJCF file's); None for the robots.
     """
 
     name: str
@@ -218,6 +220,7 @@ class RobotDescription:
     params: BodyParams
     joint_ranges: dict[str, tuple[float, float]]
     torque_limits: dict[str, float]
+    torso: str | None = None
 
 
 def _convex_hull(points: Any) -> tuple[tuple[float, float], ...]:
