@@ -280,3 +280,26 @@ def test_bodies_the_rules_cannot_decide_are_refused_listing_the_candidates(
         with pytest.raises(InvalidParameterError) as caught:
             describe_mjcf(variant(edit))
         assert words in str(caught.value)
+
+
+def test_bad_mjcf_sources_are_refused_by_name(biped_file: Path) -> None:
+    from pushrecovery.errors import ParameterTypeError
+    from pushrecovery.sim.mjcf_source import MjcfSource, model_name
+
+    for kwargs, words in (
+        ({"path": "", "feet": FEET, "torso": "torso"}, "path must be an MJCF file's path"),
+        ({"path": str(biped_file), "feet": ("left_foot",), "torso": "torso"}, "feet must be two"),
+        ({"path": str(biped_file), "feet": FEET, "torso": ""}, "must be non-empty names"),
+        ({"path": str(biped_file), "feet": FEET, "torso": "torso", "keyframe": 3}, "non-empty"),
+    ):
+        with pytest.raises(InvalidParameterError, match=words):
+            MjcfSource(**kwargs)
+    with pytest.raises(InvalidParameterError, match="malformed MJCF source"):
+        MjcfSource.from_dict({"path": str(biped_file)})
+    with pytest.raises(ParameterTypeError, match="path must be a str or a Path"):
+        model_name(3.0)  # type: ignore[arg-type]
+    assert model_name("robots/unitree_h1/scene.xml") == "unitree_h1"
+    assert model_name("my_robot.xml") == "my_robot"
+    # A source builds its plant; a missing body is the plant's one-line refusal.
+    with pytest.raises(InvalidParameterError, match="torso must be a body of the model"):
+        MjcfSource(str(biped_file), FEET, "head").plant()

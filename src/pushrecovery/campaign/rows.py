@@ -22,6 +22,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal, cast
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import UNITS
 from pushrecovery.sim.physical_checks import PhysicalChecks
@@ -212,9 +213,15 @@ def physics_columns(checks: PhysicalChecks | None) -> dict[str, Any]:
     """Return a row's :data:`COLUMNS_PHYSICS` for ``checks`` (None: a run not audited, nulls).
 
     ``peak_ground_force`` is in body weights (``PhysicalChecks.peak_force_ratio``).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``checks`` is neither PhysicalChecks nor None.
     """
     if checks is None:
         return dict.fromkeys(COLUMNS_PHYSICS)
+    require_type("checks", checks, PhysicalChecks)
     return {
         "foot_slip": checks.foot_slip,
         "peak_ground_force": checks.peak_force_ratio,

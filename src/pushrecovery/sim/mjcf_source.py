@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant
@@ -26,7 +26,14 @@ def model_name(path: str | Path) -> str:
 
     A ``scene.xml`` (robot and floor, as MuJoCo Menagerie's ``unitree_h1/scene.xml``) takes the
     name of its folder.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``path`` is not a str or a Path.
     """
+    if not isinstance(path, str | Path):
+        raise ParameterTypeError(f"path must be a str or a Path, got {type(path).__name__}")
     file = Path(path)
     return file.parent.name if file.stem == "scene" and file.parent.name else file.stem
 
