@@ -241,3 +241,38 @@ def test_a_planar_run_whose_foot_slides_is_slipped():
         assert result.physics.physics_steps == round(result.time[-1] / 1e-3) + 10
     assert outcomes[1.0][0] == "recovered" and outcomes[1.0][1] < 0.01
     assert outcomes[0.25][0] == "slipped" and outcomes[0.25][1] > 0.05
+
+
+def test_a_critical_push_carries_the_checks_of_its_run_and_counts_a_slip_as_not_fallen():
+    # The torso on μ = 0.25 slides under its larger pushes (above): the critical push is the
+    # largest that does not fall, a slipped run included, and its checks are those of the
+    # run at it (the same run again gives them to the bit). The analytic models have none.
+    from pushrecovery import load_params
+    from pushrecovery.control import make_controller
+    from pushrecovery.sim.critical import critical_push, pushed_state
+    from pushrecovery.sim.registry import make_plant
+    from pushrecovery.sim.simulate import simulate
+    from pushrecovery.sim.validation import critical_table
+
+    params = load_params(overrides={"friction": 0.25})
+    found = critical_push(
+        params, "torso", "mpc", 0.0, "forward", tolerance=0.01, duration=4.0, backend="mujoco"
+    )
+    plant = make_plant("torso", params, "mujoco")
+    state = pushed_state(plant, 0.0, found.velocity, force=True)
+    again = simulate(plant, make_controller("mpc", params), state, duration=4.0)
+    assert again.outcome.value in ("recovered", "slipped")
+    assert found.physics == again.physics and found.physics.foot_slip > 0.01  # it slid
+    beyond = simulate(
+        plant, make_controller("mpc", params),
+        pushed_state(plant, 0.0, found.bracket[1], force=True), duration=4.0,
+    )  # fmt: skip
+    assert beyond.outcome.value in ("fell", "undecided")
+    analytic = critical_push(load_params(), "flywheel", "mpc", 0.0, "forward", tolerance=0.01)
+    assert analytic.physics is None
+    (row,) = critical_table(
+        load_params(), backend="mujoco", strategies=("ankle",), x0s=(0.0,),
+        directions=("forward",), tolerance=0.01, duration=4.0,
+    )  # fmt: skip
+    data = row.to_dict(72.0)
+    assert 0.0 < data["foot_slip"] < 0.01 and 1.0 < data["peak_force"] < 2.0

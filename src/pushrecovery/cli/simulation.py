@@ -294,6 +294,9 @@ def critical_push(
             "direction": direction,
             "backend": backend,
             "predicted": _critical_prediction(params, controller, x, direction, backend),
+            # MuJoCo: the run at the critical push (the largest that does not fall).
+            "foot_slip": None if found.physics is None else found.physics.foot_slip,
+            "peak_force": None if found.physics is None else found.physics.peak_force_ratio,
         },
         as_json,
     )

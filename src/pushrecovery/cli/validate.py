@@ -179,16 +179,20 @@ def validate(
     if as_json:
         emit(data, True)
         return
+    audited = any(not np.isnan(row.foot_slip) for row in rows)  # MuJoCo's physical checks
     click.echo(
         f"{'strategy':<9}{'dir':<9}{'x0':>7}{'predicted':>11}{'corrected':>11}"
         f"{'measured':>10}{'error':>9}{'corr.err':>10}"
+        + (f"{'slip[mm]':>10}{'peak[mg]':>10}" if audited else "")
     )
     for row in rows:
         corrected = "" if np.isnan(row.corrected) else f"{row.corrected:.4f}"
         error = "" if np.isnan(row.corrected) else f"{100 * row.corrected_error:+.1f}%"
+        checks = f"{1e3 * row.foot_slip:>10.1f}{row.peak_force:>10.2f}" if audited else ""
         click.echo(
             f"{row.strategy:<9}{row.direction:<9}{row.x0:>7.3f}{row.predicted:>11.4f}"
             f"{corrected:>11}{row.measured:>10.4f}{100 * row.relative_error:>+8.1f}%{error:>10}"
+            + checks
         )
     if matrix is not None:
         from pushrecovery.sim.validation import LABELS

@@ -36,6 +36,8 @@ def _critical(ctx: _Context) -> CriticalSection:
                     percent_interval(row.bracket[0], row.bracket[1], row.predicted),
                     percent_interval(row.bracket[0], row.bracket[1], row.corrected),
                     str(row.simulations),
+                    num(1e3 * row.foot_slip, 2),
+                    num(row.peak_force, 3),
                 )
             )
     header = (
@@ -50,6 +52,8 @@ def _critical(ctx: _Context) -> CriticalSection:
         "vs predicted",
         "vs corrected",
         "simulations",
+        "foot slip [mm]",
+        "peak ground force [m g]",
     )
     return CriticalSection(Table(header, tuple(rows), text_columns=3))
 

@@ -18,6 +18,7 @@ from pushrecovery.arguments import finite_float, positive_float, require_type
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.push import Push, direction_sign
 from pushrecovery.sim.registry import make_plant
@@ -69,12 +70,18 @@ class CriticalPush:
         Simulations run.
     predicted_velocity : float
         Critical velocity of the controller's decision surface, signed like ẋ [m/s].
+    physics : PhysicalChecks or None
+        The physical checks of the run at ``velocity`` (MuJoCo; None on the analytic
+        models): its loaded-foot slip and peak ground force. The search counts a run that
+        came to rest on feet that slid (``slipped``) as not fallen, as the 3-D critical push
+        does: ``velocity`` is the largest push that does not fall, its slip beside it.
     """
 
     velocity: float
     bracket: tuple[float, float]
     iterations: int
     predicted_velocity: float
+    physics: PhysicalChecks | None = None
 
     def relative_error(self) -> float:
         """Return (abs(velocity) − abs(predicted)) / abs(predicted); < 0: worse than Eq. 4."""
@@ -274,12 +281,16 @@ def critical_push(
     ctrl = make_controller(controller, params, **(controller_options or {}))
     predicted = predicted_critical_velocity(params, ctrl.strategy, x0, direction)
 
+    checks: dict[float, PhysicalChecks | None] = {}
+
     def outcome_of(velocity: float) -> Outcome:
         start = pushed_state(plant, x0, velocity, force=force)
         run = simulate(plant, ctrl, start, duration=duration, control_period=control_period)
         if progress is not None:
             progress(1)
-        return run.outcome
+        checks[velocity] = run.physics
+        # The largest push that does not fall: a run at rest on feet that slid counts.
+        return Outcome.RECOVERED if run.outcome is Outcome.SLIPPED else run.outcome
 
     # Just below the models' validity limit (check_com_state).
     limit = 9.99 * math.sqrt(params.gravity * params.com_height)
@@ -287,5 +298,6 @@ def critical_push(
         outcome_of, direction, guess=predicted, tolerance=tolerance, max_velocity=limit
     )
     return CriticalPush(
-        found.recovered, (found.recovered, found.failed), found.simulations, predicted
-    )
+        found.recovered, (found.recovered, found.failed), found.simulations, predicted,
+        checks.get(found.recovered),
+    )  # fmt: skip

@@ -34,6 +34,7 @@ from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import critical_push, pushed_state
+from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.registry import MUJOCO_MODELS, available_models, make_plant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.classify import classify, strategy_region
@@ -170,6 +171,8 @@ class CriticalRow:
 
     ``corrected`` is :func:`corrected_critical_velocity` (NaN where no correction is
     offered: the step strategy, or the analytic backend where nothing needs correcting).
+    ``foot_slip`` [m] and ``peak_force`` [m g] are the physical checks of the run at the
+    measured push (MuJoCo; NaN on the analytic backend).
     """
 
     strategy: str
@@ -182,6 +185,8 @@ class CriticalRow:
     measured: float
     bracket: tuple[float, float]
     simulations: int
+    foot_slip: float = math.nan
+    peak_force: float = math.nan
 
     @property
     def relative_error(self) -> float:
@@ -214,6 +219,8 @@ class CriticalRow:
             "corrected_error": clean(self.corrected_error),
             "bracket": list(self.bracket),
             "simulations": self.simulations,
+            "foot_slip": clean(self.foot_slip),
+            "peak_force": clean(self.peak_force),
         }
 
 
@@ -287,11 +294,19 @@ def critical_table(
                         found.velocity,
                         found.bracket,
                         found.iterations,
+                        *_checks(found.physics),
                     )
                 )
                 if progress is not None:
                     progress(1)
     return rows
+
+
+def _checks(physics: PhysicalChecks | None) -> tuple[float, float]:
+    """Return a run's foot slip [m] and peak ground force [m g] (NaN: not audited)."""
+    if physics is None:
+        return math.nan, math.nan
+    return physics.foot_slip, physics.peak_force_ratio
 
 
 def needed_strategy(
