@@ -303,3 +303,30 @@ def test_bad_mjcf_sources_are_refused_by_name(biped_file: Path) -> None:
     # A source builds its plant; a missing body is the plant's one-line refusal.
     with pytest.raises(InvalidParameterError, match="torso must be a body of the model"):
         MjcfSource(str(biped_file), FEET, "head").plant()
+
+
+def test_a_robot_standing_off_the_world_origin_has_the_same_prediction(tmp_path: Path) -> None:
+    # The prediction's frame is the ankles' midpoint (Support.from_params), not the world:
+    # the biped3d's file standing 5 cm forward and 3 cm left of the origin has the same r0 and
+    # the same predicted critical impulses as standing on it (the H1's ankles are 4 cm ahead
+    # of its world origin: before, its backward limit was predicted 4 cm of CoM travel long).
+    from pushrecovery.experiments.validation3d_predict import predicted_critical_impulses
+
+    plants = []
+    for shift in ((0.0, 0.0), (0.05, 0.03)):
+        spec = build_biped3d(load_params())
+        model = spec.compile()
+        qpos = list(bent_knee_qpos(model))
+        qpos[0] += shift[0]
+        qpos[1] += shift[1]
+        spec.add_key(name="bent", qpos=qpos)
+        path = tmp_path / f"biped_{shift[0]}.xml"
+        path.write_text(spec.to_xml())
+        plants.append(MjcfPlant(path, FEET, "torso", keyframe="bent"))
+    here, there = plants
+    assert there.ankle == pytest.approx((0.05, 0.03), abs=1e-9)
+    assert there.standing_origin == pytest.approx(here.standing_origin, abs=1e-9)
+    for azimuth in (0.0, 90.0, 180.0):
+        predicted = [predicted_critical_impulses(p.params, azimuth, origin=p.standing_origin)
+                     for p in plants]  # fmt: skip
+        assert predicted[1]["ankle"] == pytest.approx(predicted[0]["ankle"], rel=1e-9)

@@ -77,8 +77,8 @@ def filmstrip_run(
 
         params = robot_params("g1")
     plant = make_plant3d(model, params)
-    state = plant.reset()
-    origin = (float(state[0]), float(state[1]))
+    plant.reset()
+    origin = plant.standing_origin  # in the frame of the body's feet
     impulse = fraction * predicted_critical_impulses(plant.params, azimuth, origin=origin)["ankle"]
     if controller == "step":
         wbc = WholeBodyController(plant.model, feet=plant.feet, torso=plant.upright,

@@ -314,4 +314,4 @@ class MjcfPlant(Humanoid3DPlant):
         #: What names this plant for a campaign's workers (the bodies found, if not given).
         self.source = MjcfSource(str(path), (left, right), upper, keyframe)
         super().__init__(described.params, model, described.qpos, (left, right),
-                         torso=upper, upright=upper)  # fmt: skip
+                         torso=upper, upright=upper, ankle=described.ankle)  # fmt: skip

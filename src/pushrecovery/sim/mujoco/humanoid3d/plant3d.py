@@ -123,6 +123,9 @@ class Humanoid3DPlant:
         The body a push named ``"torso"`` acts on.
     upright : str
         The body the WBC holds upright (its origin's height is the pelvis task).
+    ankle : (float, float)
+        The ankles' midpoint at the standing pose, world xy [m]: the origin of the frame of
+        ``params``' feet (``Support.from_params``), in which ``standing_origin`` is given.
     """
 
     name: ClassVar[str] = "humanoid3d"
@@ -138,11 +141,13 @@ class Humanoid3DPlant:
         feet: tuple[str, ...],
         torso: str,
         upright: str,
+        ankle: tuple[float, float] = (0.0, 0.0),
     ) -> None:
         import mujoco
 
         require_type("params", params, BodyParams)
         self.params, self.model = params, model
+        self.ankle = (float(ankle[0]), float(ankle[1]))
         self.qpos = np.array(qpos, dtype=float)
         self.feet, self.torso, self.upright = feet, torso, upright
         self.data = mujoco.MjData(model)
@@ -163,8 +168,10 @@ class Humanoid3DPlant:
         self.floor = 0.0
         self.standing_height = 1.0
         self.omega = 1.0
-        #: Standing (at reset): the CoM's ground point r₀ [m] and the pushed torso's CoM
-        #: height above the whole-body CoM d [m], the lever of a push (docs/validation3d.md).
+        #: Standing (at reset): the CoM's ground point r₀ [m] relative to the ankles'
+        #: midpoint (``ankle``: the frame of the body's feet, ``Support.from_params``) and the
+        #: pushed torso's CoM height above the whole-body CoM d [m], the lever of a push
+        #: (docs/validation3d.md).
         self.standing_origin = (0.0, 0.0)
         self.push_lever = 0.0
         #: Keep ``qpos``, ``qvel`` and ``ctrl`` at each row (``frames``) from the next reset.
@@ -218,7 +225,10 @@ class Humanoid3DPlant:
         self.info = StepInfo()
         self._push_steps = 0
         self.state = self._read()
-        self.standing_origin = (float(self.state[0]), float(self.state[1]))
+        self.standing_origin = (
+            float(self.state[0]) - self.ankle[0],
+            float(self.state[1]) - self.ankle[1],
+        )
         torso = body_id(model, self.torso)
         self.push_lever = float(data.xipos[torso][2]) - float(data.subtree_com[0][2])
         self._restart_rows()
@@ -532,7 +542,7 @@ class G1Plant(Humanoid3DPlant):
                 "params of the g1 model must be the robot's own (robot_params('g1'))"
             )
         super().__init__(params, described.model, described.qpos, G1_FEET, torso=G1_TORSO,
-                         upright=G1_TORSO)  # fmt: skip
+                         upright=G1_TORSO, ankle=described.ankle)  # fmt: skip
 
 
 def wbc_for(

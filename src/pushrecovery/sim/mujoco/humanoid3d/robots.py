@@ -210,6 +210,9 @@ class RobotDescription:
         Joint name -> motor torque limit [N m] of the hips and ankles.
     torso : str or None
         The upper body's name, where it was found (an MJCF file's); None for the robots.
+    ankle : (float, float)
+        The ankles' midpoint (the ankle pitch anchors') at the standing pose, world xy [m]:
+        the origin of the frame the body parameters' feet are in (``Support.from_params``).
     """
 
     name: str
@@ -221,6 +224,7 @@ class RobotDescription:
     joint_ranges: dict[str, tuple[float, float]]
     torque_limits: dict[str, float]
     torso: str | None = None
+    ankle: tuple[float, float] = (0.0, 0.0)
 
 
 def _convex_hull(points: Any) -> tuple[tuple[float, float], ...]:
@@ -347,7 +351,7 @@ def derive_description(
     )  # fmt: skip
     return RobotDescription(
         name=name, model=model, qpos=qpos, legs=legs, feet=feet, params=params,
-        joint_ranges=ranges, torque_limits=limits,
+        joint_ranges=ranges, torque_limits=limits, ankle=(float(ankle[0]), float(ankle[1])),
     )  # fmt: skip
 
 
