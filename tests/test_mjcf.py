@@ -330,3 +330,14 @@ def test_a_robot_standing_off_the_world_origin_has_the_same_prediction(tmp_path:
         predicted = [predicted_critical_impulses(p.params, azimuth, origin=p.standing_origin)
                      for p in plants]  # fmt: skip
         assert predicted[1]["ankle"] == pytest.approx(predicted[0]["ankle"], rel=1e-9)
+
+
+def test_a_bad_ankle_origin_is_refused_by_name(biped_file: Path) -> None:
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
+
+    described = describe_mjcf(biped_file, keyframe="bent")
+    for ankle, words in ((("a", 0.0), "ankle x must be"), ((0.0, math.nan), "ankle y must be"),
+                         ((0.0,), "ankle must be")):  # fmt: skip
+        with pytest.raises(InvalidParameterError, match=words):
+            Humanoid3DPlant(described.params, described.model, described.qpos, FEET, "torso",
+                            "torso", ankle=ankle)  # fmt: skip

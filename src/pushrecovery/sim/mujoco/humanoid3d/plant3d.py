@@ -147,7 +147,12 @@ class Humanoid3DPlant:
 
         require_type("params", params, BodyParams)
         self.params, self.model = params, model
-        self.ankle = (float(ankle[0]), float(ankle[1]))
+        if not (isinstance(ankle, tuple | list) and len(ankle) == 2):
+            raise InvalidParameterError(f"ankle must be (x, y) [m], got {ankle!r}")
+        self.ankle = (
+            finite_float("ankle x", ankle[0], "m"),
+            finite_float("ankle y", ankle[1], "m"),
+        )
         self.qpos = np.array(qpos, dtype=float)
         self.feet, self.torso, self.upright = feet, torso, upright
         self.data = mujoco.MjData(model)
