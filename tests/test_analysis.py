@@ -521,3 +521,22 @@ def test_a_number_with_a_form_feed_is_read_as_python_reads_it(tmp_path):
     path.write_text("time,com_ap,com_ml\n" + "\n".join(rows) + "\n")
     recording = read_csv_recording(path)
     assert recording.com[5, 0] == pytest.approx(0.005)
+
+
+def test_the_cop_margin_is_the_nearer_edge_and_mos_ap_the_edge_ahead(tmp_path):
+    # docs/base_polygon.md, "Which margin is which": on the same base (fixed feet), per frame
+    # the CoP margin is min(ξ − heel, toe − ξ) and mos_ap the margin toward the motion, so the
+    # first is never larger, and the trial's min_cop_margin is the smaller.
+    t, states, cop = _push_trial(0.5)
+    path = tmp_path / "trial.csv"
+    _write_csv(path, t, states, cop)
+    result = analyze(read_csv_recording(path), PARAMS, FIXED)
+    columns = result.columns
+    both = np.isfinite(columns["ap_margin_cop"]) & np.isfinite(columns["mos_ap"])
+    assert both.sum() > 100
+    assert (columns["ap_margin_cop"][both] <= columns["mos_ap"][both] + 1e-9).all()
+    moving = both & (columns["ap_com_velocity"] > 0.05)  # forward: mos_ap is to the toe
+    xi = columns["ap_capture_point"][moving]
+    np.testing.assert_allclose(columns["mos_ap"][moving], columns["ap_base_max"][moving] - xi)
+    summary = result.summary
+    assert summary.directions["ap"].min_cop_margin.value <= summary.plane.min_mos_ap.value
