@@ -540,3 +540,30 @@ def test_the_cop_margin_is_the_nearer_edge_and_mos_ap_the_edge_ahead(tmp_path):
     np.testing.assert_allclose(columns["mos_ap"][moving], columns["ap_base_max"][moving] - xi)
     summary = result.summary
     assert summary.directions["ap"].min_cop_margin.value <= summary.plane.min_mos_ap.value
+
+
+def test_the_xcom_takes_the_leg_length_when_asked(tmp_path):
+    # Hof's XCoM with l = leg length: ξ = r + v/sqrt(g/l) in the 2-D margins, by hand from the
+    # frames' own CoM and velocity; the per-axis margins of Eq. (4) keep the body's ω.
+    import dataclasses
+
+    from pushrecovery.analysis.trial import AnalysisSettings
+
+    body = dataclasses.replace(PARAMS, leg_length=0.9 * PARAMS.com_height, max_step_length=None)
+    t, states, cop = _push_trial(0.25)
+    path = tmp_path / "trial.csv"
+    _write_csv(path, t, states, cop)
+    leg = AnalysisSettings(ankle_ap=0.0, ankle_ml=0.0, xcom_length="leg_length")
+    default = analyze(read_csv_recording(path), body, FIXED)
+    mine = analyze(read_csv_recording(path), body, leg)
+    omega = math.sqrt(body.gravity / body.leg_length)
+    columns = mine.columns
+    xi = columns["ap_com"] + columns["ap_com_velocity"] / omega
+    np.testing.assert_allclose(columns["xcom_ap"], xi, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(columns["ap_margin_cop"], default.columns["ap_margin_cop"])
+    assert not np.allclose(columns["mos"], default.columns["mos"], equal_nan=True)
+    plane = mine.summary.to_dict()["plane"]
+    assert plane["xcom_length"] == "leg_length" and plane["omega"] == pytest.approx(omega)
+    assert default.summary.to_dict()["plane"]["omega"] == pytest.approx(body.omega)
+    with pytest.raises(InvalidParameterError, match="xcom_length must be one of"):
+        AnalysisSettings(xcom_length="hip")

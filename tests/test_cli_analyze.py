@@ -174,6 +174,8 @@ def test_bad_inputs_are_one_line(tmp_path, capsys):
     assert "'C7'" in err
     err = _fail(capsys, "analyze", str(kistler), "--foot", "left=LHEE", "--out", out)
     assert "NAME=HEEL,TOE,ANKLE" in err
+    err = _fail(capsys, "analyze", str(trial), *mm, "--xcom-length", "hip", "--out", out)
+    assert "'hip'" in err and "com_height" in err
 
 
 def test_no_mass_is_refused_not_guessed(tmp_path, capsys):
@@ -232,3 +234,17 @@ def _kistler():
     import biomdp
 
     return pathlib.Path(biomdp.__file__).parent / "tests" / "datasets" / "kistler_COP.c3d"
+
+
+def test_the_xcom_length_flag_reaches_the_summary(tmp_path):
+    trial = _trial(tmp_path / "trial.csv")
+    result = CliRunner().invoke(
+        cli,
+        ["analyze", str(trial), "--units", "mm", "--mass", "72", "--leg-length", "0.9",
+         "--com-height", "1.0", "--xcom-length", "leg_length", "--no-plot", "--out",
+         str(tmp_path / "o"), "--json"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    plane = json.loads(result.output)["plane"]
+    assert plane["xcom_length"] == "leg_length"
+    assert plane["omega"] == pytest.approx((9.81 / 0.9) ** 0.5)

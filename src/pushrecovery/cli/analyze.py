@@ -151,6 +151,15 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     "velocities / sqrt(g l), times * sqrt(g/l).",
 )
 @click.option(
+    "--xcom-length",
+    type=click.Choice(("com_height", "leg_length")),
+    default="com_height",
+    show_default=True,
+    help="Pendulum length l of Hof's XCoM in the 2-D margins (mos, mos_ap, ...): "
+    "omega0 = sqrt(g/l); the per-axis margins of Eq. (4) and the verdicts keep the body's CoM "
+    "height (docs/base_polygon.md).",
+)
+@click.option(
     "--plot/--no-plot",
     default=True,
     show_default=True,
@@ -185,7 +194,9 @@ def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) ->
     }
     fields = [flag[2:].replace("-", "_") for flag, _, _ in _SETTINGS]
     settings = AnalysisSettings(
-        **{field: kwargs.pop(field) for field in fields}, normalise=kwargs.pop("normalise")
+        **{field: kwargs.pop(field) for field in fields},
+        normalise=kwargs.pop("normalise"),
+        xcom_length=kwargs.pop("xcom_length"),
     )
     single = len(inputs) == 1 and Path(inputs[0]).is_file()
     batch = {name: kwargs.pop(name) for name in ("subjects", "workers", "scheduler", "resume")}

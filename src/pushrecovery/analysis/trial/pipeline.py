@@ -223,7 +223,9 @@ def analyze(
                 f"{axis}_steps": margins.steps,
             }
         )
-    plane = _plane(base, com, velocity, cop, time, params, checks.withheld)
+    plane = _plane(
+        base, com, velocity, cop, time, params, checks.withheld, settings.xcom_omega(params)
+    )
     columns.update(plane.to_columns())
     columns["strategy_2d"] = _names(plane.strategy)
     codes = np.maximum(per_axis["ap"].strategy, per_axis["ml"].strategy)
@@ -305,12 +307,16 @@ def _plane(
     time: FloatArray,
     params: BodyParams,
     withheld: NDArray[np.bool_],
+    omega: float,
 ) -> Margins2D:
-    """Return the 2-D margins against the base polygon (docs/base_polygon.md), withheld NaN."""
+    """Return the 2-D margins against the base polygon (docs/base_polygon.md), withheld NaN.
+
+    ``omega`` is the XCoM's ω0 [1/s] (``AnalysisSettings.xcom_omega``).
+    """
     cop_velocity = None
     if cop is not None:
         _, cop_velocity = smooth_and_differentiate(time, cop, 0.0)  # already low-passed
-    plane = margins_2d(base, com, velocity, params, cop=cop, cop_velocity=cop_velocity)
+    plane = margins_2d(base, com, velocity, params, omega=omega, cop=cop, cop_velocity=cop_velocity)
     for values in plane.to_columns().values():  # views of the measures' own arrays
         if values.dtype.kind == "f":
             values[withheld] = np.nan

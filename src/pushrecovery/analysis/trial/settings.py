@@ -26,6 +26,7 @@ __all__ = [
     "COP_AHEAD_OF_ANKLE",
     "PERSON_FIELDS",
     "PRESET_BODY",
+    "XCOM_LENGTHS",
     "AnalysisSettings",
     "TrialAnalysis",
     "body_for",
@@ -33,6 +34,8 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
+#: The pendulum lengths of the XCoM (``AnalysisSettings.xcom_length``).
+XCOM_LENGTHS: tuple[str, ...] = ("com_height", "leg_length")
 
 #: Assumed distance of the mean CoP ahead of the ankle in quiet standing when nothing in the
 #: file locates the feet [m] (the gravity line falls a few cm in front of the ankle joint).
@@ -66,6 +69,11 @@ class AnalysisSettings:
     normalise : bool
         Add Hof's dimensionless columns (Hof 2008, J Biomech 41:1171): lengths over the leg
         length l (``BodyParams.leg_length``), velocities over sqrt(g l): ``*_norm``.
+    xcom_length : {"com_height", "leg_length"}
+        The pendulum length l of Hof's XCoM ξ = r + v/ω0, ω0 = sqrt(g/l) [1/s], in the 2-D
+        margins (``xcom_*``, ``mos*``, ``ttb_xcom``): the body's CoM height (default, the
+        paper's L) or its leg length (Hof, Gazendam & Sinke 2005). The per-axis margins of
+        Eq. (4) and every verdict keep the body's ω = sqrt(g/L): they are its physics.
     """
 
     cutoff: float = 6.0
@@ -77,6 +85,7 @@ class AnalysisSettings:
     ankle_ap: float | None = None
     ankle_ml: float | None = None
     normalise: bool = False
+    xcom_length: str = "com_height"
 
     def widths(self, params: BodyParams) -> tuple[float, float]:
         """Foot width and stance width [m]: these settings', else the body's."""
@@ -102,6 +111,15 @@ class AnalysisSettings:
             value = getattr(self, name)
             if value is not None and not math.isfinite(value):
                 raise InvalidParameterError(f"{name} must be finite, got {value}")
+        if self.xcom_length not in XCOM_LENGTHS:
+            raise InvalidParameterError(
+                f"xcom_length must be one of {list(XCOM_LENGTHS)}, got {self.xcom_length!r}"
+            )
+
+    def xcom_omega(self, params: BodyParams) -> float:
+        """Return ω0 = sqrt(g/l) of the XCoM [1/s], l as ``xcom_length`` says [m]."""
+        length = params.com_height if self.xcom_length == "com_height" else params.leg_length
+        return math.sqrt(params.gravity / length)
 
 
 @dataclass(frozen=True, slots=True)

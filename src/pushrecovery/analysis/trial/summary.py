@@ -10,6 +10,7 @@ in its docstring, and the one serialiser that keeps the JSON's keys and order.
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -143,6 +144,11 @@ class PlaneSummary:
         Shortest times to the base's boundary of the CoP and of the XCoM [s].
     most_demanding : str or None
         The most demanding strategy of the 2-D verdicts; None without feet to classify against.
+    xcom_length : str
+        The XCoM's pendulum length: ``com_height`` or ``leg_length``
+        (``AnalysisSettings.xcom_length``).
+    omega : float
+        The XCoM's ω0 = sqrt(g/l) [1/s].
     """
 
     base_source: str
@@ -153,6 +159,8 @@ class PlaneSummary:
     min_time_to_boundary_cop: Extreme
     min_time_to_boundary_xcom: Extreme
     most_demanding: str | None
+    xcom_length: str = "com_height"
+    omega: float = math.nan
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -420,7 +428,9 @@ def _step_events(time: FloatArray, per_axis: dict[str, DirectionMargins]) -> tup
     return tuple(sorted(events, key=lambda event: event.time))
 
 
-def _plane_summary(plane: Margins2D, time: FloatArray, source: str) -> PlaneSummary:
+def _plane_summary(
+    plane: Margins2D, time: FloatArray, source: str, settings: AnalysisSettings, params: BodyParams
+) -> PlaneSummary:
     """Return the smallest 2-D margins and times to boundary, and the 2-D verdict."""
     return PlaneSummary(
         base_source=source,
@@ -431,6 +441,8 @@ def _plane_summary(plane: Margins2D, time: FloatArray, source: str) -> PlaneSumm
         min_time_to_boundary_cop=_extreme(plane.ttb_cop, time),
         min_time_to_boundary_xcom=_extreme(plane.ttb_xcom, time),
         most_demanding=_most_demanding(plane.strategy),
+        xcom_length=settings.xcom_length,
+        omega=settings.xcom_omega(params),
     )
 
 
@@ -494,7 +506,7 @@ def _summary(
         step_events=_step_events(time, per_axis),
         notes=tuple(notes),
         checks=checks,
-        plane=_plane_summary(plane, time, support_source),
+        plane=_plane_summary(plane, time, support_source, settings, params),
         events=events,
         sway=None if sway is None else sway[0],
         sway_rate=None if sway is None else sway[1],
