@@ -378,7 +378,7 @@ def _table(header, row=lambda i: f"{i / 100:.2f},0,0", n=12, change=None):
 
 MALFORMED = {
     "no time": (_table("com_ap,com_ml", lambda i: "0,0"), "missing column 'time'"),
-    "no com": (_table("time,cop_ap,cop_ml"), "no CoM"),
+    "no com": (_table("time,foo,bar"), "no CoM"),
     "half a pair": (_table("time,com_ap", lambda i: f"{i / 100:.2f},0"), "com_ml"),
     "text": (_table("time,com_ap,com_ml", change={1: "0.01,abc,0"}), "row 3 is not a number"),
     "backwards": (_table("time,com_ap,com_ml", change={2: "0.005,0,0"}), "increase"),

@@ -28,7 +28,7 @@ from pushrecovery import load_params
 from pushrecovery.analysis.base_polygon import FootModel, base_from_params
 from pushrecovery.analysis.c3d import write_c3d
 from pushrecovery.analysis.readers import read_recording
-from pushrecovery.analysis.recording import fixed_feet
+from pushrecovery.analysis.recording import Recording, fixed_feet
 from pushrecovery.control.mpc import MPCSettings
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.ground import Support, rectangle
@@ -113,6 +113,11 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         "ankle": np.zeros(2),
     },
     "pushrecovery.analysis.readers.c3d_files.read_c3d_recording": {"path": _trial_c3d()},
+    # A posturography export: the CoP alone.
+    "pushrecovery.analysis.posturography.recording_sway": {"recording": Recording(
+        time=np.arange(0.0, 10.0, 0.01), force_time=np.arange(0.0, 10.0, 0.01),
+        cop=0.01 * np.sin(np.outer(np.arange(0.0, 10.0, 0.01), [1.0, 2.0])),
+    )},
     # The 2-D base of support and margins (issue 18): three frames of stated feet.
     **{f"pushrecovery.analysis.base_polygon.{name}": {
         "model": FootModel(), "foot": fixed_feet(3, 0.0, 0.1, -0.05, 0.15, 0.2)[0],

@@ -248,3 +248,71 @@ def test_the_xcom_length_flag_reaches_the_summary(tmp_path):
     plane = json.loads(result.output)["plane"]
     assert plane["xcom_length"] == "leg_length"
     assert plane["omega"] == pytest.approx((9.81 / 0.9) ** 0.5)
+
+
+def _cop_only(path, jump=0.0, gap=False, scale=1.0):
+    """A posturography export: time, cop_ap, cop_ml [m] at 100 Hz for 30 s, slow sway (and a
+    ``jump`` [m] over 50 ms at 15 s: a step's CoP)."""
+    t = np.arange(0.0, 30.0, 0.01)
+    ap = 0.005 * np.sin(2 * np.pi * 0.3 * t) + jump * np.clip((t - 15.0) / 0.05, 0.0, 1.0)
+    ml = 0.003 * np.sin(2 * np.pi * 0.5 * t + 1.0)
+    rows = ["time,cop_ap,cop_ml"]
+    for k in range(len(t)):
+        cell = "" if gap and 1000 <= k < 1010 else f"{ap[k] * scale:.7f}"
+        rows.append(f"{t[k]:.2f},{cell},{ml[k] * scale:.7f}")
+    path.write_text("\n".join(rows) + "\n")
+    return path, np.column_stack([ap, ml])
+
+
+def test_a_cop_only_file_gives_its_sway_measures(tmp_path, capsys):
+    # No CoM, no force, no mass: not refused, the sway measures (docs/posturography.md); the
+    # path length and RMS distance by hand from the written trace (0.3 and 0.5 Hz sway: the
+    # 10 Hz low-pass leaves them).
+    path, cop = _cop_only(tmp_path / "quiet.csv")
+    out = tmp_path / "o"
+    result = CliRunner().invoke(cli, ["analyze", str(path), "--out", str(out), "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    assert data["status"] == "posturography only" and data["rate"] == pytest.approx(100.0)
+    sway = data["posturography"]
+    hand = np.sum(np.hypot(*np.diff(cop, axis=0).T))
+    assert sway["path_length"] == pytest.approx(hand, rel=5e-3)
+    centred = cop - cop.mean(axis=0)
+    rms = np.sqrt(np.mean(np.sum(centred**2, axis=1)))
+    assert sway["rms_distance"] == pytest.approx(rms, rel=5e-3)
+    assert json.loads((out / "summary.json").read_text())["posturography"] == sway
+    table = CliRunner().invoke(cli, ["analyze", str(path), "--out", str(tmp_path / "t")])
+    assert table.exit_code == 0 and "CoP only" in table.output
+    # A gap, or a trace that is no quiet standing: one line, exit 2.
+    gap, _ = _cop_only(tmp_path / "gap.csv", gap=True)
+    assert "misses 10 frame(s)" in _fail(capsys, "analyze", str(gap), "--out", str(out))
+    step, _ = _cop_only(tmp_path / "step.csv", jump=0.1)
+    assert "no quiet standing" in _fail(capsys, "analyze", str(step), "--out", str(out))
+
+
+def test_a_batch_keeps_its_cop_only_trials_as_posturography_rows(tmp_path):
+    study = tmp_path / "study"
+    study.mkdir()
+    _cop_only(study / "quiet.csv", scale=1000.0)  # in mm, as the other trial
+    _trial(study / "pushed.csv")
+    out = tmp_path / "o"
+    result = CliRunner().invoke(
+        cli, ["analyze", str(study), "--units", "mm", "--mass", "72", "--no-plot", "--workers",
+              "1", "--out", str(out), "--json"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    import pyarrow.parquet as pq
+
+    rows = {(r["trial"], r["axis"]): r for r in pq.read_table(out / "trials.parquet").to_pylist()}
+    quiet = rows[("quiet.csv", "ap")]
+    assert quiet["status"] == "posturography only" and quiet["error"] is None
+    assert quiet["sway_path_length"] > 0.0 and quiet["rate"] == pytest.approx(100.0)
+    assert quiet["mass"] is None and quiet["min_cop_margin"] is None
+    assert rows[("pushed.csv", "ap")]["status"] == "analysed"
+    # The same sway as the file alone (in metres).
+    alone, _ = _cop_only(tmp_path / "alone.csv")
+    single = CliRunner().invoke(
+        cli, ["analyze", str(alone), "--out", str(tmp_path / "a"), "--json"]
+    )
+    path_ap = json.loads(single.output)["posturography"]["path_length_ap"]
+    assert quiet["sway_path_length"] == pytest.approx(path_ap, rel=1e-4)  # 7 decimals of m, mm

@@ -26,6 +26,7 @@ __all__ = [
     "batch_summary",
     "failed_rows",
     "subject_name",
+    "sway_rows",
     "trial_rows",
     "write_table",
 ]
@@ -44,7 +45,8 @@ class TrialRow:
     axis : str
         ``ap`` or ``ml``.
     status : str
-        ``analysed``, or ``failed`` (``error`` says why; the measures are then null).
+        ``analysed``; ``posturography only`` (a CoP without a CoM or a force: the sway
+        columns, the rest null); or ``failed`` (``error`` says why; the measures are null).
     frames, valid_frames, excluded_frames, interpolated_frames : int
         Frames of the trial, with a verdict, without one, and inside filled gaps.
     rate, duration : float
@@ -282,6 +284,18 @@ def _sway(sway: SwayMeasures | None, axis: str) -> dict[str, Any]:
         "sway_ellipse_area": sway.ellipse.area,
         "sway_mean_velocity_total": sway.mean_velocity.total,
     }
+
+
+def sway_rows(job: Any, sway: SwayMeasures, rate: float) -> list[dict[str, Any]]:
+    """Return the rows of a CoP-only trial: ``posturography only`` with its sway columns."""
+    return [
+        asdict(replace(
+            TrialRow(job.name, str(job.path), subject_name(job), axis, "posturography only",
+                     None),
+            rate=rate, duration=sway.duration, **_sway(sway, axis),
+        ))
+        for axis in ("ap", "ml")
+    ]  # fmt: skip
 
 
 def failed_rows(job: Any, reason: str) -> list[dict[str, Any]]:

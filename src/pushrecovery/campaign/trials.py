@@ -24,7 +24,13 @@ from typing import Any
 
 from pushrecovery.campaign.subjects import Subject, subject_for
 from pushrecovery.campaign.trial_events import EVENT_FIELDS, EventRow, trial_events
-from pushrecovery.campaign.trial_rows import TRIAL_FIELDS, TrialRow, failed_rows, trial_rows
+from pushrecovery.campaign.trial_rows import (
+    TRIAL_FIELDS,
+    TrialRow,
+    failed_rows,
+    sway_rows,
+    trial_rows,
+)
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.extras import require
 
@@ -166,6 +172,7 @@ class TrialsResult:
 def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict[str, Any]:
     """Analyse one trial into ``out / trials / job.name``; return and store its rows."""
     from pushrecovery.analysis.output import json_safe, write_analysis
+    from pushrecovery.analysis.posturography import cop_only, recording_sway
     from pushrecovery.analysis.readers import read_recording
     from pushrecovery.analysis.trial import analyze, body_for
     from pushrecovery.presets import load_params
@@ -174,6 +181,12 @@ def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict
     directory.mkdir(parents=True, exist_ok=True)
     try:
         recording = read_recording(job.path, **job.reader.get(job.path.suffix.lower(), {}))
+        if cop_only(recording):  # a posturography export: its sway measures only
+            measures, rate = recording_sway(recording, job.settings.force_cutoff)
+            record = {"trials": json_safe(sway_rows(job, measures, rate)), "events": [],
+                      "quality": [], "files": {}}  # fmt: skip
+            _write_json(directory / ROW_FILE, record)
+            return record
         given = {k: v for k, v in job.flags.items() if v is not None}
         sources = {name: "flag" for name in given}
         if job.subject is not None:

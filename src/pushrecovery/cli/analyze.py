@@ -225,6 +225,7 @@ def _single(
 ) -> None:
     """One trial, its outputs straight into ``out`` (the first releases' contract)."""
     from pushrecovery.analysis.output import write_analysis
+    from pushrecovery.analysis.posturography import cop_only
     from pushrecovery.analysis.readers import read_recording
     from pushrecovery.analysis.trial import analyze as analyze_trial
     from pushrecovery.analysis.trial import body_for
@@ -233,6 +234,9 @@ def _single(
 
     plot = kwargs.pop("plot")
     recording = read_recording(file, **reader.get(file.suffix.lower(), {}))
+    if cop_only(recording):  # a posturography export: its sway measures, no body needed
+        _single_sway(recording, out, as_json, settings)
+        return
     overrides = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
     preset = load_params(kwargs["preset"], kwargs["params_file"], overrides)
     found, sources = body_for(
@@ -318,6 +322,42 @@ def _batch(
         },
         False,
     )
+
+
+def _single_sway(recording: Any, out: Path, as_json: bool, settings: Any) -> None:
+    """Write a CoP-only trial's sway measures to ``out/summary.json`` (docs/posturography.md)."""
+    import json
+
+    from pushrecovery.analysis.output import json_safe
+    from pushrecovery.analysis.posturography import recording_sway
+
+    measures, rate = recording_sway(recording, settings.force_cutoff)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "summary.json"
+    summary = {
+        "status": "posturography only",
+        "source": recording.source,
+        "frames": len(recording.force_time),
+        "rate": rate,
+        "posturography": {
+            **measures.to_dict(), "cop_cutoff": settings.force_cutoff, "rate": rate,
+        },
+    }  # fmt: skip
+    path.write_text(json.dumps(json_safe(summary), indent=2) + "\n")
+    files = {"summary": str(path)}
+    if as_json:
+        emit({**summary, "files": files}, True)
+        return
+    brief = {
+        "frames": f"{summary['frames']} ({rate:.6g} Hz, {measures.duration:.6g} s), CoP only: "
+        "the sway measures, no margins",
+        "path_length": measures.path_length.total,
+        "mean_velocity": measures.mean_velocity.total,
+        "rms_distance": measures.rms_distance.total,
+        "ellipse_area": measures.ellipse.area,
+        "files": files,
+    }
+    emit(brief, False)
 
 
 def _brief(summary: TrialSummary, files: dict[str, str], body_source: str) -> dict[str, Any]:

@@ -124,10 +124,12 @@ def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
         missing_base = sorted(set(base_names) - set(present))
         raise InputFileError(f"{path}: base of support columns missing: {', '.join(missing_base)}")
     has_force = all(name in data for name in (*_FORCES, "cop_ap", "cop_ml"))
-    if "com_ap" not in data and not has_force:
+    # A CoP alone is a posturography trial: its sway measures, no margins.
+    if "com_ap" not in data and not has_force and "cop_ap" not in data:
         raise InputFileError(
             f"{path}: no CoM: give columns com_ap and com_ml, or force_ap, force_ml, force_v, "
-            f"cop_ap and cop_ml; columns found: {', '.join(table) or '(none)'}"
+            "cop_ap and cop_ml (or cop_ap and cop_ml alone: the sway measures only); columns "
+            f"found: {', '.join(table) or '(none)'}"
         )
 
     for name in ("com_ap", "com_ml", "cop_ap", "cop_ml", *_FORCES):
