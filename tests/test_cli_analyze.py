@@ -176,6 +176,8 @@ def test_bad_inputs_are_one_line(tmp_path, capsys):
     assert "NAME=HEEL,TOE,ANKLE" in err
     err = _fail(capsys, "analyze", str(trial), *mm, "--xcom-length", "hip", "--out", out)
     assert "'hip'" in err and "com_height" in err
+    err = _fail(capsys, "analyze", str(trial), *mm, "--figure-format", "gif", "--out", out)
+    assert "'gif'" in err and "svg" in err
 
 
 def test_no_mass_is_refused_not_guessed(tmp_path, capsys):
@@ -316,3 +318,28 @@ def test_a_batch_keeps_its_cop_only_trials_as_posturography_rows(tmp_path):
     )
     path_ap = json.loads(single.output)["posturography"]["path_length_ap"]
     assert quiet["sway_path_length"] == pytest.approx(path_ap, rel=1e-4)  # 7 decimals of m, mm
+
+
+@pytest.mark.parametrize(("fmt", "magic"), [("svg", b"<?xml"), ("pdf", b"%PDF")])
+def test_figures_in_a_vector_format(tmp_path, fmt, magic):
+    pytest.importorskip("matplotlib")
+    trial = _trial(tmp_path / "trial.csv")
+    out = tmp_path / "o"
+    result = CliRunner().invoke(
+        cli, ["analyze", str(trial), "--units", "mm", "--mass", "72", "--figure-format", fmt,
+              "--out", str(out), "--json"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    files = json.loads(result.output)["files"]
+    for name in ("time_series", "phase_portrait", "plane"):
+        assert files[name].endswith(f".{fmt}")
+        assert (out / f"{name}.{fmt}").read_bytes().startswith(magic)
+    study = tmp_path / "study"
+    study.mkdir()
+    _trial(study / "a.csv")
+    batch = CliRunner().invoke(
+        cli, ["analyze", str(study), "--units", "mm", "--mass", "72", "--figure-format", fmt,
+              "--workers", "1", "--out", str(tmp_path / "b")],
+    )  # fmt: skip
+    assert batch.exit_code == 0, batch.output
+    assert (tmp_path / "b" / "trials" / "a.csv" / f"plane.{fmt}").read_bytes().startswith(magic)

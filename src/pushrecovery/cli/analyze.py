@@ -22,6 +22,8 @@ _SEXES = ("female", "male")
 
 
 #: (flag, default, help) of the AnalysisSettings fields named by the flags (SI units).
+#: The formats ``--figure-format`` writes (matplotlib's savefig).
+FIGURE_FORMATS = ("png", "svg", "pdf")
 _SETTINGS: tuple[tuple[str, float | None, str], ...] = (
     ("--cutoff", 6.0, "Low-pass cutoff of the CoM and markers [Hz] (0: none)."),
     ("--force-cutoff", 10.0, "Low-pass cutoff of the force-plate signals [Hz] (0: none)."),
@@ -164,7 +166,14 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     default=True,
     show_default=True,
     callback=needs_plots,
-    help="Write time_series.png and phase_portrait.png.",
+    help="Write time_series.png, phase_portrait.png and plane.png.",
+)
+@click.option(
+    "--figure-format",
+    type=click.Choice(FIGURE_FORMATS),
+    default="png",
+    show_default=True,
+    help="Format of the figures: png (150 dpi), or svg and pdf (vector, for a paper).",
 )
 @body_options
 def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) -> None:
@@ -232,7 +241,7 @@ def _single(
     from pushrecovery.analysis.trial.settings import PRESET_BODY
     from pushrecovery.presets import load_params
 
-    plot = kwargs.pop("plot")
+    plot, figure_format = kwargs.pop("plot"), kwargs.pop("figure_format")
     recording = read_recording(file, **reader.get(file.suffix.lower(), {}))
     if cop_only(recording):  # a posturography export: its sway measures, no body needed
         _single_sway(recording, out, as_json, settings)
@@ -252,22 +261,28 @@ def _single(
     result = analyze_trial(recording, params, settings, sources=sources)
     files = {name: str(path) for name, path in write_analysis(result, out).items()}
     if plot:
-        files.update(plot_trial(result, out))
+        files.update(plot_trial(result, out, figure_format))
     if as_json:
         emit({**result.summary.to_dict(), "files": files}, True)
         return
     emit(_brief(result.summary, files, sources.get("body", PRESET_BODY)), False)
 
 
-def plot_trial(result: Any, out: Path) -> dict[str, str]:
-    """Draw a trial's time series, phase portrait and plane into ``out``; return the files."""
+def plot_trial(result: Any, out: Path, figure_format: str = "png") -> dict[str, str]:
+    """Draw a trial's time series, phase portrait and plane into ``out``; return the files.
+
+    ``figure_format``: one of :data:`FIGURE_FORMATS` (the files' suffix).
+    """
     from pushrecovery.plots.analysis import plot_phase_portrait, plot_time_series
     from pushrecovery.plots.plane_trial import plot_plane
 
+    suffix = f".{figure_format}"
     return {
-        "time_series": str(plot_time_series(result, out / "time_series.png")),
-        "phase_portrait": str(plot_phase_portrait(result, out / "phase_portrait.png")),
-        "plane": str(plot_plane(result, result.base, out / "plane.png")),
+        "time_series": str(plot_time_series(result, (out / "time_series").with_suffix(suffix))),
+        "phase_portrait": str(
+            plot_phase_portrait(result, (out / "phase_portrait").with_suffix(suffix))
+        ),
+        "plane": str(plot_plane(result, result.base, (out / "plane").with_suffix(suffix))),
     }
 
 
@@ -281,11 +296,13 @@ def _batch(
     **kwargs: Any,
 ) -> None:
     """Many trials: one folder each, the tables of trials and events, the summary."""
+    import functools
+
     from pushrecovery.campaign.subjects import read_subjects
     from pushrecovery.campaign.trials import find_trials, run_trials, trial_jobs
     from pushrecovery.cli.progress import Progress
 
-    plot = kwargs.pop("plot")
+    plot, figure_format = kwargs.pop("plot"), kwargs.pop("figure_format")
     flags = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
     subjects = read_subjects(batch["subjects"]) if batch["subjects"] is not None else ()
     trials, root = find_trials(inputs)
@@ -303,7 +320,7 @@ def _batch(
             workers=batch["workers"],
             scheduler=batch["scheduler"],
             resume=batch["resume"],
-            after=plot_trial if plot else None,
+            after=functools.partial(plot_trial, figure_format=figure_format) if plot else None,
             progress=bar.update,
         )
     finally:
