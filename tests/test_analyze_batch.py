@@ -206,3 +206,18 @@ def test_synthetic_trials_refuse_bad_arguments():
     # Known truth: no push, the CoM stays where it stood (the noise apart).
     rows = lipm_trial_csv(P, 0.0, 0.0, noise=0.0).splitlines()[1:]
     assert {row.split(",")[1] for row in rows} == {"0.020000"}
+
+
+def test_a_subjects_table_that_is_no_file_is_refused_in_one_line(tmp_path, capsys):
+    # The fuzz campaign's `--subjects /dev/zero` read forever (killed): a device, a folder or
+    # a missing path is refused before reading.
+    import os
+
+    from pushrecovery.campaign.subjects import read_subjects
+    from pushrecovery.errors import InvalidParameterError
+
+    for path in ("/dev/zero", tmp_path, tmp_path / "none.csv"):
+        if str(path) == "/dev/zero" and not os.path.exists(path):
+            continue
+        with pytest.raises(InvalidParameterError, match="must be a CSV file"):
+            read_subjects(path)

@@ -223,3 +223,18 @@ def test_bad_inputs_name_the_argument() -> None:
     with pytest.raises(PushRecoveryError, match="params"):
         phase_supports(base, "body")  # type: ignore[arg-type]
     assert Support.from_params(P) is not None
+
+
+def test_a_ray_all_but_parallel_to_an_edge_gives_no_warning() -> None:
+    # The fuzz campaign's CSVs: a CoP velocity whose sideways part is subnormal (1e-311 m/s)
+    # makes the box's side edges' rate subnormal; their distance is +inf, the front edge's is
+    # the time, and numpy must not warn of an overflow.
+    import warnings
+
+    from pushrecovery.analysis.margins_2d import time_to_boundary_cop
+
+    base = _box(1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        time = time_to_boundary_cop(base, np.array([[0.05, 0.0]]), np.array([[0.5, 1e-311]]))
+    assert time[0] == pytest.approx((0.15 - 0.05) / 0.5)

@@ -157,7 +157,8 @@ def _ray(base: BasePolygons, origin: FloatArray, direction: FloatArray) -> Float
     start, _, normal, _ = _geometry(base)
     rate = np.einsum("fmk,fk->fm", normal, direction)
     gap = -np.einsum("fmk,fmk->fm", normal, origin[:, None, :] - start)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    # A ray all but parallel to an edge (a subnormal rate) reaches it at infinity: no warning.
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         ahead = np.where(rate > 0.0, np.maximum(gap, 0.0) / rate, np.inf)
     return np.asarray(np.min(ahead, axis=1), dtype=np.float64)
 

@@ -34,7 +34,10 @@ from pathlib import Path
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import LIMITS
 
-__all__ = ["SUBJECT_COLUMNS", "Subject", "read_subjects", "subject_for"]
+__all__ = ["MAX_TABLE_BYTES", "SUBJECT_COLUMNS", "Subject", "read_subjects", "subject_for"]
+
+#: Largest subjects table read [bytes]: a study's table is kilobytes.
+MAX_TABLE_BYTES = 50_000_000
 
 #: The table's columns: the two required ones, then the body's (all SI).
 SUBJECT_COLUMNS = (
@@ -91,11 +94,18 @@ def read_subjects(path: str | Path) -> tuple[Subject, ...]:
     Raises
     ------
     InvalidParameterError
-        An unreadable file, a missing ``pattern`` or ``subject`` column, an unknown column,
-        an empty pattern or subject, or a number that is not one or is out of its range,
-        naming the line.
+        An unreadable file (or one that is not a regular file, or over
+        :data:`MAX_TABLE_BYTES`), a missing ``pattern`` or ``subject`` column, an unknown
+        column, an empty pattern or subject, or a number that is not one or is out of its
+        range, naming the line.
     """
     path = Path(path)
+    # A device or a pipe (/dev/zero) would be read forever: a table is a file of some size.
+    if not path.is_file() or path.stat().st_size > MAX_TABLE_BYTES:
+        raise InvalidParameterError(
+            f"the subjects table {path} must be a CSV file of at most "
+            f"{MAX_TABLE_BYTES // 1_000_000} MB"
+        )
     try:
         text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
