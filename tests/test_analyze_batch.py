@@ -219,5 +219,5 @@ def test_a_subjects_table_that_is_no_file_is_refused_in_one_line(tmp_path, capsy
     for path in ("/dev/zero", tmp_path, tmp_path / "none.csv"):
         if str(path) == "/dev/zero" and not os.path.exists(path):
             continue
-        with pytest.raises(InvalidParameterError, match="must be a CSV file"):
+        with pytest.raises(InvalidParameterError, match="not a CSV file of at most 50 MB"):
             read_subjects(path)

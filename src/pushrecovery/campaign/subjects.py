@@ -103,7 +103,7 @@ def read_subjects(path: str | Path) -> tuple[Subject, ...]:
     # A device or a pipe (/dev/zero) would be read forever: a table is a file of some size.
     if not path.is_file() or path.stat().st_size > MAX_TABLE_BYTES:
         raise InvalidParameterError(
-            f"the subjects table {path} must be a CSV file of at most "
+            f"cannot read the subjects table {path}: not a CSV file of at most "
             f"{MAX_TABLE_BYTES // 1_000_000} MB"
         )
     try:
