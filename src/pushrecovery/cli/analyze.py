@@ -21,9 +21,9 @@ _AP_AXES = ("x", "-x", "y", "-y", "z", "-z")
 _SEXES = ("female", "male")
 
 
-#: (flag, default, help) of the AnalysisSettings fields named by the flags (SI units).
 #: The formats ``--figure-format`` writes (matplotlib's savefig).
 FIGURE_FORMATS = ("png", "svg", "pdf")
+#: (flag, default, help) of the AnalysisSettings fields named by the flags (SI units).
 _SETTINGS: tuple[tuple[str, float | None, str], ...] = (
     ("--cutoff", 6.0, "Low-pass cutoff of the CoM and markers [Hz] (0: none)."),
     ("--force-cutoff", 10.0, "Low-pass cutoff of the force-plate signals [Hz] (0: none)."),
