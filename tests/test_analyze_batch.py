@@ -221,3 +221,36 @@ def test_a_subjects_table_that_is_no_file_is_refused_in_one_line(tmp_path, capsy
             continue
         with pytest.raises(InvalidParameterError, match="not a CSV file of at most 50 MB"):
             read_subjects(path)
+
+
+def test_the_subjects_figure_shows_each_trials_margins_by_subject(study, tmp_path, capsys):
+    # Per subject, every analysed trial's two smallest margins (trials table values, plotted
+    # as they are) and its mean: the figure's points are the table's values.
+    pytest.importorskip("matplotlib")
+    import pyarrow.parquet as pq
+
+    from pushrecovery.cli import main
+    from pushrecovery.plots.subjects import MEASURES, subjects_figure
+
+    out = tmp_path / "cli"
+    args = ["analyze", str(study), "--out", str(out), "--subjects", str(study / "subjects.csv")]
+    with pytest.raises(SystemExit) as done:
+        main([*args, "--figure-format", "svg", "--json", "--workers", "1"])
+    assert done.value.code == 0
+    files = json.loads(capsys.readouterr().out)["files"]
+    assert files["subjects_figure"].endswith("subjects.svg")
+    assert (out / "subjects.svg").read_bytes().startswith(b"<?xml")
+    rows = pq.read_table(out / "trials.parquet").to_pylist()
+    figure = subjects_figure(rows)
+    ap = figure.axes[0]
+    subjects = sorted({r["subject"] for r in rows if r["status"] == "analysed"})
+    assert [t.get_text() for t in ap.get_xticklabels()] == subjects
+    plotted = sorted(
+        float(y) for line in ap.get_lines() if line.get_marker() in ("o", "^")
+        for y in line.get_ydata()
+    )  # fmt: skip
+    expected = sorted(
+        r[column] for r in rows for column, *_ in MEASURES
+        if r["status"] == "analysed" and r["axis"] == "ap" and r[column] is not None
+    )  # fmt: skip
+    assert plotted == pytest.approx(expected)

@@ -326,6 +326,11 @@ def _batch(
     finally:
         bar.close()
     files = {name: str(path) for name, path in result.files.items()}
+    if plot:  # the trials' smallest margins by subject
+        from pushrecovery.plots.subjects import plot_subjects
+
+        subjects_figure = plot_subjects(result.trials, out / f"subjects.{figure_format}")
+        files["subjects_figure"] = str(subjects_figure)
     data = {**result.summary, "root": str(root), "analysed_now": result.ran, "files": files}
     if as_json:
         emit(data, True)
