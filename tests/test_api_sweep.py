@@ -114,7 +114,7 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     },
     "pushrecovery.analysis.readers.c3d_files.read_c3d_recording": {"path": _trial_c3d()},
     # A posturography export: the CoP alone.
-    "pushrecovery.analysis.posturography.recording_sway": {"recording": Recording(
+    "pushrecovery.analysis.sway_recording.recording_sway": {"recording": Recording(
         time=np.arange(0.0, 10.0, 0.01), force_time=np.arange(0.0, 10.0, 0.01),
         cop=0.01 * np.sin(np.outer(np.arange(0.0, 10.0, 0.01), [1.0, 2.0])),
     )},

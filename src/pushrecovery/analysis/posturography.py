@@ -21,20 +21,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import detrend, welch
 
-from pushrecovery.analysis.recording import LOADED, Recording
-from pushrecovery.arguments import (
-    bounded_float,
-    float_array,
-    non_negative_float,
-    positive_float,
-    require_type,
-)
+from pushrecovery.analysis.recording import LOADED
+from pushrecovery.arguments import bounded_float, float_array, positive_float
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
-    "BAND", "SEGMENT", "Components", "Ellipse", "Spectrum", "SwayMeasures", "cop_only",
-    "mean_distance", "mean_frequency", "mean_velocity", "path_length", "prediction_ellipse",
-    "quiet_standing", "recording_sway", "rms_distance", "sway_measures", "sway_spectrum",
+    "BAND", "SEGMENT", "Components", "Ellipse", "Spectrum", "SwayMeasures", "mean_distance",
+    "mean_frequency", "mean_velocity", "path_length", "prediction_ellipse", "quiet_standing",
+    "rms_distance", "sway_measures", "sway_spectrum",
 ]  # fmt: skip
 
 #: Spectral band [Hz]: Prieto et al. (1996) analyse 0.15-5 Hz.
@@ -402,56 +396,3 @@ def quiet_standing(
     if vertical.min() < LOADED or np.abs(vertical - typical).max() > max_load_change * typical:
         return False
     return bool(np.hypot(loads[:, 0], loads[:, 1]).max() <= max_acceleration * typical / GRAVITY)
-
-
-def cop_only(recording: Recording) -> bool:
-    """Whether ``recording`` holds a CoP and nothing to find a CoM from (no CoM, no force).
-
-    Such a trial (a posturography platform's export) gives its sway measures only
-    (:func:`recording_sway`): margins need the CoM.
-
-    Raises
-    ------
-    ParameterTypeError
-        If ``recording`` is not a Recording.
-    """
-    require_type("recording", recording, Recording)
-    return recording.cop is not None and recording.com is None and recording.force is None
-
-
-def recording_sway(recording: Recording, cutoff: float) -> tuple[SwayMeasures, float]:
-    """Return the sway measures of a quiet-standing recording's CoP and its rate [Hz].
-
-    The CoP is low-passed at ``cutoff`` [Hz] (zero lag, as the analysis low-passes plate
-    signals; 0: none), then :func:`sway_measures` on the whole trial.
-
-    Raises
-    ------
-    ParameterTypeError
-        If ``recording`` is not a Recording.
-    InvalidParameterError
-        If ``cutoff`` is not a finite number >= 0 [Hz], the recording has no CoP, a CoP frame
-        is missing, the trace is no quiet standing
-        (:func:`quiet_standing`, with the force when the recording has one), or it is too
-        short for the spectra.
-    """
-    from pushrecovery.analysis.signals import smooth_and_differentiate
-
-    require_type("recording", recording, Recording)
-    cutoff = non_negative_float("cutoff", cutoff, "Hz")
-    if recording.cop is None or recording.force_time is None or len(recording.force_time) < 2:
-        raise InvalidParameterError("the recording has no CoP to measure the sway of")
-    time = recording.force_time
-    rate = 1.0 / float(np.median(np.diff(time)))
-    if not np.isfinite(recording.cop).all():
-        raise InvalidParameterError(
-            f"the CoP misses {int((~np.isfinite(recording.cop).all(axis=1)).sum())} frame(s): "
-            "the sway measures need every frame (analyse a window without gaps)"
-        )
-    cop, _ = smooth_and_differentiate(time, recording.cop, cutoff)
-    if not quiet_standing(cop, rate, force=recording.force):
-        raise InvalidParameterError(
-            "the CoP trace is no quiet standing (docs/posturography.md: a step, a push or an "
-            "unloaded plate): no sway measures"
-        )
-    return sway_measures(cop, rate), rate

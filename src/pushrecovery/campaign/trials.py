@@ -172,8 +172,8 @@ class TrialsResult:
 def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict[str, Any]:
     """Analyse one trial into ``out / trials / job.name``; return and store its rows."""
     from pushrecovery.analysis.output import json_safe, write_analysis
-    from pushrecovery.analysis.posturography import cop_only, recording_sway
     from pushrecovery.analysis.readers import read_recording
+    from pushrecovery.analysis.sway_recording import cop_only, recording_sway
     from pushrecovery.analysis.trial import analyze, body_for
     from pushrecovery.presets import load_params
 

@@ -1,4 +1,8 @@
-"""The ``analyze`` command: a measured trial (CSV or C3D) -> per-frame margins and strategies."""
+"""The ``analyze`` command: a measured trial (CSV or C3D) -> per-frame margins and strategies.
+
+Over 400 lines on purpose: one command, its options, and its three paths (one trial, a batch,
+a CoP-only trial) with what each prints.
+"""
 
 from __future__ import annotations
 
@@ -234,8 +238,8 @@ def _single(
 ) -> None:
     """One trial, its outputs straight into ``out`` (the first releases' contract)."""
     from pushrecovery.analysis.output import write_analysis
-    from pushrecovery.analysis.posturography import cop_only
     from pushrecovery.analysis.readers import read_recording
+    from pushrecovery.analysis.sway_recording import cop_only
     from pushrecovery.analysis.trial import analyze as analyze_trial
     from pushrecovery.analysis.trial import body_for
     from pushrecovery.analysis.trial.settings import PRESET_BODY
@@ -351,7 +355,7 @@ def _single_sway(recording: Any, out: Path, as_json: bool, settings: Any) -> Non
     import json
 
     from pushrecovery.analysis.output import json_safe
-    from pushrecovery.analysis.posturography import recording_sway
+    from pushrecovery.analysis.sway_recording import recording_sway
 
     measures, rate = recording_sway(recording, settings.force_cutoff)
     out.mkdir(parents=True, exist_ok=True)
