@@ -151,3 +151,58 @@ def test_the_cmp_from_the_plates_is_the_cop_moved_by_the_hip_torque(tmp_path):
     assert np.median(np.abs(measured - expected)[response]) < 0.005
     assert np.corrcoef(measured[response], expected[response])[0, 1] > 0.95
     assert np.abs(measured[time < push - 0.05]).max() < 0.003  # no torque, CMP on the CoP
+
+
+def test_the_steps_table_is_the_step_the_simulation_took(tmp_path):
+    """Issue 34: one row per step, its landing and touchdown those of the simulation.
+
+    The right leg lifts off plate 1, which both feet stood on (so the plate cannot see that
+    foot leave: its markers do), and lands on plate 2.
+    """
+    from pushrecovery.campaign.trial_steps import step_schema, trial_steps
+    from pushrecovery.campaign.trials import TrialJob
+
+    recording = _recorded("step")
+    truth = recording.truth
+    _, params, result = _analyse(_c3d(tmp_path, recording))
+    job = TrialJob(tmp_path / "trial.c3d", "trial.c3d", None)
+    (row,) = trial_steps(job, result.summary)
+    true = {(e["foot"], e["kind"]): e["time"] for e in reversed(truth["foot_events"])}
+    assert row.foot == "right" and row.step == 1
+    # Touchdown: the first sample the floor carries the right foot again, to 10 ms.
+    landing = max(e["time"] for e in truth["foot_events"] if e["kind"] == "foot-contact"
+                  and e["foot"] == "right")  # fmt: skip
+    assert abs(row.foot_contact - landing) <= 0.010
+    # Foot-off from the heel and toe markers (3 cm up): later than the contact force's end.
+    lift = true[("right", "foot-off")]
+    assert 0.0 <= row.foot_off - lift <= 0.1
+    # The landing: the foot point (heel-toe midpoint) is the ankle + (heel + toe) / 2; the
+    # simulation's foothold is the landed ankle (and the foot creeps 4.5 mm after, see
+    # test_mocap): to 1 cm.
+    offset = 0.5 * (PARAMS.heel + PARAMS.toe)
+    assert row.end_ap - offset == pytest.approx(truth["footholds"][1], abs=0.01)
+    assert row.length == pytest.approx(truth["step_lengths"][0], abs=0.01)
+    assert row.width == pytest.approx(0.0, abs=1e-9) and row.end_ml == pytest.approx(-0.1)
+    assert row.duration == pytest.approx(row.foot_contact - row.foot_off)
+    assert row.onset == pytest.approx(truth["push_time"], abs=0.01)
+    assert row.latency == pytest.approx(row.foot_off - row.onset)
+    # The verdict before the step needed it; the step taken lies in the capture range.
+    assert row.strategy_ap == "step" and row.steps_needed_ap >= 1
+    assert row.step_min_ap <= row.length <= row.step_max_ap
+    assert row.step_margin_ap == pytest.approx(
+        min(row.length - row.step_min_ap, row.step_max_ap - row.length)
+    )
+    assert row.in_capture_region is True and row.capture_region_margin > 0.0
+    # MoS at the contact: Hof's b toward the motion, from the frames' own column.
+    frame = int(np.argmin(np.abs(result.columns["time"] - row.foot_contact)))
+    assert row.mos_ap_contact == result.columns["mos_ap"][frame]
+    assert row.mos_ml_contact == result.columns["mos_ml"][frame]
+    # Hand computation of b_ant at that frame: the base's front edge minus the XCoM.
+    xcom = result.columns["ap_com"][frame] + result.columns["ap_com_velocity"][frame] / (
+        (PARAMS.gravity / params.com_height) ** 0.5
+    )
+    front = result.columns["ap_base_max"][frame]
+    assert row.mos_ap_contact == pytest.approx(front - xcom, abs=1e-9)
+    schema = step_schema()
+    assert schema.field("mos_ap_contact").metadata[b"unit"] == b"m"
+    assert schema.names[:4] == ["trial", "subject", "step", "foot"]

@@ -265,6 +265,7 @@ def record_push(
         "footholds": footholds,
         "stance_width": 2.0 * STANCE_HALF_WIDTH,
         "off_plate_samples": lab.off_plate,
+        "foot_events": _foot_events(lab, n_kept, analog_rate),
         "params": dataclasses.asdict(params),
     }
     return MocapRecording(
@@ -275,3 +276,26 @@ def record_push(
         mass=float(plant.model.body_subtreemass[0]),
         truth=truth,
     )
+
+
+def _foot_events(lab: LabRecorder, samples: int, rate: float) -> list[dict[str, object]]:
+    """Return the feet's true foot-offs and foot-contacts: their floor contact ending, starting.
+
+    Per foot of the biped (``left``, ``right``; none for the one-footed models): the analog
+    sample [s] at which the floor's vertical force on the foot's body becomes 0 (foot-off) or
+    positive (foot-contact), whatever plate it stands on.
+    """
+    if lab.model_name != "biped":
+        return []
+    events: list[dict[str, object]] = []
+    for (side, *_), load in zip(lab.feet, lab.foot_load[:samples].T, strict=True):
+        loaded = load > 0.0
+        for k in np.flatnonzero(np.diff(loaded.astype(np.int8))).tolist():
+            events.append(
+                {
+                    "foot": "left" if side == "L" else "right",
+                    "kind": "foot-contact" if loaded[k + 1] else "foot-off",
+                    "time": (k + 1) / rate,
+                }
+            )
+    return sorted(events, key=lambda event: event["time"])  # type: ignore[arg-type,return-value]

@@ -54,6 +54,8 @@ FloatArray = NDArray[np.float64]
 
 #: Baseline of the onset detection: the trial's first seconds [s].
 ONSET_BASELINE = 0.5
+#: A foot's marker event this close to its plate event of the same kind is that event [s].
+SAME_EVENT = 0.1
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,6 +72,14 @@ class AxisMargins:
         Time before the CoM would leave the CoP region at its motion [s].
     strategy : str or None
         The strategy the frame needs along the axis; None where withheld or unknown.
+    steps : int or None
+        Steps the frame needs along the axis: 0 for ankle and hip, N for step, −1 where no
+        ``max_steps`` steps capture (fall); None where withheld or unknown (the N-step verdict).
+    step_margin : float or None
+        Margin of the capture point inside the region of ``max_steps`` steps [m], + inside.
+    mos : float or None
+        Hof's margin of stability toward the motion along the axis against the base polygon
+        (``mos_ap``, ``mos_ml`` of the frames) [m]; None without a base polygon.
     """
 
     capture_point: float | None
@@ -77,6 +87,9 @@ class AxisMargins:
     cmp_margin: float | None
     time_to_leave_cop: float | None
     strategy: str | None
+    steps: int | None = None
+    step_margin: float | None = None
+    mos: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -133,6 +146,10 @@ class StepComparison:
         of ``recommended``).
     within : bool or None
         Whether ``taken`` lies in that range; None where the frame needed no step.
+    margin : float or None
+        The step's margin inside that range [m]: min(s − shortest, longest − s) with s the
+        step taken in the direction of ``recommended``; + inside, − short of or beyond it;
+        None where the frame needed no step or the foot's markers are missing.
     """
 
     taken: float | None
@@ -140,6 +157,7 @@ class StepComparison:
     shortest: float | None
     longest: float | None
     within: bool | None
+    margin: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -219,6 +237,7 @@ def _events_dict(events: TrialEvents) -> dict[str, Any]:
                         "recommended": c.recommended,
                         "capture_range": [c.shortest, c.longest],
                         "within": c.within,
+                        "margin": c.margin,
                     }
                     for axis, c in taken.against_recommended.items()
                 },
@@ -245,9 +264,16 @@ def _value(array: NDArray[Any], frame: int) -> float | None:
 
 
 def _margins_at(
-    time: FloatArray, when: float, per_axis: dict[str, DirectionMargins]
+    time: FloatArray,
+    when: float,
+    per_axis: dict[str, DirectionMargins],
+    mos: dict[str, FloatArray] | None = None,
 ) -> FrameMargins:
-    """Return the margins of the frame nearest ``when`` [s], per axis."""
+    """Return the margins of the frame nearest ``when`` [s], per axis.
+
+    ``mos``: per axis, Hof's margin toward the motion of every frame (the plane's ``mos_ap``,
+    ``mos_ml``), or None.
+    """
     frame = int(np.argmin(np.abs(time - when)))
     axes = {}
     for axis, margins in per_axis.items():
@@ -258,6 +284,9 @@ def _margins_at(
             cmp_margin=_value(margins.cmp, frame),
             time_to_leave_cop=_value(margins.time_to_leave_cop, frame),
             strategy=STRATEGY_CODES[code].value if code >= 0 else None,
+            steps=int(margins.steps[frame]) if code >= 0 else None,
+            step_margin=_value(margins.step, frame),
+            mos=None if mos is None else _value(mos[axis], frame),
         )
     return FrameMargins(float(time[frame]), axes)
 
@@ -296,20 +325,25 @@ def _compared(
         shortest = _value(margins.step_shortest, frame)
         longest = _value(margins.step_longest, frame)
         moved = taken[axis]
-        within = None
+        within = margin = None
         if recommended is not None and shortest is not None and longest is not None:
             # The range is unsigned, in the direction of the recommended step.
             along = None if moved is None else math.copysign(1.0, recommended) * moved
             within = along is not None and shortest <= along <= longest
-        result[axis] = StepComparison(moved, recommended, shortest, longest, within)
+            margin = None if along is None else min(along - shortest, longest - along)
+        result[axis] = StepComparison(moved, recommended, shortest, longest, within, margin)
     return result
 
 
 def _foot_events(recording: Recording, owners: dict[int, str]) -> list[FootEvent]:
-    """Foot events from each foot's own plate where it has one, else from its markers.
+    """Foot events from each foot's own plate where it has one, and from its markers.
 
     ``owners``: plate index -> its foot (:func:`~pushrecovery.analysis.trial.checks.plate_feet`);
-    a plate not in it (stray: under no foot) makes no events.
+    a plate not in it (stray: under no foot) makes no events. A plate sees a foot's events
+    only while that foot alone stands on it: a foot leaving a plate both feet stood on (a
+    step off a shared plate onto the next one) unloads nothing. So every foot's marker events
+    count too, except one within :data:`SAME_EVENT` of a plate event of the same foot and kind
+    (the plate's, sampled faster, is kept).
     """
     events: list[FootEvent] = []
     for k, name in owners.items():
@@ -317,14 +351,22 @@ def _foot_events(recording: Recording, owners: dict[int, str]) -> list[FootEvent
         assert recording.force_time is not None
         finite = np.isfinite(vertical)
         events += foot_events_from_force(recording.force_time[finite], vertical[finite], name)
-    on_plates = set(owners.values())
+    from_plates = list(events)
     for foot in recording.feet:
-        if foot.name in on_plates:
-            continue
         try:
-            events += foot_events_from_markers(recording.time, foot)
+            found = foot_events_from_markers(recording.time, foot)
         except InvalidParameterError:  # a foot whose markers are missing throughout
             continue
+        events += [
+            event
+            for event in found
+            if not any(
+                seen.foot == event.foot
+                and seen.kind == event.kind
+                and abs(seen.time - event.time) <= SAME_EVENT
+                for seen in from_plates
+            )
+        ]
     return sorted(events, key=lambda event: event.time)
 
 
@@ -392,6 +434,7 @@ def trial_events(
     com: FloatArray | None = None,
     plane: tuple[Any, BodyParams] | None = None,
     plates: PlateFeet,
+    mos: dict[str, FloatArray] | None = None,
 ) -> TrialEvents:
     """Return the trial's onset, foot events and steps with their margins.
 
@@ -399,7 +442,9 @@ def trial_events(
     margins, ``mass`` the subject's [kg]; with ``com`` (n, 2) [m] and ``plane`` (the base
     polygons and the body), each step is also judged against the 2-D capture region at its
     foot-off (``capture_region``). ``plates``: which foot stands on each plate
-    (:func:`~pushrecovery.analysis.trial.checks.plate_feet`).
+    (:func:`~pushrecovery.analysis.trial.checks.plate_feet`). ``mos``: per axis, Hof's margin
+    toward the motion of every frame (the plane's ``mos_ap``, ``mos_ml``), given to each event's
+    margins (:class:`AxisMargins` ``mos``).
     """
     onset, onset_source = _onset(recording, time, velocity, mass)
     events = _foot_events(recording, plates.owners)
@@ -410,16 +455,17 @@ def trial_events(
     )
     return TrialEvents(
         onset=Onset(
-            onset, onset_source, None if onset is None else _margins_at(time, onset, per_axis)
+            onset, onset_source, None if onset is None else _margins_at(time, onset, per_axis, mos)
         ),
         foot_events=tuple(
-            TriggeredFootEvent(event, _margins_at(time, event.time, per_axis)) for event in events
+            TriggeredFootEvent(event, _margins_at(time, event.time, per_axis, mos))
+            for event in events
         ),
         measured_steps=tuple(
             StepTaken(
                 step,
-                at_foot_off=_margins_at(time, step.off_time, per_axis),
-                at_foot_contact=_margins_at(time, step.contact_time, per_axis),
+                at_foot_off=_margins_at(time, step.off_time, per_axis, mos),
+                at_foot_contact=_margins_at(time, step.contact_time, per_axis, mos),
                 against_recommended=_compared(step, time, per_axis),
                 capture_region=None
                 if com is None

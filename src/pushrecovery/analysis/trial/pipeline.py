@@ -246,6 +246,7 @@ def analyze(
         com=com,
         plane=(base, params),
         plates=checks.plates,
+        mos={"ap": plane.mos_ap, "ml": plane.mos_ml},
     )
     sway = _posturography(force_time, plate_cop, plate_force)
     if sway is not None and events.onset.time is not None:

@@ -215,6 +215,7 @@ class LabRecorder:
         self._hi = np.array([p.centre[:2] + p.half for p in plates])
         self._centres = np.array([p.centre for p in plates])
         self._buffer = np.zeros(6)
+        self.model_name = model_name
         self.feet = [
             (side, self.model.body(body).id, self.model.joint(joint).id, y)
             for side, body, joint, y in _FEET[model_name]
@@ -228,6 +229,11 @@ class LabRecorder:
         #: Per analog sample and plate: force on the subject [N], moment about the centre [N m].
         self.forces = np.zeros((analog, len(plates), 3))
         self.moments = np.zeros((analog, len(plates), 3))
+        #: Per analog sample and foot (:attr:`feet`' order): the floor's vertical force on the
+        #: foot's body [N], on the plates or off them (the feet of ``foot`` and ``torso`` are
+        #: one body: both columns carry its whole load).
+        self.foot_load = np.zeros((analog, len(self.feet)))
+        self._foot_bodies = np.array([body for _, body, _, _ in self.feet])
         #: Per analog sample: the hip torque held [N m] and the plant's own CoP (world x) [m].
         self.hip_torque = np.zeros(analog)
         self.plant_cop = np.zeros(analog)
@@ -239,7 +245,7 @@ class LabRecorder:
         a = index // self.decimation
         if a >= len(self.hip_torque):
             return  # the run goes on past the recording (to the end of its last tick)
-        self.loads(self.forces[a], self.moments[a])
+        self.loads(self.forces[a], self.moments[a], self.foot_load[a])
         self.hip_torque[a] = step.applied[1]
         self.plant_cop[a] = self._plant.measured_cop_world()
         if a % self.per_frame == 0:
@@ -262,10 +268,14 @@ class LabRecorder:
             out[side + "ANK"][i] = d.xanchor[joint]
             out[side + "ANK"][i, 1] = y
 
-    def loads(self, force: FloatArray, moment: FloatArray) -> None:
-        """Write each plate's force on the subject [N] and moment about its centre [N m]."""
+    def loads(self, force: FloatArray, moment: FloatArray, feet: FloatArray) -> None:
+        """Write each plate's force on the subject [N] and moment about its centre [N m].
+
+        ``feet``: each foot body's vertical load from the floor [N] (``foot_load``'s row).
+        """
         force[:] = 0.0
         moment[:] = 0.0
+        feet[:] = 0.0
         d, floor = self.data, self.floor
         ncon = d.ncon
         if ncon == 0:
@@ -283,6 +293,9 @@ class LabRecorder:
         frames = d.contact.frame[:ncon].reshape(ncon, 3, 3)
         f = sign[:, None] * np.einsum("kji,kj->ki", frames, wrench[:, :3])  # frame^T f
         tau = sign[:, None] * np.einsum("kji,kj->ki", frames, wrench[:, 3:])
+        bodies = self.model.geom_bodyid[np.where(sign > 0.0, geoms[:, 1], geoms[:, 0])]
+        for i, body in enumerate(self._foot_bodies):
+            feet[i] = f[(bodies == body) & (sign != 0.0), 2].sum()
         pos = d.contact.pos[:ncon]
         inside = np.all((pos[:, None, :2] >= self._lo) & (pos[:, None, :2] < self._hi), axis=2)
         loaded = sign != 0.0
