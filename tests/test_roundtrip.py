@@ -206,3 +206,28 @@ def test_the_steps_table_is_the_step_the_simulation_took(tmp_path):
     schema = step_schema()
     assert schema.field("mos_ap_contact").metadata[b"unit"] == b"m"
     assert schema.names[:4] == ["trial", "subject", "step", "foot"]
+
+
+def test_the_trials_events_go_into_a_copy_of_its_c3d(tmp_path):
+    from pushrecovery.analysis.c3d import read_events, write_events
+    from pushrecovery.analysis.trial.events import c3d_events
+
+    path = _c3d(tmp_path, _recorded("step"))
+    _, _, result = _analyse(path)
+    events = result.summary.events
+    written = write_events(path, tmp_path / "events.c3d", c3d_events(events))
+    back = read_events(written)
+    assert back[0].context == "General" and "onset" in back[0].description
+    assert back[0].time == pytest.approx(events.onset.time, abs=1e-6)
+    feet = [(e.context, e.label) for e in back[1:]]
+    assert feet == [
+        ("Right" if f.event.foot == "right" else "Left",
+         "Foot Strike" if f.event.kind == "foot-contact" else "Foot Off")
+        for f in events.foot_events
+    ]  # fmt: skip
+    assert ("Right", "Foot Off") in feet and ("Right", "Foot Strike") in feet
+    times = [f.event.time for f in events.foot_events]
+    assert [e.time for e in back[1:]] == pytest.approx(times, abs=1e-6)
+    # The copy is still the trial: analysed again, the same frames.
+    _, _, again = _analyse(written)
+    assert np.array_equal(again.columns["mos_ap"], result.columns["mos_ap"], equal_nan=True)

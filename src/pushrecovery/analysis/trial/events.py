@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.analysis.c3d.event_group import FOOT_OFF, FOOT_STRIKE, GENERAL, C3DEvent
 from pushrecovery.analysis.events import perturbation_onset
 from pushrecovery.analysis.margins import DirectionMargins
 from pushrecovery.analysis.margins_2d import phase_supports
@@ -48,6 +49,7 @@ __all__ = [
     "StepTaken",
     "TrialEvents",
     "TriggeredFootEvent",
+    "c3d_events",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -474,3 +476,32 @@ def trial_events(
             for step in steps
         ),
     )
+
+
+def c3d_events(events: TrialEvents) -> list[C3DEvent]:
+    """Return a trial's onset and foot events as C3D EVENT entries (``--write-events``).
+
+    A foot named ``left`` or ``right`` (any case) gives the context ``Left`` or ``Right``,
+    another foot ``General``; foot-contact is ``Foot Strike``, foot-off ``Foot Off`` (the
+    labels gait software expects); the onset is a ``General`` event. Each description says
+    what detected it.
+    """
+    found = []
+    if events.onset.time is not None:
+        found.append(
+            C3DEvent(
+                events.onset.time, GENERAL, GENERAL, f"perturbation onset ({events.onset.signal})"
+            )
+        )
+    for triggered in events.foot_events:
+        event = triggered.event
+        side = event.foot.lower()
+        found.append(
+            C3DEvent(
+                event.time,
+                side.capitalize() if side in ("left", "right") else GENERAL,
+                FOOT_STRIKE if event.kind == "foot-contact" else FOOT_OFF,
+                f"{event.foot} {event.kind} from its {event.source} (pushrecovery)",
+            )
+        )
+    return found
