@@ -177,3 +177,33 @@ def test_base_body_keeps_its_other_fields():
 def test_bad_input_names_the_parameter(args, kwargs, name):
     with pytest.raises(InvalidParameterError, match=name):
         person_params(*args, **kwargs)
+
+
+# de Leva 1996 Table 4 as an independent transcription gives it (R. Gurchiek's deleva.m, 2018:
+# fractions, here in % and mm): (length, mass, CoM, r_sag, r_trans, r_long) per sex
+# (female, male). Its 'x' is the table's sagittal column, 'z' the transverse, 'y' the
+# longitudinal (for the foot, 'z' sagittal, 'y' transverse, 'x' longitudinal).
+TRANSCRIBED = {
+    "head": ((243.7, 6.68, 48.41, 27.1, 29.5, 26.1), (242.9, 6.94, 50.02, 30.3, 31.5, 26.1)),
+    "trunk": ((614.8, 42.57, 49.64, 30.7, 29.2, 14.7), (603.3, 43.46, 51.38, 32.8, 30.6, 16.9)),
+    "trunk_shoulders": (
+        (497.9, 42.57, 37.82, 37.9, 36.1, 18.2),
+        (515.5, 43.46, 43.10, 38.4, 35.8, 19.7),
+    ),
+    "upper_arm": ((275.1, 2.55, 57.54, 27.8, 26.0, 14.8), (281.7, 2.71, 57.72, 28.5, 26.9, 15.8)),
+    "forearm": ((264.3, 1.38, 45.59, 26.1, 25.7, 9.4), (268.9, 1.62, 45.74, 27.6, 26.5, 12.1)),
+    "hand": ((78.0, 0.56, 74.74, 53.1, 45.4, 33.5), (86.2, 0.61, 79.00, 62.8, 51.3, 40.1)),
+    "thigh": ((368.5, 14.78, 36.12, 36.9, 36.4, 16.2), (422.2, 14.16, 40.95, 32.9, 32.9, 14.9)),
+    "shank": ((438.6, 4.81, 43.52, 26.7, 26.3, 9.2), (440.3, 4.33, 43.95, 25.1, 24.6, 10.2)),
+    "foot": ((228.3, 1.29, 40.14, 29.9, 27.9, 13.9), (258.1, 1.37, 44.15, 25.7, 24.5, 12.4)),
+}
+
+
+def test_every_number_of_the_table_agrees_with_an_independent_transcription():
+    from pushrecovery.anthropometry import DE_LEVA, STATURE
+
+    assert dict(STATURE) == {"female": 1735.0, "male": 1741.0}
+    for sex, column in (("female", 0), ("male", 1)):
+        assert set(DE_LEVA[sex]) == set(TRANSCRIBED)
+        for name, rows in TRANSCRIBED.items():
+            assert tuple(DE_LEVA[sex][name]) == pytest.approx(rows[column], abs=1e-9), (sex, name)
