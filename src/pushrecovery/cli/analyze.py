@@ -179,6 +179,12 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     show_default=True,
     help="Format of the figures: png (150 dpi), or svg and pdf (vector, for a paper).",
 )
+@click.option(
+    "--write-events",
+    is_flag=True,
+    help="Also write events.c3d: a copy of a C3D trial (never the input) with the onset and "
+    "the foot events (Foot Strike, Foot Off) in its EVENT group (docs/events.md).",
+)
 @body_options
 def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) -> None:
     """Analyse measured trials: capture point, margins, strategy and step per frame.
@@ -243,11 +249,22 @@ def _single(
     from pushrecovery.analysis.trial import analyze as analyze_trial
     from pushrecovery.analysis.trial import body_for
     from pushrecovery.analysis.trial.settings import PRESET_BODY
+    from pushrecovery.errors import InvalidParameterError
     from pushrecovery.presets import load_params
 
     plot, figure_format = kwargs.pop("plot"), kwargs.pop("figure_format")
+    write_events = kwargs.pop("write_events")
+    if write_events and file.suffix.lower() != ".c3d":
+        raise InvalidParameterError(
+            f"--write-events writes the events into a C3D file's EVENT group: {file.name} is "
+            "no .c3d file (the events are in summary.json and the events table)"
+        )
     recording = read_recording(file, **reader.get(file.suffix.lower(), {}))
     if cop_only(recording):  # a posturography export: its sway measures, no body needed
+        if write_events:
+            raise InvalidParameterError(
+                f"--write-events: {file.name} has only a CoP (posturography), no foot events"
+            )
         _single_sway(recording, out, as_json, settings)
         return
     overrides = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
@@ -264,12 +281,22 @@ def _single(
     params = load_params(kwargs["preset"], kwargs["params_file"], {**overrides, **found})
     result = analyze_trial(recording, params, settings, sources=sources)
     files = {name: str(path) for name, path in write_analysis(result, out).items()}
+    if write_events:
+        files["events_c3d"] = str(trial_c3d_events(file, result, out))
     if plot:
         files.update(plot_trial(result, out, figure_format))
     if as_json:
         emit({**result.summary.to_dict(), "files": files}, True)
         return
     emit(_brief(result.summary, files, sources.get("body", PRESET_BODY)), False)
+
+
+def trial_c3d_events(file: Path, result: Any, out: Path) -> Path:
+    """Write ``out/events.c3d``: ``file`` with the trial's events in its EVENT group."""
+    from pushrecovery.analysis.c3d import write_events
+    from pushrecovery.analysis.trial.events import c3d_events
+
+    return write_events(file, out / "events.c3d", c3d_events(result.summary.events))
 
 
 def plot_trial(result: Any, out: Path, figure_format: str = "png") -> dict[str, str]:
