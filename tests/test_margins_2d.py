@@ -238,3 +238,23 @@ def test_a_ray_all_but_parallel_to_an_edge_gives_no_warning() -> None:
         warnings.simplefilter("error")
         time = time_to_boundary_cop(base, np.array([[0.05, 0.0]]), np.array([[0.5, 1e-311]]))
     assert time[0] == pytest.approx((0.15 - 0.05) / 0.5)
+
+
+def test_runs_of_equal_polygons_give_the_frame_by_frame_numbers() -> None:
+    """The edges are computed once per run of equal polygons: the same bits as frame by frame."""
+    rng = np.random.default_rng(3)
+    n = 60
+    left, right = _walk(n)
+    stepping = base_from_feet((left, right), FootModel(width=0.1), contact_height=0.02)
+    com, vel, cop = (rng.normal(scale=s, size=(n, 2)) for s in (0.1, 0.3, 0.1))
+    com[5] = np.nan
+    for base in (stepping, _box(n)):
+        whole = margins_2d(base, com, vel, P, cop=cop, cop_velocity=vel)
+        for f in (0, 5, 14, 15, 16, 29, 59):  # each frame alone: its own polygon, no run
+            one = BasePolygons(base.vertices[f : f + 1], base.counts[f : f + 1], base.source)
+            alone = margins_2d(one, com[f : f + 1], vel[f : f + 1], P, cop=cop[f : f + 1],
+                               cop_velocity=vel[f : f + 1], verdicts=False)  # fmt: skip
+            for name in ("mos", "mos_ap", "ttb_cop", "ttb_xcom", "mos_left"):
+                assert np.array_equal(
+                    getattr(whole, name)[f : f + 1], getattr(alone, name), equal_nan=True
+                ), (name, f)

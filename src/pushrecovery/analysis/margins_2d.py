@@ -25,6 +25,9 @@ Body axes x = ap (forward +), y = ml (left +) [m]; the base per frame from
 - **Verdicts**: :func:`pushrecovery.surfaces.classify_many.classify_states` against the
   library's :class:`~pushrecovery.ground.Support` of each stance phase (the CoP region, the
   CMP region P ⊕ box, the N-step regions), and the signed distance of ξ to the CMP region.
+
+Over 400 lines on purpose: the measures share one geometry of the base's edges, computed once
+per run of equal polygons (a batch's hot path, issue 34); split, it would cross modules.
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -120,7 +124,7 @@ def signed_distance(base: BasePolygons, points: ArrayLike) -> FloatArray:
     """
     require_type("base", base, BasePolygons)
     p = _frames("points", points, len(base))
-    return _signed(base, p)
+    return _signed(_geometry(base), p)
 
 
 def _frames(name: str, value: ArrayLike, n: int) -> FloatArray:
@@ -131,48 +135,80 @@ def _frames(name: str, value: ArrayLike, n: int) -> FloatArray:
     return array
 
 
-def _geometry(base: BasePolygons) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Edge starts, vectors, unit outward normals (n, m, 2) and lengths (n, m); NaN unused."""
-    start, end, valid = edges(base)
+class _Geometry(NamedTuple):
+    """Edge starts, vectors, unit outward normals (n, m, 2), lengths (n, m) (NaN unused), known.
+
+    Computed once per run of frames with the same polygon (fixed feet: one for the whole
+    trial) and spread to the frames as read-only views: the same numbers as frame by frame.
+    """
+
+    start: FloatArray
+    vector: FloatArray
+    normal: FloatArray
+    length: FloatArray
+    known: NDArray[np.bool_]
+
+
+def _geometry(base: BasePolygons) -> _Geometry:
+    """Return the edges of every frame's polygon (:class:`_Geometry`)."""
+    n = len(base)
+    bits = base.vertices.reshape(n, -1).view(np.int64)  # bit patterns: NaN pads, signed zeros
+    same = (bits[1:] == bits[:-1]).all(axis=1) & (base.counts[1:] == base.counts[:-1])
+    first = np.flatnonzero(np.concatenate([[True], ~same])) if n else np.zeros(0, np.int64)
+    unique = dataclasses.replace(base, vertices=base.vertices[first], counts=base.counts[first])
+    start, end, valid = edges(unique)
     vector = np.where(valid[..., None], end - start, np.nan)
     length = np.hypot(vector[..., 0], vector[..., 1])
     with np.errstate(invalid="ignore", divide="ignore"):
         normal = np.stack([vector[..., 1], -vector[..., 0]], axis=-1) / length[..., None]
-    return start, vector, normal, length
+    arrays = [start, vector, normal, length]
+    if len(first) == 1:
+        arrays = [np.broadcast_to(a, (n, *a.shape[1:])) for a in arrays]
+    elif len(first) < n:
+        arrays = [a[np.cumsum(np.concatenate([[False], ~same]))] for a in arrays]
+    return _Geometry(arrays[0], arrays[1], arrays[2], arrays[3], base.known)
 
 
-def _signed(base: BasePolygons, p: FloatArray) -> FloatArray:
-    start, vector, normal, length = _geometry(base)
+def _fold(ufunc: np.ufunc, values: FloatArray) -> FloatArray:
+    """``ufunc.reduce(values, axis=1)`` of an (n, m) array, column by column (faster, small m)."""
+    out = values[:, 0].copy()
+    for k in range(1, values.shape[1]):
+        ufunc(out, values[:, k], out=out)
+    return out
+
+
+def _signed(geometry: _Geometry, p: FloatArray) -> FloatArray:
+    start, vector, normal, length, known = geometry
     rel = p[:, None, :] - start
     with np.errstate(invalid="ignore", divide="ignore"):
-        excess = np.fmax.reduce(np.einsum("fmk,fmk->fm", normal, rel), axis=1)
+        excess = _fold(np.fmax, np.einsum("fmk,fmk->fm", normal, rel))
         along = np.clip(np.einsum("fmk,fmk->fm", rel, vector) / length**2, 0.0, 1.0)
-        gap = np.fmin.reduce(np.hypot(*np.moveaxis(rel - along[..., None] * vector, -1, 0)), 1)
+        gap = _fold(np.fmin, np.hypot(*np.moveaxis(rel - along[..., None] * vector, -1, 0)))
     out = np.where(excess <= 0.0, -excess, -gap)
-    return np.where(base.known & np.isfinite(p).all(axis=1), out, np.nan)
+    return np.where(known & np.isfinite(p).all(axis=1), out, np.nan)
 
 
-def _ray(base: BasePolygons, origin: FloatArray, direction: FloatArray) -> FloatArray:
+def _ray(geometry: _Geometry, origin: FloatArray, direction: FloatArray) -> FloatArray:
     """Distance from a point of each polygon along a unit direction to its boundary [m]."""
-    start, _, normal, _ = _geometry(base)
+    start, _, normal, _, _ = geometry
     rate = np.einsum("fmk,fk->fm", normal, direction)
     gap = -np.einsum("fmk,fmk->fm", normal, origin[:, None, :] - start)
     # A ray all but parallel to an edge (a subnormal rate) reaches it at infinity: no warning.
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         ahead = np.where(rate > 0.0, np.maximum(gap, 0.0) / rate, np.inf)
-    return np.asarray(np.min(ahead, axis=1), dtype=np.float64)
+    return _fold(np.minimum, ahead)
 
 
-def _nearest(base: BasePolygons, p: FloatArray) -> FloatArray:
-    """Return the polygon's point nearest each p (p itself inside) [m]."""
-    start, vector, _, length = _geometry(base)
+def _nearest(geometry: _Geometry, p: FloatArray, signed: FloatArray) -> FloatArray:
+    """Return the polygon's point nearest each p (p itself inside; ``signed``: p's) [m]."""
+    start, vector, _, length, _ = geometry
     rel = p[:, None, :] - start
     with np.errstate(invalid="ignore", divide="ignore"):
         along = np.clip(np.einsum("fmk,fmk->fm", rel, vector) / length**2, 0.0, 1.0)
     foot = start + along[..., None] * vector
     gap = np.where(np.isfinite(length), np.hypot(*np.moveaxis(p[:, None] - foot, -1, 0)), np.inf)
     best = np.take_along_axis(foot, np.argmin(gap, axis=1)[:, None, None], axis=1)[:, 0]
-    return np.where((_signed(base, p) > 0.0)[:, None], p, best)
+    return np.where((signed > 0.0)[:, None], p, best)
 
 
 def time_to_boundary_cop(base: BasePolygons, cop: ArrayLike, cop_velocity: ArrayLike) -> FloatArray:
@@ -186,13 +222,19 @@ def time_to_boundary_cop(base: BasePolygons, cop: ArrayLike, cop_velocity: Array
     """
     require_type("base", base, BasePolygons)
     p = _frames("cop", cop, len(base))
-    velocity = _frames("cop_velocity", cop_velocity, len(base))
+    return _ttb_cop(_geometry(base), p, _frames("cop_velocity", cop_velocity, len(base)))
+
+
+def _ttb_cop(
+    geometry: _Geometry, p: FloatArray, velocity: FloatArray, signed: FloatArray | None = None
+) -> FloatArray:
+    """:func:`time_to_boundary_cop` of checked arrays (``signed``: the CoP's, if known)."""
     speed = np.hypot(velocity[:, 0], velocity[:, 1])
     with np.errstate(invalid="ignore", divide="ignore"):
-        reach = _ray(base, p, velocity / speed[:, None])
+        reach = _ray(geometry, p, velocity / speed[:, None])
         time = np.where(speed > 0.0, reach / speed, np.inf)
-    time = np.where(_signed(base, p) > 0.0, time, 0.0)
-    return np.where(np.isfinite(speed) & base.known & np.isfinite(p).all(axis=1), time, np.nan)
+    time = np.where((_signed(geometry, p) if signed is None else signed) > 0.0, time, 0.0)
+    return np.where(np.isfinite(speed) & geometry.known & np.isfinite(p).all(axis=1), time, np.nan)
 
 
 def time_to_boundary_xcom(
@@ -213,15 +255,22 @@ def time_to_boundary_xcom(
     xi = _frames("xcom", xcom, len(base))
     p = _frames("cop", cop, len(base))
     omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
-    anchor = _nearest(base, p)
+    geometry = _geometry(base)
+    return _ttb_xcom(geometry, xi, p, omega, _signed(geometry, xi), _signed(geometry, p))
+
+
+def _ttb_xcom(
+    geometry: _Geometry, xi: FloatArray, p: FloatArray, omega: float, *signed: FloatArray
+) -> FloatArray:
+    """:func:`time_to_boundary_xcom` of checked arrays and their ``signed`` distances."""
+    anchor = _nearest(geometry, p, signed[1])
     delta = xi - anchor
     size = np.hypot(delta[:, 0], delta[:, 1])
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        reach = _ray(base, anchor, delta / size[:, None])
+        reach = _ray(geometry, anchor, delta / size[:, None])
         time = np.where(size > 0.0, np.log(np.maximum(reach / size, 1.0)) / omega, np.inf)
-    inside = _signed(base, xi) > 0.0
-    time = np.where(inside, time, 0.0)
-    return np.where(np.isfinite(size) & base.known, time, np.nan)
+    time = np.where(signed[0] > 0.0, time, 0.0)
+    return np.where(np.isfinite(size) & geometry.known, time, np.nan)
 
 
 def phase_supports(
@@ -348,7 +397,8 @@ def margins_2d(
     if not np.isfinite(xi[known]).all():
         raise InvalidParameterError("states are too large: the XCoM overflows")
     xi[~known] = np.nan  # a frame is known or missing
-    mos = _signed(base, xi)
+    geometry = _geometry(base)
+    mos = _signed(geometry, xi)
     xmin, xmax, ymin, ymax = base.extents()
     sides = (xmax - xi[:, 0], xi[:, 0] - xmin, ymax - xi[:, 1], xi[:, 1] - ymin)
     toward = [
@@ -358,9 +408,12 @@ def margins_2d(
     nan = np.full(n, np.nan)
     ttb_cop = ttb_xcom = nan
     if cop is not None:
-        ttb_xcom = time_to_boundary_xcom(base, xi, cop, omega)
+        p = _frames("cop", cop, n)
+        signed_p = _signed(geometry, p)
+        ttb_xcom = _ttb_xcom(geometry, xi, p, omega, mos, signed_p)
         if cop_velocity is not None:
-            ttb_cop = time_to_boundary_cop(base, cop, cop_velocity)
+            velocity = _frames("cop_velocity", cop_velocity, n)
+            ttb_cop = _ttb_cop(geometry, p, velocity, signed_p)
     codes = np.full(n, -1, dtype=np.int8)
     mos_cmp = nan.copy()
     if verdicts:

@@ -54,6 +54,7 @@ def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Pa
         ``summary`` paths.
     """
     require("analysis", "pyarrow", "writing an analysis")
+    import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
@@ -65,15 +66,18 @@ def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Pa
         "frames_csv": out / FRAME_FILES[1],
         "summary": out / SUMMARY_FILE,
     }
-    _atomic(paths["frames_parquet"], lambda p: pq.write_table(table, p))
+    # Dictionary pages for the text columns only: the numbers' dictionaries cost more than half
+    # the write (10,000 frames: 22 -> 9 ms) and make the file larger; the values are the same.
+    text = [f.name for f in table.schema if pa.types.is_string(f.type)]
+    _atomic(paths["frames_parquet"], lambda p: pq.write_table(table, p, use_dictionary=text))
     _atomic(paths["frames_csv"], lambda p: pacsv.write_csv(table, p))
     quality = _quality_table(analysis)
     paths["quality_parquet"] = out / QUALITY_FILES[0]
     paths["quality_csv"] = out / QUALITY_FILES[1]
     _atomic(paths["quality_parquet"], lambda p: pq.write_table(quality, p))
     _atomic(paths["quality_csv"], lambda p: pacsv.write_csv(quality, p))
-    text = json.dumps(analysis.summary.to_dict(), indent=2, allow_nan=False)
-    _atomic(paths["summary"], lambda p: p.write_text(text + "\n"))
+    summary = json.dumps(analysis.summary.to_dict(), indent=2, allow_nan=False)
+    _atomic(paths["summary"], lambda p: p.write_text(summary + "\n"))
     return paths
 
 
