@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
@@ -254,3 +255,81 @@ def test_the_subjects_figure_shows_each_trials_margins_by_subject(study, tmp_pat
         if r["status"] == "analysed" and r["axis"] == "ap" and r[column] is not None
     )  # fmt: skip
     assert plotted == pytest.approx(expected)
+
+
+@pytest.fixture(scope="module")
+def conditions_study(tmp_path_factory):
+    """Two subjects, each with a slip and a trip trial, and a baseline trial of the first."""
+    root = tmp_path_factory.mktemp("conditions")
+    for s, subject in enumerate(("s01", "s02")):
+        (root / subject).mkdir()
+        for k, condition in enumerate(("slip", "trip", "baseline")[: 3 - s]):
+            text = lipm_trial(0.15 + 0.1 * k, k * math.pi / 2, seed=s)
+            (root / subject / f"{condition}1.csv").write_text(text)
+    (root / "subjects.csv").write_text(
+        "pattern,subject,mass,condition\n"
+        "s01/slip*,S1,70,slip\ns01/trip*,S1,70,trip\ns01/*,S1,70,baseline\n"
+        "s02/slip*,S2,80,slip\ns02/*,S2,80,\n"
+    )
+    return root
+
+
+def test_the_subjects_tables_condition_reaches_the_trials_table(conditions_study, tmp_path):
+    table = read_subjects(conditions_study / "subjects.csv")
+    assert [s.condition for s in table] == ["slip", "trip", "baseline", "slip", None]
+    assert subject_for("s01/trip1.csv", table).condition == "trip"  # the first match applies
+    trials, root = find_trials([conditions_study / "s01", conditions_study / "s02"])
+    result = run_trials(trial_jobs(trials, root, table), tmp_path / "b", workers=1)
+    condition = {row["trial"]: row["condition"] for row in result.trials}
+    assert condition == {"s01__baseline1.csv": "baseline", "s01__slip1.csv": "slip",
+                         "s01__trip1.csv": "trip", "s02__slip1.csv": "slip",
+                         "s02__trip1.csv": None}  # fmt: skip
+    assert pq.read_table(tmp_path / "b" / "trials.parquet").column_names[-1] == "condition"
+    without = run_trials(trial_jobs(trials, root), tmp_path / "c", workers=1)
+    assert {row["condition"] for row in without.trials} == {None}
+
+
+def test_a_malformed_condition_is_refused_naming_the_column_and_line(tmp_path):
+    for cell in ('"a\tb"', "x" * 65):
+        path = _write(tmp_path / "s.csv", f"pattern,subject,condition\nx,a,slip\ny,b,{cell}\n")
+        with pytest.raises(InvalidParameterError, match=r"s.csv line 3: condition must be"):
+            read_subjects(path)
+
+
+def test_the_study_figure_shows_each_trials_margins_by_condition(conditions_study, tmp_path,
+                                                                 capsys):  # fmt: skip
+    # The CLI writes study.<fmt> in each figure format; the figure's dots are the trials
+    # table's values, the diamonds each subject's mean per condition (joined across them).
+    pytest.importorskip("matplotlib")
+    from pushrecovery.cli import main
+    from pushrecovery.plots.study import ALL, MEASURES, NONE, study_figure
+
+    out = tmp_path / "cli"
+    args = ["analyze", str(conditions_study), "--out", str(out), "--json", "--subjects",
+            str(conditions_study / "subjects.csv")]  # fmt: skip
+    magic = {"png": b"\x89PNG", "svg": b"<?xml", "pdf": b"%PDF"}
+    for k, fmt in enumerate(magic):  # the trials once, then only the batch's figures
+        with pytest.raises(SystemExit) as done:
+            main([*args, "--figure-format", fmt, *(["--resume"] if k else [])])
+        assert done.value.code == 0
+        files = json.loads(capsys.readouterr().out)["files"]
+        assert files["study_figure"] == str(out / f"study.{fmt}")
+        assert (out / f"study.{fmt}").read_bytes().startswith(magic[fmt])
+    rows = pq.read_table(out / "trials.parquet").to_pylist()
+    figure = study_figure(rows)
+    names = ["baseline", "slip", "trip", NONE]
+    assert sorted(names) == [t.get_text() for t in figure.axes[2].get_xticklabels()]
+    for ax, (axis, (column, _)) in zip(
+        figure.axes, [(a, m) for a in ("ap", "ml") for m in MEASURES], strict=True
+    ):
+        mine = [r for r in rows if r["axis"] == axis and r[column] is not None]
+        dots = sorted(y for line in ax.get_lines() if line.get_marker() == "o"
+                      for y in line.get_ydata())  # fmt: skip
+        assert dots == sorted(r[column] for r in mine)  # exactly the table's values
+        (s1, s2) = [line.get_ydata() for line in ax.get_lines() if line.get_marker() == "D"]
+        by = {(r["subject"], r["condition"] or NONE): r[column] for r in mine}
+        order = sorted(names)
+        for subject, means in (("S1", s1), ("S2", s2)):  # one trial each: its own value
+            np.testing.assert_array_equal(means, [by.get((subject, c), np.nan) for c in order])
+    plain = study_figure([{**r, "condition": None} for r in rows])  # no conditions: one group
+    assert [t.get_text() for t in plain.axes[2].get_xticklabels()] == [ALL]

@@ -16,11 +16,16 @@ preset, in that order: docs/analysis.md, "Many trials"):
 ``height``         stature [m], in [0.5, 2.5]: with ``sex``, the body from de Leva's
                    table (:func:`pushrecovery.anthropometry.person_params`)
 ``sex``            ``female`` or ``male`` (de Leva's column), with ``height``
+``condition``      the trials' condition (``slip``, ``trip``, ``baseline``: printable
+                   text, at most :data:`MAX_CONDITION` characters), the trials table's
+                   ``condition`` column and the study figure's groups
 =================  ===================================================================
 
-The first row whose pattern matches a trial applies to it. A malformed table (a missing
-column, a number that is not one, a value out of the body's range) is refused with the line
-number.
+The first row whose pattern matches a trial applies to it: one subject's trials of several
+conditions are several rows with the same subject (and body) and narrower patterns
+(``s01/slip*``, ``s01/trip*``). A malformed table (a missing column, a number that is not one,
+a value out of the body's range, a condition that is no short printable text) is refused with
+the line number.
 """
 
 from __future__ import annotations
@@ -34,10 +39,19 @@ from pathlib import Path
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import LIMITS
 
-__all__ = ["MAX_TABLE_BYTES", "SUBJECT_COLUMNS", "Subject", "read_subjects", "subject_for"]
+__all__ = [
+    "MAX_CONDITION",
+    "MAX_TABLE_BYTES",
+    "SUBJECT_COLUMNS",
+    "Subject",
+    "read_subjects",
+    "subject_for",
+]
 
 #: Largest subjects table read [bytes]: a study's table is kilobytes.
 MAX_TABLE_BYTES = 50_000_000
+#: Longest condition name [characters]: a label on a figure's axis.
+MAX_CONDITION = 64
 
 #: The table's columns: the two required ones, then the body's (all SI).
 SUBJECT_COLUMNS = (
@@ -50,8 +64,9 @@ SUBJECT_COLUMNS = (
     "foot_width",
     "height",
     "sex",
+    "condition",
 )
-_NUMBERS = SUBJECT_COLUMNS[2:-1]
+_NUMBERS = SUBJECT_COLUMNS[2:-2]
 #: Ranges of the columns that are no field of BodyParams' LIMITS [m].
 _FOOT_RANGE = (0.01, 1.0)
 _RANGES = {"height": (0.5, 2.5)}
@@ -70,6 +85,7 @@ class Subject:
     foot_width: float | None = None
     height: float | None = None
     sex: str | None = None
+    condition: str | None = None
 
     def matches(self, relative: str) -> bool:
         """Whether the pattern matches the trial's relative path or its file name."""
@@ -96,8 +112,9 @@ def read_subjects(path: str | Path) -> tuple[Subject, ...]:
     InvalidParameterError
         An unreadable file (or one that is not a regular file, or over
         :data:`MAX_TABLE_BYTES`), a missing ``pattern`` or ``subject`` column, an unknown
-        column, an empty pattern or subject, or a number that is not one or is out of its
-        range, naming the line.
+        column, an empty pattern or subject, a number that is not one or is out of its
+        range, or a condition that is not printable text of at most :data:`MAX_CONDITION`
+        characters, naming the line.
     """
     path = Path(path)
     # A device or a pipe (/dev/zero) would be read forever: a table is a file of some size.
@@ -161,7 +178,13 @@ def _subject(row: dict[str, str], where: str) -> Subject:
         raise InvalidParameterError(f"{where}: sex must be female or male, got {row['sex']!r}")
     if (numbers["height"] is None) != (sex is None):
         raise InvalidParameterError(f"{where}: height and sex go together: give both or neither")
-    return Subject(row["pattern"], row["subject"], **numbers, sex=sex)
+    condition = row.get("condition", "") or None
+    if condition is not None and not (len(condition) <= MAX_CONDITION and condition.isprintable()):
+        raise InvalidParameterError(
+            f"{where}: condition must be printable text of at most {MAX_CONDITION} characters, "
+            f"got {condition[:MAX_CONDITION]!r}"
+        )
+    return Subject(row["pattern"], row["subject"], **numbers, sex=sex, condition=condition)
 
 
 def subject_for(relative: str, subjects: tuple[Subject, ...]) -> Subject | None:

@@ -116,6 +116,9 @@ class TrialRow:
     forward_angle : float
         Angle of the feet's heel -> toe direction from the ap axis [deg], + to the left
         (null without foot markers).
+    condition : str
+        The trial's condition from the subjects table (``slip``, ``trip``, ...), null when the
+        table gives none.
     """
 
     trial: str
@@ -182,6 +185,7 @@ class TrialRow:
     saturated_channels: str | None = None
     zero_offset_channels: str | None = None
     forward_angle: float | None = None
+    condition: str | None = None
 
 
 #: Arrow types of the columns, in order.
@@ -191,6 +195,11 @@ TRIAL_FIELDS: tuple[tuple[str, str], ...] = tuple((f.name, str(f.type)) for f in
 def subject_name(job: Any) -> str:
     """Return the job's subject ("" without a subjects table)."""
     return "" if job.subject is None else str(job.subject.subject)
+
+
+def _condition(job: Any) -> str | None:
+    """Return the job's condition (None without one in the subjects table)."""
+    return None if job.subject is None else job.subject.condition
 
 
 def trial_rows(
@@ -211,6 +220,7 @@ def trial_rows(
             trial=job.name,
             path=str(job.path),
             subject=subject_name(job),
+            condition=_condition(job),
             axis=axis,
             status="analysed",
             error=None,
@@ -292,7 +302,7 @@ def sway_rows(job: Any, sway: SwayMeasures, rate: float) -> list[dict[str, Any]]
         asdict(replace(
             TrialRow(job.name, str(job.path), subject_name(job), axis, "posturography only",
                      None),
-            rate=rate, duration=sway.duration, **_sway(sway, axis),
+            rate=rate, duration=sway.duration, condition=_condition(job), **_sway(sway, axis),
         ))
         for axis in ("ap", "ml")
     ]  # fmt: skip
@@ -301,7 +311,17 @@ def sway_rows(job: Any, sway: SwayMeasures, rate: float) -> list[dict[str, Any]]
 def failed_rows(job: Any, reason: str) -> list[dict[str, Any]]:
     """Return the rows of a trial that failed: ``status`` failed and the reason."""
     return [
-        asdict(TrialRow(job.name, str(job.path), subject_name(job), axis, "failed", reason))
+        asdict(
+            TrialRow(
+                job.name,
+                str(job.path),
+                subject_name(job),
+                axis,
+                "failed",
+                reason,
+                condition=_condition(job),
+            )
+        )
         for axis in ("ap", "ml")
     ]
 

@@ -86,7 +86,7 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     type=click.Path(dir_okay=False, path_type=Path),
     default=None,
     help="CSV of subjects: pattern, subject, mass, leg_length, com_height, foot_length, "
-    "foot_width (docs/analysis.md).",
+    "foot_width, height, sex, condition (docs/analysis.md).",
 )
 @click.option(
     "--workers",
@@ -170,7 +170,8 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     default=True,
     show_default=True,
     callback=needs_plots,
-    help="Write time_series.png, phase_portrait.png and plane.png.",
+    help="Write time_series.png, phase_portrait.png and plane.png (a batch: also subjects.png "
+    "and study.png).",
 )
 @click.option(
     "--figure-format",
@@ -357,11 +358,13 @@ def _batch(
     finally:
         bar.close()
     files = {name: str(path) for name, path in result.files.items()}
-    if plot:  # the trials' smallest margins by subject
+    if plot:  # the trials' smallest margins by subject, and by condition
+        from pushrecovery.plots.study import plot_study
         from pushrecovery.plots.subjects import plot_subjects
 
         subjects_figure = plot_subjects(result.trials, out / f"subjects.{figure_format}")
         files["subjects_figure"] = str(subjects_figure)
+        files["study_figure"] = str(plot_study(result.trials, out / f"study.{figure_format}"))
     data = {**result.summary, "root": str(root), "analysed_now": result.ran, "files": files}
     if as_json:
         emit(data, True)
