@@ -1,0 +1,192 @@
+"""Verdict probabilities of an uncertain state: exact masses against sampling, certain verdicts.
+
+Every probability is checked against 10⁶ states drawn from the same Gaussian and classified
+one by one by the certain verdicts (``classify_states``, ``sagittal_verdicts``, the N-step
+polygons), within 4 standard errors of the sample (a fixed seed); latency against the LIPM's
+own solution (cosh and sinh of ωτ, not the capture point's e^{ωτ}).
+"""
+
+import math
+import re
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.support import Stance, Support
+from pushrecovery.presets import load_params
+from pushrecovery.surfaces.classify import classify
+from pushrecovery.surfaces.classify_many import classify_states
+from pushrecovery.surfaces.probability import (
+    MAX_LATENCY_GROWTH,
+    StateGaussian,
+    delayed_capture_point,
+    verdict_probabilities,
+)
+from pushrecovery.surfaces.step_regions import StepRegions
+from pushrecovery.surfaces.strategy import Strategy
+from pushrecovery.surfaces.verdicts import sagittal_verdicts
+
+P = load_params()
+N = 1_000_000
+
+
+def within(observed_hits, p, n=N):
+    se = math.sqrt(max(p * (1.0 - p), 1e-12) / n)
+    return abs(observed_hits / n - p) <= 4.0 * se
+
+
+def levels_of(codes, steps, max_steps):
+    """Per state: 0 ankle, 1 hip, 1 + k for k steps, 2 + max_steps for fall."""
+    level = np.where(codes == 3, 2 + max_steps, codes.astype(np.int64))
+    return np.where(codes == 2, 1 + steps, level)
+
+
+def lipm_delay(x, v, p, omega, tau):
+    """The LIPM x'' = ω²(x − p) with p held for τ, in closed form (cosh, sinh)."""
+    c, s = math.cosh(omega * tau), math.sinh(omega * tau)
+    return p + (x - p) * c + v / omega * s, (x - p) * omega * s + v * c
+
+
+@pytest.mark.parametrize(
+    ("mean", "cov"),
+    [
+        ((0.0, 0.5), ((1e-4, 0.0), (0.0, 0.01))),
+        ((0.02, 0.9), ((4e-4, 1e-3), (1e-3, 0.04))),  # correlated, mostly steps
+        ((-0.01, -0.6), ((1e-4, 0.0), (0.0, 0.09))),  # backward
+    ],
+)
+def test_sagittal_probabilities_against_a_million_states(mean, cov):
+    found = verdict_probabilities(StateGaussian(np.array(mean), np.array(cov)), P)
+    rng = np.random.default_rng(1)
+    x, v = rng.multivariate_normal(mean, cov, N).T
+    verdicts = sagittal_verdicts(x, v, P)
+    level = levels_of(classify_states(x, v, P), verdicts.line.steps, P.max_steps)
+    counts = np.bincount(level, minlength=3 + P.max_steps)
+    expected = [found.ankle, found.hip, *found.steps, found.fall]
+    for k, p in enumerate(expected):
+        assert within(counts[k], p), (k, counts[k] / N, p)
+    assert sum(expected) == pytest.approx(1.0, abs=1e-12)
+    assert found.method == "exact" and found.error == 0.0
+
+
+def test_plane_probabilities_against_a_million_states():
+    mean = np.array([0.01, 0.02, 2.5, -1.5])  # hard pushes: 1 to 11 steps, or a fall
+    cov = np.diag([1e-4, 1e-4, 0.6, 0.6])
+    cov[2, 3] = cov[3, 2] = 0.18
+    support = Support.from_params(P, Stance.LEFT)
+    found = verdict_probabilities(StateGaussian(mean, cov), P, support=support)
+    rng = np.random.default_rng(2)
+    x, y, vx, vy = rng.multivariate_normal(mean, cov, N).T
+    codes = classify_states(vx * 0 + x, vx, P, y=y, ydot=vy, support=support)
+    counts = np.bincount(codes, minlength=4)
+    for code, p in enumerate([found.ankle, found.hip, sum(found.steps), found.fall]):
+        assert within(counts[code], p), (code, counts[code] / N, p)
+    # Steps by count: the first N-step polygon holding the capture point, on the step states.
+    regions = StepRegions.of(P, support)
+    omega = P.omega
+    stepping = codes == 2
+    px, py = x[stepping] + vx[stepping] / omega, y[stepping] + vy[stepping] / omega
+    needed = np.zeros(len(px), dtype=np.int64)
+    for polygon, n in zip(regions.polygons, regions.steps, strict=True):
+        fresh = (needed == 0) & (polygon.signed_distance(px, py) > 0.0)
+        needed[fresh] = n
+    by_count = np.bincount(needed, minlength=P.max_steps + 1)
+    assert by_count[0] == 0
+    for k, p in enumerate(found.steps, start=1):
+        assert within(by_count[k], p), (k, by_count[k] / N, p)
+    assert min(found.steps[:4]) > 0.03 and found.fall > 0.01  # several levels in play
+
+
+@pytest.mark.parametrize("plane", [False, True])
+def test_a_zero_covariance_gives_the_certain_verdict(plane):
+    rng = np.random.default_rng(3)
+    for _ in range(40):
+        x, y = rng.uniform(-0.05, 0.1, 2)
+        vx, vy = rng.uniform(-2.5, 2.5, 2)
+        if plane:
+            state = StateGaussian(np.array([x, y, vx, vy]), np.zeros((4, 4)))
+            certain = classify(x, vx, P, y=y, ydot=vy)
+        else:
+            state = StateGaussian(np.array([x, vx]), np.zeros((2, 2)))
+            certain = classify(x, vx, P)
+        found = verdict_probabilities(state, P)
+        level = {Strategy.ANKLE: 0, Strategy.HIP: 1, Strategy.FALL: 2 + P.max_steps}.get(
+            certain.strategy, 1 + (certain.steps or 0)
+        )
+        expected = [0.0] * (3 + P.max_steps)
+        expected[level] = 1.0
+        assert [found.ankle, found.hip, *found.steps, found.fall] == expected
+        assert found.capture_point_mean[0] == pytest.approx(certain.capture_point, abs=1e-15)
+
+
+def test_latency_closed_form_is_the_lipm_with_the_cop_held():
+    omega, p = P.omega, 0.03
+    x0, v0, tau = 0.01, 0.4, 0.08
+
+    def lipm(t, s):
+        return [s[1], omega**2 * (s[0] - p)]
+
+    run = solve_ivp(lipm, (0.0, tau), [x0, v0], rtol=1e-12, atol=1e-14)
+    x, v = run.y[:, -1]
+    mean, cov = delayed_capture_point([x0 + v0 / omega], [[0.0]], omega, tau, [p])
+    assert mean[0] == pytest.approx(x + v / omega, abs=1e-10)
+    assert cov[0, 0] == 0.0
+
+
+@pytest.mark.parametrize("latency", [0.06, (0.02, 0.12)])
+def test_latency_against_states_carried_through_the_delay(latency):
+    mean, cov = np.array([0.0, 0.3]), np.array([[1e-4, 0.0], [0.0, 0.01]])
+    held = 0.5 * (P.heel + P.toe)  # the default: the middle of the foot
+    found = verdict_probabilities(StateGaussian(mean, cov), P, latency=latency)
+    rng = np.random.default_rng(4)
+    x, v = rng.multivariate_normal(mean, cov, N).T
+    tau = latency if not isinstance(latency, tuple) else rng.uniform(*latency, N)
+    c, s = np.cosh(P.omega * tau), np.sinh(P.omega * tau)
+    x, v = held + (x - held) * c + v / P.omega * s, (x - held) * P.omega * s + v * c
+    verdicts = sagittal_verdicts(x, v, P)
+    level = levels_of(classify_states(x, v, P), verdicts.line.steps, P.max_steps)
+    counts = np.bincount(level, minlength=3 + P.max_steps)
+    for k, p in enumerate([found.ankle, found.hip, *found.steps, found.fall]):
+        assert within(counts[k], p), (k, counts[k] / N, p)
+    if isinstance(latency, tuple):
+        assert found.method == "latency quadrature" and found.error < 1e-9
+        xi = x + v / P.omega  # the mixture's mean and spread at the command
+        assert found.capture_point_mean[0] == pytest.approx(xi.mean(), abs=4 * xi.std() / 1e3)
+        assert found.capture_point_cov[0][0] == pytest.approx(xi.var(), rel=0.01)
+    # Latency only moves mass outward: the ankle's share shrinks.
+    assert found.ankle < verdict_probabilities(StateGaussian(mean, cov), P).ankle
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"mean": [0.0, 0.1, 0.2], "cov": np.eye(3)}, r"shape \(2,\) or \(4,\)"),
+        ({"mean": [0.0, 0.1], "cov": np.eye(4)}, r"cov must have shape \(2, 2\)"),
+        ({"mean": [0.0, 0.1], "cov": [[1.0, 0.2], [0.3, 1.0]]}, "symmetric"),
+        ({"mean": [0.0, 0.1], "cov": [[1.0, 2.0], [2.0, 1.0]]}, "positive semi-definite"),
+        ({"mean": [0.0, math.nan], "cov": np.eye(2)}, "mean must be finite"),
+    ],
+)
+def test_bad_states_are_refused(kwargs, match):
+    with pytest.raises(InvalidParameterError, match=match):
+        StateGaussian(np.asarray(kwargs["mean"], dtype=float), np.asarray(kwargs["cov"]))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"latency": -0.01}, "latency"),
+        ({"latency": math.nan}, "latency"),
+        ({"latency": (0.1, 0.05)}, "low <= high"),
+        ({"latency": (0.1,)}, "range"),
+        ({"latency": 10.0}, re.escape(f"e^(omega tau) <= {MAX_LATENCY_GROWTH:g}")),
+        ({"cop": [0.0, 0.1]}, r"cop must be 1 numbers"),
+        ({"support": Support.from_params(P)}, "support applies to a plane state"),
+    ],
+)
+def test_bad_options_are_refused(kwargs, match):
+    state = StateGaussian(np.array([0.0, 0.3]), np.eye(2) * 1e-4)
+    with pytest.raises(InvalidParameterError, match=match):
+        verdict_probabilities(state, P, **kwargs)
