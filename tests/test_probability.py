@@ -190,3 +190,48 @@ def test_bad_options_are_refused(kwargs, match):
     state = StateGaussian(np.array([0.0, 0.3]), np.eye(2) * 1e-4)
     with pytest.raises(InvalidParameterError, match=match):
         verdict_probabilities(state, P, **kwargs)
+
+
+def _cli(capsys, *args):
+    from pushrecovery.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["classify", *args])
+    captured = capsys.readouterr()
+    return info.value.code, captured.out, captured.err
+
+
+def test_classify_cli_adds_the_probabilities(capsys):
+    import json
+
+    code, out, _ = _cli(capsys, "--x", "0", "--xdot", "0.5", "--cov", "1e-4,0,0,0.01", "--json")
+    assert code == 0
+    data = json.loads(out)
+    expected = verdict_probabilities(
+        StateGaussian(np.array([0.0, 0.5]), np.diag([1e-4, 0.01])), P
+    ).to_dict()
+    assert data["probabilities"] == expected and data["strategy"] == "hip"  # keys kept
+    code, out, _ = _cli(capsys, "--x", "0", "--xdot", "0.5", "--ydot", "0.3", "--latency",
+                        "0.02:0.06", "--json")  # fmt: skip
+    found = json.loads(out)["probabilities"]
+    assert code == 0 and found["method"] == "latency quadrature"
+    assert len(found["capture_point_mean"]) == 2
+    code, out, _ = _cli(capsys, "--x", "0", "--xdot", "0.5", "--json")
+    assert "probabilities" not in json.loads(out)  # only when asked
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (("--cov", "1,2,3"), "--cov must be 4 numbers"),
+        (("--cov", "a,b,c,d"), "--cov must be 4 comma-separated numbers"),
+        (("--cov", "1,2,2,1"), "positive semi-definite"),
+        (("--ydot", "0.1", "--cov", "1,0,0,1"), "--cov must be 16 numbers"),
+        (("--latency", "a:b"), "--latency must be S or LOW:HIGH"),
+        (("--latency", "-0.1"), "latency"),
+        (("--latency", "0.2:0.1"), "low <= high"),
+    ],
+)
+def test_classify_cli_refuses_bad_uncertainty_in_one_line(capsys, args, match):
+    code, _, err = _cli(capsys, "--x", "0", "--xdot", "0.5", *args)
+    assert code == 2 and err.count("\n") == 1 and match in err

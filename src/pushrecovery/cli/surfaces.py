@@ -101,6 +101,22 @@ def bounds(as_json: bool, model: str | None, **kwargs: Any) -> None:
     help="Yaw of the plan's landing feet [rad], in [-pi, pi] (default: the stance foot's); "
     "puts the state on the ground plane.",
 )
+@click.option(
+    "--cov",
+    default=None,
+    metavar="V,V,...",
+    help="Covariance of the state estimate, row by row: 4 numbers for (x, xdot) [m², m²/s, "
+    "m²/s²], 16 for (x, y, xdot, ydot) on the ground plane; adds the probability of each "
+    "verdict (docs/uncertainty.md).",
+)
+@click.option(
+    "--latency",
+    default=None,
+    metavar="S|LOW:HIGH",
+    help="Loop latency [s]: the state is that old when the command acts, the CoP held at the "
+    "middle of its region meanwhile; LOW:HIGH for a latency uniform in the range. Adds the "
+    "probability of each verdict.",
+)
 @support_options
 @body_options
 def classify(
@@ -109,6 +125,8 @@ def classify(
     y: float | None,
     ydot: float | None,
     landing_yaw: float | None,
+    cov: str | None,
+    latency: str | None,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
@@ -126,6 +144,9 @@ def classify(
     (lands across the stance foot's midline; a note in the table), the landing feet's yaw
     [rad], its peak ankle torque [N m] and horizontal ground force [N], and, when the body
     sets ankle_torque_max and friction (--params file), whether they hold (docs/steps.md).
+    With --cov or --latency: the probabilities of ankle, hip, each number of steps and fall
+    under that state estimate and loop latency (exact: Gaussian masses of the regions;
+    probabilities).
     """
     from pushrecovery.surfaces.classify import classify as classify_state
 
@@ -141,14 +162,59 @@ def classify(
         for name in ("stance", "left_foot", "right_foot"):
             kwargs.pop(name)
         result = classify_state(x, xdot, params).to_dict()
-        _emit_classified({**result, "state": {"x": x, "xdot": xdot}}, as_json)
+        chances = _probabilities([x, xdot], cov, latency, params, None)
+        _emit_classified({**result, "state": {"x": x, "xdot": xdot}, **chances}, as_json)
         return
     y, ydot = (0.0 if y is None else y), (0.0 if ydot is None else ydot)
     support = support_from(kwargs, params, file)
     result = classify_state(
         x, xdot, params, y=y, ydot=ydot, support=support, landing_yaw=landing_yaw
     ).to_dict()
-    _emit_classified({**result, "state": {"x": x, "xdot": xdot, "y": y, "ydot": ydot}}, as_json)
+    chances = _probabilities([x, y, xdot, ydot], cov, latency, params, support)
+    state = {"x": x, "xdot": xdot, "y": y, "ydot": ydot}
+    _emit_classified({**result, "state": state, **chances}, as_json)
+
+
+def _probabilities(
+    mean: list[float], cov: str | None, latency: str | None, params: Any, support: Any
+) -> dict[str, Any]:
+    """``{"probabilities": ...}`` under --cov and --latency, or nothing without them."""
+    if cov is None and latency is None:
+        return {}
+    import numpy as np
+
+    from pushrecovery.errors import InvalidParameterError
+    from pushrecovery.surfaces.probability import StateGaussian, verdict_probabilities
+
+    n = len(mean)
+    if cov is None:
+        matrix = np.zeros((n, n))
+    else:
+        try:
+            values = [float(v) for v in cov.split(",")]
+        except ValueError:
+            raise InvalidParameterError(
+                f"--cov must be {n * n} comma-separated numbers, got {cov!r}"
+            ) from None
+        if len(values) != n * n:
+            state = "(x, xdot)" if n == 2 else "(x, y, xdot, ydot)"
+            raise InvalidParameterError(
+                f"--cov must be {n * n} numbers for the state {state}, row by row, "
+                f"got {len(values)}"
+            )
+        matrix = np.array(values).reshape(n, n)
+    delay: float | tuple[float, float] = 0.0
+    if latency is not None:
+        try:
+            parts = [float(v) for v in latency.split(":")]
+        except ValueError:
+            parts = []
+        if len(parts) not in (1, 2):
+            raise InvalidParameterError(f"--latency must be S or LOW:HIGH [s], got {latency!r}")
+        delay = parts[0] if len(parts) == 1 else (parts[0], parts[1])
+    state = StateGaussian(np.array(mean, dtype=float), matrix)
+    found = verdict_probabilities(state, params, support=support, latency=delay)
+    return {"probabilities": found.to_dict()}
 
 
 def _emit_classified(data: dict[str, Any], as_json: bool) -> None:
