@@ -37,7 +37,10 @@
    MuJoCo alone on the same trajectory, and the lockstep rollout of ``foot`` + ankle PD.
 15. Batch analysis of measured trials (``benchmarks/trials.py``, issue 18): 200 generated
    trials on 1 and 2 workers and a Dask LocalCluster (the same tables), trials per second and
-   the time per trial-second against reading the files alone.
+   the time per trial-second against reading the files alone; then the Kistler trial in a
+   folder of 100 copies through ``pushrecovery analyze --workers 1 --no-plot`` on one core
+   against the same trials in process (median, p99, largest). Targets (issue 34): >= 20
+   trials/s, <= 0.5 s per trial above the in-process analysis.
 16. The whole-body QP (``benchmarks/wbc.py``, issue 19): the G1 (skipped with a one-line
    reason without the robots extra) and biped3d under the WBC at 500 Hz against MuJoCo alone
    on the same controls, the solve and tick median and p99. Target: ratio >= 0.5.
