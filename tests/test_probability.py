@@ -235,3 +235,13 @@ def test_classify_cli_adds_the_probabilities(capsys):
 def test_classify_cli_refuses_bad_uncertainty_in_one_line(capsys, args, match):
     code, _, err = _cli(capsys, "--x", "0", "--xdot", "0.5", *args)
     assert code == 2 and err.count("\n") == 1 and match in err
+
+
+def test_the_docs_example_prints_what_it_says(capsys):
+    from pathlib import Path
+
+    page = (Path(__file__).parent.parent / "docs" / "uncertainty.md").read_text()
+    (block,) = re.findall(r"```python\n(.*?)```", page, flags=re.S)
+    exec(compile(block, "docs/uncertainty.md", "exec"), {})
+    promised = re.search(r"# prints: (.*)", block)
+    assert promised is not None and capsys.readouterr().out.strip() == promised.group(1).strip()
