@@ -29,6 +29,7 @@ from pushrecovery.analysis.base_polygon import FootModel, base_from_params
 from pushrecovery.analysis.c3d import write_c3d
 from pushrecovery.analysis.readers import read_recording
 from pushrecovery.analysis.recording import Recording, fixed_feet
+from pushrecovery.analysis.trial.events import Onset, TrialEvents
 from pushrecovery.control.mpc import MPCSettings
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.ground import Support, rectangle
@@ -36,6 +37,7 @@ from pushrecovery.ground.minkowski import minkowski_sum, regular_polygon
 from pushrecovery.sim.result import Outcome
 from pushrecovery.surfaces.classify import classify, strategy_region
 from pushrecovery.surfaces.n_step import step_options
+from pushrecovery.surfaces.probability import StateGaussian
 
 P = load_params()
 FOOT = rectangle(-0.05, 0.15, 0.1)
@@ -181,6 +183,24 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     "pushrecovery.sim.critical.find_critical_velocity": {"direction": "forward"},
     "pushrecovery.sim.physical_checks.joint_group": {"name": "left_knee_joint"},
     "pushrecovery.sim.result.judge": {"outcome": Outcome.RECOVERED, "checks": None},
+    # Probabilities of uncertain states (issue 37).
+    "pushrecovery.ground.gaussian.covariance_2d": {"name": "cov", "cov": np.eye(2) * 1e-3},
+    **{f"pushrecovery.ground.gaussian.{name}": {
+        "mean": np.array([0.05, 0.0]), "cov": np.eye(2) * 1e-3, "first": FOOT,
+        "second": FOOT.transformed(0.05, 0.02, 0.3),
+        "polygons": [FOOT, FOOT.transformed(0.05, 0.02, 0.3)],
+    } for name in ("gaussian_mass", "gaussian_union_mass", "intersection", "maximal")},
+    **{f"pushrecovery.surfaces.probability.{name}": {
+        "mean": np.array([0.0, 0.3]), "cov": np.eye(2) * 1e-3,
+        "state": StateGaussian(np.array([0.0, 0.3]), np.eye(2) * 1e-3),
+    } for name in ("ankle_probability", "verdict_probabilities", "verdict_probability_table")},
+    "pushrecovery.surfaces.probability.delayed_capture_point": {
+        "mean": np.array([0.05]), "cov": np.array([[1e-3]]), "latency": 0.02,
+        "cop": np.array([0.0]),
+    },
+    "pushrecovery.analysis.trial.events.c3d_events": {"events": TrialEvents(
+        Onset(0.5, "force", None), (), ()
+    )},
     # Posturography: 10 s of CoP (ap, ml) [m] at 100 Hz (the spectrum needs >= 1 / 0.15 Hz).
     **{f"pushrecovery.analysis.posturography.{name}": {
         "cop": 0.01 * np.column_stack([np.sin(np.arange(1000) / 20), np.cos(np.arange(1000) / 13)]),

@@ -162,7 +162,7 @@ def test_latency_against_states_carried_through_the_delay(latency):
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"mean": [0.0, 0.1, 0.2], "cov": np.eye(3)}, r"shape \(2,\) or \(4,\)"),
+        ({"mean": [0.0, 0.1, 0.2], "cov": np.eye(3)}, r"shape \(n, 2\) or \(n, 4\)"),
         ({"mean": [0.0, 0.1], "cov": np.eye(4)}, r"cov must have shape \(2, 2\)"),
         ({"mean": [0.0, 0.1], "cov": [[1.0, 0.2], [0.3, 1.0]]}, "symmetric"),
         ({"mean": [0.0, 0.1], "cov": [[1.0, 2.0], [2.0, 1.0]]}, "positive semi-definite"),
@@ -245,3 +245,57 @@ def test_the_docs_example_prints_what_it_says(capsys):
     exec(compile(block, "docs/uncertainty.md", "exec"), {})
     promised = re.search(r"# prints: (.*)", block)
     assert promised is not None and capsys.readouterr().out.strip() == promised.group(1).strip()
+
+
+def test_many_states_at_once_equal_each_state_alone():
+    from pushrecovery.surfaces.probability import ankle_probability, verdict_probability_table
+
+    rng = np.random.default_rng(5)
+    means = np.column_stack([rng.uniform(-0.02, 0.05, 6), rng.uniform(-1.5, 2.5, 6)])
+    cov = np.array([[1e-4, 2e-4], [2e-4, 0.02]])
+    table = verdict_probability_table(means, cov, P, latency=0.03)
+    for k, mean in enumerate(means):
+        alone = verdict_probabilities(StateGaussian(mean, cov), P, latency=0.03)
+        assert table.levels[k].tolist() == pytest.approx([*alone.by_level, alone.fall], abs=1e-15)
+    assert table.levels.sum(axis=1) == pytest.approx(np.ones(6), abs=1e-12)
+    # P(ankle) alone: the table's first column (the line's closed form, and the general path
+    # with one covariance per state).
+    assert ankle_probability(means, cov, P, latency=0.03) == pytest.approx(table.ankle, abs=1e-15)
+    each = np.stack([cov * (1 + k) for k in range(6)])
+    assert ankle_probability(means, each, P) == pytest.approx(
+        verdict_probability_table(means, each, P).ankle, abs=1e-15
+    )
+    plane = np.column_stack([means[:, 0], means[:, 0], means[:, 1], 0.5 * means[:, 1]])
+    cov4 = np.diag([1e-4, 1e-4, 0.02, 0.02])
+    support = Support.from_params(P, Stance.RIGHT)
+    assert ankle_probability(plane, cov4, P, support=support) == pytest.approx(
+        verdict_probability_table(plane, cov4, P, support=support).ankle, abs=1e-15
+    )
+    assert float(ankle_probability(means[0], cov, P, latency=0.03)) == pytest.approx(
+        table.ankle[0], abs=1e-15
+    )
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (lambda f: f(np.zeros((3, 3)), np.eye(3), P), r"shape \(n, 2\) or \(n, 4\)"),
+        (lambda f: f(np.zeros((3, 2)), np.ones((2, 2, 2)), P), r"cov must have shape"),
+        (lambda f: f(np.zeros(2), np.eye(2), P, support=Support.from_params(P)), "plane state"),
+        (lambda f: f(np.zeros(2), np.eye(2), P, latency=(0.0, 0.1)), "latency"),
+        (lambda f: f(np.zeros(2), np.eye(2), "P"), "params"),
+    ],
+)
+def test_ankle_probability_refuses_bad_input(call, match):
+    from pushrecovery.errors import PushRecoveryError
+    from pushrecovery.surfaces.probability import ankle_probability
+
+    with pytest.raises(PushRecoveryError, match=match):
+        call(ankle_probability)
+
+
+def test_delayed_capture_point_refuses_bad_input():
+    with pytest.raises(InvalidParameterError, match="omega"):
+        delayed_capture_point([0.1], [[1e-3]], -3.0, 0.02, [0.0])
+    with pytest.raises(InvalidParameterError, match="mean must be finite"):
+        delayed_capture_point([math.nan], [[1e-3]], 3.0, 0.02, [0.0])

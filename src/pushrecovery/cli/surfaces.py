@@ -197,9 +197,9 @@ def _probabilities(
                 f"--cov must be {n * n} comma-separated numbers, got {cov!r}"
             ) from None
         if len(values) != n * n:
-            state = "(x, xdot)" if n == 2 else "(x, y, xdot, ydot)"
+            names = "(x, xdot)" if n == 2 else "(x, y, xdot, ydot)"
             raise InvalidParameterError(
-                f"--cov must be {n * n} numbers for the state {state}, row by row, "
+                f"--cov must be {n * n} numbers for the state {names}, row by row, "
                 f"got {len(values)}"
             )
         matrix = np.array(values).reshape(n, n)

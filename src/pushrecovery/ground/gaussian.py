@@ -5,7 +5,7 @@ z = L⁻¹(X − μ) ~ N(0, I) and Q maps to the convex polygon Q' with vertices
 (still counter-clockwise: det L > 0). Fan Q' from the origin: the signed triangles (0, w_i,
 w_{i+1}) sum to the indicator of Q' wherever the origin lies, so P(X ∈ Q) = Σ_i P_i with the
 standard normal's mass of each signed triangle. For the edge a = w_i → b = w_{i+1}, with h the
-signed distance of its line from the origin (h = (a × b)/|b − a|, > 0 when the triangle is
+signed distance of its line from the origin (h = (a × b)/‖b − a‖, > 0 when the triangle is
 counter-clockwise) and t_a, t_b the positions of a and b along the edge's unit direction e
 measured from the foot of the perpendicular (t = w · e), polar coordinates give
 
@@ -139,7 +139,7 @@ def gaussian_union_mass(
     A polygon inside another of the list (every vertex inside or on it) is dropped first.
     Arguments and result as :func:`gaussian_mass`.
     """
-    kept = maximal(list(polygons))
+    kept = maximal(polygons)
     if len(kept) > MAX_UNION:
         raise InvalidParameterError(
             f"polygons: at most {MAX_UNION} that no other contains, got {len(kept)}"
@@ -203,8 +203,9 @@ def _polygon(points: FloatArray) -> ConvexPolygon | None:
     return ConvexPolygon._from_ccw(np.array(out))
 
 
-def maximal(polygons: list[ConvexPolygon]) -> list[ConvexPolygon]:
+def maximal(polygons: Sequence[ConvexPolygon]) -> list[ConvexPolygon]:
     """Return the polygons that no other one of the list contains (of equal ones, the first)."""
+    require_type("polygons", polygons, (list, tuple))
     for k, polygon in enumerate(polygons):
         require_type(f"polygons[{k}]", polygon, ConvexPolygon)
     kept: list[ConvexPolygon] = []

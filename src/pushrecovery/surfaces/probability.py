@@ -38,7 +38,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import ndtr
 
-from pushrecovery.arguments import finite_array, finite_vector, non_negative_float, require_type
+from pushrecovery.arguments import (
+    finite_array,
+    finite_vector,
+    non_negative_float,
+    positive_float,
+    require_type,
+)
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.gaussian import covariance_2d, gaussian_union_mass, maximal
 from pushrecovery.ground.polygon import ConvexPolygon
@@ -53,10 +59,13 @@ from pushrecovery.surfaces.strategy import Strategy
 __all__ = [
     "LATENCY_NODES",
     "MAX_LATENCY_GROWTH",
+    "ProbabilityTable",
     "StateGaussian",
     "VerdictProbabilities",
+    "ankle_probability",
     "delayed_capture_point",
     "verdict_probabilities",
+    "verdict_probability_table",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -84,27 +93,14 @@ class StateGaussian:
     cov: FloatArray
 
     def __post_init__(self) -> None:
-        mean = finite_array("mean", self.mean)
-        if mean.shape not in ((2,), (4,)):
+        means, cov = _states(self.mean, self.cov)
+        if len(means) != 1 or np.ndim(self.mean) != 1 or cov.ndim != 2:
             raise InvalidParameterError(
-                "mean must be (x, xdot) or (x, y, xdot, ydot): shape (2,) or (4,), "
-                f"got {mean.shape}"
+                "a StateGaussian is one state: mean of shape (2,) or (4,) and its (d, d) cov, "
+                f"got {np.shape(self.mean)} and {cov.shape}"
             )
-        cov = finite_array("cov", self.cov)
-        n = len(mean)
-        if cov.shape != (n, n):
-            raise InvalidParameterError(
-                f"cov must have shape ({n}, {n}) for this mean, got {cov.shape}"
-            )
-        scale = float(np.max(np.abs(cov))) if cov.size else 0.0
-        if np.any(np.abs(cov - cov.T) > 1e-12 * scale):
-            raise InvalidParameterError("cov must be symmetric (a covariance matrix)")
-        smallest = float(np.linalg.eigvalsh(0.5 * (cov + cov.T))[0])
-        if smallest < -1e-12 * scale:
-            raise InvalidParameterError(
-                "cov must be positive semi-definite (a covariance), got an eigenvalue "
-                f"{smallest:.3g}"
-            )
+        mean = means[0].copy()
+        cov = cov.copy()
         for name, array in (("mean", mean), ("cov", cov)):
             array.flags.writeable = False
             object.__setattr__(self, name, array)
@@ -122,11 +118,11 @@ class VerdictProbabilities:
     Attributes
     ----------
     ankle, hip : float
-        P(the ankle suffices), P(the hip is needed and suffices).
+        P(the ankle suffices), P(the hip is needed and suffices) (dimensionless, in [0, 1]).
     steps : tuple of float
-        P(exactly k steps are needed), k = 1 … ``max_steps``.
+        P(exactly k steps are needed), k = 1 … ``max_steps`` (dimensionless).
     fall : float
-        P(no strategy of the model captures the state).
+        P(no strategy of the model captures the state) (dimensionless).
     capture_point_mean : tuple of float
         Mean of ξ at the command (after the latency) [m]: 1 or 2 numbers.
     capture_point_cov : tuple of tuple of float
@@ -195,7 +191,14 @@ def delayed_capture_point(
     cop : array_like, shape (d,)
         The CoP p held during the latency [m].
     """
-    tau = non_negative_float("latency", latency, "s")
+    omega = positive_float("omega", omega, "1/s")
+    growth = _growth(omega, non_negative_float("latency", latency, "s"))
+    p = finite_array("cop", cop)
+    return p + (finite_array("mean", mean) - p) * growth, finite_array("cov", cov) * growth**2
+
+
+def _growth(omega: float, tau: float) -> float:
+    """e^{ωτ}, refused beyond :data:`MAX_LATENCY_GROWTH`."""
     growth = math.exp(omega * tau) if omega * tau < 700.0 else math.inf
     if growth > MAX_LATENCY_GROWTH:
         raise InvalidParameterError(
@@ -203,8 +206,7 @@ def delayed_capture_point(
             f"{math.log(MAX_LATENCY_GROWTH) / omega:.3g} s for omega = {omega:.3g} 1/s), "
             f"got {tau!r} s"
         )
-    p = np.asarray(cop, dtype=np.float64)
-    return p + (np.asarray(mean) - p) * growth, np.asarray(cov) * growth**2
+    return growth
 
 
 def verdict_probabilities(
@@ -239,52 +241,250 @@ def verdict_probabilities(
         long that e^{ωτ} > :data:`MAX_LATENCY_GROWTH`, a ``cop`` of the wrong size.
     """
     require_type("state", state, StateGaussian)
+    table = verdict_probability_table(
+        state.mean, state.cov, params, support=support, latency=latency, cop=cop
+    )
+    levels = table.levels[0]
+    return VerdictProbabilities(
+        ankle=float(levels[0]),
+        hip=float(levels[1]),
+        steps=tuple(float(p) for p in levels[2:-1]),
+        fall=float(levels[-1]),
+        capture_point_mean=tuple(float(v) for v in table.capture_point_mean[0]),
+        capture_point_cov=tuple(tuple(float(v) for v in row) for row in table.capture_point_cov[0]),
+        error=table.error,
+        method=table.method,
+        by_level=tuple(float(p) for p in levels[:-1]),
+    )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ProbabilityTable:
+    """The verdict probabilities of many uncertain states (:func:`verdict_probability_table`).
+
+    Attributes
+    ----------
+    levels : ndarray, shape (n, 3 + max_steps)
+        Per state: P(ankle), P(hip), P(exactly k steps) for k = 1 … max_steps, P(fall); rows
+        sum to 1.
+    capture_point_mean : ndarray, shape (n, d)
+        Mean of ξ at the command [m] (d = 1 on the line, 2 on the plane).
+    capture_point_cov : ndarray, shape (n, d, d)
+        Its covariance [m²].
+    error : float
+        Bound on the numerical error of a probability (0: exact up to rounding).
+    method : str
+        ``exact`` or ``latency quadrature``.
+    """
+
+    levels: FloatArray
+    capture_point_mean: FloatArray
+    capture_point_cov: FloatArray
+    error: float
+    method: str
+
+    @property
+    def ankle(self) -> FloatArray:
+        """P(the ankle suffices), per state."""
+        return self.levels[:, 0]
+
+    @property
+    def hip(self) -> FloatArray:
+        """P(the hip is needed and suffices), per state."""
+        return self.levels[:, 1]
+
+    @property
+    def steps(self) -> FloatArray:
+        """P(exactly k steps), shape (n, max_steps), column k − 1."""
+        return self.levels[:, 2:-1]
+
+    @property
+    def fall(self) -> FloatArray:
+        """P(fall), per state."""
+        return self.levels[:, -1]
+
+
+def verdict_probability_table(
+    mean: ArrayLike,
+    cov: ArrayLike,
+    params: BodyParams,
+    *,
+    support: Support | None = None,
+    latency: float | tuple[float, float] = 0.0,
+    cop: ArrayLike | None = None,
+) -> ProbabilityTable:
+    """Return the verdict probabilities of many Gaussian states at once (vectorised).
+
+    Parameters
+    ----------
+    mean : array_like, shape (n, 2) or (n, 4) (or one state)
+        (x, ẋ) on the line or (x, y, ẋ, ẏ) on the plane [m, m/s], as :class:`StateGaussian`.
+    cov : array_like, shape (d, d) or (n, d, d)
+        The states' covariance, one for all or one each (d = 2 or 4), symmetric positive
+        semi-definite.
+    params : BodyParams
+        The body.
+    support : Support, optional
+        The plane's support, as :func:`verdict_probabilities`.
+    latency : float or (float, float)
+        Loop latency [s], or a range of it [s], as :func:`verdict_probabilities`.
+    cop : array_like, optional
+        The CoP held during the latency [m].
+
+    Raises
+    ------
+    InvalidParameterError
+        As :func:`verdict_probabilities`, and means or covariances of other shapes, not finite,
+        not symmetric positive semi-definite.
+    """
+    means, covs = _states(mean, cov)
     require_type("params", params, BodyParams)
-    if support is not None and not state.plane:
+    plane = means.shape[1] == 4
+    if support is not None and not plane:
         raise InvalidParameterError("support applies to a plane state (x, y, xdot, ydot)")
-    if support is None and state.plane:
+    if support is None and plane:
         support = Support.from_params(params)
     if support is not None:
         require_type("support", support, Support)
-    dims = 2 if state.plane else 1
+    dims = 2 if plane else 1
     omega = params.omega
     rows = np.hstack([np.eye(dims), np.eye(dims) / omega])
-    xi_mean, xi_cov = rows @ state.mean, rows @ state.cov @ rows.T
+    xi_mean = means @ rows.T
+    xi_cov = rows @ covs @ rows.T
     regions = _regions(params, support)
-    if cop is None:
-        held = _middle(regions[0])
-    else:
-        held = finite_vector("cop", cop, dims, unit="m")
+    held = _middle(regions[0]) if cop is None else finite_vector("cop", cop, dims, unit="m")
     nodes, weights = _latencies(latency)
-    levels = np.zeros(len(regions))
-    for tau, weight in zip(nodes, weights, strict=True):
-        mean, cov = delayed_capture_point(xi_mean, xi_cov, omega, tau, held)
-        levels += weight * _level_masses(mean, cov, regions)
+    cumulative = _mixture(xi_mean, xi_cov, omega, held, nodes, weights, regions)
     error = 0.0
     if len(nodes) > 1:
-        coarse_nodes, coarse_weights = _latencies(latency, len(nodes) // 2)
-        coarse = np.zeros(len(regions))
-        for tau, weight in zip(coarse_nodes, coarse_weights, strict=True):
-            mean, cov = delayed_capture_point(xi_mean, xi_cov, omega, tau, held)
-            coarse += weight * _level_masses(mean, cov, regions)
-        error = float(np.max(np.abs(np.cumsum(levels) - np.cumsum(coarse))))
+        coarse = _mixture(xi_mean, xi_cov, omega, held, *_latencies(latency, len(nodes) // 2),
+                          regions)  # fmt: skip
+        error = float(np.max(np.abs(cumulative - coarse)))
+    levels = np.diff(cumulative, axis=1, prepend=0.0, append=1.0)
     # ξ at the command: over a latency range the mixture's mean and covariance.
     growth = np.exp(omega * nodes)
     first, second = float(weights @ growth), float(weights @ growth**2)
     offset = xi_mean - held
-    mean = held + offset * first
-    cov = xi_cov * second + (second - first**2) * np.outer(offset, offset)
-    return VerdictProbabilities(
-        ankle=float(levels[0]),
-        hip=float(levels[1]),
-        steps=tuple(float(p) for p in levels[2:]),
-        fall=float(max(0.0, 1.0 - levels.sum())),
-        capture_point_mean=tuple(float(v) for v in mean),
-        capture_point_cov=tuple(tuple(float(v) for v in row) for row in cov),
+    outer = np.einsum("ni,nj->nij", offset, offset)
+    return ProbabilityTable(
+        levels=levels,
+        capture_point_mean=held + offset * first,
+        capture_point_cov=np.broadcast_to(xi_cov * second, outer.shape)
+        + (second - first**2) * outer,
         error=error,
         method="exact" if len(nodes) == 1 else "latency quadrature",
-        by_level=tuple(float(p) for p in levels),
     )
+
+
+def ankle_probability(
+    mean: ArrayLike,
+    cov: ArrayLike,
+    params: BodyParams,
+    *,
+    support: Support | None = None,
+    latency: float = 0.0,
+    cop: ArrayLike | None = None,
+) -> FloatArray:
+    """Return P(the ankle suffices) of Gaussian states: ξ's mass on the CoP region alone.
+
+    The first column of :func:`verdict_probability_table` without the other regions (the
+    cheap question a loop asks every tick). Arguments as there; ``latency`` one value [s].
+    Returns shape (n,) for states (n, d), () for one state.
+    """
+    means, covs = _states(mean, cov)
+    require_type("params", params, BodyParams)
+    plane = means.shape[1] == 4
+    if support is not None and not plane:
+        raise InvalidParameterError("support applies to a plane state (x, y, xdot, ydot)")
+    dims = 2 if plane else 1
+    tau = non_negative_float("latency", latency, "s")
+    if not plane and covs.ndim == 2:  # the line, one covariance: normal CDFs of ξ's z-scores
+        foot = cop_region(params)
+        inv = 1.0 / params.omega
+        centre = (
+            0.5 * (foot.lower + foot.upper)
+            if cop is None
+            else float(finite_vector("cop", cop, 1, unit="m")[0])
+        )
+        growth = _growth(params.omega, tau)
+        sd = (
+            math.sqrt(max(covs[0, 0] + 2.0 * inv * covs[0, 1] + inv * inv * covs[1, 1], 0.0))
+            * growth
+        )
+        xi = centre + (means[:, 0] + inv * means[:, 1] - centre) * growth
+        if sd == 0.0:
+            found = ((foot.lower < xi) & (xi < foot.upper)).astype(np.float64)
+        else:
+            found = ndtr((foot.upper - xi) / sd) - ndtr((foot.lower - xi) / sd)
+        return found if np.ndim(mean) > 1 else found[0]
+    if plane:
+        support = Support.from_params(params) if support is None else support
+        require_type("support", support, Support)
+        region: _Level = [support.polygon]
+    else:
+        foot = cop_region(params)
+        region = [(foot.lower, foot.upper)]
+    omega = params.omega
+    rows = np.hstack([np.eye(dims), np.eye(dims) / omega])
+    held = _middle(region) if cop is None else finite_vector("cop", cop, dims, unit="m")
+    xi_mean, xi_cov = delayed_capture_point(means @ rows.T, rows @ covs @ rows.T, omega, tau, held)
+    found = _cumulative(xi_mean, xi_cov, [region])[:, 0]
+    return found if np.ndim(mean) > 1 else found[0]
+
+
+def _states(mean: ArrayLike, cov: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Means (n, d) and covariances (d, d) or (n, d, d), checked."""
+    means = np.atleast_2d(finite_array("mean", mean))
+    if means.ndim != 2 or means.shape[1] not in (2, 4):
+        raise InvalidParameterError(
+            f"mean must be states (x, xdot) or (x, y, xdot, ydot): shape (n, 2) or (n, 4), "
+            f"got {np.shape(mean)}"
+        )
+    d = means.shape[1]
+    covs = finite_array("cov", cov)
+    if covs.shape not in ((d, d), (len(means), d, d)):
+        raise InvalidParameterError(
+            f"cov must have shape ({d}, {d}) or ({len(means)}, {d}, {d}), got {covs.shape}"
+        )
+    if covs.shape == (2, 2):  # one state's (x, xdot): the checks in closed form (a loop's tick)
+        (a, b), (c, e) = covs.tolist()
+        scale = max(abs(a), abs(b), abs(c), abs(e))
+        if abs(b - c) > 1e-12 * scale:
+            raise InvalidParameterError("cov must be symmetric (a covariance matrix)")
+        half, mid = math.hypot(0.5 * (a - e), 0.5 * (b + c)), 0.5 * (a + e)
+        if mid - half < -1e-12 * scale:
+            raise InvalidParameterError(
+                "cov must be positive semi-definite (a covariance), got an eigenvalue "
+                f"{mid - half:.3g}"
+            )
+        return means, covs
+    scale = np.max(np.abs(covs), axis=(-2, -1), keepdims=True)
+    if np.any(np.abs(covs - np.swapaxes(covs, -1, -2)) > 1e-12 * scale):
+        raise InvalidParameterError("cov must be symmetric (a covariance matrix)")
+    smallest = np.linalg.eigvalsh(0.5 * (covs + np.swapaxes(covs, -1, -2)))[..., 0]
+    if np.any(smallest < -1e-12 * scale[..., 0, 0]):
+        raise InvalidParameterError(
+            "cov must be positive semi-definite (a covariance), got an eigenvalue "
+            f"{float(np.min(smallest)):.3g}"
+        )
+    return means, covs
+
+
+def _mixture(
+    xi_mean: FloatArray,
+    xi_cov: FloatArray,
+    omega: float,
+    held: FloatArray,
+    nodes: FloatArray,
+    weights: FloatArray,
+    regions: list[_Level],
+) -> FloatArray:
+    """P(level <= L) per state and level, averaged over the latency's nodes."""
+    total = np.zeros((len(xi_mean), len(regions)))
+    for tau, weight in zip(nodes, weights, strict=True):
+        mean, cov = delayed_capture_point(xi_mean, xi_cov, omega, tau, held)
+        total += weight * _cumulative(mean, cov, regions)
+    return total
 
 
 # A level's regions: intervals (lower, upper) on the line, convex polygons on the plane.
@@ -335,9 +535,9 @@ def _latencies(
     return np.array([non_negative_float("latency", latency, "s")]), np.array([1.0])
 
 
-def _level_masses(mean: FloatArray, cov: FloatArray, regions: list[_Level]) -> FloatArray:
-    """P(the first region holding ξ is that level's), per level."""
-    cumulative = np.empty(len(regions))
+def _cumulative(mean: FloatArray, cov: FloatArray, regions: list[_Level]) -> FloatArray:
+    """P(ξ in the union of the regions of levels 0 … L), per state (rows) and level L."""
+    cumulative = np.empty((len(mean), len(regions)))
     if isinstance(regions[0][0], ConvexPolygon):
         sigma = covariance_2d("cov", cov)
         kept: list[ConvexPolygon] = []
@@ -346,31 +546,34 @@ def _level_masses(mean: FloatArray, cov: FloatArray, regions: list[_Level]) -> F
             # Only the polygons no other one contains count (nested levels change nothing);
             # once the union holds all the mass but rounding, larger unions hold it too.
             kept = maximal([*kept, *group])
-            if level and (kept == last or cumulative[level - 1] >= 1.0 - 1e-15):
-                cumulative[level] = cumulative[level - 1]
+            if level and (kept == last or np.all(cumulative[:, level - 1] >= 1.0 - 1e-15)):
+                cumulative[:, level] = cumulative[:, level - 1]
             else:
-                cumulative[level] = float(gaussian_union_mass(mean, sigma, kept))
+                cumulative[:, level] = gaussian_union_mass(mean, sigma, kept)
             last = kept
     else:
+        sd = np.sqrt(np.maximum(np.broadcast_to(cov, (len(mean), 1, 1))[:, 0, 0], 0.0))
         for level in range(len(regions)):
             pieces = [r for group in regions[: level + 1] for r in group]
-            cumulative[level] = _interval_union_mass(mean, cov, pieces)  # type: ignore[arg-type]
-    cumulative = np.maximum.accumulate(np.clip(cumulative, 0.0, 1.0))
-    return np.diff(cumulative, prepend=0.0)
+            cumulative[:, level] = _interval_union_mass(mean[:, 0], sd, pieces)  # type: ignore[arg-type]
+    return np.maximum.accumulate(np.clip(cumulative, 0.0, 1.0), axis=1)
 
 
 def _interval_union_mass(
-    mean: FloatArray, cov: FloatArray, pieces: list[tuple[float, float]]
-) -> float:
-    """P(ξ in a union of intervals) of a 1-D Gaussian (a zero variance: strictly inside)."""
-    sd = math.sqrt(max(float(cov[0, 0]), 0.0))
+    mu: FloatArray, sd: FloatArray, pieces: list[tuple[float, float]]
+) -> FloatArray:
+    """P(ξ in a union of intervals) of 1-D Gaussians (a zero deviation: strictly inside)."""
     merged: list[list[float]] = []
     for low, high in sorted(pieces):
         if merged and low <= merged[-1][1]:
             merged[-1][1] = max(merged[-1][1], high)
         else:
             merged.append([low, high])
-    mu = float(mean[0])
-    if sd == 0.0:  # known exactly: strictly inside, as the verdicts
-        return float(any(low < mu < high for low, high in merged))
-    return float(sum(ndtr((high - mu) / sd) - ndtr((low - mu) / sd) for low, high in merged))
+    total = np.zeros(len(mu))
+    exact = sd == 0.0
+    safe = np.where(exact, 1.0, sd)
+    for low, high in merged:
+        total += np.where(
+            exact, (low < mu) & (mu < high), ndtr((high - mu) / safe) - ndtr((low - mu) / safe)
+        )
+    return total

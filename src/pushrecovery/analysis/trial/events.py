@@ -35,6 +35,7 @@ from pushrecovery.analysis.steps_measured import (
     measured_steps,
 )
 from pushrecovery.analysis.trial.checks import PlateFeet
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_region import capture_region
@@ -486,6 +487,7 @@ def c3d_events(events: TrialEvents) -> list[C3DEvent]:
     labels gait software expects); the onset is a ``General`` event. Each description says
     what detected it.
     """
+    require_type("events", events, TrialEvents)
     found = []
     if events.onset.time is not None:
         found.append(
