@@ -67,3 +67,34 @@ def test_write_events_needs_a_c3d_trial(tmp_path, capsys):
     err = _fail(capsys, "analyze", str(csv), "--mass", "72", "--out", str(tmp_path / "o"),
                 "--write-events")  # fmt: skip
     assert "--write-events" in err and "t.csv is no .c3d file" in err
+
+
+def test_a_batch_writes_the_steps_table_and_each_c3d_trials_events(tmp_path, capsys):
+    import pyarrow.parquet as pq
+
+    from pushrecovery.campaign.trial_steps import STEP_FIELDS
+    from pushrecovery.experiments.synthetic_trials import lipm_trial_csv
+
+    study = tmp_path / "study"
+    study.mkdir()
+    _c3d(study / "step.c3d")
+    (study / "quiet.csv").write_text(lipm_trial_csv(P, 0.2, 0.0))  # no step, no EVENT group
+    out = tmp_path / "o"
+    with pytest.raises(SystemExit) as info:
+        main(["analyze", str(study), "--out", str(out), "--mass", "72", "--no-plot",
+              "--write-events", "--json"])  # fmt: skip
+    assert info.value.code == 0
+    files = json.loads(capsys.readouterr().out)["files"]
+    assert files["steps"] == str(out / "steps.parquet") and (out / "steps.csv").exists()
+    table = pq.read_table(out / "steps.parquet")
+    assert table.column_names == [name for name, _ in STEP_FIELDS]
+    assert table.schema.field("duration").metadata[b"unit"] == b"s"
+    (row,) = table.to_pylist()  # the C3D trial's one step; the CSV trial took none
+    assert row["trial"] == "step.c3d" and row["foot"] == "right" and row["step"] == 1
+    truth = _recording().truth
+    assert row["length"] == pytest.approx(truth["step_lengths"][0], abs=0.01)
+    summary = json.loads((out / "trials" / "step.c3d" / "summary.json").read_text())
+    assert row["foot_contact"] == summary["events"]["measured_steps"][0]["contact_time"]
+    # events.c3d beside the C3D trial's outputs only.
+    assert read_events(out / "trials" / "step.c3d" / "events.c3d")
+    assert not (out / "trials" / "quiet.csv" / "events.c3d").exists()

@@ -327,17 +327,23 @@ def failed_rows(job: Any, reason: str) -> list[dict[str, Any]]:
 
 
 def write_table(
-    rows: list[dict[str, Any]], columns: tuple[tuple[str, str], ...], stem: Path
+    rows: list[dict[str, Any]], columns: tuple[tuple[str, str], ...] | Any, stem: Path
 ) -> dict[str, Path]:
-    """Write ``rows`` as ``stem.parquet`` and ``stem.csv`` with the typed ``columns``."""
+    """Write ``rows`` as ``stem.parquet`` and ``stem.csv`` with the typed ``columns``.
+
+    ``columns``: (name, Python type) pairs, or a ``pyarrow.Schema`` (fields with metadata).
+    """
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
-    types = {"str": pa.string(), "int": pa.int64(), "float": pa.float64(), "bool": pa.bool_()}
-    schema = pa.schema(
-        [(name, types[kind.split(" ")[0].split("|")[0].strip()]) for name, kind in columns]
-    )
+    if isinstance(columns, pa.Schema):
+        schema = columns
+    else:
+        types = {"str": pa.string(), "int": pa.int64(), "float": pa.float64(), "bool": pa.bool_()}
+        schema = pa.schema(
+            [(name, types[kind.split(" ")[0].split("|")[0].strip()]) for name, kind in columns]
+        )
     table = pa.Table.from_pylist(rows, schema=schema)
     paths = {stem.name: stem.with_suffix(".parquet"), f"{stem.name}_csv": stem.with_suffix(".csv")}
     pq.write_table(table, paths[stem.name])

@@ -6,7 +6,9 @@ and glob patterns into a sorted list of trials; :func:`run_trials` analyses each
 ``trial.json`` (a trial with that file is finished: ``resume`` skips it), then joins them into
 ``OUT/trials.parquet`` (:class:`~pushrecovery.campaign.trial_rows.TrialRow`, one row per trial
 and axis; a trial that could not be read or analysed is a ``failed`` row), ``OUT/events.parquet``
-(:class:`~pushrecovery.campaign.trial_events.EventRow`), their CSV twins and
+(:class:`~pushrecovery.campaign.trial_events.EventRow`), ``OUT/steps.parquet``
+(:class:`~pushrecovery.campaign.trial_steps.StepRow`, one row per measured step), their CSV
+twins and
 ``OUT/summary.json``. Only the project's own errors make a ``failed`` row: anything else is a
 bug and stops the batch. docs/analysis.md, "Many trials", has the details.
 """
@@ -18,7 +20,7 @@ import json
 import os
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, wait
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +33,7 @@ from pushrecovery.campaign.trial_rows import (
     sway_rows,
     trial_rows,
 )
+from pushrecovery.campaign.trial_steps import StepRow, step_schema, trial_steps
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.extras import require
 
@@ -100,7 +103,8 @@ class TrialJob:
     ``reader`` are the reader's keyword options per file type (``{".csv": {...}, ".c3d":
     {...}}``), ``flags`` the body values given on the command line (None: not given),
     ``preset`` and ``params_file`` the base body, ``settings`` an
-    :class:`~pushrecovery.analysis.trial.AnalysisSettings`.
+    :class:`~pushrecovery.analysis.trial.AnalysisSettings`; ``write_events``: a C3D trial's
+    folder gets ``events.c3d``, a copy with the events in its EVENT group (docs/events.md).
     """
 
     path: Path
@@ -111,6 +115,7 @@ class TrialJob:
     preset: str = "paper"
     params_file: str | None = None
     settings: Any = None
+    write_events: bool = False
 
 
 def trial_jobs(
@@ -131,11 +136,13 @@ def trial_jobs(
 
 @dataclass(frozen=True)
 class TrialsResult:
-    """A finished batch: the rows of the trials and events, the summary and the files.
+    """A finished batch: the rows of the trials, events and steps, the summary and the files.
 
-    ``trials`` and ``events`` are the rows of ``trials.parquet`` and ``events.parquet``
-    (:class:`~pushrecovery.campaign.trial_rows.TrialRow` and
-    :class:`~pushrecovery.campaign.trial_events.EventRow` as dicts).
+    ``trials``, ``events`` and ``steps`` are the rows of ``trials.parquet``,
+    ``events.parquet`` and ``steps.parquet``
+    (:class:`~pushrecovery.campaign.trial_rows.TrialRow`,
+    :class:`~pushrecovery.campaign.trial_events.EventRow` and
+    :class:`~pushrecovery.campaign.trial_steps.StepRow` as dicts).
     """
 
     trials: list[dict[str, Any]]
@@ -143,6 +150,7 @@ class TrialsResult:
     summary: dict[str, Any]
     files: dict[str, Path]
     ran: int  # trials analysed by this call (the rest were finished on disk)
+    steps: list[dict[str, Any]] = field(default_factory=list)
 
     def trial_rows(self) -> list[TrialRow]:
         """Return the trials' rows as typed objects."""
@@ -152,8 +160,12 @@ class TrialsResult:
         """Return the events' rows as typed objects."""
         return [EventRow(**row) for row in self.events]
 
+    def step_rows(self) -> list[StepRow]:
+        """Return the steps' rows as typed objects."""
+        return [StepRow(**row) for row in self.steps]
+
     def to_pandas(self, table: str = "trials") -> Any:
-        """Return ``trials`` or ``events`` as a ``pandas.DataFrame`` (the ``tables`` extra).
+        """Return ``trials``, ``events`` or ``steps`` as a ``pandas.DataFrame`` (``tables``).
 
         Raises
         ------
@@ -164,8 +176,10 @@ class TrialsResult:
 
         from pushrecovery.analysis.trial.settings import pandas_table
 
-        if table not in ("trials", "events"):
-            raise InvalidParameterError(f"table must be 'trials' or 'events', got {table!r:.40}")
+        if table not in ("trials", "events", "steps"):
+            raise InvalidParameterError(
+                f"table must be 'trials', 'events' or 'steps', got {table!r:.40}"
+            )
         return pandas_table(pq.read_table(self.files[table]))
 
 
@@ -210,12 +224,20 @@ def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict
         params = load_params(job.preset, job.params_file, {**given, **found})
         analysis = analyze(recording, params, job.settings, sources=found_sources)
         files = {name: str(path) for name, path in write_analysis(analysis, directory).items()}
+        if job.write_events and job.path.suffix.lower() == ".c3d":
+            from pushrecovery.analysis.c3d import write_events
+            from pushrecovery.analysis.trial.events import c3d_events
+
+            events_c3d = directory / "events.c3d"
+            write_events(job.path, events_c3d, c3d_events(analysis.summary.events))
+            files["events_c3d"] = str(events_c3d)
         if after is not None:
             files.update(after(analysis, directory))
         quality = [{"trial": job.name, **row} for row in analysis.summary.checks.quality_rows()]
         record = {
             "trials": json_safe(trial_rows(job, analysis.summary, params, sources)),
             "events": json_safe(trial_events(job, analysis.summary)),
+            "steps": json_safe([asdict(row) for row in trial_steps(job, analysis.summary)]),
             "quality": json_safe(quality),
             "files": files,
         }
@@ -348,18 +370,21 @@ def _join(jobs: list[TrialJob], out: Path, ran: int) -> TrialsResult:
 
     trials: list[dict[str, Any]] = []
     events: list[dict[str, Any]] = []
+    steps: list[dict[str, Any]] = []
     quality: list[dict[str, Any]] = []
     for job in jobs:
         record = json.loads((out / TRIALS_DIR / job.name / ROW_FILE).read_text())
         trials += record["trials"]
         events += record["events"]
+        steps += record.get("steps", [])  # trials finished before the table existed
         quality += record.get("quality", [])  # trials finished before the table existed
     files = {
         **write_table(trials, TRIAL_FIELDS, out / "trials"),
         **write_table(events, EVENT_FIELDS, out / "events"),
+        **write_table(steps, step_schema(), out / "steps"),
         **write_table(quality, (("trial", "str"), *QUALITY_FIELDS), out / "quality"),
     }
     summary = batch_summary(trials)
     _write_json(out / "summary.json", summary)
     files["summary"] = out / "summary.json"
-    return TrialsResult(trials, events, summary, files, ran)
+    return TrialsResult(trials, events, summary, files, ran, steps)

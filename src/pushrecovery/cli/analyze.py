@@ -79,7 +79,8 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     type=click.Path(file_okay=False, path_type=Path),
     required=True,
     help="Directory for frames.parquet, frames.csv, summary.json and the plots (one file); "
-    "for many, trials/<trial>/ per trial and trials, events (Parquet, CSV) and summary.json.",
+    "for many, trials/<trial>/ per trial and trials, events, steps (Parquet, CSV) and "
+    "summary.json.",
 )
 @click.option(
     "--subjects",
@@ -183,7 +184,7 @@ def _foot(text: str) -> tuple[str, str, str, str]:
 @click.option(
     "--write-events",
     is_flag=True,
-    help="Also write events.c3d: a copy of a C3D trial (never the input) with the onset and "
+    help="Also write events.c3d: a copy of each C3D trial (never the input) with the onset and "
     "the foot events (Foot Strike, Foot Off) in its EVENT group (docs/events.md).",
 )
 @body_options
@@ -194,8 +195,8 @@ def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) ->
     force plates), a folder (every .csv and .c3d below it) or a glob pattern. Both directions
     are analysed, each with its own base of support; mass and CoM height come from the
     subjects table, the flags, the file, else (mass) the force plates. One file writes its
-    outputs into OUT; many write one folder per trial and the tables of trials and events.
-    Positions are in the lab frame [m], ap forward and ml to the subject's left; margins are
+    outputs into OUT; many write one folder per trial and the tables of trials, events and
+    steps. Positions are in the lab frame [m], ap forward and ml to the subject's left; margins are
     signed distances of the capture point to the base of support [m], positive inside. Prints
     the frames analysed, the body and where it came from, the most demanding strategy and the
     least CoP margin per direction, the step events and gaps, and the files; --json prints the
@@ -335,6 +336,7 @@ def _batch(
     from pushrecovery.cli.progress import Progress
 
     plot, figure_format = kwargs.pop("plot"), kwargs.pop("figure_format")
+    write_events = kwargs.pop("write_events")
     flags = {field: kwargs.pop(field) for _, field, _ in PARAM_FLAGS}
     subjects = read_subjects(batch["subjects"]) if batch["subjects"] is not None else ()
     trials, root = find_trials(inputs)
@@ -342,7 +344,7 @@ def _batch(
         trials = [t for t in trials if t != batch["subjects"].resolve()]
     jobs = trial_jobs(
         trials, root, subjects, reader=reader, flags=flags, preset=kwargs["preset"],
-        params_file=kwargs["params_file"], settings=settings,
+        params_file=kwargs["params_file"], settings=settings, write_events=write_events,
     )  # fmt: skip
     bar = Progress(len(jobs), "analyze", "trial")
     try:
