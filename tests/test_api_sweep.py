@@ -193,11 +193,14 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     **{f"pushrecovery.surfaces.probability.{name}": {
         "mean": np.array([0.0, 0.3]), "cov": np.eye(2) * 1e-3,
         "state": StateGaussian(np.array([0.0, 0.3]), np.eye(2) * 1e-3),
-    } for name in ("ankle_probability", "verdict_probabilities", "verdict_probability_table")},
-    "pushrecovery.surfaces.probability.delayed_capture_point": {
+    } for name in ("verdicts.ankle_probability", "verdicts.verdict_probabilities",
+                   "verdicts.verdict_probability_table", "inputs.check_states")},
+    "pushrecovery.surfaces.probability.latency.delayed_capture_point": {
         "mean": np.array([0.05]), "cov": np.array([[1e-3]]), "latency": 0.02,
         "cop": np.array([0.0]),
     },
+    "pushrecovery.surfaces.probability.latency.latency_growth": {"tau": 0.02},
+    "pushrecovery.surfaces.probability.latency.latency_nodes": {"latency": (0.01, 0.03)},
     "pushrecovery.analysis.trial.events.c3d_events": {"events": TrialEvents(
         Onset(0.5, "force", None), (), ()
     )},
@@ -224,6 +227,8 @@ NOT_SWEPT = {
     "pushrecovery.surfaces.capture_lp_steps.step_lp": "an LP per call: tests only",
     "pushrecovery.presets.load_params": "no required argument: test_api_hostile.py",
     "pushrecovery.analysis.output.json_safe": "any value in, a JSON value out: test_cli_analyze.py",
+    "pushrecovery.surfaces.probability.regions.cumulative_masses": "checked arguments only",
+    "pushrecovery.surfaces.probability.regions.region_middle": "of regions the module built",
 }
 HOSTILE: list[Any] = [math.nan, math.inf, -1e300, 0.0, None, "x", [1.0, 2.0], np.zeros((2, 2))]
 #: Floors above the library's functions: they draw, write or run campaigns. And below them: the

@@ -6,6 +6,7 @@ polygons), within 4 standard errors of the sample (a fixed seed); latency agains
 own solution (cosh and sinh of ωτ, not the capture point's e^{ωτ}).
 """
 
+import dataclasses
 import math
 import re
 
@@ -241,10 +242,14 @@ def test_the_docs_example_prints_what_it_says(capsys):
     from pathlib import Path
 
     page = (Path(__file__).parent.parent / "docs" / "uncertainty.md").read_text()
-    (block,) = re.findall(r"```python\n(.*?)```", page, flags=re.S)
-    exec(compile(block, "docs/uncertainty.md", "exec"), {})
-    promised = re.search(r"# prints: (.*)", block)
-    assert promised is not None and capsys.readouterr().out.strip() == promised.group(1).strip()
+    blocks = re.findall(r"```python\n(.*?)```", page, flags=re.S)
+    assert len(blocks) == 2
+    namespace: dict = {}
+    for block in blocks:  # in order, in one namespace, as a reader runs them
+        exec(compile(block, "docs/uncertainty.md", "exec"), namespace)
+        promised = re.search(r"# prints: (.*)", block)
+        assert promised is not None
+        assert capsys.readouterr().out.strip() == promised.group(1).strip()
 
 
 def test_many_states_at_once_equal_each_state_alone():
@@ -299,3 +304,70 @@ def test_delayed_capture_point_refuses_bad_input():
         delayed_capture_point([0.1], [[1e-3]], -3.0, 0.02, [0.0])
     with pytest.raises(InvalidParameterError, match="mean must be finite"):
         delayed_capture_point([math.nan], [[1e-3]], 3.0, 0.02, [0.0])
+
+
+def test_a_body_known_up_to_a_spread_against_sampling_bodies_and_states():
+    from scipy.stats import truncnorm
+
+    from pushrecovery.surfaces.probability import TRUNCATION, BodySpread
+
+    spread = BodySpread(mass=6.0, com_height=0.05, foot_length=0.02, torque_max=15.0)
+    mean, cov = np.array([0.0, 0.55]), np.diag([1e-4, 0.01])
+    found = verdict_probabilities(StateGaussian(mean, cov), P, spread=spread)
+    assert found.method == "quasi-Monte Carlo over the body" and 0.0 < found.error < 2e-3
+    # Plain Monte Carlo: 2,000 bodies from the truncated normals, 500 states each.
+    rng = np.random.default_rng(6)
+    bodies, per_body = 2000, 500
+    z = truncnorm.rvs(-TRUNCATION, TRUNCATION, size=(bodies, 4), random_state=rng)
+    counts = np.zeros(3 + P.max_steps)
+    for row in z:
+        scale = 1.0 + spread.foot_length * row[2] / (P.toe - P.heel)
+        body = dataclasses.replace(
+            P,
+            mass=P.mass + spread.mass * row[0],
+            com_height=P.com_height + spread.com_height * row[1],
+            heel=P.heel * scale,
+            toe=P.toe * scale,
+            torque_max=P.torque_max + spread.torque_max * row[3],
+        )
+        x, v = rng.multivariate_normal(mean, cov, per_body).T
+        level = levels_of(classify_states(x, v, body), sagittal_verdicts(x, v, body).line.steps,
+                          P.max_steps)  # fmt: skip
+        counts += np.bincount(level, minlength=3 + P.max_steps)
+    n = bodies * per_body
+    for k, p in enumerate([found.ankle, found.hip, *found.steps, found.fall]):
+        se = math.sqrt(max(p * (1 - p), 1e-12) / n + found.error**2)
+        assert abs(counts[k] / n - p) <= 4.0 * se, (k, counts[k] / n, p)
+    # The spread matters here: the certain body gives other numbers.
+    exact = verdict_probabilities(StateGaussian(mean, cov), P)
+    assert abs(exact.hip - found.hip) > 10 * found.error
+
+
+def test_a_zero_spread_is_the_exact_answer():
+    from pushrecovery.surfaces.probability import BodySpread
+
+    state = StateGaussian(np.array([0.0, 0.5]), np.diag([1e-4, 0.01]))
+    found = verdict_probabilities(state, P, spread=BodySpread(), samples=4, replicates=2)
+    exact = verdict_probabilities(state, P)
+    assert found.by_level == pytest.approx(exact.by_level, abs=1e-15) and found.error == 0.0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"spread": {"mass": -1.0}}, "mass"),
+        ({"spread": {"com_height": math.nan}}, "com_height"),
+        ({"spread": {"com_height": 0.5}}, "spread: the body"),
+        ({"samples": 48}, "power of 2"),
+        ({"samples": 1}, "samples"),
+        ({"replicates": 1}, "replicates"),
+        ({"seed": -1}, "seed"),
+    ],
+)
+def test_bad_spreads_are_refused(kwargs, match):
+    from pushrecovery.surfaces.probability import BodySpread
+
+    state = StateGaussian(np.array([0.0, 0.5]), np.diag([1e-4, 0.01]))
+    with pytest.raises(InvalidParameterError, match=match):
+        spread = BodySpread(**kwargs.pop("spread", {"mass": 1.0}))
+        verdict_probabilities(state, P, spread=spread, **kwargs)

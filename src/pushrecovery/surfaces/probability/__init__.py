@@ -1,0 +1,42 @@
+"""The strategy a state needs, as probabilities: an uncertain state, latency and body.
+
+:mod:`.inputs` (a Gaussian state estimate), :mod:`.latency` (the capture point moving on
+during a loop's latency), :mod:`.body` (a spread of the body's parameters) and
+:mod:`.regions` (the verdict regions and a Gaussian's masses on them), :mod:`.results`
+(the typed results) and :mod:`.verdicts` (the probability of each verdict: exact Gaussian
+masses of the regions, averaged over the body by quasi-Monte Carlo). docs/uncertainty.md
+derives and checks them.
+"""
+
+from pushrecovery.surfaces.probability.body import TRUNCATION, BodySpread
+from pushrecovery.surfaces.probability.inputs import StateGaussian, check_states
+from pushrecovery.surfaces.probability.latency import (
+    LATENCY_NODES,
+    MAX_LATENCY_GROWTH,
+    delayed_capture_point,
+    latency_growth,
+    latency_nodes,
+)
+from pushrecovery.surfaces.probability.results import ProbabilityTable, VerdictProbabilities
+from pushrecovery.surfaces.probability.verdicts import (
+    ankle_probability,
+    verdict_probabilities,
+    verdict_probability_table,
+)
+
+__all__ = [
+    "LATENCY_NODES",
+    "MAX_LATENCY_GROWTH",
+    "TRUNCATION",
+    "BodySpread",
+    "ProbabilityTable",
+    "StateGaussian",
+    "VerdictProbabilities",
+    "ankle_probability",
+    "check_states",
+    "delayed_capture_point",
+    "latency_growth",
+    "latency_nodes",
+    "verdict_probabilities",
+    "verdict_probability_table",
+]
