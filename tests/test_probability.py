@@ -371,3 +371,19 @@ def test_bad_spreads_are_refused(kwargs, match):
     with pytest.raises(InvalidParameterError, match=match):
         spread = BodySpread(**kwargs.pop("spread", {"mass": 1.0}))
         verdict_probabilities(state, P, spread=spread, **kwargs)
+
+
+def test_the_margin_for_a_one_percent_fall_probability():
+    """docs/uncertainty.md: m = z σ_ξ + (b − p)(1 − e^{−ωτ}) puts P(beyond the toe) at 1 %."""
+    from scipy.special import ndtri
+
+    from pushrecovery.surfaces.probability import ankle_probability
+
+    sx, sv, tau = 0.005, 0.05, 0.05
+    omega, held = P.omega, 0.5 * (P.heel + P.toe)
+    sigma = math.sqrt(sx**2 + (sv / omega) ** 2)
+    margin = -ndtri(0.01) * sigma + (P.toe - held) * (1.0 - math.exp(-omega * tau))
+    assert margin == pytest.approx(0.0534, abs=5e-5)  # the table's 53 mm
+    xi = P.toe - margin  # the estimate: x = 0, xdot = ω ξ
+    outside = 1.0 - ankle_probability([0.0, xi * omega], np.diag([sx**2, sv**2]), P, latency=tau)
+    assert outside == pytest.approx(0.01, abs=1e-9)  # the heel side adds ~1e-12
