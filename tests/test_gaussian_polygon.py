@@ -18,9 +18,9 @@ from pushrecovery.ground.gaussian import (
     MAX_UNION,
     gaussian_mass,
     gaussian_union_mass,
-    intersection,
     maximal,
 )
+from pushrecovery.ground.minkowski import clip
 from pushrecovery.ground.polygon import convex_hull, rectangle
 from pushrecovery.ground.support import Support
 from pushrecovery.presets import load_params
@@ -165,7 +165,7 @@ def test_unions_by_inclusion_and_exclusion():
     assert maximal([inner, FOOT, FOOT]) == [FOOT]
     # Disjoint: the masses add.
     far = FOOT.transformed(1.0, 0.0, 0.0)
-    assert intersection(FOOT, far) is None
+    assert clip(FOOT, far) is None
     assert float(gaussian_union_mass(mean, cov, [FOOT, far])) == pytest.approx(
         alone + float(gaussian_mass(mean, cov, far)), abs=1e-15
     )
@@ -173,10 +173,10 @@ def test_unions_by_inclusion_and_exclusion():
 
 def test_the_intersection_of_two_rectangles_is_their_overlap():
     a, b = rectangle(0.0, 2.0, 2.0), rectangle(1.0, 3.0, 1.0)  # y in ±1 and ±0.5
-    common = intersection(a, b)
+    common = clip(a, b)
     assert common is not None and common.area == pytest.approx(1.0 * 1.0)
     assert common.xmin == pytest.approx(1.0) and common.ymax == pytest.approx(0.5)
-    assert intersection(a, a).area == pytest.approx(a.area)
+    assert clip(a, a).area == pytest.approx(a.area)
 
 
 @pytest.mark.parametrize(

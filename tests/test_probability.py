@@ -387,3 +387,36 @@ def test_the_margin_for_a_one_percent_fall_probability():
     xi = P.toe - margin  # the estimate: x = 0, xdot = ω ξ
     outside = 1.0 - ankle_probability([0.0, xi * omega], np.diag([sx**2, sv**2]), P, latency=tau)
     assert outside == pytest.approx(0.01, abs=1e-9)  # the heel side adds ~1e-12
+
+
+def test_latency_against_a_lipm_whose_controller_acts_late():
+    """A controller that reacts τ late (CoP held at the foot's middle until then, at the toe
+    after: the ankle's best) stops the LIPM exactly when ξ(τ) = p + (ξ − p)e^{ωτ} is inside the
+    foot. Simulated with solve_ivp from states 1 mm either side of the predicted limit."""
+    omega, held, tau = P.omega, 0.5 * (P.heel + P.toe), 0.08
+    limit = held + (P.toe - held) * math.exp(-omega * tau)  # ξ(0) whose ξ(τ) is the toe
+
+    def stops(xi0: float) -> bool:
+        def lipm(t, s, p):
+            return [s[1], omega**2 * (s[0] - p)]
+
+        delayed = solve_ivp(lipm, (0.0, tau), [0.0, xi0 * omega], args=(held,), rtol=1e-12,
+                            atol=1e-14)  # fmt: skip
+        moving = lambda t, s, p: s[1]  # noqa: E731 - the CoM comes to rest
+        moving.terminal, moving.direction = True, -1
+        away = lambda t, s, p: s[0] - 1.0  # noqa: E731 - or leaves over the toe
+        away.terminal = True
+        run = solve_ivp(lipm, (0.0, 10.0), delayed.y[:, -1], args=(P.toe,), events=[moving, away],
+                        rtol=1e-12, atol=1e-14)  # fmt: skip
+        return len(run.t_events[0]) > 0
+
+    assert stops(limit - 1e-3) and not stops(limit + 1e-3)
+    # The probabilities put the same limit at their 50 % point for a symmetric estimate.
+    cov = np.diag([0.0, (1e-3 * omega) ** 2])
+    half = (
+        1.0
+        - verdict_probabilities(
+            StateGaussian(np.array([0.0, limit * omega]), cov), P, latency=tau
+        ).ankle
+    )
+    assert half == pytest.approx(0.5, abs=1e-9)

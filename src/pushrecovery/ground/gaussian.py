@@ -25,7 +25,7 @@ A singular Σ (a state known exactly along some direction) has no L⁻¹: rank 1
 line, whose chord through Q gives P = Φ(s⁺/σ) − Φ(s⁻/σ); rank 0 gives the indicator of Q's
 interior (a point on the boundary counts as outside, as the verdicts' strict inequalities).
 A union of convex polygons is summed by inclusion and exclusion over their intersections
-(:func:`intersection`, Sutherland–Hodgman clipping).
+(:func:`~pushrecovery.ground.minkowski.clip`).
 """
 
 from __future__ import annotations
@@ -40,6 +40,7 @@ from scipy.special import ndtr, owens_t
 
 from pushrecovery.arguments import finite_array, require_type
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.minkowski import clip
 from pushrecovery.ground.polygon import ConvexPolygon
 
 __all__ = [
@@ -48,7 +49,6 @@ __all__ = [
     "covariance_2d",
     "gaussian_mass",
     "gaussian_union_mass",
-    "intersection",
     "maximal",
 ]
 
@@ -149,58 +149,10 @@ def gaussian_union_mass(
         for group in itertools.combinations(kept, size):
             common: ConvexPolygon | None = group[0]
             for other in group[1:]:
-                common = None if common is None else intersection(common, other)
+                common = None if common is None else clip(common, other)
             if common is not None:
                 total = total + (-1.0) ** (size + 1) * gaussian_mass(mean, cov, common)
     return np.clip(total, 0.0, 1.0)
-
-
-def intersection(first: ConvexPolygon, second: ConvexPolygon) -> ConvexPolygon | None:
-    """Return the intersection of two convex polygons, or None when it has no area.
-
-    Sutherland–Hodgman: ``first`` clipped by each edge's half-plane n · p <= b of ``second``.
-    """
-    require_type("first", first, ConvexPolygon)
-    require_type("second", second, ConvexPolygon)
-    points = first.vertices
-    for normal, offset in zip(second.normals, second.offsets, strict=True):
-        if len(points) == 0:
-            return None
-        here = points @ normal - offset  # > 0: outside this half-plane
-        ahead = np.roll(points, -1, axis=0)
-        there = np.roll(here, -1)
-        crossing = ((here < 0.0) & (there > 0.0)) | ((there < 0.0) & (here > 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            cut = points + (ahead - points) * (here / (here - there))[:, None]
-        # Per vertex: itself if inside, then the crossing of its edge if the edge crosses.
-        both = np.stack([points, cut], axis=1).reshape(-1, 2)
-        keep = np.stack([here <= 0.0, crossing], axis=1).reshape(-1)
-        points = both[keep]
-    return _polygon(points)
-
-
-def _polygon(points: FloatArray) -> ConvexPolygon | None:
-    """Return the counter-clockwise polygon of clipped points (repeats, collinear runs dropped)."""
-    scale = max(1.0, float(np.max(np.abs(points)))) if len(points) else 1.0
-    tol = 1e-12 * scale
-    out: list[FloatArray] = []
-    for p in points:
-        if not out or np.hypot(*(p - out[-1])) > tol:
-            out.append(p)
-    if len(out) > 1 and np.hypot(*(out[0] - out[-1])) <= tol:
-        out.pop()
-    changed = True
-    while changed and len(out) >= 3:
-        changed = False
-        for i in range(len(out)):
-            a, b, c = out[i - 1], out[i], out[(i + 1) % len(out)]
-            if (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) <= tol * scale:
-                del out[i]
-                changed = True
-                break
-    if len(out) < 3:
-        return None
-    return ConvexPolygon._from_ccw(np.array(out))
 
 
 def maximal(polygons: Sequence[ConvexPolygon]) -> list[ConvexPolygon]:
