@@ -193,7 +193,8 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         "mean": np.array([0.0, 0.3]), "cov": np.eye(2) * 1e-3,
         "state": StateGaussian(np.array([0.0, 0.3]), np.eye(2) * 1e-3),
     } for name in ("verdicts.ankle_probability", "verdicts.verdict_probabilities",
-                   "verdicts.verdict_probability_table", "inputs.check_states")},
+                   "verdicts.verdict_probability_table", "inputs.check_states",
+                   "margins.margin_quantiles")},
     "pushrecovery.surfaces.probability.latency.delayed_capture_point": {
         "mean": np.array([0.05]), "cov": np.array([[1e-3]]), "latency": 0.02,
         "cop": np.array([0.0]),

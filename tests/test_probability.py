@@ -420,3 +420,59 @@ def test_latency_against_a_lipm_whose_controller_acts_late():
         ).ankle
     )
     assert half == pytest.approx(0.5, abs=1e-9)
+
+
+@pytest.mark.parametrize(("plane", "region"), [(False, "cop"), (False, "cmp"), (True, "cop")])
+def test_margin_quantiles_against_a_million_states(plane, region):
+    """P(margin <= q_α) of 10⁶ drawn states is α within 4 standard errors."""
+    from pushrecovery.surfaces.cmp import cmp_offset
+    from pushrecovery.surfaces.probability import margin_quantiles
+
+    levels = (0.01, 0.05, 0.5, 0.95, 0.99)
+    rng = np.random.default_rng(8)
+    if plane:
+        state = StateGaussian(np.array([0.0, 0.0, 0.3, 0.2]), np.diag([1e-4, 1e-4, 0.01, 0.01]))
+        x, y, vx, vy = rng.multivariate_normal(state.mean, state.cov, N).T
+        polygon = Support.from_params(P).polygon
+        margin = polygon.signed_distance(x + vx / P.omega, y + vy / P.omega)
+    else:
+        state = StateGaussian(np.array([0.0, 0.3]), np.diag([1e-4, 0.01]))
+        x, v = rng.multivariate_normal(state.mean, state.cov, N).T
+        xi = x + v / P.omega
+        grow = cmp_offset(P) if region == "cmp" else 0.0
+        margin = np.minimum(xi - (P.heel - grow), P.toe + grow - xi)
+    found = margin_quantiles(state, P, levels, region=region)
+    assert found.error < 5e-5  # the plane's round corners bracketed to 15 µm
+    for alpha, value in zip(levels, found.values, strict=True):
+        assert within(np.count_nonzero(margin <= value), alpha), (alpha, value)
+
+
+def test_a_zero_covariance_gives_the_certain_margin():
+    from pushrecovery.surfaces.probability import margin_quantiles
+
+    for mean in ([0.01, 0.4], [0.0, 1.2]):
+        certain = classify(mean[0], mean[1], P).margins["cop"]
+        found = margin_quantiles(StateGaussian(np.array(mean), np.zeros((2, 2))), P)
+        assert found.values == pytest.approx((certain,) * 5, abs=1e-15) and found.error == 0.0
+    plane = StateGaussian(np.array([0.0, 0.02, 0.3, 0.1]), np.zeros((4, 4)))
+    certain = classify(0.0, 0.3, P, y=0.02, ydot=0.1).margins["cop"]
+    assert margin_quantiles(plane, P, (0.5,)).values == pytest.approx((certain,), abs=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"levels": (0.0, 0.5)}, r"levels must be probabilities in \(0, 1\)"),
+        ({"levels": ()}, "levels"),
+        ({"region": "step"}, "region must be 'cop' or 'cmp'"),
+        ({"latency": (0.0, 0.1)}, "latency"),
+        ({"support": Support.from_params(P)}, "plane state"),
+    ],
+)
+def test_margin_quantiles_refuse_bad_input(kwargs, match):
+    from pushrecovery.errors import PushRecoveryError
+    from pushrecovery.surfaces.probability import margin_quantiles
+
+    state = StateGaussian(np.array([0.0, 0.3]), np.diag([1e-4, 0.01]))
+    with pytest.raises(PushRecoveryError, match=match):
+        margin_quantiles(state, P, **kwargs)

@@ -1,11 +1,11 @@
 """The strategy a state needs, as probabilities: an uncertain state, latency and body.
 
 :mod:`.inputs` (a Gaussian state estimate), :mod:`.latency` (the capture point moving on
-during a loop's latency), :mod:`.body` (a spread of the body's parameters) and
-:mod:`.regions` (the verdict regions and a Gaussian's masses on them), :mod:`.results`
-(the typed results) and :mod:`.verdicts` (the probability of each verdict: exact Gaussian
-masses of the regions, averaged over the body by quasi-Monte Carlo). docs/uncertainty.md
-derives and checks them.
+during a loop's latency), :mod:`.body` (a spread of the body's parameters), :mod:`.regions`
+(the verdict regions and a Gaussian's masses on them), :mod:`.results` (the typed results),
+:mod:`.verdicts` (the probability of each verdict: exact Gaussian masses of the regions,
+averaged over the body by quasi-Monte Carlo) and :mod:`.margins` (quantiles of the CoP and CMP
+margins). docs/uncertainty.md derives and checks them.
 """
 
 from pushrecovery.surfaces.probability.body import TRUNCATION, BodySpread
@@ -17,6 +17,7 @@ from pushrecovery.surfaces.probability.latency import (
     latency_growth,
     latency_nodes,
 )
+from pushrecovery.surfaces.probability.margins import SIDES, MarginQuantiles, margin_quantiles
 from pushrecovery.surfaces.probability.results import ProbabilityTable, VerdictProbabilities
 from pushrecovery.surfaces.probability.verdicts import (
     ankle_probability,
@@ -27,8 +28,10 @@ from pushrecovery.surfaces.probability.verdicts import (
 __all__ = [
     "LATENCY_NODES",
     "MAX_LATENCY_GROWTH",
+    "SIDES",
     "TRUNCATION",
     "BodySpread",
+    "MarginQuantiles",
     "ProbabilityTable",
     "StateGaussian",
     "VerdictProbabilities",
@@ -37,6 +40,7 @@ __all__ = [
     "delayed_capture_point",
     "latency_growth",
     "latency_nodes",
+    "margin_quantiles",
     "verdict_probabilities",
     "verdict_probability_table",
 ]
