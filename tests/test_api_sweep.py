@@ -199,6 +199,9 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         "mean": np.array([0.05]), "cov": np.array([[1e-3]]), "latency": 0.02,
         "cop": np.array([0.0]),
     },
+    **{f"pushrecovery.surfaces.probability.scores.{name}": {
+        "predicted": np.array([0.1, 0.8]), "happened": np.array([False, True]),
+    } for name in ("brier_score", "reliability")},
     "pushrecovery.surfaces.probability.latency.latency_growth": {"tau": 0.02},
     "pushrecovery.surfaces.probability.latency.latency_nodes": {"latency": (0.01, 0.03)},
     "pushrecovery.analysis.trial.events.c3d_events": {"events": TrialEvents(

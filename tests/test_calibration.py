@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.experiments.calibration import calibration_study, reliability
+from pushrecovery.experiments.calibration import calibration_study
 from pushrecovery.presets import load_params
+from pushrecovery.surfaces.probability import brier_score, reliability
 
 P = dataclasses.replace(load_params(), max_steps=2)
 
@@ -54,3 +55,16 @@ def test_bad_arguments_are_refused(kwargs, match):
     options = {"velocities": (2.6, 3.9), "pushes": 20, "noise": (0.01, 0.1), **kwargs}
     with pytest.raises(InvalidParameterError, match=match):
         calibration_study("stepping", "recovery", P, **options)
+
+
+def test_the_brier_score_by_hand_and_its_refusals():
+    assert brier_score([0.2, 0.9, 0.5], np.array([False, True, True])) == pytest.approx(
+        (0.04 + 0.01 + 0.25) / 3
+    )
+    assert math.isnan(brier_score([], np.array([], dtype=bool)))
+    with pytest.raises(InvalidParameterError, match="booleans"):
+        brier_score([0.2], np.array([1.0]))
+    with pytest.raises(InvalidParameterError, match=r"probabilities in \[0, 1\]"):
+        reliability([1.2], np.array([True]))
+    with pytest.raises(InvalidParameterError, match="one length"):
+        reliability([0.2, 0.3], np.array([True]))

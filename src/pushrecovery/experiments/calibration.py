@@ -24,7 +24,6 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import (
     bounded_float,
-    finite_array,
     positive_float,
     require_type,
     whole_number,
@@ -35,14 +34,12 @@ from pushrecovery.sim.many import run_many
 from pushrecovery.sim.result import Outcome
 from pushrecovery.surfaces.classify_many import classify_states
 from pushrecovery.surfaces.probability import verdict_probability_table
+from pushrecovery.surfaces.probability.scores import ReliabilityRow, brier_score, reliability
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
-__all__ = ["Calibration", "calibration_study", "reliability"]
+__all__ = ["Calibration", "calibration_study"]
 
 FloatArray = NDArray[np.float64]
-
-#: Equal-width bins of the predicted probability in the reliability table.
-BINS = 10
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -77,7 +74,7 @@ class Calibration:
     certain: NDArray[np.bool_]
     failed: NDArray[np.bool_]
     kept: NDArray[np.bool_]
-    bins: tuple[tuple[float, float, int, float, float, float], ...]
+    bins: tuple[ReliabilityRow, ...]
     brier: float
     brier_certain: float
     brier_base_rate: float
@@ -86,37 +83,6 @@ class Calibration:
     def excluded(self) -> int:
         """Runs left out: undecided, or no outcome."""
         return int(np.count_nonzero(~self.kept))
-
-
-def reliability(
-    predicted: FloatArray, failed: NDArray[np.bool_], bins: int = BINS
-) -> tuple[tuple[float, float, int, float, float, float], ...]:
-    """Return the reliability table of probabilities against outcomes (:class:`Calibration`).
-
-    ``predicted`` (n,) in [0, 1] and ``failed`` (n,) bool; ``bins`` equal-width bins of
-    [0, 1] (the last one closed), only those with runs.
-    """
-    p = finite_array("predicted", predicted)
-    hit = np.asarray(failed, dtype=bool)
-    if p.shape != hit.shape or p.ndim != 1:
-        raise InvalidParameterError(
-            f"predicted and failed must be 1-D of one length, got {p.shape} and {hit.shape}"
-        )
-    count = whole_number("bins", bins, 1, 1000)
-    edges = np.linspace(0.0, 1.0, count + 1)
-    which = np.clip(np.searchsorted(edges, p, side="right") - 1, 0, count - 1)
-    rows = []
-    for b in range(count):
-        mine = which == b
-        n = int(np.count_nonzero(mine))
-        if n == 0:
-            continue
-        rate = float(hit[mine].mean())
-        rows.append(
-            (float(edges[b]), float(edges[b + 1]), n, float(p[mine].mean()), rate,
-             float(np.sqrt(rate * (1.0 - rate) / n)))
-        )  # fmt: skip
-    return tuple(rows)
 
 
 def calibration_study(
@@ -199,7 +165,7 @@ def calibration_study(
         failed=failed,
         kept=kept,
         bins=reliability(p, hit),
-        brier=float(np.mean((p - hit) ** 2)),
-        brier_certain=float(np.mean(certain[kept] != hit)),
+        brier=brier_score(p, hit),
+        brier_certain=brier_score(certain[kept].astype(np.float64), hit),
         brier_base_rate=base * (1.0 - base),
     )

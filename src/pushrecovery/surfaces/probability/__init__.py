@@ -4,8 +4,9 @@
 during a loop's latency), :mod:`.body` (a spread of the body's parameters), :mod:`.regions`
 (the verdict regions and a Gaussian's masses on them), :mod:`.results` (the typed results),
 :mod:`.verdicts` (the probability of each verdict: exact Gaussian masses of the regions,
-averaged over the body by quasi-Monte Carlo) and :mod:`.margins` (quantiles of the CoP and CMP
-margins). docs/uncertainty.md derives and checks them.
+averaged over the body by quasi-Monte Carlo), :mod:`.margins` (quantiles of the CoP and CMP
+margins) and :mod:`.scores` (reliability and Brier score against outcomes).
+docs/uncertainty.md derives and checks them.
 """
 
 from pushrecovery.surfaces.probability.body import TRUNCATION, BodySpread
@@ -19,6 +20,7 @@ from pushrecovery.surfaces.probability.latency import (
 )
 from pushrecovery.surfaces.probability.margins import SIDES, MarginQuantiles, margin_quantiles
 from pushrecovery.surfaces.probability.results import ProbabilityTable, VerdictProbabilities
+from pushrecovery.surfaces.probability.scores import brier_score, reliability
 from pushrecovery.surfaces.probability.verdicts import (
     ankle_probability,
     verdict_probabilities,
@@ -36,11 +38,13 @@ __all__ = [
     "StateGaussian",
     "VerdictProbabilities",
     "ankle_probability",
+    "brier_score",
     "check_states",
     "delayed_capture_point",
     "latency_growth",
     "latency_nodes",
     "margin_quantiles",
+    "reliability",
     "verdict_probabilities",
     "verdict_probability_table",
 ]
