@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from pushrecovery.campaign import watchdog
+from pushrecovery.campaign.estimates import estimate_columns
 from pushrecovery.campaign.pushes3d import error_row3d, run_push3d
 from pushrecovery.campaign.rows import (
     COLUMNS,
@@ -172,6 +173,7 @@ def _rows_of_runs(spec: CampaignSpec, pushes: list[Push], runs: PushRuns) -> lis
     """Rows of simulated pushes: each run's outcome with the push's verdict."""
     rows = []
     predictions = _predictions(pushes)
+    estimates = estimate_columns(spec, pushes)
     # Python floats and ints, as float(a[k]) and int(a[k]) give them (tolist: at C speed).
     steps, peaks = runs.steps.tolist(), runs.peak_hip_torque.tolist()
     lows, highs, times = runs.cop_min.tolist(), runs.cop_max.tolist(), runs.times.tolist()
@@ -187,7 +189,7 @@ def _rows_of_runs(spec: CampaignSpec, pushes: list[Push], runs: PushRuns) -> lis
             outcome, used, steps[k], peaks[k], lows[k], highs[k], times[k], impacts[k],
             runs.checks(k),
         )  # fmt: skip
-        rows.append(_row(spec, push, run, predictions[k]))
+        rows.append(_row(spec, push, run, predictions[k]) | estimates[k])
     return rows
 
 

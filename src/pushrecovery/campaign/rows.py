@@ -36,6 +36,7 @@ __all__ = [
     "COLUMNS",
     "COLUMNS_3D",
     "COLUMNS_PHYSICS",
+    "COLUMNS_UNCERTAIN",
     "ERROR_OUTCOME",
     "ERROR_OUTCOME_3D",
     "FAMILIES",
@@ -79,6 +80,7 @@ class Column:
 _NULL_PLANAR = "null on the planar models"
 _MUJOCO = "MuJoCo, every physics step"
 _NULL_ANALYTIC = "null on the analytic models and in the compiled and rollout engines"
+_NULL_CERTAIN = "null without the spec's state_sd or latency, in error rows and in 3-D"
 
 #: The columns after ``index`` and the ``param_<name>`` ones, in order, as the planar models
 #: read them (positions relative to the stance ankle).
@@ -141,6 +143,18 @@ _PLANAR: tuple[Column, ...] = (
            f"{_NULL_ANALYTIC}"),
     Column("joint_limit_steps", "int64", "-",
            f"physics steps with a joint on its range limit ({_MUJOCO}); {_NULL_ANALYTIC}"),
+    Column("estimate_x", "float64", "m",
+           f"the state estimate's x: x0 + a seeded error of SD state_sd[0]; {_NULL_CERTAIN}"),
+    Column("estimate_xdot", "float64", "m/s",
+           f"the state estimate's xdot: xdot + a seeded error of SD state_sd[1]; {_NULL_CERTAIN}"),
+    Column("p_recovers", "float64", "-",
+           "P(the controller's strategy suffices | estimate, state_sd, latency) "
+           f"(docs/uncertainty.md); {_NULL_CERTAIN}"),
+    Column("p_fall", "float64", "-",
+           f"P(no strategy of the model captures | estimate, state_sd, latency); {_NULL_CERTAIN}"),
+    Column("estimate_recovers", "bool", "-",
+           "the certain verdict of the estimate after the latency is within the controller's "
+           f"strategy; {_NULL_CERTAIN}"),
 )  # fmt: skip
 
 #: How the 3-D models read the columns whose meaning differs (the others read as planar).
@@ -184,11 +198,15 @@ COLUMNS: tuple[tuple[str, str], ...] = tuple((c.name, c.kind) for c in _PLANAR)
 COLUMNS_PHYSICS: tuple[str, ...] = (
     "foot_slip", "peak_ground_force", "max_penetration", "friction_use", "joint_limit_steps",
 )  # fmt: skip
+#: A campaign's uncertain estimates (``state_sd``, ``latency``): null without them and in 3-D.
+COLUMNS_UNCERTAIN: tuple[str, ...] = (
+    "estimate_x", "estimate_xdot", "p_recovers", "p_fall", "estimate_recovers",
+)  # fmt: skip
 #: The columns of the 3-D models only: null (None) in the other models' rows.
 COLUMNS_3D: tuple[str, ...] = tuple(
     name
     for name, _ in COLUMNS[[n for n, _ in COLUMNS].index("azimuth") :]
-    if name not in COLUMNS_PHYSICS
+    if name not in COLUMNS_PHYSICS + COLUMNS_UNCERTAIN
 )
 
 #: The outcome columns of a push that raised, or whose worker died (both families).
@@ -332,6 +350,7 @@ def verdict_columns(
         predicted_steps=-1 if steps is None else steps,
         predicted_recovers=STRATEGY_CODES.index(strategy) <= reach,
     )
+    row.update(dict.fromkeys(COLUMNS_UNCERTAIN))  # filled by a campaign with state_sd
     return row
 
 

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.arguments import bounded_float, non_negative_float
 from pushrecovery.campaign.ranges import MAX_PUSHES, Range, value_range
 from pushrecovery.campaign.ranges import interval as _interval
 from pushrecovery.campaign.spec3d import (
@@ -146,6 +147,13 @@ class CampaignSpec:
     mjcf : MjcfSource or None
         Model ``mjcf`` only (and then required): the user's MJCF humanoid, its file and bodies;
         ``params`` is its derived body (``MjcfPlant(...).params``) and cannot be swept.
+    state_sd : (float, float) or None
+        Planar models: standard deviations of a state estimate's errors in x [m] and ẋ [m/s],
+        each >= 0. Each push then gets a seeded estimate and the probability that its
+        controller's strategy suffices (``p_recovers``, docs/uncertainty.md).
+    latency : float
+        Planar models: the estimate's age when the command acts [s], in [0, 1]; with a
+        ``state_sd`` or alone (then the probabilities are 0 or 1).
     """
 
     backend: str
@@ -164,6 +172,8 @@ class CampaignSpec:
     azimuths: tuple[float, ...] | None = None
     fraction: Range | None = None
     mjcf: MjcfSource | None = None
+    state_sd: tuple[float, float] | None = None
+    latency: float = 0.0
 
     def __post_init__(self) -> None:
         if self.backend not in BACKENDS:
@@ -208,6 +218,7 @@ class CampaignSpec:
             )
         if self.batch_size is not None and self.batch_size < 1:
             raise InvalidParameterError(f"batch_size must be >= 1, got {self.batch_size}")
+        self._check_uncertainty()
         # Every range, every body it sweeps and the setup are checked now, before any
         # simulation and before anything is written.
         if self.samples is None:
@@ -233,6 +244,27 @@ class CampaignSpec:
                         f"x0 must lie on the foot, {body.heel:g} < x0 < {body.toe:g} m, got {x0:g}"
                     )
         self._check_setup()
+
+    def _check_uncertainty(self) -> None:
+        """Check ``state_sd`` and ``latency`` (planar models only)."""
+        latency = bounded_float("latency", self.latency, 0.0, 1.0, "s")
+        object.__setattr__(self, "latency", latency)
+        if self.state_sd is None and latency == 0.0:
+            return
+        if self.is_3d:
+            raise InvalidParameterError(
+                "state_sd and latency apply to the planar models, not to the 3-D humanoids"
+            )
+        if self.state_sd is not None:
+            if isinstance(self.state_sd, str) or len(self.state_sd) != 2:
+                raise InvalidParameterError(
+                    f"state_sd must be (sd of x [m], sd of xdot [m/s]), got {self.state_sd!r}"
+                )
+            sd = (
+                non_negative_float("state_sd[0]", self.state_sd[0], "m"),
+                non_negative_float("state_sd[1]", self.state_sd[1], "m/s"),
+            )
+            object.__setattr__(self, "state_sd", sd)
 
     @property
     def is_3d(self) -> bool:
@@ -419,6 +451,10 @@ class CampaignSpec:
         }
         if self.mjcf is not None:
             extra["mjcf"] = self.mjcf.to_dict()
+        if self.state_sd is not None:
+            extra["state_sd"] = list(self.state_sd)
+        if self.latency:
+            extra["latency"] = self.latency
         return extra | {
             "backend": self.backend,
             "model": self.model,
@@ -458,6 +494,8 @@ class CampaignSpec:
                 azimuths=None if data.get("azimuths") is None else tuple(data["azimuths"]),
                 fraction=None if data.get("fraction") is None else tuple(data["fraction"]),
                 mjcf=None if data.get("mjcf") is None else MjcfSource.from_dict(data["mjcf"]),
+                state_sd=None if data.get("state_sd") is None else tuple(data["state_sd"]),
+                latency=data.get("latency", 0.0),
             )
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InvalidParameterError(f"malformed campaign spec: {exc}") from None

@@ -26,6 +26,7 @@ from pushrecovery.campaign.arrow import column_array
 from pushrecovery.campaign.spec import CampaignSpec
 from pushrecovery.sim.critical import predicted_critical_velocity
 from pushrecovery.sim.validation import LABELS as VALIDATION_LABELS
+from pushrecovery.surfaces.probability.scores import BINS
 
 __all__ = ["APART", "LABELS", "SummaryTally", "boundary", "summarize"]
 
@@ -129,6 +130,10 @@ class SummaryTally:
         self.boundary_names = [f"param_{name}" for name in spec.sweeps] + ["x0", "xdot"]
         self.boundary_names += ["azimuth"] if spec.is_3d else []
         self.boundary_parts: list[dict[str, np.ndarray]] = []
+        # p_recovers against the outcome, per bin of 0.1: pushes, sum of p, recoveries; and the
+        # squared errors of p and of the estimate's certain verdict (campaigns with state_sd).
+        self.bins = np.zeros((3, BINS))
+        self.squared = np.zeros(2)
 
     def add(self, table: Any) -> None:
         """Count the pushes of ``table`` (a ``pyarrow.Table`` of the campaign's columns)."""
@@ -159,9 +164,57 @@ class SummaryTally:
         for name in APART:  # tables written before these runs had their own `used`
             self.used[name] += int(np.sum(outcome == name))
         self._add_steps(columns, recovered)
+        self._add_calibration(table, judged, recovered)
         if self.spec.samples is None:
             part = {name: columns[name] for name in self.boundary_names}
             self.boundary_parts.append(part | {"outcome": outcome})
+
+    def _add_calibration(self, table: Any, judged: Any, recovered: Any) -> None:
+        if "p_recovers" not in table.column_names:
+            return
+        p = column_array(table, "p_recovers")
+        certain = np.array(
+            [v is not None and bool(v) for v in column_array(table, "estimate_recovers")]
+        )
+        scored = judged & np.isfinite(p)
+        if not scored.any():
+            return
+        p, hit, certain = p[scored], recovered[scored].astype(np.float64), certain[scored]
+        which = np.clip((p * BINS).astype(np.int64), 0, BINS - 1)
+        for row, values in enumerate((np.ones_like(p), p, hit)):
+            self.bins[row] += np.bincount(which, weights=values, minlength=BINS)
+        self.squared += (np.sum((p - hit) ** 2), np.sum((certain - hit) ** 2))
+
+    def _calibration(self) -> dict[str, Any] | None:
+        """p_recovers against the outcomes (campaigns with state_sd or latency), or None.
+
+        ``brier``: mean (p − recovered)²; ``brier_estimate_verdict``: the same for the certain
+        verdict of the estimate (0 or 1); ``brier_base_rate``: for always predicting the
+        share recovered; ``reliability``: per bin of p with pushes, the mean p and the share
+        recovered with its binomial standard error. Undecided pushes and errors are left out.
+        """
+        count = float(self.bins[0].sum())
+        if count == 0:
+            return None
+        rate = float(self.bins[2].sum()) / count
+        rows = []
+        for b in range(BINS):
+            n = self.bins[0, b]
+            if n == 0:
+                continue
+            share = float(self.bins[2, b] / n)
+            rows.append({
+                "low": b / BINS, "high": (b + 1) / BINS, "pushes": int(n),
+                "mean_predicted": float(self.bins[1, b] / n), "recovered": share,
+                "standard_error": float(np.sqrt(share * (1.0 - share) / n)),
+            })  # fmt: skip
+        return {
+            "pushes": int(count),
+            "brier": float(self.squared[0] / count),
+            "brier_estimate_verdict": float(self.squared[1] / count),
+            "brier_base_rate": rate * (1.0 - rate),
+            "reliability": rows,
+        }
 
     def _add_steps(self, columns: dict[str, Any], recovered: Any) -> None:
         if "predicted_steps" not in columns:  # a table written before the column existed
@@ -201,6 +254,7 @@ class SummaryTally:
             "boundary": found,
             "steps": self._steps(),
             "judged": self.judged,
+            "calibration": self._calibration(),
         }
 
     def _steps(self) -> dict[str, Any]:

@@ -29,6 +29,19 @@ from pushrecovery.sim.registry import MODELS, MUJOCO_MODELS
 __all__ = ["campaign", "report"]
 
 
+def _pair(flag: str, text: str | None) -> tuple[float, float] | None:
+    """``A,B`` as two floats, or refuse naming the flag."""
+    if text is None:
+        return None
+    from pushrecovery.errors import InvalidParameterError
+
+    try:
+        first, second = (float(part) for part in text.split(","))
+    except ValueError:
+        raise InvalidParameterError(f"{flag} must be two numbers A,B, got {text!r}") from None
+    return first, second
+
+
 def _refuse_wbc(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
     """Refuse the whole-body controller (``wbc-*``), naming ``humanoid campaign --strategy``."""
     if value is not None and value.startswith("wbc-"):
@@ -86,6 +99,21 @@ def _refuse_wbc(ctx: click.Context, param: click.Parameter, value: str | None) -
     batch_size_help="Pushes per task (default about a second of work: 100 / 10 MuJoCo; up to "
     "10,000 / 1,000 for the compiled pendulum, lipm / stepping + recovery pairs).",
 )
+@click.option(
+    "--state-sd",
+    default=None,
+    metavar="SX,SXDOT",
+    help="Standard deviations of a state estimate's errors in x [m] and xdot [m/s]: each push "
+    "gets a seeded estimate and p_recovers, P(its controller's strategy suffices); the "
+    "summary scores them (calibration). docs/uncertainty.md.",
+)
+@click.option(
+    "--latency",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="The estimate's age when the command acts [s], in [0, 1] (with --state-sd or alone).",
+)
 @body_options
 def campaign(
     backend: str,
@@ -94,6 +122,8 @@ def campaign(
     x0: tuple[float, float, float] | None,
     xdot: tuple[float, float, float] | None,
     impulse: tuple[float, float, float] | None,
+    state_sd: str | None,
+    latency: float,
     as_json: bool,
     **kwargs: Any,
 ) -> None:
@@ -128,6 +158,8 @@ def campaign(
             x0=x0,
             xdot=xdot,
             impulse=impulse,
+            state_sd=_pair("--state-sd", state_sd),
+            latency=latency,
             **run.spec_options(),
         )
     result = run.run(spec)
