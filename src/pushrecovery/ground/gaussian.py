@@ -77,7 +77,11 @@ def covariance_2d(name: str, cov: ArrayLike) -> FloatArray:
     scale = np.max(np.abs(array), axis=(-2, -1))
     if np.any(np.abs(array[..., 0, 1] - array[..., 1, 0]) > 1e-12 * scale):
         raise InvalidParameterError(f"{name} must be symmetric (a covariance matrix)")
-    smallest = _eigenvalues(array)[0][..., 0]
+    if array.shape == (2, 2):  # one covariance (a loop's tick): its eigenvalues in floats
+        (a, b), (_, d) = array.tolist()
+        smallest = np.array(0.5 * (a + d) - math.hypot(0.5 * (a - d), b))
+    else:
+        smallest = _eigenvalues(array)[0][..., 0]
     if np.any(smallest < -1e-12 * scale):
         raise InvalidParameterError(
             f"{name} must be positive semi-definite (a covariance), got an eigenvalue "
@@ -118,6 +122,8 @@ def gaussian_mass(mean: ArrayLike, cov: ArrayLike, polygon: ConvexPolygon) -> Fl
         raise InvalidParameterError(
             f"cov of shape {sigma.shape} needs means of shape ({len(sigma)}, 2), got {mu.shape}"
         )
+    if mu.ndim == 1 and sigma.ndim == 2:  # one mean, one covariance: no batch overhead
+        return np.array(_one(mu, sigma, polygon))
     means = np.atleast_2d(mu)
     sigmas = np.broadcast_to(sigma, (len(means), 2, 2))
     values, _ = _eigenvalues(sigmas)
@@ -197,6 +203,41 @@ def _eigenvalues(cov: FloatArray) -> tuple[FloatArray, FloatArray]:
     vector = np.divide(vector, norm, out=np.tile([1.0, 0.0], (*vector.shape[:-1], 1)),
                        where=norm > 0.0)  # fmt: skip
     return values, vector
+
+
+def _one(mean: FloatArray, sigma: FloatArray, polygon: ConvexPolygon) -> float:
+    """:func:`gaussian_mass` of one mean and covariance, in floats (the same sum)."""
+    (a, b), (_, d) = sigma.tolist()
+    half = math.hypot(0.5 * (a - d), b)
+    if 0.5 * (a + d) - half <= RANK_TOLERANCE * (0.5 * (a + d) + half):
+        return _singular(mean, sigma, polygon)
+    # Cholesky of [[a, b], [b, d]]: L = [[l0, 0], [l1, l2]].
+    l0 = math.sqrt(a)
+    l1 = b / l0
+    l2 = math.sqrt(d - l1 * l1)
+    offsets = polygon.vertices - mean
+    z0 = offsets[:, 0] / l0
+    z1 = (offsets[:, 1] - l1 * z0) / l2
+    x0, y0 = z0.tolist(), z1.tolist()
+    x1, y1 = x0[1:] + x0[:1], y0[1:] + y0[:1]
+    angles: list[float] = []
+    heights: list[float] = []
+    along: list[float] = []
+    for ax, ay, bx, by in zip(x0, y0, x1, y1, strict=True):
+        cross = ax * by - ay * bx
+        if cross == 0.0:
+            continue
+        ex, ey = bx - ax, by - ay
+        length = math.hypot(ex, ey)
+        h = cross / length
+        angles.append(math.atan2(cross, ax * bx + ay * by))
+        heights += (h, h)
+        along += ((bx * ex + by * ey) / length / h, (ax * ex + ay * ey) / length / h)
+    if not angles:
+        return 0.0
+    t = owens_t(heights, along).tolist()  # T(h, t_b/h), T(h, t_a/h) of each edge
+    total = sum(angles) / (2.0 * math.pi) - sum(t[0::2]) + sum(t[1::2])
+    return min(max(total, 0.0), 1.0)
 
 
 def _regular(means: FloatArray, sigmas: FloatArray, vertices: FloatArray) -> FloatArray:

@@ -41,6 +41,7 @@ from scipy.special import ndtr
 
 from pushrecovery.arguments import finite_vector, non_negative_float, require_type, whole_number
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.ground.gaussian import gaussian_mass
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cop import cop_region
@@ -324,6 +325,8 @@ def ankle_probability(
     rows = np.hstack([np.eye(dims), np.eye(dims) / omega])
     held = region_middle(region) if cop is None else finite_vector("cop", cop, dims, unit="m")
     xi_mean, xi_cov = delayed_capture_point(means @ rows.T, rows @ covs @ rows.T, omega, tau, held)
+    if plane and np.ndim(mean) == 1 and xi_cov.ndim == 2:  # one state: the mass in floats
+        return gaussian_mass(xi_mean[0], xi_cov, region[0])  # type: ignore[arg-type]
     found = cumulative_masses(xi_mean, xi_cov, [region])[:, 0]
     return found if np.ndim(mean) > 1 else found[0]
 
