@@ -38,6 +38,7 @@ __all__ = [
     "Gap",
     "find_gaps",
     "lowpass",
+    "noise_gains",
     "repair_gaps",
     "resample",
     "segments",
@@ -296,6 +297,39 @@ def smooth_and_differentiate(
         smooth[part] = _lowpass(flat[part], rate, cutoff)
         slope[part] = np.gradient(smooth[part], time[part], axis=0)
     return smooth.reshape(values.shape), slope.reshape(values.shape)
+
+
+def noise_gains(rate: float, cutoff: float) -> tuple[float, float]:
+    """Return how :func:`smooth_and_differentiate` scales white noise: (position, rate) gains.
+
+    A signal with independent errors of standard deviation σ at each sample comes out of the
+    low-pass with errors of σ·g₀ and its derivative with σ·g₁ [1/s], g² = Σ h_k² over the
+    chain's impulse response h (linear and time-invariant away from the ends). Computed from
+    the impulse response itself: a unit sample in the middle of ``20 rate / cutoff`` zeros
+    (at least 401). For a zero-phase filter the two errors at one sample are uncorrelated.
+
+    Parameters
+    ----------
+    rate : float
+        Sample rate [Hz], > 0.
+    cutoff : float
+        Low-pass cutoff [Hz], 0 (none) or in (0, rate/2).
+    """
+    rate = positive_float("rate", rate, "Hz")
+    cutoff = finite_float("cutoff", cutoff, "Hz", allowed=">= 0")
+    if cutoff < 0.0:
+        raise InvalidParameterError(f"cutoff must be >= 0 Hz, got {cutoff:g}")
+    half = max(200, int(10.0 * rate / cutoff) if cutoff > 0.0 else 0)
+    if half > 10**6:
+        raise InvalidParameterError(
+            f"cutoff must be at least 1e-5 of the rate for the noise gains, got {cutoff:g} Hz "
+            f"at {rate:g} Hz"
+        )
+    impulse = np.zeros(2 * half + 1)
+    impulse[half] = 1.0
+    time = np.arange(impulse.size) / rate
+    smooth, slope = smooth_and_differentiate(time, impulse, cutoff)
+    return float(np.sqrt(np.sum(smooth**2))), float(np.sqrt(np.sum(slope**2)))
 
 
 def resample(source: FloatArray, values: FloatArray, target: FloatArray) -> FloatArray:

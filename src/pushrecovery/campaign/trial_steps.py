@@ -101,6 +101,12 @@ class StepRow:
         "m", "landing ankle's signed distance to the 2-D one-step capture region at foot-off"
     )
     in_capture_region: bool | None = _col("", "the landing ankle lies in that region")
+    risk_ap_off: float | None = _col(
+        "", "P(the ankle does not suffice) along ap at foot-off under com_noise (else null)"
+    )
+    risk_ml_off: float | None = _col(
+        "", "P(the ankle does not suffice) along ml at foot-off under com_noise (else null)"
+    )
 
 
 #: Column names and their Python types, in order.
@@ -169,6 +175,8 @@ def trial_steps(job: Any, summary: TrialSummary) -> list[StepRow]:
                 step_margin_ml=ml.margin,
                 capture_region_margin=None if region is None else region.margin,
                 in_capture_region=None if region is None else region.within,
+                risk_ap_off=off["ap"].risk,
+                risk_ml_off=off["ml"].risk,
             )
         )
     return rows

@@ -167,6 +167,14 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     "height (docs/base_polygon.md).",
 )
 @click.option(
+    "--com-noise",
+    type=float,
+    default=None,
+    metavar="M",
+    help="SD of the CoM signal's errors per sample [m]: adds <axis>_risk, P(the ankle does not "
+    "suffice) per frame, through the analysis' own filter (docs/uncertainty.md).",
+)
+@click.option(
     "--plot/--no-plot",
     default=True,
     show_default=True,
@@ -218,6 +226,7 @@ def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) ->
         **{field: kwargs.pop(field) for field in fields},
         normalise=kwargs.pop("normalise"),
         xcom_length=kwargs.pop("xcom_length"),
+        com_noise=kwargs.pop("com_noise"),
     )
     single = len(inputs) == 1 and Path(inputs[0]).is_file()
     batch = {name: kwargs.pop(name) for name in ("subjects", "workers", "scheduler", "resume")}

@@ -83,6 +83,9 @@ class AxisMargins:
     mos : float or None
         Hof's margin of stability toward the motion along the axis against the base polygon
         (``mos_ap``, ``mos_ml`` of the frames) [m]; None without a base polygon.
+    risk : float or None
+        P(the ankle does not suffice) under the analysis' ``com_noise`` (``<axis>_risk`` of
+        the frames, dimensionless); None without it.
     """
 
     capture_point: float | None
@@ -93,6 +96,7 @@ class AxisMargins:
     steps: int | None = None
     step_margin: float | None = None
     mos: float | None = None
+    risk: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -271,6 +275,7 @@ def _margins_at(
     when: float,
     per_axis: dict[str, DirectionMargins],
     mos: dict[str, FloatArray] | None = None,
+    risk: dict[str, FloatArray] | None = None,
 ) -> FrameMargins:
     """Return the margins of the frame nearest ``when`` [s], per axis.
 
@@ -290,6 +295,7 @@ def _margins_at(
             steps=int(margins.steps[frame]) if code >= 0 else None,
             step_margin=_value(margins.step, frame),
             mos=None if mos is None else _value(mos[axis], frame),
+            risk=None if risk is None else _value(risk[axis], frame),
         )
     return FrameMargins(float(time[frame]), axes)
 
@@ -438,6 +444,7 @@ def trial_events(
     plane: tuple[Any, BodyParams] | None = None,
     plates: PlateFeet,
     mos: dict[str, FloatArray] | None = None,
+    risk: dict[str, FloatArray] | None = None,
 ) -> TrialEvents:
     """Return the trial's onset, foot events and steps with their margins.
 
@@ -447,7 +454,7 @@ def trial_events(
     foot-off (``capture_region``). ``plates``: which foot stands on each plate
     (:func:`~pushrecovery.analysis.trial.checks.plate_feet`). ``mos``: per axis, Hof's margin
     toward the motion of every frame (the plane's ``mos_ap``, ``mos_ml``), given to each event's
-    margins (:class:`AxisMargins` ``mos``).
+    margins (:class:`AxisMargins` ``mos``); ``risk`` likewise the frames' ``<axis>_risk``.
     """
     onset, onset_source = _onset(recording, time, velocity, mass)
     events = _foot_events(recording, plates.owners)
@@ -458,17 +465,19 @@ def trial_events(
     )
     return TrialEvents(
         onset=Onset(
-            onset, onset_source, None if onset is None else _margins_at(time, onset, per_axis, mos)
+            onset,
+            onset_source,
+            None if onset is None else _margins_at(time, onset, per_axis, mos, risk),
         ),
         foot_events=tuple(
-            TriggeredFootEvent(event, _margins_at(time, event.time, per_axis, mos))
+            TriggeredFootEvent(event, _margins_at(time, event.time, per_axis, mos, risk))
             for event in events
         ),
         measured_steps=tuple(
             StepTaken(
                 step,
-                at_foot_off=_margins_at(time, step.off_time, per_axis, mos),
-                at_foot_contact=_margins_at(time, step.contact_time, per_axis, mos),
+                at_foot_off=_margins_at(time, step.off_time, per_axis, mos, risk),
+                at_foot_contact=_margins_at(time, step.contact_time, per_axis, mos, risk),
                 against_recommended=_compared(step, time, per_axis),
                 capture_region=None
                 if com is None

@@ -31,6 +31,7 @@ from pushrecovery.analysis.trial.checks import (
     plate_feet,
 )
 from pushrecovery.analysis.trial.events import Onset, trial_events
+from pushrecovery.analysis.trial.risk import frame_risk
 from pushrecovery.analysis.trial.settings import AnalysisSettings, TrialAnalysis
 from pushrecovery.analysis.trial.summary import (
     _exclusions,
@@ -223,6 +224,8 @@ def analyze(
                 f"{axis}_steps": margins.steps,
             }
         )
+    risk = frame_risk(time, per_axis, support, params, settings.com_noise, settings.cutoff)
+    columns.update({f"{axis}_risk": values for axis, values in risk.items()})
     plane = _plane(
         base, com, velocity, cop, time, params, checks.withheld, settings.xcom_omega(params)
     )
@@ -247,6 +250,7 @@ def analyze(
         plane=(base, params),
         plates=checks.plates,
         mos={"ap": plane.mos_ap, "ml": plane.mos_ml},
+        risk=risk or None,
     )
     sway = _posturography(force_time, plate_cop, plate_force)
     if sway is not None and events.onset.time is not None:

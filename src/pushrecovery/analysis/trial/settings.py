@@ -74,6 +74,12 @@ class AnalysisSettings:
         margins (``xcom_*``, ``mos*``, ``ttb_xcom``): the body's CoM height (default, the
         paper's L) or its leg length (Hof, Gazendam & Sinke 2005). The per-axis margins of
         Eq. (4) and every verdict keep the body's ω = sqrt(g/L): they are its physics.
+    com_noise : float or None
+        Standard deviation of the CoM signal's errors at each sample [m] (independent, before
+        the low-pass), >= 0: adds ``<axis>_risk``, the probability that the ankle does not
+        suffice, P(ξ outside the base along the axis), with ξ's spread through the
+        pipeline's own filter (:func:`~pushrecovery.analysis.signals.noise_gains`); None:
+        no risk columns.
     """
 
     cutoff: float = 6.0
@@ -86,6 +92,7 @@ class AnalysisSettings:
     ankle_ml: float | None = None
     normalise: bool = False
     xcom_length: str = "com_height"
+    com_noise: float | None = None
 
     def widths(self, params: BodyParams) -> tuple[float, float]:
         """Foot width and stance width [m]: these settings', else the body's."""
@@ -95,7 +102,7 @@ class AnalysisSettings:
         )
 
     def __post_init__(self) -> None:
-        for name in ("cutoff", "force_cutoff", "max_gap", "stance_width"):
+        for name in ("cutoff", "force_cutoff", "max_gap", "stance_width", "com_noise"):
             value = getattr(self, name)
             if value is None:
                 continue
