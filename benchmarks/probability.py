@@ -5,7 +5,8 @@
 2. 10**6 states: ``ankle_probability`` on the line against ``numpy.add`` of two arrays of the
    same length, per state. Goal: <= 20x.
 3. For information: one state's full ``verdict_probabilities`` on the line and on the plane
-   (double support, every level of 11 steps), and a plane state's ``ankle_probability``.
+   (double support, every level of 11 steps), a plane state's ``ankle_probability`` and a
+   ``ProbabilityMonitor`` query on the line and the plane.
 """
 
 from __future__ import annotations
@@ -17,8 +18,10 @@ import timeit
 import numpy as np
 
 from pushrecovery import load_params
+from pushrecovery.ground.support import Support
 from pushrecovery.surfaces.classify import classify
 from pushrecovery.surfaces.probability import (
+    ProbabilityMonitor,
     StateGaussian,
     ankle_probability,
     verdict_probabilities,
@@ -86,6 +89,12 @@ def main() -> int:
                 _each(lambda: verdict_probabilities(plane_state, params), 100)))  # fmt: skip
     plane_ankle = _each(lambda: ankle_probability(plane_state.mean, plane_state.cov, params), 500)
     print(_line("  P(ankle), one plane state", plane_ankle))
+    line_monitor = ProbabilityMonitor(params)
+    plane_monitor = ProbabilityMonitor(params, Support.from_params(params))
+    line_query = _each(lambda: line_monitor.query(line_state.mean, line_state.cov), 2000)
+    print(_line("  ProbabilityMonitor.query, line", line_query))
+    plane_query = _each(lambda: plane_monitor.query(plane_state.mean, plane_state.cov), 500)
+    print(_line("  ProbabilityMonitor.query, plane (double support)", plane_query))
     return int(not (met_single and met_bulk))
 
 

@@ -476,3 +476,70 @@ def test_margin_quantiles_refuse_bad_input(kwargs, match):
     state = StateGaussian(np.array([0.0, 0.3]), np.diag([1e-4, 0.01]))
     with pytest.raises(PushRecoveryError, match=match):
         margin_quantiles(state, P, **kwargs)
+
+
+def test_the_monitor_gives_the_verdict_probabilities_tick_after_tick():
+    from pushrecovery.surfaces.probability import ProbabilityMonitor
+
+    rng = np.random.default_rng(9)
+    line = ProbabilityMonitor(P, latency=0.03)
+    support = Support.from_params(P, Stance.LEFT)
+    plane = ProbabilityMonitor(P, support, latency=0.03)
+    for _ in range(10):
+        mean = np.array([rng.uniform(-0.03, 0.08), rng.uniform(-1.0, 3.0)])
+        cov = np.diag([rng.uniform(1e-5, 1e-3), rng.uniform(1e-3, 0.2)])
+        found = line.query(mean, cov)
+        exact = verdict_probabilities(StateGaussian(mean, cov), P, latency=0.03)
+        assert (found.ankle, found.hip, found.step, found.fall) == pytest.approx(
+            (exact.ankle, exact.hip, sum(exact.steps), exact.fall), abs=1e-12
+        )
+        mean4 = np.array([mean[0], 0.05, mean[1], rng.uniform(-1.5, 1.5)])
+        cov4 = np.diag([cov[0, 0], cov[0, 0], cov[1, 1], cov[1, 1]])
+        found = plane.query(mean4, cov4)
+        exact = verdict_probabilities(StateGaussian(mean4, cov4), P, support=support, latency=0.03)
+        assert (found.ankle, found.hip, found.step, found.fall) == pytest.approx(
+            (exact.ankle, exact.hip, sum(exact.steps), exact.fall), abs=1e-12
+        )
+
+
+def test_the_monitor_swaps_its_support_whole():
+    import threading
+
+    from pushrecovery.surfaces.probability import ProbabilityMonitor
+
+    left, right = Support.from_params(P, Stance.LEFT), Support.from_params(P, Stance.RIGHT)
+    monitor = ProbabilityMonitor(P, left)
+    mean, cov = np.array([0.0, 0.05, 0.4, 0.5]), np.diag([1e-4, 1e-4, 0.01, 0.01])
+    answers = {monitor.query(mean, cov)}
+    monitor.set_support(right)
+    answers.add(monitor.query(mean, cov))
+    assert len(answers) == 2  # the supports answer differently
+    seen, stop = [], threading.Event()
+
+    def switch() -> None:
+        while not stop.is_set():
+            monitor.set_support(left)
+            monitor.set_support(right)
+
+    worker = threading.Thread(target=switch)
+    worker.start()
+    try:
+        seen = [monitor.query(mean, cov) for _ in range(300)]
+    finally:
+        stop.set()
+        worker.join()
+    assert set(seen) <= answers  # the old support's answer or the new one's, never a mix
+
+
+def test_the_monitor_refuses_bad_input():
+    from pushrecovery.surfaces.probability import ProbabilityMonitor
+
+    line = ProbabilityMonitor(P)
+    with pytest.raises(InvalidParameterError, match="one state of 2 numbers"):
+        line.query(np.zeros(4), np.eye(4))
+    with pytest.raises(InvalidParameterError, match="no support"):
+        line.set_support(Support.from_params(P))
+    with pytest.raises(InvalidParameterError, match="positive semi-definite"):
+        line.query(np.zeros(2), np.array([[1.0, 2.0], [2.0, 1.0]]))
+    with pytest.raises(InvalidParameterError, match="latency"):
+        ProbabilityMonitor(P, latency=-1.0)

@@ -5,7 +5,8 @@ during a loop's latency), :mod:`.body` (a spread of the body's parameters), :mod
 (the verdict regions and a Gaussian's masses on them), :mod:`.results` (the typed results),
 :mod:`.verdicts` (the probability of each verdict: exact Gaussian masses of the regions,
 averaged over the body by quasi-Monte Carlo), :mod:`.margins` (quantiles of the CoP and CMP
-margins) and :mod:`.scores` (reliability and Brier score against outcomes).
+margins), :mod:`.monitor` (the probabilities tick after tick) and :mod:`.scores`
+(reliability and Brier score against outcomes).
 docs/uncertainty.md derives and checks them.
 """
 
@@ -19,6 +20,7 @@ from pushrecovery.surfaces.probability.latency import (
     latency_nodes,
 )
 from pushrecovery.surfaces.probability.margins import SIDES, MarginQuantiles, margin_quantiles
+from pushrecovery.surfaces.probability.monitor import MonitorProbabilities, ProbabilityMonitor
 from pushrecovery.surfaces.probability.results import ProbabilityTable, VerdictProbabilities
 from pushrecovery.surfaces.probability.scores import brier_score, reliability
 from pushrecovery.surfaces.probability.verdicts import (
@@ -34,6 +36,8 @@ __all__ = [
     "TRUNCATION",
     "BodySpread",
     "MarginQuantiles",
+    "MonitorProbabilities",
+    "ProbabilityMonitor",
     "ProbabilityTable",
     "StateGaussian",
     "VerdictProbabilities",
