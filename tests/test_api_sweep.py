@@ -188,7 +188,7 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     **{f"pushrecovery.ground.gaussian.{name}": {
         "mean": np.array([0.05, 0.0]), "cov": np.eye(2) * 1e-3,
         "polygons": [FOOT, FOOT.transformed(0.05, 0.02, 0.3)],
-    } for name in ("gaussian_mass", "gaussian_union_mass", "maximal")},
+    } for name in ("gaussian_mass", "gaussian_union_mass", "maximal", "union_terms")},
     **{f"pushrecovery.surfaces.probability.{name}": {
         "mean": np.array([0.0, 0.3]), "cov": np.eye(2) * 1e-3,
         "state": StateGaussian(np.array([0.0, 0.3]), np.eye(2) * 1e-3),

@@ -50,6 +50,7 @@ __all__ = [
     "gaussian_mass",
     "gaussian_union_mass",
     "maximal",
+    "union_terms",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -142,23 +143,36 @@ def gaussian_union_mass(
 ) -> FloatArray:
     """Return P(X ∈ ⋃ polygons) by inclusion and exclusion (at most :data:`MAX_UNION`).
 
-    A polygon inside another of the list (every vertex inside or on it) is dropped first.
-    Arguments and result as :func:`gaussian_mass`.
+    The sum of :func:`union_terms`; arguments and result as :func:`gaussian_mass`.
+    """
+    terms = union_terms(polygons)
+    total = np.zeros(np.shape(finite_array("mean", mean))[:-1])
+    for sign, polygon in terms:
+        total = total + sign * gaussian_mass(mean, cov, polygon)
+    return np.clip(total, 0.0, 1.0)
+
+
+def union_terms(polygons: Sequence[ConvexPolygon]) -> tuple[tuple[float, ConvexPolygon], ...]:
+    """Return the inclusion–exclusion terms of a union of convex polygons: (sign, polygon).
+
+    The polygons no other one contains (:func:`maximal`, at most :data:`MAX_UNION`), then
+    their intersections two by two, three by three …, with signs +, −, + …; the mass of the
+    union is the signed sum of the terms' masses. Empty intersections are left out.
     """
     kept = maximal(polygons)
     if len(kept) > MAX_UNION:
         raise InvalidParameterError(
             f"polygons: at most {MAX_UNION} that no other contains, got {len(kept)}"
         )
-    total = np.zeros(np.shape(finite_array("mean", mean))[:-1])
+    terms: list[tuple[float, ConvexPolygon]] = []
     for size in range(1, len(kept) + 1):
         for group in itertools.combinations(kept, size):
             common: ConvexPolygon | None = group[0]
             for other in group[1:]:
                 common = None if common is None else clip(common, other)
             if common is not None:
-                total = total + (-1.0) ** (size + 1) * gaussian_mass(mean, cov, common)
-    return np.clip(total, 0.0, 1.0)
+                terms.append(((-1.0) ** (size + 1), common))
+    return tuple(terms)
 
 
 def maximal(polygons: Sequence[ConvexPolygon]) -> list[ConvexPolygon]:

@@ -15,7 +15,6 @@ mix (the rule of :class:`~pushrecovery.surfaces.monitor.BalanceMonitor`).
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass
 
@@ -25,8 +24,7 @@ from scipy.special import ndtr
 
 from pushrecovery.arguments import non_negative_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.gaussian import gaussian_mass, maximal
-from pushrecovery.ground.minkowski import clip
+from pushrecovery.ground.gaussian import gaussian_mass, union_terms
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
@@ -154,16 +152,8 @@ class ProbabilityMonitor:
         require_type("support", support, Support)
         regions = StepRegions.of(params, support)
         grown = cmp_polygon(support, params)
-        kept = maximal([support.polygon, grown, *regions.polygons])
-        terms: list[tuple[float, ConvexPolygon]] = []
-        for size in range(1, len(kept) + 1):
-            for group in itertools.combinations(kept, size):
-                common: ConvexPolygon | None = group[0]
-                for other in group[1:]:
-                    common = None if common is None else clip(common, other)
-                if common is not None:
-                    terms.append(((-1.0) ** (size + 1), common))
-        return _State(support.polygon, grown, tuple(terms), tuple(support.polygon.centroid))
+        terms = union_terms([support.polygon, grown, *regions.polygons])
+        return _State(support.polygon, grown, terms, tuple(support.polygon.centroid))
 
 
 def _interval(mu: float, sd: float, region: tuple[float, float]) -> float:
