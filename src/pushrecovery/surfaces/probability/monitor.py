@@ -46,7 +46,7 @@ class MonitorProbabilities:
     ----------
     ankle, hip, step, fall : float
         P(the ankle suffices), P(the hip is needed and suffices), P(at most ``max_steps``
-        steps are needed, and some), P(fall).
+        steps are needed, and some), P(fall) (dimensionless, in [0, 1]).
     """
 
     ankle: float
