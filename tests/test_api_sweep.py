@@ -232,6 +232,7 @@ NOT_SWEPT = {
     "pushrecovery.analysis.output.json_safe": "any value in, a JSON value out: test_cli_analyze.py",
     "pushrecovery.surfaces.probability.regions.cumulative_masses": "checked arguments only",
     "pushrecovery.analysis.trial.risk.frame_risk": "an analysis' margins: test_trial_risk.py",
+    "pushrecovery.control.delay.reaction_delay": "a controller object: test_delay.py",
     "pushrecovery.surfaces.probability.regions.region_middle": "of regions the module built",
 }
 HOSTILE: list[Any] = [math.nan, math.inf, -1e300, 0.0, None, "x", [1.0, 2.0], np.zeros((2, 2))]

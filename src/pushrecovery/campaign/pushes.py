@@ -78,8 +78,9 @@ def push_rows(
         return rows
     runs = run_many(
         spec.model, spec.controller, [p.params for p in pushes], [p.x0 for p in pushes],
-        [p.xdot for p in pushes], duration=spec.duration, backend=spec.backend, engine=engine,
-        push_timeout=spec.push_timeout, on_start=on_start,
+        [p.xdot for p in pushes], duration=spec.duration, backend=spec.backend,
+        engine="loop" if spec.latency > 0.0 else engine, push_timeout=spec.push_timeout,
+        on_start=on_start, latency=spec.latency,
     )  # fmt: skip
     return _rows_of_runs(spec, pushes, runs)
 

@@ -152,8 +152,9 @@ class CampaignSpec:
         each >= 0. Each push then gets a seeded estimate and the probability that its
         controller's strategy suffices (``p_recovers``, docs/uncertainty.md).
     latency : float
-        Planar models: the estimate's age when the command acts [s], in [0, 1]; with a
-        ``state_sd`` or alone (then the probabilities are 0 or 1).
+        Planar models: the controller reacts this late [s], in [0, 1], the CoP held at the
+        foot's middle until then (``run_many``'s ``latency``: the pushes run through the
+        loop), and the probabilities take the same latency; with a ``state_sd`` or alone.
     """
 
     backend: str

@@ -112,7 +112,8 @@ def _refuse_wbc(ctx: click.Context, param: click.Parameter, value: str | None) -
     type=float,
     default=0.0,
     show_default=True,
-    help="The estimate's age when the command acts [s], in [0, 1] (with --state-sd or alone).",
+    help="The controller reacts this late [s], in [0, 1], the CoP held at the foot's middle "
+    "until then; the probabilities (--state-sd) take the same latency.",
 )
 @body_options
 def campaign(

@@ -11,7 +11,8 @@ the estimate (0 or 1) and that of the base rate (always predicting the observed 
 
 A run that slipped counts as a failure, like a fall (it did not recover as the model assumes);
 an undecided run or one whose physics failed is left out and counted. The controller sees the
-true state: the estimate is the monitor's, not the controller's.
+true state (the estimate is the monitor's, not the controller's), ``latency`` seconds late if
+one is given, the CoP held at the foot's middle until then, as the prediction assumes.
 """
 
 from __future__ import annotations
@@ -32,10 +33,8 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.many import run_many
 from pushrecovery.sim.result import Outcome
-from pushrecovery.surfaces.classify_many import classify_states
 from pushrecovery.surfaces.probability import verdict_probability_table
 from pushrecovery.surfaces.probability.scores import ReliabilityRow, brier_score, reliability
-from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
 __all__ = ["Calibration", "calibration_study"]
 
@@ -96,6 +95,7 @@ def calibration_study(
     backend: str = "analytic",
     duration: float = 4.0,
     seed: int = 0,
+    latency: float = 0.0,
 ) -> Calibration:
     """Push, simulate, estimate with noise, predict P(fall) and score it (module docstring).
 
@@ -120,6 +120,9 @@ def calibration_study(
         Longest simulated time per push [s].
     seed : int
         Seed of the pushes and the estimates, >= 0.
+    latency : float
+        The controller reacts this late [s], in [0, 1], the CoP held at the foot's middle
+        meanwhile (``run_many``'s ``latency``), and the prediction takes the same latency.
 
     Raises
     ------
@@ -143,7 +146,7 @@ def calibration_study(
     rng = np.random.default_rng(seed)
     velocity = rng.uniform(low, high, count)
     runs = run_many(model, controller, [params] * count, [0.0] * count, velocity.tolist(),
-                    duration=duration, backend=backend)  # fmt: skip
+                    duration=duration, backend=backend, latency=latency)  # fmt: skip
     outcome = np.array([o.value for o in runs.outcomes])
     errors = (
         np.array([e is not None for e in runs.errors]) if runs.errors else np.zeros(count, bool)
@@ -151,10 +154,10 @@ def calibration_study(
     failed = np.isin(outcome, (Outcome.FELL.value, Outcome.SLIPPED.value))
     kept = ~errors & (outcome != Outcome.UNDECIDED.value)
     estimate = np.column_stack([np.zeros(count), velocity]) + rng.normal(0.0, sd, (count, 2))
-    table = verdict_probability_table(estimate, np.diag(sd**2), params)
+    table = verdict_probability_table(estimate, np.diag(sd**2), params, latency=latency)
     predicted = table.fall
-    codes = classify_states(estimate[:, 0], estimate[:, 1], params)
-    certain = codes == STRATEGY_CODES.index(Strategy.FALL)
+    exact = verdict_probability_table(estimate, np.zeros((2, 2)), params, latency=latency)
+    certain = exact.fall > 0.5  # the certain verdict of the estimate (after the latency)
     p, hit = predicted[kept], failed[kept]
     base = float(hit.mean()) if hit.size else 0.0
     return Calibration(

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import require_type
+from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import (
     InvalidParameterError,
     ParameterTypeError,
@@ -104,6 +104,7 @@ def run_many(
     engine: str = "auto",
     push_timeout: float | None = None,
     on_start: Callable[[int], None] | None = None,
+    latency: float = 0.0,
 ) -> PushRuns:
     """Simulate ``controller`` on ``model`` after each push (x0[i], xdot[i]) on bodies[i].
 
@@ -130,6 +131,10 @@ def run_many(
     on_start : callable, optional
         Called with the number of pushes about to run as one unit, before each (the loop: 1;
         ``rollout``: the whole batch): a campaign arms its watchdog there.
+    latency : float
+        The controller reacts this late after the push [s], in [0, 1], the CoP held at the
+        foot's middle meanwhile (:func:`~pushrecovery.control.delay.reaction_delay`); above 0
+        the pushes run through the loop.
 
     Returns
     -------
@@ -158,14 +163,23 @@ def run_many(
         raise InvalidParameterError(
             f"bodies, x0 and xdot must have one entry per push, got {count}, {len(x0)}, {len(xdot)}"
         )
-    chosen = _engine(engine, model, controller, backend, count)
+    latency = bounded_float("latency", latency, 0.0, 1.0, "s")
+    chosen = (
+        "loop"
+        if latency > 0.0 and engine == "auto"
+        else _engine(engine, model, controller, backend, count)
+    )
+    if latency > 0.0 and chosen != "loop":
+        raise InvalidParameterError(f"a latency runs through the loop, not the {chosen!r} engine")
     if chosen == "compiled":
         return _compiled(model, controller, bodies, x0, xdot, duration)
     if chosen == "rollout":
         if on_start is not None:
             on_start(count)
         return _rollout(bodies, x0, xdot, duration)
-    return _loop(model, controller, bodies, x0, xdot, duration, backend, push_timeout, on_start)
+    return _loop(
+        model, controller, bodies, x0, xdot, duration, backend, push_timeout, on_start, latency
+    )
 
 
 def _engine(engine: str, model: str, controller: str, backend: str, count: int) -> str:
@@ -237,9 +251,11 @@ def _loop(
     backend: str,
     push_timeout: float | None,
     on_start: Callable[[int], None] | None,
+    latency: float = 0.0,
 ) -> PushRuns:
     """Each push through ``simulate``; one plant and controller per body (MuJoCo compiles one)."""
     from pushrecovery.control.base import make_controller
+    from pushrecovery.control.delay import reaction_delay
     from pushrecovery.sim.critical import pushed_state
     from pushrecovery.sim.registry import make_plant
     from pushrecovery.sim.simulate import simulate
@@ -256,7 +272,10 @@ def _loop(
         if on_start is not None:
             on_start(1)
         if body not in cache:
-            cache[body] = (make_plant(model, body, backend), make_controller(controller, body))
+            made = make_controller(controller, body)
+            if latency > 0.0:
+                made = reaction_delay(made, latency)
+            cache[body] = (make_plant(model, body, backend), made)
         plant, control = cache[body]
         state = pushed_state(plant, x0[k], xdot[k], force=backend == "mujoco")
         try:
