@@ -79,3 +79,27 @@ def test_bad_noise_is_refused(tmp_path, capsys):
               "--com-noise", "nan"])  # fmt: skip
     err = capsys.readouterr().err
     assert info.value.code == 2 and "com_noise" in err and err.count("\n") == 1
+
+
+def test_a_com_height_spread_is_the_average_over_bodies(tmp_path):
+    """The risk with com_height_sd equals the risks of bodies of those heights, averaged."""
+    import dataclasses
+
+    path = tmp_path / "push.csv"
+    path.write_text(lipm_trial_csv(P, 0.39, 0.0, duration=2.0, push_time=0.5, noise=0.0))
+    recording = read_recording(path)
+    spread = 0.05
+    together = analyze(recording, P, AnalysisSettings(com_noise=0.002, com_height_sd=spread))
+    rng = np.random.default_rng(11)
+    risks = np.array([
+        analyze(recording, dataclasses.replace(P, com_height=P.com_height + spread * z),
+                AnalysisSettings(com_noise=0.002)).columns["ap_risk"]
+        for z in rng.normal(0.0, 1.0, 200)
+    ])  # fmt: skip
+    expected, se = risks.mean(axis=0), risks.std(axis=0) / math.sqrt(len(risks))
+    found = together.columns["ap_risk"]
+    moving = np.isfinite(found) & (se > 1e-4)  # the frames whose risk the height changes
+    assert moving.sum() > 10
+    assert np.all(np.abs(found[moving] - expected[moving]) <= 4.0 * se[moving] + 1e-6)
+    with pytest.raises(InvalidParameterError, match="com_height_sd"):
+        AnalysisSettings(com_height_sd=-0.01)

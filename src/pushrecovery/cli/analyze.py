@@ -175,6 +175,14 @@ def _foot(text: str) -> tuple[str, str, str, str]:
     "suffice) per frame, through the analysis' own filter (docs/uncertainty.md).",
 )
 @click.option(
+    "--com-height-sd",
+    type=float,
+    default=None,
+    metavar="M",
+    help="SD of the body's CoM height [m] (an anthropometric table's spread): the risk "
+    "columns average over it.",
+)
+@click.option(
     "--plot/--no-plot",
     default=True,
     show_default=True,
@@ -227,6 +235,7 @@ def analyze(inputs: tuple[str, ...], out: Path, as_json: bool, **kwargs: Any) ->
         normalise=kwargs.pop("normalise"),
         xcom_length=kwargs.pop("xcom_length"),
         com_noise=kwargs.pop("com_noise"),
+        com_height_sd=kwargs.pop("com_height_sd"),
     )
     single = len(inputs) == 1 and Path(inputs[0]).is_file()
     batch = {name: kwargs.pop(name) for name in ("subjects", "workers", "scheduler", "resume")}

@@ -224,7 +224,11 @@ def analyze(
                 f"{axis}_steps": margins.steps,
             }
         )
-    risk = frame_risk(time, per_axis, support, params, settings.com_noise, settings.cutoff)
+    risk = frame_risk(
+        time, per_axis, support, params, settings.com_noise, settings.cutoff,
+        state={axis: (com[:, i], velocity[:, i]) for i, axis in enumerate(AXES)},
+        com_height_sd=settings.com_height_sd,
+    )  # fmt: skip
     columns.update({f"{axis}_risk": values for axis, values in risk.items()})
     plane = _plane(
         base, com, velocity, cop, time, params, checks.withheld, settings.xcom_omega(params)

@@ -20,11 +20,15 @@ from scipy.special import ndtr
 
 from pushrecovery.analysis.margins import DirectionMargins
 from pushrecovery.analysis.signals import noise_gains
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
-__all__ = ["frame_risk"]
+__all__ = ["HERMITE_NODES", "frame_risk"]
 
 FloatArray = NDArray[np.float64]
+
+#: Gauss–Hermite nodes over the CoM height's spread.
+HERMITE_NODES = 20
 
 
 def frame_risk(
@@ -34,26 +38,53 @@ def frame_risk(
     params: BodyParams,
     com_noise: float | None,
     cutoff: float,
+    *,
+    state: dict[str, tuple[FloatArray, FloatArray]] | None = None,
+    com_height_sd: float | None = None,
 ) -> dict[str, FloatArray]:
     """Return per axis P(the ankle does not suffice) of every frame (module docstring).
 
     ``time`` [s] at a constant rate, ``per_axis`` the frames' margins (their capture points
     [m] and CoP margins: NaN where a frame has no verdict, and so is its risk), ``support`` the
-    base's ``lower`` and ``upper`` per axis [m], ``com_noise`` σ [m] (None: no risk, an
-    empty dict), ``cutoff`` the analysis' low-pass [Hz].
+    base's ``lower`` and ``upper`` per axis [m], ``com_noise`` σ [m] (None and no
+    ``com_height_sd``: no risk, an empty dict), ``cutoff`` the analysis' low-pass [Hz].
+
+    With ``com_height_sd`` σ_L [m] (and ``state``: per axis the frames' CoM and velocity
+    [m, m/s]) the CoM height L is normal about the body's with that deviation (an
+    anthropometric table's spread): ω = sqrt(g/L) moves ξ = x + ẋ/ω and σ_ξ, and the risk is
+    averaged over L by :data:`HERMITE_NODES`-point Gauss–Hermite quadrature.
     """
-    if com_noise is None or len(time) < 3:
+    if (com_noise is None and not com_height_sd) or len(time) < 3:
         return {}
     rate = (len(time) - 1) / (time[-1] - time[0])
     position, slope = noise_gains(rate, cutoff)
-    sd = com_noise * math.hypot(position, slope / params.omega)
+    noise = 0.0 if com_noise is None else com_noise
+    if com_height_sd and state is not None:
+        nodes, weights = np.polynomial.hermite_e.hermegauss(HERMITE_NODES)
+        heights = params.com_height + com_height_sd * nodes
+        if np.any(heights <= 0.0):
+            raise InvalidParameterError(
+                f"com_height_sd must leave the CoM height > 0 over the quadrature (its nodes "
+                f"reach {float(-nodes.min()):.1f} SD), got {com_height_sd:g} m"
+            )
+        omegas = np.sqrt(params.gravity / heights)
+        weights = weights / weights.sum()
+    else:
+        omegas, weights = np.array([params.omega]), np.array([1.0])
     found = {}
     for axis, margins in per_axis.items():
-        xi = margins.capture_point
         lower, upper = support.lower[axis], support.upper[axis]
-        if sd == 0.0:
-            inside = ((lower < xi) & (xi < upper)).astype(np.float64)
-        else:
-            inside = ndtr((upper - xi) / sd) - ndtr((lower - xi) / sd)
+        inside = np.zeros(len(time))
+        for omega, weight in zip(omegas.tolist(), weights.tolist(), strict=True):
+            if state is not None and len(omegas) > 1:
+                com, velocity = state[axis]
+                xi = com + velocity / omega
+            else:
+                xi = margins.capture_point
+            sd = noise * math.hypot(position, slope / omega)
+            if sd == 0.0:
+                inside += weight * ((lower < xi) & (xi < upper))
+            else:
+                inside += weight * (ndtr((upper - xi) / sd) - ndtr((lower - xi) / sd))
         found[axis] = np.where(np.isfinite(margins.cop), 1.0 - inside, np.nan)
     return found

@@ -80,6 +80,9 @@ class AnalysisSettings:
         suffice, P(ξ outside the base along the axis), with ξ's spread through the
         pipeline's own filter (:func:`~pushrecovery.analysis.signals.noise_gains`); None:
         no risk columns.
+    com_height_sd : float or None
+        Standard deviation of the body's CoM height [m], >= 0 (an anthropometric table's
+        spread): the risk columns average over it (with or without ``com_noise``).
     """
 
     cutoff: float = 6.0
@@ -93,6 +96,7 @@ class AnalysisSettings:
     normalise: bool = False
     xcom_length: str = "com_height"
     com_noise: float | None = None
+    com_height_sd: float | None = None
 
     def widths(self, params: BodyParams) -> tuple[float, float]:
         """Foot width and stance width [m]: these settings', else the body's."""
@@ -102,7 +106,8 @@ class AnalysisSettings:
         )
 
     def __post_init__(self) -> None:
-        for name in ("cutoff", "force_cutoff", "max_gap", "stance_width", "com_noise"):
+        for name in ("cutoff", "force_cutoff", "max_gap", "stance_width", "com_noise",
+                     "com_height_sd"):  # fmt: skip
             value = getattr(self, name)
             if value is None:
                 continue
