@@ -202,6 +202,8 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     **{f"pushrecovery.surfaces.probability.scores.{name}": {
         "predicted": np.array([0.1, 0.8]), "happened": np.array([False, True]),
     } for name in ("brier_score", "reliability")},
+    "pushrecovery.surfaces.n_step.hip_box": {"yaw": 0.3},
+    "pushrecovery.surfaces.n_step.reach_polygon": {"side": "left", "yaw": 0.3},
     "pushrecovery.surfaces.probability.latency.latency_growth": {"tau": 0.02},
     "pushrecovery.surfaces.probability.latency.latency_nodes": {"latency": (0.01, 0.03)},
     "pushrecovery.analysis.trial.events.c3d_events": {"events": TrialEvents(

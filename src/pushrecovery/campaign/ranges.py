@@ -33,7 +33,13 @@ def value_range(name: str, triple: Range, limit: int = MAX_PUSHES) -> np.ndarray
         raise InvalidParameterError(
             f"{name} needs START <= STOP and STEP > 0, got {start:g} {stop:g} {increment:g}"
         )
-    count = int(np.floor((stop - start) / increment + 1e-9)) + 1
+    spans = (stop - start) / increment
+    if not math.isfinite(spans):  # a subnormal STEP: too many values to count
+        raise InvalidParameterError(
+            f"{name} gives too many values (STEP {increment:g} over {stop - start:g}); "
+            f"at most {limit}"
+        )
+    count = int(np.floor(spans + 1e-9)) + 1
     if count > limit:
         raise InvalidParameterError(f"{name} gives {count} values; at most {limit}")
     # Rounded to 12 digits: 0.1 * 3 is 0.3 in the results, not 0.30000000000000004; never

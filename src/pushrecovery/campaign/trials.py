@@ -71,6 +71,8 @@ def find_trials(inputs: Sequence[str | Path]) -> tuple[list[Path], Path]:
     found: set[Path] = set()
     for item in inputs:
         text = str(item)
+        if not text.strip():  # Path("") is the current folder: every trial below it
+            raise InvalidParameterError("a trial path is empty: give a file, folder or pattern")
         path = Path(text)
         if path.is_dir():
             matches = [p for p in path.rglob("*") if p.suffix.lower() in TRIAL_SUFFIXES]

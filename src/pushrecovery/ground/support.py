@@ -23,7 +23,7 @@ from enum import StrEnum
 import numpy as np
 
 from pushrecovery.arguments import finite_float, require_type
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import ConvexPolygon, convex_hull, rectangle
 from pushrecovery.ground.user_polygon import convex_polygon
 from pushrecovery.params import BodyParams
@@ -144,6 +144,12 @@ class Support:
             raise InvalidParameterError(
                 f"stance must be one of {[s.value for s in Stance]}, got {stance!r}"
             ) from None
+        require_type("params", params, BodyParams)
+        for name, pose in (("left", left), ("right", right)):
+            if pose is not None and not isinstance(pose, FootPose):
+                raise ParameterTypeError(
+                    f"{name} must be a FootPose(x, y, yaw) [m, m, rad], got {type(pose).__name__}"
+                )
         half = 0.5 * params.stance_width
         left = FootPose(0.0, half) if left is None else left
         right = FootPose(0.0, -half) if right is None else right

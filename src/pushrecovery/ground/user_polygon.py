@@ -50,7 +50,7 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
     """
     try:
         pts = np.asarray(vertices, dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # an int beyond float too
         raise InvalidParameterError(
             f"{name} must be a list of [x, y] vertices in m, got {vertices!r:.60}"
         ) from None

@@ -146,13 +146,32 @@ def _capturability_distance(
     return hip + foot_radius + reach * geometric
 
 
-@functools.lru_cache(maxsize=64)
 def hip_box(params: BodyParams, yaw: float) -> FloatArray | None:
     """Return the hip's box H: ±(pitch, roll) corrected Eq. 15 offsets, heading-aligned [m].
 
     Counter-clockwise corners (a segment when one axis has no torque), or None when neither;
-    read-only (the answers are kept).
+    read-only (the answers are kept). ``yaw`` [rad] in [−2π, 2π].
+
+    Raises
+    ------
+    InvalidParameterError
+        A ``yaw`` that is not a finite number in [−2π, 2π] (radians, not degrees).
     """
+    return _hip_box(_body(params), _yaw(yaw))
+
+
+def _body(params: object) -> BodyParams:
+    require_type("params", params, BodyParams)
+    return params  # type: ignore[return-value]
+
+
+def _yaw(yaw: object) -> float:
+    """Return a yaw [rad] as a float in [−2π, 2π] (beyond, its sine and cosine lose precision)."""
+    return bounded_float("yaw", yaw, -2.0 * math.pi, 2.0 * math.pi, "rad, not degrees")
+
+
+@functools.lru_cache(maxsize=64)
+def _hip_box(params: BodyParams, yaw: float) -> FloatArray | None:
     half_x, half_y = cmp_offset(params), cmp_offset_roll(params)
     if half_x == 0.0 and half_y == 0.0:
         return None
@@ -172,8 +191,27 @@ def landing_foot(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon:
     return (foot if side is Stance.LEFT else foot.mirrored()).transformed(0.0, 0.0, yaw)
 
 
-@functools.lru_cache(maxsize=32)
 def reach_polygon(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon:
+    """Footholds of the ``side`` foot relative to the stance ankle: R [m] (:func:`_reach`).
+
+    ``side`` LEFT or RIGHT, ``yaw`` [rad] in [−2π, 2π].
+
+    Raises
+    ------
+    InvalidParameterError
+        An unknown side, or a ``yaw`` that is not a finite number in [−2π, 2π].
+    """
+    try:
+        side = Stance(side)
+    except ValueError:
+        raise InvalidParameterError(f"side must be left or right, got {side!r:.40}") from None
+    if side is Stance.DOUBLE:
+        raise InvalidParameterError("side must be left or right (a foot), got double")
+    return _reach(_body(params), side, _yaw(yaw))
+
+
+@functools.lru_cache(maxsize=32)
+def _reach(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon:
     """Footholds of the ``side`` foot relative to the stance ankle: R [m].
 
     The regular polygon of :data:`REACH_SIDES` sides inscribed in the disc of radius
