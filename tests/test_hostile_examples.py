@@ -56,3 +56,35 @@ def test_reach_is_a_foot_s():
     with pytest.raises(InvalidParameterError, match="side must be left or right"):
         reach_polygon(P, "double", 0.0)
     assert reach_polygon(P, "left", 0.3) is reach_polygon(P, "left", 0.3)  # still kept
+
+
+def _csv_trial(tmp_path):
+    from pushrecovery.experiments.synthetic_trials import lipm_trial_csv
+
+    path = tmp_path / "c.csv"
+    path.write_text(lipm_trial_csv(P, 0.2, 0.0))
+    return path
+
+
+def test_a_fifo_trial_is_refused(tmp_path, capsys):
+    import os
+
+    fifo = tmp_path / "f.csv"
+    os.mkfifo(fifo)
+    assert "not a regular file" in _fail(capsys, "analyze", str(fifo), "--out", str(tmp_path / "o"))
+
+
+def test_an_integer_of_thousands_of_digits_in_toml_is_refused(tmp_path, capsys):
+    big = tmp_path / "big.toml"
+    big.write_text("mass = " + "9" * 5000 + "\n")
+    err = _fail(capsys, "classify", "--x", "0", "--xdot", "0.3", "--params", str(big))
+    assert "unreadable TOML" in err
+
+
+@pytest.mark.parametrize("flag", ["--cutoff", "--force-cutoff"])
+@pytest.mark.parametrize("value", ["1e-300", "5e-324"])
+def test_a_vanishing_cutoff_is_refused(tmp_path, capsys, flag, value):
+    trial = _csv_trial(tmp_path)
+    err = _fail(capsys, "analyze", str(trial), "--mass", "72", "--out", str(tmp_path / "o"),
+                flag, value)  # fmt: skip
+    assert "cutoff must be" in err and ("at least" in err or "in (0," in err)

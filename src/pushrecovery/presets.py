@@ -320,6 +320,8 @@ def _read_toml(path: Path) -> dict[str, Any]:
         raise InputFileError(f"malformed TOML in {path}: {exc}") from None
     except UnicodeDecodeError:
         raise InputFileError(f"parameter file {path} is not UTF-8 text (TOML)") from None
+    except ValueError as exc:  # an integer of thousands of digits
+        raise InputFileError(f"unreadable TOML in {path}: {str(exc).splitlines()[0]}") from None
     except RecursionError:
         raise InputFileError(f"malformed TOML in {path}: nested too deeply") from None
     body = data.pop("body", None)

@@ -35,6 +35,7 @@ from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 __all__ = [
     "FILTER_ORDER",
+    "MIN_CUTOFF_RATIO",
     "Gap",
     "find_gaps",
     "lowpass",
@@ -49,6 +50,8 @@ FloatArray = NDArray[np.float64]
 
 #: Order of the Butterworth design; run forward and backward it acts as a 4th-order filter.
 FILTER_ORDER = 2
+#: The lowest cutoff, as a fraction of the sampling rate: below it the design is singular.
+MIN_CUTOFF_RATIO = 1e-6
 
 
 @dataclass(frozen=True, slots=True)
@@ -232,22 +235,29 @@ def lowpass(values: FloatArray, rate: float, cutoff: float) -> FloatArray:
     values = sample_array("values", values, (1, 2))
     rate = positive_float("rate", rate, "Hz")
     cutoff = finite_float("cutoff", cutoff, "Hz", allowed=f"0 or in (0, {0.5 * rate:g})")
-    if cutoff != 0.0 and not 0.0 < cutoff < 0.5 * rate:
-        raise InvalidParameterError(
-            f"cutoff must be 0 or in (0, {0.5 * rate:g}) Hz (half the sampling rate), "
-            f"got {cutoff:g}"
-        )
+    if cutoff != 0.0:
+        _check_cutoff(cutoff, rate)
     return _lowpass(values, rate, cutoff)
+
+
+def _check_cutoff(cutoff: float, rate: float) -> None:
+    """Refuse a cutoff [Hz] at or past Nyquist, or below a millionth of the rate [Hz]."""
+    if not 0.0 < cutoff < 0.5 * rate:
+        raise InvalidParameterError(
+            f"cutoff must be in (0, {0.5 * rate:g}) Hz (half the sampling rate), got {cutoff:g}"
+        )
+    if cutoff < MIN_CUTOFF_RATIO * rate:
+        raise InvalidParameterError(
+            f"cutoff must be 0 or at least {MIN_CUTOFF_RATIO * rate:g} Hz (a millionth of the "
+            f"sampling rate: below, the filter's design is singular), got {cutoff:g}"
+        )
 
 
 def _lowpass(values: FloatArray, rate: float, cutoff: float) -> FloatArray:
     """:func:`lowpass` of checked arguments."""
     if cutoff == 0.0 or len(values) < 4:
         return values
-    if not 0.0 < cutoff < 0.5 * rate:
-        raise InvalidParameterError(
-            f"cutoff must be in (0, {0.5 * rate:g}) Hz (half the sampling rate), got {cutoff:g}"
-        )
+    _check_cutoff(cutoff, rate)
     # Winter's correction: the double pass lowers the -3 dB point; design above it.
     correction = (2.0 ** (1.0 / 2.0) - 1.0) ** 0.25
     design = rate / np.pi * np.arctan(np.tan(np.pi * cutoff / rate) / correction)

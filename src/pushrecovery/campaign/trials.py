@@ -77,6 +77,8 @@ def find_trials(inputs: Sequence[str | Path]) -> tuple[list[Path], Path]:
         if path.is_dir():
             matches = [p for p in path.rglob("*") if p.suffix.lower() in TRIAL_SUFFIXES]
         elif path.exists():
+            if not path.is_file():  # a FIFO or a device: read it and wait for ever
+                raise InvalidParameterError(f"{text}: not a regular file (a trial is a file)")
             if path.suffix.lower() not in TRIAL_SUFFIXES:
                 raise InvalidParameterError(
                     f"{text}: a trial must be a .csv or .c3d file, got {path.suffix or 'none'}"
