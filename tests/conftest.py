@@ -25,3 +25,15 @@ AS_FROM_A_TERMINAL = (
     "import runpy, signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
     "sys.argv[0] = 'pushrecovery'; runpy.run_module('pushrecovery', run_name='__main__')",
 )
+
+
+def cli_error(capsys: pytest.CaptureFixture[str], *args: str) -> str:
+    """Run ``pushrecovery ARGS``; check it is refused in one line with exit 2; return the line."""
+    from pushrecovery.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(list(args))
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pushrecovery: error: ") and err.count("\n") == 1, err
+    return err

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from conftest import cli_error
 from pushrecovery.analysis.readers import AP_AXES, LENGTH_UNITS
-from pushrecovery.cli import main
 from pushrecovery.cli.analyze import _AP_AXES, _UNITS
 from pushrecovery.cli.app import cli
 
@@ -134,56 +134,49 @@ def test_analyze_table_output(tmp_path):
     assert not (tmp_path / "o" / "time_series.png").exists()
 
 
-def _fail(capsys, *args):
-    with pytest.raises(SystemExit) as info:
-        main(list(args))
-    assert info.value.code == 2
-    err = capsys.readouterr().err
-    assert err.startswith("pushrecovery: error: ") and err.count("\n") == 1, err
-    return err
-
-
 def test_bad_inputs_are_one_line(tmp_path, capsys):
     trial = _trial(tmp_path / "trial.csv")
     out = str(tmp_path / "o")
-    assert "not found" in _fail(capsys, "analyze", str(tmp_path / "none.csv"), "--out", out)
+    assert "not found" in cli_error(capsys, "analyze", str(tmp_path / "none.csv"), "--out", out)
     empty = tmp_path / "empty"
     empty.mkdir()  # a folder is a batch of trials (issue 18), but this one has none
-    assert "no .csv or .c3d trial" in _fail(capsys, "analyze", str(empty), "--out", out)
-    assert "'furlongs'" in _fail(capsys, "analyze", str(trial), "--units", "furlongs", "--out", out)
-    assert "units" in _fail(capsys, "analyze", str(trial), "--out", out)  # mm read as m
+    assert "no .csv or .c3d trial" in cli_error(capsys, "analyze", str(empty), "--out", out)
+    assert "'furlongs'" in cli_error(
+        capsys, "analyze", str(trial), "--units", "furlongs", "--out", out
+    )
+    assert "units" in cli_error(capsys, "analyze", str(trial), "--out", out)  # mm read as m
     text = tmp_path / "trial.txt"
     text.write_text("hello")
-    assert "expected .csv or .c3d" in _fail(capsys, "analyze", str(text), "--out", out)
+    assert "expected .csv or .c3d" in cli_error(capsys, "analyze", str(text), "--out", out)
     mm = ("--units", "mm", "--mass", "72")
-    err = _fail(capsys, "analyze", str(trial), *mm, "--cutoff", "-1", "--out", out)
+    err = cli_error(capsys, "analyze", str(trial), *mm, "--cutoff", "-1", "--out", out)
     assert "cutoff" in err
-    err = _fail(capsys, "analyze", str(trial), *mm, "--cutoff", "80", "--out", out)
+    err = cli_error(capsys, "analyze", str(trial), *mm, "--cutoff", "80", "--out", out)
     assert "cutoff must be in (0, 50)" in err
-    err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--mass", "-3", "--out", out)
+    err = cli_error(capsys, "analyze", str(trial), "--units", "mm", "--mass", "-3", "--out", out)
     assert "mass" in err
-    assert "--out" in _fail(capsys, "analyze", str(trial))
+    assert "--out" in cli_error(capsys, "analyze", str(trial))
     fake = tmp_path / "fake.c3d"
     fake.write_text("time,com_ap\n0,0\n")
-    _fail(capsys, "analyze", str(fake), "--out", out)
+    cli_error(capsys, "analyze", str(fake), "--out", out)
     kistler = _kistler()
     cut = tmp_path / "cut.c3d"
     cut.write_bytes(kistler.read_bytes()[:30_000])
-    _fail(capsys, "analyze", str(cut), "--out", out)
-    err = _fail(capsys, "analyze", str(kistler), "--com-marker", "C7", "--out", out)
+    cli_error(capsys, "analyze", str(cut), "--out", out)
+    err = cli_error(capsys, "analyze", str(kistler), "--com-marker", "C7", "--out", out)
     assert "'C7'" in err
-    err = _fail(capsys, "analyze", str(kistler), "--foot", "left=LHEE", "--out", out)
+    err = cli_error(capsys, "analyze", str(kistler), "--foot", "left=LHEE", "--out", out)
     assert "NAME=HEEL,TOE,ANKLE" in err
-    err = _fail(capsys, "analyze", str(trial), *mm, "--xcom-length", "hip", "--out", out)
+    err = cli_error(capsys, "analyze", str(trial), *mm, "--xcom-length", "hip", "--out", out)
     assert "'hip'" in err and "com_height" in err
-    err = _fail(capsys, "analyze", str(trial), *mm, "--figure-format", "gif", "--out", out)
+    err = cli_error(capsys, "analyze", str(trial), *mm, "--figure-format", "gif", "--out", out)
     assert "'gif'" in err and "svg" in err
 
 
 def test_no_mass_is_refused_not_guessed(tmp_path, capsys):
     """A CSV without a mass, plates or --mass: refused in one line, no silent 72 kg preset."""
     trial = _trial(tmp_path / "trial.csv")
-    err = _fail(capsys, "analyze", str(trial), "--units", "mm", "--out", str(tmp_path / "o"))
+    err = cli_error(capsys, "analyze", str(trial), "--units", "mm", "--out", str(tmp_path / "o"))
     assert "no body mass for trial.csv" in err and "--mass" in err
 
 
@@ -218,15 +211,17 @@ def test_height_and_sex_scale_the_body_to_the_person(tmp_path):
 def test_bad_height_and_sex_are_one_line(tmp_path, capsys):
     trial = str(_trial(tmp_path / "trial.csv"))
     base = ("analyze", trial, "--units", "mm", "--mass", "60", "--out", str(tmp_path / "o"))
-    assert "height" in _fail(capsys, *base, "--height", "3", "--sex", "male")
-    assert "height" in _fail(capsys, *base, "--height", "0.4", "--sex", "male")
-    assert "'other'" in _fail(capsys, *base, "--height", "1.7", "--sex", "other")
-    assert "height and sex go together" in _fail(capsys, *base, "--height", "1.7")
-    assert "height and sex go together" in _fail(capsys, *base, "--sex", "male")
+    assert "height" in cli_error(capsys, *base, "--height", "3", "--sex", "male")
+    assert "height" in cli_error(capsys, *base, "--height", "0.4", "--sex", "male")
+    assert "'other'" in cli_error(capsys, *base, "--height", "1.7", "--sex", "other")
+    assert "height and sex go together" in cli_error(capsys, *base, "--height", "1.7")
+    assert "height and sex go together" in cli_error(capsys, *base, "--sex", "male")
     folder = tmp_path / "many"
     folder.mkdir()
     _trial(folder / "a.csv")
-    err = _fail(capsys, "analyze", str(folder), "--height", "1.7", "--sex", "male", "--out", "o")
+    err = cli_error(
+        capsys, "analyze", str(folder), "--height", "1.7", "--sex", "male", "--out", "o"
+    )
     assert "--height and --sex apply to one trial" in err
 
 
@@ -287,9 +282,9 @@ def test_a_cop_only_file_gives_its_sway_measures(tmp_path, capsys):
     assert table.exit_code == 0 and "CoP only" in table.output
     # A gap, or a trace that is no quiet standing: one line, exit 2.
     gap, _ = _cop_only(tmp_path / "gap.csv", gap=True)
-    assert "misses 10 frame(s)" in _fail(capsys, "analyze", str(gap), "--out", str(out))
+    assert "misses 10 frame(s)" in cli_error(capsys, "analyze", str(gap), "--out", str(out))
     step, _ = _cop_only(tmp_path / "step.csv", jump=0.1)
-    assert "no quiet standing" in _fail(capsys, "analyze", str(step), "--out", str(out))
+    assert "no quiet standing" in cli_error(capsys, "analyze", str(step), "--out", str(out))
 
 
 def test_a_batch_keeps_its_cop_only_trials_as_posturography_rows(tmp_path):

@@ -10,6 +10,7 @@ import json
 
 import pytest
 
+from conftest import cli_error
 from pushrecovery.analysis.c3d import read_events, write_c3d
 from pushrecovery.cli import main
 from pushrecovery.experiments.mocap import record_push
@@ -28,15 +29,6 @@ def _c3d(path):
     write_c3d(path, point_rate=rec.point_rate, markers=rec.markers, analog_rate=rec.analog_rate,
               plates=rec.plates, mass=rec.mass)  # fmt: skip
     return path
-
-
-def _fail(capsys, *args):
-    with pytest.raises(SystemExit) as info:
-        main(list(args))
-    assert info.value.code == 2
-    err = capsys.readouterr().err
-    assert err.startswith("pushrecovery: error: ") and err.count("\n") == 1, err
-    return err
 
 
 def test_one_c3d_trial_writes_its_events_into_a_copy(tmp_path, capsys):
@@ -64,7 +56,7 @@ def test_write_events_needs_a_c3d_trial(tmp_path, capsys):
 
     csv = tmp_path / "t.csv"
     csv.write_text(lipm_trial_csv(P, 0.3, 0.0))
-    err = _fail(capsys, "analyze", str(csv), "--mass", "72", "--out", str(tmp_path / "o"),
+    err = cli_error(capsys, "analyze", str(csv), "--mass", "72", "--out", str(tmp_path / "o"),
                 "--write-events")  # fmt: skip
     assert "--write-events" in err and "t.csv is no .c3d file" in err
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
+from conftest import cli_error
 from pushrecovery import load_params
-from pushrecovery.cli import main
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError, PushRecoveryError
 from pushrecovery.ground import Support
 from pushrecovery.ground.user_polygon import convex_polygon
@@ -13,23 +13,14 @@ from pushrecovery.surfaces.n_step import hip_box, reach_polygon
 P = load_params()
 
 
-def _fail(capsys, *args):
-    with pytest.raises(SystemExit) as info:
-        main(list(args))
-    err = capsys.readouterr().err
-    assert info.value.code == 2 and err.startswith("pushrecovery: error: ")
-    assert err.count("\n") == 1, err
-    return err
-
-
 def test_a_subnormal_range_step_is_refused(capsys):
-    err = _fail(capsys, "step", "--v0-range", "0.1", "3", "5e-324")
+    err = cli_error(capsys, "step", "--v0-range", "0.1", "3", "5e-324")
     assert "--v0-range gives too many values" in err
 
 
 def test_an_empty_trial_path_is_refused(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    err = _fail(capsys, "analyze", "", "--out", str(tmp_path / "o"))
+    err = cli_error(capsys, "analyze", "", "--out", str(tmp_path / "o"))
     assert "a trial path is empty" in err
     assert not (tmp_path / "o").exists()
 
@@ -53,7 +44,7 @@ def test_hip_box_and_reach_refuse_a_yaw_beyond_a_turn(yaw):
 
 
 def test_reach_is_a_foot_s():
-    with pytest.raises(InvalidParameterError, match="side must be left or right"):
+    with pytest.raises(InvalidParameterError, match="side must be 'left' or 'right'"):
         reach_polygon(P, "double", 0.0)
     assert reach_polygon(P, "left", 0.3) is reach_polygon(P, "left", 0.3)  # still kept
 
@@ -71,13 +62,15 @@ def test_a_fifo_trial_is_refused(tmp_path, capsys):
 
     fifo = tmp_path / "f.csv"
     os.mkfifo(fifo)
-    assert "not a regular file" in _fail(capsys, "analyze", str(fifo), "--out", str(tmp_path / "o"))
+    assert "not a regular file" in cli_error(
+        capsys, "analyze", str(fifo), "--out", str(tmp_path / "o")
+    )
 
 
 def test_an_integer_of_thousands_of_digits_in_toml_is_refused(tmp_path, capsys):
     big = tmp_path / "big.toml"
     big.write_text("mass = " + "9" * 5000 + "\n")
-    err = _fail(capsys, "classify", "--x", "0", "--xdot", "0.3", "--params", str(big))
+    err = cli_error(capsys, "classify", "--x", "0", "--xdot", "0.3", "--params", str(big))
     assert "unreadable TOML" in err
 
 
@@ -85,6 +78,6 @@ def test_an_integer_of_thousands_of_digits_in_toml_is_refused(tmp_path, capsys):
 @pytest.mark.parametrize("value", ["1e-300", "5e-324"])
 def test_a_vanishing_cutoff_is_refused(tmp_path, capsys, flag, value):
     trial = _csv_trial(tmp_path)
-    err = _fail(capsys, "analyze", str(trial), "--mass", "72", "--out", str(tmp_path / "o"),
+    err = cli_error(capsys, "analyze", str(trial), "--mass", "72", "--out", str(tmp_path / "o"),
                 flag, value)  # fmt: skip
     assert "cutoff must be" in err and ("at least" in err or "in (0," in err)

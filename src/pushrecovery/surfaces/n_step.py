@@ -201,13 +201,20 @@ def reach_polygon(params: BodyParams, side: Stance, yaw: float) -> ConvexPolygon
     InvalidParameterError
         An unknown side, or a ``yaw`` that is not a finite number in [−2π, 2π].
     """
+    return _reach(_body(params), _foot_side("side", side), _yaw(yaw))
+
+
+def _foot_side(name: str, value: str | Stance) -> Stance:
+    """Return ``value`` as a foot, LEFT or RIGHT, or raise naming ``name``."""
     try:
-        side = Stance(side)
+        side = Stance(value)
     except ValueError:
-        raise InvalidParameterError(f"side must be left or right, got {side!r:.40}") from None
+        raise InvalidParameterError(
+            f"{name} must be 'left' or 'right', got {value!r:.40}"
+        ) from None
     if side is Stance.DOUBLE:
-        raise InvalidParameterError("side must be left or right (a foot), got double")
-    return _reach(_body(params), side, _yaw(yaw))
+        raise InvalidParameterError(f"{name} must be 'left' or 'right', got 'double'")
+    return side
 
 
 @functools.lru_cache(maxsize=32)
@@ -268,12 +275,7 @@ def step_options(
     require_type("params", params, BodyParams)
     require_type("support", support, Support)
     if swing is not None:
-        try:
-            swing = Stance(swing)
-        except ValueError:
-            raise InvalidParameterError(f"swing must be 'left' or 'right', got {swing!r}") from None
-        if swing is Stance.DOUBLE:
-            raise InvalidParameterError("swing must be 'left' or 'right', got 'double'")
+        swing = _foot_side("swing", swing)
         if support.stance is not Stance.DOUBLE and swing is support.stance:
             raise InvalidParameterError(
                 f"swing must be the free foot: the {support.stance.value} foot carries the body"
