@@ -1,5 +1,7 @@
 """Issue 38's examples, each refused in one named line (the ones this change fixed)."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -81,3 +83,57 @@ def test_a_vanishing_cutoff_is_refused(tmp_path, capsys, flag, value):
     err = cli_error(capsys, "analyze", str(trial), "--mass", "72", "--out", str(tmp_path / "o"),
                 flag, value)  # fmt: skip
     assert "cutoff must be" in err and ("at least" in err or "in (0," in err)
+
+
+@pytest.mark.parametrize("tolerance", [0.0, 1e-300, -1e-3, float("nan"), 1.0])
+def test_a_step_bisection_refuses_a_tolerance_it_cannot_reach(tolerance):
+    from pushrecovery.surfaces.step import step_critical_velocity, step_thresholds
+
+    with pytest.raises(InvalidParameterError, match=r"tolerance must be .*in \[1e-12, 0.1\]"):
+        step_critical_velocity(0.0994, -1, P, tolerance=tolerance)
+    with pytest.raises(InvalidParameterError, match="tolerance"):
+        step_thresholds(P, tolerance=tolerance)
+
+
+def test_the_finest_step_tolerance_still_ends():
+    from pushrecovery.surfaces.step import step_thresholds
+
+    fine, coarse = step_thresholds(P, tolerance=1e-12), step_thresholds(P, tolerance=1e-3)
+    assert abs(fine[0] - coarse[0]) <= 1e-3 and abs(fine[1] - coarse[1]) <= 1e-3
+
+
+def test_an_mpc_period_of_a_microsecond_is_refused(capsys):
+    err = cli_error(
+        capsys, "simulate", "--model", "flywheel", "--controller", "mpc", "--impulse", "31.55",
+        "--option", "dt=1e-6", "--json",
+    )  # fmt: skip
+    assert "dt must be in [0.001, 1]" in err
+
+
+def test_the_monitor_refuses_a_capture_point_beyond_any_foot():
+    from pushrecovery.surfaces.monitor import BalanceMonitor
+
+    monitor = BalanceMonitor(P, Support.from_params(P))
+    with pytest.raises(InvalidParameterError, match="capture point within"):
+        monitor.query(0.19, -1.79e308, -0.94, 1e-300)
+    assert monitor.query(0.19, -1e5, -0.94, 0.0).strategy.value == "fall"  # far, still finite
+
+
+def test_a_trial_sixty_folders_deep_keeps_the_batch(tmp_path, capsys):
+    from pushrecovery.cli import main
+    from pushrecovery.experiments.synthetic_trials import lipm_trial_csv
+
+    text = lipm_trial_csv(P, 0.2, 0.0)
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "good.csv").write_text(text)
+    deep = tmp_path / "data" / "/".join(["n" * 40] * 60)
+    deep.mkdir(parents=True)
+    (deep / "deep.csv").write_text(text)
+    args = ["analyze", str(tmp_path / "data"), "--mass", "70", "--out", str(tmp_path / "o")]
+    with pytest.raises(SystemExit) as end:
+        main([*args, "--json"])
+    assert end.value.code == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert (summary["trials"], summary["analysed"]) == (2, 2)
+    names = sorted(p.name for p in (tmp_path / "o" / "trials").iterdir())
+    assert "good.csv" in names and all(len(n.encode()) <= 200 for n in names)

@@ -16,6 +16,7 @@ bug and stops the batch. docs/analysis.md, "Many trials", has the details.
 from __future__ import annotations
 
 import glob
+import hashlib
 import json
 import os
 from collections.abc import Callable, Iterator, Sequence
@@ -50,6 +51,8 @@ __all__ = [
 TRIAL_SUFFIXES = (".csv", ".c3d")
 ROW_FILE = "trial.json"
 TRIALS_DIR = "trials"
+#: Longest trial name [bytes]: a file name, with room for a suffix the outputs add.
+MAX_NAME = 200
 
 #: Called in the worker after a trial is analysed: (analysis, its directory) -> files written.
 AfterTrial = Callable[[Any, Path], dict[str, str]]
@@ -128,13 +131,21 @@ def trial_jobs(
     subjects: tuple[Subject, ...] = (),
     **options: Any,
 ) -> list[TrialJob]:
-    """One job per trial; its name is its path below ``root`` (``/`` as ``__``)."""
+    """One job per trial; its name is its path below ``root`` (``/`` as ``__``).
+
+    A name longer than :data:`MAX_NAME` bytes (a trial many folders deep: the name is also its
+    output folder's, and a file system allows 255 bytes) keeps its end after a hash of the
+    whole path, so that it stays unique.
+    """
     jobs = []
     for path in trials:
         relative = path.relative_to(root).as_posix()
-        jobs.append(
-            TrialJob(path, relative.replace("/", "__"), subject_for(relative, subjects), **options)
-        )
+        name = relative.replace("/", "__")
+        if len(name.encode()) > MAX_NAME:
+            digest = hashlib.sha256(name.encode()).hexdigest()[:12]
+            tail = name.encode()[-(MAX_NAME - 14) :].decode(errors="ignore")
+            name = f"{digest}__{tail}"
+        jobs.append(TrialJob(path, name, subject_for(relative, subjects), **options))
     return jobs
 
 
@@ -245,8 +256,11 @@ def run_trial(job: TrialJob, out: Path, after: AfterTrial | None = None) -> dict
             "quality": json_safe(quality),
             "files": files,
         }
-    except PushRecoveryError as exc:
-        record = {"trials": failed_rows(job, str(exc)), "events": [], "quality": [], "files": {}}
+    except (PushRecoveryError, OSError) as exc:  # OSError: the trial's files, not the library
+        reason = str(exc)
+        if isinstance(exc, OSError):
+            reason = f"{job.path}: {exc.strerror or exc}"
+        record = {"trials": failed_rows(job, reason), "events": [], "quality": [], "files": {}}
     _write_json(directory / ROW_FILE, record)
     return record
 

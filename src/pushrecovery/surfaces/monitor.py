@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.ground.support import Stance, Support
+from pushrecovery.ground.support import MAX_POSE, Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import Strategy
 from pushrecovery.surfaces.cmp import _flywheel_offsets, cmp_offset, cmp_offset_roll
@@ -376,17 +376,20 @@ class BalanceMonitor:
         Raises
         ------
         InvalidParameterError
-            If a value is NaN or infinite; if ``pitch`` or ``roll`` is not a pair, an angle is
-            outside its joint range [−θmax, θmax] or a rate is one from which no torque within
-            τmax stops the upper body inside that range (the message names the axis and
-            ``theta0`` or ``thetadot0``, as :func:`~pushrecovery.surfaces.cmp.cmp_offset_from`).
+            If a value is NaN or infinite or the capture point is beyond
+            ±:data:`~pushrecovery.ground.support.MAX_POSE` m (as a foot pose); if ``pitch``
+            or ``roll`` is not a pair, an angle is outside its joint range [−θmax, θmax] or a
+            rate is one from which no torque within τmax stops the upper body inside that
+            range (the message names the axis and ``theta0`` or ``thetadot0``, as
+            :func:`~pushrecovery.surfaces.cmp.cmp_offset_from`).
         """
         if not (type(x) is type(y) is type(xdot) is type(ydot) is float):
             x, y, xdot, ydot = _floats(x, y, xdot, ydot)  # numpy scalars: 5x slower otherwise
         try:
             px = capture_point(x, xdot, self._omega)
             py = capture_point(y, ydot, self._omega)
-            finite = math.isfinite(px) and math.isfinite(py) and math.isfinite(x + y)
+            # NaN fails the comparisons; beyond MAX_POSE a distance to a foot overflows.
+            finite = abs(px) <= MAX_POSE and abs(py) <= MAX_POSE and math.isfinite(x + y)
         except (TypeError, ValueError):  # an array or text where a number belongs: no cost here
             raise ParameterTypeError(
                 "x, y, xdot, ydot must be numbers (one state per query; classify_states for "
@@ -395,7 +398,8 @@ class BalanceMonitor:
             ) from None
         if not finite:
             raise InvalidParameterError(
-                f"x, y, xdot, ydot must be finite, got {x!r}, {y!r}, {xdot!r}, {ydot!r}"
+                f"x, y, xdot, ydot must be finite, with the capture point within "
+                f"±{MAX_POSE:g} m, got {x!r}, {y!r}, {xdot!r}, {ydot!r}"
             )
         box = None if pitch is None and roll is None else self._torso_box(pitch, roll)
         state = self._state  # read once: the old support or the new one, never a mix

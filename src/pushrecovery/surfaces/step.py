@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import finite_array, finite_float, require_type
+from pushrecovery.arguments import bounded_float, finite_array, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.kernels.step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
 from pushrecovery.kernels.step_scalar import decide, feasible
@@ -298,9 +298,19 @@ def step_critical_velocity(
     Found by bisection on the feasibility of :func:`plan_step` (monotone in the
     push: a harder push needs a longer step and loads the stance leg less). Pure Python: no
     numba or scipy is loaded.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` is not a :class:`BodyParams`.
+    InvalidParameterError
+        If ``x`` is not finite, ``direction`` is not ±1, or ``tolerance`` is outside
+        [1e-12, 0.1] m/s (a bisection of speeds up to sqrt(g L) ends at float resolution
+        below, and would never end at 0).
     """
     require_type("params", params, BodyParams)
     x = finite_float("x", x, "m")
+    tolerance = bounded_float("tolerance", tolerance, 1e-12, 0.1, "m/s")
     if finite_float("direction", direction) not in (1.0, -1.0):
         raise InvalidParameterError(f"direction must be +1 or -1, got {direction!r}")
     sign = 1.0 if direction > 0.0 else -1.0
@@ -323,6 +333,11 @@ def step_thresholds(params: BodyParams, *, tolerance: float = 1e-9) -> tuple[flo
     -------
     (v_back, v_fwd) : tuple of float
         Signed: v_back < 0 < v_fwd.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``tolerance`` [m/s] is outside [1e-12, 0.1] (:func:`step_critical_velocity`).
     """
     require_type("params", params, BodyParams)
     return (

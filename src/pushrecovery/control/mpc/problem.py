@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, positive_float, require_type
+from pushrecovery.arguments import bounded_float, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
@@ -32,6 +32,8 @@ FloatArray = NDArray[np.float64]
 #: Longest horizon [samples]: 4 s at the default 0.02 s; the condensed QP grows as N² (a
 #: horizon of 3000 would take minutes to build and gigabytes to hold).
 MAX_HORIZON = 200
+#: Shortest prediction step and control period [s]: a 1 kHz loop.
+MIN_DT = 1e-3
 
 
 @dataclass(frozen=True, slots=True)
@@ -41,7 +43,9 @@ class MPCSettings:
     Parameters
     ----------
     dt : float
-        Step of the prediction and of the control loop [s] (paper: 0.02).
+        Step of the prediction and of the control loop [s] (paper: 0.02), in
+        [``MIN_DT``, 1]: a loop faster than 1 kHz multiplies a run's QPs without changing
+        the plan (at 1e-6 s a 3 s run is 3 million QPs).
     horizon : int
         Number of steps N (paper: 50, a 1 s look-ahead).
     state_weights : tuple of 4 floats
@@ -70,7 +74,7 @@ class MPCSettings:
     realtime: bool = False
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "dt", positive_float("dt", self.dt, "s"))
+        object.__setattr__(self, "dt", bounded_float("dt", self.dt, MIN_DT, 1.0, "s"))
         if (
             isinstance(self.horizon, bool)
             or not isinstance(self.horizon, int)
