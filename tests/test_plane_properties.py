@@ -128,7 +128,8 @@ def test_rotating_feet_and_state_together_keeps_margins(
         return c * vx - s * vy, s * vx + c * vy
 
     def turned(pose):
-        return FootPose(*rotate(pose[0], pose[1]), pose[2] + turn)
+        # The same heading, wrapped into [-pi, pi] (a FootPose refuses more than half a turn).
+        return FootPose(*rotate(pose[0], pose[1]), math.remainder(pose[2] + turn, 2 * math.pi))
 
     here = Support.from_params(p, stance, left=FootPose(*left), right=FootPose(*right))
     there = Support.from_params(p, stance, left=turned(left), right=turned(right))

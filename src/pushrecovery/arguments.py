@@ -68,16 +68,37 @@ def bounded_float(name: str, value: object, low: float, high: float, unit: str =
 def float_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
     """Return ``value`` as a float64 array (values not checked), or raise naming ``name``.
 
-    None is refused (numpy would read it as NaN).
+    None is refused (numpy would read it as NaN), and so are complex numbers (numpy would drop
+    their imaginary parts with a warning).
     """
     if value is None:
         raise ParameterTypeError(f"{name} must be a number or an array of numbers, got None")
+    if isinstance(value, complex | np.complexfloating) or (
+        isinstance(value, np.ndarray) and value.dtype.kind == "c"
+    ):
+        raise ParameterTypeError(f"{name} must be real numbers, got complex")
     try:
         return np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
         raise InvalidParameterError(
             f"{name} must be a number or an array of numbers, got {str(value)[:40]!r}"
         ) from None
+
+
+def output_array(name: str, value: object, shape: tuple[int, ...]) -> NDArray[np.float64]:
+    """Return ``value`` if it is a writeable float64 array of ``shape``, or raise naming ``name``.
+
+    The ``out=`` arguments that save an allocation: a wrong one is refused before any work.
+    """
+    if not isinstance(value, np.ndarray) or value.dtype != np.float64:
+        kind = value.dtype if isinstance(value, np.ndarray) else type(value).__name__
+        raise ParameterTypeError(f"{name} must be a float64 numpy array, got {kind}")
+    if value.shape != shape or not value.flags.writeable:
+        raise InvalidParameterError(
+            f"{name} must be a writeable array of shape {shape} (the inputs' broadcast shape), "
+            f"got shape {value.shape}" + ("" if value.flags.writeable else ", read-only")
+        )
+    return value
 
 
 def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:

@@ -95,7 +95,7 @@ def problems(result: dict) -> list[str]:
     code, err, out = result["code"], result["stderr"], result["stdout"]
     if result["escaped"] or "Traceback" in err:
         found.append("traceback")
-    if code not in (0, 2, 130):
+    if code not in (0, 2, 130) and not result["escaped"]:  # an escaped error: a traceback
         found.append("exit")
     if code == 2 and not (err.count("\n") == 1 and err.startswith("pushrecovery: error: ")):
         found.append("multiline")
@@ -106,8 +106,19 @@ def problems(result: dict) -> list[str]:
     return found
 
 
-def generate(rng: random.Random, folder: Path, index: int, sources: list[Path]) -> fuzz_cases.Case:
+def generate(
+    rng: random.Random,
+    folder: Path,
+    index: int,
+    sources: list[Path],
+    callables: list[str],
+    api_share: float = 0.4,
+) -> fuzz_cases.Case:
     draw = rng.random()
+    if draw < api_share:  # a library call: the callable's name and the seed of its arguments
+        name = rng.choice(callables)
+        return fuzz_cases.Case(f"api:{name.split('.')[1]}", [name, str(rng.randrange(2**31))])
+    draw = (draw - api_share) / (1.0 - api_share) if api_share < 1.0 else 0.0
     if draw < 0.5:
         return fuzz_cases.command_case(rng, folder)
     if draw < 0.7:
@@ -123,10 +134,14 @@ def main() -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--timeout", type=float, default=60.0, help="hang limit per case [s]")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--api", type=float, default=0.4, help="share of library calls")
     parser.add_argument("--out", type=Path, default=ROOT / "out" / "fuzz")
     options = parser.parse_args()
 
+    import api as fuzz_api
     import biomdp
+
+    callables = sorted(fuzz_api.public())
 
     sources = sorted((Path(biomdp.__file__).parent / "tests" / "datasets").glob("*.c3d"))
     options.out = options.out.resolve()
@@ -155,11 +170,20 @@ def main() -> int:
             # Each case from its own seed: the same cases whatever the threads' timing.
             folder = work / f"{index}"
             folder.mkdir()
-            case = generate(random.Random(options.seed * 1_000_003 + index), folder, index, sources)
-            began = time.monotonic()
-            status, answer = worker.ask(
-                {"id": index, "args": case.args, "cwd": str(folder)}, options.timeout
+            case = generate(
+                random.Random(options.seed * 1_000_003 + index),
+                folder,
+                index,
+                sources,
+                callables,
+                options.api,
             )
+            began = time.monotonic()
+            request: dict = {"id": index, "args": case.args, "cwd": str(folder)}
+            if case.kind.startswith("api:"):
+                request = {"id": index, "api": case.args[0], "seed": int(case.args[1]),
+                           "cwd": str(folder)}  # fmt: skip
+            status, answer = worker.ask(request, options.timeout)
             spent = time.monotonic() - began
             found = (
                 problems(answer) if status == "answer" and isinstance(answer, dict) else [status]

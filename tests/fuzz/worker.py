@@ -1,6 +1,7 @@
 """One fuzzing worker: runs cases from stdin in this process, one JSON line out per case.
 
-Protocol (``campaign.py``): a line ``{"id": ..., "args": [...]}`` in; ``{"id": ...,
+Protocol (``campaign.py``): a line ``{"id": ..., "args": [...]}`` (a command line) or
+``{"id": ..., "api": name, "seed": int}`` (a library call, ``api.py``) in; ``{"id": ...,
 "code": int, "stdout": str, "stderr": str, "warnings": [str], "escaped": str | null}`` out,
 after the line ``{"started": id}`` that tells the parent which case a crash belongs to.
 ``escaped`` is an exception that left ``pushrecovery.cli.main`` (a traceback for the user).
@@ -15,6 +16,7 @@ import os
 import sys
 import traceback
 import warnings
+from pathlib import Path
 
 
 def run(args: list[str]) -> dict[str, object]:
@@ -55,7 +57,12 @@ def serve() -> None:
         folder = case.get("cwd", home)
         os.makedirs(folder, exist_ok=True)
         os.chdir(folder)
-        result = run(case["args"])
+        if "api" in case:
+            import api
+
+            result = api.call(case["api"], case["seed"], Path(folder))
+        else:
+            result = run(case["args"])
         os.chdir(home)
         sys.__stdout__.write(json.dumps({"id": case["id"], **result}) + "\n")
         sys.__stdout__.flush()

@@ -150,6 +150,7 @@ class Controller(ABC):
     state_labels: ClassVar[tuple[str, ...]] = ANKLE_STATE
 
     def __init__(self, params: BodyParams) -> None:
+        require_type("params", params, BodyParams)  # every controller's boundary
         self.params = params
 
     @abstractmethod

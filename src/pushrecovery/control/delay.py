@@ -27,6 +27,7 @@ class ReactionDelay(Controller):
     name = "reaction-delay"
 
     def __init__(self, inner: Controller, latency: float) -> None:
+        require_type("inner", inner, Controller)
         super().__init__(inner.params)
         self.inner = inner
         self.latency = latency

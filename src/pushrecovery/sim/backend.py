@@ -87,8 +87,13 @@ class Step(NamedTuple):
     info: StepInfo
 
 
+@runtime_checkable
 class Backend(Protocol):
-    """A plant behind the numbered contract of the module docstring."""
+    """A plant behind the numbered contract of the module docstring.
+
+    ``isinstance`` checks the names only: the boundary of
+    :func:`~pushrecovery.sim.simulate.simulate`.
+    """
 
     name: ClassVar[str]
     state_labels: ClassVar[tuple[str, ...]]
@@ -291,6 +296,7 @@ class PlantBase:
     input_labels: ClassVar[tuple[str, ...]] = ("cop", "hip_torque")
 
     def __init__(self, params: BodyParams) -> None:
+        require_type("params", params, BodyParams)  # every plant's boundary
         self.params = params
         self.stop_impacts = 0
         self.footholds: list[float] = [0.0]

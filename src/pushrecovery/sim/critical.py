@@ -18,6 +18,7 @@ from pushrecovery.arguments import finite_float, positive_float, require_type
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import Backend
 from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.push import Push, direction_sign
@@ -176,6 +177,7 @@ def pushed_state(plant: Plant, x0: float, velocity: float, *, force: bool) -> ND
     A velocity jump, or with ``force`` a real force at the CoM delivering the impulse m v
     (MuJoCo plants' :meth:`push`).
     """
+    require_type("plant", plant, Backend)
     if not force:
         return plant.reset(x0, velocity)
     plant.reset(x0, 0.0)

@@ -9,11 +9,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from pushrecovery.arguments import finite_array, positive_float
+from pushrecovery.arguments import finite_array, positive_float, require_type
 from pushrecovery.control.base import Command, Controller, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged, SimulationTimeout
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS
-from pushrecovery.sim.backend import Audited, Clocked, PlantBase
+from pushrecovery.sim.backend import Audited, Backend, Clocked, PlantBase
 from pushrecovery.sim.events import ForcePushing, Observer, ScheduledPush
 from pushrecovery.sim.plants import Plant
 from pushrecovery.sim.push import Push
@@ -294,8 +294,11 @@ def check_run(
     Returns the start state as a float array, the control period [s] and the number of control
     ticks. Raises :class:`InvalidParameterError` naming what is wrong: a non-finite state, a
     controller that needs another model, a period that does not fit the controller, the
-    duration or the dynamics.
+    duration or the dynamics; :class:`ParameterTypeError` when ``plant`` or ``controller``
+    is not one.
     """
+    require_type("plant", plant, Backend)
+    require_type("controller", controller, Controller)
     duration = positive_float("duration", duration, "s")
     if duration > MAX_DURATION:
         raise InvalidParameterError(

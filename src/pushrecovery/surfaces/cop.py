@@ -20,7 +20,13 @@ from typing import overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import finite_array, float_array, positive_float, require_type
+from pushrecovery.arguments import (
+    finite_array,
+    float_array,
+    output_array,
+    positive_float,
+    require_type,
+)
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 
@@ -104,7 +110,13 @@ def capture_point(x: ArrayLike, xdot: ArrayLike, omega: float) -> float | NDArra
     inv = 1.0 / omega  # multiplied, as the compiled kernels do: the same ξ to the bit
     if type(x) is float and type(xdot) is float:
         return x + xdot * inv
-    return float_array("x", x) + float_array("xdot", xdot) * inv
+    position, velocity = float_array("x", x), float_array("xdot", xdot)
+    try:
+        return position + velocity * inv
+    except ValueError:
+        raise InvalidParameterError(
+            f"x and xdot must broadcast, got shapes {position.shape} and {velocity.shape}"
+        ) from None
 
 
 def cop_region(params: BodyParams) -> CaptureInterval:
@@ -172,6 +184,15 @@ def capture_margin(
     x = float_array("x", x)
     xdot = float_array("xdot", xdot)
     inv_omega = 1.0 / positive_float("omega", omega, "1/s")
+    if out is not None or x.shape != xdot.shape:
+        try:
+            shape = np.broadcast_shapes(x.shape, xdot.shape)
+        except ValueError:
+            raise InvalidParameterError(
+                f"x and xdot must broadcast, got shapes {x.shape} and {xdot.shape}"
+            ) from None
+        if out is not None:
+            out = output_array("out", out, shape)
     centre, half = region.centre, region.half_width
     if _fusable(x, xdot, out):
         margin = np.empty_like(x) if out is None else out

@@ -34,6 +34,7 @@ from pushrecovery.arguments import (
     finite_float,
     finite_vector,
     float_array,
+    output_array,
     require_type,
 )
 from pushrecovery.errors import InvalidParameterError
@@ -88,11 +89,19 @@ def capture_point_xy(
     -------
     (ndarray, ndarray)
         ξ_x and ξ_y [m].
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``omega`` is outside [0.1, 100] 1/s, or ``x``/``xdot`` or ``y``/``ydot`` do not
+        broadcast (the states are not checked: NaN in, NaN out, as
+        :func:`~pushrecovery.surfaces.cop.capture_point`).
     """
-    return (
-        np.asarray(capture_point(x, xdot, omega), dtype=np.float64),
-        np.asarray(capture_point(y, ydot, omega), dtype=np.float64),
-    )
+    try:
+        py = np.asarray(capture_point(y, ydot, omega), dtype=np.float64)
+    except InvalidParameterError as exc:  # name the sideways axis
+        raise InvalidParameterError(str(exc).replace("x and xdot", "y and ydot")) from None
+    return np.asarray(capture_point(x, xdot, omega), dtype=np.float64), py
 
 
 def cmp_polygon(support: Support, params: BodyParams) -> ConvexPolygon:
@@ -213,6 +222,8 @@ def capture_margin_xy(
     except ValueError:
         shapes = ", ".join(str(a.shape) for a in arrays)
         raise InvalidParameterError(f"x, y, xdot and ydot must broadcast, got {shapes}") from None
+    if out is not None:
+        out = output_array("out", out, shape)
     if (
         all(a.shape == shape for a in arrays)
         and _fusable(arrays[0], arrays[2], out)

@@ -34,7 +34,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import bounded_float, finite_array, finite_vector, require_type
+from pushrecovery.arguments import (
+    bounded_float,
+    finite_array,
+    finite_vector,
+    require_type,
+    whole_number,
+)
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
@@ -145,7 +151,8 @@ def line_steps(
     ParameterTypeError
         If ``params`` is not a :class:`~pushrecovery.params.BodyParams`.
     InvalidParameterError
-        Values that are not finite, shapes that do not broadcast, or positions so large that
+        Values that are not finite, shapes that do not broadcast, a ``lower`` above its
+        ``upper``, or positions so large that
         the intervals or the first steps overflow.
     """
     require_type("params", params, BodyParams)
@@ -158,6 +165,11 @@ def line_steps(
         raise InvalidParameterError(
             f"capture, lower, upper and ankle must broadcast, got shapes {shapes}"
         ) from None
+    if np.any(lower > upper):
+        raise InvalidParameterError(
+            "lower must be <= upper (the support's back and front edges on the line) [m], got "
+            f"{int(np.count_nonzero(lower > upper))} pair(s) the other way round"
+        )
     with np.errstate(over="ignore", invalid="ignore"):  # reported below, as one error
         found = _line_steps(capture, lower, upper, ankle, params)
     stepping = found.steps > 0
@@ -223,7 +235,7 @@ def _line_steps(
 def sagittal_step_interval(params: BodyParams, steps: int | None = None) -> CaptureInterval:
     """C_N on the sagittal line (module docstring) [m]; N defaults to ``max_steps``."""
     require_type("params", params, BodyParams)
-    count = params.max_steps if steps is None else steps
+    count = params.max_steps if steps is None else whole_number("steps", steps, 1, 10**6)
     low, high = _line_step_bounds(params.heel, params.toe, 0.0, params, count)
     return CaptureInterval(float(low), float(high))
 

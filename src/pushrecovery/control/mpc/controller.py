@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.base import Command, Controller, register
 from pushrecovery.control.mpc.plan import Plan, Status
 from pushrecovery.control.mpc.problem import MPCSettings
@@ -62,6 +63,8 @@ class MPCController(Controller):
         self, params: BodyParams, settings: MPCSettings | None = None, **overrides: Any
     ) -> None:
         super().__init__(params)
+        if settings is not None:
+            require_type("settings", settings, MPCSettings)
         settings = settings or MPCSettings(**overrides)
         from qpsolvers import available_solvers
 

@@ -8,11 +8,14 @@ the first level whose region holds ξ, so P(level <= L) is the mass of the union
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 from scipy.special import ndtr
 
-from pushrecovery.arguments import require_type
+from pushrecovery.arguments import finite_array, require_type
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.gaussian import covariance_2d, gaussian_union_mass, maximal
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
@@ -48,8 +51,32 @@ def verdict_regions(params: BodyParams, support: Support | None) -> list[Level]:
     return [[support.polygon], [cmp_polygon(support, params)], *per_n]
 
 
+def _check_levels(name: str, levels: object) -> None:
+    """Raise naming ``name`` unless ``levels`` are non-empty lists of regions of one kind.
+
+    Polygons, or (lower, upper) pairs [m] with lower <= upper: what :func:`strategy_levels`
+    returns.
+    """
+    groups = levels if isinstance(levels, list) else None
+    regions = [r for g in groups or () if isinstance(g, list | tuple) for r in g]
+    if not groups or not regions or len(groups) != sum(isinstance(g, list | tuple) for g in groups):
+        raise ParameterTypeError(f"{name} must be a non-empty list of lists of regions")
+    if all(isinstance(r, ConvexPolygon) for r in regions):
+        return
+    pairs = [r for r in regions if isinstance(r, tuple) and len(r) == 2]
+    if len(pairs) != len(regions) or not all(
+        isinstance(v, float | int) and math.isfinite(v) for r in pairs for v in r
+    ):
+        raise ParameterTypeError(
+            f"{name} must hold polygons or finite (lower, upper) pairs [m], not a mix"
+        )
+    if any(low > high for low, high in pairs):
+        raise InvalidParameterError(f"{name} must have lower <= upper in every interval [m]")
+
+
 def region_middle(level: Level) -> FloatArray:
     """Return the middle of a level's first region [m]: an interval's, a polygon's centroid."""
+    _check_levels("level", [level])
     region = level[0]
     if isinstance(region, ConvexPolygon):
         return np.array(region.centroid)
@@ -61,6 +88,17 @@ def cumulative_masses(mean: FloatArray, cov: FloatArray, regions: list[Level]) -
 
     ``mean`` (n, d) [m] and ``cov`` (d, d) or (n, d, d) [m²] of ξ; d = 1 on the line.
     """
+    _check_levels("regions", regions)
+    mean = finite_array("mean", mean)
+    if mean.ndim != 2:
+        raise InvalidParameterError(f"mean must be of shape (n, d), got shape {mean.shape}")
+    if not isinstance(regions[0][0], ConvexPolygon):
+        cov = finite_array("cov", cov)
+        if cov.shape not in ((1, 1), (len(mean), 1, 1)) or np.any(cov < 0.0):
+            raise InvalidParameterError(
+                f"cov must be a variance >= 0 [m²] of shape (1, 1) or (n, 1, 1) on the line, "
+                f"got shape {cov.shape}"
+            )
     cumulative = np.empty((len(mean), len(regions)))
     if isinstance(regions[0][0], ConvexPolygon):
         sigma = covariance_2d("cov", cov)
