@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -99,6 +101,23 @@ def output_array(name: str, value: object, shape: tuple[int, ...]) -> NDArray[np
             f"got shape {value.shape}" + ("" if value.flags.writeable else ", read-only")
         )
     return value
+
+
+def output_folder(name: str, value: object) -> Path:
+    """Create the folder ``value`` (and its parents) and return it, or raise naming ``name``.
+
+    A path that is a file, a device, empty, too long or not writable is refused in one line.
+    """
+    if not isinstance(value, str | os.PathLike) or not str(value):
+        raise ParameterTypeError(f"{name} must be a folder's path, got {str(value)[:40]!r}")
+    folder = Path(value)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InvalidParameterError(
+            f"{name}: cannot create the folder {str(folder)[:200]}: {exc.strerror or exc}"
+        ) from None
+    return folder
 
 
 def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:

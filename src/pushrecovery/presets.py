@@ -9,11 +9,13 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InputFileError, InvalidParameterError, ParameterTypeError
 from pushrecovery.params import FIELD_NAMES, BodyParams
 
@@ -90,7 +92,7 @@ def load_params(
         Missing, unreadable or malformed TOML file.
     """
     values: dict[str, Any] = {}
-    from_file: dict[str, Any] = _read_toml(Path(file)) if file is not None else {}
+    from_file: dict[str, Any] = _read_toml(_toml_path(file)) if file is not None else {}
     if "feet" in from_file:  # where the body stands, not the body: load_support's
         _feet_values(from_file.pop("feet"))
     preset = str(from_file.pop("preset", preset))
@@ -190,7 +192,7 @@ def load_support(
     from pushrecovery.ground.support import FootPose, Support
 
     require_type("params", params, BodyParams)
-    values = _feet_values(_read_toml(Path(file)).get("feet", {})) if file is not None else {}
+    values = _feet_values(_read_toml(_toml_path(file)).get("feet", {})) if file is not None else {}
     if overrides is not None and not isinstance(overrides, Mapping):
         raise ParameterTypeError(
             f"overrides must be a mapping of stance, left and right, got {type(overrides).__name__}"
@@ -292,6 +294,12 @@ def _polygon_value(value: Any) -> tuple[tuple[float, float], ...]:
             )
         pairs.append((float(vertex[0]), float(vertex[1])))
     return tuple(pairs)
+
+
+def _toml_path(file: object) -> Path:
+    """``file`` as a Path, or raise naming it unless it is a str or a path."""
+    require_type("file", file, (str, os.PathLike))
+    return Path(file)  # type: ignore[arg-type]
 
 
 def _read_toml(path: Path) -> dict[str, Any]:

@@ -135,6 +135,9 @@ def main() -> int:
     parser.add_argument("--timeout", type=float, default=60.0, help="hang limit per case [s]")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--api", type=float, default=0.4, help="share of library calls")
+    parser.add_argument(
+        "--boundary", action="store_true", help="library calls on the validating floors only"
+    )
     parser.add_argument("--out", type=Path, default=ROOT / "out" / "fuzz")
     options = parser.parse_args()
 
@@ -142,6 +145,8 @@ def main() -> int:
     import biomdp
 
     callables = sorted(fuzz_api.public())
+    if options.boundary:
+        callables = [name for name in callables if fuzz_api.in_boundary(name)]
 
     sources = sorted((Path(biomdp.__file__).parent / "tests" / "datasets").glob("*.c3d"))
     options.out = options.out.resolve()

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from pushrecovery.arguments import output_folder, require_type
 from pushrecovery.extras import require
 
 if TYPE_CHECKING:  # the trial's summary serialises itself with json_safe
@@ -58,8 +59,10 @@ def write_analysis(analysis: TrialAnalysis, out_dir: str | Path) -> dict[str, Pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    from pushrecovery.analysis.trial import TrialAnalysis
+
+    require_type("analysis", analysis, TrialAnalysis)
+    out = output_folder("out_dir", out_dir)
     table = analysis.to_arrow()
     paths = {
         "frames_parquet": out / FRAME_FILES[0],

@@ -203,7 +203,9 @@ def mean_frequency(cop: ArrayLike, rate: float) -> Components:
 
     The resultant is the turn rate of a circle of radius MDIST run at MVELO; per axis, Prieto's
     sinusoid form (a sine of frequency f gives π f / (2√2) ≈ 1.11 f, a triangle wave √2 f).
-    Arguments and errors as :func:`mean_velocity`; returns (total, ap, ml) [Hz].
+    Arguments and errors as :func:`mean_velocity`; returns (total, ap, ml) [Hz], NaN for a
+    component without sway (a mean distance of 0: the frequency is undefined, as the ml of a
+    recording along ap only).
     """
     velocity, distance = mean_velocity(cop, rate), mean_distance(cop)
     scale = (2.0 * math.pi, 4.0 * math.sqrt(2.0), 4.0 * math.sqrt(2.0))
@@ -250,7 +252,8 @@ def _band(band: object, rate: float) -> tuple[float, float]:
     try:
         low, high = (float(value) for value in band)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
-        raise InvalidParameterError(f"band must be (low, high) [Hz], got {band!r}") from None
+        shown = f"shape {band.shape}" if isinstance(band, np.ndarray) else repr(band)[:60]
+        raise InvalidParameterError(f"band must be (low, high) [Hz], got {shown}") from None
     if not 0.0 < low < high <= rate / 2.0:  # NaN fails too
         raise InvalidParameterError(
             f"band must satisfy 0 < low < high <= rate / 2 = {rate / 2.0:g} Hz, got {band!r}"

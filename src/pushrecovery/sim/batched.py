@@ -157,6 +157,7 @@ def recovery_pushes(
 
     starts, speeds, ticks, rest_ticks = _checked_pushes(bodies, x0, xdot, duration)
     controllers = {} if controllers is None else controllers
+    require_type("controllers", controllers, dict)
     count, rest = len(bodies), RestCriterion()
     code, end = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
     steps, stops = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)

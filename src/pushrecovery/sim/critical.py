@@ -265,6 +265,7 @@ def critical_push(
     CriticalPush
         ``velocity`` signed like ẋ [m/s]; ``predicted_velocity`` from the surface.
     """
+    require_type("params", params, BodyParams)
     x0 = finite_float("x", x0, "m")
     if not params.heel < x0 < params.toe:
         raise InvalidParameterError(

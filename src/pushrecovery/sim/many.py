@@ -164,6 +164,8 @@ def run_many(
             f"bodies, x0 and xdot must have one entry per push, got {count}, {len(x0)}, {len(xdot)}"
         )
     latency = bounded_float("latency", latency, 0.0, 1.0, "s")
+    if on_start is not None and not callable(on_start):
+        raise ParameterTypeError(f"on_start must be callable, got {type(on_start).__name__}")
     chosen = (
         "loop"
         if latency > 0.0 and engine == "auto"

@@ -75,7 +75,8 @@ class MjcfSource:
         names = [*self.feet, self.torso] + ([] if self.keyframe is None else [self.keyframe])
         if not all(isinstance(name, str) and name for name in names):
             raise InvalidParameterError(
-                f"feet, torso and keyframe must be non-empty names, got {names!r}"
+                "feet, torso and keyframe must be non-empty names, got "
+                f"{[n if isinstance(n, str) else type(n).__name__ for n in names]!r}"
             )
 
     @property

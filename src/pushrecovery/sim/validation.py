@@ -29,9 +29,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, non_negative_float, require_type
+from pushrecovery.arguments import finite_array, finite_float, non_negative_float, require_type
 from pushrecovery.control.base import make_controller
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import critical_push, pushed_state
 from pushrecovery.sim.physical_checks import PhysicalChecks
@@ -380,6 +380,10 @@ def confusion_matrix(
     The prediction is :func:`~pushrecovery.surfaces.classify.classify` of the state after
     the push (x0, v); a strategy left out of ``strategies`` counts as failing.
     """
+    x0s = finite_array("x0s", x0s).reshape(-1).tolist()
+    velocities = finite_array("velocities", velocities).reshape(-1).tolist()
+    if progress is not None and not callable(progress):
+        raise ParameterTypeError(f"progress must be callable, got {type(progress).__name__}")
     for strategy in strategies:
         _setup(backend, strategy)
     counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)

@@ -125,8 +125,13 @@ def _plane_codes(
     the states beyond the hip region only, on their step lines.
     """
     support = Support.from_params(params) if support is None else support
-    inputs = [np.asarray(0.0 if a is None else a, dtype=np.float64) for a in (x, y, xdot, ydot)]
-    shape = np.broadcast_shapes(*(a.shape for a in inputs))
+    given = {"x": x, "y": y, "xdot": xdot, "ydot": ydot}
+    inputs = [float_array(n, 0.0 if a is None else a) for n, a in given.items()]
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in inputs))
+    except ValueError:
+        shapes = ", ".join(str(a.shape) for a in inputs)
+        raise InvalidParameterError(f"x, y, xdot and ydot must broadcast, got {shapes}") from None
     size = math.prod(shape)
     codes = np.empty(shape, dtype=np.int8)
     flat_codes = codes.reshape(-1)

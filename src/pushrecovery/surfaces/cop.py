@@ -262,6 +262,8 @@ def critical_velocity(
     InvalidParameterError
         If a position is not finite or a direction is not +1 or −1.
     """
+    if region is not None:
+        require_type("region", region, CaptureInterval)
     region = cop_region(params) if region is None else region
     x = finite_array("x", x)
     direction = finite_array("direction", direction)

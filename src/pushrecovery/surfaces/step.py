@@ -28,7 +28,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import bounded_float, finite_array, finite_float, require_type
+from pushrecovery.arguments import (
+    bounded_float,
+    finite_array,
+    finite_float,
+    float_array,
+    require_type,
+)
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.kernels.step_scalar import MIN_STEP_LENGTH as MIN_STEP_LENGTH
 from pushrecovery.kernels.step_scalar import decide, feasible
@@ -277,8 +283,8 @@ def _edges(
     """Return the new foot's edges: ``params``' unless given, checked (heel < toe)."""
     if heel is None and toe is None:
         return params.heel, params.toe
-    back = params.heel if heel is None else np.asarray(heel, dtype=np.float64)
-    front = params.toe if toe is None else np.asarray(toe, dtype=np.float64)
+    back = params.heel if heel is None else float_array("heel", heel)
+    front = params.toe if toe is None else float_array("toe", toe)
     _check_edges(not np.any(np.greater_equal(back, front)), heel, toe)
     return back, front
 

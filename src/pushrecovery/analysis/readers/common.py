@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.analysis.recording import Recording
-from pushrecovery.arguments import require_type
+from pushrecovery.arguments import finite_vector, require_type
 from pushrecovery.errors import InputFileError, InvalidParameterError
 
 __all__ = [
@@ -71,11 +72,19 @@ def _path(path: object) -> Path:
 
 
 def _check_file(path: Path) -> None:
-    if not path.exists():
-        raise InputFileError(f"file not found: {path}")
-    if path.is_dir():
+    try:  # a name too long, a symlink loop, a folder without permission: the OS says why
+        found = path.stat()
+    except FileNotFoundError:
+        raise InputFileError(f"file not found: {path}") from None
+    except ValueError:  # a NUL in the name
+        raise InputFileError(f"{str(path)[:200]!r} is not a file name (a NUL character)") from None
+    except OSError as exc:
+        raise InputFileError(f"{str(path)[:200]}: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(found.st_mode):
         raise InputFileError(f"{path} is a directory, not a file")
-    if path.stat().st_size == 0:
+    if not stat.S_ISREG(found.st_mode):  # a FIFO would block, /dev/zero never end
+        raise InputFileError(f"{path} is not a regular file (a pipe or a device)")
+    if found.st_size == 0:
         raise InputFileError(f"{path} is empty")
 
 
@@ -157,12 +166,15 @@ def body_rotation(ap_axis: str, up: FloatArray | None = None) -> FloatArray:
     ParameterTypeError
         If ``ap_axis`` is not a str.
     InvalidParameterError
-        If ``ap_axis`` is not one of the names, or not horizontal.
+        If ``ap_axis`` is not one of the names, or not horizontal, or ``up`` is not a unit
+        lab axis (3 numbers).
     """
     require_type("ap_axis", ap_axis, str)
     if ap_axis not in AP_AXES:
         raise InvalidParameterError(f"ap_axis must be one of {', '.join(AP_AXES)}, got {ap_axis!r}")
-    vertical = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, dtype=np.float64)
+    vertical = np.array([0.0, 0.0, 1.0]) if up is None else finite_vector("up", up, 3)
+    if up is not None and sorted(np.abs(vertical).tolist()) != [0.0, 0.0, 1.0]:
+        raise InvalidParameterError(f"up must be a unit lab axis, got {vertical.tolist()}")
     sign = -1.0 if ap_axis.startswith("-") else 1.0
     ap = sign * np.eye(3)["xyz".index(ap_axis[-1])]
     if abs(float(ap @ vertical)) > 1e-9:

@@ -41,6 +41,7 @@ from pushrecovery.analysis.trial.summary import (
 )
 from pushrecovery.analysis.trial.support import _repair_loaded, _support
 from pushrecovery.analysis.zero_point import ZERO_FORCE, com_from_force
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 
@@ -84,6 +85,10 @@ def analyze(
         When the trial has no usable CoM (neither positions nor a ground reaction force that
         crosses zero), or the base of support is inconsistent.
     """
+    require_type("recording", recording, Recording)
+    require_type("params", params, BodyParams)
+    if settings is not None:
+        require_type("settings", settings, AnalysisSettings)
     settings = settings or AnalysisSettings()
     gaps: list[Gap] = []
     notes = list(recording.notes)

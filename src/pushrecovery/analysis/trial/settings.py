@@ -15,6 +15,7 @@ from pushrecovery.analysis.recording import (
     LOADED,
     Recording,
 )
+from pushrecovery.arguments import finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.extras import require
 from pushrecovery.params import BodyParams
@@ -111,18 +112,20 @@ class AnalysisSettings:
             value = getattr(self, name)
             if value is None:
                 continue
-            if not (math.isfinite(value) and value >= 0.0):
+            value = finite_float(name, value)
+            if not value >= 0.0:
                 raise InvalidParameterError(f"{name} must be a finite number >= 0, got {value}")
         for name in ("contact_height", "foot_width"):
             value = getattr(self, name)
             if value is None:
                 continue
-            if not (math.isfinite(value) and value > 0.0):
+            value = finite_float(name, value)
+            if not value > 0.0:
                 raise InvalidParameterError(f"{name} must be a finite number > 0, got {value}")
         for name in ("ankle_ap", "ankle_ml"):
             value = getattr(self, name)
-            if value is not None and not math.isfinite(value):
-                raise InvalidParameterError(f"{name} must be finite, got {value}")
+            if value is not None:
+                finite_float(name, value, "m")
         if self.xcom_length not in XCOM_LENGTHS:
             raise InvalidParameterError(
                 f"xcom_length must be one of {list(XCOM_LENGTHS)}, got {self.xcom_length!r}"

@@ -88,7 +88,7 @@ class MPCSettings:
             ("input_weights", self.input_weights, 2),
         ):
             if not isinstance(values, tuple | list) or len(values) != size:
-                got = len(values) if isinstance(values, tuple | list) else repr(values)
+                got = len(values) if isinstance(values, tuple | list) else type(values).__name__
                 raise InvalidParameterError(f"{name} must have {size} entries, got {got}")
             checked = tuple(finite_float(name, v) for v in values)
             if min(checked) < 0.0 or (name == "input_weights" and min(checked) <= 0.0):

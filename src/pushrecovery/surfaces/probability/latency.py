@@ -12,7 +12,12 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import finite_array, non_negative_float, positive_float
+from pushrecovery.arguments import (
+    finite_array,
+    non_negative_float,
+    positive_float,
+    whole_number,
+)
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
@@ -72,7 +77,12 @@ def latency_growth(omega: float, tau: float) -> float:
 def latency_nodes(
     latency: float | tuple[float, float], nodes: int = LATENCY_NODES
 ) -> tuple[FloatArray, FloatArray]:
-    """Return the nodes [s] and weights (sum 1) of a latency: one, or Gauss–Legendre on a range."""
+    """Return the nodes [s] and weights (sum 1) of a latency: one, or Gauss–Legendre on a range.
+
+    ``nodes``: the Gauss–Legendre order on a range, in [1, 100] (an eigenvalue problem of that
+    size: beyond 100 nodes the weights gain nothing and the work grows as its cube).
+    """
+    nodes = whole_number("nodes", nodes, 1, 100)
     if isinstance(latency, tuple | list):
         if len(latency) != 2:
             raise InvalidParameterError(
