@@ -101,7 +101,7 @@ VALID: dict[str, Any] = {
     "force": FORCE, "rate": 100.0, "cutoff": 6.0, "max_gap": 0.1, "ap_axis": "x",
     "missing": np.zeros(10, dtype=bool), "valid": np.ones(10, dtype=bool),
     "source": TIME, "outcome_of": lambda v: Outcome.RECOVERED if abs(v) < 1.0 else Outcome.FELL,
-    "guess": 0.5, "max_velocity": 4.0,
+    "guess": 0.5, "max_velocity": 4.0, "horizon": 1.0,
     # Events of measured trials.
     "signal": SWAY, "vertical_force": np.full(len(TIME), 700.0), "windows": [(0.0, 1.0)],
     "events": [],

@@ -11,6 +11,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
+#: A bound for numbers a formula squares where nothing narrower is checked
+#: (:func:`finite_array`'s ``bound``): no quantity of a humanoid comes near, and squares and
+#: products stay finite (1e300 < 1.8e308).
+MAX_MAGNITUDE = 1e150
+_LARGEST = float(np.finfo(np.float64).max)
+
 
 def require_type(name: str, value: object, kind: type | tuple[type, ...]) -> None:
     """Raise :class:`ParameterTypeError` naming ``name`` unless ``value`` is a ``kind``."""
@@ -120,12 +126,26 @@ def output_folder(name: str, value: object) -> Path:
     return folder
 
 
-def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
-    """Return ``value`` as a float64 array with only finite entries, or raise naming ``name``."""
+def finite_array(
+    name: str, value: ArrayLike, bound: float = math.inf, unit: str = ""
+) -> NDArray[np.float64]:
+    """Return ``value`` as a float64 array with only finite entries, or raise naming ``name``.
+
+    With ``bound``, entries must also lie in ±``bound`` (e.g. :data:`MAX_MAGNITUDE` where
+    the formula that follows squares them and nothing narrower is checked).
+    """
     array = float_array(name, value)
-    if not np.isfinite(array).all():
+    # Two reductions, no temporary: NaN propagates into both and fails the comparisons, and
+    # so do infinities (the limit is the largest float at most).
+    limit = min(bound, _LARGEST)
+    if array.size and not (array.max() <= limit and array.min() >= -limit):
         bad = int(np.size(array) - np.count_nonzero(np.isfinite(array)))
-        raise InvalidParameterError(f"{name} must be finite, got {bad} non-finite value(s)")
+        if bad:
+            raise InvalidParameterError(f"{name} must be finite, got {bad} non-finite value(s)")
+        raise InvalidParameterError(
+            f"{name} must have entries in [-{bound:g}, {bound:g}]{_unit(unit)}, "
+            f"got {float(np.max(np.abs(array))):g}"
+        )
     return array
 
 
@@ -155,6 +175,15 @@ def whole_number(name: str, value: object, low: int, high: int) -> int:
     return int(value)
 
 
+def broadcast(**arrays: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+    """Return the arrays broadcast together, or raise naming them and their shapes."""
+    try:
+        return list(np.broadcast_arrays(*arrays.values()))
+    except ValueError:
+        shapes = ", ".join(f"{name} {a.shape}" for name, a in arrays.items())
+        raise InvalidParameterError(f"{', '.join(arrays)} must broadcast, got {shapes}") from None
+
+
 def finite_vector(
     name: str, value: ArrayLike, size: int, bound: float = math.inf, unit: str = ""
 ) -> NDArray[np.float64]:
@@ -164,12 +193,7 @@ def finite_vector(
         raise InvalidParameterError(
             f"{name} must be {size} numbers (shape ({size},)){_unit(unit)}, got shape {array.shape}"
         )
-    if bound < math.inf and float(np.max(np.abs(array))) > bound:
-        raise InvalidParameterError(
-            f"{name} must have entries in [-{bound:g}, {bound:g}]{_unit(unit)}, "
-            f"got {array.tolist()}"
-        )
-    return array
+    return finite_array(name, array, bound, unit)
 
 
 def sample_array(

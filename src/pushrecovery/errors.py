@@ -19,7 +19,16 @@ __all__ = [
 
 
 class PushRecoveryError(Exception):
-    """Base class of every error pushrecovery raises on purpose."""
+    """Base class of every error pushrecovery raises on purpose.
+
+    Its message is one line (the CLI prints it as one): a message that quotes a value whose
+    form spans lines (a numpy array's repr) has its line breaks folded into spaces.
+    """
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        if len(args) == 1 and isinstance(args[0], str) and "\n" in args[0]:
+            args = (" ".join(args[0].split()),)
+        super().__init__(*args, **kwargs)  # ModuleNotFoundError's name= (MissingExtraError)
 
 
 class InvalidParameterError(PushRecoveryError, ValueError):

@@ -42,6 +42,7 @@ EXCLUDED = {
     "pushrecovery.campaign.watchdog.start": "ends its own process when armed (a worker's)",
     "pushrecovery.campaign.watchdog.arm": "ends its own process at the deadline (a worker's)",
     "pushrecovery.control.base.register": "a class decorator: registering changes the registry",
+    "pushrecovery.control.mpc.plan.Plan": "a result the MPC builds at every tick (1 kHz path)",
 }
 #: Floors where every public entry validates its arguments (the boundary of issue 38): the
 #: suite's fixed-seed run (``tests/test_fuzz.py``) draws from these. ``make fuzz`` draws from
@@ -55,41 +56,27 @@ BOUNDARY = (
 #: and C3D files written (``make fuzz`` mutates those files instead).
 NOT_BOUNDARY = ("pushrecovery.sim.mujoco", "pushrecovery.control.wbc", "pushrecovery.analysis.c3d")
 #: Entries of the boundary floors that do not validate yet: the suite's run leaves them out,
-#: ``make fuzz`` counts them (docs/reliability.md). The MPC's parts are built by
-#: MPCController from checked settings; ConvexPolygon's own constructor takes the library's
-#: arrays (users build polygons with convex_polygon, rectangle or convex_hull); the LPs are the
-#: tests' exact programs.
-NOT_YET = (
-    "pushrecovery.control.mpc.solvers", "pushrecovery.control.mpc.feasibility",
-    "pushrecovery.control.mpc.qp", "pushrecovery.control.mpc.plan",
-    "pushrecovery.ground.polygon.ConvexPolygon", "pushrecovery.surfaces.capture_lp",
-    "pushrecovery.analysis.trial.risk.frame_risk", "pushrecovery.analysis.signals.find_gaps",
-    "pushrecovery.sim.backend.check_com_state", "pushrecovery.sim.validation.critical_table",
-    "pushrecovery.analysis.readers.c3d_files.read_c3d_recording",
-    "pushrecovery.surfaces.probability.scores", "pushrecovery.ground.gaussian.gaussian_mass",
-    "pushrecovery.surfaces.probability.latency.delayed_capture_point",
-    "pushrecovery.analysis.posturography.sway_measures",
-    "pushrecovery.analysis.margins_2d.time_to_boundary_cop",
-    "pushrecovery.analysis.margins.direction_margins", "pushrecovery.sim.mjcf_source",
-    "pushrecovery.sim.batched.recovery_pushes", "pushrecovery.surfaces.step.plan_steps",
-    # A NaN field for y = 1e300 (found by this fuzz, not fixed yet).
-    "pushrecovery.surfaces.classify.classify",
-    "pushrecovery.sim.validation.needed_strategy", "pushrecovery.sim.many.run_many",
-    "pushrecovery.analysis.zero_point.com_from_force", "pushrecovery.analysis.trial.pipeline",
-    "pushrecovery.sim.validation.confusion_matrix", "pushrecovery.analysis.events.mass_from_quiet",
-    "pushrecovery.models.lipm.lipm_state", "pushrecovery.ground.minkowski.regular_polygon",
-    "pushrecovery.surfaces.step_regions.line_steps",
-    "pushrecovery.analysis.posturography.sway_spectrum",
-)  # fmt: skip
-#: Callables that return NaN by their documentation (a value that does not exist), and where.
+#: ``make fuzz`` counts them (docs/reliability.md). None today.
+NOT_YET: tuple[str, ...] = ()
+#: Callables that return NaN or an infinity by their documentation (a value that does not
+#: exist, a time that never comes), and where.
 NAN_DOCUMENTED = {
     "pushrecovery.surfaces.cop.capture_point": "the states unchecked: NaN in, NaN out (per tick)",
+    "pushrecovery.surfaces.plane.capture_point_xy": "the states unchecked, as capture_point",
     "pushrecovery.surfaces.step.plan_step": "theta, step_length: NaN where no step is ready",
     "pushrecovery.surfaces.step.plan_steps": "theta, step_length: NaN where no step is ready",
     "pushrecovery.surfaces.plane.plan_step_xy": "the step's plan: NaN where no step is ready",
     "pushrecovery.analysis.margins_2d.margins_2d": "NaN: a missing frame, or no CoP given",
+    "pushrecovery.analysis.margins_2d.time_to_boundary_cop": "+inf: the CoP never leaves",
+    "pushrecovery.analysis.margins_2d.time_to_boundary_xcom": "+inf: the XCoM never leaves",
     "pushrecovery.analysis.margins.time_to_leave": "NaN: a missing frame",
     "pushrecovery.analysis.posturography.mean_frequency": "NaN: an axis without sway",
+    "pushrecovery.surfaces.step_regions.line_steps": "first steps: NaN where no step is taken",
+    "pushrecovery.analysis.margins.direction_margins": "NaN: a missing frame, or no step",
+    "pushrecovery.sim.many.run_many": "NaN: the measures of an error row (a push that timed out)",
+    "pushrecovery.sim.validation.critical_table": "NaN: no correction, no measured force",
+    "pushrecovery.analysis.zero_point.com_from_force": "NaN outside the zero points",
+    "pushrecovery.surfaces.probability.scores.brier_score": "NaN: no predictions",
 }
 #: Floors whose work is minutes of simulation or whole campaigns on valid input: fuzzed only
 #: with at least one argument drawn hostile for its type, so that a refusal is what is checked.
@@ -168,6 +155,8 @@ def public() -> dict[str, Any]:
         for attribute in getattr(module, "__all__", []):
             item = getattr(module, attribute, None)
             if getattr(item, "__module__", None) != name or f"{name}.{attribute}" in EXCLUDED:
+                continue
+            if attribute.endswith("_unchecked"):  # the checked function's kernel, by its name
                 continue
             if inspect.isfunction(item) or (inspect.isclass(item) and _takes_input(item)):
                 found[f"{name}.{attribute}"] = item

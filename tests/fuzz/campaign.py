@@ -1,10 +1,12 @@
-"""``make fuzz``: thousands of hostile command lines and mutated files, each counted.
+"""``make fuzz``: thousands of hostile library calls, command lines and files, each counted.
 
-Cases (``cases.py``) run in worker processes (``worker.py``), many per process; a worker that
-dies takes only its current case with it (a *crash*, then a new worker goes on), one that does
-not answer within ``--timeout`` is killed (a *hang*). Each answer is checked as a user would
+Cases (``api.py``: library calls; ``cases.py``: command lines, mutated files, folders) run
+in worker processes (``worker.py``), many per process; a worker that dies takes only its
+current case with it (a *crash*, then a new worker goes on), one that does not answer within
+``--timeout`` is killed (a *hang*). Each answer is checked as a user would
 see it: exit status 0 or 2; on 2, exactly one stderr line ``pushrecovery: error: ...``; no
-traceback, no Python warning, and no NaN or infinity in the output. One summary line, the
+traceback, no Python warning, and no NaN or infinity in the output; a batch over a folder
+keeps every good trial (else *lost*). One summary line, the
 failures in ``OUT/failures.jsonl`` (with their input files kept), exit status 1 on any.
 
 Usage: ``python tests/fuzz/campaign.py [--cases 10000] [--seed 0] [--timeout 60]``.
@@ -33,7 +35,7 @@ ROOT = Path(__file__).resolve().parents[2]
 #: A NaN or an infinity printed as a value: not the key "inf" (N = ∞ steps) of ``bounds``,
 #: which is followed by a colon (JSON) or a value (the table).
 NUMBER = re.compile(r"(?<![\w.\"])-?(nan|NaN|inf|Inf|Infinity)(?![\w\"])(?!\s+\[)")
-KINDS = ("crash", "hang", "traceback", "nan", "multiline", "warning", "exit")
+KINDS = ("crash", "hang", "traceback", "nan", "multiline", "warning", "exit", "lost")
 
 
 class Worker:
@@ -106,6 +108,15 @@ def problems(result: dict) -> list[str]:
     return found
 
 
+def keeps_good_trials(folder: Path, expect: int) -> bool:
+    """Whether a batch over a folder kept its good trials: at least ``expect`` analysed."""
+    try:
+        summary = json.loads((folder / "out" / "summary.json").read_text())
+    except (OSError, ValueError):
+        return False
+    return int(summary.get("analysed", 0)) >= expect
+
+
 def generate(
     rng: random.Random,
     folder: Path,
@@ -119,13 +130,17 @@ def generate(
         name = rng.choice(callables)
         return fuzz_cases.Case(f"api:{name.split('.')[1]}", [name, str(rng.randrange(2**31))])
     draw = (draw - api_share) / (1.0 - api_share) if api_share < 1.0 else 0.0
-    if draw < 0.5:
+    if draw < 0.45:
         return fuzz_cases.command_case(rng, folder)
-    if draw < 0.7:
+    if draw < 0.6:
         return fuzz_cases.c3d_case(rng, folder, index, sources)
-    if draw < 0.85:
+    if draw < 0.72:
         return fuzz_cases.csv_case(rng, folder, index)
-    return fuzz_cases.toml_case(rng, folder, index)
+    if draw < 0.84:
+        return fuzz_cases.toml_case(rng, folder, index)
+    if draw < 0.92:
+        return fuzz_cases.mjcf_case(rng, folder, index)
+    return fuzz_cases.folder_case(rng, folder, index)
 
 
 def main() -> int:
@@ -138,6 +153,7 @@ def main() -> int:
     parser.add_argument(
         "--boundary", action="store_true", help="library calls on the validating floors only"
     )
+    parser.add_argument("--only", default="", help="library calls of these prefixes (a,b,...)")
     parser.add_argument("--out", type=Path, default=ROOT / "out" / "fuzz")
     options = parser.parse_args()
 
@@ -147,6 +163,8 @@ def main() -> int:
     callables = sorted(fuzz_api.public())
     if options.boundary:
         callables = [name for name in callables if fuzz_api.in_boundary(name)]
+    if options.only:
+        callables = [n for n in callables if n.startswith(tuple(options.only.split(",")))]
 
     sources = sorted((Path(biomdp.__file__).parent / "tests" / "datasets").glob("*.c3d"))
     options.out = options.out.resolve()
@@ -193,6 +211,8 @@ def main() -> int:
             found = (
                 problems(answer) if status == "answer" and isinstance(answer, dict) else [status]
             )
+            if case.expect is not None and not found and not keeps_good_trials(folder, case.expect):
+                found.append("lost")
             if status != "answer":
                 worker.close()
                 worker = Worker(log)
@@ -216,7 +236,15 @@ def main() -> int:
             shutil.rmtree(folder, ignore_errors=True)  # the case's files and outputs
         worker.close()
 
-    threads = [threading.Thread(target=serve) for _ in range(options.workers)]
+    broken: list[str] = []  # the campaign's own errors: a fuzzer that stops early fails
+
+    def guarded() -> None:
+        try:
+            serve()
+        except Exception as exc:
+            broken.append(f"{type(exc).__name__}: {exc}")
+
+    threads = [threading.Thread(target=guarded) for _ in range(options.workers)]
     for thread in threads:
         thread.start()
     for thread in threads:
@@ -233,6 +261,9 @@ def main() -> int:
         + f"; slowest {slowest[0]:.1f} s ({slowest[1]})"
         + (f"; details in {options.out / 'failures.jsonl'}" if bad else "")
     )
+    if broken or total != options.cases:
+        print(f"fuzz: the campaign itself failed ({total} of {options.cases} cases): {broken}")
+        return 2
     return 1 if bad else 0
 
 

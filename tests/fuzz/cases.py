@@ -1,4 +1,5 @@
-"""Fuzzing cases: random command lines of every command and mutated C3D, CSV and TOML files.
+"""Fuzzing cases: random command lines of every command, mutated C3D, CSV, TOML and MJCF files,
+and folders of good and bad trials.
 
 Every draw comes from one ``random.Random(seed)``: a campaign is reproducible from its seed.
 The options and their types are read from the commands themselves (click's parameters), so a
@@ -9,6 +10,7 @@ from __future__ import annotations
 
 import importlib
 import math
+import os
 import random
 from dataclasses import dataclass
 from pathlib import Path
@@ -99,10 +101,14 @@ SKIP = {"--help", "--version"}
 
 @dataclass(frozen=True)
 class Case:
-    """One command line, and what it exercises (the input class of the summary)."""
+    """One command line, and what it exercises (the input class of the summary).
+
+    ``expect``: for a folder of trials, how many good ones the batch must keep.
+    """
 
     kind: str
     args: list[str]
+    expect: int | None = None
 
 
 def _commands() -> dict[str, click.Command]:
@@ -260,3 +266,90 @@ def c3d_case(rng: random.Random, folder: Path, index: int, sources: list[Path]) 
     path.write_bytes(mutate_bytes(rng, source.read_bytes()))
     extra: list[Any] = rng.choice([[], ["--json"], ["--units", "mm"]])
     return Case("file:c3d", ["analyze", str(path), "--out", str(folder / f"out{index}"), *extra])
+
+
+# --- MJCF files and folders of trials ---------------------------------------------------------
+_MJCF: list[str] = []
+
+
+def _biped3d_xml() -> str:
+    """The generated biped3d's MJCF (once per worker process: a mutation's source)."""
+    if not _MJCF:
+        from pushrecovery import load_params
+        from pushrecovery.sim.mujoco.humanoid3d.biped3d import build_biped3d
+
+        _MJCF.append(build_biped3d(load_params()).to_xml())
+    return _MJCF[0]
+
+
+def mjcf_case(rng: random.Random, folder: Path, index: int) -> Case:
+    """``humanoid simulate --model FILE.xml`` with a mutated MJCF file (the generated biped3d).
+
+    Numbers become NaN, huge or negative, elements and lines go, the file is cut or its bytes
+    flipped: every file is refused in one line or simulated (for 0.05 s).
+    """
+    lines = _biped3d_xml().splitlines()
+    for _ in range(rng.choice([1, 2, 3])):
+        i = rng.randrange(len(lines))
+        action = rng.random()
+        if action < 0.4 and '"' in lines[i]:
+            parts = lines[i].split('"')
+            j = rng.randrange(1, len(parts), 2) if len(parts) > 2 else 0
+            parts[j] = rng.choice(["nan", "inf", "-1", "0", "1e300", "", "x", "1 2", "-0"])
+            lines[i] = '"'.join(parts)
+        elif action < 0.6:
+            del lines[i]
+        elif action < 0.7:
+            lines = lines[: max(1, i)]
+        elif action < 0.8:
+            lines.insert(i, rng.choice(["<include file='/dev/zero'/>", "<!--", "<body>", "&x;"]))
+        else:
+            raw = mutate_bytes(rng, "\n".join(lines).encode(), head=1 << 20)
+            lines = raw.decode("latin-1").splitlines() or [""]
+    path = folder / f"case{index}.xml"
+    path.write_text("\n".join(lines) + "\n", encoding="latin-1")
+    return Case(
+        "file:mjcf",
+        ["humanoid", "simulate", "--model", str(path), "--duration", "0.05", "--json"],
+    )
+
+
+def folder_case(rng: random.Random, folder: Path, index: int) -> Case:
+    """``analyze FOLDER`` over a folder of good and bad trials: each bad one an error row.
+
+    Good trials (quiet standing) beside a FIFO, a symlink loop, a link to ``/dev/zero``, an
+    empty file, a folder named like a trial, a trial 60 folders deep, odd names and mutated
+    trials; sometimes thousands of other files. ``expect`` is the number of good trials the
+    batch must keep (its ``analysed`` count).
+    """
+    data = folder / "data"
+    data.mkdir()
+    good = rng.choice([1, 2, 5, 12])
+    if rng.random() < 0.2:
+        for k in range(3000):
+            (data / f"notes{k}.txt").write_text("not a trial\n")
+    for k in range(good):
+        (data / f"good{k}.csv").write_text(csv_text(random.Random(k)))
+    bad = rng.sample(["fifo", "loop", "zero", "empty", "dir", "deep", "name", "mutated"], 3)
+    if "fifo" in bad:
+        os.mkfifo(data / "fifo.csv")
+    if "loop" in bad:
+        (data / "loop.c3d").symlink_to(data / "loop.c3d")
+    if "zero" in bad:
+        (data / "zero.c3d").symlink_to("/dev/zero")
+    if "empty" in bad:
+        (data / "empty.csv").write_bytes(b"")
+    if "dir" in bad:
+        (data / "folder.csv").mkdir()
+    if "deep" in bad:
+        deep = data.joinpath(*(["n" * 40] * 60))
+        deep.mkdir(parents=True)
+        (deep / "deep.csv").write_text(csv_text(rng))
+        good += 1
+    if "name" in bad:
+        (data / "new\nline é.csv").write_text(csv_text(rng))
+        good += 1
+    if "mutated" in bad:
+        (data / "mutated.csv").write_text(mutate_text(rng, csv_text(rng)), encoding="latin-1")
+    args = ["analyze", str(data), "--mass", "70", "--out", str(folder / "out"), "--json"]
+    return Case("folder", args, expect=good)

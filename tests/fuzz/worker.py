@@ -13,10 +13,14 @@ import contextlib
 import io
 import json
 import os
+import resource
 import sys
 import traceback
 import warnings
 from pathlib import Path
+
+#: Address space of a worker [bytes]: MuJoCo, numba and the report fit well within.
+MEMORY_LIMIT = 8 << 30
 
 
 def run(args: list[str]) -> dict[str, object]:
@@ -48,6 +52,10 @@ def run(args: list[str]) -> dict[str, object]:
 def serve() -> None:
     """Answer cases from stdin until it closes."""
     os.environ.setdefault("MPLBACKEND", "Agg")
+    # A memory bomb (an argument asking for billions of samples) raises MemoryError here,
+    # a traceback counted against its case, instead of taking the machine's memory.
+    _, hard = resource.getrlimit(resource.RLIMIT_AS)
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, hard))
     # Every case's relative paths land in the case folder the parent names.
     home = os.getcwd()
     for line in sys.stdin:

@@ -98,7 +98,7 @@ class FootModel:
             ("lateral_offset", -0.1, 0.1),
         ):
             object.__setattr__(self, name, bounded_float(name, getattr(self, name), low, high, "m"))
-        if self.lateral not in _LATERAL:
+        if not isinstance(self.lateral, str) or self.lateral not in _LATERAL:
             raise InvalidParameterError(f"lateral must be one of {_LATERAL}, got {self.lateral!r}")
 
 

@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.analysis.recording import LOADED
 from pushrecovery.analysis.signals import _find_gaps, _times
 from pushrecovery.arguments import (
+    bounded_float,
     finite_float,
     non_negative_float,
     positive_float,
@@ -32,6 +33,7 @@ from pushrecovery.arguments import (
     sample_array,
 )
 from pushrecovery.errors import InvalidParameterError
+from pushrecovery.params import LIMITS
 
 __all__ = [
     "MIN_DURATION",
@@ -190,7 +192,8 @@ def perturbation_onset(
     mean, sd = float(np.mean(values[inside])), float(np.std(values[inside], ddof=1))
     with np.errstate(invalid="ignore"):
         beyond = (np.abs(values - mean) > k * sd) & (time > end)
-    needed = max(1, math.ceil(min_duration / _period(time) - 1e-9))
+    # Clamped before rounding: a duration beyond the recording needs more samples than it has.
+    needed = max(1, math.ceil(min(min_duration / _period(time), len(time) + 1.0) - 1e-9))
     for first, stop in _find_gaps(np.asarray(beyond)):
         if stop - first >= needed:
             return float(time[first])
@@ -297,15 +300,17 @@ def quiet_windows(
     ------
     InvalidParameterError
         Bad times or force (as :func:`flight_phases`), ``window`` <= 0 or of fewer than 3
-        samples, ``max_acceleration`` or ``gravity`` <= 0, or a non-finite ``threshold``.
+        samples, ``max_acceleration`` outside [1e-6, 100] m/s², ``gravity`` outside [0.1, 100]
+        m/s², or a non-finite ``threshold``.
     """
     time = _times("time", time)
     force = _signal("vertical_force", vertical_force, time)
     window = positive_float("window", window, "s")
-    max_acceleration = positive_float("max_acceleration", max_acceleration, "m/s²")
-    gravity = positive_float("gravity", gravity, "m/s²")
+    # A still window's bound [m/s²]: beyond g it no longer tells standing from falling.
+    max_acceleration = bounded_float("max_acceleration", max_acceleration, 1e-6, 100.0, "m/s²")
+    gravity = bounded_float("gravity", gravity, *LIMITS["gravity"][:2], "m/s²")
     threshold = finite_float("threshold", threshold, "N")
-    size = round(window / _period(time))
+    size = round(min(window / _period(time), len(time) + 1.0))  # clamped before rounding
     if size < 3:
         raise InvalidParameterError(
             f"window must hold at least 3 samples ({3 * _period(time):g} s at this rate), "
@@ -369,12 +374,12 @@ def mass_from_quiet(
     Raises
     ------
     InvalidParameterError
-        Bad times or force (as :func:`quiet_windows`), a non-positive ``gravity``, windows
-        that are not (start, end) pairs, or windows holding fewer than 2 finite samples.
+        Bad times or force (as :func:`quiet_windows`), ``gravity`` outside [0.1, 100] m/s²,
+        windows that are not (start, end) pairs, or windows holding fewer than 2 finite samples.
     """
     time = _times("time", time)
     force = _signal("vertical_force", vertical_force, time)
-    gravity = positive_float("gravity", gravity, "m/s²")
+    gravity = bounded_float("gravity", gravity, *LIMITS["gravity"][:2], "m/s²")
     intervals = _windows(windows)
     means, samples, duration = [], [], 0.0
     for start, end in intervals:

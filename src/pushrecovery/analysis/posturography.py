@@ -250,6 +250,8 @@ def prediction_ellipse(cop: ArrayLike, probability: float = 0.95) -> Ellipse:
 def _band(band: object, rate: float) -> tuple[float, float]:
     """Check a band (low, high) [Hz]: 0 < low < high <= rate / 2."""
     try:
+        if isinstance(band, np.ndarray) and band.dtype.kind == "c":
+            raise TypeError  # float() would drop the imaginary parts with a warning
         low, high = (float(value) for value in band)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
         shown = f"shape {band.shape}" if isinstance(band, np.ndarray) else repr(band)[:60]

@@ -25,6 +25,7 @@ from scipy.interpolate import CubicSpline
 from scipy.signal import butter, sosfiltfilt
 
 from pushrecovery.arguments import (
+    bounded_float,
     finite_float,
     positive_float,
     require_type,
@@ -35,7 +36,9 @@ from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 __all__ = [
     "FILTER_ORDER",
+    "MAX_RATE",
     "MIN_CUTOFF_RATIO",
+    "MIN_RATE",
     "Gap",
     "find_gaps",
     "lowpass",
@@ -52,6 +55,8 @@ FloatArray = NDArray[np.float64]
 FILTER_ORDER = 2
 #: The lowest cutoff, as a fraction of the sampling rate: below it the design is singular.
 MIN_CUTOFF_RATIO = 1e-6
+#: Sampling rates a recording may have [Hz]: a sample per 100 s to a MHz.
+MIN_RATE, MAX_RATE = 1e-2, 1e6
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,7 +95,10 @@ class Gap:
 
 def _flags(name: str, value: object) -> NDArray[np.bool_]:
     """Return ``value`` as a one-dimensional bool array, or raise naming ``name``."""
-    array = np.asarray(value)
+    try:
+        array = np.asarray(value)
+    except ValueError:  # ragged
+        raise ParameterTypeError(f"{name} must be a one-dimensional bool array") from None
     if array.dtype != np.bool_ or array.ndim != 1:
         raise ParameterTypeError(
             f"{name} must be a one-dimensional bool array, got {array.dtype} of shape {array.shape}"
@@ -321,15 +329,16 @@ def noise_gains(rate: float, cutoff: float) -> tuple[float, float]:
     Parameters
     ----------
     rate : float
-        Sample rate [Hz], > 0.
+        Sample rate [Hz], in [``MIN_RATE``, ``MAX_RATE``].
     cutoff : float
         Low-pass cutoff [Hz], 0 (none) or in (0, rate/2).
     """
-    rate = positive_float("rate", rate, "Hz")
+    rate = bounded_float("rate", rate, MIN_RATE, MAX_RATE, "Hz")
     cutoff = finite_float("cutoff", cutoff, "Hz", allowed=">= 0")
     if cutoff < 0.0:
         raise InvalidParameterError(f"cutoff must be >= 0 Hz, got {cutoff:g}")
-    half = max(200, int(10.0 * rate / cutoff) if cutoff > 0.0 else 0)
+    ratio = 10.0 * rate / cutoff if cutoff > 0.0 else 0.0  # compared before int(): may be inf
+    half = max(200, int(ratio) if ratio <= 10**6 else 10**6 + 1)
     if half > 10**6:
         raise InvalidParameterError(
             f"cutoff must be at least 1e-5 of the rate for the noise gains, got {cutoff:g} Hz "

@@ -308,7 +308,7 @@ def measured_steps(
         require_type("each of events", event, FootEvent)
     if onset is not None:
         onset = finite_float("onset", onset, "s")
-    if position not in ("stance", "event"):
+    if not isinstance(position, str) or position not in ("stance", "event"):
         raise InvalidParameterError(f"position must be 'stance' or 'event', got {position!r}")
     steps = []
     for foot in feet:

@@ -44,7 +44,7 @@ def _analytic3d(spec: CampaignSpec, params: Any, azimuth: float) -> float:
     """Return the ground plane's critical push along ``azimuth`` [m/s] (NaN for step)."""
     from pushrecovery.campaign.spec3d import critical_impulse, standing_origin
 
-    if spec.strategy not in ("ankle", "hip"):
+    if not isinstance(spec.strategy, str) or spec.strategy not in ("ankle", "hip"):
         return math.nan
     origin = standing_origin(spec.source, params)
     return critical_impulse(params, origin, azimuth, spec.strategy) / params.mass

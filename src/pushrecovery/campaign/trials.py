@@ -191,7 +191,7 @@ class TrialsResult:
 
         from pushrecovery.analysis.trial.settings import pandas_table
 
-        if table not in ("trials", "events", "steps"):
+        if not isinstance(table, str) or table not in ("trials", "events", "steps"):
             raise InvalidParameterError(
                 f"table must be 'trials', 'events' or 'steps', got {table!r:.40}"
             )

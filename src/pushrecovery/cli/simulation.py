@@ -128,7 +128,7 @@ def simulate(
     'pushrecovery humanoid simulate'.
     """
     from pushrecovery.control.base import make_controller
-    from pushrecovery.sim.backend import Measuring, Recording
+    from pushrecovery.sim.backend import Measuring, Recording, check_com_state
     from pushrecovery.sim.push import Push
     from pushrecovery.sim.registry import make_plant
     from pushrecovery.sim.simulate import simulate as run
@@ -151,7 +151,11 @@ def simulate(
                 f"got --model {model}"
             )
     support = support_from(kwargs, params, file) if plane else None
+    # The models' validity first: its message names the coordinate (the prediction's would
+    # only say that the capture point is out of reach).
+    check_com_state(x, velocity, params)
     if plane:
+        check_com_state(y, ydot, params, ("y", "ydot"))
         predicted = classify_state(x, velocity, params, y=y, ydot=ydot, support=support)
     else:
         predicted = classify_state(x, velocity, params)

@@ -42,6 +42,7 @@ from pushrecovery.arguments import finite_array, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import clip
 from pushrecovery.ground.polygon import ConvexPolygon
+from pushrecovery.ground.support import MAX_POSE
 
 __all__ = [
     "MAX_UNION",
@@ -111,11 +112,12 @@ def gaussian_mass(mean: ArrayLike, cov: ArrayLike, polygon: ConvexPolygon) -> Fl
     Raises
     ------
     InvalidParameterError
-        Means or covariances that are not finite or of other shapes, a covariance that is not
+        Means that are not finite, beyond ±1e6 m (:data:`~pushrecovery.ground.support.MAX_POSE`)
+        or of other shapes, covariances not finite or of other shapes, a covariance that is not
         symmetric positive semi-definite.
     """
     require_type("polygon", polygon, ConvexPolygon)
-    mu = finite_array("mean", mean)
+    mu = finite_array("mean", mean, MAX_POSE, "m")  # as a foot pose: beyond, distances overflow
     if mu.ndim not in (1, 2) or mu.shape[-1] != 2:
         raise InvalidParameterError(f"mean must have shape (2,) or (n, 2), got {mu.shape}")
     sigma = covariance_2d("cov", cov)

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import (
+    bounded_float,
     finite_array,
     finite_float,
     finite_vector,
@@ -258,12 +259,12 @@ def regular_polygon(
     ------
     InvalidParameterError
         If ``radius`` is not finite and > 0, ``sides`` is not a whole number in
-        [3, :data:`MAX_SIDES`], or ``centre`` or ``phase`` is not finite.
+        [3, :data:`MAX_SIDES`], ``centre`` is not finite or ``phase`` not in [-100, 100] rad.
     """
     radius = positive_float("radius", radius, "m")
     sides = whole_number("sides", sides, 3, MAX_SIDES)
     middle = finite_vector("centre", centre, 2, unit="m")
-    phase = finite_float("phase", phase, "rad")
+    phase = bounded_float("phase", phase, -100.0, 100.0, "rad")  # beyond, the angles round
     angle = phase + 2.0 * math.pi * np.arange(sides) / sides
     vertices = np.column_stack([np.cos(angle), np.sin(angle)]) * radius + middle
     return ConvexPolygon._from_ccw(vertices)

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.arguments import bounded_float, finite_array
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 __all__ = ["ConvexPolygon", "convex_hull", "rectangle"]
 
@@ -74,7 +74,21 @@ class ConvexPolygon:
     _edges: tuple[tuple[float, ...], ...] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        start = self.vertices
+        start, normals, offsets = self.vertices, self.normals, self.offsets
+        if not (
+            isinstance(start, np.ndarray)
+            and isinstance(normals, np.ndarray)
+            and isinstance(offsets, np.ndarray)
+            and start.ndim == 2
+            and start.shape[1] == 2
+            and len(start) >= 3
+            and normals.shape == start.shape
+            and offsets.shape == (len(start),)
+        ):  # the library's form: users build polygons with the functions the docstring names
+            raise ParameterTypeError(
+                "ConvexPolygon takes arrays vertices (n, 2), normals (n, 2) and offsets (n,), "
+                "n >= 3; build one with convex_polygon, convex_hull or rectangle"
+            )
         rows = np.column_stack([start, following(start), self.normals, self.offsets])
         object.__setattr__(self, "_edges", tuple(map(tuple, rows.tolist())))
 

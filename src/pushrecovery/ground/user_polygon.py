@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import (
     MAX_COORDINATE,
     MIN_AREA,
@@ -100,6 +100,10 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
     keep = np.abs(turns) > bends
     ordered = pts[keep] if sign > 0.0 else pts[keep][::-1]
     polygon = ConvexPolygon._from_ccw(ordered)
+    if not isinstance(contains_origin, bool | np.bool_):
+        raise ParameterTypeError(
+            f"contains_origin must be True or False, got {type(contains_origin).__name__}"
+        )
     if contains_origin and float(polygon.signed_distance(0.0, 0.0)) <= 0.0:
         raise InvalidParameterError(
             f"{name} must contain the ankle (0, 0) strictly inside; it spans x in "

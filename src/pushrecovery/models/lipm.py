@@ -14,7 +14,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import bounded_float, finite_array, finite_float
+from pushrecovery.arguments import (
+    MAX_MAGNITUDE,
+    bounded_float,
+    broadcast,
+    finite_array,
+    finite_float,
+)
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN
 
@@ -53,7 +59,8 @@ def lipm_acceleration(x: ArrayLike, cop: ArrayLike, omega: float) -> FloatArray:
         ẍ = ω² (x − δ) [m/s²]; positive accelerates the CoM forward.
     """
     omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
-    return omega**2 * (finite_array("x", x) - finite_array("cop", cop))
+    big = MAX_MAGNITUDE  # beyond, ω² (x − δ) overflows
+    return omega**2 * (finite_array("x", x, big, "m") - finite_array("cop", cop, big, "m"))
 
 
 def lipm_state(
@@ -91,11 +98,17 @@ def lipm_state(
         raise InvalidParameterError(
             f"|t| must be <= {MAX_OMEGA_T:g}/omega = {MAX_OMEGA_T / omega:g} s, got t={t!r}"
         )
+    big = MAX_MAGNITUDE  # beyond, the terms times cosh(ω t) <= e^50 overflow
+    start, cop, xdot0, times = broadcast(
+        x0=finite_array("x0", x0, big, "m"),
+        cop=finite_array("cop", cop, big, "m"),
+        xdot0=finite_array("xdot0", xdot0, big, "m/s"),
+        t=times,
+    )
     wt = omega * times
-    offset = finite_array("x0", x0) - finite_array("cop", cop)
-    xdot0 = finite_array("xdot0", xdot0)
+    offset = start - cop
     cosh, sinh = np.cosh(wt), np.sinh(wt)
-    x = np.asarray(cop, dtype=np.float64) + offset * cosh + xdot0 / omega * sinh
+    x = cop + offset * cosh + xdot0 / omega * sinh
     xdot = omega * offset * sinh + xdot0 * cosh
     return x, xdot
 

@@ -32,6 +32,25 @@ __all__ = [
 ]
 
 
+#: Largest lean rate [rad/s]: a thousand times any body's fall (sqrt(g/L) <= 100 1/s).
+MAX_RATE = 1e5
+
+
+def _state(theta: object, theta_rate: object, cop: object, length: float) -> tuple[float, ...]:
+    """Return the lean [rad], its rate [rad/s] and a CoP [m] within the leg's reach, checked."""
+    theta, theta_rate, cop = (
+        finite_float(name, value)
+        for name, value in (("theta", theta), ("theta_rate", theta_rate), ("cop", cop))
+    )
+    if not abs(cop) < length:
+        raise InvalidParameterError(f"cop must satisfy |cop| < length = {length:g} m, got {cop:g}")
+    if not abs(theta_rate) < MAX_RATE:  # beyond, L θ̇² overflows
+        raise InvalidParameterError(
+            f"theta_rate must satisfy |theta_rate| < {MAX_RATE:g} rad/s, got {theta_rate:g}"
+        )
+    return theta, theta_rate, cop
+
+
 def _body(mass: object, length: object, gravity: object) -> tuple[float, float, float]:
     """M [kg], L [m] and g [m/s²] checked against :data:`~pushrecovery.params.LIMITS`."""
     return (
@@ -69,15 +88,15 @@ def ankle_torque_for_cop(
         m [kg], L [m] (ankle to CoM), g [m/s²].
     hip_torque : float
         Torque on an upper body whose CoM is at the top of the rod [N m], positive pitching
-        it forward; 0 for the plain pendulum.
+        it forward; 0 for the plain pendulum; within ±1e7.
     push_force : float
-        Horizontal force P pushing the CoM [N], positive forward.
+        Horizontal force P pushing the CoM [N], positive forward; within ±1e7.
     ankle_height : float
-        Height h of the ankle above the sole [m]; 0 in the paper. The friction force then
-        has a lever arm too.
+        Height h of the ankle above the sole [m], in [0, L]; 0 in the paper. The friction
+        force then has a lever arm too.
     foot_mass, foot_centre : float
-        Mass of the foot [kg] (0 in the paper) and the x of its centre of mass relative to
-        the ankle [m]: its weight loads the floor too.
+        Mass of the foot [kg], in [0, m] (0 in the paper), and the x of its centre of mass
+        relative to the ankle [m], within ±L: its weight loads the floor too.
 
     Returns
     -------
@@ -87,21 +106,17 @@ def ankle_torque_for_cop(
         k = h cosθ − δ sinθ, B = δ m (g − L cosθ θ̇²) − h m L sinθ θ̇² (docs/errata.md, E3).
         0 when the foot is unloaded (F_z ≤ 0).
     """
-    theta, theta_rate, cop = (
-        finite_float(name, value)
-        for name, value in (("theta", theta), ("theta_rate", theta_rate), ("cop", cop))
-    )
     mass, length, gravity = _body(mass, length, gravity)
-    if not abs(cop) < length:
-        raise InvalidParameterError(f"cop must satisfy |cop| < length = {length:g} m, got {cop:g}")
+    theta, theta_rate, cop = _state(theta, theta_rate, cop, length)
+    # Bounds far beyond any body's, within which the products stay finite.
     extras = {
-        name: finite_float(name, value)
-        for name, value in (
-            ("hip_torque", hip_torque),
-            ("push_force", push_force),
-            ("ankle_height", ankle_height),
-            ("foot_mass", foot_mass),
-            ("foot_centre", foot_centre),
+        name: bounded_float(name, value, low, high, unit)
+        for name, value, low, high, unit in (
+            ("hip_torque", hip_torque, -1e7, 1e7, "N m"),
+            ("push_force", push_force, -1e7, 1e7, "N"),
+            ("ankle_height", ankle_height, 0.0, length, "m"),
+            ("foot_mass", foot_mass, 0.0, mass, "kg"),
+            ("foot_centre", foot_centre, -length, length, "m"),
         )
     }
     return ankle_torque_for_cop_unchecked(theta, theta_rate, cop, mass, length, gravity, **extras)
@@ -159,9 +174,8 @@ def pendulum_acceleration(
         If a value is not finite, or ``mass``, ``length`` or ``gravity`` is outside
         :data:`~pushrecovery.params.LIMITS` (``length`` as ``com_height``).
     """
-    for name, value in (("theta", theta), ("theta_rate", theta_rate), ("cop", cop)):
-        finite_float(name, value)
     mass, length, gravity = _body(mass, length, gravity)
+    theta, theta_rate, cop = _state(theta, theta_rate, cop, length)
     return _pendulum_acceleration(theta, theta_rate, cop, mass, length, gravity)
 
 
@@ -249,10 +263,9 @@ def pendulum_step(
         If a value is not finite, ``dt`` is not in (0, 1] s, ``substeps`` not a whole number
         in [1, 1000], or the body is outside :data:`~pushrecovery.params.LIMITS`.
     """
-    for name, value in (("theta", theta), ("theta_rate", theta_rate), ("cop", cop)):
-        finite_float(name, value)
     dt = bounded_float("dt", dt, 1e-9, 1.0, "s")
     mass, length, gravity = _body(mass, length, gravity)
+    theta, theta_rate, cop = _state(theta, theta_rate, cop, length)
     if isinstance(substeps, bool) or not isinstance(substeps, int) or not 1 <= substeps <= 1000:
         raise InvalidParameterError(
             f"substeps must be a whole number in [1, 1000], got {substeps!r}"

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import bounded_float, finite_array, finite_float
+from pushrecovery.arguments import bounded_float, broadcast, finite_array, finite_float
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.kernels.step_scalar import MAX_STEP_ANGLE as MAX_STEP_ANGLE
 from pushrecovery.kernels.step_scalar import step_angle
@@ -98,8 +98,7 @@ def _speeds(v0: ArrayLike, length: float, gravity: float, least: float = 0.0) ->
 def fall_rate(theta: ArrayLike, v0: ArrayLike, length: float, gravity: float) -> FloatArray:
     """Stance-leg rate θ̇ [rad/s] at lean θ [rad], from energy, starting at θ = 0 with v0 [m/s]."""
     length, gravity = _leg(length, gravity)
-    theta = _angles("theta", theta)
-    v0 = _speeds(v0, length, gravity)
+    theta, v0 = broadcast(theta=_angles("theta", theta), v0=_speeds(v0, length, gravity))
     return np.sqrt((v0 / length) ** 2 + 2.0 * gravity / length * (1.0 - np.cos(theta)))
 
 
@@ -112,8 +111,8 @@ def time_to_angle(theta: ArrayLike, v0: ArrayLike, length: float, gravity: float
     from scipy.special import ellipkinc
 
     length, gravity = _leg(length, gravity)
-    theta = _angles("theta", theta)
-    a = (_speeds(v0, length, gravity, MIN_V0) / length) ** 2
+    theta, v0 = broadcast(theta=_angles("theta", theta), v0=_speeds(v0, length, gravity, MIN_V0))
+    a = (v0 / length) ** 2
     return 2.0 / np.sqrt(a) * ellipkinc(0.5 * theta, -4.0 * gravity / length / a)
 
 

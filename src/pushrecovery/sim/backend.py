@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import finite_float, float_array, non_negative_float, require_type
 from pushrecovery.control.base import Command, StepInfo
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.push import Push
@@ -224,6 +224,9 @@ def check_com_state(
     coordinate's in the messages (``("y", "ydot")`` sideways).
     """
     require_type("params", params, BodyParams)
+    pair = isinstance(names, tuple) and len(names) == 2
+    if not (pair and all(isinstance(name, str) for name in names)):
+        raise ParameterTypeError(f"names must be two coordinate names, got {str(names)[:40]!r}")
     position, velocity = names
     x = finite_float(names[0], x, "m")
     xdot = finite_float(names[1], xdot, "m/s")

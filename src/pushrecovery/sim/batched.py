@@ -248,10 +248,13 @@ def _checked_pushes(
         )
     for body, start, speed in zip(bodies, starts.tolist(), speeds.tolist(), strict=True):
         check_com_state(start, speed, body)  # as the plants' reset
-    duration = bounded_float("duration", duration, 0.0, MAX_DURATION, "s")
-    if duration == 0.0:
-        raise InvalidParameterError(f"duration must be in (0, {MAX_DURATION:g}] s, got 0")
     dt, rest = DEFAULT_CONTROL_PERIOD, RestCriterion()
+    duration = bounded_float("duration", duration, 0.0, MAX_DURATION, "s")
+    if duration < dt:  # not one control tick: nothing would be simulated
+        raise InvalidParameterError(
+            f"duration must be in [{dt:g}, {MAX_DURATION:g}] s (one control tick at least), "
+            f"got {duration:g}"
+        )
     # As simulate(): whole ticks in the duration, and in the rest criterion's time.
     ticks = math.ceil(duration / dt - 1e-9)
     rest_ticks = max(1, math.ceil(rest.duration / dt - 1e-9))

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import bounded_float, require_type
+from pushrecovery.arguments import bounded_float, finite_array, require_type
 from pushrecovery.errors import (
     InvalidParameterError,
     ParameterTypeError,
@@ -154,12 +154,17 @@ def run_many(
                        ("engine", engine)):  # fmt: skip
         require_type(name, text, str)
     for name, value in (("bodies", bodies), ("x0", x0), ("xdot", xdot)):
-        if isinstance(value, str) or not isinstance(value, Sequence | np.ndarray):
+        scalar = isinstance(value, np.ndarray) and value.ndim == 0
+        if isinstance(value, str) or not isinstance(value, Sequence | np.ndarray) or scalar:
             raise ParameterTypeError(
                 f"{name} must be a sequence (one entry per push), got {type(value).__name__}"
             )
     count = len(bodies)
-    if len(x0) != count or len(xdot) != count:
+    # One number per push: the engines index them (a 0-d array has no length).
+    starts, speeds = finite_array("x0", x0), finite_array("xdot", xdot)
+    if starts.ndim != 1 or speeds.ndim != 1:
+        raise InvalidParameterError("x0 and xdot must be one number per push")
+    if len(starts) != count or len(speeds) != count:
         raise InvalidParameterError(
             f"bodies, x0 and xdot must have one entry per push, got {count}, {len(x0)}, {len(xdot)}"
         )

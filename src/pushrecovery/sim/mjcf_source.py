@@ -65,7 +65,7 @@ class MjcfSource:
     keyframe: str | None = None
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.path, str) and self.path):
+        if not (isinstance(self.path, str) and self.path) or "\x00" in self.path:
             raise InvalidParameterError(f"path must be an MJCF file's path, got {self.path!r}")
         object.__setattr__(self, "path", str(Path(self.path).expanduser().resolve()))
         feet = self.feet

@@ -246,7 +246,7 @@ class PlaneSteppingPlant(PlantBase):
         """Lift the free foot (from double support: ``swing``) toward the foothold ``wanted``."""
         support = self.support
         if support.stance is Stance.DOUBLE:
-            if swing not in ("left", "right"):
+            if not isinstance(swing, str) or swing not in ("left", "right"):
                 raise InvalidParameterError(
                     f"a step from double support needs swing 'left' or 'right', got {swing!r}"
                 )

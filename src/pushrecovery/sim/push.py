@@ -87,7 +87,7 @@ class Push:
         object.__setattr__(
             self, "delta_velocity", finite_float("delta_velocity", self.delta_velocity, "m/s")
         )
-        if self.kind not in ("force", "velocity"):
+        if not isinstance(self.kind, str) or self.kind not in ("force", "velocity"):
             raise InvalidParameterError(
                 f"push kind must be 'force' or 'velocity', got {str(self.kind)[:40]!r}"
             )

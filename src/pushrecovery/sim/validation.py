@@ -69,7 +69,21 @@ SETUPS: dict[str, dict[str, tuple[str, str]]] = {
 LABELS = ("ankle", "hip", "step", "fall")
 
 
+def _strategies(strategies: object, progress: object = None) -> tuple[str, ...]:
+    """Return the strategies asked for as a tuple; check that ``progress`` is callable."""
+    if isinstance(strategies, str) or not isinstance(strategies, Sequence):
+        raise ParameterTypeError(f"strategies must be a sequence of names, got {strategies!r:.40}")
+    if progress is not None and not callable(progress):
+        raise ParameterTypeError(f"progress must be callable, got {type(progress).__name__}")
+    return tuple(strategies)
+
+
 def _setup(backend: str, strategy: str) -> tuple[str, str]:
+    if not (isinstance(backend, str) and isinstance(strategy, str)):
+        raise ParameterTypeError(
+            f"backend and strategy must be names, got {type(backend).__name__} and "
+            f"{type(strategy).__name__}"
+        )
     try:
         model, controller = SETUPS[backend][strategy]
     except KeyError:
@@ -124,7 +138,7 @@ def corrected_critical_velocity(
         leaves no foot.
     """
     require_type("strategy", strategy, str)
-    if strategy not in ("ankle", "hip"):
+    if not isinstance(strategy, str) or strategy not in ("ankle", "hip"):
         raise InvalidParameterError(f"strategy must be 'ankle' or 'hip', got {strategy!r}")
     require_type("params", params, BodyParams)
     x0 = finite_float("x0", x0, "m")
@@ -261,6 +275,10 @@ def critical_table(
     list of CriticalRow
     """
     require_type("params", params, BodyParams)
+    strategies = _strategies(strategies, progress)
+    x0s = finite_array("x0s", x0s).reshape(-1).tolist()
+    if isinstance(directions, str) or not isinstance(directions, Sequence):
+        raise ParameterTypeError(f"directions must be a sequence of names, got {directions!r:.40}")
     for strategy in strategies:
         _setup(backend, strategy)  # every strategy checked before any simulation
     rows = []
@@ -323,6 +341,9 @@ def needed_strategy(
     Tries each strategy's model and controller in escalating order (ankle, hip, step); a push
     of ``velocity`` [m/s] from ``x0`` [m], as a real force on MuJoCo.
     """
+    strategies = _strategies(strategies)
+    for strategy in strategies:
+        _setup(backend, strategy)
     for strategy in LABELS[:3]:
         if strategy not in strategies:
             continue
@@ -382,8 +403,7 @@ def confusion_matrix(
     """
     x0s = finite_array("x0s", x0s).reshape(-1).tolist()
     velocities = finite_array("velocities", velocities).reshape(-1).tolist()
-    if progress is not None and not callable(progress):
-        raise ParameterTypeError(f"progress must be callable, got {type(progress).__name__}")
+    strategies = _strategies(strategies, progress)
     for strategy in strategies:
         _setup(backend, strategy)
     counts = np.zeros((len(LABELS), len(LABELS)), dtype=np.int64)

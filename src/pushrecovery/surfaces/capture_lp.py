@@ -21,10 +21,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import positive_float, require_type
-from pushrecovery.errors import PushRecoveryError
+from pushrecovery.arguments import finite_float, positive_float, require_type
+from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
+from pushrecovery.surfaces.capture_lp_plane import grid_steps
 from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["CaptureLP", "largest_capture_point"]
@@ -81,8 +82,11 @@ def largest_capture_point(
     require_type("params", params, BodyParams)
     from scipy.optimize import linprog
 
+    direction = finite_float("direction", direction)
+    if direction not in (1.0, -1.0):
+        raise InvalidParameterError(f"direction must be +1 or -1, got {direction!r}")
     dt = positive_float("dt", dt, "s")
-    steps = max(1, round(positive_float("horizon", horizon, "s") / dt))
+    steps = grid_steps(positive_float("horizon", horizon, "s"), dt)
     a, b = flywheel_discrete(params, dt)
     # State k is affine in the decision vector z = (ẋ0, δ_0, τ_0, ..., δ_{N-1}, τ_{N-1}):
     # X_k = S_k z. Build S_k forward with the dynamics.

@@ -34,7 +34,7 @@ from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.models.flywheel_plane import plane_discrete
 from pushrecovery.params import BodyParams
 
-__all__ = ["MAX_STEPS", "PlaneCaptureLP", "support_function_lp"]
+__all__ = ["MAX_STEPS", "PlaneCaptureLP", "grid_steps", "support_function_lp"]
 
 FloatArray = NDArray[np.float64]
 
@@ -77,6 +77,21 @@ class PlaneCaptureLP:
     torques: FloatArray
     states: FloatArray
     dt: float
+
+
+def grid_steps(horizon: float, dt: float) -> int:
+    """Return the steps of ``dt`` [s] in ``horizon`` [s], in [1, :data:`MAX_STEPS`].
+
+    Compared before rounding: a subnormal ``dt`` gives an infinite ratio, refused.
+    """
+    horizon, dt = positive_float("horizon", horizon, "s"), positive_float("dt", dt, "s")
+    ratio = horizon / dt
+    if not ratio <= MAX_STEPS + 0.5:
+        raise InvalidParameterError(
+            f"horizon / dt must be at most {MAX_STEPS} steps, got horizon={horizon:g} s, "
+            f"dt={dt:g} s ({ratio:g} steps)"
+        )
+    return max(1, round(ratio))
 
 
 def support_function_lp(
@@ -132,12 +147,7 @@ def support_function_lp(
     yaw = finite_float("yaw", yaw, "rad")
     dt = positive_float("dt", dt, "s")
     horizon = positive_float("horizon", horizon, "s")
-    steps = max(1, round(horizon / dt))
-    if steps > MAX_STEPS:
-        raise InvalidParameterError(
-            f"horizon / dt must be at most {MAX_STEPS} steps, got horizon={horizon:g} s, "
-            f"dt={dt:g} s ({steps} steps)"
-        )
+    steps = grid_steps(horizon, dt)
     direction = np.array([math.cos(angle), math.sin(angle)])
     problem = _Problem(polygon, params, dt, steps, yaw)
     cost = np.zeros(problem.size)

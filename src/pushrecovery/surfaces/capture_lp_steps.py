@@ -28,7 +28,14 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.arguments import (
+    bounded_float,
+    finite_array,
+    finite_float,
+    finite_vector,
+    require_type,
+)
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError, PushRecoveryError
 from pushrecovery.ground.support import Stance
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.n_step import StepOption, landing_foot, reach_polygon
@@ -99,9 +106,33 @@ def step_lp(
         Let the upper body torque.
     capture_point : (float, float), optional
         A fixed ξ0 [m]: then the objective is d · q_1 (first footholds).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``params`` or ``option`` has the wrong type.
+    InvalidParameterError
+        If ``touchdowns`` are not increasing positive multiples of ``dt`` (in [1 ms, 1 s]),
+        ``tail`` is not in [0, 10] s, the grid is longer than ``MAX_GRID`` samples, or the
+        heading or the fixed ξ0 is not finite.
     """
     from scipy.optimize import linprog
 
+    require_type("params", params, BodyParams)
+    require_type("option", option, StepOption)
+    dt = bounded_float("dt", dt, 1e-3, 1.0, "s")
+    tail = bounded_float("tail", tail, 0.0, 10.0, "s")
+    direction_angle = finite_float("direction_angle", direction_angle, "rad")
+    times = finite_array("touchdowns", touchdowns)
+    if times.ndim != 1 or np.any(times <= 0.0) or np.any(np.diff(times) <= 0.0):
+        raise InvalidParameterError(
+            f"touchdowns must be increasing times > 0 [s], got {np.atleast_1d(times).tolist()[:8]}"
+        )
+    touchdowns = tuple(times.tolist())
+    if capture_point is not None:
+        capture_point = tuple(finite_vector("capture_point", capture_point, 2, unit="m"))
+    if not isinstance(hip, bool | np.bool_):
+        raise ParameterTypeError(f"hip must be True or False, got {type(hip).__name__}")
     n_steps = len(touchdowns)
     grid = [round(t / dt) for t in touchdowns]
     if any(abs(g * dt - t) > 1e-9 for g, t in zip(grid, touchdowns, strict=True)):

@@ -383,7 +383,7 @@ def _checked_plan(steps: int, timing: str, hip: bool) -> bool:
         raise InvalidParameterError(
             f"steps must be a whole number in [1, {MAX_STEPS}], got {steps!r}"
         )
-    if timing not in ("exact", "after"):
+    if not isinstance(timing, str) or timing not in ("exact", "after"):
         raise InvalidParameterError(f"timing must be 'exact' or 'after', got {timing!r}")
     require_type("hip", hip, (bool, np.bool_))
     return bool(hip)

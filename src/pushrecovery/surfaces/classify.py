@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.ground.support import Support
+from pushrecovery.ground.support import MAX_POSE, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan, plan_loads
 from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
@@ -369,9 +369,12 @@ def _classify_plane(
     tables = _plane_tables(params, support)
     # ξ as capture_point computes it: x + ẋ (1/ω).
     xi = (x + xdot * tables.inv_omega, y + ydot * tables.inv_omega)
+    if not (abs(xi[0]) <= MAX_POSE and abs(xi[1]) <= MAX_POSE):  # as BalanceMonitor.query
+        raise InvalidParameterError(
+            f"states are too large: the capture point must be within ±{MAX_POSE:g} m of the "
+            f"origin (as a foot pose), got ({xi[0]:g}, {xi[1]:g})"
+        )
     cop, cmp = signed_distance(tables.cop, *xi), signed_distance(tables.cmp, *xi)
-    if not (math.isfinite(cop) and math.isfinite(cmp)):
-        raise InvalidParameterError("states are too large: the capture point overflows")
     steps, step_margin = tables.regions.locate(*xi)
     strategy = _strategy(cop, cmp, steps)
     planned = None

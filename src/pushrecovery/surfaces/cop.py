@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pushrecovery.arguments import (
+    MAX_MAGNITUDE,
     finite_array,
     float_array,
     output_array,
@@ -265,7 +266,7 @@ def critical_velocity(
     if region is not None:
         require_type("region", region, CaptureInterval)
     region = cop_region(params) if region is None else region
-    x = finite_array("x", x)
+    x = finite_array("x", x, MAX_MAGNITUDE, "m")  # beyond, ω (edge − x) overflows
     direction = finite_array("direction", direction)
     if not np.all(np.abs(direction) == 1.0):
         raise InvalidParameterError("direction must be +1 (forward) or -1 (backward)")

@@ -32,7 +32,6 @@ from pushrecovery.arguments import (
     bounded_float,
     finite_array,
     finite_float,
-    float_array,
     require_type,
 )
 from pushrecovery.errors import InvalidParameterError
@@ -169,13 +168,16 @@ def plan_steps(
         If a heel is not behind its toe, or a state or an edge is NaN or infinite.
     """
     require_type("params", params, BodyParams)
-    back, front = _edges(params, heel, toe)
-    xs, xds, backs, fronts = np.broadcast_arrays(
-        *(
-            finite_array(name, a)
-            for name, a in (("x", x), ("xdot", xdot), ("heel", back), ("toe", front))
-        )
-    )
+    given = {"x": x, "xdot": xdot, "heel": heel, "toe": toe}
+    arrays = [finite_array(n, params.heel if n == "heel" else params.toe) if a is None
+              else finite_array(n, a) for n, a in given.items()]  # fmt: skip
+    try:
+        xs, xds, backs, fronts = np.broadcast_arrays(*arrays)
+    except ValueError:
+        shapes = ", ".join(str(a.shape) for a in arrays)
+        raise InvalidParameterError(f"x, xdot, heel and toe must broadcast, got {shapes}") from None
+    if heel is not None or toe is not None:
+        _check_edges(not np.any(backs >= fronts), heel, toe)
     shape = xs.shape
     height, gravity, reach = params.com_height, params.gravity, params.max_step_length
     if xs.size <= _PYTHON_MAX_SIZE:
@@ -275,18 +277,6 @@ def compiled_plan_step() -> ScalarPlanner:
     from pushrecovery.kernels.stepping import scalar_decide
 
     return scalar_decide()
-
-
-def _edges(
-    params: BodyParams, heel: ArrayLike | None, toe: ArrayLike | None
-) -> tuple[ArrayLike, ArrayLike]:
-    """Return the new foot's edges: ``params``' unless given, checked (heel < toe)."""
-    if heel is None and toe is None:
-        return params.heel, params.toe
-    back = params.heel if heel is None else float_array("heel", heel)
-    front = params.toe if toe is None else float_array("toe", toe)
-    _check_edges(not np.any(np.greater_equal(back, front)), heel, toe)
-    return back, front
 
 
 def _check_edges(valid: bool, heel: object, toe: object) -> None:

@@ -10,7 +10,7 @@ import numpy as np
 
 from pushrecovery.analysis.recording import LOADED, Foot, Recording
 from pushrecovery.analysis.signals import resample
-from pushrecovery.errors import InputFileError
+from pushrecovery.errors import InputFileError, ParameterTypeError
 
 if TYPE_CHECKING:
     from pushrecovery.analysis.c3d import ForcePlate
@@ -19,6 +19,7 @@ from pushrecovery.analysis.readers.common import (
     FOOT_MARKERS,
     STANDING_PERCENTILE,
     FloatArray,
+    _check_file,
     _path,
     body_rotation,
 )
@@ -26,6 +27,19 @@ from pushrecovery.analysis.readers.common import (
 __all__ = [
     "read_c3d_recording",
 ]
+
+
+def _labels(name: str, value: object, size: int) -> None:
+    """Raise naming ``name`` unless ``value`` is a list of labels (None: the default).
+
+    ``size`` 4: exactly four, a foot's name and its heel, toe and ankle markers.
+    """
+    if value is None and size == 1:
+        return
+    ok = isinstance(value, list | tuple) and all(isinstance(v, str) for v in value)
+    if not ok or (size == 4 and len(value) != 4):  # type: ignore[arg-type]
+        what = "(name, heel, toe, ankle) labels" if size == 4 else "a list of marker labels"
+        raise ParameterTypeError(f"{name} must be {what}, got {str(value)[:60]!r}")
 
 
 def read_c3d_recording(
@@ -59,7 +73,8 @@ def read_c3d_recording(
     Raises
     ------
     ParameterTypeError
-        If ``path`` is not a str or path, or ``ap_axis`` not a str.
+        If ``path`` is not a str or path, ``ap_axis`` not a str, ``com_markers`` not labels
+        or ``feet`` not (name, heel, toe, ankle) labels.
     InputFileError
         A missing or malformed file, or markers it does not have.
     """
@@ -67,6 +82,13 @@ def read_c3d_recording(
 
     path = _path(path)
     body_rotation(ap_axis)  # a bad axis name fails before the file is read
+    _labels("com_markers", com_markers, 1)
+    if feet is not None:
+        if not isinstance(feet, list | tuple) or not feet:
+            raise ParameterTypeError("feet must be a list of (name, heel, toe, ankle) labels")
+        for foot in feet:
+            _labels("each of feet", foot, 4)
+    _check_file(path)
     content = read_c3d(path, threshold=LOADED)
     rotation = body_rotation(ap_axis, content.up)
     markers = {name: values @ rotation.T for name, values in content.markers.items()}

@@ -42,7 +42,7 @@ from pushrecovery.analysis.trial.summary import (
 from pushrecovery.analysis.trial.support import _repair_loaded, _support
 from pushrecovery.analysis.zero_point import ZERO_FORCE, com_from_force
 from pushrecovery.arguments import require_type
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 
 __all__ = [
@@ -89,6 +89,11 @@ def analyze(
     require_type("params", params, BodyParams)
     if settings is not None:
         require_type("settings", settings, AnalysisSettings)
+    if sources is not None and not (
+        isinstance(sources, dict)
+        and all(isinstance(k, str) and isinstance(v, str) for k, v in sources.items())
+    ):
+        raise ParameterTypeError("sources must map body values' names to where they came from")
     settings = settings or AnalysisSettings()
     gaps: list[Gap] = []
     notes = list(recording.notes)

@@ -20,7 +20,8 @@ from scipy.special import ndtr
 
 from pushrecovery.analysis.margins import DirectionMargins
 from pushrecovery.analysis.signals import noise_gains
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import non_negative_float, require_type, sample_array
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 
 __all__ = ["HERMITE_NODES", "frame_risk"]
@@ -54,6 +55,20 @@ def frame_risk(
     anthropometric table's spread): ω = sqrt(g/L) moves ξ = x + ẋ/ω and σ_ξ, and the risk is
     averaged over L by :data:`HERMITE_NODES`-point Gauss–Hermite quadrature.
     """
+    time = sample_array("time", time, (1,))
+    require_type("params", params, BodyParams)
+    require_type("per_axis", per_axis, dict)
+    for axis, margins in per_axis.items():
+        require_type(f"per_axis[{axis!r}]", margins, DirectionMargins)
+        if not all(axis in getattr(support, side, {}) for side in ("lower", "upper")):
+            raise ParameterTypeError(f"support must have lower and upper of axis {axis!r}")
+    com_noise = None if com_noise is None else non_negative_float("com_noise", com_noise, "m")
+    com_height_sd = (
+        None if com_height_sd is None else non_negative_float("com_height_sd", com_height_sd, "m")
+    )
+    cutoff = non_negative_float("cutoff", cutoff, "Hz")
+    if state is not None:
+        require_type("state", state, dict)
     if (com_noise is None and not com_height_sd) or len(time) < 3:
         return {}
     rate = (len(time) - 1) / (time[-1] - time[0])

@@ -23,6 +23,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.params import BodyParams
 
@@ -125,6 +126,8 @@ class FlywheelFeasibility:
     __slots__ = ("_braking", "facets")
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
+        require_type("params", params, BodyParams)
+        require_type("settings", settings, MPCSettings)
         self.facets = viable_facets(
             params.flywheel_inertia, params.torque_max, params.flywheel_angle_max,
             settings.dt, settings.horizon,

@@ -38,6 +38,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.mpc.plan import Plan, Status
 from pushrecovery.control.mpc.problem import MPCSettings
 from pushrecovery.models.flywheel import flywheel_discrete
@@ -115,6 +116,8 @@ class CondensedQP:
     """
 
     def __init__(self, params: BodyParams, settings: MPCSettings) -> None:
+        require_type("params", params, BodyParams)
+        require_type("settings", settings, MPCSettings)
         n = settings.horizon
         a, b = flywheel_discrete(params, settings.dt)
         self.params, self.settings = params, settings

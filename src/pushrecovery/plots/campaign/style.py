@@ -72,7 +72,7 @@ def step_limit_curve(
     """
     from pushrecovery.surfaces.step import plan_steps
 
-    if direction not in ("forward", "backward"):
+    if not isinstance(direction, str) or direction not in ("forward", "backward"):
         raise InvalidParameterError(f"direction must be forward or backward, got {direction!r}")
     sign = 1.0 if direction == "forward" else -1.0
     top = float(np.sqrt(params.gravity * params.leg_length))

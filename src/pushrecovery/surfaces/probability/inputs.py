@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.arguments import finite_array
 from pushrecovery.errors import InvalidParameterError
 
-__all__ = ["StateGaussian", "check_states"]
+__all__ = ["MAX_STATE", "StateGaussian", "check_states"]
 
 FloatArray = NDArray[np.float64]
 
@@ -51,6 +51,11 @@ class StateGaussian:
         return len(self.mean) == 4
 
 
+#: Largest magnitude of a position [m] or velocity [m/s] in a state's mean: a foot pose's bound
+#: (:data:`~pushrecovery.ground.support.MAX_POSE`).
+MAX_STATE = 1e6
+
+
 def check_states(mean: ArrayLike, cov: ArrayLike) -> tuple[FloatArray, FloatArray]:
     """Return states' means (n, d) and covariances (d, d) or (n, d, d), checked.
 
@@ -60,13 +65,19 @@ def check_states(mean: ArrayLike, cov: ArrayLike) -> tuple[FloatArray, FloatArra
     Raises
     ------
     InvalidParameterError
-        Other shapes, non-finite values, an asymmetric or indefinite covariance.
+        Other shapes, non-finite values, a mean beyond ±:data:`MAX_STATE`, an asymmetric or
+        indefinite covariance.
     """
     means = np.atleast_2d(finite_array("mean", mean))
     if means.ndim != 2 or means.shape[1] not in (2, 4):
         raise InvalidParameterError(
             f"mean must be states (x, xdot) or (x, y, xdot, ydot): shape (n, 2) or (n, 4), "
             f"got {np.shape(mean)}"
+        )
+    if means.size and float(np.max(np.abs(means))) > MAX_STATE:
+        raise InvalidParameterError(
+            f"mean must have positions [m] and velocities [m/s] within ±{MAX_STATE:g} (beyond, "
+            "the capture point's distances overflow)"
         )
     d = means.shape[1]
     covs = finite_array("cov", cov)

@@ -56,8 +56,19 @@ def delayed_capture_point(
     """
     omega = positive_float("omega", omega, "1/s")
     growth = latency_growth(omega, non_negative_float("latency", latency, "s"))
-    p = finite_array("cop", cop)
-    return p + (finite_array("mean", mean) - p) * growth, finite_array("cov", cov) * growth**2
+    p, mu, sigma = finite_array("cop", cop), finite_array("mean", mean), finite_array("cov", cov)
+    d = mu.shape[-1] if mu.ndim else 0
+    try:  # one state (d,) or many (n, d), d = 1 or 2
+        agree = d in (1, 2) and sigma.shape[-2:] == (d, d) and p.shape[-1:] in ((d,), ())
+        agree = agree and len(np.broadcast_shapes(p.shape, mu.shape, sigma.shape[:-1])) > 0
+    except ValueError:
+        agree = False
+    if not agree:
+        raise InvalidParameterError(
+            f"mean (..., d), cop (..., d) and cov (..., d, d) must agree, d = 1 or 2, got "
+            f"shapes {mu.shape}, {p.shape} and {sigma.shape}"
+        )
+    return p + (mu - p) * growth, sigma * growth**2
 
 
 def latency_growth(omega: float, tau: float) -> float:

@@ -111,7 +111,7 @@ def margin_quantiles(
     alphas = finite_array("levels", levels)
     if alphas.ndim != 1 or alphas.size == 0 or np.any((alphas <= 0.0) | (alphas >= 1.0)):
         raise InvalidParameterError(f"levels must be probabilities in (0, 1), got {levels!r}")
-    if region not in ("cop", "cmp"):
+    if not isinstance(region, str) or region not in ("cop", "cmp"):
         raise InvalidParameterError(f"region must be 'cop' or 'cmp', got {region!r:.40}")
     if support is not None and not state.plane:
         raise InvalidParameterError("support applies to a plane state (x, y, xdot, ydot)")

@@ -26,7 +26,10 @@ ReliabilityRow = tuple[float, float, int, float, float, float]
 
 def _checked(predicted: ArrayLike, happened: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     p = finite_array("predicted", predicted)
-    hit = np.asarray(happened)
+    try:
+        hit = np.asarray(happened)
+    except ValueError:  # ragged
+        raise InvalidParameterError("happened must be a 1-D array of booleans") from None
     if p.ndim != 1 or p.shape != hit.shape:
         raise InvalidParameterError(
             f"predicted and happened must be 1-D of one length, got {p.shape} and {hit.shape}"

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.qp import CondensedQP
 from pushrecovery.control.mpc.solvers.base import Guess
@@ -71,6 +72,7 @@ class DaqpSolver:
     def __init__(self, qp: CondensedQP) -> None:
         import daqp
 
+        require_type("qp", qp, CondensedQP)
         if not all(hasattr(getattr(daqp, "Model", None), a) for a in ("update", "settings")):
             raise ImportError("this daqp has no Model workspace with update() and settings")
         self.qp = qp

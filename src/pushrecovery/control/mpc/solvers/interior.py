@@ -23,11 +23,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import positive_float
+from pushrecovery.arguments import positive_float, require_type
 from pushrecovery.control.mpc.plan import Plan, Status
 from pushrecovery.control.mpc.problem import SparseQP
 from pushrecovery.control.mpc.solvers.base import Guess, Solver
 from pushrecovery.control.mpc.solvers.riccati import POLISH_PASSES
+from pushrecovery.errors import ParameterTypeError
 from pushrecovery.kernels.mpc.interior import (
     COLD,
     CONVERGED,
@@ -115,6 +116,9 @@ class InteriorPointSolver:
         polish: Solver | None = None,
         guide_centre: float = GUIDE_CENTRE,
     ) -> None:
+        require_type("problem", problem, SparseQP)
+        if polish is not None and not callable(getattr(polish, "solve", None)):
+            raise ParameterTypeError(f"polish must be a solver, got {type(polish).__name__}")
         self.problem = problem
         self.polish = polish
         self.guide_centre = positive_float("guide_centre", guide_centre)

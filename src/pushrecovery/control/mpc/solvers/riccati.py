@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.mpc.plan import Plan, Status
 from pushrecovery.control.mpc.problem import SparseQP
 from pushrecovery.control.mpc.solvers.base import Guess
@@ -85,6 +86,7 @@ class RiccatiSolver:
     """
 
     def __init__(self, problem: SparseQP) -> None:
+        require_type("problem", problem, SparseQP)
         self.problem = problem
         n = problem.horizon
         bounds = problem.bounds

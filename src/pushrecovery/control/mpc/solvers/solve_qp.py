@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.mpc.plan import Plan
 from pushrecovery.control.mpc.qp import CondensedQP
 from pushrecovery.control.mpc.solvers.base import Guess
@@ -36,6 +37,8 @@ class SolveQpSolver:
     """
 
     def __init__(self, qp: CondensedQP, backend: str) -> None:
+        require_type("qp", qp, CondensedQP)
+        require_type("backend", backend, str)
         self.qp = qp
         self.backend = backend
         # DAQP's tolerance of the workspace here too: its default (1e-6) is not exact.

@@ -9,9 +9,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery.arguments import whole_number
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
+    "MAX_FRAMES",
     "Frame",
     "FrameLike",
     "nearest_indices",
@@ -20,6 +22,9 @@ __all__ = [
     "subsample",
     "subsample_indices",
 ]
+
+#: Most frames a selection asks for: a minute of video at 1 kHz.
+MAX_FRAMES = 60_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,17 +132,17 @@ def select_indices(times: ArrayLike, count: int) -> list[int]:
     times : Sequence[float]
         Frame times [s], finite and non-decreasing.
     count : int
-        Number of frames wanted, >= 1 (fewer are returned if there are fewer distinct ones).
+        Number of frames wanted, in [1, :data:`MAX_FRAMES`] (fewer are returned if there are
+        fewer distinct ones).
 
     Returns
     -------
     list[int]
         Increasing indices.
     """
-    if count < 1:
-        raise InvalidParameterError(f"count must be >= 1, got {count}")
+    count = whole_number("count", count, 1, MAX_FRAMES)
     t = _checked_times(times)
-    return nearest_indices(t, np.linspace(t[0], t[-1], count))
+    return nearest_indices(t, np.linspace(t[0], t[-1], min(count, len(t))))
 
 
 def _checked_times(times: ArrayLike) -> NDArray[np.float64]:
@@ -185,7 +190,5 @@ def select_times(frames: Sequence[FrameLike], count: int) -> list[Frame]:
     list[Frame]
         The frames nearest to ``count`` evenly spaced times.
     """
-    if count < 1:
-        raise InvalidParameterError(f"count must be >= 1, got {count}")
     frames = _as_frames(frames)
     return [frames[i] for i in select_indices([f.time for f in frames], count)]
