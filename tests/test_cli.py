@@ -381,9 +381,9 @@ def test_figures_report_their_progress(monkeypatch):
 
     for name in ("fig3a", "fig3b", "fig5", "fig6", "fig9", "fig10", "plane", "steps"):
         monkeypatch.setattr(module, name, lambda *args, **kwargs: [])
-    from types import SimpleNamespace
+    from pushrecovery.experiments.paper_figures import PaperRuns
 
-    runs = SimpleNamespace(fig3a=[], fig3b=[], fig5=[], fig5_worst=[], fig6=[])
+    runs = PaperRuns(fig3a=[], fig3b=[], fig5=[], fig5_worst=[], fig6=[])
     calls = []
     module.write_figures(load_params(), runs, Path("unused"), progress=calls.append)
     assert calls == [1] * module.FIGURE_COUNT

@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.analysis.recording import AXES
 from pushrecovery.analysis.trial import TrialAnalysis
+from pushrecovery.arguments import require_type
 from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR, save_figure
 from pushrecovery.surfaces.classify import Strategy
 
@@ -97,6 +98,7 @@ def withheld_frames(
     CoP beyond the base, a base the CoP contradicts (the whole trial unclassified), missing data
     (or, for ``strategy_2d``, a base with no feet to classify against).
     """
+    require_type("analysis", analysis, TrialAnalysis)
     columns = analysis.columns
     strategy = columns[column]
     none = ~np.isin(strategy.astype(str), list(STRATEGY_COLOURS))
@@ -132,6 +134,7 @@ def time_series_figure(analysis: TrialAnalysis) -> Figure:
     no verdict, with its reason); flight phases are shaded grey, events marked by vertical
     lines. Positions [m] are relative to the median stance ankle (ap) or base centre (ml).
     """
+    require_type("analysis", analysis, TrialAnalysis)
     columns = analysis.columns
     time = columns["time"]
     fig, axes = _figure(2, 1, 9.0, 7.2)
@@ -193,11 +196,13 @@ def time_series_figure(analysis: TrialAnalysis) -> Figure:
 
 def plot_time_series(analysis: TrialAnalysis, path: Path) -> Path:
     """Write :func:`time_series_figure` to ``path`` (format from its suffix, default PNG)."""
+    require_type("analysis", analysis, TrialAnalysis)
     return _save(time_series_figure(analysis), path)
 
 
 def plot_phase_portrait(analysis: TrialAnalysis, path: Path) -> Path:
     """Write :func:`phase_portrait_figure` to ``path`` (format from its suffix, default PNG)."""
+    require_type("analysis", analysis, TrialAnalysis)
     return _save(phase_portrait_figure(analysis), path)
 
 
@@ -268,6 +273,7 @@ def phase_coordinates(analysis: TrialAnalysis, axis: str) -> tuple[np.ndarray, n
     velocity : ndarray
         CoM velocity [m/s].
     """
+    require_type("analysis", analysis, TrialAnalysis)
     columns = analysis.columns
     low, high = columns[f"{axis}_base_min"], columns[f"{axis}_base_max"]
     length = high - low
@@ -287,6 +293,7 @@ def phase_portrait_figure(analysis: TrialAnalysis) -> Figure:
     with no verdict grey, with their reason; frames with no base are not drawn (counted in
     the legend).
     """
+    require_type("analysis", analysis, TrialAnalysis)
     columns = analysis.columns
     fig, axes = _figure(1, 2, 11.0, 5.6)
     for ax, axis in zip(axes[0], AXES, strict=True):

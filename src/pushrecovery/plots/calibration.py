@@ -11,6 +11,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from pushrecovery.errors import ParameterTypeError
+
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
@@ -21,6 +23,13 @@ __all__ = ["reliability_figure"]
 
 def reliability_figure(studies: Sequence[tuple[str, Calibration]]) -> Figure:
     """Return one reliability diagram per (label, study), side by side (module docstring)."""
+    from pushrecovery.experiments.calibration import Calibration
+
+    pairs = isinstance(studies, list | tuple) and all(
+        isinstance(s, tuple) and len(s) == 2 for s in studies
+    )
+    if not pairs or not all(isinstance(s[1], Calibration) for s in studies):
+        raise ParameterTypeError("studies must be a list of (label, Calibration) pairs")
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(5.0 * max(1, len(studies)), 5.5), layout="constrained")

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import os
+from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from pushrecovery.errors import InputFileError, InvalidParameterError
+from pushrecovery.arguments import bounded_float, finite_array, finite_vector, require_type
+from pushrecovery.errors import InputFileError, InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import cop_region
@@ -17,12 +19,18 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
+    from pushrecovery.sim.result import SimulationResult
+
 __all__ = [
     "FALL_COLOUR",
     "HIP_COLOUR",
     "PLOT_FORMATS",
     "RECOVER_COLOUR",
+    "check_axes",
+    "check_formats",
     "check_plot_path",
+    "check_rows",
+    "figure_outputs",
     "frame_points",
     "new_figure",
     "save_figure",
@@ -44,6 +52,7 @@ def check_plot_path(path: Path) -> Path:
     InvalidParameterError
         Naming the file and the formats.
     """
+    require_type("path", path, (str, os.PathLike))
     path = Path(path)
     if path.suffix.lower() not in PLOT_FORMATS:
         raise InvalidParameterError(
@@ -52,8 +61,63 @@ def check_plot_path(path: Path) -> Path:
     return path
 
 
+def check_formats(formats: object) -> tuple[str, ...]:
+    """Return ``formats`` as names among :data:`PLOT_FORMATS` (without the dot), or raise."""
+    if isinstance(formats, str) or not isinstance(formats, Iterable):
+        raise ParameterTypeError(f"formats must be a list of names, got {formats!r:.40}")
+    names = tuple(formats)
+    if not names or not all(isinstance(f, str) and f".{f}" in PLOT_FORMATS for f in names):
+        raise InvalidParameterError(
+            f"formats must be names among {sorted(f[1:] for f in PLOT_FORMATS)}, got {names!r:.60}"
+        )
+    return names
+
+
+def figure_outputs(
+    params: object, formats: object, out: object, runs: object = ()
+) -> tuple[tuple[str, ...], Path, list[SimulationResult]]:
+    """Check a figure writer's arguments; return its formats, output folder and runs.
+
+    ``params`` a BodyParams, ``formats`` names among :data:`PLOT_FORMATS` (without the dot),
+    ``out`` a folder's path, ``runs`` simulation results (an iterable, read once here).
+    """
+    from pushrecovery.sim.result import SimulationResult
+
+    require_type("params", params, BodyParams)
+    require_type("out", out, (str, os.PathLike))
+    names = check_formats(formats)
+    if isinstance(runs, str) or not isinstance(runs, Iterable):
+        raise ParameterTypeError(f"runs must be simulation results, got {type(runs).__name__}")
+    results = list(runs)
+    for run in results:
+        require_type("each of runs", run, SimulationResult)
+    return names, Path(out), results  # type: ignore[arg-type]
+
+
+def check_rows(name: str, rows: object) -> list[Mapping[str, Any]]:
+    """Return ``rows`` (a table's rows: mappings of column to value) as a list, or raise."""
+    if isinstance(rows, str | bytes | Mapping) or not isinstance(rows, Iterable):
+        raise ParameterTypeError(f"{name} must be a list of rows (mappings), got {rows!r:.40}")
+    try:
+        found = list(rows)
+    except TypeError:  # a 0-d array
+        raise ParameterTypeError(f"{name} must be a list of rows (mappings)") from None
+    if not all(isinstance(row, Mapping) for row in found):
+        raise ParameterTypeError(f"{name} must be a list of rows (mappings of column to value)")
+    return found
+
+
+def check_axes(name: str, ax: object) -> None:
+    """Raise naming ``name`` unless ``ax`` is a matplotlib ``Axes``."""
+    from matplotlib.axes import Axes
+
+    require_type(name, ax, Axes)
+
+
 def new_figure(width: float = 6.4, height: float = 4.8) -> tuple[Figure, Axes]:
     """Create a figure with one axes, outside pyplot (no global backend, nothing to close)."""
+    width = bounded_float("width", width, 1.0, 100.0, "in")
+    height = bounded_float("height", height, 1.0, 100.0, "in")
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(width, height), layout="constrained")
@@ -62,6 +126,11 @@ def new_figure(width: float = 6.4, height: float = 4.8) -> tuple[Figure, Axes]:
 
 def frame_points(ax: Axes, points: np.ndarray, margin: float) -> None:
     """Limit ``ax`` to the (x, y) ``points`` [m] grown by ``margin`` [m], at equal scales."""
+    check_axes("ax", ax)
+    points = finite_array("points", points, 1e6, "m")
+    if points.ndim != 2 or points.shape[1] != 2 or not len(points):
+        raise InvalidParameterError(f"points must be (x, y) rows [m], got shape {points.shape}")
+    margin = bounded_float("margin", margin, 0.0, 1e3, "m")
     low, high = points.min(axis=0) - margin, points.max(axis=0) + margin
     ax.set_xlim(low[0], high[0])
     ax.set_ylim(low[1], high[1])
@@ -81,6 +150,10 @@ def shade_regions(
     Green: CoP balancing, Eq. (4). With ``hip``, orange: the extra states CMP balancing
     recovers (corrected Eq. 15). Red: beyond every balancing strategy.
     """
+    check_axes("ax", ax)
+    require_type("params", params, BodyParams)
+    xlim = tuple(finite_vector("xlim", xlim, 2, 1e6))
+    ylim = tuple(finite_vector("ylim", ylim, 2, 1e6))
     omega = params.omega
     xs = np.linspace(*xlim, 200)
     outer = cmp_region(params) if hip else cop_region(params)
@@ -126,6 +199,11 @@ def save_figure(fig: Figure, stem: Path, formats: Iterable[str]) -> list[Path]:
 
     The format is appended to the stem's name, so a stem with a dot (``push0.30``) keeps it.
     """
+    from matplotlib.figure import Figure
+
+    require_type("fig", fig, Figure)
+    require_type("stem", stem, Path)
+    formats = check_formats(formats)
     paths = []
     try:
         stem.parent.mkdir(parents=True, exist_ok=True)

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
+from pushrecovery.arguments import require_type
 from pushrecovery.experiments.confusion3d import APART, LABELS, USED, Confusion3D
 from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR
 
@@ -35,6 +36,7 @@ def confusion3d_figure(result: Confusion3D, *, corrected: bool = False) -> Figur
     With ``corrected`` the rows of the matrix and the dots' agreement are the verdict
     corrected for the push's height (``predicted_corrected``).
     """
+    require_type("result", result, Confusion3D)
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(11.0, 5.2))

@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.arguments import require_type
+from pushrecovery.errors import ParameterTypeError
 from pushrecovery.experiments.paper_figures import PaperRuns
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.params import BodyParams
@@ -21,6 +23,7 @@ from pushrecovery.plots.common import (
     FALL_COLOUR,
     HIP_COLOUR,
     RECOVER_COLOUR,
+    figure_outputs,
     new_figure,
     save_figure,
     shade_regions,
@@ -49,6 +52,7 @@ def fig3a(
     params: BodyParams, runs: Iterable[SimulationResult], formats: Iterable[str], out: Path
 ) -> list[Path]:
     """Fig. 3(a): open-loop saturated ankle torque on the LIPM from upright, pushed."""
+    formats, out, runs = figure_outputs(params, formats, out, runs)
     title = "Fig. 3(a): saturated ankle torque, LIPM (green recovers, red falls)"
     return _phase(params, runs, title, out / "fig3a", formats, hip=False)
 
@@ -57,6 +61,7 @@ def fig3b(
     params: BodyParams, runs: Iterable[SimulationResult], formats: Iterable[str], out: Path
 ) -> list[Path]:
     """Fig. 3(b): saturated PD ankle control of the nonlinear pendulum from many states."""
+    formats, out, runs = figure_outputs(params, formats, out, runs)
     title = (
         "Fig. 3(b): saturated PD ankle control, nonlinear pendulum\n"
         "(pushes 15 % inside / outside Eq. (4); falls drawn until certain)"
@@ -80,7 +85,10 @@ def write_figures(
     ``plane`` and the step figures. ``progress`` is called with 1 after each of them
     (:data:`FIGURE_COUNT` in all, a progress bar's ``update``).
     """
-    formats = tuple(formats)
+    formats, out, _ = figure_outputs(params, formats, out)
+    require_type("runs", runs, PaperRuns)
+    if progress is not None and not callable(progress):
+        raise ParameterTypeError(f"progress must be callable, got {type(progress).__name__}")
     drawers: list[Callable[[], list[Path]]] = [
         lambda: fig3a(params, runs.fig3a, formats, out),
         lambda: fig3b(params, runs.fig3b, formats, out),
@@ -109,6 +117,7 @@ def steps(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     :func:`~pushrecovery.plots.steps.capture_regions_figure` and
     :func:`~pushrecovery.plots.steps.n_step_map_figure`.
     """
+    formats, out, _ = figure_outputs(params, formats, out)
     from pushrecovery.plots.steps import capture_regions_figure, n_step_map_figure
 
     formats = tuple(formats)
@@ -125,6 +134,7 @@ def plane(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     CoM at rest above the stance's reference point, at their capture point and coloured by the
     strategy they need (:func:`~pushrecovery.plots.plane.capture_plane_panels`).
     """
+    formats, out, _ = figure_outputs(params, formats, out)
     from pushrecovery.plots.plane import capture_plane_panels
 
     return save_figure(capture_plane_panels(params), out / "plane", formats)
@@ -219,6 +229,8 @@ def fig5(
 
     ``worst`` switches at T = T_max.
     """
+    formats, out, runs = figure_outputs(params, formats, out, runs)
+    _, _, worst = figure_outputs(params, formats, out, worst)
     formats = tuple(formats)
     files = _phase(
         params,
@@ -247,6 +259,7 @@ def fig6(
 
     ``runs``: pushes at 0.3, 0.6, 0.85, 0.99 and 1.05 of the hip's critical push.
     """
+    formats, out, runs = figure_outputs(params, formats, out, runs)
     formats = tuple(formats)
     files = _phase(
         params,
@@ -273,6 +286,7 @@ def fig9(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     Velocities are divided by ω(z) = sqrt(g / z) of the current CoM height (the paper scales
     by √z), so every height shares the capture-point line ẋ/ω = −x of Eq. (21).
     """
+    formats, out, _ = figure_outputs(params, formats, out)
     from pushrecovery.models.stepping import step_solution
 
     length, gravity = params.leg_length, params.gravity
@@ -316,6 +330,7 @@ def fig9(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
 
 def fig10(params: BodyParams, formats: Iterable[str], out: Path) -> list[Path]:
     """Fig. 10: optimal step length vs initial CoM velocity, with the admissible range."""
+    formats, out, _ = figure_outputs(params, formats, out)
     from pushrecovery.models.stepping import step_solution
     from pushrecovery.surfaces.step import step_thresholds
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from pushrecovery.analysis.base_polygon import BasePolygons
 from pushrecovery.analysis.trial import TrialAnalysis
+from pushrecovery.arguments import require_type
 from pushrecovery.plots.analysis import (
     STRATEGY_COLOURS,
     WITHHELD_COLOURS,
@@ -51,6 +52,7 @@ def base_moments(analysis: TrialAnalysis, base: BasePolygons) -> list[tuple[int,
     list of (frame, descriptions)
         In time order; a description is e.g. ``"1.60 s push onset"``.
     """
+    require_type("analysis", analysis, TrialAnalysis)
     time = analysis.columns["time"]
     known = np.flatnonzero(base.counts >= 3)
     if not known.size:
@@ -109,6 +111,7 @@ def plot_plane(analysis: TrialAnalysis, base: BasePolygons | None, path: Path) -
     Path
         The file written.
     """
+    require_type("analysis", analysis, TrialAnalysis)
     return _save(plane_figure(analysis, base), path)
 
 
@@ -133,6 +136,7 @@ def plane_figure(analysis: TrialAnalysis, base: BasePolygons | None = None) -> F
     ValueError
         If ``base`` has not one polygon per frame of ``analysis``.
     """
+    require_type("analysis", analysis, TrialAnalysis)
     columns = analysis.columns
     time = columns["time"]
     if base is None:

@@ -12,6 +12,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
+from pushrecovery.arguments import require_type
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import (
     FALL_COLOUR,
@@ -29,6 +30,8 @@ __all__ = ["plane_run_figure", "save_run"]
 
 def save_run(result: SimulationResult, params: BodyParams, path: Path) -> Path:
     """Write a two-panel plot of ``result`` to ``path`` (format from the extension)."""
+    require_type("result", result, SimulationResult)
+    require_type("params", params, BodyParams)
     path = check_plot_path(path)
     if result.states.shape[1] == 8:
         figure = plane_run_figure(result, params)
@@ -60,6 +63,8 @@ def plane_run_figure(result: SimulationResult, params: BodyParams) -> Figure:
     The feet are the two of the start (ankles at y = ±stance_width/2) and one at every
     landed foothold (``result.footholds_xy``), numbered in order; x forward, y left.
     """
+    require_type("result", result, SimulationResult)
+    require_type("params", params, BodyParams)
     from pushrecovery.ground.support import foot_shape
 
     states = result.states

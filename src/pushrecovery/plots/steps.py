@@ -15,10 +15,11 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import finite_vector, require_type, whole_number
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
-from pushrecovery.params import BodyParams
+from pushrecovery.params import MAX_STEPS, BodyParams
 from pushrecovery.plots.common import FALL_COLOUR, HIP_COLOUR, RECOVER_COLOUR, frame_points
 from pushrecovery.surfaces.cop import capture_point
 
@@ -109,6 +110,16 @@ def capture_regions_figure(
     By default four pushes from rest over the ankles' midpoint: forward 2.0 m/s, left
     1.2 m/s, backward-right 1.8 m/s and forward-left 2.8 m/s (two steps needed).
     """
+    steps = whole_number("steps", steps, 1, MAX_STEPS)
+    if states is not None and (isinstance(states, str) or not isinstance(states, list | tuple)):
+        raise ParameterTypeError(
+            f"states must be a list of CoM states, got {type(states).__name__}"
+        )
+    if states is not None:  # (x, y, xdot, ydot) [m, m/s] each, as classify takes them
+        states = [tuple(finite_vector("each of states", s, 4, 1e3)) for s in states]
+    require_type("params", params, BodyParams)
+    if support is not None:
+        require_type("support", support, Support)
     support = Support.from_params(params) if support is None else support
     if states is None:
         ax0, ay0 = support.ankle
@@ -154,6 +165,11 @@ def n_step_map_figure(
     from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify_states
     from pushrecovery.surfaces.step_regions import line_steps
 
+    require_type("params", params, BodyParams)
+    xlim = tuple(finite_vector("xlim", xlim, 2, 1e3, "m"))
+    resolution = whole_number("resolution", resolution, 2, 4001)  # 16 million states at most
+    if ylim is not None:
+        ylim = tuple(finite_vector("ylim", ylim, 2, 1e3, "m/s"))
     omega = params.omega
     top = ylim if ylim is not None else (-1.2 * omega * 1.2, 1.2 * omega * 1.4)
     xs = np.linspace(*xlim, resolution)

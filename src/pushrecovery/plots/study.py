@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from pushrecovery.plots.common import save_figure
+from pushrecovery.arguments import require_type
+from pushrecovery.plots.common import check_rows, save_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -42,6 +43,7 @@ _TRIALS, _SUBJECTS, _MEAN = -0.22, 0.0, 0.22
 
 def conditions(rows: Sequence[Mapping[str, Any]]) -> dict[str, str]:
     """Return each analysed trial's group (module docstring), by trial name."""
+    rows = check_rows("rows", rows)
     analysed = [row for row in rows if row.get("status") == "analysed"]
     given = any(row.get("condition") for row in analysed)
     return {
@@ -56,6 +58,7 @@ def study_figure(rows: Sequence[Mapping[str, Any]]) -> Figure:
     ``to_pylist``); rows whose ``status`` is not ``analysed`` or whose value is null are left
     out.
     """
+    rows = check_rows("rows", rows)
     from matplotlib.figure import Figure
 
     group = conditions(rows)
@@ -109,5 +112,7 @@ def _panel(
 
 def plot_study(rows: Sequence[Mapping[str, Any]], path: Path) -> Path:
     """Write :func:`study_figure` to ``path`` (format from its suffix, default PNG)."""
+    require_type("path", path, Path)
+    rows = check_rows("rows", rows)
     figure = study_figure(rows)
     return save_figure(figure, path.with_suffix(""), [path.suffix.lstrip(".") or "png"])[0]

@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from pushrecovery.plots.common import save_figure
+from pushrecovery.arguments import require_type
+from pushrecovery.plots.common import check_rows, save_figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -37,6 +38,7 @@ def subjects_figure(rows: Sequence[Mapping[str, Any]]) -> Figure:
     ``to_pylist``); rows whose ``status`` is not ``analysed`` or whose value is null are left
     out.
     """
+    rows = check_rows("rows", rows)
     from matplotlib.figure import Figure
 
     analysed = [row for row in rows if row.get("status") == "analysed"]
@@ -70,5 +72,7 @@ def subjects_figure(rows: Sequence[Mapping[str, Any]]) -> Figure:
 
 def plot_subjects(rows: Sequence[Mapping[str, Any]], path: Path) -> Path:
     """Write :func:`subjects_figure` to ``path`` (format from its suffix, default PNG)."""
+    require_type("path", path, Path)
+    rows = check_rows("rows", rows)
     figure = subjects_figure(rows)
     return save_figure(figure, path.with_suffix(""), [path.suffix.lstrip(".") or "png"])[0]

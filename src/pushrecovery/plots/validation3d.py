@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any, cast
 
+from pushrecovery.arguments import require_type
 from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS, Validation3D
 from pushrecovery.experiments.validation3d_step import StepValidation
 from pushrecovery.plots.common import HIP_COLOUR, RECOVER_COLOUR
@@ -32,6 +33,10 @@ def validation3d_figure(result: Validation3D | None, step: StepValidation | None
     Either may be None (not both); the step column is a model's
     (:func:`~pushrecovery.experiments.validation3d_step.run_step_validation`).
     """
+    if result is not None:
+        require_type("result", result, Validation3D)
+    if step is not None:
+        require_type("step", step, StepValidation)
     from matplotlib.figure import Figure
 
     from pushrecovery.errors import InvalidParameterError

@@ -7,6 +7,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from pushrecovery.arguments import require_type
+from pushrecovery.errors import ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import check_plot_path, save_figure
 
@@ -90,6 +92,13 @@ def plot_outcome_map(table: Any, spec: CampaignSpec, path: Path) -> Path:
     Path
         The file written.
     """
+    from pushrecovery.campaign.spec import CampaignSpec
+
+    require_type("spec", spec, CampaignSpec)
+    if not hasattr(table, "column_names"):
+        raise ParameterTypeError(
+            f"table must be a campaign's pyarrow table, got {type(table).__name__}"
+        )
     path = check_plot_path(path)
     columns = _columns(table)
     panels = _panels(spec, columns)
@@ -167,6 +176,7 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     Path
         The file written.
     """
+    require_type("params", params, BodyParams)
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 

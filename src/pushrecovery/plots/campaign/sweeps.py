@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.plots.campaign.style import UNITS
 from pushrecovery.plots.common import check_plot_path, save_figure
 
@@ -44,6 +44,10 @@ def plot_critical_vs_parameter(summary: Mapping[str, Any], path: Path) -> Path:
     InvalidParameterError
         If the campaign does not sweep exactly one parameter or has no boundary rows.
     """
+    if not isinstance(summary, Mapping):
+        raise ParameterTypeError(
+            f"summary must be a campaign summary (a mapping), got {type(summary).__name__}"
+        )
     import matplotlib
 
     path = check_plot_path(path)

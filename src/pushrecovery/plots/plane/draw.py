@@ -9,11 +9,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.campaign import STEP_COLOUR, STRATEGY_COLOURS
-from pushrecovery.plots.common import HIP_COLOUR, RECOVER_COLOUR
+from pushrecovery.plots.common import HIP_COLOUR, RECOVER_COLOUR, check_axes
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -91,6 +92,9 @@ def draw_capture_plane(
         (xmin, xmax, ymin, ymax) [m] of everything drawn, and of a close-up around the CMP
         region and the feet.
     """
+    check_axes("ax", ax)
+    require_type("params", params, BodyParams)
+    require_type("support", support, Support)
     from matplotlib.patches import Polygon
 
     from pushrecovery.surfaces.classify import STRATEGY_CODES
@@ -298,6 +302,11 @@ def capture_plane_panels(
     Figure
         The panels, sharing axes row by row.
     """
+    require_type("params", params, BodyParams)
+    if supports is not None and (not isinstance(supports, list | tuple) or not supports):
+        raise InvalidParameterError("supports must be a list of at least one Support")
+    for support in supports or ():
+        require_type("each of supports", support, Support)
     if supports is None:
         supports = [Support.from_params(params, stance) for stance in Stance]
     if not supports:

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pushrecovery.arguments import finite_array, require_type, whole_number
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
 from pushrecovery.params import BodyParams
@@ -15,12 +16,16 @@ from pushrecovery.params import BodyParams
 __all__ = [
     "HEADINGS",
     "LIMIT_HEADINGS",
+    "MAX_HEADINGS",
     "SPEEDS",
     "PlaneSamples",
     "plane_samples",
     "recovery_limits",
     "threshold_lines",
 ]
+
+#: Most headings, or push speeds, of a sampling (a polar grid of their product).
+MAX_HEADINGS = 1000
 
 
 #: Default number of push headings (evenly spaced, the first straight forward).
@@ -65,12 +70,11 @@ class PlaneSamples:
 
 
 def _headings(headings: int | ArrayLike) -> NDArray[np.float64]:
-    if isinstance(headings, int | np.integer):
-        if headings < 1:
-            raise InvalidParameterError(f"headings must be >= 1, got {headings}")
-        return np.linspace(0.0, 2.0 * math.pi, int(headings), endpoint=False)
-    values = np.atleast_1d(np.asarray(headings, dtype=np.float64))
-    if values.ndim != 1 or values.size == 0 or not np.isfinite(values).all():
+    if isinstance(headings, int | np.integer) and not isinstance(headings, bool):
+        count = whole_number("headings", headings, 1, MAX_HEADINGS)
+        return np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
+    values = np.atleast_1d(finite_array("headings", headings, 100.0, "rad"))
+    if values.ndim != 1 or not 0 < values.size <= MAX_HEADINGS:
         raise InvalidParameterError("headings must be finite angles in rad (or a count)")
     return values
 
@@ -134,9 +138,11 @@ def _speeds(
         reach = float(np.max(limits))
         top = _SPEED_REACH * reach if reach > 0.0 else 1.0
         return np.linspace(top / SPEEDS, top, SPEEDS)
-    values = np.atleast_1d(np.asarray(speeds, dtype=np.float64))
-    if values.ndim != 1 or values.size == 0 or not np.isfinite(values).all() or (values < 0).any():
-        raise InvalidParameterError("speeds must be finite push speeds >= 0 in m/s")
+    values = np.atleast_1d(finite_array("speeds", speeds, 1e3, "m/s"))
+    if values.ndim != 1 or not 0 < values.size <= MAX_HEADINGS or (values < 0).any():
+        raise InvalidParameterError(
+            f"speeds must be 1 to {MAX_HEADINGS} push speeds in [0, 1000] m/s"
+        )
     return values
 
 
@@ -167,6 +173,8 @@ def plane_samples(
     PlaneSamples
         Speed-major order: heading k of speed j is sample j * len(headings) + k.
     """
+    require_type("params", params, BodyParams)
+    require_type("support", support, Support)
     return _samples(params, support, _speeds(params, support, speeds), _headings(headings))
 
 
