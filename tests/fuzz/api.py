@@ -214,6 +214,10 @@ def draw(name: str, item: Any, seed: int, folder: Path) -> tuple[dict[str, Any],
             arguments[p.name] = rng.choice(pool)
             if p.name not in hostile:
                 hostile.append(p.name)
+        if name.startswith(HEAVY):  # one value no parameter takes: a refusal, not minutes of work
+            p = rng.choice(params)
+            arguments[p.name] = rng.choice([object(), b"\xff", math.nan])
+            hostile.append(p.name)
     return arguments, hostile
 
 

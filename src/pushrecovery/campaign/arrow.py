@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import require_type
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 __all__ = ["column_array", "table_of_rows"]
 
@@ -76,6 +77,12 @@ def table_of_rows(rows: Sequence[Mapping[str, Any]], schema: Any) -> Any:
     InvalidParameterError
         Naming the column, for a type other than those four or more than 2 GiB of text.
     """
+    if (
+        isinstance(rows, str)
+        or not isinstance(rows, Sequence)
+        or not all(isinstance(r, Mapping) for r in rows)
+    ):
+        raise ParameterTypeError("rows must be a list of mappings (column to value)")
     import pyarrow as pa
 
     keys = list(rows[0]) if rows else []
@@ -134,6 +141,9 @@ def column_array(table: Any, name: str) -> np.ndarray:
     InvalidParameterError
         Naming ``name``: not a column of ``table``, or of a type no row column has.
     """
+    if not hasattr(table, "column_names"):
+        raise ParameterTypeError(f"table must be a pyarrow table, got {type(table).__name__}")
+    require_type("name", name, str)
     if name not in table.column_names:
         raise InvalidParameterError(f"name must be a column of the table, got {name!r}")
     chunks = table.column(name).chunks

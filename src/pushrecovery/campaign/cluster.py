@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any
 
+from pushrecovery.arguments import require_type
 from pushrecovery.campaign.isolation import BatchRunner, PushRunner
 from pushrecovery.campaign.pushes import error_row, run_batch, run_push
 from pushrecovery.campaign.spec import CampaignError, CampaignSpec
@@ -23,6 +24,7 @@ CONNECT_TIMEOUT = 10.0
 
 def connect(scheduler: str) -> Any:
     """Connect to the scheduler at ``scheduler`` (a client that is not made the default)."""
+    require_type("scheduler", scheduler, str)
     require("campaign", "distributed", "a Dask scheduler")
     from distributed import Client
     from distributed.comm import parse_address

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from pushrecovery.arguments import require_type
 from pushrecovery.surfaces.probability import verdict_probability_table
 
 if TYPE_CHECKING:
@@ -27,6 +28,11 @@ __all__ = ["estimate_columns"]
 
 def estimate_columns(spec: CampaignSpec, pushes: Sequence[Push]) -> list[dict[str, Any]]:
     """Return each push's estimate columns (module docstring); empty dicts without them."""
+    from pushrecovery.campaign.spec import CampaignSpec, Push
+
+    require_type("spec", spec, CampaignSpec)
+    for push in pushes:
+        require_type("each of pushes", push, Push)
     if spec.state_sd is None and spec.latency == 0.0:
         return [{} for _ in pushes]
     sd = np.array(spec.state_sd if spec.state_sd is not None else (0.0, 0.0))

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pushrecovery.arguments import require_type
 from pushrecovery.campaign.arrow import table_of_rows
 from pushrecovery.campaign.cluster import connect, on_cluster
 from pushrecovery.campaign.isolation import (
@@ -31,7 +32,7 @@ from pushrecovery.campaign.isolation import (
 from pushrecovery.campaign.pushes import run_batch
 from pushrecovery.campaign.rows import row_schema
 from pushrecovery.campaign.spec import CampaignError, CampaignSpec
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.extras import require_extra
 
 __all__ = ["CampaignError", "CampaignResult", "missing_batches", "read_spec", "run_campaign"]
@@ -74,6 +75,7 @@ def schema(spec: CampaignSpec) -> Any:
 
 def read_spec(directory: Path) -> CampaignSpec:
     """Return the spec of the campaign in ``directory``."""
+    require_type("directory", directory, (str, os.PathLike))
     path = Path(directory) / SPEC_FILE
     try:
         data = json.loads(path.read_text())
@@ -86,6 +88,8 @@ def read_spec(directory: Path) -> CampaignSpec:
 
 def missing_batches(spec: CampaignSpec, directory: Path) -> list[int]:
     """Batch numbers of ``spec`` with no finished file in ``directory``."""
+    require_type("spec", spec, CampaignSpec)
+    require_type("directory", directory, (str, os.PathLike))
     done = set()
     folder = Path(directory) / BATCH_DIR
     if folder.is_dir():
@@ -238,6 +242,10 @@ def run_campaign(
     MissingExtraError
         Without the ``campaign`` extra, or the ``sim`` extra for a MuJoCo campaign.
     """
+    require_type("spec", spec, CampaignSpec)
+    require_type("directory", directory, (str, os.PathLike))
+    if progress is not None and not callable(progress):
+        raise ParameterTypeError(f"progress must be callable, got {type(progress).__name__}")
     require_extra("campaign")
     if spec.backend == "mujoco":
         require_extra("sim", "a MuJoCo campaign")

@@ -21,6 +21,7 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
 
+from pushrecovery.arguments import require_type, whole_number
 from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.pushes import error_row, run_batch, run_push
 from pushrecovery.campaign.spec import CampaignSpec
@@ -110,6 +111,7 @@ def new_pool(workers: int) -> ProcessPoolExecutor:
     They ignore Ctrl-C (the parent stops them) and end themselves when a push hangs
     (:mod:`~pushrecovery.campaign.watchdog`).
     """
+    workers = whole_number("workers", workers, 1, 1024)
     return ProcessPoolExecutor(
         max_workers=workers,
         mp_context=_context(),
@@ -120,6 +122,7 @@ def new_pool(workers: int) -> ProcessPoolExecutor:
 
 def batch_deadline(spec: CampaignSpec) -> float:
     """Wall time after which a batch's worker counts as hung [s]: every push at its limit."""
+    require_type("spec", spec, CampaignSpec)
     return spec.batch * watchdog.hung_after(spec.push_timeout) + watchdog.GRACE
 
 

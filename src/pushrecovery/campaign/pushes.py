@@ -18,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from pushrecovery.arguments import require_type, whole_number
 from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.estimates import estimate_columns
 from pushrecovery.campaign.pushes3d import error_row3d, run_push3d
@@ -31,6 +32,7 @@ from pushrecovery.campaign.rows import (
     verdict_columns,
 )
 from pushrecovery.campaign.spec import CampaignSpec, Push
+from pushrecovery.errors import ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.many import COMPILED, LOOP_UP_TO, PushRuns, run_many
 from pushrecovery.sim.physical_checks import PhysicalChecks
@@ -52,6 +54,8 @@ __all__ = [
 
 def run_push(spec: CampaignSpec, push: Push) -> dict[str, Any]:
     """Simulate one push through the one-push loop; return its row (module docstring)."""
+    require_type("spec", spec, CampaignSpec)
+    require_type("push", push, Push)
     return push_rows(spec, [push], engine="loop")[0]
 
 
@@ -68,6 +72,12 @@ def push_rows(
     the pushes share one plant and controller per body, as a batch does. ``on_start`` is
     called with the number of pushes about to run as one unit (a worker arms its watchdog).
     """
+    require_type("spec", spec, CampaignSpec)
+    if not isinstance(pushes, list) or not all(isinstance(p, Push) for p in pushes):
+        raise ParameterTypeError("pushes must be a list of Push")
+    require_type("engine", engine, str)
+    if on_start is not None and not callable(on_start):
+        raise ParameterTypeError(f"on_start must be callable, got {type(on_start).__name__}")
     if spec.is_3d:
         cache: dict[BodyParams, Any] = {}  # one compiled plant per body
         rows = []
@@ -199,6 +209,9 @@ def error_row(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
 
     The simulated columns are NaN (counts 0), ``used`` is ``error`` and ``error`` says why.
     """
+    require_type("spec", spec, CampaignSpec)
+    require_type("push", push, Push)
+    require_type("reason", reason, str)
     if spec.is_3d:
         return error_row3d(spec, push, reason)
     row = _inputs_and_prediction(spec, push, _predictions([push])[0])
@@ -213,6 +226,8 @@ def run_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]
     and with one worker per core, more threads per worker only compete for the cores (we saw
     a push whose 102 step queries take 0.04 s take 0.8 s on a busy machine).
     """
+    require_type("spec", spec, CampaignSpec)
+    batch = whole_number("batch", batch, 0, 10**9)
     from pushrecovery.kernels.threads import one_thread
 
     with one_thread():

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.arguments import require_type
 from pushrecovery.campaign.rows import (
     ERROR_OUTCOME,
     ERROR_OUTCOME_3D,
@@ -37,6 +38,8 @@ PUSH_TIME = 0.1
 
 def predict3d(spec: CampaignSpec, push: Push) -> dict[str, Any]:
     """Return the columns of a 3-D push that do not depend on the run: the push and its verdict."""
+    require_type("spec", spec, CampaignSpec)
+    require_type("push", push, Push)
     params = push.params
     azimuth = 0.0 if push.azimuth is None else push.azimuth
     (x0, y0), ratio = push_geometry(spec.source, params)
@@ -63,6 +66,10 @@ def run_push3d(
 
     ``cache`` keeps one plant per body across the pushes of a batch.
     """
+    require_type("spec", spec, CampaignSpec)
+    require_type("push", push, Push)
+    if cache is not None:
+        require_type("cache", cache, dict)
     from pushrecovery.sim.mujoco.humanoid3d import runs3d
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import PUSH_DURATION, wbc_for
     from pushrecovery.sim.push import Push3D
@@ -124,6 +131,9 @@ def _torque_ratio(ctrl: Any, ranges: Any) -> float:
 
 def error_row3d(spec: CampaignSpec, push: Push, reason: str) -> dict[str, Any]:
     """Return the row of a 3-D push without an outcome: the prediction, ``outcome`` = error."""
+    require_type("spec", spec, CampaignSpec)
+    require_type("push", push, Push)
+    require_type("reason", reason, str)
     row = predict3d(spec, push)
     row.update(ERROR_OUTCOME, error=reason)
     row.update(ERROR_OUTCOME_3D)

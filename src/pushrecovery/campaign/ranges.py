@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from pushrecovery.arguments import whole_number
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = ["MAX_PUSHES", "Range", "interval", "value_range"]
@@ -16,6 +17,15 @@ MAX_PUSHES = 1_000_000
 Range = tuple[float, float, float]
 
 
+def _triple(name: str, triple: object) -> tuple[float, float, float]:
+    """START, STOP, STEP as floats (not yet checked finite), or raise naming ``name``."""
+    try:
+        start, stop, increment = (float(v) for v in triple)  # type: ignore[attr-defined]
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidParameterError(f"{name} needs START STOP STEP, got {triple!r:.60}") from None
+    return start, stop, increment
+
+
 def value_range(name: str, triple: Range, limit: int = MAX_PUSHES) -> np.ndarray:
     """START, START + STEP, ... up to STOP inclusive; STEP > 0, START <= STOP, finite.
 
@@ -24,9 +34,8 @@ def value_range(name: str, triple: Range, limit: int = MAX_PUSHES) -> np.ndarray
     InvalidParameterError
         Naming ``name`` when the range is empty, not finite or longer than ``limit``.
     """
-    if len(triple) != 3:
-        raise InvalidParameterError(f"{name} needs START STOP STEP, got {triple!r}")
-    start, stop, increment = (float(v) for v in triple)
+    start, stop, increment = _triple(name, triple)
+    limit = whole_number("limit", limit, 1, MAX_PUSHES)
     if not all(math.isfinite(v) for v in (start, stop, increment)):
         raise InvalidParameterError(f"{name} must be finite, got {start:g} {stop:g} {increment:g}")
     if increment <= 0.0 or stop < start:
@@ -49,9 +58,7 @@ def value_range(name: str, triple: Range, limit: int = MAX_PUSHES) -> np.ndarray
 
 def interval(name: str, triple: Range) -> tuple[float, float]:
     """START and STOP of a range whose STEP is not used (random samples): finite, ordered."""
-    if len(triple) != 3:
-        raise InvalidParameterError(f"{name} needs START STOP STEP, got {triple!r}")
-    start, stop = float(triple[0]), float(triple[1])
+    start, stop, _ = _triple(name, triple)
     if not (math.isfinite(start) and math.isfinite(stop)) or stop < start:
         raise InvalidParameterError(f"{name} needs finite START <= STOP, got {start:g} {stop:g}")
     return start, stop

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal, cast
 
 from pushrecovery.arguments import require_type
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import UNITS
 from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.result import Outcome
@@ -255,6 +255,8 @@ def used_label(outcome: Outcome, strategy: Strategy) -> str:
     A run that neither recovered nor fell (``undecided``: not at rest yet; ``slipped``: at
     rest, but a loaded foot slid) is labelled by its outcome: it is not a fall.
     """
+    require_type("outcome", outcome, Outcome)
+    require_type("strategy", strategy, Strategy)
     if outcome is Outcome.RECOVERED:
         return strategy.value
     return Strategy.FALL.value if outcome is Outcome.FELL else outcome.value
@@ -281,6 +283,9 @@ def columns(family: Family, sweeps: Sequence[str] = ()) -> tuple[Column, ...]:
     InvalidParameterError
         Naming ``family`` or ``sweeps``: an unknown family, a parameter that cannot be swept.
     """
+    require_type("family", family, str)
+    if isinstance(sweeps, str) or not all(isinstance(s, str) for s in sweeps):
+        raise ParameterTypeError("sweeps must be a list of parameter names")
     return _columns(_family(family), tuple(sweeps))
 
 
@@ -332,6 +337,11 @@ def verdict_columns(
     steps : int or None
         Steps predicted (None: a fall, written -1).
     """
+    from pushrecovery.campaign.spec import CampaignSpec, Push
+
+    require_type("spec", spec, CampaignSpec)
+    require_type("push", push, Push)
+    require_type("strategy", strategy, Strategy)
     # STRATEGY_CODES escalates: a controller of one strategy recovers the lesser's pushes.
     reach = STRATEGY_CODES.index(Strategy(spec.strategy))
     row: dict[str, Any] = {

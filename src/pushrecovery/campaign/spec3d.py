@@ -16,8 +16,9 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from pushrecovery.arguments import finite_float, finite_vector, require_type
 from pushrecovery.campaign.ranges import value_range
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mjcf_source import MjcfSource
 
@@ -122,6 +123,10 @@ def check_spec3d(spec: Any) -> tuple[float, ...] | None:
     """
     from pushrecovery.control.base import controller_class
 
+    if not all(hasattr(spec, f) for f in ("model", "mjcf", "controller", "sweeps")):
+        # Checked by its fields: spec.py imports this module.
+        raise ParameterTypeError(f"spec must be a CampaignSpec, got {type(spec).__name__}")
+
     if (spec.model == "mjcf") != (spec.mjcf is not None):
         raise InvalidParameterError(
             "model 'mjcf' needs its file (mjcf, an MjcfSource), and mjcf needs model 'mjcf'"
@@ -182,6 +187,8 @@ def push_geometry(model: str | MjcfSource, params: BodyParams) -> tuple[tuple[fl
 
 def standing_origin(model: str | MjcfSource, params: BodyParams) -> tuple[float, float]:
     """Return the standing CoM's ground point r₀ [m] (:func:`push_geometry`)."""
+    require_type("params", params, BodyParams)
+    require_type("model", model, (str, MjcfSource))
     return push_geometry(model, params)[0]
 
 
@@ -200,6 +207,10 @@ def critical_impulse(
     InvalidParameterError
         For another strategy, or ``origin`` outside the region.
     """
+    require_type("params", params, BodyParams)
+    origin = tuple(finite_vector("origin", origin, 2, 1e3, "m"))
+    azimuth = finite_float("azimuth", azimuth, "deg")
+    require_type("strategy", strategy, str)
     from pushrecovery.ground.support import Support
     from pushrecovery.surfaces.plane import cmp_polygon
 
@@ -234,6 +245,10 @@ def predict_push(
     (Classification, str)
         The verdict (strategy, capture point, margins, steps) and the corrected strategy.
     """
+    require_type("params", params, BodyParams)
+    origin = tuple(finite_vector("origin", origin, 2, 1e3, "m"))
+    azimuth = finite_float("azimuth", azimuth, "deg")
+    impulse = finite_float("impulse", impulse, "N s")
     from pushrecovery.arguments import bounded_float
     from pushrecovery.sim.push import Push3D
     from pushrecovery.surfaces.classify import classify

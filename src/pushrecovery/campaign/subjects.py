@@ -33,10 +33,12 @@ from __future__ import annotations
 import csv
 import fnmatch
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import require_type
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import LIMITS
 
 __all__ = [
@@ -116,6 +118,7 @@ def read_subjects(path: str | Path) -> tuple[Subject, ...]:
         range, or a condition that is not printable text of at most :data:`MAX_CONDITION`
         characters, naming the line.
     """
+    require_type("path", path, (str, os.PathLike))
     path = Path(path)
     # A device or a pipe (/dev/zero) would be read forever: a table is a file of some size.
     if not path.is_file() or path.stat().st_size > MAX_TABLE_BYTES:
@@ -189,6 +192,9 @@ def _subject(row: dict[str, str], where: str) -> Subject:
 
 def subject_for(relative: str, subjects: tuple[Subject, ...]) -> Subject | None:
     """Return the first subject whose pattern matches ``relative`` (a trial's path), or None."""
+    require_type("relative", relative, str)
+    if not isinstance(subjects, tuple) or not all(isinstance(s, Subject) for s in subjects):
+        raise ParameterTypeError("subjects must be a tuple of Subject")
     for subject in subjects:
         if subject.matches(relative):
             return subject

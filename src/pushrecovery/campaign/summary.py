@@ -22,8 +22,10 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.arguments import require_type
 from pushrecovery.campaign.arrow import column_array
 from pushrecovery.campaign.spec import CampaignSpec
+from pushrecovery.errors import ParameterTypeError
 from pushrecovery.sim.critical import predicted_critical_velocity
 from pushrecovery.sim.validation import LABELS as VALIDATION_LABELS
 from pushrecovery.surfaces.probability.scores import BINS
@@ -52,6 +54,8 @@ def _analytic3d(spec: CampaignSpec, params: Any, azimuth: float) -> float:
 
 def boundary(spec: CampaignSpec, columns: dict[str, np.ndarray]) -> list[dict[str, Any]]:
     """Empirical critical pushes against the analytic ones (module docstring)."""
+    require_type("spec", spec, CampaignSpec)
+    require_type("columns", columns, dict)
     strategy = spec.strategy
     names = [f"param_{name}" for name in spec.sweeps]
     where = "azimuth" if spec.is_3d else "x0"
@@ -102,6 +106,9 @@ def boundary(spec: CampaignSpec, columns: dict[str, np.ndarray]) -> list[dict[st
 
 def summarize(spec: CampaignSpec, table: Any) -> dict[str, Any]:
     """Return the summary JSON of the pushes in ``table`` (a ``pyarrow.Table``)."""
+    require_type("spec", spec, CampaignSpec)
+    if not hasattr(table, "column_names"):
+        raise ParameterTypeError(f"table must be a pyarrow table, got {type(table).__name__}")
     tally = SummaryTally(spec)
     tally.add(table)
     return tally.result()
@@ -116,6 +123,7 @@ class SummaryTally:
     """
 
     def __init__(self, spec: CampaignSpec) -> None:
+        require_type("spec", spec, CampaignSpec)
         self.spec = spec
         self.total = self.judged = self.agree = 0
         self.outcomes = dict.fromkeys(("recovered", "fell", "undecided", "slipped", "error"), 0)

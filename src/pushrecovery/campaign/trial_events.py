@@ -10,7 +10,8 @@ import math
 from dataclasses import asdict, dataclass, fields, replace
 from typing import TYPE_CHECKING, Any
 
-from pushrecovery.campaign.trial_rows import subject_name
+from pushrecovery.arguments import require_type
+from pushrecovery.campaign.trial_rows import check_job, subject_name
 
 if TYPE_CHECKING:
     from pushrecovery.analysis.trial import TrialSummary
@@ -86,6 +87,10 @@ def trial_events(job: Any, summary: TrialSummary) -> list[dict[str, Any]]:
 
     The values are the summary's own (NaN, not yet None: ``json_safe`` them for a JSON file).
     """
+    from pushrecovery.analysis.trial import TrialSummary
+
+    check_job(job)
+    require_type("summary", summary, TrialSummary)
     subject = subject_name(job)
     rows = [
         EventRow(job.name, subject, event.axis, "step needed", event.time, event.end,

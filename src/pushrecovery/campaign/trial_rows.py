@@ -14,6 +14,8 @@ from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from pushrecovery.arguments import positive_float, require_type
+from pushrecovery.errors import ParameterTypeError
 from pushrecovery.params import BodyParams
 
 if TYPE_CHECKING:
@@ -24,6 +26,7 @@ __all__ = [
     "TRIAL_FIELDS",
     "TrialRow",
     "batch_summary",
+    "check_job",
     "failed_rows",
     "subject_name",
     "sway_rows",
@@ -192,8 +195,18 @@ class TrialRow:
 TRIAL_FIELDS: tuple[tuple[str, str], ...] = tuple((f.name, str(f.type)) for f in fields(TrialRow))
 
 
+def check_job(job: object) -> None:
+    """Raise unless ``job`` is a trial job, a :class:`~pushrecovery.campaign.trials.TrialJob`.
+
+    Checked by its fields: that module imports this one.
+    """
+    if not all(hasattr(job, field) for field in ("path", "name", "subject", "flags")):
+        raise ParameterTypeError(f"job must be a TrialJob, got {type(job).__name__}")
+
+
 def subject_name(job: Any) -> str:
     """Return the job's subject ("" without a subjects table)."""
+    check_job(job)
     return "" if job.subject is None else str(job.subject.subject)
 
 
@@ -209,6 +222,12 @@ def trial_rows(
 
     The values are the summary's own (NaN, not yet None: ``json_safe`` them for a JSON file).
     """
+    from pushrecovery.analysis.trial import TrialSummary
+
+    check_job(job)
+    require_type("summary", summary, TrialSummary)
+    require_type("params", params, BodyParams)
+    require_type("sources", sources, dict)
     from pushrecovery.analysis.trial.settings import PRESET_BODY
 
     checks, plane = summary.checks, summary.plane
@@ -298,6 +317,11 @@ def _sway(sway: SwayMeasures | None, axis: str) -> dict[str, Any]:
 
 def sway_rows(job: Any, sway: SwayMeasures, rate: float) -> list[dict[str, Any]]:
     """Return the rows of a CoP-only trial: ``posturography only`` with its sway columns."""
+    from pushrecovery.analysis.posturography import SwayMeasures
+
+    check_job(job)
+    require_type("sway", sway, SwayMeasures)
+    rate = positive_float("rate", rate, "Hz")
     return [
         asdict(replace(
             TrialRow(job.name, str(job.path), subject_name(job), axis, "posturography only",
@@ -310,6 +334,8 @@ def sway_rows(job: Any, sway: SwayMeasures, rate: float) -> list[dict[str, Any]]
 
 def failed_rows(job: Any, reason: str) -> list[dict[str, Any]]:
     """Return the rows of a trial that failed: ``status`` failed and the reason."""
+    check_job(job)
+    require_type("reason", reason, str)
     return [
         asdict(
             TrialRow(
@@ -333,6 +359,9 @@ def write_table(
 
     ``columns``: (name, Python type) pairs, or a ``pyarrow.Schema`` (fields with metadata).
     """
+    if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
+        raise ParameterTypeError("rows must be a list of rows (dicts)")
+    require_type("stem", stem, Path)
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
@@ -362,6 +391,8 @@ def _mean_sd(values: list[float]) -> dict[str, float | None]:
 
 def batch_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     """Return the counts and measures across the trials, per subject and axis."""
+    if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
+        raise ParameterTypeError("rows must be a list of trial rows (dicts)")
     trials = {row["trial"] for row in rows}
     failed = {row["trial"]: row["error"] for row in rows if row["status"] == "failed"}
     subjects: dict[str, Any] = {}

@@ -17,7 +17,8 @@ import functools
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
-from pushrecovery.campaign.trial_rows import subject_name
+from pushrecovery.arguments import require_type
+from pushrecovery.campaign.trial_rows import check_job, subject_name
 
 if TYPE_CHECKING:
     from pushrecovery.analysis.trial import TrialSummary
@@ -134,6 +135,10 @@ def step_schema() -> Any:
 
 def trial_steps(job: Any, summary: TrialSummary) -> list[StepRow]:
     """Return the measured steps of an analysed trial, in time order (:class:`StepRow`)."""
+    from pushrecovery.analysis.trial import TrialSummary
+
+    check_job(job)
+    require_type("summary", summary, TrialSummary)
     subject = subject_name(job)
     rows = []
     for k, taken in enumerate(summary.events.measured_steps, start=1):

@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from pushrecovery.arguments import require_type
 from pushrecovery.campaign.subjects import Subject, subject_for
 from pushrecovery.campaign.trial_events import EVENT_FIELDS, EventRow, trial_events
 from pushrecovery.campaign.trial_rows import (
@@ -35,7 +36,7 @@ from pushrecovery.campaign.trial_rows import (
     trial_rows,
 )
 from pushrecovery.campaign.trial_steps import StepRow, step_schema, trial_steps
-from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError, PushRecoveryError
 from pushrecovery.extras import require
 
 __all__ = [
@@ -69,6 +70,10 @@ def find_trials(inputs: Sequence[str | Path]) -> tuple[list[Path], Path]:
     InvalidParameterError
         No input, an input that names nothing, or a named file that is not CSV or C3D.
     """
+    if isinstance(inputs, str | os.PathLike) or not isinstance(inputs, list | tuple):
+        raise ParameterTypeError(f"inputs must be a list of paths, got {type(inputs).__name__}")
+    for text in inputs:
+        require_type("each of inputs", text, (str, os.PathLike))
     if isinstance(inputs, str | Path) or not inputs:
         raise InvalidParameterError("give at least one trial file, folder or glob pattern")
     found: set[Path] = set()
@@ -137,6 +142,10 @@ def trial_jobs(
     output folder's, and a file system allows 255 bytes) keeps its end after a hash of the
     whole path, so that it stays unique.
     """
+    if not isinstance(trials, list) or not all(isinstance(t, Path) for t in trials):
+        raise ParameterTypeError("trials must be a list of paths (find_trials)")
+    require_type("root", root, Path)
+    require_type("subjects", subjects, tuple)
     jobs = []
     for path in trials:
         relative = path.relative_to(root).as_posix()
@@ -317,6 +326,9 @@ def run_trials(
     InvalidParameterError
         ``workers`` < 1, no jobs, or two jobs with the same name.
     """
+    if not isinstance(jobs, list) or not all(isinstance(j, TrialJob) for j in jobs):
+        raise ParameterTypeError("jobs must be a list of TrialJob (trial_jobs)")
+    require_type("out", out, (str, os.PathLike))
     if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
         raise InvalidParameterError(f"workers must be an int >= 1, got {workers!r}")
     if not jobs:

@@ -16,6 +16,8 @@ import os
 import threading
 import time
 
+from pushrecovery.arguments import positive_float
+
 __all__ = ["GRACE", "HUNG_EXIT", "ORPHAN_EXIT", "PERIOD", "arm", "disarm", "hung_after", "start"]
 
 #: Longest time a push gets beyond its wall-time limit before its worker counts as hung [s]:
@@ -37,6 +39,7 @@ def hung_after(push_timeout: float) -> float:
 
     Its limit, then as long again (at most :data:`GRACE`) for the simulation to notice first.
     """
+    push_timeout = positive_float("push_timeout", push_timeout, "s")
     return push_timeout + min(GRACE, push_timeout)
 
 

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import (
-    bounded_float,
+    finite_vector,
     positive_float,
     require_type,
     whole_number,
@@ -130,15 +130,13 @@ def calibration_study(
         Out-of-range arguments; the checks of ``run_many``.
     """
     require_type("params", params, BodyParams)
-    low = bounded_float("velocities[0]", velocities[0], -10.0, 10.0, "m/s")
-    high = bounded_float("velocities[1]", velocities[1], -10.0, 10.0, "m/s")
+    low, high = finite_vector("velocities", velocities, 2, 10.0, "m/s")
     if not low < high:
         raise InvalidParameterError(
             f"velocities must be (low, high) with low < high, got {velocities}"
         )
     count = whole_number("pushes", pushes, 10, 100_000)
-    if len(noise) != 2:
-        raise InvalidParameterError(f"noise must be (sd of x [m], sd of xdot [m/s]), got {noise!r}")
+    noise = tuple(finite_vector("noise", noise, 2, 10.0))  # (sd of x [m], sd of xdot [m/s])
     sd = np.array(
         [positive_float("noise[0]", noise[0], "m"), positive_float("noise[1]", noise[1], "m/s")]
     )

@@ -20,7 +20,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import require_type
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 __all__ = [
     "APART",
@@ -147,6 +148,7 @@ def classify_cause(push: ConfusionPush) -> str:
        a step begun.
     8. ``other``.
     """
+    require_type("push", push, ConfusionPush)
     predicted, corrected, used = push.predicted, push.predicted_corrected, push.used
     if used == predicted:
         return "agree"
@@ -176,6 +178,13 @@ def confusion_counts(
     InvalidParameterError
         If the sequences differ in length or hold a label not in ``labels``.
     """
+    for name, names in (("predicted", predicted), ("used", used), ("labels", labels)):
+        if (
+            isinstance(names, str)
+            or not isinstance(names, Sequence)
+            or not all(isinstance(n, str) for n in names)
+        ):
+            raise ParameterTypeError(f"{name} must be a list of strategy names")
     if len(predicted) != len(used):
         raise InvalidParameterError(
             f"predicted and used must have the same length, got {len(predicted)} and {len(used)}"
@@ -297,6 +306,14 @@ def confusion_from_rows(rows: Iterable[Mapping[str, Any]], model: str) -> Confus
         If a row lacks a column of :data:`COLUMNS` (a 2-D campaign's rows) or holds a label
         not in :data:`LABELS`.
     """
+    require_type("model", model, str)
+    if isinstance(rows, str | Mapping) or not isinstance(rows, Iterable):
+        raise ParameterTypeError(
+            f"rows must be campaign rows (mappings), got {type(rows).__name__}"
+        )
+    rows = list(rows)
+    if not all(isinstance(r, Mapping) for r in rows):
+        raise ParameterTypeError("rows must be campaign rows (mappings)")
     pushes, errors = [], 0
     for row in rows:
         missing = [name for name in COLUMNS if row.get(name) is None]

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pushrecovery.arguments import require_type
 from pushrecovery.control.base import make_controller
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.params import BodyParams
@@ -37,12 +38,14 @@ HIP_FRACTIONS = (0.3, 0.6, 0.85, 0.99, 1.05)
 
 def fig3a_starts(params: BodyParams) -> list[tuple[float, float]]:
     """Pushes from upright from 1.4× the backward to 1.4× the forward Eq. (4) limit [m, m/s]."""
+    require_type("params", params, BodyParams)
     v_back, v_fwd = params.omega * params.heel, params.omega * params.toe
     return [(0.0, float(v)) for v in np.linspace(1.4 * v_back, 1.4 * v_fwd, 13)]
 
 
 def fig3b_starts(params: BodyParams) -> list[tuple[float, float]]:
     """From three positions, pushes at 0.5, 0.85 and 1.15 of Eq. (4) both ways [m, m/s]."""
+    require_type("params", params, BodyParams)
     return [
         (float(x0), float(fraction * critical_velocity(x0, direction, params)))
         for x0 in np.linspace(params.heel, params.toe, 5)[1:-1]
@@ -94,6 +97,7 @@ class PaperRuns:
 
 def paper_runs(params: BodyParams) -> PaperRuns:
     """Simulate every run of Figs. 3, 5 and 6 for ``params``."""
+    require_type("params", params, BodyParams)
     return PaperRuns(
         fig3a=ankle_runs(params, "lipm", "ankle-saturated", fig3a_starts(params)),
         fig3b=ankle_runs(params, "pendulum", "ankle-pd", fig3b_starts(params)),

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from pushrecovery.arguments import finite_float, finite_vector
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import critical_velocity
@@ -87,6 +88,8 @@ def push_scale(params: BodyParams, strategy: str, reference: BodyParams) -> floa
 
 def scaled_range(triple: tuple[float, float, float], scale: float) -> tuple[float, float, float]:
     """Return (start, stop, step) [m/s] multiplied by ``scale`` (6 significant digits)."""
+    triple = tuple(finite_vector("triple", triple, 3))
+    scale = finite_float("scale", scale)
     return (
         float(f"{triple[0] * scale:.6g}"),
         float(f"{triple[1] * scale:.6g}"),

@@ -25,6 +25,7 @@ from pushrecovery.experiments.validation3d_predict import (
     predicted_critical_impulses,
 )
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import Backend
 
 if TYPE_CHECKING:
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
@@ -300,6 +301,9 @@ def validation_plant(model: str, params: BodyParams | None = None) -> Humanoid3D
         If ``model`` is not one of :data:`MODELS`, or ``params`` is not a BodyParams (or not
         the G1's own).
     """
+    require_type("model", model, str)
+    if params is not None:
+        require_type("params", params, BodyParams)
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, G1Plant
 
     if model not in MODELS:
@@ -352,6 +356,11 @@ def run_validation3d(
     InvalidParameterError
         Naming the bad argument.
     """
+    require_type("model", model, str)
+    if params is not None:
+        require_type("params", params, BodyParams)
+    if plant is not None:
+        require_type("plant", plant, Backend)
     if plant is None and model not in MODELS:
         raise InvalidParameterError(f"model must be one of {list(MODELS)}, got {model!r}")
     angles = azimuth_list(azimuths)

@@ -53,6 +53,7 @@ from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS, DEFAULT_AZIMUT
 from pushrecovery.experiments.validation3d_predict import CriticalErrors, critical_impulse_along
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.backend import Backend
 from pushrecovery.surfaces.n_step import step_options, viable_region
 
 if TYPE_CHECKING:
@@ -359,6 +360,11 @@ def run_step_validation(
     InvalidParameterError
         Naming the bad argument.
     """
+    require_type("model", model, str)
+    if params is not None:
+        require_type("params", params, BodyParams)
+    if plant is not None:
+        require_type("plant", plant, Backend)
     from pushrecovery.experiments.validation3d import MODELS, azimuth_list, validation_plant
 
     if plant is None and model not in MODELS:

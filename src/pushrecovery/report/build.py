@@ -18,6 +18,7 @@ from collections.abc import Callable, Collection, Mapping
 from dataclasses import replace
 from pathlib import Path
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
 from pushrecovery.report.campaigns import CAMPAIGNS, _sweep, accuracy, campaign_section
@@ -86,6 +87,9 @@ def build_report(
     InvalidParameterError
         On an unknown size or section key, or an invalid grid.
     """
+    if params is not None:
+        require_type("params", params, BodyParams)
+    require_type("out_dir", out_dir, (str, os.PathLike))
     from pushrecovery import __version__, load_params
 
     if size not in SIZES:

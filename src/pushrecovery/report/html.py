@@ -32,9 +32,11 @@ any grid can be replaced (:class:`~pushrecovery.report.PushGrid`), any section l
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.params import BodyParams
 from pushrecovery.report.build import build_report
@@ -102,6 +104,9 @@ def write_report(
     InvalidParameterError
         On an unknown size or section key, or an invalid grid.
     """
+    if params is not None:
+        require_type("params", params, BodyParams)
+    require_type("out_dir", out_dir, (str, os.PathLike))
     report = build_report(params, out_dir, **options)
     path = Path(out_dir) / "index.html"
     partial = path.with_suffix(".partial")

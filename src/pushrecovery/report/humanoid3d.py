@@ -23,6 +23,7 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import PushRecoveryError
 from pushrecovery.experiments.filmstrip3d import STRIP_DURATION, filmstrip_run
 from pushrecovery.report.config import HUMANOID3D_STRIPS
@@ -275,6 +276,7 @@ def _mass(ctx: _Context, model: str) -> float:
 
 def humanoid3d_section(ctx: _Context) -> Humanoid3DSection:
     """Return the "3-D humanoid" section (module docstring), or its one line without the extra."""
+    require_type("ctx", ctx, _Context)
     if not _installed():
         return Humanoid3DSection(unavailable=HINT)
     from pushrecovery.sim.mujoco.render import require_offscreen_gl

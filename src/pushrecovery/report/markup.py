@@ -9,11 +9,26 @@ import base64
 import math
 from pathlib import Path
 
+import numpy as np
+
+from pushrecovery.arguments import require_type, whole_number
+from pushrecovery.errors import ParameterTypeError
+
 __all__ = ["data_uri", "num", "percent", "percent_within"]
+
+
+def _number(value: object) -> float | None:
+    """``value`` as a float (NaN and infinities kept: they print as signs), None as None."""
+    if value is None:
+        return None
+    if isinstance(value, str | bytes) or not isinstance(value, int | float | np.number):
+        raise ParameterTypeError(f"value must be a number or None, got {type(value).__name__}")
+    return float(value)
 
 
 def num(value: float | None, digits: int = 4) -> str:
     """Format a number with ``digits`` significant digits; an em dash for None or NaN."""
+    value, digits = _number(value), whole_number("digits", digits, 1, 17)
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "—"
     if isinstance(value, float) and math.isinf(value):
@@ -23,6 +38,7 @@ def num(value: float | None, digits: int = 4) -> str:
 
 def percent(value: float | None, digits: int = 1) -> str:
     """Format a fraction as a signed percentage (``+1.2 %``); an em dash for None or NaN."""
+    value, digits = _number(value), whole_number("digits", digits, 0, 17)
     if value is None or math.isnan(value):
         return "—"
     return f"{100.0 * value:+.{digits}f} %".replace("-", "−")
@@ -47,6 +63,7 @@ def percent_within(value: float | None, resolution: float | None) -> str:
     ``+27 % ± 4 %`` for a value known to ±0.04; one more digit per factor of ten finer, up
     to two decimals; :func:`percent` when the resolution is unknown.
     """
+    value, resolution = _number(value), _number(resolution)
     if value is None or math.isnan(value) or resolution is None or not resolution > 0.0:
         return percent(value)
     digits = min(2, max(0, math.ceil(-math.log10(100.0 * resolution))))
@@ -55,6 +72,7 @@ def percent_within(value: float | None, resolution: float | None) -> str:
 
 def data_uri(path: Path) -> str:
     """Encode the file at ``path`` (PNG, GIF or SVG) as a base64 ``data:`` URI."""
+    require_type("path", path, Path)
     kinds = {".png": "image/png", ".gif": "image/gif", ".svg": "image/svg+xml"}
     kind = kinds.get(Path(path).suffix.lower(), "application/octet-stream")
     encoded = base64.b64encode(Path(path).read_bytes()).decode("ascii")

@@ -12,6 +12,7 @@ from functools import lru_cache
 
 import jinja2
 
+from pushrecovery.arguments import require_type
 from pushrecovery.report.data import Report
 from pushrecovery.report.markup import data_uri, num, percent
 
@@ -38,4 +39,5 @@ def render_report(report: Report) -> str:
     Figures are embedded as base64 ``data:`` URIs (read from their paths now), the CSS is
     inline; there is no script and no external reference.
     """
+    require_type("report", report, Report)
     return _environment().get_template("page.html.j2").render(report=report)

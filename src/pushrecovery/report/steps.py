@@ -6,6 +6,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from pushrecovery.arguments import require_type
+from pushrecovery.errors import ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.report.data import Picture, StepCounts, StepsSection, Table
 from pushrecovery.report.markup import num
@@ -15,6 +17,8 @@ __all__ = ["step_counts", "steps_section"]
 
 def steps_section(params: BodyParams, out: Path) -> StepsSection:
     """Return the report's "Steps" section: capture regions, the N-step map, thresholds."""
+    require_type("params", params, BodyParams)
+    require_type("out", out, Path)
     from pushrecovery.plots.common import save_figure
     from pushrecovery.plots.steps import capture_regions_figure, n_step_map_figure
     from pushrecovery.surfaces.bounds import bounds_data
@@ -49,6 +53,10 @@ def steps_section(params: BodyParams, out: Path) -> StepsSection:
 
 def step_counts(summary: Mapping[str, Any]) -> StepCounts | None:
     """Return the N-step predictions against the steps taken (summary ``steps``), if any."""
+    if not isinstance(summary, Mapping):
+        raise ParameterTypeError(
+            f"summary must be a campaign summary (a mapping), got {type(summary).__name__}"
+        )
     steps = summary.get("steps") or {}
     if not steps.get("predicted"):
         return None

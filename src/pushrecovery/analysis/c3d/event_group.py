@@ -15,6 +15,7 @@ caller).
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,8 +24,8 @@ from typing import Any
 from pushrecovery.analysis.c3d.header import _check_header
 from pushrecovery.analysis.c3d.isolated import run_isolated
 from pushrecovery.analysis.c3d.structure import check_parameter_section, read_parameter_section
-from pushrecovery.arguments import finite_float
-from pushrecovery.errors import InputFileError, InvalidParameterError
+from pushrecovery.arguments import finite_float, require_type
+from pushrecovery.errors import InputFileError, InvalidParameterError, ParameterTypeError
 from pushrecovery.extras import require
 
 __all__ = ["C3DEvent", "read_events", "write_events"]
@@ -80,7 +81,13 @@ def write_events(source: str | Path, target: str | Path, events: Sequence[C3DEve
     InputFileError
         ``source`` cannot be read as a C3D file.
     """
+    if isinstance(events, str) or not isinstance(events, list | tuple):
+        raise ParameterTypeError(f"events must be a list of C3DEvent, got {type(events).__name__}")
+    require_type("source", source, (str, os.PathLike))
+    require_type("target", target, (str, os.PathLike))
     source, target = Path(source), Path(target)
+    if "\x00" in f"{source}{target}":
+        raise InvalidParameterError("source and target must be file names (a NUL character)")
     if target.resolve() == source.resolve():
         raise InvalidParameterError(f"target must differ from source ({source}): never modified")
     rows = []
@@ -102,6 +109,7 @@ def write_events(source: str | Path, target: str | Path, events: Sequence[C3DEve
 
 def read_events(path: str | Path) -> list[C3DEvent]:
     """Return the events of a C3D file's EVENT group, in time order (none: empty)."""
+    require_type("path", path, (str, os.PathLike))
     path = Path(path)
     _check(path)
     require("analysis", "ezc3d", "read_events")
@@ -111,15 +119,16 @@ def read_events(path: str | Path) -> list[C3DEvent]:
 
 def _check(file: Path) -> None:
     """Refuse what is no C3D file before ezc3d (C++, trusting the file) opens it, as the reader."""
-    if not file.is_file():
-        raise InputFileError(
-            f"{file}: no such file" if not file.exists() else f"{file}: not a file"
-        )
     try:
+        if not file.is_file():
+            raise InputFileError(
+                f"{file}: no such file" if not file.exists() else f"{file}: not a file"
+            )
         _check_header(file)
         check_parameter_section(file, read_parameter_section(file))
-    except OSError as exc:
-        raise InputFileError(f"{file}: cannot read ({str(exc).splitlines()[0]})") from exc
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise InputFileError(f"{str(file)[:200]}: cannot read ({reason.splitlines()[0]})") from None
 
 
 def _open(path: str) -> Any:

@@ -29,7 +29,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any, TypeVar
 
-from pushrecovery.errors import InputFileError
+from pushrecovery.arguments import require_type
+from pushrecovery.errors import InputFileError, ParameterTypeError
 
 __all__ = ["READ_SECONDS_PER_MB", "READ_TIMEOUT", "read_message", "run_isolated", "write_message"]
 
@@ -43,6 +44,8 @@ READ_SECONDS_PER_MB = 2.0
 
 def write_message(stream: IO[bytes], message: Any) -> None:
     """Write one length-prefixed pickle."""
+    if not callable(getattr(stream, "write", None)):
+        raise ParameterTypeError(f"stream must be a binary stream, got {type(stream).__name__}")
     data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
     stream.write(len(data).to_bytes(8, "big") + data)
     stream.flush()
@@ -50,6 +53,8 @@ def write_message(stream: IO[bytes], message: Any) -> None:
 
 def read_message(stream: IO[bytes]) -> Any:
     """Read one length-prefixed pickle (EOFError at the end of the stream)."""
+    if not callable(getattr(stream, "read", None)):
+        raise ParameterTypeError(f"stream must be a binary stream, got {type(stream).__name__}")
     head = stream.read(8)
     if len(head) < 8:
         raise EOFError
@@ -135,6 +140,9 @@ def run_isolated(function: Callable[..., T], args: tuple[Any, ...], file: Path) 
         If the helper dies on the file (a crash of the C3D reader) or does not finish in time;
         the function's own errors are raised as they are.
     """
+    if not callable(function) or not isinstance(args, tuple):
+        raise ParameterTypeError("function must be callable and args a tuple")
+    require_type("file", file, Path)
     timeout = READ_TIMEOUT + READ_SECONDS_PER_MB * os.path.getsize(file) / 1e6
     status, answer = _HELPER.ask((function.__module__, function.__qualname__, args), timeout)
     if status == "timeout":

@@ -23,10 +23,12 @@ An offset of 0 (or a name length of 0) ends the section.
 from __future__ import annotations
 
 import math
+import stat
 import struct
 from dataclasses import dataclass
 from pathlib import Path
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InputFileError
 
 __all__ = [
@@ -70,6 +72,8 @@ def parameter_records(file: Path, data: bytes) -> dict[tuple[str, str], Paramete
         On a record that overruns the parameter section or its neighbour, an unknown type,
         too many dimensions, a parameter of no group or a name that is not ASCII.
     """
+    require_type("file", file, Path)
+    require_type("data", data, bytes)
     if len(data) < 512 or data[0] < 1:
         raise InputFileError(f"{file}: not a C3D file (no C3D header)")
     start = (data[0] - 1) * 512
@@ -132,6 +136,9 @@ def parameter_records(file: Path, data: bytes) -> dict[tuple[str, str], Paramete
 
 def read_parameter_section(file: Path) -> bytes:
     """Return the bytes of ``file`` up to the end of its parameter section (header included)."""
+    require_type("file", file, Path)
+    if not stat.S_ISREG(file.stat().st_mode):  # a FIFO would block, a device never end
+        raise InputFileError(f"{file}: not a regular file")
     with file.open("rb") as stream:
         head = stream.read(512)
         if len(head) < 512 or head[0] < 1:
@@ -154,6 +161,8 @@ def check_parameter_section(file: Path, data: bytes) -> None:
     InputFileError
         One line naming the file and what is wrong.
     """
+    require_type("file", file, Path)
+    require_type("data", data, bytes)
     records = parameter_records(file, data)
     endian = ">" if data[(data[0] - 1) * 512 + 3] == 86 else "<"
     n_points, per_frame = struct.unpack_from(endian + "2H", data, 2)
