@@ -91,6 +91,29 @@ class Worker:
                 self.proc.kill()
 
 
+class _NonFinite(Exception):
+    """A NaN or an infinity among a JSON output's numbers."""
+
+
+def _refuse(constant: str) -> None:
+    raise _NonFinite(constant)
+
+
+def nonfinite_output(out: str) -> bool:
+    """Whether ``out`` prints a NaN or an infinity as a number.
+
+    JSON is parsed (a message quoting "inf m" in a string is text, not a number); other output
+    is searched with :data:`NUMBER`.
+    """
+    try:
+        json.loads(out, parse_constant=_refuse)
+    except _NonFinite:
+        return True
+    except ValueError:  # not JSON: a table or a summary
+        return bool(NUMBER.search(out))
+    return False
+
+
 def problems(result: dict) -> list[str]:
     """What a user would call broken in one answer."""
     found = []
@@ -103,7 +126,7 @@ def problems(result: dict) -> list[str]:
         found.append("multiline")
     if result["warnings"] or "Warning" in err:
         found.append("warning")
-    if code == 0 and NUMBER.search(out):
+    if code == 0 and nonfinite_output(out):
         found.append("nan")
     return found
 

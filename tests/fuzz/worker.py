@@ -42,7 +42,7 @@ def run(args: list[str]) -> dict[str, object]:
                 escaped += " | " + traceback.format_tb(exc.__traceback__)[-1].strip()[:300]
     return {
         "code": code,
-        "stdout": out.getvalue()[-4000:],
+        "stdout": out.getvalue()[:200_000],  # whole, for the JSON check
         "stderr": err.getvalue()[-4000:],
         "warnings": [f"{w.category.__name__}: {w.message}"[:300] for w in caught],
         "escaped": escaped,

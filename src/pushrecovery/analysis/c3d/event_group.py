@@ -88,7 +88,11 @@ def write_events(source: str | Path, target: str | Path, events: Sequence[C3DEve
     source, target = Path(source), Path(target)
     if "\x00" in f"{source}{target}":
         raise InvalidParameterError("source and target must be file names (a NUL character)")
-    if target.resolve() == source.resolve():
+    try:
+        same = target.resolve() == source.resolve()
+    except (OSError, RuntimeError) as exc:  # RuntimeError: a symlink loop
+        raise InputFileError(f"{str(source)[:200]}: {exc}") from None
+    if same:
         raise InvalidParameterError(f"target must differ from source ({source}): never modified")
     rows = []
     for k, event in enumerate(events):

@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.errors import InvalidParameterError
+
 FloatArray = NDArray[np.float64]
 
 __all__ = ["SOLE_TOLERANCE", "body_id", "colliding_geoms", "sole_points"]
@@ -78,5 +80,10 @@ def sole_points(model: Any, data: Any, foot: int) -> FloatArray:
     ``mj_kinematics``): the corners of a flat box, the bottoms of contact spheres, the ends of
     capsules lying on the floor.
     """
-    points = np.vstack([_geom_low_points(model, data, g) for g in colliding_geoms(model, foot)])
+    geoms = colliding_geoms(model, foot)
+    if not geoms:  # a model's file without a sole on this body
+        raise InvalidParameterError(
+            f"foot body {model.body(foot).name!r} has no colliding geom to stand on"
+        )
+    points = np.vstack([_geom_low_points(model, data, g) for g in geoms])
     return np.asarray(points[points[:, 2] <= points[:, 2].min() + SOLE_TOLERANCE], dtype=float)

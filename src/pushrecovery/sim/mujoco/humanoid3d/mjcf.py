@@ -80,7 +80,9 @@ def load_mjcf(path: str | Path) -> Any:
     try:
         spec = mujoco.MjSpec.from_file(str(file))
         model = torque_motors(spec).compile()
-    except ValueError as exc:  # MuJoCo's parse and compile errors
+        for i in range(model.nbody):
+            model.body(i).name  # noqa: B018 - names MuJoCo cannot decode fail here, not later
+    except (ValueError, UnicodeDecodeError) as exc:  # parse and compile errors, bad names
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InvalidParameterError(f"model {file.name}: {first}") from None
     if model.njnt < 1 or int(model.jnt_type[0]) != int(mujoco.mjtJoint.mjJNT_FREE):

@@ -172,6 +172,11 @@ def torque_motors(spec: Any) -> Any:
 
     for actuator in spec.actuators:
         joint = spec.joint(actuator.target)
+        if joint is None:  # a tendon's, a site's or a missing joint's actuator
+            raise InvalidParameterError(
+                f"actuator {actuator.name!r} drives {actuator.target!r}, which is no joint: the "
+                "whole-body controller commands joint torques"
+            )
         limit = None
         if joint.actfrcrange[1] > joint.actfrcrange[0]:  # the joint's actuator force range
             limit = joint.actfrcrange
