@@ -2,9 +2,10 @@
 
 The campaign (``tests/fuzz/campaign.py``) draws 200 cases from seed 0: four in five are calls
 of the public functions and classes of the floors whose entries validate
-(``tests/fuzz/api.py``, ``--boundary``), the rest command lines and mutated files. Every case
+(``tests/fuzz/api.py``, ``--boundary``: all but the MuJoCo floor's and the whole-body
+controller's parts), the rest command lines, mutated files and folders of trials. Every case
 must end in a result or one named line: no crash, hang, traceback, NaN for finite inputs,
-multi-line error or warning. ``make fuzz`` runs 10,000 cases of every floor.
+multi-line error, warning or good trial lost. ``make fuzz`` runs 10,000 cases of every floor.
 """
 
 import subprocess

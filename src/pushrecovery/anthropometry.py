@@ -25,7 +25,7 @@ from typing import Literal, NamedTuple
 
 from pushrecovery.arguments import bounded_float, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.params import BodyParams
+from pushrecovery.params import LIMITS, BodyParams
 
 __all__ = [
     "ANKLE_HEIGHT",
@@ -185,7 +185,7 @@ def person_params(
     Parameters
     ----------
     mass : float
-        Body mass m [kg], in (0, 500].
+        Body mass m [kg], in [0.01, 500] (0.01: :data:`~pushrecovery.params.LIMITS`' lowest).
     height : float
         Stature H [m], in [0.5, 2.5].
     sex : {"female", "male"}
@@ -212,9 +212,7 @@ def person_params(
     de Leva (1996), J Biomech 29(9):1223-1230, Table 4; Winter (2009), Biomechanics and Motor
     Control of Human Movement, 4th ed., Fig. 4.1.
     """
-    mass = finite_float("mass", mass, "kg")
-    if not 0.0 < mass <= 500.0:
-        raise InvalidParameterError(f"mass must be in (0, 500] kg, got {mass:g}")
+    mass = bounded_float("mass", mass, LIMITS["mass"][0], 500.0, "kg")  # a body's, at least
     height = bounded_float("height", height, 0.5, 2.5, "m")
     if not (isinstance(sex, str) and sex in SEXES):
         raise InvalidParameterError(f"sex must be 'female' or 'male', got {str(sex)[:20]!r}")

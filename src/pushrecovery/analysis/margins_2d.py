@@ -416,6 +416,7 @@ def margins_2d(
             ttb_cop = _ttb_cop(geometry, p, velocity, signed_p)
     codes = np.full(n, -1, dtype=np.int8)
     mos_cmp = nan.copy()
+    require_type("verdicts", verdicts, bool)
     if verdicts:
         _verdicts(base, r, v, params, codes, mos_cmp)
     return Margins2D(

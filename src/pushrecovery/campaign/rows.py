@@ -263,7 +263,7 @@ def used_label(outcome: Outcome, strategy: Strategy) -> str:
 
 
 def _family(family: str) -> Family:
-    if family in FAMILIES:
+    if isinstance(family, str) and family in FAMILIES:
         return cast(Family, family)
     raise InvalidParameterError(f"family must be one of {list(FAMILIES)}, got {family!r}")
 
@@ -284,7 +284,7 @@ def columns(family: Family, sweeps: Sequence[str] = ()) -> tuple[Column, ...]:
         Naming ``family`` or ``sweeps``: an unknown family, a parameter that cannot be swept.
     """
     require_type("family", family, str)
-    if isinstance(sweeps, str) or not all(isinstance(s, str) for s in sweeps):
+    if not isinstance(sweeps, list | tuple) or not all(isinstance(s, str) for s in sweeps):
         raise ParameterTypeError("sweeps must be a list of parameter names")
     return _columns(_family(family), tuple(sweeps))
 

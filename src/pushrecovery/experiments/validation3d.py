@@ -277,7 +277,7 @@ def azimuth_list(azimuths: Sequence[float]) -> list[float]:
     InvalidParameterError
         Not a sequence (a str is not one), too few or many angles, or one out of range.
     """
-    if isinstance(azimuths, str) or not isinstance(azimuths, Sequence):
+    if isinstance(azimuths, str | bytes) or not isinstance(azimuths, Sequence):
         raise InvalidParameterError("azimuths must be a sequence of angles [deg]")
     if not 1 <= len(azimuths) <= 72:
         raise InvalidParameterError(f"azimuths must hold 1 to 72 angles, got {len(azimuths)}")

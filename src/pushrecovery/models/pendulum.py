@@ -193,12 +193,18 @@ def lean_from_com(x: float, xdot: float, length: float) -> tuple[float, float]:
     Raises
     ------
     InvalidParameterError
-        If a value is not finite, ``length`` is outside [0.01, 10] m or abs(x) >= length.
+        If a value is not finite, ``length`` is outside [0.01, 10] m, abs(x) >= length or
+        abs(xdot) >= :data:`MAX_RATE` length.
     """
     x, xdot = finite_float("x", x, "m"), finite_float("xdot", xdot, "m/s")
     length = bounded_float("length", length, *LIMITS["com_height"])
     if not abs(x) < length:
         raise InvalidParameterError(f"x must satisfy |x| < length = {length:g} m, got {x:g}")
+    if not abs(xdot) < MAX_RATE * length:  # as the lean rate's bound
+        raise InvalidParameterError(
+            f"xdot must satisfy |xdot| < {MAX_RATE:g} length = {MAX_RATE * length:g} m/s, "
+            f"got {xdot:g}"
+        )
     return lean_from_com_unchecked(x, xdot, length)
 
 

@@ -18,8 +18,8 @@ from collections.abc import Callable, Collection, Mapping
 from dataclasses import replace
 from pathlib import Path
 
-from pushrecovery.arguments import require_type
-from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.arguments import require_type, whole_number
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError, PushRecoveryError
 from pushrecovery.params import BodyParams
 from pushrecovery.report.campaigns import CAMPAIGNS, _sweep, accuracy, campaign_section
 from pushrecovery.report.config import (
@@ -90,6 +90,24 @@ def build_report(
     if params is not None:
         require_type("params", params, BodyParams)
     require_type("out_dir", out_dir, (str, os.PathLike))
+    given = {"analytic_grid": analytic_grid, "sweep_grid": sweep_grid,
+             "mujoco_grid": mujoco_grid, "biped_grid": biped_grid}  # fmt: skip
+    for name, grid in given.items():
+        if grid is not None:
+            require_type(name, grid, PushGrid)
+    if workers is not None:
+        workers = whole_number("workers", workers, 1, 1024)
+    if scheduler is not None:
+        require_type("scheduler", scheduler, str)
+    if progress is not None and not callable(progress):
+        raise ParameterTypeError(f"progress must be callable, got {type(progress).__name__}")
+    if robot is not None:
+        require_type("robot", robot, MjcfSource)
+    for name, flag in (("full", full), ("mujoco", mujoco)):
+        require_type(name, flag, bool)
+    require_type("size", size, str)
+    if isinstance(skip, str | bytes) or not all(isinstance(s, str) for s in skip):
+        raise ParameterTypeError("skip must be a list of section names")
     from pushrecovery import __version__, load_params
 
     if size not in SIZES:

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from pushrecovery.arguments import require_type
+from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.plots.common import check_plot_path, save_figure
@@ -184,6 +184,8 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     from pushrecovery.surfaces.step_regions import sagittal_step_interval
 
     path = check_plot_path(path)
+    if xdot_max is not None:
+        xdot_max = bounded_float("xdot_max", xdot_max, 1e-3, 100.0, "m/s")
     if xdot_max is None:
         interval = sagittal_step_interval(params)
         xdot_max = 1.25 * params.omega * max(abs(interval.lower), abs(interval.upper))
