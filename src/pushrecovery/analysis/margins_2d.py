@@ -387,6 +387,7 @@ def margins_2d(
     """
     require_type("base", base, BasePolygons)
     require_type("params", params, BodyParams)
+    require_type("verdicts", verdicts, bool)
     n = len(base)
     r, v = _frames("com", com, n), _frames("velocity", velocity, n)
     omega = params.omega if omega is None else omega
@@ -416,7 +417,6 @@ def margins_2d(
             ttb_cop = _ttb_cop(geometry, p, velocity, signed_p)
     codes = np.full(n, -1, dtype=np.int8)
     mos_cmp = nan.copy()
-    require_type("verdicts", verdicts, bool)
     if verdicts:
         _verdicts(base, r, v, params, codes, mos_cmp)
     return Margins2D(
