@@ -137,3 +137,61 @@ def test_a_trial_sixty_folders_deep_keeps_the_batch(tmp_path, capsys):
     assert (summary["trials"], summary["analysed"]) == (2, 2)
     names = sorted(p.name for p in (tmp_path / "o" / "trials").iterdir())
     assert "good.csv" in names and all(len(n.encode()) <= 200 for n in names)
+
+
+# --- Found by the library fuzz (issue 38, item 3) ---------------------------------------------
+def test_project_errors_are_one_line():
+    error = InvalidParameterError(f"x bad {np.ones((3, 3))!r}")
+    assert "\n" not in str(error) and isinstance(error, ValueError)
+
+
+def test_out_arrays_and_shapes_are_checked():
+    from pushrecovery.surfaces.cop import capture_margin, cop_region
+
+    region = cop_region(P)
+    with pytest.raises(InvalidParameterError, match="out must be a writeable array of shape"):
+        capture_margin(np.zeros(2), 0.1, P.omega, region, out=np.zeros(1))
+    with pytest.raises(ParameterTypeError, match="out must be a float64 numpy array"):
+        capture_margin(np.zeros(2), 0.1, P.omega, region, out=0.1)
+    with pytest.raises(InvalidParameterError, match="x and xdot must broadcast"):
+        capture_margin(np.zeros(2), np.zeros(3), P.omega, region)
+    with pytest.raises(ParameterTypeError, match="real numbers, got complex"):
+        capture_margin(np.array([1 + 2j]), 0.1, P.omega, region)
+
+
+def test_classify_refuses_a_capture_point_beyond_any_foot():
+    from pushrecovery.surfaces.classify import classify
+
+    with pytest.raises(InvalidParameterError, match="capture point must be within"):
+        classify(0.01, -1.0, P, y=1e300)
+
+
+def test_a_billion_frames_are_refused_before_any_allocation():
+    from pushrecovery.sim.mujoco.render.frames import select_indices
+
+    with pytest.raises(InvalidParameterError, match="count must be"):
+        select_indices([0.0, 0.0], 10**9)
+    assert select_indices([0.0, 1.0, 2.0], 2) == [0, 2]
+
+
+def test_a_fifo_is_no_c3d_parameter_section(tmp_path):
+    import os
+    from pathlib import Path
+
+    from pushrecovery.analysis.c3d.structure import read_parameter_section
+    from pushrecovery.errors import InputFileError
+
+    fifo = Path(tmp_path / "f.c3d")
+    os.mkfifo(fifo)
+    with pytest.raises(InputFileError, match="not a regular file"):
+        read_parameter_section(fifo)
+
+
+def test_mjcf_files_without_a_joint_or_a_sole_are_refused(tmp_path, capsys):
+    from pushrecovery.sim.mujoco.humanoid3d.biped3d import build_biped3d
+
+    xml = build_biped3d(P).to_xml()
+    no_joint = tmp_path / "no_joint.xml"
+    no_joint.write_text(xml.replace('joint="right_hip_roll"', 'joint="nowhere"', 1))
+    err = cli_error(capsys, "humanoid", "simulate", "--model", str(no_joint), "--duration", "0.05")
+    assert "actuator 'right_hip_roll' drives 'nowhere', which is no joint" in err
