@@ -93,15 +93,14 @@ def capture_point_xy(
     Raises
     ------
     InvalidParameterError
-        If ``omega`` is outside [0.1, 100] 1/s, or ``x``/``xdot`` or ``y``/``ydot`` do not
-        broadcast (the states are not checked: NaN in, NaN out, as
-        :func:`~pushrecovery.surfaces.cop.capture_point`).
+        If ``omega`` is outside [0.1, 100] 1/s, or a position and its velocity do not
+        broadcast (named as :func:`~pushrecovery.surfaces.cop.capture_point` names them; the
+        states are not checked: NaN in, NaN out).
     """
-    try:
-        py = np.asarray(capture_point(y, ydot, omega), dtype=np.float64)
-    except InvalidParameterError as exc:  # name the sideways axis
-        raise InvalidParameterError(str(exc).replace("x and xdot", "y and ydot")) from None
-    return np.asarray(capture_point(x, xdot, omega), dtype=np.float64), py
+    return (
+        np.asarray(capture_point(x, xdot, omega), dtype=np.float64),
+        np.asarray(capture_point(y, ydot, omega), dtype=np.float64),
+    )
 
 
 def cmp_polygon(support: Support, params: BodyParams) -> ConvexPolygon:
