@@ -14,7 +14,7 @@ from pushrecovery.control.wbc.gains import WbcGains
 from pushrecovery.control.wbc.observation import mujoco_observation
 from pushrecovery.control.wbc.qp import WholeBodyQP
 from pushrecovery.control.wbc.tasks.task import Task
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.support import Support
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, wbc_for
@@ -214,7 +214,7 @@ def test_bad_inputs_are_refused_naming_the_parameter(params, model, plant):
         wbc(model, data, gains={"dcm": 1.0})
     with pytest.raises(InvalidParameterError, match="observation"):
         WholeBodyController(model, observation=data)
-    with pytest.raises(InvalidParameterError, match="model"):
+    with pytest.raises(ParameterTypeError, match="model must be a MjModel"):
         mujoco_observation("biped3d", data)
     with pytest.raises(InvalidParameterError, match="data"):
         ball = mujoco.MjModel.from_xml_string(BALL)

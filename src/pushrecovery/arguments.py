@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.errors import InvalidParameterError, ParameterTypeError
+from pushrecovery.errors import InputFileError, InvalidParameterError, ParameterTypeError
 
 #: A bound for numbers a formula squares where nothing narrower is checked
 #: (:func:`finite_array`'s ``bound``): no quantity of a humanoid comes near, and squares and
@@ -124,6 +125,36 @@ def output_folder(name: str, value: object) -> Path:
             f"{name}: cannot create the folder {str(folder)[:200]}: {exc.strerror or exc}"
         ) from None
     return folder
+
+
+def input_path(name: str, value: object) -> Path:
+    """Return ``value`` as a Path, or raise :class:`ParameterTypeError` unless str or PathLike."""
+    require_type(name, value, (str, os.PathLike))
+    return Path(value)  # type: ignore[arg-type]
+
+
+def input_file(name: str, value: object) -> Path:
+    """Return ``value`` as the Path of a regular, non-empty file, or raise naming why.
+
+    A FIFO would block a reader and ``/dev/zero`` never end; a name too long, with a NUL or in a
+    symlink loop is refused with the OS's reason, all as :class:`InputFileError` in one line.
+    """
+    path = input_path(name, value)
+    try:
+        found = path.stat()
+    except FileNotFoundError:
+        raise InputFileError(f"file not found: {path}") from None
+    except ValueError:  # a NUL in the name
+        raise InputFileError(f"{str(path)[:200]!r} is not a file name (a NUL character)") from None
+    except OSError as exc:
+        raise InputFileError(f"{str(path)[:200]}: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(found.st_mode):
+        raise InputFileError(f"{path} is a directory, not a file")
+    if not stat.S_ISREG(found.st_mode):
+        raise InputFileError(f"{path} is not a regular file (a pipe or a device)")
+    if found.st_size == 0:
+        raise InputFileError(f"{path} is empty")
+    return path
 
 
 def finite_array(

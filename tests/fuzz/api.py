@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import enum
+import functools
 import importlib
 import inspect
 import io
@@ -44,21 +45,6 @@ EXCLUDED = {
     "pushrecovery.control.base.register": "a class decorator: registering changes the registry",
     "pushrecovery.control.mpc.plan.Plan": "a result the MPC builds at every tick (1 kHz path)",
 }
-#: Floors where every public entry validates its arguments (the boundary of issue 38): the
-#: suite's fixed-seed run (``tests/test_fuzz.py``) draws from these. ``make fuzz`` draws from
-#: every floor and counts the others' failures too.
-BOUNDARY = (
-    "pushrecovery.analysis", "pushrecovery.anthropometry", "pushrecovery.control",
-    "pushrecovery.extras", "pushrecovery.ground", "pushrecovery.models", "pushrecovery.params",
-    "pushrecovery.presets", "pushrecovery.sim", "pushrecovery.surfaces", "pushrecovery.plots",
-    "pushrecovery.campaign", "pushrecovery.report", "pushrecovery.experiments",
-)  # fmt: skip
-#: ... but for these parts of them, which take MuJoCo's own objects (``MjModel``, ``MjData``)
-#: and do not check them yet.
-NOT_BOUNDARY = ("pushrecovery.sim.mujoco", "pushrecovery.control.wbc")
-#: Entries of the boundary floors that do not validate yet: the suite's run leaves them out,
-#: ``make fuzz`` counts them (docs/reliability.md). None today.
-NOT_YET: tuple[str, ...] = ()
 #: Callables that return NaN or an infinity by their documentation (a value that does not
 #: exist, a time that never comes), and where.
 NAN_DOCUMENTED = {
@@ -166,11 +152,6 @@ def public() -> dict[str, Any]:
     return found
 
 
-def in_boundary(name: str) -> bool:
-    """Whether ``name`` is on a floor whose entries validate (:data:`BOUNDARY`)."""
-    return name.startswith(BOUNDARY) and not name.startswith(NOT_BOUNDARY + NOT_YET)
-
-
 def _takes_input(cls: type) -> bool:
     """Whether a class is built from a caller's values: not an error, enum, protocol or
     abstract class, nor a record the library fills (a dataclass without ``__post_init__``)."""
@@ -194,7 +175,24 @@ def _parameters(item: Any) -> list[inspect.Parameter]:
 def _examples(name: str) -> dict[str, Any]:
     import test_api_sweep as sweep
 
-    return {**sweep.VALID, **sweep.OVERRIDES.get(name, {})}
+    floors = ("pushrecovery.sim.mujoco", "pushrecovery.control.wbc")
+    mujoco = _mujoco_examples() if name.startswith(floors) else {}
+    return {**sweep.VALID, **mujoco, **sweep.OVERRIDES.get(name, {})}
+
+
+@functools.cache
+def _mujoco_examples() -> dict[str, Any]:
+    """Valid MuJoCo objects for the floors that take them: the generated biped3d, standing
+    (built once per worker), so that the other parameters' checks are reached too."""
+    from pushrecovery.presets import load_params
+    from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant
+
+    plant = Biped3DPlant(load_params())
+    return {
+        "model": plant.model, "data": plant.data, "qpos": plant.qpos.copy(), "feet": plant.feet,
+        "torso": plant.torso, "upright": plant.upright, "observation": plant.observation,
+        "plant": plant, "name": "torso", "knee": 0.3,
+    }  # fmt: skip
 
 
 def draw(name: str, item: Any, seed: int, folder: Path) -> tuple[dict[str, Any], list[str]]:

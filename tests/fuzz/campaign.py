@@ -173,9 +173,6 @@ def main() -> int:
     parser.add_argument("--timeout", type=float, default=60.0, help="hang limit per case [s]")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--api", type=float, default=0.4, help="share of library calls")
-    parser.add_argument(
-        "--boundary", action="store_true", help="library calls on the validating floors only"
-    )
     parser.add_argument("--only", default="", help="library calls of these prefixes (a,b,...)")
     parser.add_argument("--out", type=Path, default=ROOT / "out" / "fuzz")
     options = parser.parse_args()
@@ -184,8 +181,6 @@ def main() -> int:
     import biomdp
 
     callables = sorted(fuzz_api.public())
-    if options.boundary:
-        callables = [name for name in callables if fuzz_api.in_boundary(name)]
     if options.only:
         callables = [n for n in callables if n.startswith(tuple(options.only.split(",")))]
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from pushrecovery.analysis.recording import LOADED, Foot, Recording
 from pushrecovery.analysis.signals import resample
+from pushrecovery.arguments import input_file, input_path
 from pushrecovery.errors import InputFileError, ParameterTypeError
 
 if TYPE_CHECKING:
@@ -19,8 +20,6 @@ from pushrecovery.analysis.readers.common import (
     FOOT_MARKERS,
     STANDING_PERCENTILE,
     FloatArray,
-    _check_file,
-    _path,
     body_rotation,
 )
 
@@ -80,7 +79,7 @@ def read_c3d_recording(
     """
     from pushrecovery.analysis.c3d import read_c3d
 
-    path = _path(path)
+    path = input_path("path", path)
     body_rotation(ap_axis)  # a bad axis name fails before the file is read
     _labels("com_markers", com_markers, 1)
     if feet is not None:
@@ -88,7 +87,7 @@ def read_c3d_recording(
             raise ParameterTypeError("feet must be a list of (name, heel, toe, ankle) labels")
         for foot in feet:
             _labels("each of feet", foot, 4)
-    _check_file(path)
+    input_file("path", path)
     content = read_c3d(path, threshold=LOADED)
     rotation = body_rotation(ap_axis, content.up)
     markers = {name: values @ rotation.T for name, values in content.markers.items()}

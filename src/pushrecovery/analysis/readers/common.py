@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import stat
 from pathlib import Path
 
 import numpy as np
@@ -63,29 +61,6 @@ def _unit_scale(units: str) -> float:
         raise InvalidParameterError(
             f"units must be one of {', '.join(LENGTH_UNITS)}, got {units!r}"
         ) from None
-
-
-def _path(path: object) -> Path:
-    """Return ``path`` as a Path, or raise :class:`ParameterTypeError` unless str or PathLike."""
-    require_type("path", path, (str, os.PathLike))
-    return Path(path)  # type: ignore[arg-type]
-
-
-def _check_file(path: Path) -> None:
-    try:  # a name too long, a symlink loop, a folder without permission: the OS says why
-        found = path.stat()
-    except FileNotFoundError:
-        raise InputFileError(f"file not found: {path}") from None
-    except ValueError:  # a NUL in the name
-        raise InputFileError(f"{str(path)[:200]!r} is not a file name (a NUL character)") from None
-    except OSError as exc:
-        raise InputFileError(f"{str(path)[:200]}: {exc.strerror or exc}") from None
-    if stat.S_ISDIR(found.st_mode):
-        raise InputFileError(f"{path} is a directory, not a file")
-    if not stat.S_ISREG(found.st_mode):  # a FIFO would block, /dev/zero never end
-        raise InputFileError(f"{path} is not a regular file (a pipe or a device)")
-    if found.st_size == 0:
-        raise InputFileError(f"{path} is empty")
 
 
 def _check_time(path: Path, time: FloatArray) -> None:

@@ -11,13 +11,12 @@ from pushrecovery.analysis.readers.c3d_files import read_c3d_recording
 from pushrecovery.analysis.readers.common import (
     MIN_FRAMES,
     FloatArray,
-    _check_file,
     _check_plausible,
     _check_time,
-    _path,
     _unit_scale,
 )
 from pushrecovery.analysis.recording import AXES, LOADED, Recording
+from pushrecovery.arguments import input_file, input_path
 from pushrecovery.errors import InputFileError
 from pushrecovery.extras import require
 
@@ -74,8 +73,8 @@ def read_recording(path: str | Path, **options: object) -> Recording:
     InputFileError
         Missing or empty file, an unknown extension, or what the reader raises.
     """
-    path = _path(path)
-    _check_file(path)
+    path = input_path("path", path)
+    input_file("path", path)
     suffix = path.suffix.lower()
     if suffix == ".csv":
         return read_csv_recording(path, **options)  # type: ignore[arg-type]
@@ -107,7 +106,7 @@ def read_csv_recording(path: str | Path, *, units: str = "m") -> Recording:
         Missing, empty or malformed file, missing or non-numeric columns, a time column that
         is not increasing at a constant rate, or values implausible in the given units.
     """
-    path = _path(path)
+    path = input_path("path", path)
     scale = _unit_scale(units)
     table = _read_table(path)
     lengths = {name for name in table if name in _LENGTHS or VERTEX_COLUMN.fullmatch(name)}
@@ -227,7 +226,7 @@ def _read_table(path: Path) -> dict[str, FloatArray]:
     import pyarrow as pa
     import pyarrow.csv as pacsv
 
-    _check_file(path)
+    input_file("path", path)
     try:
         table = pacsv.read_csv(
             path,

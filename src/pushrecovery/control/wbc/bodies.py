@@ -9,28 +9,91 @@ bindings ship no type information.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import MAX_MAGNITUDE, finite_vector, require_type
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["SOLE_TOLERANCE", "body_id", "colliding_geoms", "sole_points"]
+__all__ = [
+    "SOLE_TOLERANCE",
+    "body_id",
+    "body_names",
+    "check_data",
+    "check_model",
+    "check_qpos",
+]
 
 #: Points of a foot's colliding geoms within this height of its lowest one form its sole [m].
 SOLE_TOLERANCE = 1e-3
 
 
-def body_id(model: Any, name: str) -> int:
-    """Return the id of body ``name`` (a KeyError naming it if the model has none)."""
+def check_model(model: object) -> None:
+    """Raise :class:`ParameterTypeError` unless ``model`` is a compiled ``mujoco.MjModel``.
+
+    The check of the floors' entries that take MuJoCo's own objects (the plants, the
+    controller, the renderers): a type check, once where they are built.
+    """
     import mujoco
 
+    require_type("model", model, mujoco.MjModel)
+
+
+def check_data(model: Any, data: Any) -> None:
+    """Raise unless ``data`` is a ``mujoco.MjData`` made for ``model`` (its nq, nv, nbody)."""
+    import mujoco
+
+    check_model(model)
+    require_type("data", data, mujoco.MjData)
+    if (data.qpos.size, data.qvel.size, data.xpos.shape[0]) != (model.nq, model.nv, model.nbody):
+        raise InvalidParameterError(
+            f"data must be made for model (nq {model.nq}, nv {model.nv}), "
+            f"got nq {data.qpos.size}, nv {data.qvel.size}"
+        )
+
+
+def check_qpos(model: Any, qpos: ArrayLike, name: str = "qpos") -> FloatArray:
+    """Return ``qpos`` as model.nq finite numbers ([m], [-] quaternions, [rad]), or raise."""
+    check_model(model)
+    return finite_vector(name, qpos, int(model.nq), bound=MAX_MAGNITUDE)
+
+
+def body_names(model: Any, names: object, name: str) -> tuple[str, ...]:
+    """Return ``names`` as a tuple of distinct body names of ``model``, or raise naming ``name``."""
+    if isinstance(names, str) or not isinstance(names, Sequence):
+        raise ParameterTypeError(f"{name} must be a sequence of body names, got {names!r:.40}")
+    if not names:
+        raise InvalidParameterError(f"{name} must name at least one body, got none")
+    check_model(model)
+    found = tuple(names)
+    if not all(isinstance(n, str) for n in found) or len(set(found)) != len(found):
+        raise InvalidParameterError(f"{name} must be distinct body names, got {str(found)[:80]}")
+    for each in found:
+        body_id(model, each)
+    return found
+
+
+def body_id(model: Any, name: str) -> int:
+    """Return the id of body ``name`` of ``model``.
+
+    Raises
+    ------
+    InvalidParameterError
+        If the model has no body ``name`` (``name`` not a string included).
+    """
+    import mujoco
+
+    check_model(model)
+    if not isinstance(name, str):
+        raise ParameterTypeError(f"a body name must be a string, got {type(name).__name__}")
     index = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name))
     if index < 0:
-        raise KeyError(f"the model has no body {name!r}")
+        raise InvalidParameterError(f"the model has no body {name[:60]!r}")
     return index
 
 

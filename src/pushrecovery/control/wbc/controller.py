@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Controller
-from pushrecovery.control.wbc.bodies import body_id, sole_points
+from pushrecovery.control.wbc.bodies import body_id, body_names, sole_points
 from pushrecovery.control.wbc.foot_contact import FootContact, foot_contact
 from pushrecovery.control.wbc.gains import WbcGains
 from pushrecovery.control.wbc.hip import UPRIGHT, HipLaw
@@ -115,13 +115,10 @@ class WholeBodyController(Controller):
             raise InvalidParameterError(
                 f"observation must be a HumanoidObservation, got {type(observation).__name__}"
             )
-        if isinstance(feet, str) or not feet or len(set(feet)) != len(feet):
-            raise InvalidParameterError(f"feet must be distinct body names, got {feet!r}")
-        for name in (*feet, torso):
-            try:
-                body_id(model, name)
-            except KeyError:
-                raise InvalidParameterError(f"no body {name!r} in the model") from None
+        feet = body_names(model, feet, "feet")
+        body_id(model, torso)
+        if observation.qpos.shape != (model.nq,) or observation.xpos.shape[0] != model.nbody:
+            raise InvalidParameterError("observation must be of model's MjData (nq, nbody)")
         if int(model.nq) - 7 != int(model.nv) - 6:
             raise InvalidParameterError(
                 "model must have a free joint and hinge or slide joints only (nq − 7 = nv − 6)"

@@ -29,7 +29,7 @@ from pushrecovery.ground.polygon import convex_hull
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["FootContact", "contact_wrench_cone", "foot_contact"]
+__all__ = ["FootContact"]
 
 
 def contact_wrench_cone(vertices: FloatArray, mu: float) -> FloatArray:
@@ -132,7 +132,7 @@ def foot_contact(model: Any, data: Any, name: str) -> FootContact:
     """
     try:
         body = body_id(model, name)
-    except KeyError:
+    except InvalidParameterError:
         raise InvalidParameterError(f"feet must name bodies of the model, got {name!r}") from None
     geoms = colliding_geoms(model, body)
     if not geoms:

@@ -19,6 +19,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import bounded_float, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.params import BodyParams
@@ -68,11 +69,12 @@ class HipLaw:
     ) -> None:  # fmt: skip
         if not isinstance(params, BodyParams):
             raise InvalidParameterError(f"hip must be a BodyParams, got {type(params).__name__}")
-        for name, value in (("weight", weight), ("omega", omega), ("period", period)):
-            if not (math.isfinite(value) and 0.0 < value <= 1e7):
-                raise InvalidParameterError(f"{name} must be in (0, 1e7], got {value!r}")
-        if not (math.isfinite(margin) and 0.0 <= margin <= 1.0):
-            raise InvalidParameterError(f"margin must be in [0, 1] m, got {margin!r}")
+        require_type("support", support, ConvexPolygon)
+        for name, value, unit in (("weight", weight, "N"), ("omega", omega, "1/s"),
+                                  ("period", period, "s")):  # fmt: skip
+            if positive_float(name, value, unit) > 1e7:
+                raise InvalidParameterError(f"{name} must be in (0, 1e7] {unit}, got {value!r}")
+        margin = bounded_float("margin", margin, 0.0, 1.0, "m")
         self.torque = np.array([params.torque_max, params.torque_max_roll])
         self.inertia = np.array([params.flywheel_inertia, params.flywheel_inertia_roll])
         self.angle_max = np.array([params.flywheel_angle_max, params.flywheel_angle_max_roll])

@@ -24,7 +24,7 @@ from pushrecovery.kernels.wbc import commands, least_distance, recover, transfor
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["LeastDistanceSolver"]
+__all__ = []
 
 #: DAQP's sense flags: an active, immutable row (an equality).
 _EQUALITY = 5

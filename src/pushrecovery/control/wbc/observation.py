@@ -25,7 +25,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.control.base import Command
-from pushrecovery.errors import InvalidParameterError
 
 if TYPE_CHECKING:
     from pushrecovery.ground.polygon import ConvexPolygon
@@ -115,16 +114,17 @@ def mujoco_observation(model: Any, data: Any) -> HumanoidObservation:
 
     Raises
     ------
+    ParameterTypeError
+        If ``model`` is not a ``mujoco.MjModel`` or ``data`` not a ``mujoco.MjData``.
     InvalidParameterError
-        If ``model`` is not a ``mujoco.MjModel`` or ``data`` not a ``mujoco.MjData`` of its
-        size.
+        If ``data`` is not of ``model``'s size.
     """
     import mujoco
 
-    if not isinstance(model, mujoco.MjModel):
-        raise InvalidParameterError(f"model must be a mujoco.MjModel, got {type(model).__name__}")
-    if not isinstance(data, mujoco.MjData) or data.qpos.shape != (model.nq,):
-        raise InvalidParameterError("data must be the model's mujoco.MjData")
+    from pushrecovery.control.wbc.bodies import check_data, check_model
+
+    check_model(model)
+    check_data(model, data)
     return HumanoidObservation(
         qpos=data.qpos, qvel=data.qvel, xpos=data.xpos, xmat=data.xmat, xipos=data.xipos,
         ximat=data.ximat, xanchor=data.xanchor, xaxis=data.xaxis, geom_xpos=data.geom_xpos,

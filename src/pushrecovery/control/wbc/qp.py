@@ -37,7 +37,7 @@ from pushrecovery.kernels.wbc import add_task, assemble_rows, constraints, sole_
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["CONTACT_DAMPING", "WbcProblem", "WbcSolution", "WholeBodyQP"]
+__all__ = ["CONTACT_DAMPING", "WbcProblem", "WbcSolution"]
 
 #: The default k_c, the damping of a foot's drift in its fixed-foot rows [1/s].
 CONTACT_DAMPING = 20.0

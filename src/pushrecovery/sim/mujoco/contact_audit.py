@@ -50,9 +50,10 @@ class ContactAudit:
     Raises
     ------
     InvalidParameterError
-        If ``weight`` or ``slip_limit`` is out of range.
-    KeyError
-        If a foot is not a body of the model.
+        If ``weight`` or ``slip_limit`` is out of range, a foot is not a body of the model or
+        ``qpos`` is not ``model.nq`` finite numbers.
+    ParameterTypeError
+        If ``model`` or ``data`` is not MuJoCo's.
     """
 
     def __init__(
@@ -66,12 +67,21 @@ class ContactAudit:
     ) -> None:
         import mujoco
 
-        from pushrecovery.control.wbc.bodies import sole_points
+        from pushrecovery.control.wbc.bodies import (
+            body_names,
+            check_data,
+            check_model,
+            check_qpos,
+            sole_points,
+        )
 
+        check_model(model)
+        check_data(model, data)
         self.model, self.data = model, data
         self.weight = positive_float("weight", weight, "N")
         self.slip_limit = bounded_float("slip_limit", slip_limit, 1e-6, 1.0, "m")
-        self.feet = tuple(feet)
+        self.feet = body_names(model, feet, "feet")
+        qpos = check_qpos(model, qpos)
         foot_ids = [model.body(name).id for name in self.feet]
         self._foot_ids = np.array(foot_ids, dtype=np.int64)
         pose = mujoco.MjData(model)

@@ -11,15 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = [
-    "floor_cop_world",
-    "integration_spec",
-    "restore_state",
-    "save_state",
-    "settle",
-    "touches_floor",
-    "unstable_warnings",
-]
+__all__ = ["integration_spec", "unstable_warnings"]
 
 FloatArray = NDArray[np.float64]
 

@@ -58,7 +58,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import bounded_float, require_type, whole_number
 from pushrecovery.control.base import Command
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import Step
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT
@@ -75,7 +77,6 @@ __all__ = [
     "MocapRecording",
     "PlateArea",
     "plate_areas",
-    "plate_channels",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -172,6 +173,7 @@ class PlateArea:
 
 def plate_areas(first_centre_x: float) -> tuple[PlateArea, PlateArea]:
     """Return the walkway: plate 1 centred at ``first_centre_x`` [m], plate 2 in front of it."""
+    first_centre_x = bounded_float("first_centre_x", first_centre_x, -1e3, 1e3, "m")
     half = (0.5 * PLATE_LENGTH, 0.5 * PLATE_WIDTH)
     return (
         PlateArea(np.array([first_centre_x, 0.0, 0.0]), half),
@@ -191,7 +193,8 @@ class LabRecorder:
     plates : tuple of PlateArea
         The plates on the floor.
     frames, per_frame, decimation : int
-        Marker frames to record, analog samples per frame, physics steps per analog sample.
+        Marker frames to record (at most 1e6), analog samples per frame and physics steps per
+        analog sample (each at most 1000; frames × per_frame at most 1e7).
     """
 
     def __init__(
@@ -206,6 +209,24 @@ class LabRecorder:
     ) -> None:
         import mujoco
 
+        require_type("plant", plant, MujocoPlant)
+        if model_name not in _FEET:
+            raise InvalidParameterError(
+                f"model_name must be one of {sorted(_FEET)}, got {model_name!r:.40}"
+            )
+        if (
+            not isinstance(plates, tuple | list)
+            or not plates
+            or not all(isinstance(p, PlateArea) for p in plates)
+        ):
+            raise ParameterTypeError("plates must be a non-empty tuple of PlateArea")
+        frames = whole_number("frames", frames, 1, 10**6)
+        per_frame = whole_number("per_frame", per_frame, 1, 1000)
+        decimation = whole_number("decimation", decimation, 1, 1000)
+        if frames * per_frame > 10**7:
+            raise InvalidParameterError(
+                f"frames * per_frame must be at most 1e7 analog samples, got {frames * per_frame}"
+            )
         self._mj = mujoco
         self.model, self.data = plant.model, plant.data
         self.params: BodyParams = plant.params
@@ -216,10 +237,15 @@ class LabRecorder:
         self._centres = np.array([p.centre for p in plates])
         self._buffer = np.zeros(6)
         self.model_name = model_name
-        self.feet = [
-            (side, self.model.body(body).id, self.model.joint(joint).id, y)
-            for side, body, joint, y in _FEET[model_name]
-        ]
+        try:
+            self.feet = [
+                (side, self.model.body(body).id, self.model.joint(joint).id, y)
+                for side, body, joint, y in _FEET[model_name]
+            ]
+        except KeyError:
+            raise InvalidParameterError(
+                f"model_name {model_name!r} does not name the plant's model (its feet)"
+            ) from None
         self.off_plate = 0
         self._plant = plant
         self.per_frame, self.decimation = per_frame, decimation

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from pushrecovery.arguments import require_type
 from pushrecovery.params import BodyParams
 
 __all__ = [
@@ -30,9 +31,6 @@ __all__ = [
     "FOOT_MASS",
     "MODEL_BUILDERS",
     "TIMESTEP",
-    "add_foot",
-    "add_motor",
-    "add_upper_body",
     "foot_model",
     "model_spec",
     "torso_model",
@@ -62,6 +60,8 @@ def model_spec(name: str, params: BodyParams) -> Any:
     The shared part of every model (the ``<mujoco>`` header of an MJCF file). Every contact's
     sliding friction is ``params.friction`` when given, else 1.
     """
+    require_type("name", name, str)
+    require_type("params", params, BodyParams)
     import mujoco
 
     spec = mujoco.MjSpec()
@@ -179,6 +179,7 @@ def add_upper_body(
 
 def foot_model(params: BodyParams) -> Any:
     """Return the ``MjSpec`` of the ``foot`` model (single inverted pendulum on a foot)."""
+    require_type("params", params, BodyParams)
     import mujoco
 
     spec = model_spec("foot", params)
@@ -199,6 +200,7 @@ def foot_model(params: BodyParams) -> Any:
 
 def torso_model(params: BodyParams) -> Any:
     """Return the ``MjSpec`` of the ``torso`` model (pendulum + upper body on a hip)."""
+    require_type("params", params, BodyParams)
     import mujoco
 
     spec = model_spec("torso", params)

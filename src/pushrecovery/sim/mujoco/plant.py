@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import require_type
+from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged
 from pushrecovery.params import BodyParams
@@ -105,11 +105,10 @@ class MujocoPlant(ABC):
     def __init__(self, params: BodyParams, cop_margin: float = DEFAULT_COP_MARGIN) -> None:
         import mujoco
 
-        widest = 0.25 * (params.toe - params.heel)
-        if not (math.isfinite(cop_margin) and 0.0 <= cop_margin <= widest):
-            raise InvalidParameterError(
-                f"cop_margin must be in [0, (toe - heel)/4] m, got {cop_margin:g}"
-            )
+        require_type("params", params, BodyParams)
+        cop_margin = bounded_float(
+            "cop_margin", cop_margin, 0.0, 0.25 * (params.toe - params.heel), "m"
+        )
         self._mj: Any = mujoco
         self.params = params
         self.cop_margin = cop_margin

@@ -30,7 +30,7 @@ from pushrecovery.kernels.wbc import guard_rows
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["GuardSettings", "JointGuard"]
+__all__ = ["GuardSettings"]
 
 
 @dataclass(frozen=True)

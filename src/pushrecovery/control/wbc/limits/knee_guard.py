@@ -22,7 +22,7 @@ import numpy as np
 from pushrecovery.control.wbc.observation import HumanoidObservation
 from pushrecovery.control.wbc.tasks.task import Task
 
-__all__ = ["knee_guard_tasks"]
+__all__ = []
 
 
 def knee_guard_tasks(

@@ -25,7 +25,7 @@ from pushrecovery.errors import InvalidParameterError
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["leg_span", "pelvis_limit", "segment_lengths"]
+__all__ = []
 
 
 def segment_lengths(data: HumanoidObservation, leg: Leg) -> tuple[float, float]:

@@ -19,7 +19,7 @@ from pushrecovery.control.wbc.stepper.plan import QUINTIC_PEAK, lipm_com
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["Leg", "axis_inertia", "leg_joints", "leg_swing_time"]
+__all__ = ["Leg"]
 
 
 @dataclass(frozen=True)

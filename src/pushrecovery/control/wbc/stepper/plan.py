@@ -30,18 +30,7 @@ from pushrecovery.surfaces.capture_region import capture_region
 
 FloatArray = NDArray[np.float64]
 
-__all__ = [
-    "StepRecord",
-    "choose_step",
-    "collides",
-    "evaluate",
-    "lipm_com",
-    "plan_foothold",
-    "planning_params",
-    "quintic",
-    "rotation_vector",
-    "yaw_of",
-]
+__all__ = ["StepRecord"]
 
 #: Peak acceleration of a rest-to-rest quintic over its distance / duration² [-]: 10/√3.
 QUINTIC_PEAK = 10.0 / math.sqrt(3.0)

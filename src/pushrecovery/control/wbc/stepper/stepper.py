@@ -46,7 +46,7 @@ from pushrecovery.params import BodyParams
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["Stepper"]
+__all__ = []
 
 
 class Stepper:

@@ -21,7 +21,7 @@ from pushrecovery.control.wbc.observation import HumanoidObservation
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["momentum_rows"]
+__all__ = []
 
 
 def momentum_rows(

@@ -22,7 +22,7 @@ from pushrecovery.control.wbc.tasks.task import Task
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["TaskStack"]
+__all__ = []
 
 #: Rows beyond the ankle controller's the buffers start with (grown on demand).
 _SPARE = 8

@@ -28,7 +28,7 @@ from pushrecovery.control.wbc.tasks.task import Task
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["swing_foot_task"]
+__all__ = []
 
 
 def swing_foot_task(

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.models import (
@@ -54,6 +55,7 @@ def torso_com(params: BodyParams) -> tuple[float, float]:
     InvalidParameterError
         If the mass does not exceed the legs' or c is outside (−ℓ/2, ℓ/2).
     """
+    require_type("params", params, BodyParams)
     torso_mass = params.mass - 2.0 * LEG_MASS
     if torso_mass <= 0.0:
         raise InvalidParameterError(
@@ -80,6 +82,7 @@ def biped_model(params: BodyParams) -> Any:
     InvalidParameterError
         As :func:`torso_com`.
     """
+    require_type("params", params, BodyParams)
     import mujoco
 
     torso_mass, torso_height = torso_com(params)

@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, FOOT_HALF_THICKNESS, model_spec
@@ -119,6 +120,7 @@ def joint_ranges(params: BodyParams) -> dict[str, tuple[float, float]]:
     ``HIP_FLEXION_MAX``) so the swing leg can reach (its limit on the torso is the
     controller's).
     """
+    require_type("params", params, BodyParams)
     pitch, roll = params.flywheel_angle_max, params.flywheel_angle_max_roll
     return {
         "hip_yaw": (-HIP_YAW_MAX, HIP_YAW_MAX),
@@ -138,6 +140,7 @@ def torque_limits(params: BodyParams) -> dict[str, float]:
     weight at half a leg's lever); ankle pitch ``ANKLE_TORQUE_MARGIN`` m g max(−heel, toe) and
     roll ``ANKLE_TORQUE_MARGIN`` m g max|y| of the sole (the CoP at the foot's edges).
     """
+    require_type("params", params, BodyParams)
     weight = params.weight
     reach_y = max(abs(y) for _, y in _foot_outline(params))
     return {
@@ -157,6 +160,7 @@ def upper_body_layout(params: BodyParams) -> tuple[float, float, float]:
     straight: m_u c = m L − Σ legs m_i z_i − m_u ℓ (z from the ankle, ℓ = leg_length), and
     m_u x_u = −2 m_foot x_foot.
     """
+    require_type("params", params, BodyParams)
     length = params.leg_length
     mass = params.mass
     thigh, shank, foot = (SEGMENT_FRACTIONS[k] * mass for k in ("thigh", "shank", "foot"))

@@ -20,7 +20,7 @@ from pushrecovery.errors import InvalidParameterError
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["body_origins", "inertia_about_axis", "joint_id", "standing_qpos", "subtree"]
+__all__ = []
 
 
 def joint_id(model: Any, name: str) -> int:

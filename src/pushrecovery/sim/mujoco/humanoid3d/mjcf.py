@@ -40,8 +40,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from pushrecovery.arguments import input_file
 from pushrecovery.control.wbc.bodies import body_id
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InputFileError, InvalidParameterError
 from pushrecovery.sim.mjcf_source import MjcfSource, model_name
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import CONTROL_PERIOD, Humanoid3DPlant
 from pushrecovery.sim.mujoco.humanoid3d.robots import (
@@ -51,7 +52,7 @@ from pushrecovery.sim.mujoco.humanoid3d.robots import (
     torque_motors,
 )
 
-__all__ = ["AXIS_TOLERANCE", "MjcfPlant", "describe_mjcf", "find_bodies", "load_mjcf"]
+__all__ = ["AXIS_TOLERANCE", "MjcfPlant", "describe_mjcf", "load_mjcf"]
 
 #: A hinge is a pitch (roll) joint when its axis is within this angle of ±y (±x) [deg].
 AXIS_TOLERANCE = 25.0
@@ -67,16 +68,19 @@ def load_mjcf(path: str | Path) -> Any:
 
     Raises
     ------
+    ParameterTypeError
+        If ``path`` is not a str or a Path.
     InvalidParameterError
-        If the file does not exist or MuJoCo cannot read it (its message, one line), its first
-        joint is not a free joint (a floating base), or its timestep does not divide the
-        whole-body controller's 2 ms period.
+        If the file does not exist (or is not a regular file) or MuJoCo cannot read it (its
+        message, one line), its first joint is not a free joint (a floating base), or its
+        timestep does not divide the whole-body controller's 2 ms period.
     """
     import mujoco
 
-    file = Path(path)
-    if not file.is_file():
-        raise InvalidParameterError(f"model must be an MJCF file, got {str(path)[:80]!r}")
+    try:
+        file = input_file("path", path)
+    except InputFileError as exc:  # missing, a folder, a pipe, a device, empty
+        raise InvalidParameterError(f"model must be an MJCF file: {exc}") from None
     try:
         spec = mujoco.MjSpec.from_file(str(file))
         model = torque_motors(spec).compile()
@@ -103,7 +107,7 @@ def _body(model: Any, name: object, role: str) -> int:
     if isinstance(name, str):
         try:
             return body_id(model, name)
-        except KeyError:
+        except InvalidParameterError:
             pass
     names = [model.body(i).name for i in range(1, model.nbody)]
     words = _HINTS["foot" if "foot" in role else "torso"]

@@ -67,7 +67,13 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, finite_float, non_negative_float, require_type
 from pushrecovery.control.base import Command, StepInfo
-from pushrecovery.control.wbc.bodies import body_id, sole_points
+from pushrecovery.control.wbc.bodies import (
+    body_id,
+    body_names,
+    check_model,
+    check_qpos,
+    sole_points,
+)
 from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.control.wbc.observation import (
     HUMANOID_STATE,
@@ -146,6 +152,9 @@ class Humanoid3DPlant:
         import mujoco
 
         require_type("params", params, BodyParams)
+        check_model(model)
+        feet = body_names(model, feet, "feet")
+        body_id(model, torso)
         self.params, self.model = params, model
         if not (isinstance(ankle, tuple | list) and len(ankle) == 2):
             raise InvalidParameterError(f"ankle must be (x, y) [m], got {ankle!r}")
@@ -153,7 +162,7 @@ class Humanoid3DPlant:
             finite_float("ankle x", ankle[0], "m"),
             finite_float("ankle y", ankle[1], "m"),
         )
-        self.qpos = np.array(qpos, dtype=float)
+        self.qpos = check_qpos(model, qpos).copy()
         self.feet, self.torso, self.upright = feet, torso, upright
         self.data = mujoco.MjData(model)
         self.observation = mujoco_observation(model, self.data)
@@ -302,7 +311,7 @@ class Humanoid3DPlant:
         target = self.torso if name == "torso" else name
         try:
             return body_id(self.model, target)
-        except KeyError:
+        except InvalidParameterError:
             raise InvalidParameterError(
                 f"body must be a body of the {self.name} model, got {name[:40]!r}"
             ) from None

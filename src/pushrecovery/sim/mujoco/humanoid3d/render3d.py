@@ -32,8 +32,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import bounded_float, positive_float, require_type
-from pushrecovery.control.wbc.bodies import body_id, sole_points
+from pushrecovery.arguments import bounded_float, positive_float, require_type, sample_array
+from pushrecovery.control.wbc.bodies import body_id, check_model, sole_points
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import convex_hull
 from pushrecovery.sim.mujoco.humanoid3d.measure import subtree
@@ -46,19 +46,13 @@ from pushrecovery.sim.mujoco.render.frames import (
 )
 from pushrecovery.sim.mujoco.render.output import output_paths, write_animation, write_filmstrip
 from pushrecovery.sim.mujoco.render.overlay3d import LEGEND3D, Frame3D
+from pushrecovery.sim.mujoco.render.scene import check_size
 from pushrecovery.sim.mujoco.render.scene3d import Camera3D, fit_camera3d, render_frames3d
 from pushrecovery.sim.result import SimulationResult
 
 FloatArray = NDArray[np.float64]
 
-__all__ = [
-    "CONTACT_FORCE",
-    "Recording3D",
-    "default_camera",
-    "filmstrip_rows",
-    "render_recording3d",
-    "run_frames",
-]
+__all__ = ["CONTACT_FORCE", "Recording3D", "default_camera", "render_recording3d", "run_frames"]
 
 #: A foot supports the body when the floor pushes it with more than this [N].
 CONTACT_FORCE = 1.0
@@ -115,7 +109,8 @@ class Recording3D:
     com_velocity: FloatArray
 
     def __post_init__(self) -> None:
-        model, n = self.model, len(self.time)
+        check_model(self.model)
+        model, n = self.model, sample_array("time", self.time).size
         shapes = {"qpos": (n, model.nq), "qvel": (n, model.nv), "ctrl": (n, model.nu),
                   "com": (n, 3), "com_velocity": (n, 3)}  # fmt: skip
         if n == 0:
@@ -285,16 +280,6 @@ def filmstrip_rows(time: FloatArray, times: Sequence[float] | None, panels: int)
     return nearest_indices(time, wanted)
 
 
-def _check_size(name: str, size: object) -> tuple[int, int]:
-    if (
-        not isinstance(size, tuple | list)
-        or len(size) != 2
-        or not all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in size)
-    ):
-        raise InvalidParameterError(f"{name} must be (width, height), positive integers [px]")
-    return int(size[0]), int(size[1])
-
-
 def render_recording3d(
     recording: Recording3D,
     path: Path | str,
@@ -347,7 +332,7 @@ def render_recording3d(
     require_type("recording", recording, Recording3D)
     if not (isinstance(fps, int | float) and math.isfinite(fps) and 0.0 < fps <= 50.0):
         raise InvalidParameterError(f"fps must be in (0, 50] 1/s, got {fps!r}")
-    panel_size, size = _check_size("panel_size", panel_size), _check_size("size", size)
+    panel_size, size = check_size("panel_size", panel_size), check_size("size", size)
     camera = default_camera(recording.azimuth) if camera is None else camera
     require_type("camera", camera, Camera3D)
     rows = filmstrip_rows(recording.time, times, panels)

@@ -42,13 +42,11 @@ __all__ = [
     "Robot",
     "RobotDescription",
     "RobotsExtraMissing",
-    "derive_description",
     "describe_robot",
     "load_robot",
     "robot_licence",
     "robot_params",
     "robot_path",
-    "torque_motors",
 ]
 
 #: The wheel holding the models, and the version the derived parameters were checked on.

@@ -23,7 +23,7 @@ from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.control.base import Command
 from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.sim.backend import Step
 from pushrecovery.sim.events import Observer, ScheduledPush
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
@@ -353,15 +353,37 @@ def bisect_critical(
     ``low`` is taken to stand (0: no push). The upper end grows by ``grow`` (up to the push's
     largest impulse) while it stands; then the bracket halves until at most ``tolerance`` [N s]
     wide. Returns the largest impulse that stood, the bracket and that run's strategy
-    ("ankle" when none stood but the assumed ``low``).
+    ("ankle" when none stood but the assumed ``low``). Once the lower end is below
+    ``tolerance`` no push (0) is taken to stand, so every loop ends: at most
+    log(high / tolerance) / log(1 / shrink) + log(IMPULSE_MAX / high) / log(grow)
+    + log2(IMPULSE_MAX / tolerance) + 3 runs.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``stands`` is not callable, 0 <= low < high <= IMPULSE_MAX (1e4 N s) fails,
+        ``tolerance`` is not in [1e-6, 1e3] N s, ``grow`` not in [1.05, 100] or ``shrink`` not in
+        (0, 1).
     """
     from pushrecovery.sim.push import IMPULSE_MAX
 
+    if not callable(stands):
+        raise ParameterTypeError(f"stands must be callable, got {type(stands).__name__}")
+    low = bounded_float("low", low, 0.0, IMPULSE_MAX, "N s")
+    high = bounded_float("high", high, 0.0, IMPULSE_MAX, "N s")
+    if not low < high:
+        raise InvalidParameterError(f"low must be < high, got low={low:g}, high={high:g} N s")
+    tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
+    grow = bounded_float("grow", grow, 1.05, 100.0)
     strategy = "ankle"
     if shrink is not None:
+        shrink = bounded_float("shrink", shrink, 1e-9, 1.0 - 1e-9)
         stood, strategy = stands(low)
         while not stood:
             high, low = low, shrink * low
+            if low < tolerance:  # no push stands: the assumed end
+                low, strategy = 0.0, "ankle"
+                break
             stood, strategy = stands(low)
     while True:
         stood, used = stands(high)

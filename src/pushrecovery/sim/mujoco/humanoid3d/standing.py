@@ -30,7 +30,7 @@ from pushrecovery.sim.mujoco.humanoid3d.measure import inertia_about_axis, subtr
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["DAMPING_RATIO", "STIFFNESS_RATIO", "StandingPD", "hold_standing"]
+__all__ = ["DAMPING_RATIO", "STIFFNESS_RATIO", "StandingPD"]
 
 #: Each loop's ω² over g / h, the pendulum's [-] (module docstring).
 STIFFNESS_RATIO = 4.0

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from pushrecovery.arguments import finite_float, require_type
 from pushrecovery.control.wbc.bodies import sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
 from pushrecovery.control.wbc.gains import WbcGains
@@ -37,12 +38,15 @@ def g1_controller(
 
     ``observation`` is the run's (:func:`~pushrecovery.control.wbc.observation.mujoco_observation`).
     """
+    require_type("robot", robot, RobotDescription)
     return WholeBodyController(robot.model, G1_FEET, G1_TORSO, gains, observation=observation,
                                hip=robot.params if hip else None)  # fmt: skip
 
 
 def g1_ankle_impulse(robot: RobotDescription, azimuth: float = 0.0) -> float:
     """Return the CoP region's critical impulse m ω × (CoM's ray to the soles' hull) [N s]."""
+    require_type("robot", robot, RobotDescription)
+    azimuth = finite_float("azimuth", azimuth, "rad")
     import mujoco
 
     model, params = robot.model, robot.params

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.control.wbc.bodies import body_id
+from pushrecovery.control.wbc.bodies import body_id, check_model
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES
 from pushrecovery.sim.mujoco.humanoid3d.measure import standing_qpos
@@ -37,6 +37,7 @@ def bent_knee_qpos(model: Any, knee: float = KNEE_BEND) -> FloatArray:
     InvalidParameterError
         If ``knee`` is not in [0, 1] rad.
     """
+    check_model(model)
     if not (isinstance(knee, int | float) and 0.0 <= knee <= 1.0):
         raise InvalidParameterError(f"knee must be in [0, 1] rad, got {knee!r}")
     qpos = np.array(model.key("stand").qpos, dtype=float)

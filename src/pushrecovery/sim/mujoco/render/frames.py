@@ -9,22 +9,22 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import whole_number
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import (
+    bounded_float,
+    finite_array,
+    finite_float,
+    finite_vector,
+    float_array,
+    whole_number,
+)
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 
-__all__ = [
-    "MAX_FRAMES",
-    "Frame",
-    "FrameLike",
-    "nearest_indices",
-    "select_indices",
-    "select_times",
-    "subsample",
-    "subsample_indices",
-]
+__all__ = ["MAX_FPS", "MAX_FRAMES", "Frame", "FrameLike", "select_times", "subsample"]
 
 #: Most frames a selection asks for: a minute of video at 1 kHz.
 MAX_FRAMES = 60_000
+#: Highest frame rate a subsampling takes [1/s]: ten times the plants' 1 kHz recording.
+MAX_FPS = 1e4
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,27 +59,33 @@ FrameLike = Frame | tuple[float, NDArray[np.float64], tuple[float, float], float
 
 
 def _as_frames(frames: Sequence[FrameLike]) -> list[Frame]:
+    """Return ``frames`` as :class:`Frame` objects, or raise naming what is wrong."""
+    if isinstance(frames, str | bytes) or not isinstance(frames, Sequence):
+        raise ParameterTypeError(
+            f"frames must be a sequence of frames, got {type(frames).__name__}"
+        )
     if len(frames) == 0:
         raise InvalidParameterError("frames must not be empty")
     out = []
     for f in frames:
         if isinstance(f, Frame):
             out.append(f)
-        else:
-            if len(f) != 5:
-                raise InvalidParameterError(
-                    "a frame must be a Frame or a tuple (time, qpos, com, capture_point, cop)"
-                )
-            t, qpos, com, capture_point, cop = f
-            out.append(
-                Frame(
-                    float(t),
-                    np.asarray(qpos, dtype=float),
-                    (float(com[0]), float(com[1])),
-                    float(capture_point),
-                    float(cop),
-                )
+            continue
+        if not isinstance(f, tuple | list) or len(f) != 5:
+            raise InvalidParameterError(
+                "a frame must be a Frame or a tuple (time, qpos, com, capture_point, cop)"
             )
+        t, qpos, com, capture_point, cop = f
+        xz = finite_vector("a frame's com", com, 2, unit="m")
+        out.append(
+            Frame(
+                finite_float("a frame's time", t, "s"),
+                finite_array("a frame's qpos", qpos),
+                (float(xz[0]), float(xz[1])),
+                float(float_array("a frame's capture_point", capture_point)),
+                float(float_array("a frame's cop", cop)),
+            )
+        )
     return out
 
 
@@ -110,15 +116,14 @@ def subsample_indices(times: ArrayLike, fps: float) -> list[int]:
     times : Sequence[float]
         Frame times [s], finite and non-decreasing (any frames: 2-D or 3-D).
     fps : float
-        Target frame rate [1/s], > 0.
+        Target frame rate [1/s], in (0, :data:`MAX_FPS`].
 
     Returns
     -------
     list[int]
         Increasing indices, at most about ``duration * fps + 1`` of them.
     """
-    if not (math.isfinite(fps) and fps > 0.0):
-        raise InvalidParameterError(f"fps must be > 0 1/s, got {fps:g}")
+    fps = _checked_fps(fps)
     t = _checked_times(times)
     count = math.floor((t[-1] - t[0]) * fps + 1e-9) + 1
     return nearest_indices(t, np.append(t[0] + np.arange(count) / fps, t[-1]))
@@ -145,8 +150,16 @@ def select_indices(times: ArrayLike, count: int) -> list[int]:
     return nearest_indices(t, np.linspace(t[0], t[-1], min(count, len(t))))
 
 
+def _checked_fps(fps: object) -> float:
+    """Return a frame rate in (0, MAX_FPS] [1/s] (a grid finer than the recording's is no use)."""
+    fps = bounded_float("fps", fps, 0.0, MAX_FPS, "1/s")
+    if fps == 0.0:
+        raise InvalidParameterError("fps must be > 0 1/s, got 0")
+    return fps
+
+
 def _checked_times(times: ArrayLike) -> NDArray[np.float64]:
-    t = np.asarray(times, dtype=float).reshape(-1)
+    t = float_array("times", times).reshape(-1)
     if t.size == 0:
         raise InvalidParameterError("frames must not be empty")
     if not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0.0):
@@ -162,15 +175,14 @@ def subsample(frames: Sequence[FrameLike], fps: float) -> list[Frame]:
     frames : Sequence[FrameLike]
         Recorded frames, times non-decreasing (e.g. recorded at 1 kHz).
     fps : float
-        Target frame rate [1/s], > 0.
+        Target frame rate [1/s], in (0, :data:`MAX_FPS`].
 
     Returns
     -------
     list[Frame]
         At most about ``duration * fps + 1`` frames.
     """
-    if not (math.isfinite(fps) and fps > 0.0):
-        raise InvalidParameterError(f"fps must be > 0 1/s, got {fps:g}")
+    fps = _checked_fps(fps)
     frames = _as_frames(frames)
     return [frames[i] for i in subsample_indices([f.time for f in frames], fps)]
 

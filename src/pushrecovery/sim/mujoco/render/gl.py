@@ -13,7 +13,9 @@ import sys
 from types import ModuleType
 from typing import TYPE_CHECKING
 
-from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+import numpy as np
+
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError, PushRecoveryError
 
 if TYPE_CHECKING:
     import mujoco
@@ -57,6 +59,9 @@ def _mujoco_for_rendering() -> ModuleType:
 
 
 def _open_renderer(model: mujoco.MjModel, width: int, height: int) -> mujoco.Renderer:
+    for name, value in (("width", width), ("height", height)):
+        if isinstance(value, bool) or not isinstance(value, int | np.integer):
+            raise ParameterTypeError(f"{name} must be a whole number [px], got {value!r:.40}")
     mj = _mujoco_for_rendering()
     buffer = (model.vis.global_.offwidth, model.vis.global_.offheight)
     if not (0 < width <= buffer[0] and 0 < height <= buffer[1]):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -10,13 +9,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.errors import InvalidParameterError, PushRecoveryError
+from pushrecovery.arguments import bounded_float, finite_array, input_path, require_type
+from pushrecovery.control.wbc.bodies import check_model
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError, PushRecoveryError
 
 if TYPE_CHECKING:
     import mujoco
     from PIL import Image as PILImage
 from pushrecovery.sim.mujoco.render.frames import FrameLike, _as_frames, select_times, subsample
-from pushrecovery.sim.mujoco.render.scene import LEGEND, fit_view, render_frames
+from pushrecovery.sim.mujoco.render.scene import LEGEND, check_size, fit_view, render_frames
 
 __all__ = [
     "HOLD_LAST",
@@ -31,6 +32,10 @@ __all__ = [
 HOLD_LAST = 1.0
 # Heights of a filmstrip's label, legend and title strips and the gap between panels [px].
 _LABEL_HEIGHT, _LEGEND_HEIGHT, _TITLE_HEIGHT, _GAP = 20, 22, 22, 4
+
+
+#: Largest time an image may carry [s] (its label and GIF delay; a run lasts at most 60 s).
+_MAX_TIME = 1e6
 
 
 # --- images ----------------------------------------------------------------------------------
@@ -64,14 +69,46 @@ def _draw_legend(
         x += int(draw.textlength(name, font=font)) + 12
 
 
-def _check_images(images: Sequence[NDArray[np.uint8]], times: Sequence[float]) -> None:
-    if len(images) == 0 or len(images) != len(times):
+def _check_images(
+    images: Sequence[NDArray[np.uint8]], times: Sequence[float], legend: object
+) -> NDArray[np.float64]:
+    """Return the images' times [s], or raise: RGB uint8 images of one shape, a time each."""
+    if isinstance(images, str | bytes) or not (
+        isinstance(images, Sequence) or (isinstance(images, np.ndarray) and images.ndim == 4)
+    ):
+        raise ParameterTypeError(f"images must be a sequence of RGB arrays, got {images!r:.40}")
+    stamps = finite_array("times", times, bound=_MAX_TIME, unit="s").reshape(-1)
+    if len(images) == 0 or len(images) != stamps.size:
         raise InvalidParameterError(
-            f"need as many times as images (>= 1), got {len(times)} and {len(images)}"
+            f"need as many times as images (>= 1), got {stamps.size} and {len(images)}"
         )
-    shape = np.shape(images[0])
-    if len(shape) != 3 or shape[2] != 3 or any(np.shape(im) != shape for im in images):
-        raise InvalidParameterError("images must be RGB arrays of one shape (height, width, 3)")
+    first = images[0]
+    shape = np.shape(first) if isinstance(first, np.ndarray) else ()
+    if (
+        len(shape) != 3
+        or shape[2] != 3
+        or any(not isinstance(im, np.ndarray) or im.dtype != np.uint8 for im in images)
+        or any(np.shape(im) != shape for im in images)
+    ):
+        raise InvalidParameterError(
+            "images must be uint8 RGB arrays of one shape (height, width, 3)"
+        )
+    if (
+        isinstance(legend, str | bytes)
+        or not isinstance(legend, Sequence)
+        or not all(
+            isinstance(entry, tuple | list)
+            and len(entry) == 2
+            and isinstance(entry[0], str)
+            and np.shape(entry[1]) == (4,)
+            for entry in legend
+        )
+    ):
+        raise InvalidParameterError("legend must be (name, (r, g, b, a)) pairs, colours in [0, 1]")
+    for _, rgba in legend:
+        bounded_float("a legend colour", min(rgba), 0.0, 1.0)
+        bounded_float("a legend colour", max(rgba), 0.0, 1.0)
+    return stamps
 
 
 def _save(image: PILImage.Image, path: Path, **options: Any) -> Path:
@@ -79,7 +116,9 @@ def _save(image: PILImage.Image, path: Path, **options: Any) -> Path:
         path.parent.mkdir(parents=True, exist_ok=True)
         image.save(path, **options)
     except OSError as exc:
-        raise PushRecoveryError(f"cannot write {path}: {exc.strerror or exc}") from exc
+        raise PushRecoveryError(f"cannot write {str(path)[:200]}: {exc.strerror or exc}") from exc
+    except ValueError as exc:  # a NUL in the name, a suffix PIL does not know
+        raise InvalidParameterError(f"cannot write {str(path)[:200]!r}: {exc}") from None
     return path
 
 
@@ -113,7 +152,9 @@ def write_filmstrip(
     """
     from PIL import Image, ImageDraw
 
-    _check_images(images, times)
+    times = list(_check_images(images, times, legend))
+    path = input_path("path", path)
+    require_type("title", title, (str, type(None)))
     h, w = np.shape(images[0])[:2]
     n = len(images)
     top = _TITLE_HEIGHT if title else 0
@@ -133,7 +174,7 @@ def write_filmstrip(
         canvas.paste(Image.fromarray(np.asarray(image, dtype=np.uint8)), (x, top + _LABEL_HEIGHT))
     _draw_legend(draw, _GAP, top + _LABEL_HEIGHT + h, _LEGEND_HEIGHT, font, legend)
     paletted = canvas.quantize(colors=256, dither=Image.Dither.NONE)
-    return _save(paletted, Path(path), optimize=True)
+    return _save(paletted, path, optimize=True)
 
 
 def write_animation(
@@ -160,10 +201,10 @@ def write_animation(
     """
     from PIL import Image, ImageDraw
 
-    _check_images(images, times)
-    t = np.asarray(times, dtype=float)
-    if not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0.0):
-        raise InvalidParameterError("times must be finite and non-decreasing")
+    t = _check_images(images, times, legend)
+    path = input_path("path", path)
+    if np.any(np.diff(t) < 0.0):
+        raise InvalidParameterError("times must be non-decreasing")
     ticks = np.round((t - t[0]) * 100.0).astype(int)  # centiseconds, rounded without drift
     delays = [max(10, int(10 * d)) for d in np.diff(ticks)] + [round(1000 * HOLD_LAST)]
     h, w = np.shape(images[0])[:2]
@@ -188,7 +229,7 @@ def write_animation(
     paletted = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
     return _save(
         paletted[0],
-        Path(path),
+        path,
         save_all=True,
         append_images=paletted[1:],
         duration=delays,
@@ -204,7 +245,9 @@ def output_paths(path: Path) -> tuple[Path, Path]:
     A ``.png`` or ``.gif`` suffix of ``path`` is replaced, any other suffix is kept
     (``run.v2`` gives ``run.v2.png``).
     """
-    path = Path(path)
+    path = input_path("path", path)
+    if not path.name or path.name == "..":
+        raise InvalidParameterError(f"path must name a file, got {str(path)[:200]!r}")
     base = path.with_suffix("") if path.suffix.lower() in (".png", ".gif") else path
     return base.with_name(base.name + ".png"), base.with_name(base.name + ".gif")
 
@@ -254,8 +297,12 @@ def render_run(
         If offscreen OpenGL is unavailable (message names ``MUJOCO_GL``) or a file cannot be
         written; :class:`~pushrecovery.errors.InvalidParameterError` on bad arguments.
     """
-    if not (math.isfinite(fps) and 0.0 < fps <= 50.0):
-        raise InvalidParameterError(f"fps must be in (0, 50] 1/s, got {fps:g}")
+    check_model(model)
+    fps = bounded_float("fps", fps, 0.0, 50.0, "1/s")
+    if fps == 0.0:
+        raise InvalidParameterError("fps must be in (0, 50] 1/s, got 0")
+    panel_size, size = check_size("panel_size", panel_size), check_size("size", size)
+    require_type("title", title, (str, type(None)))
     png, gif = output_paths(path)
     frames = _as_frames(frames)
     strip = select_times(frames, panels)

@@ -34,7 +34,7 @@ from pushrecovery.sim.mujoco.render.scene import CAPTURE_POINT_RGBA, COM_RGBA, C
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["LEGEND3D", "PULL", "SUPPORT_RGBA", "Frame3D", "Marker", "overlay_markers"]
+__all__ = ["LEGEND3D", "PULL", "SUPPORT_RGBA", "Frame3D", "Marker"]
 
 #: Colour of the support polygon's outline.
 SUPPORT_RGBA = (0.85, 0.1, 0.85, 1.0)

@@ -10,6 +10,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import bounded_float, require_type
+from pushrecovery.control.wbc.bodies import check_model
 from pushrecovery.errors import InvalidParameterError
 
 if TYPE_CHECKING:
@@ -82,6 +84,22 @@ class View:
     elevation: float = ELEVATION
 
 
+def check_size(name: str, size: object) -> tuple[int, int]:
+    """Return ``size`` as (width, height) [px], positive whole numbers, or raise naming ``name``."""
+    if (
+        not isinstance(size, tuple | list)
+        or len(size) != 2
+        or not all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in size)
+    ):
+        raise InvalidParameterError(f"{name} must be (width, height), positive integers [px]")
+    return int(size[0]), int(size[1])
+
+
+def check_aspect(aspect: object) -> float:
+    """Return an image's width / height in [1e-3, 1e3], or raise naming ``aspect``."""
+    return bounded_float("aspect", aspect, 1e-3, 1e3)
+
+
 def _check_qpos(model: mujoco.MjModel, frame: Frame) -> None:
     if np.shape(frame.qpos) != (model.nq,):
         raise InvalidParameterError(
@@ -139,7 +157,7 @@ def fit_view(model: mujoco.MjModel, frames: Sequence[FrameLike], aspect: float) 
     frames : Sequence[FrameLike]
         Recorded frames.
     aspect : float
-        Image width / height, > 0.
+        Image width / height, in [1e-3, 1e3].
 
     Returns
     -------
@@ -147,8 +165,8 @@ def fit_view(model: mujoco.MjModel, frames: Sequence[FrameLike], aspect: float) 
         Camera looking at the centre of the box from the side (azimuth 90 deg, elevation
         -10 deg), far enough for the box to fit.
     """
-    if not (math.isfinite(aspect) and aspect > 0.0):
-        raise InvalidParameterError(f"aspect must be > 0, got {aspect:g}")
+    check_model(model)
+    aspect = check_aspect(aspect)
     frames = _as_frames(frames)
     _checked_times([f.time for f in frames])
     for f in frames:
@@ -322,6 +340,8 @@ def render_frames(
     PushRecoveryError
         If offscreen OpenGL is unavailable (message names ``MUJOCO_GL``).
     """
+    check_model(model)
+    require_type("view", view, (View, type(None)))
     frames = _as_frames(frames)
     _checked_times([f.time for f in frames])
     for f in frames:

@@ -25,8 +25,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import bounded_float
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import bounded_float, require_type
+from pushrecovery.control.wbc.bodies import check_model
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.sim.mujoco.render.frames import _checked_times, select_indices
 from pushrecovery.sim.mujoco.render.overlay3d import Frame3D, Marker, overlay_markers
 from pushrecovery.sim.mujoco.render.scene import (
@@ -36,6 +37,7 @@ from pushrecovery.sim.mujoco.render.scene import (
     _moving_boxes,
     _render_each,
     _wall_emission,
+    check_aspect,
 )
 
 if TYPE_CHECKING:
@@ -43,13 +45,7 @@ if TYPE_CHECKING:
 
 FloatArray = NDArray[np.float64]
 
-__all__ = [
-    "Camera3D",
-    "View3D",
-    "camera_eye",
-    "fit_camera3d",
-    "render_frames3d",
-]
+__all__ = ["Camera3D", "View3D", "fit_camera3d", "render_frames3d"]
 
 #: Margin around the body in the fitted view, as a fraction of its size.
 _MARGIN = 0.12
@@ -106,6 +102,11 @@ def camera_eye(view: View3D, target: ArrayLike) -> FloatArray:
 
 
 def _check_frames(model: mujoco.MjModel, frames: Sequence[Frame3D]) -> None:
+    check_model(model)
+    if isinstance(frames, str | bytes) or not isinstance(frames, Sequence):
+        raise ParameterTypeError(
+            f"frames must be a sequence of Frame3D, got {type(frames).__name__}"
+        )
     if len(frames) == 0:
         raise InvalidParameterError("frames must not be empty")
     for f in frames:
@@ -147,10 +148,10 @@ def fit_camera3d(
     camera : Camera3D
         Azimuth and elevation.
     aspect : float
-        Image width / height, > 0.
+        Image width / height, in [1e-3, 1e3].
     """
-    if not (isinstance(aspect, int | float) and math.isfinite(aspect) and aspect > 0.0):
-        raise InvalidParameterError(f"aspect must be > 0, got {aspect!r}")
+    aspect = check_aspect(aspect)
+    require_type("camera", camera, Camera3D)
     _check_frames(model, frames)
     points = _body_points(model, frames)
     points = points[np.all(np.isfinite(points), axis=1)]
@@ -232,6 +233,8 @@ def render_frames3d(
         :func:`~pushrecovery.sim.mujoco.render.scene.render_frames`'s).
     """
     _check_frames(model, frames)
+    require_type("camera", camera, (Camera3D, type(None)))
+    require_type("view", view, (View3D, type(None)))
     seen = view or fit_camera3d(model, frames, camera or Camera3D(), width / max(height, 1))
     forward, _, _ = _axes(seen.camera)
     level = np.array([forward[0], forward[1], 0.0]) / math.hypot(forward[0], forward[1])
