@@ -44,6 +44,23 @@ def test_one_worker_runs_the_campaign_in_this_process(
     assert json.loads(out)["pushes"] == 6
 
 
+def test_one_worker_isolates_mujoco_pushes_in_a_worker_process(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # MuJoCo is C: a push that crashes it must cost one error row (the isolation's tests),
+    # not the campaign, so --workers 1 runs MuJoCo pushes in one worker process.
+    def here(*args: Any) -> Any:
+        raise AssertionError("--workers 1 ran MuJoCo pushes in the campaign's own process")
+
+    monkeypatch.setattr(execute, "_serial", here)
+    args = ["campaign", "--backend", "mujoco", "--model", "foot", "--controller", "ankle-pd",
+            "--x0", "0", "0", "1", "--xdot", "0.1", "0.1", "1", "--duration", "0.5",
+            "--no-plot", "--json", "--workers", "1", "--out", str(tmp_path / "m")]  # fmt: skip
+    code, out, err = run_cli(capsys, *args)
+    assert code == 0, err
+    assert json.loads(out)["pushes"] == 1
+
+
 @pytest.mark.parametrize("workers", ["0", "-3"])
 def test_bad_worker_counts_are_one_line_and_exit_2(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, workers: str

@@ -43,6 +43,15 @@ def crash_push(spec: CampaignSpec, push: Any) -> dict[str, Any]:
     return run_push(spec, push)
 
 
+def crash_once_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]]:
+    """Kill the first worker that runs batch 1 (a machine lost), then run as usual."""
+    marker = os.environ["PUSHRECOVERY_TEST_CRASHED"]
+    if batch == 1 and not os.path.exists(marker):
+        open(marker, "w").close()
+        os.kill(os.getpid(), signal.SIGKILL)
+    return run_batch(spec, batch)
+
+
 def hang_batch(spec: CampaignSpec, batch: int) -> tuple[int, list[dict[str, Any]]]:
     from pushrecovery.campaign import watchdog
 
@@ -253,6 +262,26 @@ def test_a_push_that_kills_its_dask_worker_is_one_error_row() -> None:
                 assert row["outcome"] == "error" and row["error"] == "its worker process died"
             else:
                 assert row == reference
+
+
+def test_a_dead_dask_workers_batch_runs_on_another_and_the_campaign_finishes(
+    tmp_path: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from distributed import Client, LocalCluster
+
+    from pushrecovery.campaign.cluster import on_cluster as _dask
+
+    # The scheduler's default: a task whose worker died runs again elsewhere (the other
+    # worker, or the one its nanny restarts); the batch's rows are those of an unbroken run.
+    marker = tmp_path / "crashed"
+    monkeypatch.setenv("PUSHRECOVERY_TEST_CRASHED", str(marker))
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+    ) as cluster:
+        with Client(cluster, set_as_default=False) as client:
+            found = dict(_dask(SPEC, [0, 1, 2], client, batch_runner=crash_once_batch))
+    assert marker.exists()  # a worker did die
+    assert found == {b: run_batch(SPEC, b)[1] for b in (0, 1, 2)}
 
 
 def test_a_worker_whose_campaign_was_killed_ends_itself() -> None:

@@ -188,6 +188,17 @@ def _what(name: str, unit: str, allowed: str) -> str:
     return f"{name} must be a finite number{' ' + allowed if allowed else ''}{_unit(unit)}"
 
 
+def flag(name: str, value: object) -> bool:
+    """Return ``value`` as a bool, or raise naming ``name``: True or False only (numpy's too).
+
+    A flag given any other value (a string, None, an object) is refused, not taken by its
+    truth value.
+    """
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    raise ParameterTypeError(f"{name} must be True or False, got {str(value)[:40]!r}")
+
+
 def whole_number(name: str, value: object, low: int, high: int) -> int:
     """Return ``value`` as an int in [``low``, ``high``], or raise naming ``name`` and the range.
 

@@ -157,8 +157,8 @@ def _takes_input(cls: type) -> bool:
     abstract class, nor a record the library fills (a dataclass without ``__post_init__``)."""
     if issubclass(cls, BaseException | enum.Enum) or getattr(cls, "_is_protocol", False):
         return False
-    if inspect.isabstract(cls):
-        return False
+    if inspect.isabstract(cls) or (issubclass(cls, tuple) and hasattr(cls, "_fields")):
+        return False  # an abstract class, or a NamedTuple: a record the library fills
     return not (dataclasses.is_dataclass(cls) and "__post_init__" not in vars(cls))
 
 
@@ -252,13 +252,46 @@ def _short(value: Any) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
+#: (callable, parameter) pairs that take a NaN or an infinity by their documentation (an
+#: unbounded limit, a missing value), and why: no silent acceptance there.
+TAKES_NONFINITE: dict[tuple[str, str], str] = {
+    ("pushrecovery.report.markup.percent_within", "value"): "NaN: not computed, an em dash",
+    ("pushrecovery.report.markup.percent_within", "resolution"): "NaN: unknown, no ± shown",
+    ("pushrecovery.surfaces.n_step.capturability_distance", "steps"): "inf: N = ∞ steps",
+    **{(f"pushrecovery.report.markup.{f}", "value"): "NaN: not computed, an em dash; ±inf: ∞"
+       for f in ("num", "percent")},
+}  # fmt: skip
+
+
+def certainly_invalid(value: Any, parameter: inspect.Parameter, name: str) -> bool:
+    """Whether no documented input of ``parameter`` could be ``value``: a bare ``object()``,
+    bytes where no bytes are taken, None where the annotation has no None, a NaN or an
+    infinity for a parameter annotated a float (a number, not an array)."""
+    text = str(parameter.annotation).replace(" ", "")
+    if "Any" in text or text in ("object", "inspect._empty", "_empty"):
+        return False
+    if type(value) is object:
+        return True
+    if isinstance(value, bytes) and "bytes" not in text:
+        return True
+    if value is None and "None" not in text and parameter.default is not None:
+        return True
+    if (
+        isinstance(value, float) and not math.isfinite(value)
+        and text in ("float", "float|None") and name not in NAN_DOCUMENTED
+        and (name, parameter.name) not in TAKES_NONFINITE
+    ):  # fmt: skip
+        return True
+    return False
+
+
 def call(name: str, seed: int, folder: Path) -> dict[str, Any]:
     """Run one case; the answer in the CLI campaign's form (``code`` 0 result, 2 refusal)."""
     item = public()[name]
     arguments, hostile = draw(name, item, seed, folder)
     shown = ", ".join(f"{k}={_short(v)}" for k, v in arguments.items())
     reproduction = f"{name}({shown})  # api.draw({name!r}, seed={seed})"
-    code, out, err, escaped = 0, "", "", None
+    code, out, err, escaped, accepted = 0, "", "", None, []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -275,6 +308,11 @@ def call(name: str, seed: int, folder: Path) -> dict[str, Any]:
             where = f" | {tb.filename}:{tb.lineno}" if tb else ""
             escaped = f"{type(exc).__name__}: {str(exc)[:300]}{where}"
         else:
+            parameters = {p.name: p for p in _parameters(item)}
+            accepted = [
+                p for p in hostile
+                if p in parameters and certainly_invalid(arguments[p], parameters[p], name)
+            ]  # fmt: skip
             inputs_finite = not any(nonfinite(v) for v in arguments.values())
             if inputs_finite and nonfinite(result) and name not in NAN_DOCUMENTED:
                 out = "nan"  # the campaign's NUMBER pattern
@@ -286,4 +324,5 @@ def call(name: str, seed: int, folder: Path) -> dict[str, Any]:
         "escaped": escaped,
         "call": reproduction,
         "hostile": hostile,
+        "accepted": accepted,
     }

@@ -35,7 +35,7 @@ ROOT = Path(__file__).resolve().parents[2]
 #: A NaN or an infinity printed as a value: not the key "inf" (N = ∞ steps) of ``bounds``,
 #: which is followed by a colon (JSON) or a value (the table).
 NUMBER = re.compile(r"(?<![\w.\"])-?(nan|NaN|inf|Inf|Infinity)(?![\w\"])(?!\s+\[)")
-KINDS = ("crash", "hang", "traceback", "nan", "multiline", "warning", "exit", "lost")
+KINDS = ("crash", "hang", "traceback", "nan", "multiline", "warning", "exit", "lost", "accepted")
 
 
 class Worker:
@@ -128,6 +128,8 @@ def problems(result: dict) -> list[str]:
         found.append("warning")
     if code == 0 and nonfinite_output(out):
         found.append("nan")
+    if code == 0 and result.get("accepted"):  # a library call given what it cannot take
+        found.append("accepted")
     return found
 
 

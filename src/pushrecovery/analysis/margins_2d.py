@@ -408,13 +408,15 @@ def margins_2d(
     ]
     nan = np.full(n, np.nan)
     ttb_cop = ttb_xcom = nan
+    cop_rate = None if cop_velocity is None else _frames("cop_velocity", cop_velocity, n)
+    if cop_rate is not None and cop is None:
+        raise InvalidParameterError("cop_velocity needs cop (the time to boundary of the CoP)")
     if cop is not None:
         p = _frames("cop", cop, n)
         signed_p = _signed(geometry, p)
         ttb_xcom = _ttb_xcom(geometry, xi, p, omega, mos, signed_p)
-        if cop_velocity is not None:
-            velocity = _frames("cop_velocity", cop_velocity, n)
-            ttb_cop = _ttb_cop(geometry, p, velocity, signed_p)
+        if cop_rate is not None:
+            ttb_cop = _ttb_cop(geometry, p, cop_rate, signed_p)
     codes = np.full(n, -1, dtype=np.int8)
     mos_cmp = nan.copy()
     if verdicts:

@@ -85,6 +85,7 @@ def table_of_rows(rows: Sequence[Mapping[str, Any]], schema: Any) -> Any:
         raise ParameterTypeError("rows must be a list of mappings (column to value)")
     import pyarrow as pa
 
+    require_type("schema", schema, pa.Schema)
     keys = list(rows[0]) if rows else []
     if all(list(row) == keys for row in rows):  # one key order (a batch's rows): transpose
         found = dict(zip(keys, zip(*(row.values() for row in rows), strict=True), strict=True))

@@ -10,10 +10,10 @@ from collections.abc import Iterator
 from typing import Any
 
 from pushrecovery.arguments import require_type
-from pushrecovery.campaign.isolation import BatchRunner, PushRunner
+from pushrecovery.campaign.isolation import BatchRunner, PushRunner, check_batches
 from pushrecovery.campaign.pushes import error_row, run_batch, run_push
 from pushrecovery.campaign.spec import CampaignError, CampaignSpec
-from pushrecovery.errors import PushRecoveryError
+from pushrecovery.errors import ParameterTypeError, PushRecoveryError
 from pushrecovery.extras import require
 
 __all__ = ["CONNECT_TIMEOUT", "connect", "on_cluster"]
@@ -62,8 +62,22 @@ def on_cluster(
     ``distributed.scheduler.allowed-failures``, then fails it with ``KilledWorker``. Such a
     batch is sent again one push per task: the push that kills its worker once more is an
     ``error`` row, every other push is simulated. ``batch_runner`` and ``push_runner`` are
-    :func:`run_batch` and :func:`run_push` (replaceable for tests).
+    :func:`run_batch` and :func:`run_push` (replaceable for tests). The arguments are checked
+    at the call (:func:`~pushrecovery.campaign.isolation.check_batches`).
     """
+    batches = check_batches(spec, batches, batch_runner, push_runner)
+    if not callable(getattr(client, "submit", None)):
+        raise ParameterTypeError(f"client must be a dask.distributed Client, got {client!r:.40}")
+    return _on_cluster(spec, batches, client, batch_runner, push_runner)
+
+
+def _on_cluster(
+    spec: CampaignSpec,
+    batches: list[int],
+    client: Any,
+    batch_runner: BatchRunner,
+    push_runner: PushRunner,
+) -> Iterator[tuple[int, list[dict]]]:
     from distributed import as_completed
 
     # pure=False: every batch runs, even if an identical task ran before on the cluster.

@@ -17,7 +17,7 @@ import multiprocessing
 import os
 import signal
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
 
@@ -25,8 +25,9 @@ from pushrecovery.arguments import require_type, whole_number
 from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.pushes import error_row, run_batch, run_push
 from pushrecovery.campaign.spec import CampaignSpec
+from pushrecovery.errors import ParameterTypeError
 
-__all__ = ["batch_deadline", "new_pool", "quarantine", "quiet_worker_start"]
+__all__ = ["batch_deadline", "check_batches", "new_pool", "quarantine", "quiet_worker_start"]
 
 BatchRunner = Callable[[CampaignSpec, int], tuple[int, list[dict[str, Any]]]]
 PushRunner = Callable[..., dict[str, Any]]
@@ -169,6 +170,21 @@ def _reason(status: str, spec: CampaignSpec) -> str:
     return "its worker process died"
 
 
+def check_batches(spec: CampaignSpec, batches: object, *runners: object) -> list[int]:
+    """Return ``batches`` as batch numbers of ``spec``, its runners checked callable, or raise.
+
+    Called where a run of batches starts, before any result is asked for: the runs are
+    generators, which would otherwise meet a bad argument only at their first result.
+    """
+    require_type("spec", spec, CampaignSpec)
+    if isinstance(batches, str | bytes) or not isinstance(batches, Sequence):
+        raise ParameterTypeError(f"batches must be a list of batch numbers, got {batches!r:.40}")
+    found = [whole_number("a batch number", b, 0, spec.batches - 1) for b in batches]
+    if not all(callable(runner) for runner in runners):
+        raise ParameterTypeError("batch_runner and push_runner must be callable")
+    return found
+
+
 def quarantine(
     spec: CampaignSpec,
     batches: list[int],
@@ -181,8 +197,16 @@ def quarantine(
     Yields each batch with its rows in push order, as the pool does. A push that kills its
     process, or that gives no answer within its ``push_timeout`` plus the watchdog's grace, is
     an ``error`` row. ``batch_runner`` and ``push_runner`` are :func:`run_batch` and
-    :func:`run_push` (replaceable for tests).
+    :func:`run_push` (replaceable for tests). The arguments are checked at the call
+    (:func:`check_batches`).
     """
+    batches = check_batches(spec, batches, batch_runner, push_runner)
+    return _quarantine(spec, batches, batch_runner, push_runner)
+
+
+def _quarantine(
+    spec: CampaignSpec, batches: list[int], batch_runner: BatchRunner, push_runner: PushRunner
+) -> Iterator[tuple[int, list[dict[str, Any]]]]:
     for batch in batches:
         status, result = _alone(batch_runner, (spec, batch), batch_deadline(spec))
         if status == "ok":

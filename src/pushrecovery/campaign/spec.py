@@ -177,7 +177,7 @@ class CampaignSpec:
     latency: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.backend not in BACKENDS:
+        if not isinstance(self.backend, str) or self.backend not in BACKENDS:
             raise InvalidParameterError(
                 f"backend must be one of {list(BACKENDS)}, got {self.backend!r}"
             )

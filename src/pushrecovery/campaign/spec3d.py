@@ -56,7 +56,8 @@ def check_azimuths(values: Sequence[float], name: str = "azimuths") -> tuple[flo
         Naming ``name``, for an empty or too long list, a value that is not a finite number
         in range, or two values that are the same direction.
     """
-    if isinstance(values, str) or not isinstance(values, Sequence):
+    require_type("name", name, str)
+    if isinstance(values, str | bytes) or not isinstance(values, Sequence):
         raise InvalidParameterError(f"{name} must be a sequence of angles [deg], got {values!r}")
     if not 1 <= len(values) <= MAX_AZIMUTHS:
         raise InvalidParameterError(
@@ -89,6 +90,7 @@ def azimuth_grid(text: str, name: str = "--azimuths") -> tuple[float, ...]:
         Naming ``name``, for text that is neither form, or angles :func:`check_azimuths`
         refuses.
     """
+    require_type("name", name, str)
     if not isinstance(text, str) or not text.strip():
         raise InvalidParameterError(f"{name} needs START:STOP:STEP or a list A,B,... [deg]")
     try:

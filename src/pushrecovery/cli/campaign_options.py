@@ -34,7 +34,8 @@ WORKERS = click.option(
     "--workers",
     type=int,
     default=None,
-    help="Local worker processes (default: all cores; 1: the pushes run in this process).",
+    help="Local worker processes (default: all cores; 1: analytic pushes run in this process, "
+    "MuJoCo pushes in one worker process).",
 )
 #: ``--scheduler ADDRESS`` (``campaign``, ``humanoid campaign``, ``report``).
 SCHEDULER = click.option(
@@ -186,9 +187,11 @@ class CampaignRun:
     def run(self, spec: Any) -> Any:
         """Run ``spec`` into ``--out`` with a progress bar; Ctrl-C keeps the finished batches.
 
-        ``--workers 1`` runs the pushes in this process (no worker to start and import
-        everything again; a push that crashes the engine ends the campaign, its finished
-        batches kept). An interrupted campaign exits with status 130.
+        ``--workers 1`` runs an analytic campaign's pushes in this process (no worker to start
+        and import everything again: pure Python and the project's kernels, whose failures
+        are exceptions, each an ``error`` row) and a MuJoCo campaign's in one worker process,
+        isolated, as with more workers: a push that crashes the engine or hangs it outside the
+        simulation's loop is one ``error`` row. An interrupted campaign exits with status 130.
 
         Returns
         -------
@@ -206,7 +209,7 @@ class CampaignRun:
                 scheduler=self.scheduler,
                 resume=self.resume,
                 progress=bar.update,
-                isolated=self.workers != 1,
+                isolated=self.workers != 1 or spec.backend == "mujoco",
             )
         except KeyboardInterrupt:
             bar.close()

@@ -114,7 +114,7 @@ class ConfusionPush:
     def __post_init__(self) -> None:
         for name, allowed in (("predicted", LABELS), ("predicted_corrected", LABELS),
                               ("used", USED)):  # fmt: skip
-            if getattr(self, name) not in allowed:
+            if not isinstance(getattr(self, name), str) or getattr(self, name) not in allowed:
                 raise InvalidParameterError(
                     f"{name} must be one of {list(allowed)}, got {getattr(self, name)!r}"
                 )

@@ -66,7 +66,7 @@ def filmstrip_run(
     from pushrecovery.sim.push import Push3D
     from pushrecovery.sim.registry import make_plant3d
 
-    if controller not in STRIP_CONTROLLERS:
+    if not isinstance(controller, str) or controller not in STRIP_CONTROLLERS:
         raise InvalidParameterError(
             f"controller must be one of {list(STRIP_CONTROLLERS)}, got {controller!r}"
         )

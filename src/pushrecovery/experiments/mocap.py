@@ -151,7 +151,7 @@ def record_push(
         For an unknown model or controller, both pushes, rates that do not fit the 1 ms step,
         or a duration not longer than ``quiet``.
     """
-    if model not in MUJOCO_MODELS:
+    if not isinstance(model, str) or model not in MUJOCO_MODELS:
         raise InvalidParameterError(f"model must be one of {sorted(MUJOCO_MODELS)}, got {model!r}")
     if xdot is not None and impulse is not None:
         raise InvalidParameterError("give a push as xdot or as impulse, not both")

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pushrecovery.arguments import finite_float, finite_vector
+from pushrecovery.arguments import finite_float, finite_vector, require_type
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import critical_velocity
@@ -82,7 +83,19 @@ def push_scale(params: BodyParams, strategy: str, reference: BodyParams) -> floa
     The forward critical push from upright: Eq. (4) (``ankle``), corrected Eq. (15) (``hip``)
     or Sec. IV's single step (``step``). A grid of pushes drawn for ``reference`` and scaled
     by it covers the same part of ``params``' strategy map.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``strategy`` is not ``"ankle"``, ``"hip"`` or ``"step"``, or a body is not a
+        BodyParams.
     """
+    require_type("params", params, BodyParams)
+    require_type("reference", reference, BodyParams)
+    if not isinstance(strategy, str) or strategy not in ("ankle", "hip", "step"):
+        raise InvalidParameterError(
+            f"strategy must be 'ankle', 'hip' or 'step', got {str(strategy)[:40]!r}"
+        )
     return _threshold(params, strategy) / _threshold(reference, strategy)
 
 

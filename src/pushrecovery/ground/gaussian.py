@@ -71,6 +71,7 @@ def covariance_2d(name: str, cov: ArrayLike) -> FloatArray:
         Another shape, a non-finite entry, an asymmetric matrix (beyond 1e-12 of its largest
         entry) or a negative eigenvalue (beyond 1e-12 of the largest), naming ``name``.
     """
+    require_type("name", name, str)
     array = finite_array(name, cov)
     if array.ndim < 2 or array.shape[-2:] != (2, 2):
         raise InvalidParameterError(

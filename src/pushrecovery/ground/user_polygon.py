@@ -12,6 +12,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.polygon import (
     MAX_COORDINATE,
@@ -48,6 +49,7 @@ def convex_polygon(name: str, vertices: object, *, contains_origin: bool = False
         Fewer than 3 vertices, a non-finite or repeated vertex, self-intersecting edges, a
         non-convex vertex, zero area, or (with ``contains_origin``) the origin not inside.
     """
+    require_type("name", name, str)
     try:
         pts = np.asarray(vertices, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):  # an int beyond float too

@@ -60,7 +60,8 @@ def lipm_acceleration(x: ArrayLike, cop: ArrayLike, omega: float) -> FloatArray:
     """
     omega = bounded_float("omega", omega, OMEGA_MIN, OMEGA_MAX, "1/s")
     big = MAX_MAGNITUDE  # beyond, ω² (x − δ) overflows
-    return omega**2 * (finite_array("x", x, big, "m") - finite_array("cop", cop, big, "m"))
+    x, cop = broadcast(x=finite_array("x", x, big, "m"), cop=finite_array("cop", cop, big, "m"))
+    return omega**2 * (x - cop)
 
 
 def lipm_state(

@@ -85,6 +85,7 @@ def figure_legend(fig: Figure, **options: Any) -> None:
 
 def strategy_label(name: str) -> str:
     """Legend text of a strategy's colour."""
+    require_type("name", name, str)
     return f"needs {name}"
 
 

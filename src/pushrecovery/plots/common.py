@@ -96,6 +96,7 @@ def figure_outputs(
 
 def check_rows(name: str, rows: object) -> list[Mapping[str, Any]]:
     """Return ``rows`` (a table's rows: mappings of column to value) as a list, or raise."""
+    require_type("name", name, str)
     if isinstance(rows, str | bytes | Mapping) or not isinstance(rows, Iterable):
         raise ParameterTypeError(f"{name} must be a list of rows (mappings), got {rows!r:.40}")
     try:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import functools
 import os
 import time
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping
 from dataclasses import replace
 from pathlib import Path
 
@@ -106,7 +106,11 @@ def build_report(
     for name, flag in (("full", full), ("mujoco", mujoco)):
         require_type(name, flag, bool)
     require_type("size", size, str)
-    if isinstance(skip, str | bytes) or not all(isinstance(s, str) for s in skip):
+    if (
+        isinstance(skip, str | bytes)
+        or not isinstance(skip, Iterable)
+        or not all(isinstance(s, str) for s in skip)
+    ):
         raise ParameterTypeError("skip must be a list of section names")
     from pushrecovery import __version__, load_params
 

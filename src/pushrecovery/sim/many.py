@@ -190,7 +190,7 @@ def run_many(
 
 
 def _engine(engine: str, model: str, controller: str, backend: str, count: int) -> str:
-    if engine not in ENGINES:
+    if not isinstance(engine, str) or engine not in ENGINES:
         raise InvalidParameterError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
     pair = (model, controller)
     compiled = backend == "analytic" and pair in COMPILED

@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
-from pushrecovery.arguments import bounded_float, finite_float, positive_float
+from pushrecovery.arguments import bounded_float, finite_float, flag, positive_float
 from pushrecovery.errors import InvalidParameterError
 
 __all__ = [
@@ -91,10 +91,12 @@ class Push:
             raise InvalidParameterError(
                 f"push kind must be 'force' or 'velocity', got {str(self.kind)[:40]!r}"
             )
-        if self.duration != PUSH_DURATION:  # the default needs no check (pushes are many)
+        if self.duration is not PUSH_DURATION:  # the default needs no check (pushes are many)
             object.__setattr__(self, "duration", positive_float("duration", self.duration, "s"))
         if self.body is not None:
             _check_body(self.body)
+        if self.scheduled is not False:  # the default needs no check (pushes are many)
+            flag("scheduled", self.scheduled)
 
     @classmethod
     def from_impulse(

@@ -29,14 +29,20 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_array, finite_float, non_negative_float, require_type
+from pushrecovery.arguments import (
+    bounded_float,
+    finite_array,
+    finite_float,
+    non_negative_float,
+    require_type,
+)
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.critical import critical_push, pushed_state
 from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.registry import MUJOCO_MODELS, available_models, make_plant
-from pushrecovery.sim.simulate import simulate
+from pushrecovery.sim.simulate import MAX_DURATION, simulate
 from pushrecovery.surfaces.classify import classify, strategy_region
 
 __all__ = [
@@ -399,8 +405,13 @@ def confusion_matrix(
     """Classify every push of the grid ``x0s`` × ``velocities`` and simulate what it needs.
 
     The prediction is :func:`~pushrecovery.surfaces.classify.classify` of the state after
-    the push (x0, v); a strategy left out of ``strategies`` counts as failing.
+    the push (x0, v); a strategy left out of ``strategies`` counts as failing. Every
+    argument is checked before the first run (``duration`` in (0, 60] s), an empty grid too.
     """
+    require_type("params", params, BodyParams)
+    duration = bounded_float("duration", duration, 0.0, MAX_DURATION, "s")
+    if duration == 0.0:
+        raise InvalidParameterError(f"duration must be in (0, {MAX_DURATION:g}] s, got 0")
     x0s = finite_array("x0s", x0s).reshape(-1).tolist()
     velocities = finite_array("velocities", velocities).reshape(-1).tolist()
     strategies = _strategies(strategies, progress)

@@ -15,7 +15,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import finite_array, float_array, require_type
+from pushrecovery.arguments import broadcast, finite_array, float_array, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
@@ -68,7 +68,7 @@ def classify_states(
     if y is not None or ydot is not None or support is not None:
         return _plane_codes(x, xdot, params, y, ydot, support)
     require_type("params", params, BodyParams)
-    x, xdot = np.broadcast_arrays(float_array("x", x), float_array("xdot", xdot))
+    x, xdot = broadcast(x=float_array("x", x), xdot=float_array("xdot", xdot))
     codes = np.empty(x.shape, dtype=np.int8)
     if x.size == 0:
         return codes
@@ -125,8 +125,10 @@ def _plane_codes(
     the states beyond the hip region only, on their step lines.
     """
     support = Support.from_params(params) if support is None else support
-    given = {"x": x, "y": y, "xdot": xdot, "ydot": ydot}
-    inputs = [float_array(n, 0.0 if a is None else a) for n, a in given.items()]
+    zero = 0.0  # y and ydot not given: on the x axis, at rest sideways
+    given = {"x": x, "y": zero if y is None else y, "xdot": xdot,
+             "ydot": zero if ydot is None else ydot}  # fmt: skip
+    inputs = [float_array(n, a) for n, a in given.items()]
     try:
         shape = np.broadcast_shapes(*(a.shape for a in inputs))
     except ValueError:

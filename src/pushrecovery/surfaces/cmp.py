@@ -205,6 +205,7 @@ def cmp_offset_from(
         its range (:func:`flywheel_offsets`), non-finite values, or an unknown ``axis``.
     """
     require_type("params", params, BodyParams)
+    require_type("axis", axis, str)
     if axis == "pitch":
         limits = (params.torque_max, params.flywheel_inertia, params.flywheel_angle_max)
     elif axis == "roll":

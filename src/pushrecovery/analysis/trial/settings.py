@@ -15,10 +15,10 @@ from pushrecovery.analysis.recording import (
     LOADED,
     Recording,
 )
-from pushrecovery.arguments import finite_float
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.arguments import bounded_float, finite_float, flag, require_type
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.extras import require
-from pushrecovery.params import BodyParams
+from pushrecovery.params import LIMITS, BodyParams
 
 if TYPE_CHECKING:
     from pushrecovery.analysis.trial.summary import TrialSummary
@@ -110,15 +110,16 @@ class AnalysisSettings:
         for name in ("cutoff", "force_cutoff", "max_gap", "stance_width", "com_noise",
                      "com_height_sd"):  # fmt: skip
             value = getattr(self, name)
-            if value is None:
-                continue
+            if value is None and name in ("stance_width", "com_noise", "com_height_sd"):
+                continue  # not given: the body's, none
             value = finite_float(name, value)
             if not value >= 0.0:
                 raise InvalidParameterError(f"{name} must be a finite number >= 0, got {value}")
+        flag("normalise", self.normalise)
         for name in ("contact_height", "foot_width"):
             value = getattr(self, name)
-            if value is None:
-                continue
+            if value is None and name == "foot_width":
+                continue  # not given: the body's
             value = finite_float(name, value)
             if not value > 0.0:
                 raise InvalidParameterError(f"{name} must be a finite number > 0, got {value}")
@@ -126,7 +127,7 @@ class AnalysisSettings:
             value = getattr(self, name)
             if value is not None:
                 finite_float(name, value, "m")
-        if self.xcom_length not in XCOM_LENGTHS:
+        if not isinstance(self.xcom_length, str) or self.xcom_length not in XCOM_LENGTHS:
             raise InvalidParameterError(
                 f"xcom_length must be one of {list(XCOM_LENGTHS)}, got {self.xcom_length!r}"
             )
@@ -240,8 +241,16 @@ def body_for(
     ------
     InvalidParameterError
         No mass (neither given, in the file, nor weighed on its force plates): no body is
-        guessed. ``height`` without ``sex`` or the reverse, or either out of its range.
+        guessed. ``height`` without ``sex`` or the reverse, or either out of its range; a
+        mass, CoM height or gravity outside :data:`pushrecovery.params.LIMITS`.
     """
+    require_type("recording", recording, Recording)
+    if isinstance(keep, str | bytes) or not isinstance(keep, Collection):
+        raise ParameterTypeError(f"keep must be a collection of field names, got {keep!r:.40}")
+    mass = None if mass is None else bounded_float("mass", mass, *LIMITS["mass"])
+    if com_height is not None:
+        com_height = bounded_float("com_height", com_height, *LIMITS["com_height"])
+    gravity = bounded_float("gravity", gravity, *LIMITS["gravity"])
     values: dict[str, float] = {}
     sources = {"mass": "preset", "com_height": "preset"}
     if mass is not None:

@@ -105,6 +105,7 @@ class MPCSettings:
                 f"realtime must be True or False (or 1, 0), got {self.realtime!r}"
             )
         object.__setattr__(self, "realtime", bool(self.realtime))
+        require_type("solver", self.solver, str)
         if self.realtime and self.solver != "daqp":
             raise InvalidParameterError(
                 f"realtime=True needs solver='daqp' (the sparse solvers' route), "

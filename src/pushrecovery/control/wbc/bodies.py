@@ -60,6 +60,7 @@ def check_data(model: Any, data: Any) -> None:
 def check_qpos(model: Any, qpos: ArrayLike, name: str = "qpos") -> FloatArray:
     """Return ``qpos`` as model.nq finite numbers ([m], [-] quaternions, [rad]), or raise."""
     check_model(model)
+    require_type("name", name, str)
     return finite_vector(name, qpos, int(model.nq), bound=MAX_MAGNITUDE)
 
 

@@ -143,6 +143,8 @@ class WholeBodyController(Controller):
         self.capture_point, self.cmp_target, self.returning = np.zeros(2), np.zeros(2), False
         if not isinstance(stepping, bool):
             raise InvalidParameterError(f"stepping must be a bool, got {stepping!r}")
+        if params is not None and not isinstance(params, BodyParams):
+            raise InvalidParameterError(f"params must be a BodyParams, got {type(params).__name__}")
         params = hip if params is None else params
         if stepping and (not isinstance(params, BodyParams) or len(feet) != 2):
             raise InvalidParameterError("stepping needs params (a BodyParams) and two feet")

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pushrecovery.arguments import require_type
+from pushrecovery.arguments import flag, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
@@ -247,6 +247,7 @@ def capture_plane_figure(
     Figure
         Save it with :func:`~pushrecovery.plots.common.save_figure` or ``fig.savefig``.
     """
+    require_type("title", title, (str, type(None)))
     support = Support.from_params(params) if support is None else support
     (prepared,) = _prepare(params, [support], speeds, headings)
     fig = _new_figure(12.5, 5.4)
@@ -264,7 +265,7 @@ def capture_plane_figure(
     close.set_title("close to the feet (dotted frame on the left)", fontsize=9)
     side.axis("off")
     side.legend(handles=_legend_handles(close), loc="upper center", fontsize=8, frameon=False)
-    if thresholds:
+    if flag("thresholds", thresholds):
         _thresholds_box(side, threshold_lines(params, support), 0.5, 0.02, "bottom")
     fig.suptitle(title or f"{_title(support)}\n{_SUPTITLE}", fontsize=10)
     return fig
@@ -331,7 +332,7 @@ def capture_plane_panels(
             for ax in (whole, close):
                 ax.set_ylabel("")
                 ax.tick_params(labelleft=False)
-        if thresholds:
+        if flag("thresholds", thresholds):
             _thresholds_box(whole, threshold_lines(params, support), 0.5, -0.13, "top")
     # The same limits row by row (not shared axes: equal aspect adjusts each one's limits).
     whole_box, near_box = _union(extents), _union(nears)

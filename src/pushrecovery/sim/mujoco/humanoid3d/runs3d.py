@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import bounded_float, require_type
+from pushrecovery.arguments import bounded_float, flag, require_type
 from pushrecovery.control.base import Command
 from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
@@ -323,7 +323,7 @@ def critical_push3d(
     require_type("plant", plant, Humanoid3DPlant)
     tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
     Push3D(0.0, azimuth, body)  # checks azimuth and body
-    stepping = bool(stepping)
+    stepping = flag("stepping", stepping)
     wbc_for(plant, hip=hip, stepping=stepping)  # checks hip before any run
     slips: dict[float, float] = {}
 
