@@ -226,7 +226,7 @@ def test_swing_foot_contacts_in_the_qp(model):
     [
         ({"stepping": True}, "stepping"),
         ({"stepping": "yes"}, "stepping"),
-        ({"stepping": True, "params": "body"}, "stepping"),
+        ({"stepping": True, "params": "body"}, "params must be a BodyParams"),
         ({"step_settings": 0.2}, "step_settings"),
     ],
 )

@@ -233,6 +233,8 @@ def main() -> int:
             )
             if case.expect is not None and not found and not keeps_good_trials(folder, case.expect):
                 found.append("lost")
+            if case.invalid and not found and answer.get("code") == 0:
+                found.append("accepted")  # e.g. --duration nan ran
             if status != "answer":
                 worker.close()
                 worker = Worker(log)

@@ -97,18 +97,23 @@ INVALID_BODY = [
     ["--leg-length", "1e300"], ["--max-steps", "0.5"], ["--heel", "0.3"],
 ]  # fmt: skip
 SKIP = {"--help", "--version"}
+#: Number texts click reads as NaN or an infinity: no option of a number takes one.
+NONFINITE = {"nan", "inf"}
 
 
 @dataclass(frozen=True)
 class Case:
     """One command line, and what it exercises (the input class of the summary).
 
-    ``expect``: for a folder of trials, how many good ones the batch must keep.
+    ``expect``: for a folder of trials, how many good ones the batch must keep. ``invalid``:
+    the options given a value no documented input can be (NaN or an infinity for a number):
+    the command must refuse it (exit 2), not end well.
     """
 
     kind: str
     args: list[str]
     expect: int | None = None
+    invalid: tuple[str, ...] = ()
 
 
 def _commands() -> dict[str, click.Command]:
@@ -149,19 +154,24 @@ def command_case(rng: random.Random, folder: Path) -> Case:
     command = commands[name]
     args = name.split()
     params = [p for p in command.params if isinstance(p, click.Option) and p.opts[0] not in SKIP]
+    invalid: list[str] = []
     for param in rng.sample(params, k=min(len(params), rng.choice([0, 1, 2, 3, 4, 6]))):
         option = max(param.opts, key=len)
         if param.is_flag:
             args.append(option)
             continue
-        args += [option, *_value(rng, param, option, folder)]
+        values = _value(rng, param, option, folder)
+        args += [option, *values]
+        number = isinstance(param.type, click.types.FloatParamType) and option not in STRINGS
+        if number and any(v.lower().lstrip("+-") in NONFINITE for v in values):
+            invalid.append(option)
     if name in ("analyze", "campaign", "humanoid campaign"):
         args += ["--out", str(folder / "out")]
     if name == "analyze":
         args.insert(1, rng.choice(["missing.c3d", str(folder), "/dev/null"]))
     if name in HEAVY or "mujoco" in args:
         args += rng.choice(INVALID_BODY)
-    return Case(f"cli:{name}", args)
+    return Case(f"cli:{name}", args, invalid=tuple(invalid))
 
 
 # --- files ------------------------------------------------------------------------------------
