@@ -181,6 +181,10 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         "cop_margin": 0.0, "push_duration": 0.01
     },
     "pushrecovery.sim.critical.find_critical_velocity": {"direction": "forward"},
+    "pushrecovery.sim.critical.bisect_critical": {  # a body that stands below 5 N s
+        "stands": lambda impulse: (impulse < 5.0, "ankle"), "low": 0.0, "high": 10.0,
+        "tolerance": 0.1,
+    },
     "pushrecovery.sim.physical_checks.joint_group": {"name": "left_knee_joint"},
     "pushrecovery.sim.result.judge": {"outcome": Outcome.RECOVERED, "checks": None},
     # Probabilities of uncertain states (issue 37).

@@ -18,10 +18,10 @@ import pytest
 from pushrecovery.control.wbc.bodies import body_id, body_names, check_data, check_qpos
 from pushrecovery.errors import InputFileError, InvalidParameterError, ParameterTypeError
 from pushrecovery.presets import load_params
+from pushrecovery.sim.critical import bisect_critical
 from pushrecovery.sim.mujoco.contact_audit import ContactAudit
 from pushrecovery.sim.mujoco.humanoid3d.mjcf import load_mjcf
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, Humanoid3DPlant
-from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical
 from pushrecovery.sim.mujoco.lab import LabRecorder, plate_areas
 from pushrecovery.sim.mujoco.pendulums import MujocoFootPlant
 from pushrecovery.sim.mujoco.render.frames import subsample

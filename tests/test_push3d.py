@@ -238,7 +238,7 @@ def test_g1_without_the_robots_extra_is_one_line_and_exit_2(capsys, monkeypatch)
 def test_the_critical_impulse_search_brackets_a_known_threshold():
     # A body that stands below 12.3 N s (ankle below 10, hip above): the search of both
     # critical_push3d (from 0, doubling) and the validation (from a guess, shrinking) finds it.
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical
+    from pushrecovery.sim.critical import bisect_critical
 
     def stands(impulse):
         return impulse < 12.3, "ankle" if impulse < 10.0 else "hip"

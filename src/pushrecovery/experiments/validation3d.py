@@ -124,8 +124,9 @@ def measure_critical_impulse(
     InvalidParameterError
         For a non-positive guess, a tolerance or duration out of range.
     """
+    from pushrecovery.sim.critical import bisect_critical
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import wbc_for
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical, run_push3d
+    from pushrecovery.sim.mujoco.humanoid3d.runs3d import run_push3d
     from pushrecovery.sim.push import IMPULSE_MAX, Push3D
     from pushrecovery.sim.result import Outcome
 

@@ -22,8 +22,9 @@ along ψ. Beside the +y edge of C₁ for a left step of a rectangle foot, ρ = w
 **Measured.** The largest impulse at ψ the body stands (:func:`~.runs3d.run_push3d` at the
 plant's pushed body, its whole-body controller with ``stepping=True``: ankles and steps, no
 hip task, reacting through the push's 10 ms as a robot's would: ``Push3D(...,
-scheduled=True)``) by ``runs3d.bisect_critical``: a run *falls* when it ends in the plant's
-fall set (under a controller that steps: the CoM below 0.7 z₀, ``plant3d``) or the torso
+scheduled=True)``) by :func:`~pushrecovery.sim.critical.bisect_critical`: a run *falls* when
+it ends in the plant's fall set (under a controller that steps: the CoM below 0.7 z₀,
+``plant3d``) or the torso
 tilted more than 1 rad after the push, or ends with ξ more than :data:`FALL_MARGIN` outside
 the support polygon of the feet it stands on then (undecided within ``duration``). Each stood
 run at the measured impulse reports its steps, their longest swing time and its largest
@@ -295,8 +296,8 @@ def measure_step_critical(
     of ``params``), else the biped3d of ``params``. Returns the measured impulse, the
     bracket, the runs made and the run at the measured impulse.
     """
+    from pushrecovery.sim.critical import bisect_critical
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, Humanoid3DPlant
-    from pushrecovery.sim.mujoco.humanoid3d.runs3d import bisect_critical
     from pushrecovery.sim.push import IMPULSE_MAX, Push3D
 
     require_type("params", params, BodyParams)

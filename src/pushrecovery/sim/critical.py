@@ -2,6 +2,9 @@
 
 On the MuJoCo backend the push is a real force at the CoM (an impulse J over 10 ms) and the
 search runs on the equivalent velocity J / m, so that it compares with the surfaces directly.
+:func:`bisect_critical` is the same search on impulses [N s] for any run that says whether
+it stood (the 3-D humanoids' :func:`~pushrecovery.sim.mujoco.humanoid3d.runs3d.critical_push3d`
+and validations).
 """
 
 from __future__ import annotations
@@ -14,14 +17,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, positive_float, require_type
+from pushrecovery.arguments import bounded_float, finite_float, positive_float, require_type
 from pushrecovery.control.base import make_controller
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import Backend
 from pushrecovery.sim.physical_checks import PhysicalChecks
 from pushrecovery.sim.plants import Plant
-from pushrecovery.sim.push import Push, direction_sign
+from pushrecovery.sim.push import IMPULSE_MAX, Push, direction_sign
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.result import Outcome
 from pushrecovery.sim.simulate import simulate
@@ -33,6 +36,7 @@ __all__ = [
     "Bracket",
     "CriticalPush",
     "NotRecoverableError",
+    "bisect_critical",
     "critical_push",
     "find_critical_velocity",
     "predicted_critical_velocity",
@@ -304,3 +308,66 @@ def critical_push(
         found.recovered, (found.recovered, found.failed), found.simulations, predicted,
         checks.get(found.recovered),
     )  # fmt: skip
+
+
+def bisect_critical(
+    stands: Callable[[float], tuple[bool, str]],
+    low: float,
+    high: float,
+    tolerance: float,
+    *,
+    grow: float = 2.0,
+    shrink: float | None = None,
+) -> tuple[float, tuple[float, float], str]:
+    """Bracket and bisect the largest impulse [N s] that ``stands`` (a run: stood?, strategy).
+
+    With ``shrink`` the lower end is run first and multiplied by it until it stands; without,
+    ``low`` is taken to stand (0: no push). The upper end grows by ``grow`` (up to the push's
+    largest impulse) while it stands; then the bracket halves until at most ``tolerance`` [N s]
+    wide. Returns the largest impulse that stood, the bracket and that run's strategy
+    ("ankle" when none stood but the assumed ``low``). Once the lower end is below
+    ``tolerance`` no push (0) is taken to stand, so every loop ends: at most
+    log(high / tolerance) / log(1 / shrink) + log(IMPULSE_MAX / high) / log(grow)
+    + log2(IMPULSE_MAX / tolerance) + 3 runs.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``stands`` is not callable, 0 <= low < high <= IMPULSE_MAX (1e4 N s) fails,
+        ``tolerance`` is not in [1e-6, 1e3] N s, ``grow`` not in [1.05, 100] or ``shrink`` not in
+        (0, 1).
+    """
+    if not callable(stands):
+        raise ParameterTypeError(f"stands must be callable, got {type(stands).__name__}")
+    low = bounded_float("low", low, 0.0, IMPULSE_MAX, "N s")
+    high = bounded_float("high", high, 0.0, IMPULSE_MAX, "N s")
+    if not low < high:
+        raise InvalidParameterError(f"low must be < high, got low={low:g}, high={high:g} N s")
+    tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
+    grow = bounded_float("grow", grow, 1.05, 100.0)
+    strategy = "ankle"
+    if shrink is not None:
+        shrink = bounded_float("shrink", shrink, 1e-9, 1.0 - 1e-9)
+        stood, strategy = stands(low)
+        while not stood:
+            high, low = low, shrink * low
+            if low < tolerance:  # no push stands: the assumed end
+                low, strategy = 0.0, "ankle"
+                break
+            stood, strategy = stands(low)
+    while True:
+        stood, used = stands(high)
+        if not stood:
+            break
+        low, strategy = high, used
+        if high >= IMPULSE_MAX:
+            return low, (low, low), strategy
+        high = min(grow * high, IMPULSE_MAX)
+    while high - low > tolerance:
+        middle = 0.5 * (low + high)
+        stood, used = stands(middle)
+        if stood:
+            low, strategy = middle, used
+        else:
+            high = middle
+    return low, (low, high), strategy

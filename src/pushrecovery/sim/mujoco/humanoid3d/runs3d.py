@@ -13,7 +13,7 @@ push sees); a :class:`WbcTrace` passed to it records the controller's figures ti
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -23,8 +23,9 @@ from pushrecovery.arguments import bounded_float, flag, require_type
 from pushrecovery.control.base import Command
 from pushrecovery.control.wbc.bodies import body_id, sole_points
 from pushrecovery.control.wbc.controller import WholeBodyController
-from pushrecovery.errors import InvalidParameterError, ParameterTypeError
+from pushrecovery.errors import InvalidParameterError
 from pushrecovery.sim.backend import Step
+from pushrecovery.sim.critical import bisect_critical
 from pushrecovery.sim.events import Observer, ScheduledPush
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     CONTROL_PERIOD,
@@ -42,7 +43,6 @@ __all__ = [
     "PUSH_TIME",
     "CriticalPush3D",
     "WbcTrace",
-    "bisect_critical",
     "critical_push3d",
     "pushed_rows",
     "run_push3d",
@@ -336,68 +336,3 @@ def critical_push3d(
 
     low, bracket, strategy = bisect_critical(recovers, 0.0, 0.25 * plant.params.mass, tolerance)
     return CriticalPush3D(low, bracket, len(slips), strategy, slips.get(low, 0.0))
-
-
-def bisect_critical(
-    stands: Callable[[float], tuple[bool, str]],
-    low: float,
-    high: float,
-    tolerance: float,
-    *,
-    grow: float = 2.0,
-    shrink: float | None = None,
-) -> tuple[float, tuple[float, float], str]:
-    """Bracket and bisect the largest impulse [N s] that ``stands`` (a run: stood?, strategy).
-
-    With ``shrink`` the lower end is run first and multiplied by it until it stands; without,
-    ``low`` is taken to stand (0: no push). The upper end grows by ``grow`` (up to the push's
-    largest impulse) while it stands; then the bracket halves until at most ``tolerance`` [N s]
-    wide. Returns the largest impulse that stood, the bracket and that run's strategy
-    ("ankle" when none stood but the assumed ``low``). Once the lower end is below
-    ``tolerance`` no push (0) is taken to stand, so every loop ends: at most
-    log(high / tolerance) / log(1 / shrink) + log(IMPULSE_MAX / high) / log(grow)
-    + log2(IMPULSE_MAX / tolerance) + 3 runs.
-
-    Raises
-    ------
-    InvalidParameterError
-        If ``stands`` is not callable, 0 <= low < high <= IMPULSE_MAX (1e4 N s) fails,
-        ``tolerance`` is not in [1e-6, 1e3] N s, ``grow`` not in [1.05, 100] or ``shrink`` not in
-        (0, 1).
-    """
-    from pushrecovery.sim.push import IMPULSE_MAX
-
-    if not callable(stands):
-        raise ParameterTypeError(f"stands must be callable, got {type(stands).__name__}")
-    low = bounded_float("low", low, 0.0, IMPULSE_MAX, "N s")
-    high = bounded_float("high", high, 0.0, IMPULSE_MAX, "N s")
-    if not low < high:
-        raise InvalidParameterError(f"low must be < high, got low={low:g}, high={high:g} N s")
-    tolerance = bounded_float("tolerance", tolerance, 1e-6, 1e3, "N s")
-    grow = bounded_float("grow", grow, 1.05, 100.0)
-    strategy = "ankle"
-    if shrink is not None:
-        shrink = bounded_float("shrink", shrink, 1e-9, 1.0 - 1e-9)
-        stood, strategy = stands(low)
-        while not stood:
-            high, low = low, shrink * low
-            if low < tolerance:  # no push stands: the assumed end
-                low, strategy = 0.0, "ankle"
-                break
-            stood, strategy = stands(low)
-    while True:
-        stood, used = stands(high)
-        if not stood:
-            break
-        low, strategy = high, used
-        if high >= IMPULSE_MAX:
-            return low, (low, low), strategy
-        high = min(grow * high, IMPULSE_MAX)
-    while high - low > tolerance:
-        middle = 0.5 * (low + high)
-        stood, used = stands(middle)
-        if stood:
-            low, strategy = middle, used
-        else:
-            high = middle
-    return low, (low, high), strategy
