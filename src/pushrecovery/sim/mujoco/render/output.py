@@ -69,10 +69,13 @@ def _draw_legend(
         x += int(draw.textlength(name, font=font)) + 12
 
 
-def _check_images(
+def _checked_inputs(
     images: Sequence[NDArray[np.uint8]], times: Sequence[float], legend: object
 ) -> NDArray[np.float64]:
-    """Return the images' times [s], or raise: RGB uint8 images of one shape, a time each."""
+    """Return the images' times [s] after checking images, times and legend, or raise.
+
+    Images: uint8 RGB arrays of one shape, a time each; the legend: (name, RGBA) entries.
+    """
     if isinstance(images, str | bytes) or not (
         isinstance(images, Sequence) or (isinstance(images, np.ndarray) and images.ndim == 4)
     ):
@@ -152,7 +155,7 @@ def write_filmstrip(
     """
     from PIL import Image, ImageDraw
 
-    times = list(_check_images(images, times, legend))
+    times = list(_checked_inputs(images, times, legend))
     path = input_path("path", path)
     require_type("title", title, (str, type(None)))
     h, w = np.shape(images[0])[:2]
@@ -201,7 +204,7 @@ def write_animation(
     """
     from PIL import Image, ImageDraw
 
-    t = _check_images(images, times, legend)
+    t = _checked_inputs(images, times, legend)
     path = input_path("path", path)
     if np.any(np.diff(t) < 0.0):
         raise InvalidParameterError("times must be non-decreasing")
