@@ -91,7 +91,8 @@ class Push:
             raise InvalidParameterError(
                 f"push kind must be 'force' or 'velocity', got {str(self.kind)[:40]!r}"
             )
-        if self.duration is not PUSH_DURATION:  # the default needs no check (pushes are many)
+        # The default needs no check (pushes are many); anything else, an array too, is checked.
+        if type(self.duration) is not float or self.duration != PUSH_DURATION:
             object.__setattr__(self, "duration", positive_float("duration", self.duration, "s"))
         if self.body is not None:
             _check_body(self.body)

@@ -125,9 +125,9 @@ def _plane_codes(
     the states beyond the hip region only, on their step lines.
     """
     support = Support.from_params(params) if support is None else support
-    zero = 0.0  # y and ydot not given: on the x axis, at rest sideways
-    given = {"x": x, "y": zero if y is None else y, "xdot": xdot,
-             "ydot": zero if ydot is None else ydot}  # fmt: skip
+    # y and ydot not given: on the x axis, at rest sideways.
+    given = {"x": x, "y": 0.0 if y is None else y, "xdot": xdot,
+             "ydot": 0.0 if ydot is None else ydot}  # fmt: skip
     inputs = [float_array(n, a) for n, a in given.items()]
     try:
         shape = np.broadcast_shapes(*(a.shape for a in inputs))

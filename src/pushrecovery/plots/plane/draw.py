@@ -248,6 +248,7 @@ def capture_plane_figure(
         Save it with :func:`~pushrecovery.plots.common.save_figure` or ``fig.savefig``.
     """
     require_type("title", title, (str, type(None)))
+    thresholds = flag("thresholds", thresholds)
     support = Support.from_params(params) if support is None else support
     (prepared,) = _prepare(params, [support], speeds, headings)
     fig = _new_figure(12.5, 5.4)
@@ -265,7 +266,7 @@ def capture_plane_figure(
     close.set_title("close to the feet (dotted frame on the left)", fontsize=9)
     side.axis("off")
     side.legend(handles=_legend_handles(close), loc="upper center", fontsize=8, frameon=False)
-    if flag("thresholds", thresholds):
+    if thresholds:
         _thresholds_box(side, threshold_lines(params, support), 0.5, 0.02, "bottom")
     fig.suptitle(title or f"{_title(support)}\n{_SUPTITLE}", fontsize=10)
     return fig
@@ -304,6 +305,7 @@ def capture_plane_panels(
         The panels, sharing axes row by row.
     """
     require_type("params", params, BodyParams)
+    thresholds = flag("thresholds", thresholds)
     if supports is not None and (not isinstance(supports, list | tuple) or not supports):
         raise InvalidParameterError("supports must be a list of at least one Support")
     for support in supports or ():
@@ -332,7 +334,7 @@ def capture_plane_panels(
             for ax in (whole, close):
                 ax.set_ylabel("")
                 ax.tick_params(labelleft=False)
-        if flag("thresholds", thresholds):
+        if thresholds:
             _thresholds_box(whole, threshold_lines(params, support), 0.5, -0.13, "top")
     # The same limits row by row (not shared axes: equal aspect adjusts each one's limits).
     whole_box, near_box = _union(extents), _union(nears)
