@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.arguments import bounded_float, positive_float
+from pushrecovery.kernels import contact_audit as kernel
 from pushrecovery.kernels.contact_audit import audit_step
 from pushrecovery.sim.physical_checks import (
     DEFAULT_SLIP_LIMIT,
@@ -83,38 +84,35 @@ class ContactAudit:
         self.feet = body_names(model, feet, "feet")
         qpos = check_qpos(model, qpos)
         foot_ids = [model.body(name).id for name in self.feet]
-        self._foot_ids = np.array(foot_ids, dtype=np.int64)
         pose = mujoco.MjData(model)
         pose.qpos[:] = qpos
         mujoco.mj_kinematics(model, pose)
         # Each foot's sole points in its body frame, R^T (c - o) in the standing pose, padded
-        # to the most points of a foot.
+        # to the most points of a foot (the kernel's layouts: kernels.contact_audit).
         soles = [
             (sole_points(model, pose, body) - pose.xpos[body]) @ pose.xmat[body].reshape(3, 3)
             for body in foot_ids
         ]
         most = max(len(sole) for sole in soles)
-        self._soles = np.zeros((len(soles), most, 3))
-        for index, sole in enumerate(soles):
-            self._soles[index, : len(sole)] = sole
-        self._sole_counts = np.array([len(sole) for sole in soles], dtype=np.int64)
-        self._slip = np.zeros((len(soles), most, 2))
-        self._pending = np.zeros((len(soles), most, 2))
-        self._cop = np.zeros((len(soles), 2))
-        self._unloaded = np.zeros(len(soles), dtype=np.int64)
-        self._loads, self._moments = np.zeros(len(soles)), np.zeros((len(soles), 2))
-        # Each geom's foot (index into feet) or -1; floor geoms are the world body's.
-        owner = np.full(model.nbody, -1, dtype=np.intp)
+        self._soles = np.zeros((len(soles), most, 7))
+        self._feet_int = np.zeros((len(soles), 4), dtype=np.int64)
+        for index, (sole, body) in enumerate(zip(soles, foot_ids, strict=True)):
+            self._soles[index, : len(sole), kernel.SOLE : kernel.SOLE + 3] = sole
+            self._feet_int[index, [kernel.BODY, kernel.ROOT, kernel.POINTS]] = (
+                body, model.body_rootid[body], len(sole),
+            )  # fmt: skip
+        self._feet_float = np.zeros((len(soles), 5))
+        # Each geom's foot (index into feet), NO_FOOT, or FLOOR (the world body's geoms).
+        owner = np.full(model.nbody, kernel.NO_FOOT, dtype=np.int64)
         for index, body in enumerate(foot_ids):
             owner[body] = index
         for body in range(1, model.nbody):  # parents come before children
             if owner[body] < 0:
                 owner[body] = owner[model.body_parentid[body]]
-        bodies = np.asarray(model.geom_bodyid)
-        self._geom_foot = np.ascontiguousarray(owner[bodies], dtype=np.int64)
-        self._floor = np.ascontiguousarray(bodies == 0)
-        self._limits = _torque_limits(model)
-        self._torque_use = np.zeros(model.nu)
+        owner[0] = kernel.FLOOR
+        self._geom_class = np.ascontiguousarray(owner[np.asarray(model.geom_bodyid)])
+        self._actuators = np.zeros((model.nu, 2))  # each one's limit and torque use
+        self._actuators[:, 0] = _torque_limits(model)
         groups = [joint_group(model.actuator(i).name) for i in range(model.nu)]
         order = [group for group, _ in JOINT_GROUPS] + ["other"]
         self._groups = [
@@ -122,37 +120,35 @@ class ContactAudit:
             for group in order
             if group in groups
         ]
-        self._limit_type = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
-        self._pyramidal = int(model.opt.cone) == int(mujoco.mjtCone.mjCONE_PYRAMIDAL)
-        self._roots = np.asarray(model.body_rootid, dtype=np.int64)
-        self._h = float(model.opt.timestep)
-        self._light = 1e-3 * LOAD_FRACTION * self.weight
-        self._threshold = LOAD_FRACTION * self.weight
         self._lift_steps = max(1, round(LIFT_TIME / float(model.opt.timestep)))
+        settings = np.zeros(6)
+        settings[kernel.PYRAMIDAL] = int(model.opt.cone) == int(mujoco.mjtCone.mjCONE_PYRAMIDAL)
+        settings[kernel.LIGHT] = 1e-3 * LOAD_FRACTION * self.weight
+        settings[kernel.THRESHOLD] = LOAD_FRACTION * self.weight
+        settings[kernel.LIFT_STEPS] = self._lift_steps
+        settings[kernel.STEP] = float(model.opt.timestep)
+        settings[kernel.LIMIT_TYPE] = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
+        self._totals = np.zeros(7)
         self.reset()
         # The kernel's arguments after the step's contacts and constraints: MuJoCo's arrays of
         # fixed size (views of ``data``'s arena, valid while it lives) and the audit's state.
         self._kernel_arguments = (
-            data.xpos, data.xmat, data.cvel, data.subtree_com, data.actuator_force,
-            self._pyramidal, self._floor, self._geom_foot, self._light, self._threshold,
-            self._lift_steps, self._h, self._foot_ids, self._roots, self._soles,
-            self._sole_counts, self._slip, self._pending, self._unloaded, self._cop,
-            self._loads, self._moments, self._limits, self._torque_use, self._limit_type,
+            data.xpos, data.xmat, data.cvel, data.subtree_com, data.actuator_force, settings,
+            self._geom_class, self._feet_int, self._feet_float, self._soles, self._actuators,
+            self._totals,
         )  # fmt: skip
 
     def reset(self) -> None:
         """Start a new run's audit."""
         # The current stance interval's travel of each sole point, and a bounce's (pending).
-        self._slip[:] = 0.0
-        self._pending[:] = 0.0
-        self._cop[:] = 0.0  # each foot's last CoP (world xy) [m]
+        self._soles[:, :, kernel.SLIP :] = 0.0
+        self._feet_float[:] = 0.0  # each foot's load, moments and last CoP (world xy) [m]
         # Physics steps each foot has carried less than the load threshold (a new interval
         # starts at the next load only after LIFT_TIME of them: a bounce is not a step).
-        self._unloaded[:] = self._lift_steps
-        self.foot_slip, self.slip_foot = 0.0, ""
-        self.peak_ground_force = self.max_penetration = self.friction_use = 0.0
-        self._torque_use[:] = 0.0
-        self.joint_limit_steps = self.physics_steps = 0
+        self._feet_int[:, kernel.UNLOADED] = self._lift_steps
+        self._actuators[:, 1] = 0.0
+        self._totals[:] = 0.0
+        self._totals[kernel.MOVED_FOOT] = -1.0
 
     def after_step(self) -> None:
         """Audit the physics step MuJoCo just took (its contacts, forces and velocities).
@@ -162,35 +158,27 @@ class ContactAudit:
         """
         data = self.data
         contact = data.contact
-        total, depth, use, moved, foot, on_limit = audit_step(
+        audit_step(
             contact.geom, contact.dist, contact.frame, contact.pos, contact.friction,
-            contact.efc_address, contact.dim, data.efc_force, data.efc_type, data.nefc,
+            contact.efc_address, contact.dim, data.efc_force, data.efc_type,
             *self._kernel_arguments,
         )  # fmt: skip
-        if total > self.peak_ground_force:
-            self.peak_ground_force = total
-        if depth > self.max_penetration:
-            self.max_penetration = depth
-        if use > self.friction_use:
-            self.friction_use = use
-        if moved > self.foot_slip:
-            self.foot_slip, self.slip_foot = moved, self.feet[foot]
-        self.joint_limit_steps += on_limit
-        self.physics_steps += 1
 
     def result(self) -> PhysicalChecks:
         """Return the checks of the run so far."""
-        use = self._torque_use
+        totals, use = self._totals, self._actuators[:, 1]
+        foot = int(totals[kernel.MOVED_FOOT])
+        peak = float(totals[kernel.PEAK])
         return PhysicalChecks(
-            foot_slip=float(self.foot_slip),
-            slip_foot=self.slip_foot,
-            peak_ground_force=float(self.peak_ground_force),
-            peak_force_ratio=float(self.peak_ground_force) / self.weight,
-            max_penetration=float(self.max_penetration),
-            friction_use=float(self.friction_use),
+            foot_slip=float(totals[kernel.MOVED]),
+            slip_foot=self.feet[foot] if foot >= 0 else "",
+            peak_ground_force=peak,
+            peak_force_ratio=peak / self.weight,
+            max_penetration=float(totals[kernel.DEPTH]),
+            friction_use=float(totals[kernel.USE]),
             torque_use=tuple((group, float(use[index].max())) for group, index in self._groups),
-            joint_limit_steps=self.joint_limit_steps,
-            physics_steps=self.physics_steps,
+            joint_limit_steps=int(totals[kernel.LIMIT_STEPS]),
+            physics_steps=int(totals[kernel.STEPS]),
             slip_limit=self.slip_limit,
         )
 
