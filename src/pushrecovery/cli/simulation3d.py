@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from pushrecovery.params import BodyParams
     from pushrecovery.sim.mujoco.humanoid3d.plant3d import Humanoid3DPlant
     from pushrecovery.sim.result import SimulationResult
 
@@ -134,7 +135,7 @@ def _render_3d(
 
 def simulate_3d(
     model: str,
-    params: Any,
+    params: BodyParams,
     impulse: float | None,
     azimuth: float | None,
     duration: float,
@@ -142,7 +143,7 @@ def simulate_3d(
     pictures: dict[str, Any] | None = None,
     stepping: bool = False,
     slip_limit: float = 0.01,
-    plant: Any = None,
+    plant: Humanoid3DPlant | None = None,
 ) -> dict[str, Any]:
     """Push a 3-D model at ``azimuth`` and run the whole-body controller (the JSON).
 
@@ -250,12 +251,12 @@ def simulate_3d(
 
 def critical_3d(
     model: str,
-    params: Any,
+    params: BodyParams,
     azimuth: float | None,
     tolerance: float,
     duration: float,
     strategy: str | None = None,
-    plant: Any = None,
+    plant: Humanoid3DPlant | None = None,
 ) -> dict[str, Any]:
     """Bisect the impulse at ``azimuth`` on a 3-D model against the predictions (the JSON).
 

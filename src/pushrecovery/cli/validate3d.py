@@ -16,9 +16,13 @@ import itertools
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
+
+if TYPE_CHECKING:
+    from pushrecovery.params import BodyParams
+    from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant
 
 __all__ = ["QUICK", "Validate3DOptions", "validate_3d"]
 
@@ -69,7 +73,9 @@ def fraction_list(text: str | None, default: tuple[float, ...]) -> tuple[float, 
     return values
 
 
-def validate_3d(options: Validate3DOptions, params: Any, plant: Any = None) -> dict[str, Any]:
+def validate_3d(
+    options: Validate3DOptions, params: BodyParams, plant: MjcfPlant | None = None
+) -> dict[str, Any]:
     """Run the 3-D validation and confusion matrix; write them under ``options.out``; JSON.
 
     ``plant``: an MJCF file's plant (its tables are named after the file's stem); default the
@@ -177,7 +183,9 @@ def _write_csv(result: Any, path: Path) -> None:
             writer.writerow({**row, "fell": fell})
 
 
-def _confusion(options: Validate3DOptions, params: Any, plant: Any = None) -> dict[str, Any]:
+def _confusion(
+    options: Validate3DOptions, params: BodyParams, plant: MjcfPlant | None = None
+) -> dict[str, Any]:
     """Run the confusion campaigns (resumable) and write the matrix; return its JSON.
 
     ``plant``: an MJCF file's plant, whose source the campaigns' workers build.
