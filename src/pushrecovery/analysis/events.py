@@ -12,6 +12,9 @@ definitions, the sources, the defaults' reasons and the numbers on real jump fil
 * Quiet: windows loaded throughout whose vertical CoM acceleration a_z = F_z/m − g has an SD
   ≤ ``max_acceleration`` and a mean within it of the still windows' median; the mass is their
   mean force over g.
+
+Over 400 lines on purpose: the events of a trial are read from the same plate signals, with
+the same baseline and run-length helpers.
 """
 
 from __future__ import annotations

@@ -4,6 +4,9 @@ Columns of ``trials.parquet`` (:class:`TrialRow`; SI units, axes ap and ml as in
 :mod:`pushrecovery.analysis.recording`); the events are in
 :mod:`pushrecovery.campaign.trial_events`. These tables are contracts: columns are added,
 never renamed or dropped.
+
+Over 400 lines on purpose: :class:`TrialRow` is the batch table's schema, one documented
+field per column, and the functions that fill it, fail it and sum it up read those fields.
 """
 
 from __future__ import annotations

@@ -11,6 +11,9 @@ and axis; a trial that could not be read or analysed is a ``failed`` row), ``OUT
 twins and
 ``OUT/summary.json``. Only the project's own errors make a ``failed`` row: anything else is a
 bug and stops the batch. docs/analysis.md, "Many trials", has the details.
+
+Over 400 lines on purpose: finding, running and joining the trials of a batch share the job,
+its result and the resumable state on disk; local processes and Dask run the same jobs.
 """
 
 from __future__ import annotations

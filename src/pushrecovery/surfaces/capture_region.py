@@ -8,6 +8,9 @@ foothold: for a landing at time t (T = e^{ωt}) followed by N − 1 further step
 intersected with the reach; for a touchdown at any time from t on, the union
 Q_{T_0} ⊕ cone(A), A = ξ_0 ⊕ (−H) ⊕ (−S). docs/steps.md, "Footholds: the capture region of a
 step (S3)", derives both and the recommended foothold (the region's Chebyshev centre).
+
+Over 400 lines on purpose: the region, its recommended foothold and the step terms they are
+built from are one construction (the Minkowski terms of a step), kept together.
 """
 
 from __future__ import annotations

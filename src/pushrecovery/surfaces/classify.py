@@ -8,6 +8,9 @@ Vocabulary (stable, part of the JSON contract), escalating as the paper proposes
 On the ground plane (:func:`classify` with ``y``, ``ydot`` or a ``support``) the ankle and hip
 regions are the support polygon and the CMP region of :mod:`pushrecovery.surfaces.plane` and
 the step regions are polygons; on the line, intervals (``docs/steps.md``).
+
+Over 400 lines on purpose: one decision (the strategy a state needs) on the line and on the
+plane, with the plans, impacts and ranges a verdict builds only when asked.
 """
 
 from __future__ import annotations

@@ -17,6 +17,9 @@ axis are independent, an outer bound otherwise; docs/plane.md, "The CMP (hip) re
 derivation"). From a moving upper body each axis's interval is [−Δ⁻, Δ⁺] instead
 (:func:`cmp_polygon_from`, errata E19). Margins are signed Euclidean distances of ξ to a
 region, positive inside.
+
+Over 400 lines on purpose: the closed forms of the ground plane share the capture point and
+the CoP and CMP polygons, from the margins of a state to the one-step threshold of a direction.
 """
 
 from __future__ import annotations

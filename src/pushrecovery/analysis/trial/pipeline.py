@@ -1,4 +1,8 @@
-"""The analysis of one measured trial: signals, the CoM, margins and strategies per frame."""
+"""The analysis of one measured trial: signals, the CoM, margins and strategies per frame.
+
+Over 400 lines on purpose: :func:`analyze` is the sequence of one trial's stages, kept in one
+place so that each stage's inputs and outputs can be read in order.
+"""
 
 from __future__ import annotations
 
