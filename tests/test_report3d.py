@@ -110,8 +110,7 @@ def test_a_report_on_an_mjcf_robot_validates_and_films_it(
     # of the biped3d: its table and filmstrip are named after the file, its body is the file's.
     pytest.importorskip("mujoco")
     from pushrecovery.sim.mjcf_source import MjcfSource
-    from pushrecovery.sim.mujoco.humanoid3d.biped3d import build_biped3d
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos
+    from pushrecovery.sim.mujoco.humanoid3d.biped3d import bent_knee_qpos, build_biped3d
 
     spec = build_biped3d(load_params())
     spec.add_key(name="bent", qpos=list(bent_knee_qpos(spec.compile())))

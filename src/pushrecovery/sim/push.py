@@ -17,6 +17,7 @@ __all__ = [
     "AZIMUTH_MAX",
     "IMPULSE_MAX",
     "PUSH_DURATION",
+    "PUSH_TIME",
     "Direction",
     "Push",
     "Push3D",
@@ -30,6 +31,9 @@ AZIMUTH_MAX = 360.0
 IMPULSE_MAX = 1e4
 #: Default duration of a force push [s].
 PUSH_DURATION = 0.01
+#: When a 3-D run pushes, after quiet standing, unless told [s]
+#: (:func:`~pushrecovery.sim.mujoco.humanoid3d.runs3d.run_push3d`, the 3-D campaigns).
+PUSH_TIME = 0.1
 
 #: A push direction along x: ``"forward"`` or ``"backward"``.
 Direction = str

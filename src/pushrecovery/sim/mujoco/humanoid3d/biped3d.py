@@ -44,18 +44,23 @@ import math
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pushrecovery.arguments import require_type
+from pushrecovery.control.wbc.bodies import body_id, check_model
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
+from pushrecovery.sim.mujoco.humanoid3d.measure import standing_qpos
 from pushrecovery.sim.mujoco.models import ANKLE_HEIGHT, FOOT_HALF_THICKNESS, model_spec
 
 __all__ = [
     "JOINTS",
+    "KNEE_BEND",
     "SEGMENT_COM",
     "SEGMENT_FRACTIONS",
     "SIDES",
     "TIMESTEP",
+    "bent_knee_qpos",
     "biped3d_model",
     "build_biped3d",
     "joint_ranges",
@@ -65,6 +70,7 @@ __all__ = [
 
 #: Leg names; +y is left.
 SIDES = ("left", "right")
+KNEE_BEND = 0.3  #: Knee flexion of the standing posture [rad] (:func:`bent_knee_qpos`).
 #: One leg's joints from the hip down (each ``<side>_<joint>``), the order of the motors.
 JOINTS = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
 #: Segment mass over body mass (Winter, *Biomechanics and Motor Control of Human Movement*,
@@ -372,3 +378,23 @@ def build_biped3d(params: BodyParams) -> Any:
 def biped3d_model(params: BodyParams) -> Any:
     """Return the compiled ``mujoco.MjModel`` of :func:`build_biped3d`."""
     return build_biped3d(params).compile()
+
+
+def bent_knee_qpos(model: Any, knee: float = KNEE_BEND) -> NDArray[np.float64]:
+    """Return the standing posture, knees bent ``knee`` [rad] (not on their stops), soles on z = 0.
+
+    Hip pitch −knee/2, knee +knee, ankle pitch −knee/2: each foot flat and under its hip.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``knee`` is not in [0, 1] rad.
+    """
+    check_model(model)
+    if not (isinstance(knee, int | float) and 0.0 <= knee <= 1.0):
+        raise InvalidParameterError(f"knee must be in [0, 1] rad, got {knee!r}")
+    qpos = np.array(model.key("stand").qpos, dtype=float)
+    for side in SIDES:
+        for joint, angle in (("hip_pitch", -0.5), ("knee", 1.0), ("ankle_pitch", -0.5)):
+            qpos[model.jnt_qposadr[model.joint(f"{side}_{joint}").id]] = angle * knee
+    return standing_qpos(model, qpos, [body_id(model, f"{side}_foot") for side in SIDES])

@@ -1,8 +1,9 @@
 r"""The 3-D humanoids as plants: the backend contract where it fits, a 3-D push, the WBC's loop.
 
-:class:`Biped3DPlant` (``biped3d``, the biped of :mod:`.biped3d` with its knees bent as in
-:mod:`.wbc_push`) and :class:`G1Plant` (``g1``, the Unitree G1 of the ``robots`` extra) keep
-their state in MuJoCo and report the contract's (docs/architecture.md) where it is 3-D:
+:class:`Biped3DPlant` (``biped3d``, the biped of :mod:`.biped3d` with its knees bent,
+:func:`~.biped3d.bent_knee_qpos`) and :class:`G1Plant` (``g1``, the Unitree G1 of the
+``robots`` extra) keep their state in MuJoCo and report the contract's
+(docs/architecture.md) where it is 3-D:
 
 * **State** (:data:`STATE_LABELS`): the whole-body CoM ``x, y, z`` [m] and its velocity
   ``xdot, ydot, zdot`` [m/s], world frame (x forward, y left, z up, the floor at 0):
@@ -85,10 +86,9 @@ from pushrecovery.ground.polygon import ConvexPolygon, convex_hull
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import RunRows, Step
 from pushrecovery.sim.mujoco.contact_audit import ContactAudit
-from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, biped3d_model
-from pushrecovery.sim.mujoco.humanoid3d.wbc_push import PUSH_DURATION, bent_knee_qpos
+from pushrecovery.sim.mujoco.humanoid3d.biped3d import SIDES, bent_knee_qpos, biped3d_model
 from pushrecovery.sim.physical_checks import PhysicalChecks
-from pushrecovery.sim.push import Push, Push3D
+from pushrecovery.sim.push import PUSH_DURATION, Push, Push3D
 
 FloatArray = NDArray[np.float64]
 
@@ -507,7 +507,7 @@ class Humanoid3DPlant:
 
 
 class Biped3DPlant(Humanoid3DPlant):
-    """The biped3d of ``params`` standing with its knees bent 0.3 rad (:mod:`.wbc_push`)."""
+    """The biped3d of ``params``, its knees bent 0.3 rad (:func:`~.biped3d.bent_knee_qpos`)."""
 
     name: ClassVar[str] = "biped3d"
 
@@ -529,7 +529,7 @@ class G1Plant(Humanoid3DPlant):
 
     Its body is the robot's: ``params`` must be ``robot_params("g1")`` (the CLI passes it).
     A push named ``"torso"`` acts on ``torso_link``, which the WBC also holds upright (the
-    feet and torso of :mod:`.wbc_g1`).
+    feet and torso of :mod:`.g1`).
 
     Raises
     ------
@@ -546,8 +546,8 @@ class G1Plant(Humanoid3DPlant):
     hip_task: ClassVar[bool] = False
 
     def __init__(self, params: BodyParams) -> None:
+        from pushrecovery.sim.mujoco.humanoid3d.g1 import G1_FEET, G1_TORSO
         from pushrecovery.sim.mujoco.humanoid3d.robots import describe_robot
-        from pushrecovery.sim.mujoco.humanoid3d.wbc_g1 import G1_FEET, G1_TORSO
 
         require_type("params", params, BodyParams)
         described = describe_robot("g1")

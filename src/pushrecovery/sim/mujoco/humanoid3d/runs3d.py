@@ -33,7 +33,7 @@ from pushrecovery.sim.mujoco.humanoid3d.plant3d import (
     wbc_for,
 )
 from pushrecovery.sim.physical_checks import DEFAULT_SLIP_LIMIT
-from pushrecovery.sim.push import Push3D
+from pushrecovery.sim.push import PUSH_TIME, Push3D
 from pushrecovery.sim.result import Outcome, Push3DExtras, SimulationResult
 from pushrecovery.sim.simulate import MAX_DURATION, RestCriterion, simulate
 
@@ -47,10 +47,6 @@ __all__ = [
     "pushed_rows",
     "run_push3d",
 ]
-
-
-#: When :func:`run_push3d` pushes, after quiet standing, unless told [s].
-PUSH_TIME = 0.1
 
 
 def pushed_rows(result: SimulationResult) -> NDArray[np.intp]:
