@@ -12,6 +12,11 @@ import sys
 
 __all__ = ["main"]
 
+#: Commands that answer for one state and exit: run from a command line of their own (``argv``
+#: None), their kernels run as plain Python, which is faster than loading numba
+#: (:mod:`pushrecovery.kernels.jit`).
+ONE_STATE_COMMANDS = frozenset({"classify", "capture-region", "step"})
+
 
 def main(argv: list[str] | None = None) -> None:
     """Run the ``pushrecovery`` command; never shows a traceback for bad input."""
@@ -21,6 +26,10 @@ def main(argv: list[str] | None = None) -> None:
     from pushrecovery.errors import PushRecoveryError
 
     args = sys.argv[1:] if argv is None else argv
+    if argv is None and args[:1] and args[0] in ONE_STATE_COMMANDS:
+        from pushrecovery.kernels.jit import run_as_python
+
+        run_as_python()
     try:
         code = cli.main(args=args, prog_name="pushrecovery", standalone_mode=False)
     except click.exceptions.NoArgsIsHelpError as exc:

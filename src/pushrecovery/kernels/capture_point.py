@@ -9,16 +9,16 @@ from __future__ import annotations
 
 import math
 
-import numba
+from pushrecovery.kernels.jit import njit, prange
 
 __all__ = ["capture_margins"]
 
 
-@numba.njit(parallel=True, cache=True, nogil=True)
+@njit(parallel=True, cache=True, nogil=True)
 def capture_margins(x, xdot, inv_omega, centre, half, out):  # type: ignore[no-untyped-def]
     """Write each state's margin into ``out``; return how many are not finite."""
     bad = 0
-    for i in numba.prange(x.shape[0]):
+    for i in prange(x.shape[0]):
         margin = half - abs(x[i] + xdot[i] * inv_omega - centre)
         out[i] = margin
         if not math.isfinite(margin):

@@ -9,9 +9,7 @@ at every physics step.
 
 from __future__ import annotations
 
-import math
-
-import numba
+from pushrecovery.kernels.jit import hypot, njit
 
 #: ``settings``: the cone is pyramidal (1.0) or elliptic, the light load [N], the load
 #: threshold [N], the lift steps, the physics step h [s] and MuJoCo's joint-limit constraint type.
@@ -31,7 +29,7 @@ PEAK, DEPTH, USE, MOVED, MOVED_FOOT, LIMIT_STEPS, STEPS = range(7)
 FLOOR, NO_FOOT = -2, -1
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def audit_step(  # type: ignore[no-untyped-def]
     geom, dist, frame, pos, friction, address, dim, efc_force, efc_type, xpos, xmat, cvel,
     subtree_com, actuator_force, settings, geom_class, feet_int, feet_float, soles, actuators,
@@ -100,7 +98,7 @@ def audit_step(  # type: ignore[no-untyped-def]
         fz = sign * (normal * frame[i, 2] + tangent1 * frame[i, 5] + tangent2 * frame[i, 8])
         total += fz
         if normal > light and friction[i, 0] > 0.0:
-            ratio = math.hypot(tangent1, tangent2) / (friction[i, 0] * normal)
+            ratio = hypot(tangent1, tangent2) / (friction[i, 0] * normal)
             if ratio > use:
                 use = ratio
         foot = geom_class[geom[i, 1] if first else geom[i, 0]]
@@ -158,7 +156,7 @@ def audit_step(  # type: ignore[no-untyped-def]
             if loaded:
                 soles[foot, j, SLIP] += dx
                 soles[foot, j, SLIP + 1] += dy
-                travel = math.hypot(soles[foot, j, SLIP], soles[foot, j, SLIP + 1])
+                travel = hypot(soles[foot, j, SLIP], soles[foot, j, SLIP + 1])
                 if travel > moved:
                     moved, moved_foot = travel, foot
             else:

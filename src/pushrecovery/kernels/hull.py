@@ -6,15 +6,14 @@ is the hull of its supporting soles' corners.
 
 from __future__ import annotations
 
-import math
-
-import numba
 import numpy as np
+
+from pushrecovery.kernels.jit import hypot, njit
 
 __all__: list[str] = []
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def hull_kernel(points, out, counts, min_edge):  # type: ignore[no-untyped-def]
     """Andrew's monotone chain per frame (as :func:`pushrecovery.ground.convex_hull`).
 
@@ -51,7 +50,7 @@ def hull_kernel(points, out, counts, min_edge):  # type: ignore[no-untyped-def]
         tol = max(min_edge, 1e-12 * scale)
         for i in range(size):
             j = i - 1 if i > 0 else size - 1
-            if math.hypot(chain[i, 0] - chain[j, 0], chain[i, 1] - chain[j, 1]) > tol:
+            if hypot(chain[i, 0] - chain[j, 0], chain[i, 1] - chain[j, 1]) > tol:
                 out[f, kept, 0], out[f, kept, 1] = chain[i, 0], chain[i, 1]
                 kept += 1
         area = 0.0
@@ -65,7 +64,7 @@ def hull_kernel(points, out, counts, min_edge):  # type: ignore[no-untyped-def]
                 out[f, i, 0], out[f, i, 1] = np.nan, np.nan
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _turn(chain, size, px, py):  # type: ignore[no-untyped-def]
     """Return z of (b − a) × (p − b), a, b the chain's last two points: > 0 turning left."""
     ax, ay = chain[size - 2, 0], chain[size - 2, 1]

@@ -12,12 +12,12 @@ R the rotation by ψ: a handful of flops per edge instead of the Minkowski sums.
 
 from __future__ import annotations
 
-import numba
+from pushrecovery.kernels.jit import njit
 
 __all__: list[str] = []
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def place_tables(tables, counts, discs, poses, out, out_discs):  # type: ignore[no-untyped-def]
     """Rotate and move K stances' canonical tables into ``out``, levels interleaved.
 

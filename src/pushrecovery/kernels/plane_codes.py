@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from pushrecovery.kernels.jit import njit, prange
 
 #: Edge tables come padded to one of these row counts when they have no more (repeating a row
 #: changes no maximum or minimum): the loop over edges then has a constant count, unrolls and
@@ -17,7 +18,7 @@ import numpy as np
 EDGE_BLOCKS = (4, 8)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _point_margin(edges, count, px, py):  # type: ignore[no-untyped-def]
     """Signed distance of p to the convex polygon of the first ``count`` rows of ``edges``.
 
@@ -56,7 +57,7 @@ def polygon_margin(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-
 def _margins_loop(count):  # type: ignore[no-untyped-def]
     def margins(x, y, xdot, ydot, inv_omega, edges, out):  # type: ignore[no-untyped-def]
         bad = 0
-        for i in numba.prange(x.shape[0]):
+        for i in prange(x.shape[0]):
             px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
             margin = _point_margin(edges, count if count else edges.shape[0], px, py)
             out[i] = margin
@@ -65,13 +66,13 @@ def _margins_loop(count):  # type: ignore[no-untyped-def]
         return bad
 
     margins.__qualname__ = f"_margins_{count or 'any'}"
-    return numba.njit(parallel=True, cache=True, nogil=True)(margins)
+    return njit(parallel=True, cache=True, nogil=True)(margins)
 
 
 _MARGINS = {count: _margins_loop(count) for count in (0, *EDGE_BLOCKS)}
 
 
-@numba.njit(parallel=True, cache=True, nogil=True)
+@njit(parallel=True, cache=True, nogil=True)
 def sagittal_codes(  # type: ignore[no-untyped-def]
     x, xdot, inv_omega, cop_centre, cop_half, cmp_centre, cmp_half, step_centre, step_half, out
 ):
@@ -82,7 +83,7 @@ def sagittal_codes(  # type: ignore[no-untyped-def]
     Returns the number of non-finite states.
     """
     bad = 0
-    for i in numba.prange(x.shape[0]):
+    for i in prange(x.shape[0]):
         xi = x[i] + xdot[i] * inv_omega
         if cop_half - abs(xi - cop_centre) > 0.0:
             out[i] = 0
@@ -120,7 +121,7 @@ def _codes_loop(count):  # type: ignore[no-untyped-def]
     def codes(x, y, xdot, ydot, inv_omega, cop_edges, cmp_edges, out):  # type: ignore[no-untyped-def]
         beyond = 0
         bad = 0
-        for i in numba.prange(x.shape[0]):
+        for i in prange(x.shape[0]):
             px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega
             cop = _max_excess(cop_edges, count if count else cop_edges.shape[0], px, py)
             hip = _max_excess(cmp_edges, count if count else cmp_edges.shape[0], px, py)
@@ -131,10 +132,10 @@ def _codes_loop(count):  # type: ignore[no-untyped-def]
         return beyond, bad
 
     codes.__qualname__ = f"_codes_{count or 'any'}"
-    return numba.njit(parallel=True, cache=True, nogil=True)(codes)
+    return njit(parallel=True, cache=True, nogil=True)(codes)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _max_excess(edges, count, px, py):  # type: ignore[no-untyped-def]
     """max_i(n_i · p − b_i) over the first ``count`` rows of ``edges``."""
     excess = -np.inf
@@ -159,7 +160,7 @@ def padded_edges(table, smallest=0):  # type: ignore[no-untyped-def]
     return np.ascontiguousarray(np.vstack([rows, np.repeat(rows[-1:], missing, axis=0)]))
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def locate_steps(table, counts, steps, outer, px, py):  # type: ignore[no-untyped-def]
     """Return (steps of the first region holding p, 0 if none; largest signed distance [m]).
 
@@ -180,7 +181,7 @@ def locate_steps(table, counts, steps, outer, px, py):  # type: ignore[no-untype
     return 0, best  # pragma: no cover - inside the union is inside one of them
 
 
-@numba.njit(parallel=True, cache=True, nogil=True)
+@njit(parallel=True, cache=True, nogil=True)
 def mark_regions(  # type: ignore[no-untyped-def]
     x, y, xdot, ydot, inv_omega, table, counts, discs, codes, pending, mark
 ):
@@ -189,7 +190,7 @@ def mark_regions(  # type: ignore[no-untyped-def]
     ``discs`` rows (c_x, c_y, r_in², r_out²): inside the inscribed disc is inside, outside the
     circumscribed one outside, so that most states skip the edges.
     """
-    for i in numba.prange(x.shape[0]):
+    for i in prange(x.shape[0]):
         if codes[i] != pending:
             continue
         px, py = x[i] + xdot[i] * inv_omega, y[i] + ydot[i] * inv_omega

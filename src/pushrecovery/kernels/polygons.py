@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from pushrecovery.kernels.jit import hypot, njit
 
-@numba.njit(cache=True, nogil=True)
+
+@njit(cache=True, nogil=True)
 def clip_loop(points, normals, offsets):  # type: ignore[no-untyped-def]
     """Return the vertices of ``points`` ∩ {p : n_i · p <= b_i} (fewer than 3: empty).
 
@@ -51,7 +52,7 @@ def clip_loop(points, normals, offsets):  # type: ignore[no-untyped-def]
     return current[:count].copy()
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def minkowski_loop(shapes, counts, weights, offset):  # type: ignore[no-untyped-def]
     """Vertices of offset ⊕ Σ_k w_k P_k (shapes stacked (K, M, 2), ``counts`` rows used).
 
@@ -87,7 +88,7 @@ def minkowski_loop(shapes, counts, weights, offset):  # type: ignore[no-untyped-
     angle = np.empty(e)
     for i in range(e):
         angle[i] = math.atan2(edges[i, 1], edges[i, 0]) % (2.0 * math.pi)
-    order = np.argsort(angle)
+    order = np.argsort(angle, kind="mergesort")  # stable, as minkowski_sum: ties in order
     points = np.empty((e, 2))
     x, y = start[0], start[1]
     count = 0
@@ -103,7 +104,7 @@ def minkowski_loop(shapes, counts, weights, offset):  # type: ignore[no-untyped-
     return cleaned_loop(points[:count])
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def cleaned_loop(points):  # type: ignore[no-untyped-def]
     """Drop repeated, then non-turning vertices of a convex loop (as minkowski._cleaned)."""
     n = points.shape[0]
@@ -117,7 +118,7 @@ def cleaned_loop(points):  # type: ignore[no-untyped-def]
     m = 0
     for i in range(n):
         j = (i + 1) % n
-        if math.hypot(points[j, 0] - points[i, 0], points[j, 1] - points[i, 1]) > tol:
+        if hypot(points[j, 0] - points[i, 0], points[j, 1] - points[i, 1]) > tol:
             kept[m] = points[i]
             m += 1
     loop = kept[:m].copy()
@@ -136,7 +137,7 @@ def cleaned_loop(points):  # type: ignore[no-untyped-def]
     return loop
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def chebyshev_centre(normals, offsets):  # type: ignore[no-untyped-def]
     """(q_x, q_y, r, ok): the largest disc n_i · q + r <= b_i in a convex polygon [m].
 
@@ -194,7 +195,7 @@ def chebyshev_centre(normals, offsets):  # type: ignore[no-untyped-def]
     return 0.0, 0.0, 0.0, False
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def foothold_kernel(shapes, counts, weights, offset, window_normals, window_offsets):  # type: ignore[no-untyped-def]
     """Return (vertices, centre_x, centre_y, ok): (S3) clipped to the window, its centre.
 
@@ -223,7 +224,7 @@ def foothold_kernel(shapes, counts, weights, offset, window_normals, window_offs
     for i in range(n):
         j = (i + 1) % n
         ex, ey = region[j, 0] - region[i, 0], region[j, 1] - region[i, 1]
-        length = math.hypot(ex, ey)
+        length = hypot(ex, ey)
         normals[i, 0], normals[i, 1] = ey / length, -ex / length
         offsets[i] = normals[i, 0] * region[i, 0] + normals[i, 1] * region[i, 1]
     qx, qy, radius, ok = chebyshev_centre(normals, offsets)
@@ -256,7 +257,7 @@ def foothold_kernel(shapes, counts, weights, offset, window_normals, window_offs
     return region, qx, qy, True
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def decompose_loop(point, shapes, counts, weights, offset, total):  # type: ignore[no-untyped-def]
     """Decompose a point in a Minkowski sum: :func:`~pushrecovery.ground.minkowski.decompose`.
 
@@ -274,7 +275,7 @@ def decompose_loop(point, shapes, counts, weights, offset, total):  # type: igno
         cx += weights[k] * centres[k, 0]
         cy += weights[k] * centres[k, 1]
     gx, gy = point[0] - cx, point[1] - cy
-    distance = math.hypot(gx, gy)
+    distance = hypot(gx, gy)
     if distance == 0.0:
         return centres, 0.0
     ux, uy = gx / distance, gy / distance
@@ -284,7 +285,7 @@ def decompose_loop(point, shapes, counts, weights, offset, total):  # type: igno
     for i in range(m):
         j = (i + 1) % m
         ex, ey = total[j, 0] - total[i, 0], total[j, 1] - total[i, 1]
-        length = math.hypot(ex, ey)
+        length = hypot(ex, ey)
         ax, ay = ey / length, -ex / length
         rate = ax * ux + ay * uy
         scale = max(scale, abs(total[i, 0]), abs(total[i, 1]))
@@ -330,7 +331,7 @@ def decompose_loop(point, shapes, counts, weights, offset, total):  # type: igno
     return points, share
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def loop_signed_distance(loop, px, py):  # type: ignore[no-untyped-def]
     """Signed distance of (px, py) to a convex counter-clockwise loop [m], + inside.
 
@@ -343,7 +344,7 @@ def loop_signed_distance(loop, px, py):  # type: ignore[no-untyped-def]
     for i in range(n):
         j = (i + 1) % n
         ex, ey = loop[j, 0] - loop[i, 0], loop[j, 1] - loop[i, 1]
-        length = math.hypot(ex, ey)
+        length = hypot(ex, ey)
         nx, ny = ey / length, -ex / length
         dx, dy = px - loop[i, 0], py - loop[i, 1]
         e = nx * dx + ny * dy

@@ -13,10 +13,9 @@ reduction (e_i · e_i) come from numpy too (:func:`edge_rows`).
 
 from __future__ import annotations
 
-import math
-
-import numba
 import numpy as np
+
+from pushrecovery.kernels.jit import hypot, njit
 
 __all__ = ["edge_rows", "signed_distance"]
 
@@ -35,7 +34,7 @@ def edge_rows(vertices, normals, offsets):  # type: ignore[no-untyped-def]
     return rows
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def signed_distance(rows, px, py):  # type: ignore[no-untyped-def]
     """Signed distance of p = (px, py) to the polygon of ``rows`` (:func:`edge_rows`) [m].
 
@@ -59,7 +58,7 @@ def signed_distance(rows, px, py):  # type: ignore[no-untyped-def]
             along = 0.0
         if along > 1.0:
             along = 1.0
-        gap = math.hypot(dx - along * ex, dy - along * ey)
+        gap = hypot(dx - along * ex, dy - along * ey)
         if gap < best or gap != gap:
             best = gap
     return -best

@@ -25,8 +25,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from pushrecovery.kernels.jit import njit
 
 #: Bounds at or beyond this magnitude are infinite for DAQP: never shifted.
 INF = 1e30
@@ -35,13 +36,13 @@ INF = 1e30
 _FAST = {"reassoc", "contract"}
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def add_task(hessian, linear, matrix, target, weight):  # type: ignore[no-untyped-def]
     """Add W AᵀA to ``hessian`` and −W Aᵀb to ``linear``, skipping A's zero entries."""
     add_rows(hessian, linear, matrix, target, np.full(matrix.shape[0], weight), matrix.shape[0])
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def add_rows(hessian, linear, matrix, target, weights, count):  # type: ignore[no-untyped-def]
     """:func:`add_task` of the first ``count`` rows, row r weighted by ``weights[r]``.
 
@@ -64,7 +65,7 @@ def add_rows(hessian, linear, matrix, target, weights, count):  # type: ignore[n
                 hessian[i, j] += scaled * matrix[r, j]
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def constraints(  # type: ignore[no-untyped-def]
     mass, qfrc_bias, qfrc_passive, jac, jac_dot, local, qvel, contacts, unactuated, actuated,
     gear, ctrl_low, ctrl_high, foot_rows, foot_start, damping, rows, upper, lower, offset,
@@ -127,7 +128,7 @@ def constraints(  # type: ignore[no-untyped-def]
     return count
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def assemble_rows(  # type: ignore[no-untyped-def]
     matrix, target, weights, tasks, damping, xmat, bodies, dots, qvel, regular, mass, qfrc_bias,
     qfrc_passive, contacts, unactuated, actuated, gear, ctrl_low, ctrl_high, foot_rows,
@@ -153,7 +154,7 @@ def assemble_rows(  # type: ignore[no-untyped-def]
     )  # fmt: skip
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def commands(product, offset, low, high, ctrl):  # type: ignore[no-untyped-def]
     """Write the motor commands A_a x + h_a/gear, clipped to [low, high], into ``ctrl``.
 
@@ -173,7 +174,7 @@ def commands(product, offset, low, high, ctrl):  # type: ignore[no-untyped-def]
     return inside
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def least_distance(  # type: ignore[no-untyped-def]
     hessian, linear, rows, upper, lower, count, factor, first, shift, out_rows, out_upper,
     out_lower,
@@ -209,7 +210,7 @@ def least_distance(  # type: ignore[no-untyped-def]
     return True
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def transform_rows(  # type: ignore[no-untyped-def]
     factor, first, shift, rows, upper, lower, start, stop, out_rows, out_upper, out_lower
 ):
@@ -224,7 +225,7 @@ def transform_rows(  # type: ignore[no-untyped-def]
         out_lower[r] = lower[r] + moved if lower[r] > -INF else lower[r]
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def _forward(factor, first, rhs, out, r):  # type: ignore[no-untyped-def]
     """Solve L y = rhs[r] for y (into ``out[r]``), L lower triangular on its envelope ``first``.
 
@@ -239,7 +240,7 @@ def _forward(factor, first, rhs, out, r):  # type: ignore[no-untyped-def]
         out[r, j] = total / factor[j, j] if total != 0.0 else total
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def recover(factor, first, shift, solution, x):  # type: ignore[no-untyped-def]
     """Write x = L⁻ᵀ (u − v) for DAQP's ``solution`` u (module docstring)."""
     n = x.shape[0]
@@ -251,7 +252,7 @@ def recover(factor, first, shift, solution, x):  # type: ignore[no-untyped-def]
             x[k] -= factor[j, k] * x[j]
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def sole_origins(xpos, xmat, bodies, origins, out):  # type: ignore[no-untyped-def]
     """Write each sole frame's origin x_b + R_b o_b [m] (world) into ``out`` (n, 3)."""
     for i in range(bodies.shape[0]):
@@ -264,7 +265,7 @@ def sole_origins(xpos, xmat, bodies, origins, out):  # type: ignore[no-untyped-d
             )
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def sole_frames(xmat, bodies, jac, dots, qvel, jac_dot, local):  # type: ignore[no-untyped-def]
     """Write J̇ q̇ (from ``dots`` = J̇) and the sole-frame Jacobian Rᵀ J of each foot."""
     nv = jac.shape[1]
@@ -285,7 +286,7 @@ def sole_frames(xmat, bodies, jac, dots, qvel, jac_dot, local):  # type: ignore[
                     )
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def rotation_vector(rot, ref, out):  # type: ignore[no-untyped-def]
     """Write the rotation vector (axis × angle) [rad] of R R₀ᵀ (both row-major, 9) into ``out``.
 
@@ -309,7 +310,7 @@ def rotation_vector(rot, ref, out):  # type: ignore[no-untyped-def]
     out[0], out[1], out[2] = x * scale, y * scale, z * scale
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def balance_point(  # type: ignore[no-untyped-def]
     xmat, torso, upright, com, vel, omega, gain, rest, normals, offsets, out
 ):
@@ -336,7 +337,7 @@ def balance_point(  # type: ignore[no-untyped-def]
     return excess < 0.0
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def ankle_targets(  # type: ignore[no-untyped-def]
     xmat, bodies, mass, com, cop, offset, omega2, gravity, error, jacp, jacr, dots, qvel, qpos,
     posture, height, torso_z, gains, upright, stack, targets,
@@ -382,7 +383,7 @@ def ankle_targets(  # type: ignore[no-untyped-def]
     return math.sqrt(error2) < upright and math.sqrt(spin2) < upright
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def guard_rows(qpos, qvel, joints, edges, settings, stack, targets, weights, start):  # type: ignore[no-untyped-def]
     """Write the joint guard's rows (``JointGuard.task_rows``) from row ``start``.
 

@@ -13,9 +13,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
+
+from pushrecovery.kernels.jit import njit
 
 FloatArray = NDArray[np.float64]
 
@@ -23,7 +24,7 @@ FloatArray = NDArray[np.float64]
 UNDECIDED, RECOVERED, FELL = 0, 1, 2
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _pd_cop(x: float, xdot: float, length: float, kp: float, kd: float, inv_weight: float) -> float:
     """AnklePD.compute before clipping: τ / (m g) of τ = k_p θ + k_d θ̇."""
     lean = math.asin(max(-1.0, min(1.0, x / length)))
@@ -33,7 +34,7 @@ def _pd_cop(x: float, xdot: float, length: float, kp: float, kd: float, inv_weig
     return torque * inv_weight
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _acceleration(
     theta: float, rate: float, cop: float, mass: float, length: float, gravity: float
 ) -> float:
@@ -45,7 +46,7 @@ def _acceleration(
     return gravity * math.sin(theta) / length - torque / (mass * length * length)
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def ankle_pd_pushes(
     pendulum: bool,
     x0: FloatArray,

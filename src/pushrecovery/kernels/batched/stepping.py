@@ -30,9 +30,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
+
+from pushrecovery.kernels.jit import njit
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -77,7 +78,7 @@ def new_records() -> tuple[FloatArray, IntArray, FloatArray]:
     return np.zeros(FLOAT_SIZE), np.zeros(INT_SIZE, dtype=np.int64), np.zeros((4, 6))
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def start(c: FloatArray, x: float, xdot: float, f: FloatArray, n: IntArray) -> None:
     """Begin a run standing at the CoM height with the CoM at x [m] moving at ẋ [m/s]."""
     f[:] = 0.0
@@ -89,19 +90,19 @@ def start(c: FloatArray, x: float, xdot: float, f: FloatArray, n: IntArray) -> N
     n[STANCE] = 1
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _clip(value: float, low: float, high: float) -> float:
     """BodyParams.clip_cop / clip_hip_torque: min(high, max(low, value))."""
     return min(high, max(low, value))
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _command(f: FloatArray, n: IntArray, cop: float, torque: float, saturated: bool) -> None:
     f[CMD_COP], f[CMD_TAU], f[CMD_STEP] = cop, torque, math.nan
     n[CMD_SAT] = 1 if saturated else 0
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _compute(c: FloatArray, f: FloatArray, n: IntArray, t: float) -> int:
     """RecoveryController.compute at time t: the command into f/n, or a request code."""
     x, theta, z, xdot, theta_rate = f[X], f[TH], f[Z], f[XD], f[THD]
@@ -158,7 +159,7 @@ def _compute(c: FloatArray, f: FloatArray, n: IntArray, t: float) -> int:
     return DONE
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _stance_step(
     c: FloatArray, f: FloatArray, n: IntArray, ab: FloatArray, dt: float, cop: float, tau: float
 ) -> None:
@@ -187,7 +188,7 @@ def _stance_step(
     f[X], f[TH], f[XD], f[THD], f[ZD] = x, theta, xdot, rate, 0.0
 
 
-@numba.njit(cache=True, inline="always")
+@njit(cache=True, inline="always")
 def _row(
     ab: FloatArray, i: int, s0: float, s1: float, s2: float, s3: float, cop: float, tau: float
 ) -> float:
@@ -201,13 +202,13 @@ def _row(
     )
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _swing_acceleration(theta: float, length: float, gravity: float) -> float:
     """models.pendulum._pendulum_acceleration with no ankle torque (δ = 0, m = 1)."""
     return gravity * math.sin(theta) / length - 0.0 / (1.0 * length * length)
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _rk4(theta: float, rate: float, h: float, length: float, gravity: float) -> tuple[float, float]:
     """models.pendulum.pendulum_step_unchecked, one substep."""
     k1a = _swing_acceleration(theta, length, gravity)
@@ -222,7 +223,7 @@ def _rk4(theta: float, rate: float, h: float, length: float, gravity: float) -> 
     return theta, rate
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _start_swing(f: FloatArray, n: IntArray, step_length: float) -> None:
     """SteppingPlant._start_swing: the leg locks, only the tangential velocity survives."""
     x, z, xdot = f[X], f[Z], f[XD]
@@ -237,7 +238,7 @@ def _start_swing(f: FloatArray, n: IntArray, step_length: float) -> None:
     f[XD], f[ZD] = length * math.cos(lean) * rate, -length * math.sin(lean) * rate
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _swing_step(c: FloatArray, f: FloatArray, n: IntArray, ab: FloatArray, dt: float) -> None:
     """SteppingPlant._swing_step with the held torque f[CMD_TAU] clipped (and the impact)."""
     length, landing, sign = f[SW_LEN], f[SW_LAND], f[SW_SIGN]
@@ -271,7 +272,7 @@ def _swing_step(c: FloatArray, f: FloatArray, n: IntArray, ab: FloatArray, dt: f
         n[STOPS] += 1
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _impact(
     c: FloatArray,
     f: FloatArray,
@@ -292,7 +293,7 @@ def _impact(
         _stance_step(c, f, n, ab, remaining, _clip(0.0, c[HEEL], c[TOE]), 0.0)
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def _falling(c: FloatArray, f: FloatArray, n: IntArray) -> bool:
     """SteppingPlant.falling: the swing's fall tests, or the flywheel model's fall set."""
     x, xdot = f[X], f[XD]
@@ -310,7 +311,7 @@ def _falling(c: FloatArray, f: FloatArray, n: IntArray) -> bool:
     )
 
 
-@numba.njit(cache=True)
+@njit(cache=True)
 def advance(
     c: FloatArray, ticks: int, rest_ticks: int, f: FloatArray, n: IntArray, ab: FloatArray
 ) -> int:

@@ -29,8 +29,9 @@ and shift of an iterate sharing one iterate layout.
 
 from __future__ import annotations
 
-import numba
 import numpy as np
+
+from pushrecovery.kernels.jit import njit
 
 # Step-to-boundary fraction of Mehrotra's method.
 _FRACTION = 0.99
@@ -49,7 +50,7 @@ _CENTRE = (0.0, 1.0, 0.01)
 GUIDE_FLOOR, GUIDE_CENTRE = 0.003, 3.0
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def identify_active(bounds, scale, sl, su, zl, zu, active):  # type: ignore[no-untyped-def]
     """Write the iterate's active set into ``active`` (N, 3); the number of rows that changed.
 
@@ -71,7 +72,7 @@ def identify_active(bounds, scale, sl, su, zl, zu, active):  # type: ignore[no-u
     return changed
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _value(u, x, i, j):  # type: ignore[no-untyped-def]
     """Return the bounded component j of stage i: δ_i, τ_i or θ_{i+1}."""
     if j < 2:
@@ -79,7 +80,7 @@ def _value(u, x, i, j):  # type: ignore[no-untyped-def]
     return x[i + 1, 1]
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _advance(a, b, x, u, i):  # type: ignore[no-untyped-def]
     """Write x[i + 1] = A x[i] + B u[i] (the dynamics, Eq. 16 discretised; zeros skipped)."""
     for r in range(4):
@@ -89,7 +90,7 @@ def _advance(a, b, x, u, i):  # type: ignore[no-untyped-def]
         x[i + 1, r] = acc
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _residuals(  # type: ignore[no-untyped-def]
     a, b, wx, wu, bounds, u, x, nu, sl, su, zl, zu, rdu, rdx, rl, ru, mdu, mdx
 ):
@@ -128,7 +129,7 @@ def _residuals(  # type: ignore[no-untyped-def]
             ru[i, j] = bounds[j, 1] - v - su[i, j]
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _newton(  # type: ignore[no-untyped-def]
     a, b, wx, wu, sl, su, zl, zu, rdu, rdx, rl, ru, cl, cu, factor,
     big_s, gain, hinv, vec_s, sbs, closeds, off, rdiag, du, dx, dnu, dsl, dsu, dzl, dzu,
@@ -342,7 +343,7 @@ def _newton(  # type: ignore[no-untyped-def]
     return primal, dual
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _start(  # type: ignore[no-untyped-def]
     x0, a, b, bounds, scale, feedback, u, x, nu, sl, su, zl, zu, start, guide, guide_centre,
 ):  # fmt: skip
@@ -387,7 +388,7 @@ def _start(  # type: ignore[no-untyped-def]
                     zu[i, j] = guide_centre * scale[i, j] / su[i, j] * span
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def shift_iterate(x0, a, b, feedback, u, x, nu, sl, su, zl, zu):  # type: ignore[no-untyped-def]
     """Shift an unfinished iterate by one stage (the receding horizon) to continue it from x0.
 
@@ -426,7 +427,7 @@ def shift_iterate(x0, a, b, feedback, u, x, nu, sl, su, zl, zu):  # type: ignore
                 dev[c] = x[i + 1, c] - x[i + 2, c]  # the old x[i + 2]: stage i + 1's x̄
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def solve_interior(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, bounds, scale, feedback, tol, dual_tol, max_iter, start, guide,
     u, x, nu, sl, su, zl, zu, work, big_s, gain, hinv, vec_s, sbs, closeds, active,

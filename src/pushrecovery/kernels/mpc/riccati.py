@@ -40,8 +40,9 @@ they would pass a dozen arrays between modules for nothing.
 
 from __future__ import annotations
 
-import numba
 import numpy as np
+
+from pushrecovery.kernels.jit import njit
 
 # Outcomes of one pass of :func:`_pass`.
 OPTIMAL, CHANGED, DEGENERATE = 0, 1, -1
@@ -72,7 +73,7 @@ _SAVED = 15 + 6 * CARRIED
 _COUNT, _ORDER = _WIDTH, _WIDTH + 1
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def scratch(n):  # type: ignore[no-untyped-def]
     """Return the passes' scratch at horizon ``n``: floats, ints, the rows' origins, the record.
 
@@ -88,7 +89,7 @@ def scratch(n):  # type: ignore[no-untyped-def]
     return floats, ints, origins, saved
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _entry(ata, g0r, g1r, er, fr, kh0r, kh1r, g0c, g1c, ec, fc):  # type: ignore[no-untyped-def]
     """P_i[r, c] = (A^T S A)[r, c] + (G^T K)[r, c] + (K^T G)[r, c] + (K^T H K)[r, c], as summed."""
     acc = ata + (g0r * ec + g1r * fc)
@@ -97,7 +98,7 @@ def _entry(ata, g0r, g1r, er, fr, kh0r, kh1r, g0c, g1c, ec, fc):  # type: ignore
     return acc
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, rows, origins, start, saved):  # type: ignore[no-untyped-def]
     """Riccati recursion with the active rows as equalities; the number of rows left on x_0.
 
@@ -322,7 +323,7 @@ def _backward(a, b, wx, wu, active, bounds, gains, offsets, curvature, rows, ori
     return 0
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _free(pd0, pd1, pc, norm2, th0, th1, t0, t1, hz, g0, g1):  # type: ignore[no-untyped-def]
     """Column of K with one pivot row d^T u + c^T x = e: the row's part, then the free one's.
 
@@ -334,7 +335,7 @@ def _free(pd0, pd1, pc, norm2, th0, th1, t0, t1, hz, g0, g1):  # type: ignore[no
     return fd0 - t0 * gz / hz, fd1 - t1 * gz / hz
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _eliminate(p, e, k, floats, ints, top):  # type: ignore[no-untyped-def]
     """Record unknown ``p`` from equation ``e``: w_p = (rhs_e − Σ_{c ≠ p} jac_ec w_c) / jac_ep.
 
@@ -354,7 +355,7 @@ def _eliminate(p, e, k, floats, ints, top):  # type: ignore[no-untyped-def]
     return idx
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _multipliers(a, b, wx, wu, active, inputs, states, mult, floats, ints):  # type: ignore[no-untyped-def]
     """Multipliers of the active rows into ``mult`` (N, 3); False if they are not unique.
 
@@ -481,7 +482,7 @@ def _multipliers(a, b, wx, wu, active, inputs, states, mult, floats, ints):  # t
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _pass(  # type: ignore[no-untyped-def]
     x0, a, b, wx, wu, active, bounds, tols, dual_tol, inputs, states, gains, offsets, curvature,
     mult, forced, work, swept,
@@ -608,7 +609,7 @@ def _pass(  # type: ignore[no-untyped-def]
     return CHANGED
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def solve_active_set(  # type: ignore[no-untyped-def]
     x0,
     a,
@@ -648,7 +649,7 @@ def solve_active_set(  # type: ignore[no-untyped-def]
     return -1
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def solve_from(  # type: ignore[no-untyped-def]
     x0,
     shift,

@@ -8,11 +8,12 @@ iterations' kernels (:mod:`~pushrecovery.kernels.mpc.interior`): it calls none o
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
+from pushrecovery.kernels.jit import njit
 
-@numba.njit(cache=True, nogil=True, inline="always")
+
+@njit(cache=True, nogil=True, inline="always")
 def _sandwich(b, s, m, r, c):  # type: ignore[no-untyped-def]
     """(Bᵀ S M)[r, c], summed over q then p as the recursion always has."""
     acc = 0.0
@@ -22,7 +23,7 @@ def _sandwich(b, s, m, r, c):  # type: ignore[no-untyped-def]
     return acc
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def dual_scales(a, b, wx, wu, bounds, scales, feedback):  # type: ignore[no-untyped-def]
     """Fill ``scales`` (N, 7) and ``feedback`` (N, 2, 4) from the unconstrained problem.
 
