@@ -15,31 +15,51 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 
 from pushrecovery.cli import main
 
-PLAIN_RUNNER = """
-import contextlib, io, json, sys
+# A fresh process, switched to plain Python before anything computes, runs the commands with
+# this module's _run.
+PLAIN_RUNNER = f"""
+import json, sys
 from pushrecovery.kernels.jit import run_as_python
 run_as_python()
-from pushrecovery.cli import main
-outputs = []
-for argv in json.load(sys.stdin):
-    out, code = io.StringIO(), None
-    with contextlib.redirect_stdout(out):
-        try:
-            main(argv)
-        except SystemExit as exc:
-            code = exc.code
-    outputs.append(f"{out.getvalue()}|exit {code}")
-json.dump({"outputs": outputs, "numba": "numba" in sys.modules}, sys.stdout)
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+from test_plain_kernels import _run
+outputs = [_run(argv) for argv in json.load(sys.stdin)]
+json.dump({{"outputs": outputs, "numba": "numba" in sys.modules}}, sys.stdout)
 """
 
 
-def _environment() -> dict[str, str]:
-    return {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+# Commands whose plain run once printed another last digit: the interpreter's own math.hypot
+# (the first), numba's unstable argsort in the Minkowski sum (the others).
+FOUND = [
+    "classify --x 0.0540 --xdot 1.996 --y -0.0200 --ydot 0.487 "
+    "--cov 0.0001,0,0,0,0,0.0001,0,0,0,0,0.004,0,0,0,0,0.004 --json",
+    "capture-region --x 0.0 --xdot 1.0 --steps 3 --json",
+    "capture-region --x 0.02 --xdot 1.4 --ydot -0.7 --steps 2 --stance left "
+    "--left-foot 0.05,0.1,0.3 --json",
+    "classify --x 0.01 --xdot 1.1 --ydot -0.9 --stance right --right-foot 0.1,-0.1,-0.4 "
+    "--landing-yaw 0.2 --json",
+    "classify --x 0.0 --xdot 0.9 --y 0.02 --latency 0.02 --json",
+]
+
+
+def _python(script: str, stdin: str = "") -> subprocess.CompletedProcess[str]:
+    """Run ``script`` in a fresh interpreter (numba's settings from the environment left out)."""
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        input=stdin,
+        capture_output=True,
+        text=True,
+        env={k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")},
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stderr
+    return done
 
 
 def _commands(seed: int, count: int) -> list[list[str]]:
@@ -73,8 +93,8 @@ def _commands(seed: int, count: int) -> list[list[str]]:
     return commands
 
 
-def _compiled(argv: list[str]) -> str:
-    """The command's output and exit status, in this process (compiled kernels)."""
+def _run(argv: list[str]) -> str:
+    """The command's output and exit status, run in this process."""
     out, code = io.StringIO(), None
     with contextlib.redirect_stdout(out):
         try:
@@ -85,21 +105,12 @@ def _compiled(argv: list[str]) -> str:
 
 
 def test_plain_kernels_print_the_compiled_numbers():
-    commands = _commands(seed=7, count=80)
-    done = subprocess.run(
-        [sys.executable, "-c", PLAIN_RUNNER],
-        input=json.dumps(commands),
-        capture_output=True,
-        text=True,
-        env=_environment(),
-        timeout=600,
-    )
-    assert done.returncode == 0, done.stderr
-    plain = json.loads(done.stdout)
+    commands = [line.split() for line in FOUND] + _commands(seed=7, count=80)
+    plain = json.loads(_python(PLAIN_RUNNER, json.dumps(commands)).stdout)
     assert plain["numba"] is False
     verdicts, refused = set(), 0
     for argv, text in zip(commands, plain["outputs"], strict=True):
-        assert text == _compiled(argv), argv
+        assert text == _run(argv), argv  # this process: compiled
         body, _, code = text.rpartition("|exit ")
         refused += code == "2"
         if argv[0] == "classify" and code in ("None", "0"):
@@ -116,10 +127,7 @@ def test_a_one_state_command_line_loads_no_numba():
         "from pushrecovery.cli import main\n"
         "try:\n    main()\nfinally:\n    print('numba' in sys.modules, file=sys.stderr)\n"
     )
-    done = subprocess.run(
-        [sys.executable, "-c", script], capture_output=True, text=True, env=_environment()
-    )
-    assert done.returncode == 0, done.stderr
+    done = _python(script)
     assert done.stderr.strip() == "False"
     assert json.loads(done.stdout)["strategy"] == "step"
 
@@ -135,8 +143,4 @@ def test_main_with_arguments_keeps_the_compiled_kernels():
         "from pushrecovery.kernels.placement import place_tables\n"
         "print(plain_python(), type(place_tables).__name__)\n"
     )
-    done = subprocess.run(
-        [sys.executable, "-c", script], capture_output=True, text=True, env=_environment()
-    )
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.split() == ["False", "CPUDispatcher"]
+    assert _python(script).stdout.split() == ["False", "CPUDispatcher"]
