@@ -15,7 +15,7 @@ __all__ = ["main"]
 #: Commands that answer for one state and exit: run from a command line of their own (``argv``
 #: None), their kernels run as plain Python, which is faster than loading numba
 #: (:mod:`pushrecovery.kernels.jit`).
-ONE_STATE_COMMANDS = frozenset({"classify", "capture-region", "step"})
+ONE_STATE_COMMANDS = frozenset({"classify", "capture-region"})
 
 
 def main(argv: list[str] | None = None) -> None:
