@@ -24,7 +24,7 @@ import math
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-__all__ = ["njit", "plain_python", "run_as_python"]
+__all__ = ["njit", "run_as_python"]
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -39,11 +39,6 @@ def run_as_python() -> None:
     """
     global _plain
     _plain = True
-
-
-def plain_python() -> bool:
-    """Return whether kernel modules imported now run as plain Python (:func:`run_as_python`)."""
-    return _plain
 
 
 def njit(**options: Any) -> Callable[[_F], _F]:
