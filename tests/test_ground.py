@@ -166,6 +166,30 @@ def test_yawed_feet_in_double_support():
     assert support.yaw == pytest.approx(0.0)
 
 
+def test_lifting_a_foot_keeps_that_sole_and_the_poses():
+    """``Support.single`` from double support gives the single support ``from_params`` builds."""
+    params = load_params(
+        overrides={"foot_polygon": [[-0.05, -0.03], [0.2, -0.05], [0.2, 0.06], [-0.05, 0.02]]}
+    )
+    poses = {"left": FootPose(0.3, 0.2, 0.4), "right": FootPose(0.1, -0.1, -2.5)}
+    double = Support.from_params(params, **poses)
+    for side in ("left", "right"):
+        lifted = double.single(side)
+        built = Support.from_params(params, side, **poses)
+        assert lifted.stance == side and (lifted.left, lifted.right) == (double.left, double.right)
+        np.testing.assert_array_equal(lifted.polygon.vertices, built.polygon.vertices)
+        np.testing.assert_array_equal(lifted.polygon.offsets, built.polygon.offsets)
+        assert lifted.single(side) is lifted and lifted.soles is None
+        # From the other single support the sole is placed anew: the same numbers.
+        other = built.single("right" if side == "left" else "left")
+        np.testing.assert_array_equal(
+            other.polygon.vertices, double.single(other.stance).polygon.vertices
+        )
+    for bad in ("double", "both", None, 1):
+        with pytest.raises(InvalidParameterError, match="stance must be 'left' or 'right'"):
+            double.single(bad)
+
+
 def test_double_support_refuses_overlapping_or_distant_feet():
     with pytest.raises(InvalidParameterError, match=r"the feet overlap by 0\.05 m"):
         Support.from_params(load_params(overrides={"stance_width": 0.05}))

@@ -17,7 +17,7 @@ from scipy.integrate import solve_ivp
 from pushrecovery import load_params
 from pushrecovery.cli import main
 from pushrecovery.cli.app import cli
-from pushrecovery.errors import InvalidParameterError
+from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground import FootPose, Support
 from pushrecovery.ground.support import Stance
 from pushrecovery.surfaces.capture_plan import CapturePlan, capture_plan, plan_loads
@@ -259,6 +259,29 @@ def test_a_landing_yaw_outside_pi_is_refused_naming_radians(params, bad):
         classify(0.0, 1.0, params, landing_yaw=bad)
     with pytest.raises(InvalidParameterError, match=r"landing_yaw.*rad"):
         viable_region(params, option, (0.2,), landing_yaw=bad)
+
+
+@pytest.mark.parametrize(
+    ("args", "kwargs", "message"),
+    [
+        (("a", 0.0, 1), {}, r"px must be a finite number \[m\]"),
+        ((0.4, math.nan, 1), {}, r"py must be a finite number \[m\]"),
+        ((0.4, 0.0, 0), {}, r"steps must be a whole number in \[1, 11\]"),
+        ((0.4, 0.0, 12), {}, r"steps must be a whole number in \[1, 11\]"),
+        ((0.4, 0.0, 1.5), {}, r"steps must be a whole number in \[1, 11\]"),
+        ((0.4, 0.0, True), {}, r"steps must be a whole number in \[1, 11\]"),
+        ((3e3, 0.0, 1), {}, r"\(px, py\) must lie within ±2000 m of the stance ankle"),
+        ((0.4, 0.0, 1), {"com": (2e3, 0.0)}, r"com must have entries in \[-1000, 1000\] \[m\]"),
+    ],
+)
+def test_a_plan_of_the_regions_refuses_bad_input_naming_it(params, args, kwargs, message):
+    regions = StepRegions.of(params, Support.from_params(params, Stance.RIGHT))
+    assert params.max_steps == 11
+    with pytest.raises((InvalidParameterError, ParameterTypeError), match=message):
+        regions.plan(*args, **kwargs)
+    # Numbers numpy gives are numbers: the same plan as Python's.
+    plan = regions.plan(np.float64(0.4), np.float64(0.0), np.int64(1))
+    assert repr(plan) == repr(regions.plan(0.4, 0.0, 1))
 
 
 def test_plan_loads_refuses_half_a_state(params):

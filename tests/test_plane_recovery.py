@@ -108,8 +108,16 @@ def test_a_turned_and_moved_stance_gets_the_turned_and_moved_command(monkeypatch
         raise AssertionError("a Minkowski sum built in the loop")
 
     for module, name in ((n_step, "minkowski_sum_unchecked"), (plans, "minkowski_sum_unchecked"),
-                         (plans, "minkowski_sum_loop"), (polygons, "minkowski_loop")):  # fmt: skip
+                         (plans, "minkowski_sum_loop")):  # fmt: skip
         monkeypatch.setattr(module, name, built)
+    compiled = polygons.minkowski_loop
+    sums = []
+
+    def cmp_region_only(shapes, counts, weights, offset):
+        sums.append(counts.tolist())  # the support polygon and the hip's box: 4 corners
+        return compiled(shapes, counts, weights, offset)
+
+    monkeypatch.setattr(polygons, "minkowski_loop", cmp_region_only)
     push = np.array([0.9, 0.5])  # CoM velocity in the stance foot's frame [m/s]
     commands = {}
     for yaw, x, y in ((0.0, 0.0, 0.0), (0.7, 1.3, -0.4), (-2.9, -0.8, 2.1), (math.pi, 0.2, 0.3)):
@@ -127,6 +135,8 @@ def test_a_turned_and_moved_stance_gets_the_turned_and_moved_command(monkeypatch
         commands[yaw] = np.concatenate([local, cop])
     for found in commands.values():
         assert np.abs(found - commands[0.0]).max() <= 1e-12
+    # One compiled sum per new support, the CMP region's (its test), and no other.
+    assert sums == [[4, 4]] * len(commands)
 
 
 def test_the_hip_share_is_the_integral_of_the_bang_bang_profile():

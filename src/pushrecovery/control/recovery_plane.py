@@ -36,7 +36,7 @@ from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
-from pushrecovery.surfaces.monitor import BalanceMonitor
+from pushrecovery.surfaces.edge_rows import Edges, cmp_rows, signed_distance
 from pushrecovery.surfaces.n_step import hip_box
 from pushrecovery.surfaces.step_regions import StepRegions
 
@@ -113,10 +113,10 @@ class PlaneRecoveryController(Controller):
         self._spin_up = (max_spin_up_time(params), max_spin_up_time(roll_axis(params)))
         self._offsets = (cmp_offset(params), cmp_offset_roll(params))
         self._torques = (params.torque_max, params.torque_max_roll)
-        # The support's regions, CMP region and the compiled tests, loaded now rather than in
-        # the loop: a support change then costs tens of µs, any stance, pose or yaw.
-        self._monitor = BalanceMonitor(params)
         self.reset(np.zeros(len(PLANE_STATE_LABELS)))
+        # The compiled paths (the CMP region's sum, the regions' placement and tests) loaded
+        # now rather than in the loop: a support change then costs tens of µs, any pose or yaw.
+        self._cmp_margin(0.0, 0.0)
         # Plans are made in the stance foot's frame: these are every plan's terms, kept.
         for body in (params, self._without_hip):
             regions = StepRegions.of(body, self.support)
@@ -135,6 +135,7 @@ class PlaneRecoveryController(Controller):
                 f"got shape {np.shape(state)}"
             )
         self.support = Support.from_params(self.params, Stance.DOUBLE)
+        self._cmp: tuple[Support | None, Edges] = (None, ())
         self.mode = "ankle"
         self.plan: CapturePlan | None = None
         self._hip: _HipManoeuvre | None = None
@@ -168,14 +169,19 @@ class PlaneRecoveryController(Controller):
         if polygon.point_signed_distance(float(effective[0]), float(effective[1])) > 0.0:
             self.mode = "ankle" if self._hip is None else self.mode
             return Command(float(effective[0]), pitch, cop_y=float(effective[1]), roll_torque=roll)
-        if self._hip is None:
-            # The monitor's CMP margin of ξ (a state at rest at ξ has its capture point at ξ),
-            # told the support only here: a lift-off and a swing need no CMP region.
-            if self._monitor.support is not self.support:
-                self._monitor.set_support(self.support)
-            if self._monitor.query(float(xi[0]), float(xi[1]), 0.0, 0.0).cmp_margin > 0.0:
-                return self._start_hip(t, xi)
+        if self._hip is None and self._cmp_margin(float(xi[0]), float(xi[1])) > 0.0:
+            return self._start_hip(t, xi)
         return self._start_step(t, effective)
+
+    def _cmp_margin(self, px: float, py: float) -> float:
+        """Signed distance of ξ to the support's CMP region [m] (``BalanceMonitor``'s).
+
+        The region is built only here, when a support first needs it: a lift-off and a swing
+        need none.
+        """
+        if self._cmp[0] is not self.support:
+            self._cmp = (self.support, cmp_rows(self.support, *self._offsets))
+        return signed_distance(self._cmp[1], px, py)
 
     def _start_hip(self, t: float, xi: FloatArray) -> Command:
         """Split ξ over the support and the hip's box; start the scaled profile."""
@@ -212,9 +218,7 @@ class PlaneRecoveryController(Controller):
         self._swing = (side, foothold, touchdown)
         stance = Stance.RIGHT if side is Stance.LEFT else Stance.LEFT
         if self.support.stance is not stance:  # from double support: the other foot lifts
-            self.support = Support.from_params(
-                self.params, stance, left=self.support.left, right=self.support.right
-            )
+            self.support = self.support.single(stance)
         pitch, roll = self._hip_torques(t)
         cop = plan.cops[0]
         return Command(

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import StrEnum
 
 import numpy as np
@@ -111,6 +111,9 @@ class Support:
         The left foot in its own frame [m].
     polygon : ConvexPolygon
         The support polygon in the world frame [m].
+    soles : (ConvexPolygon, ConvexPolygon) or None
+        In double support, the left and right soles in the world frame, whose hull
+        ``polygon`` is [m]; None in single support (the sole is ``polygon``).
     """
 
     stance: Stance
@@ -118,6 +121,7 @@ class Support:
     right: FootPose
     foot: ConvexPolygon
     polygon: ConvexPolygon
+    soles: tuple[ConvexPolygon, ConvexPolygon] | None = field(default=None, repr=False)
 
     @classmethod
     def from_params(
@@ -168,7 +172,32 @@ class Support:
         other = foot.transformed(left.x, left.y, left.yaw)
         _check_double_support(params, left, right, other, placed)
         polygon = convex_hull(np.vstack([other.vertices, placed.vertices]))
-        return cls(stance, left, right, foot, polygon)
+        return cls(stance, left, right, foot, polygon, (other, placed))
+
+    def single(self, stance: str | Stance) -> Support:
+        """Return the single support on one of these feet, the other lifted (the same poses).
+
+        From double support the sole is the one the hull was built from (no polygon built:
+        a lift-off in a loop costs a µs); the sole is otherwise placed as
+        :meth:`from_params` places it.
+
+        Raises
+        ------
+        InvalidParameterError
+            If ``stance`` is not ``left`` or ``right``.
+        """
+        if stance not in (Stance.LEFT, Stance.RIGHT):
+            raise InvalidParameterError(f"stance must be 'left' or 'right', got {stance!r}")
+        stance = Stance(stance)
+        if stance is self.stance:
+            return self
+        if self.soles is not None:
+            sole = self.soles[0 if stance is Stance.LEFT else 1]
+        elif stance is Stance.LEFT:
+            sole = self.foot.transformed(self.left.x, self.left.y, self.left.yaw)
+        else:
+            sole = self.foot.mirrored().transformed(self.right.x, self.right.y, self.right.yaw)
+        return type(self)(stance, self.left, self.right, self.foot, sole)
 
     @property
     def ankle(self) -> tuple[float, float]:

@@ -19,9 +19,6 @@ A query may also give the upper body's current pitch and roll, each (angle [rad]
 P ⊕ an off-centre box in the support's axes. The sum's edges are ordered per support (P's
 edges and the box's four, merged by direction), so a query only moves the box's corners: a
 few µs more, no hull built.
-
-Over 400 lines on purpose: one concept, a query's verdict for one support, with the
-per-support tables it reads and the distance routines it runs on them in Python floats.
 """
 
 from __future__ import annotations
@@ -35,23 +32,17 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
-from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import MAX_POSE, Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.classify import Strategy
 from pushrecovery.surfaces.cmp import _flywheel_offsets, cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
+from pushrecovery.surfaces.edge_rows import Edges, cmp_rows, polygon_rows, signed_distance
 from pushrecovery.surfaces.step_regions import StepRegions
 
 __all__ = ["BalanceMonitor", "Verdict"]
 
 FloatArray = NDArray[np.float64]
-#: The box's corners (±1, ±1), counter-clockwise, and the sum's weights and offset.
-_CORNERS = ((-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0))
-_UNIT_WEIGHTS = np.ones(2)
-_ORIGIN = np.zeros(2)
-
-_Edges = tuple[tuple[float, float, float, float, float, float, float, float], ...]
 #: Per edge of P ⊕ box, CCW: outward normal, the vertex of P and the box corner it starts from.
 _SumEdges = tuple[tuple[float, float, float, float, int], ...]
 #: An upper-body axis's (angle [rad], rate [rad/s]).
@@ -63,8 +54,8 @@ class _SupportState:
     """Everything a query needs of one support, built whole and never changed."""
 
     support: Support
-    cop: _Edges
-    cmp: _Edges
+    cop: Edges
+    cmp: Edges
     torso: tuple[_SumEdges, float, float]  # P ⊕ box's edges, cos and sin of the yaw
     regions: tuple[object, ...]  # locate_steps' table, counts, steps, outer
 
@@ -97,50 +88,7 @@ class Verdict:
     steps: int
 
 
-def _edges(polygon: ConvexPolygon) -> _Edges:
-    """Per edge: normal, offset, start vertex, edge vector, 1/‖edge‖² as Python floats."""
-    v = polygon.vertices.tolist()
-    rows = []
-    for (nx, ny), b, (x0, y0), (x1, y1) in zip(
-        polygon.normals.tolist(), polygon.offsets.tolist(), v, v[1:] + v[:1], strict=True
-    ):
-        ex, ey = x1 - x0, y1 - y0
-        rows.append((nx, ny, b, x0, y0, ex, ey, 1.0 / (ex * ex + ey * ey)))
-    return tuple(rows)
-
-
-def _loop_edges(loop: list[list[float]]) -> _Edges:
-    """:func:`_edges` of a counter-clockwise vertex loop (normals as ``ConvexPolygon``'s)."""
-    rows = []
-    for (x0, y0), (x1, y1) in zip(loop, loop[1:] + loop[:1], strict=True):
-        ex, ey = x1 - x0, y1 - y0
-        length = math.hypot(ex, ey)
-        nx, ny = ey / length, -ex / length
-        rows.append((nx, ny, nx * x0 + ny * y0, x0, y0, ex, ey, 1.0 / (ex * ex + ey * ey)))
-    return tuple(rows)
-
-
-def _signed_distance(edges: _Edges, px: float, py: float) -> float:
-    """Signed distance to a convex polygon, + inside (see :mod:`pushrecovery.ground.polygon`)."""
-    excess = -math.inf
-    for nx, ny, b, _, _, _, _, _ in edges:
-        e = nx * px + ny * py - b
-        if e > excess:
-            excess = e
-    if excess <= 0.0:
-        return -excess
-    best = math.inf
-    for _, _, _, vx, vy, ex, ey, inv in edges:
-        dx, dy = px - vx, py - vy
-        t = (dx * ex + dy * ey) * inv
-        t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
-        gap = math.hypot(dx - t * ex, dy - t * ey)
-        if gap < best:
-            best = gap
-    return -best
-
-
-def _sum_edges(polygon: _Edges, yaw: float) -> tuple[_SumEdges, float, float]:
+def _sum_edges(polygon: Edges, yaw: float) -> tuple[_SumEdges, float, float]:
     """Return the edges of P ⊕ box for any box [lo_x, hi_x] × [lo_y, hi_y] in the stance axes.
 
     The sum of a convex polygon and a box has P's edges, each moved by the box corner whose
@@ -152,9 +100,10 @@ def _sum_edges(polygon: _Edges, yaw: float) -> tuple[_SumEdges, float, float]:
     0 if u, w <= 0 and 1 if w <= 0 < u (a partition of the directions, turning with them, so
     each box edge is inserted once; a tie gives two collinear edges, one possibly of length 0).
 
-    ``polygon`` is P's :func:`_edges`, ``yaw`` the stance's heading [rad]. Each row: the edge's
-    outward normal and its start (a vertex of P and a corner), in the world frame; each edge
-    ends where the next starts. Then cos and sin of the yaw.
+    ``polygon`` is P's rows (:func:`~pushrecovery.surfaces.edge_rows.polygon_rows`), ``yaw``
+    the stance's heading [rad]. Each row: the edge's outward normal and its start (a vertex
+    of P and a corner), in the world frame; each edge ends where the next starts. Then cos
+    and sin of the yaw.
     """
     c, s = math.cos(yaw), math.sin(yaw)
     # The box edge from corner k to k + 1: its outward normal in the world frame.
@@ -255,11 +204,10 @@ class BalanceMonitor:
     'step'
     """
 
-    __slots__ = ("_axes", "_box", "_locate", "_minkowski", "_omega", "_state", "params")
+    __slots__ = ("_axes", "_box", "_locate", "_omega", "_state", "params")
 
     def __init__(self, params: BodyParams, support: Support | None = None) -> None:
         from pushrecovery.kernels.plane_codes import locate_steps
-        from pushrecovery.kernels.polygons import minkowski_loop
 
         require_type("params", params, BodyParams)
         if support is not None:
@@ -267,7 +215,6 @@ class BalanceMonitor:
         self.params = params
         self._omega = params.omega
         self._locate: Callable[..., tuple[int, float]] = locate_steps
-        self._minkowski: Callable[..., FloatArray] = minkowski_loop
         self._box = (cmp_offset(params), cmp_offset_roll(params))
         # Each upper-body axis's τmax, I, θmax, m g and ω, for the offsets from θ0, θ̇0 (E19).
         limits = (
@@ -303,33 +250,14 @@ class BalanceMonitor:
         """
         require_type("support", support, Support)
         regions = StepRegions.of(self.params, support)
-        cop = _edges(support.polygon)
+        cop = polygon_rows(support.polygon)
         self._state = _SupportState(
             support,
             cop,
-            self._cmp_edges(support),
+            cmp_rows(support, *self._box),
             _sum_edges(cop, support.yaw),
             (regions.table, regions.counts, regions.steps_array, regions.outer),
         )
-
-    def _cmp_edges(self, support: Support) -> _Edges:
-        """Return the edges of the CMP region P ⊕ box (``plane.cmp_polygon``), compiled.
-
-        The box's corners as :meth:`~pushrecovery.ground.polygon.ConvexPolygon.grown` places
-        them (turned by the stance's heading); one Minkowski sum of two shapes.
-        """
-        half_x, half_y = self._box
-        if half_x == 0.0 and half_y == 0.0:
-            return _edges(support.polygon)
-        vertices = support.polygon.vertices
-        count = len(vertices)
-        shapes = np.zeros((2, max(count, 4), 2))
-        shapes[0, :count] = vertices
-        c, s = math.cos(support.yaw), math.sin(support.yaw)
-        for k, (sx, sy) in enumerate(_CORNERS):
-            shapes[1, k] = (c * sx * half_x - s * sy * half_y, s * sx * half_x + c * sy * half_y)
-        loop = self._minkowski(shapes, np.array([count, 4]), _UNIT_WEIGHTS, _ORIGIN)
-        return _loop_edges(loop.tolist())
 
     def query(
         self,
@@ -403,9 +331,9 @@ class BalanceMonitor:
             )
         box = None if pitch is None and roll is None else self._torso_box(pitch, roll)
         state = self._state  # read once: the old support or the new one, never a mix
-        cop = _signed_distance(state.cop, px, py)
+        cop = signed_distance(state.cop, px, py)
         if box is None:
-            cmp = _signed_distance(state.cmp, px, py)
+            cmp = signed_distance(state.cmp, px, py)
         else:
             cmp = _sum_distance(state.torso, box, px, py)
         # The N-step regions (compiled, one call), as StepRegions.locate.

@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 from pushrecovery.arguments import (
     bounded_float,
     finite_array,
+    finite_float,
     finite_vector,
     require_type,
     whole_number,
@@ -45,7 +46,8 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_plan import CapturePlan, capture_plan, plan_loads
+from pushrecovery.surfaces.capture_plan import CapturePlan, _plan, plan_loads
+from pushrecovery.surfaces.capture_region import MAX_CAPTURE_POINT, MAX_POSITION
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.cop import CaptureInterval
 from pushrecovery.surfaces.n_step import (
@@ -371,23 +373,48 @@ def _canonical(params: BodyParams) -> _Canonical:
     )
 
 
-def _row_counts(counts: NDArray[np.int64]) -> NDArray[np.int64]:
-    """Edge counts by row (level m of stance k at row m K + k), read-only."""
+@dataclass(frozen=True, slots=True, eq=False)
+class _Layout:
+    """The rows of one stance's regions before placement (:func:`_layout`), all read-only.
+
+    ``tables``, ``counts`` and ``discs`` are the canonical arrays of its stance feet (both from
+    double support); ``rows`` of at most ``longest`` edges, level m of side k at row m K + k.
+    """
+
+    stances: tuple[Stance, ...]
+    tables: FloatArray
+    counts: NDArray[np.int64]
+    discs: FloatArray
+    rows: int
+    longest: int
+    row_counts: NDArray[np.int64]
+    steps: tuple[int, ...]
+    steps_array: NDArray[np.int64]
+    outer: NDArray[np.bool_]
+
+
+@functools.lru_cache(maxsize=48)
+def _layout(params: BodyParams, stance: Stance) -> _Layout:
+    """Return the canonical rows a support of ``stance`` places (kept: a support costs less)."""
+    canonical = _canonical(params)
+    stances: tuple[Stance, ...]
+    if stance is Stance.DOUBLE:
+        stances = (Stance.RIGHT, Stance.LEFT)  # the left foot lifts first
+        tables, counts, discs = canonical.tables, canonical.counts, canonical.discs
+        nested = canonical.nested[0] and canonical.nested[1]
+    else:
+        stances = (stance,)
+        k = _SIDE[stance]
+        tables, counts = canonical.tables[k : k + 1], canonical.counts[k : k + 1]
+        discs, nested = canonical.discs[k : k + 1], canonical.nested[k]
     rows = np.ascontiguousarray(counts.T).reshape(-1)
-    rows.flags.writeable = False
-    return rows
-
-
-@functools.lru_cache(maxsize=16)
-def _levels(
-    params: BodyParams, sides: int, nested: bool
-) -> tuple[tuple[int, ...], NDArray[np.int64], NDArray[np.bool_]]:
-    """N of each row (ascending, ``sides`` rows each), as int64, and the ``outer`` flags."""
-    steps = tuple(n for n in range(1, params.max_steps + 1) for _ in range(sides))
+    steps = tuple(n for n in range(1, params.max_steps + 1) for _ in stances)
     array = np.array(steps, dtype=np.int64)
     outer = np.array([not nested or n == params.max_steps for n in steps])
-    array.flags.writeable = outer.flags.writeable = False
-    return steps, array, outer
+    rows.flags.writeable = array.flags.writeable = outer.flags.writeable = False
+    return _Layout(
+        stances, tables, counts, discs, len(steps), int(counts.max()), rows, steps, array, outer
+    )
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -512,6 +539,8 @@ class StepRegions:
         """
         from pushrecovery.kernels.plane_codes import locate_steps
 
+        px, py = finite_float("px", px, "m"), finite_float("py", py, "m")
+        steps = whole_number("steps", steps, 1, self.params.max_steps)
         if landing_yaw is not None:
             landing_yaw = bounded_float("landing_yaw", landing_yaw, -math.pi, math.pi, "rad")
         if com is not None:
@@ -542,21 +571,32 @@ class StepRegions:
         stance, x, y, yaw = self._stances[k]
         c, s = math.cos(yaw), math.sin(yaw)
         dx, dy = px - x, py - y
-        local = np.array([c * dx + s * dy, -s * dx + c * dy])
+        lx, ly = c * dx + s * dy, -s * dx + c * dy
+        local = np.array([lx, ly])
+        if not (abs(lx) <= MAX_CAPTURE_POINT and abs(ly) <= MAX_CAPTURE_POINT):
+            raise InvalidParameterError(
+                f"(px, py) must lie within ±{MAX_CAPTURE_POINT:g} m of the stance ankle, got "
+                f"({px!r}, {py!r}) (ankle ({x!r}, {y!r}))"
+            )
         option = _canonical(self.params).options[_SIDE[stance]]
         turned = None if landing_yaw is None else math.remainder(landing_yaw - yaw, math.tau)
-        local_com = None
+        local_com = velocity = None
         if com is not None:
             gx, gy = float(com[0]) - x, float(com[1]) - y
-            local_com = (c * gx + s * gy, -s * gx + c * gy)
-        plan = capture_plan(
+            local_com = finite_vector("com", (c * gx + s * gy, -s * gx + c * gy), 2, MAX_POSITION,
+                                      "m")  # fmt: skip
+            velocity = self.params.omega * (local - local_com)
+        # capture_plan's own steps, its arguments checked here (a loop's tick pays them once).
+        step_time = self.params.min_step_time
+        plan = _plan(
             local,
             self.params,
             option,
             steps,
-            margin=margins[k] if not turned else None,
-            landing_yaw=turned,
-            com=local_com,
+            tuple(step_time + step_time * n for n in range(steps)),
+            True,
+            margins[k] if not turned else None,
+            option.yaw if turned is None else turned,
         )
         turn = np.array([[c, s], [-s, c]])  # row vectors times this: turned by the yaw
         shift = np.array([x, y])
@@ -571,7 +611,7 @@ class StepRegions:
             shift,
             yaw,
             yaw if landing_yaw is None else landing_yaw,
-            plan.loads,
+            plan_loads(plan, self.params, local_com, velocity),
         )
 
 
@@ -580,34 +620,23 @@ def _regions(params: BodyParams, support: Support) -> StepRegions:
     """Place both stance feet's canonical regions at the support's feet."""
     from pushrecovery.kernels.placement import place_tables
 
-    canonical = _canonical(params)
-    stances: tuple[Stance, ...]
-    if support.stance is Stance.DOUBLE:
-        stances = (Stance.RIGHT, Stance.LEFT)  # the left foot lifts first
-        tables, counts, discs = canonical.tables, canonical.counts, canonical.discs
-        nested = canonical.nested[0] and canonical.nested[1]
-    else:
-        stances = (support.stance,)
-        k = _SIDE[support.stance]
-        tables, counts = canonical.tables[k : k + 1], canonical.counts[k : k + 1]
-        discs, nested = canonical.discs[k : k + 1], canonical.nested[k]
-    poses = [support.left if stance is Stance.LEFT else support.right for stance in stances]
+    layout = _layout(params, support.stance)
+    poses = [support.left if stance is Stance.LEFT else support.right for stance in layout.stances]
     placed = np.array([(math.cos(p.yaw), math.sin(p.yaw), p.x, p.y) for p in poses])
-    rows = len(stances) * params.max_steps
-    table = np.empty((rows, int(counts.max()), 7))
-    circles = np.empty((rows, 4))
-    place_tables(tables, counts, discs, placed, table, circles)
-    steps, array, outer = _levels(params, len(stances), nested)
+    table = np.empty((layout.rows, layout.longest, 7))
+    circles = np.empty((layout.rows, 4))
+    place_tables(layout.tables, layout.counts, layout.discs, placed, table, circles)
     return StepRegions(
         params,
         support,
-        steps,
-        array,
+        layout.steps,
+        layout.steps_array,
         table,
-        _row_counts(counts),
+        layout.row_counts,
         circles,
-        outer,
+        layout.outer,
         tuple(
-            (stance, pose.x, pose.y, pose.yaw) for stance, pose in zip(stances, poses, strict=True)
+            (stance, pose.x, pose.y, pose.yaw)
+            for stance, pose in zip(layout.stances, poses, strict=True)
         ),
     )
