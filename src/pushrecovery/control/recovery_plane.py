@@ -158,20 +158,22 @@ class PlaneRecoveryController(Controller):
         if swing is not None and t >= swing[2] - 1e-9:
             self._land(*swing)
         omega = self.params.omega
-        xi = capture_point(state[0:2], state[4:6], omega)
+        values = np.asarray(state, dtype=np.float64).tolist()  # floats: the tick off numpy
+        px = capture_point(values[0], values[4], omega)
+        py = capture_point(values[1], values[5], omega)
         pitch, roll = self._hip_torques(t)
         if self._swing is not None and self.plan is not None:
             cop = self.plan.cops[0]
             saturated = self.plan.margin <= 0.0
             return Command(float(cop[0]), pitch, saturated, cop_y=float(cop[1]), roll_torque=roll)
-        effective = xi - self._hip_remaining(t)
-        polygon = self.support.polygon
-        if polygon.point_signed_distance(float(effective[0]), float(effective[1])) > 0.0:
+        hx, hy = self._hip_remaining(t)
+        ex, ey = px - hx, py - hy  # ξ_e = ξ − h(t)
+        if self.support.polygon.point_signed_distance(ex, ey) > 0.0:
             self.mode = "ankle" if self._hip is None else self.mode
-            return Command(float(effective[0]), pitch, cop_y=float(effective[1]), roll_torque=roll)
-        if self._hip is None and self._cmp_margin(float(xi[0]), float(xi[1])) > 0.0:
-            return self._start_hip(t, xi)
-        return self._start_step(t, effective)
+            return Command(ex, pitch, cop_y=ey, roll_torque=roll)
+        if self._hip is None and self._cmp_margin(px, py) > 0.0:
+            return self._start_hip(t, np.array([px, py]))
+        return self._start_step(t, ex, ey)
 
     def _cmp_margin(self, px: float, py: float) -> float:
         """Signed distance of ξ to the support's CMP region [m] (``BalanceMonitor``'s).
@@ -202,14 +204,13 @@ class PlaneRecoveryController(Controller):
         cop = points[1]
         return Command(float(cop[0]), pitch, cop_y=float(cop[1]), roll_torque=roll)
 
-    def _start_step(self, t: float, effective: FloatArray) -> Command:
-        """Lift the first foot of the smallest plan that captures ξ_e."""
+    def _start_step(self, t: float, px: float, py: float) -> Command:
+        """Lift the first foot of the smallest plan that captures ξ_e = (px, py) [m]."""
         body = self.params if self._hip is None else self._without_hip
         regions = StepRegions.of(body, self.support)
-        px, py = float(effective[0]), float(effective[1])
         steps, _ = regions.locate(px, py)
         plan = regions.plan(px, py, steps if steps else body.max_steps)
-        if self._hip is None and float(np.abs(plan.hip).max()) > 0.0:
+        if self._hip is None and plan.hip.any():
             self._begin_hip(t, plan.hip)
         foothold = (float(plan.footholds[0, 0]), float(plan.footholds[0, 1]))
         touchdown = t + float(plan.touchdowns[0])
@@ -253,10 +254,10 @@ class PlaneRecoveryController(Controller):
         )
         self._hip = _HipManoeuvre(t, (fractions[0], fractions[1]), yaw)
 
-    def _hip_remaining(self, t: float) -> FloatArray:
+    def _hip_remaining(self, t: float) -> tuple[float, float]:
         """Return the hip manoeuvre's remaining capture-point share h(t), world frame [m]."""
         if self._hip is None:
-            return np.zeros(2)
+            return 0.0, 0.0
         omega, weight = self.params.omega, self.params.weight
         along = [
             fraction * torque / weight * _hip_share(t - self._hip.start, spin_up, omega)
@@ -265,7 +266,7 @@ class PlaneRecoveryController(Controller):
             )
         ]
         c, s = math.cos(self._hip.yaw), math.sin(self._hip.yaw)
-        return np.array([c * along[0] - s * along[1], s * along[0] + c * along[1]])
+        return c * along[0] - s * along[1], s * along[0] + c * along[1]
 
     def _hip_torques(self, t: float) -> tuple[float, float]:
         """Pitch and roll torques [N m]: the profile's mean over this tick (exact under ZOH)."""
