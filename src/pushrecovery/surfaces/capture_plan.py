@@ -462,7 +462,8 @@ def _plan(
         sides.append(swing)
         # The landed foot is the next stance; its capture point arrives relative to its ankle.
         ankle, relative = ankle + foothold, points[2].copy()
-        stance_key = landing_foot(params, swing, landing).vertices.tobytes()
+        if more > 1:  # the next step's stance
+            stance_key = landing_foot(params, swing, landing).vertices.tobytes()
         swing = Stance.RIGHT if swing is Stance.LEFT else Stance.LEFT
         touchdown, use_hip, yaw = params.min_step_time, False, landing
     cops.append(relative + ankle)  # the last CoP holds the capture point, in the last foot

@@ -567,7 +567,7 @@ class StepRegions:
             outward = lateral >= 0.0 if stance is Stance.RIGHT else lateral <= 0.0
             return margins[k] > 0.0 and outward, margins[k]
 
-        k = max(range(sides), key=preference)
+        k = 0 if sides == 1 else max(range(sides), key=preference)
         stance, x, y, yaw = self._stances[k]
         c, s = math.cos(yaw), math.sin(yaw)
         dx, dy = px - x, py - y
