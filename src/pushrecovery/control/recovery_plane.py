@@ -113,6 +113,9 @@ class PlaneRecoveryController(Controller):
         self._spin_up = (max_spin_up_time(params), max_spin_up_time(roll_axis(params)))
         self._offsets = (cmp_offset(params), cmp_offset_roll(params))
         self._torques = (params.torque_max, params.torque_max_roll)
+        # The CMP region's rows of the last support asked (supports are immutable: kept
+        # across resets, so a run from the default feet builds none).
+        self._cmp: tuple[Support | None, Edges] = (None, ())
         self.reset(np.zeros(len(PLANE_STATE_LABELS)))
         # The compiled paths (the CMP region's sum, the regions' placement and tests) loaded
         # now rather than in the loop: a support change then costs tens of µs, any pose or yaw.
@@ -135,7 +138,6 @@ class PlaneRecoveryController(Controller):
                 f"got shape {np.shape(state)}"
             )
         self.support = Support.from_params(self.params, Stance.DOUBLE)
-        self._cmp: tuple[Support | None, Edges] = (None, ())
         self.mode = "ankle"
         self.plan: CapturePlan | None = None
         self._hip: _HipManoeuvre | None = None
@@ -210,7 +212,8 @@ class PlaneRecoveryController(Controller):
         regions = StepRegions.of(body, self.support)
         steps, _ = regions.locate(px, py)
         plan = regions.plan(px, py, steps if steps else body.max_steps)
-        if self._hip is None and plan.hip.any():
+        hx, hy = plan.hip.tolist()
+        if self._hip is None and (hx or hy):
             self._begin_hip(t, plan.hip)
         foothold = (float(plan.footholds[0, 0]), float(plan.footholds[0, 1]))
         touchdown = t + float(plan.touchdowns[0])

@@ -92,7 +92,9 @@ def cmp_rows(support: Support, half_x: float, half_y: float) -> Edges:
     shapes = np.zeros((2, max(count, 4), 2))
     shapes[0, :count] = vertices
     c, s = math.cos(support.yaw), math.sin(support.yaw)
-    for k, (sx, sy) in enumerate(_CORNERS):
-        shapes[1, k] = (c * sx * half_x - s * sy * half_y, s * sx * half_x + c * sy * half_y)
+    shapes[1, :4] = [
+        (c * sx * half_x - s * sy * half_y, s * sx * half_x + c * sy * half_y)
+        for sx, sy in _CORNERS
+    ]
     loop = minkowski_loop(shapes, np.array([count, 4]), _UNIT_WEIGHTS, _ORIGIN)
     return loop_rows(loop.tolist())
