@@ -89,15 +89,21 @@ class ConvexPolygon:
                 "ConvexPolygon takes arrays vertices (n, 2), normals (n, 2) and offsets (n,), "
                 "n >= 3; build one with convex_polygon, convex_hull or rectangle"
             )
-        rows = np.column_stack([start, following(start), self.normals, self.offsets])
-        object.__setattr__(self, "_edges", tuple(map(tuple, rows.tolist())))
+        v, n, b = start.tolist(), normals.tolist(), offsets.tolist()
+        rows = tuple(
+            (x0, y0, x1, y1, nx, ny, bb)
+            for (x0, y0), (x1, y1), (nx, ny), bb in zip(v, v[1:] + v[:1], n, b, strict=True)
+        )
+        object.__setattr__(self, "_edges", rows)
 
     @classmethod
     def _from_ccw(cls, vertices: FloatArray) -> ConvexPolygon:
         vertices = np.array(vertices, dtype=np.float64)
         edges = following(vertices) - vertices
         lengths = np.hypot(edges[:, 0], edges[:, 1])
-        normals = np.column_stack([edges[:, 1], -edges[:, 0]]) / lengths[:, None]
+        normals = np.empty_like(edges)  # (e_y, −e_x)/‖e‖: the edge turned −90°
+        normals[:, 0], normals[:, 1] = edges[:, 1], -edges[:, 0]
+        normals /= lengths[:, None]
         offsets = np.einsum("ij,ij->i", normals, vertices)
         for array in (vertices, normals, offsets):
             array.flags.writeable = False
@@ -368,7 +374,11 @@ def _chain(points: Sequence[list[float]]) -> list[list[float]]:
     """One chain of Andrew's monotone chain: left turns kept, collinear points dropped."""
     hull: list[list[float]] = []
     for p in points:
-        while len(hull) >= 2 and _cross(hull[-2], hull[-1], p) <= 0.0:
+        cx, cy = p
+        while len(hull) >= 2:
+            (ax, ay), (bx, by) = hull[-2], hull[-1]
+            if not (bx - ax) * (cy - by) - (by - ay) * (cx - bx) <= 0.0:  # a left turn at b
+                break
             hull.pop()
         hull.append(p)
     return hull
