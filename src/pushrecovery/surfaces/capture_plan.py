@@ -41,7 +41,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import bounded_float, finite_float, finite_vector, require_type
+from pushrecovery.arguments import (
+    bounded_float,
+    finite_float,
+    finite_pair,
+    finite_vector,
+    require_type,
+)
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import (
     decompose_unchecked,
@@ -270,8 +276,8 @@ def plan_loads(
         raise InvalidParameterError("give both position and velocity (the CoM state), or neither")
     if position is None or velocity is None:
         return PlanLoads(torques, peak, torque_ok)
-    rx, ry = _point("position", position, MAX_POSITION, "m")
-    vx, vy = _point("velocity", velocity, MAX_SPEED, "m/s")
+    rx, ry = finite_pair("position", position, MAX_POSITION, "m")
+    vx, vy = finite_pair("velocity", velocity, MAX_SPEED, "m/s")
     omega = params.omega
     first = math.exp(-omega * float(plan.touchdowns[0]))
     hx, hy = (h / (1.0 - first) for h in plan.hip.tolist()) if first < 1.0 else (0.0, 0.0)
@@ -295,16 +301,6 @@ def plan_loads(
         return PlanLoads(torques, peak, torque_ok, force)
     ratio = force / (params.friction * weight)
     return PlanLoads(torques, peak, torque_ok, force, ratio, ratio <= 1.0)
-
-
-def _point(name: str, value: object, bound: float, unit: str) -> tuple[float, float]:
-    """Return a finite (x, y) within ±``bound`` as two floats (a float pair skips numpy)."""
-    if type(value) is tuple and len(value) == 2 and all(type(v) is float for v in value):
-        a, b = value
-        if abs(a) <= bound and abs(b) <= bound:  # False for NaN: refused below, by name
-            return a, b
-    a, b = finite_vector(name, value, 2, bound, unit).tolist()  # type: ignore[arg-type]
-    return a, b
 
 
 def capture_plan(

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pushrecovery.arguments import finite_float, finite_vector, require_type
+from pushrecovery.arguments import finite_float, finite_pair, require_type
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan
 from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
@@ -120,8 +120,8 @@ def plan_impacts(
     from pushrecovery.kernels.single_margins import edge_rows, signed_distance
 
     require_type("plan", plan, CapturePlan)
-    rx, ry = _pair("position", position, MAX_POSITION, "m")
-    vx, vy = _pair("velocity", velocity, MAX_SPEED, "m/s")
+    rx, ry = finite_pair("position", position, MAX_POSITION, "m")
+    vx, vy = finite_pair("velocity", velocity, MAX_SPEED, "m/s")
     require_type("params", params, BodyParams)
     yaw = finite_float("yaw", yaw, "rad")
     omega, height = params.omega, params.com_height
@@ -168,13 +168,3 @@ def plan_impacts(
         )
         ax, ay = qx, qy
     return found
-
-
-def _pair(name: str, value: object, bound: float, unit: str) -> tuple[float, float]:
-    """``finite_vector(name, value, 2, bound, unit)`` as two floats; a float pair skips numpy."""
-    if type(value) is tuple and len(value) == 2 and all(type(v) is float for v in value):
-        a, b = value
-        if abs(a) <= bound and abs(b) <= bound:  # False for NaN: checked below, by name
-            return a, b
-    a, b = finite_vector(name, value, 2, bound, unit).tolist()  # type: ignore[arg-type]
-    return a, b
