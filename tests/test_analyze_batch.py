@@ -178,7 +178,7 @@ def _write(path, text):
 
 
 def test_the_batch_tables_are_typed_and_read_by_pandas(study, tmp_path):
-    from pushrecovery.campaign.trial_rows import TrialRow
+    from pushrecovery.campaign.trials.rows import TrialRow
 
     trials, root = find_trials([study / "s01"])
     jobs = trial_jobs(trials, root, flags={"mass": P.mass})  # no silent preset mass (issue 34)

@@ -64,7 +64,7 @@ def test_write_events_needs_a_c3d_trial(tmp_path, capsys):
 def test_a_batch_writes_the_steps_table_and_each_c3d_trials_events(tmp_path, capsys):
     import pyarrow.parquet as pq
 
-    from pushrecovery.campaign.trial_steps import STEP_FIELDS
+    from pushrecovery.campaign.trials.steps import STEP_FIELDS
     from pushrecovery.experiments.synthetic_trials import lipm_trial_csv
 
     study = tmp_path / "study"

@@ -309,7 +309,7 @@ def test_a_robot_standing_off_the_world_origin_has_the_same_prediction(tmp_path:
     # the biped3d's file standing 5 cm forward and 3 cm left of the origin has the same r0 and
     # the same predicted critical impulses as standing on it (the H1's ankles are 4 cm ahead
     # of its world origin: before, its backward limit was predicted 4 cm of CoM travel long).
-    from pushrecovery.experiments.validation3d_predict import predicted_critical_impulses
+    from pushrecovery.experiments.validation3d.predict import predicted_critical_impulses
 
     plants = []
     for shift in ((0.0, 0.0), (0.05, 0.03)):

@@ -159,8 +159,8 @@ def test_the_steps_table_is_the_step_the_simulation_took(tmp_path):
     The right leg lifts off plate 1, which both feet stood on (so the plate cannot see that
     foot leave: its markers do), and lands on plate 2.
     """
-    from pushrecovery.campaign.trial_steps import step_schema, trial_steps
     from pushrecovery.campaign.trials import TrialJob
+    from pushrecovery.campaign.trials.steps import step_schema, trial_steps
 
     recording = _recorded("step")
     truth = recording.truth

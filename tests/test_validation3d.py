@@ -134,7 +134,7 @@ def test_polar_figure_draws_a_synthetic_result():
 
 def test_the_validation_has_the_dense_prediction_of_the_ground_plane():
     from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS
-    from pushrecovery.experiments.validation3d_predict import predicted_critical_impulses
+    from pushrecovery.experiments.validation3d.predict import predicted_critical_impulses
 
     params = load_params()
     result = run_validation3d("biped3d", (0.0,), ("ankle",), rel_tolerance=0.3, duration=0.3)
@@ -146,7 +146,7 @@ def test_the_validation_has_the_dense_prediction_of_the_ground_plane():
 
 
 def test_polar_figure_of_a_step_column_alone_is_titled_by_its_model():
-    from pushrecovery.experiments.validation3d_step import StepRow, StepValidation
+    from pushrecovery.experiments.validation3d.step import StepRow, StepValidation
     from pushrecovery.plots.validation3d import validation3d_figure
 
     rows = tuple(StepRow(a, 40.0, 30.0, 25.0, (25.0, 25.5), 6, 1, 0.2, 0.4)

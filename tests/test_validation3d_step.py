@@ -7,7 +7,7 @@ import pytest
 
 from pushrecovery import load_params
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
-from pushrecovery.experiments.validation3d_step import (
+from pushrecovery.experiments.validation3d.step import (
     StepRow,
     measure_step_critical,
     predicted_step_critical,

@@ -62,7 +62,7 @@ NAN_DOCUMENTED = {
     "pushrecovery.analysis.margins.direction_margins": "NaN: a missing frame, or no step",
     "pushrecovery.sim.many.run_many": "NaN: the measures of an error row (a push that timed out)",
     "pushrecovery.sim.validation.critical_table": "NaN: no correction, no measured force",
-    "pushrecovery.experiments.validation3d_step.run_step_validation": "NaN: no run, no step",
+    "pushrecovery.experiments.validation3d.step.run_step_validation": "NaN: no run, no step",
     "pushrecovery.experiments.validation3d.run_validation3d": "NaN: no run",
     "pushrecovery.analysis.zero_point.com_from_force": "NaN outside the zero points",
     "pushrecovery.surfaces.probability.scores.brier_score": "NaN: no predictions",

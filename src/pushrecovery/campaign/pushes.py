@@ -2,10 +2,11 @@
 
 Every row records the push's inputs, what the paper's surfaces predict for the state just after
 it, and what the simulation did: a ``dict`` from column name to value, the columns of
-:mod:`.rows` (whose :func:`~.rows.row_schema` gives each one's unit and description; positions
-relative to the stance ankle). A push without an outcome (its physics diverged, it was too
-slow, its worker died) is an error row (:func:`error_row`): ``outcome`` = ``used`` = error, the
-simulated columns NaN (counts 0), ``error`` saying why.
+:mod:`pushrecovery.campaign.rows` (whose :func:`~pushrecovery.campaign.rows.row_schema`
+gives each one's unit and description; positions relative to the stance ankle). A push
+without an outcome (its physics diverged, it was too slow, its worker died) is an error row
+(:func:`error_row`): ``outcome`` = ``used`` = error, the simulated columns NaN (counts 0),
+``error`` saying why.
 
 The 3-D models (``biped3d``, ``g1``) add columns, null on the others, and read some of them in
 3-D (:mod:`.pushes3d`).

@@ -58,7 +58,7 @@ def bounds(as_json: bool, model: str | None, **kwargs: Any) -> None:
     if model is not None:
         if not model.lower().endswith(".xml"):
             raise InvalidParameterError(f"--model must be an MJCF file PATH.xml, got {model!r}")
-        from pushrecovery.cli.bodies3d import mjcf_plant
+        from pushrecovery.cli.humanoid.bodies import mjcf_plant
 
         params = mjcf_plant(model, kwargs, plant=False).params
     else:

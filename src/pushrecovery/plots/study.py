@@ -1,7 +1,7 @@
 """The per-study figure of a batch of trials: each trial's smallest margins, by condition.
 
 Two rows of panels, the axes (ap, ml), and two columns, the measures of the trials table
-(:class:`~pushrecovery.campaign.trial_rows.TrialRow`): the smallest margin of stability toward
+(:class:`~pushrecovery.campaign.trials.rows.TrialRow`): the smallest margin of stability toward
 the motion (``min_mos_axis``: Hof's b_AP, b_ML) and the smallest CoP margin
 (``min_cop_margin``: to the nearer edge, Eq. 4), in metres, positive inside the base
 (docs/base_polygon.md, "Which margin is which"). Along x the conditions (``condition``, from

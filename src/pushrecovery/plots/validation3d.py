@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 from pushrecovery.arguments import require_type
 from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS, Validation3D
-from pushrecovery.experiments.validation3d_step import StepValidation
+from pushrecovery.experiments.validation3d.step import StepValidation
 from pushrecovery.plots.common import HIP_COLOUR, RECOVER_COLOUR
 
 if TYPE_CHECKING:
@@ -31,7 +31,7 @@ def validation3d_figure(result: Validation3D | None, step: StepValidation | None
     """Return the polar plot of ``result`` and the step column ``step`` as a Figure.
 
     Either may be None (not both); the step column is a model's
-    (:func:`~pushrecovery.experiments.validation3d_step.run_step_validation`).
+    (:func:`~pushrecovery.experiments.validation3d.step.run_step_validation`).
     """
     if result is not None:
         require_type("result", result, Validation3D)

@@ -4,8 +4,9 @@
 campaign`` run biped3d and g1 (MuJoCo, pushes at the torso from any azimuth;
 docs/humanoid3d_pushes.md, "The commands") and list only the options that work for them
 (issue 31); the planar commands of the same names refuse the humanoids in one line naming
-these. The runs are in :mod:`pushrecovery.cli.simulation3d`, :mod:`pushrecovery.cli.validate3d`
-and :mod:`pushrecovery.cli.campaign3d`.
+these. The runs are in this package's modules: :mod:`~pushrecovery.cli.humanoid.simulate`,
+:mod:`~pushrecovery.cli.humanoid.validate` and :mod:`~pushrecovery.cli.humanoid.campaign`,
+and the bodies they run in :mod:`~pushrecovery.cli.humanoid.bodies`.
 
 Over 400 lines on purpose: the four commands of one group, each mostly its options and
 their help, which a reader compares side by side.
@@ -18,7 +19,7 @@ from typing import Any
 import click
 
 from pushrecovery.cli.app import example
-from pushrecovery.cli.campaign_options import CampaignRun, run_options
+from pushrecovery.cli.campaign.options import CampaignRun, run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, planar_only
 from pushrecovery.cli.options import (
     body_options_of,
@@ -182,8 +183,8 @@ def simulate(
     (--preset, --params, --mass, ...) build biped3d; g1 has the robot's own body and refuses
     them.
     """
-    from pushrecovery.cli.bodies3d import body_3d
-    from pushrecovery.cli.simulation3d import check_views, render_options, simulate_3d
+    from pushrecovery.cli.humanoid.bodies import body_3d
+    from pushrecovery.cli.humanoid.simulate import check_views, render_options, simulate_3d
 
     if not render:
         check_views(view_azimuth, view_elevation, frame_times)
@@ -251,8 +252,8 @@ def critical_push(
     against the prediction of the strategy measured. The body flags (--preset, --params,
     --mass, ...) build biped3d; g1 has the robot's own body and refuses them.
     """
-    from pushrecovery.cli.bodies3d import body_3d
-    from pushrecovery.cli.simulation3d import critical_3d
+    from pushrecovery.cli.humanoid.bodies import body_3d
+    from pushrecovery.cli.humanoid.simulate import critical_3d
 
     params, plant = body_3d(model, kwargs)
     emit(critical_3d(model, params, azimuth, tolerance, duration, strategy, plant), as_json)
@@ -354,8 +355,13 @@ def validate(
     from pathlib import Path
 
     from pushrecovery.cli.azimuths import azimuths_from
-    from pushrecovery.cli.bodies3d import body_3d, is_mjcf
-    from pushrecovery.cli.validate3d import QUICK, Validate3DOptions, fraction_list, validate_3d
+    from pushrecovery.cli.humanoid.bodies import body_3d, is_mjcf
+    from pushrecovery.cli.humanoid.validate import (
+        QUICK,
+        Validate3DOptions,
+        fraction_list,
+        validate_3d,
+    )
     from pushrecovery.experiments.confusion3d import DEFAULT_AZIMUTHS, DEFAULT_FRACTIONS
 
     quick_values: dict[str, Any] = QUICK if quick else {}
@@ -451,8 +457,8 @@ def campaign(
     named) have the robot's own body and refuse them and --param.
     """
     from pushrecovery.cli.azimuths import azimuths_from
-    from pushrecovery.cli.bodies3d import body_3d
-    from pushrecovery.cli.campaign3d import echo_causes, spec_3d, write_confusion
+    from pushrecovery.cli.humanoid.bodies import body_3d
+    from pushrecovery.cli.humanoid.campaign import echo_causes, spec_3d, write_confusion
     from pushrecovery.errors import InvalidParameterError
 
     run = CampaignRun.pop(kwargs)

@@ -2,7 +2,7 @@
 
 ``humanoid validate --model biped3d|g1``: each strategy's critical push per azimuth against the 2-D
 prediction (:mod:`pushrecovery.experiments.validation3d`, and for the step
-:mod:`pushrecovery.experiments.validation3d_step`: tables and one polar plot), then a 3-D
+:mod:`pushrecovery.experiments.validation3d.step`: tables and one polar plot), then a 3-D
 campaign over azimuths × fractions of the ankle's predicted critical push under the
 whole-body controller with all its tasks, read as the confusion matrix of predicted against
 used strategy (:mod:`pushrecovery.experiments.confusion3d`). Everything is written under
@@ -108,7 +108,7 @@ def validate_3d(
         data["critical"] = [_row(row) for row in result.rows]
         files |= {"table": str(stem.with_suffix(".md")), "csv": str(stem.with_suffix(".csv"))}
     if "step" in options.strategies:
-        from pushrecovery.experiments.validation3d_step import run_step_validation
+        from pushrecovery.experiments.validation3d.step import run_step_validation
 
         step = run_step_validation(
             options.azimuths,
@@ -191,7 +191,7 @@ def _confusion(
     ``plant``: an MJCF file's plant, whose source the campaigns' workers build.
     """
     from pushrecovery.campaign import CampaignError, CampaignSpec, run_campaign
-    from pushrecovery.cli.campaign3d import write_confusion
+    from pushrecovery.cli.humanoid.campaign import write_confusion
     from pushrecovery.cli.progress import Progress
 
     # One campaign per push size (the sizes need not be evenly spaced: a campaign's range is),

@@ -2,7 +2,7 @@
 
 Columns of ``trials.parquet`` (:class:`TrialRow`; SI units, axes ap and ml as in
 :mod:`pushrecovery.analysis.recording`); the events are in
-:mod:`pushrecovery.campaign.trial_events`. These tables are contracts: columns are added,
+:mod:`pushrecovery.campaign.trials.events`. These tables are contracts: columns are added,
 never renamed or dropped.
 
 Over 400 lines on purpose: :class:`TrialRow` is the batch table's schema, one documented

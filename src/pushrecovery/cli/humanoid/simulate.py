@@ -3,7 +3,7 @@
 ``humanoid simulate --model biped3d|g1|PATH.xml --azimuth DEG``: the whole-body controller
 after a push from any direction (:mod:`pushrecovery.sim.mujoco.humanoid3d.runs3d`); the
 commands are in :mod:`pushrecovery.cli.humanoid`, the body and plant of ``--model`` in
-:mod:`pushrecovery.cli.bodies3d`.
+:mod:`pushrecovery.cli.humanoid.bodies`.
 """
 
 from __future__ import annotations
@@ -166,7 +166,7 @@ def simulate_3d(
     slip_limit : float
         Largest loaded-foot slip of a recovered run [m] (more: ``slipped``).
     plant : Humanoid3DPlant, optional
-        The plant (an MJCF file's, :func:`~pushrecovery.cli.bodies3d.body_3d`); default the
+        The plant (an MJCF file's, :func:`~pushrecovery.cli.humanoid.bodies.body_3d`); default the
         built-in ``model``'s.
 
     Returns
@@ -275,7 +275,7 @@ def critical_3d(
         reacting during the push), or None: the model's own controller without stepping
         (the biped3d's with its hip task, the G1's and an MJCF model's without).
     plant : Humanoid3DPlant, optional
-        The plant (an MJCF file's, :func:`~pushrecovery.cli.bodies3d.body_3d`); default the
+        The plant (an MJCF file's, :func:`~pushrecovery.cli.humanoid.bodies.body_3d`); default the
         built-in ``model``'s.
 
     Returns
@@ -289,8 +289,8 @@ def critical_3d(
         ``corrected_error`` against it.
     """
     from pushrecovery.arguments import positive_float
-    from pushrecovery.experiments.validation3d_predict import predicted_critical_impulses
-    from pushrecovery.experiments.validation3d_step import predicted_step_critical
+    from pushrecovery.experiments.validation3d.predict import predicted_critical_impulses
+    from pushrecovery.experiments.validation3d.step import predicted_step_critical
     from pushrecovery.sim.mujoco.humanoid3d.runs3d import critical_push3d
     from pushrecovery.sim.registry import make_plant3d
 

@@ -51,7 +51,7 @@ import numpy as np
 from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.experiments.validation3d import CURVE_AZIMUTHS, DEFAULT_AZIMUTHS, MAX_RUNS
-from pushrecovery.experiments.validation3d_predict import CriticalErrors, critical_impulse_along
+from pushrecovery.experiments.validation3d.predict import CriticalErrors, critical_impulse_along
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import Backend

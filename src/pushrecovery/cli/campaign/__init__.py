@@ -1,4 +1,4 @@
-"""The ``campaign`` and ``report`` commands (registered on the group in :mod:`.app`).
+"""The ``campaign`` and ``report`` commands (registered on :mod:`pushrecovery.cli.app`'s group).
 
 ``campaign`` runs the planar models (analytic and sagittal MuJoCo); the 3-D humanoids' is
 ``pushrecovery humanoid campaign`` (:mod:`pushrecovery.cli.humanoid`), and a 3-D model or
@@ -14,7 +14,7 @@ from typing import Any
 import click
 
 from pushrecovery.cli.app import example
-from pushrecovery.cli.campaign_options import SCHEDULER, WORKERS, CampaignRun, run_options
+from pushrecovery.cli.campaign.options import SCHEDULER, WORKERS, CampaignRun, run_options
 from pushrecovery.cli.families import HUMANOID_MODELS, ModelChoice, humanoid_only
 from pushrecovery.cli.options import (
     body_options,
@@ -220,7 +220,7 @@ def report(
     and grids. With --model PATH.xml the body is your robot's, derived from its MJCF file
     (body flags refused), and the 3-D section validates and films it beside the G1.
     """
-    from pushrecovery.cli.bodies3d import mjcf_body, params_3d
+    from pushrecovery.cli.humanoid.bodies import mjcf_body, params_3d
     from pushrecovery.report import write_report
 
     source = None

@@ -25,7 +25,7 @@ def spec_3d(model: str, params: Any, strategy: str | None, **options: Any) -> An
     model : str
         ``biped3d``, ``g1`` or ``mjcf`` (with ``mjcf=`` the file's MjcfSource in ``options``).
     params : BodyParams
-        The body (:func:`pushrecovery.cli.bodies3d.body_3d`).
+        The body (:func:`pushrecovery.cli.humanoid.bodies.body_3d`).
     strategy : str or None
         ``--strategy``: the controller ``wbc-STRATEGY`` (None: ``wbc-step``).
     **options

@@ -4,13 +4,13 @@
 and glob patterns into a sorted list of trials; :func:`run_trials` analyses each one as
 ``pushrecovery analyze`` does a single file into ``OUT/trials/<trial>/``, its rows last into
 ``trial.json`` (a trial with that file is finished: ``resume`` skips it), then joins them into
-``OUT/trials.parquet`` (:class:`~pushrecovery.campaign.trial_rows.TrialRow`, one row per trial
-and axis; a trial that could not be read or analysed is a ``failed`` row), ``OUT/events.parquet``
-(:class:`~pushrecovery.campaign.trial_events.EventRow`), ``OUT/steps.parquet``
-(:class:`~pushrecovery.campaign.trial_steps.StepRow`, one row per measured step), their CSV
-twins and
-``OUT/summary.json``. Only the project's own errors make a ``failed`` row: anything else is a
-bug and stops the batch. docs/analysis.md, "Many trials", has the details.
+``OUT/trials.parquet`` (:class:`~pushrecovery.campaign.trials.rows.TrialRow`, one row per
+trial and axis; a trial that could not be read or analysed is a ``failed`` row),
+``OUT/events.parquet`` (:class:`~pushrecovery.campaign.trials.events.EventRow`),
+``OUT/steps.parquet`` (:class:`~pushrecovery.campaign.trials.steps.StepRow`, one row per
+measured step), their CSV twins and ``OUT/summary.json``. Only the project's own errors make
+a ``failed`` row: anything else is a bug and stops the batch. docs/analysis.md, "Many
+trials", has the details.
 
 Over 400 lines on purpose: finding, running and joining the trials of a batch share the job,
 its result and the resumable state on disk; local processes and Dask run the same jobs.
@@ -30,15 +30,15 @@ from typing import Any
 
 from pushrecovery.arguments import require_type
 from pushrecovery.campaign.subjects import Subject, subject_for
-from pushrecovery.campaign.trial_events import EVENT_FIELDS, EventRow, trial_events
-from pushrecovery.campaign.trial_rows import (
+from pushrecovery.campaign.trials.events import EVENT_FIELDS, EventRow, trial_events
+from pushrecovery.campaign.trials.rows import (
     TRIAL_FIELDS,
     TrialRow,
     failed_rows,
     sway_rows,
     trial_rows,
 )
-from pushrecovery.campaign.trial_steps import StepRow, step_schema, trial_steps
+from pushrecovery.campaign.trials.steps import StepRow, step_schema, trial_steps
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError, PushRecoveryError
 from pushrecovery.extras import require
 
@@ -167,9 +167,9 @@ class TrialsResult:
 
     ``trials``, ``events`` and ``steps`` are the rows of ``trials.parquet``,
     ``events.parquet`` and ``steps.parquet``
-    (:class:`~pushrecovery.campaign.trial_rows.TrialRow`,
-    :class:`~pushrecovery.campaign.trial_events.EventRow` and
-    :class:`~pushrecovery.campaign.trial_steps.StepRow` as dicts).
+    (:class:`~pushrecovery.campaign.trials.rows.TrialRow`,
+    :class:`~pushrecovery.campaign.trials.events.EventRow` and
+    :class:`~pushrecovery.campaign.trials.steps.StepRow` as dicts).
     """
 
     trials: list[dict[str, Any]]
@@ -399,7 +399,7 @@ def _on_cluster(
 def _join(jobs: list[TrialJob], out: Path, ran: int) -> TrialsResult:
     """Read every trial's rows (in job order) and write the batch's tables and summary."""
     from pushrecovery.analysis.trial.checks import QUALITY_FIELDS
-    from pushrecovery.campaign.trial_rows import batch_summary, write_table
+    from pushrecovery.campaign.trials.rows import batch_summary, write_table
 
     trials: list[dict[str, Any]] = []
     events: list[dict[str, Any]] = []

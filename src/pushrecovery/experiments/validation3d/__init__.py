@@ -2,7 +2,7 @@ r"""The 2-D prediction of the critical push against the 3-D bodies, from every d
 
 For a 3-D model (``biped3d``, or ``g1`` with the ``robots`` extra) and push azimuths ψ (0 forward
 +x, 90 left +y, degrees), each strategy's **predicted** critical impulse J* = m ω ρ_R(r₀, ψ)
-comes from the ground plane's regions (:mod:`~pushrecovery.experiments.validation3d_predict`),
+comes from the ground plane's regions (:mod:`~pushrecovery.experiments.validation3d.predict`),
 its **corrected** one J*/(1 + d/z₀) puts back the push's height d above the CoM, and its
 **measured** one is bisected under the whole-body controller in MuJoCo
 (:func:`measure_critical_impulse`). The relative error is (measured − predicted)/predicted.
@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 from pushrecovery.arguments import bounded_float, require_type
 from pushrecovery.errors import InvalidParameterError
-from pushrecovery.experiments.validation3d_predict import (
+from pushrecovery.experiments.validation3d.predict import (
     CriticalErrors,
     critical_impulse_along,
     predicted_critical_impulses,

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
 from pushrecovery.arguments import require_type
-from pushrecovery.campaign.trial_rows import check_job, subject_name
+from pushrecovery.campaign.trials.rows import check_job, subject_name
 
 if TYPE_CHECKING:
     from pushrecovery.analysis.trial import TrialSummary

@@ -1,6 +1,6 @@
 """Commands that simulate one push or bisect one: ``simulate`` and ``critical-push``.
 
-Their shared options are in :mod:`pushrecovery.cli.simulation_options`. The planar models only:
+Their shared options are in :mod:`pushrecovery.cli.simulation.options`. The planar models only:
 the 3-D humanoids are ``pushrecovery humanoid simulate`` and ``critical-push``
 (:mod:`pushrecovery.cli.humanoid`).
 """
@@ -24,7 +24,7 @@ from pushrecovery.cli.options import (
     support_options,
 )
 from pushrecovery.cli.progress import Progress
-from pushrecovery.cli.simulation_options import controller_options, planar_run, timing
+from pushrecovery.cli.simulation.options import controller_options, planar_run, timing
 
 __all__ = ["critical_push", "simulate"]
 
