@@ -128,7 +128,7 @@ def set_support() -> bool:
 
 
 def replan() -> bool:
-    from pushrecovery.surfaces.step_regions import StepRegions
+    from pushrecovery.surfaces.step.regions import StepRegions
 
     params = load_params()
     controller = PlaneRecoveryController(params)

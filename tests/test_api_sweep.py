@@ -156,7 +156,7 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     "pushrecovery.sim.result.strategy_used": {"peak_hip_torque": 2.0},
     "pushrecovery.sim.push.direction_sign": {"direction": "forward"},
     "pushrecovery.sim.push.push_direction": {"azimuth": 90.0},
-    "pushrecovery.surfaces.step_impact.plan_impacts": {"velocity": (2.0, 0.0)},
+    "pushrecovery.surfaces.step.impact.plan_impacts": {"velocity": (2.0, 0.0)},
     "pushrecovery.control.base.controller_class": {"name": "ankle-pd"},
     "pushrecovery.control.base.make_controller": {"name": "ankle-pd"},
     "pushrecovery.sim.registry.make_plant": {"name": "pendulum"},

@@ -315,7 +315,7 @@ def test_the_impact_at_a_symmetric_touchdown_is_sec4s():
     from pushrecovery.ground.support import Stance
     from pushrecovery.models.stepping import impact_velocities
     from pushrecovery.surfaces.capture_plan import CapturePlan
-    from pushrecovery.surfaces.step_impact import plan_impacts
+    from pushrecovery.surfaces.step.impact import plan_impacts
 
     params = load_params(overrides={"min_step_time": 0.0})
     height = params.com_height
@@ -451,7 +451,7 @@ def test_bad_plan_and_region_arguments_are_refused(call, match):
 
 def test_line_steps_all_levels_at_once_equal_level_by_level(monkeypatch):
     # Small inputs test every N at once; large ones loop over N: the same numbers.
-    from pushrecovery.surfaces import step_regions
+    from pushrecovery.surfaces.step import regions as step_regions
 
     P = load_params()
     rng = np.random.default_rng(11)

@@ -32,8 +32,8 @@ from pushrecovery.surfaces.classify import Strategy, classify
 from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.n_step import hip_box, landing_viable, reach_polygon, step_options
 from pushrecovery.surfaces.plane import cmp_polygon
-from pushrecovery.surfaces.step_impact import plan_impacts
-from pushrecovery.surfaces.step_regions import StepRegions, _sagittal_plan, line_steps
+from pushrecovery.surfaces.step.impact import plan_impacts
+from pushrecovery.surfaces.step.regions import StepRegions, _sagittal_plan, line_steps
 from pushrecovery.surfaces.verdicts import sagittal_verdict, sagittal_verdicts
 
 

@@ -24,7 +24,7 @@ from pushrecovery.ground.minkowski import clip
 from pushrecovery.ground.polygon import convex_hull, rectangle
 from pushrecovery.ground.support import Support
 from pushrecovery.presets import load_params
-from pushrecovery.surfaces.step_regions import StepRegions
+from pushrecovery.surfaces.step.regions import StepRegions
 
 P = load_params()
 FOOT = rectangle(-0.05, 0.15, 0.10)

@@ -30,7 +30,7 @@ from pushrecovery.analysis.margins_2d import (
 from pushrecovery.analysis.recording import Foot, fixed_feet
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.ground import FootPose, Support, rectangle
-from pushrecovery.surfaces.classify_many import classify_states
+from pushrecovery.surfaces.classify.many import classify_states
 
 P = load_params()
 W = P.omega

@@ -22,7 +22,7 @@ from pushrecovery.surfaces.cmp import cmp_offset_from
 from pushrecovery.surfaces.monitor import BalanceMonitor
 from pushrecovery.surfaces.n_step import step_options, viable_region
 from pushrecovery.surfaces.plane import cmp_polygon, cmp_polygon_from
-from pushrecovery.surfaces.step_regions import StepRegions
+from pushrecovery.surfaces.step.regions import StepRegions
 
 P = load_params()
 SOLE = [

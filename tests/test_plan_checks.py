@@ -23,7 +23,7 @@ from pushrecovery.ground.support import Stance
 from pushrecovery.surfaces.capture_plan import CapturePlan, capture_plan, plan_loads
 from pushrecovery.surfaces.classify import Strategy, classify
 from pushrecovery.surfaces.n_step import landing_foot, step_options, viable_region
-from pushrecovery.surfaces.step_regions import StepRegions
+from pushrecovery.surfaces.step.regions import StepRegions
 
 #: The keys of a plan's JSON before the checks: kept, in this order, with the same values.
 OLD_KEYS = ["steps", "swing", "footholds", "touchdowns", "cops", "hip", "margin", "ankle"]

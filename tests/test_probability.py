@@ -18,14 +18,14 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.presets import load_params
 from pushrecovery.surfaces.classify import classify
-from pushrecovery.surfaces.classify_many import classify_states
+from pushrecovery.surfaces.classify.many import classify_states
 from pushrecovery.surfaces.probability import (
     MAX_LATENCY_GROWTH,
     StateGaussian,
     delayed_capture_point,
     verdict_probabilities,
 )
-from pushrecovery.surfaces.step_regions import StepRegions
+from pushrecovery.surfaces.step.regions import StepRegions
 from pushrecovery.surfaces.strategy import Strategy
 from pushrecovery.surfaces.verdicts import sagittal_verdicts
 

@@ -58,7 +58,7 @@ NAN_DOCUMENTED = {
     "pushrecovery.analysis.margins_2d.time_to_boundary_xcom": "+inf: the XCoM never leaves",
     "pushrecovery.analysis.margins.time_to_leave": "NaN: a missing frame",
     "pushrecovery.analysis.posturography.mean_frequency": "NaN: an axis without sway",
-    "pushrecovery.surfaces.step_regions.line_steps": "first steps: NaN where no step is taken",
+    "pushrecovery.surfaces.step.regions.line_steps": "first steps: NaN where no step is taken",
     "pushrecovery.analysis.margins.direction_margins": "NaN: a missing frame, or no step",
     "pushrecovery.sim.many.run_many": "NaN: the measures of an error row (a push that timed out)",
     "pushrecovery.sim.validation.critical_table": "NaN: no correction, no measured force",

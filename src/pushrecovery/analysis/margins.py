@@ -9,7 +9,7 @@ region edges are arrays (one value per frame), in the lab frame:
   strategy alone recovers (Eq. 4);
 - CMP margin, the CoP margin plus the hip strategy's reach a (1 − e^{−ω T_max})², corrected
   Eq. (15) (errata E11);
-- step: the N-step intervals of :func:`pushrecovery.surfaces.step_regions.line_steps` (at
+- step: the N-step intervals of :func:`pushrecovery.surfaces.step.regions.line_steps` (at
   most ``max_steps`` steps, touchdowns every ``min_step_time``) from the measured base and
   the stance ankle, landing on the single foot's own edges;
 - time to leave: with the CoP (or the CMP) held where it is, ξ − p grows as e^{ωt}
@@ -34,7 +34,7 @@ from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.cop import capture_point
-from pushrecovery.surfaces.step_regions import line_steps
+from pushrecovery.surfaces.step.regions import line_steps
 
 __all__ = ["DirectionMargins", "direction_margins", "time_to_leave"]
 
@@ -53,7 +53,7 @@ class DirectionMargins:
         ξ = x + ẋ/ω, lab frame [m].
     cop, cmp, step : ndarray
         Margins to the CoP region, the CMP region and the region of ``max_steps`` steps [m]
-        (:func:`~pushrecovery.surfaces.step_regions.line_steps`; > 0 when steps capture).
+        (:func:`~pushrecovery.surfaces.step.regions.line_steps`; > 0 when steps capture).
     strategy : ndarray of int8
         Codes into :data:`~pushrecovery.surfaces.classify.STRATEGY_CODES`, −1 where invalid.
     time_to_leave_cop, time_to_leave_cmp : ndarray

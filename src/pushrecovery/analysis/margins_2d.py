@@ -22,7 +22,7 @@ Body axes x = ap (forward +), y = ml (left +) [m]; the base per frame from
 - **Time to boundary of the XCoM** (LIPM, the CoP held): ξ̇ = ω0 (ξ − p) gives
   ξ(t) = p + (ξ − p) e^{ω0 t}, so TtB = ln(D(p, ξ − p)/‖ξ − p‖)/ω0 [s]; 0 with ξ outside,
   +inf with ξ = p (the 2-D :func:`pushrecovery.analysis.margins.time_to_leave`).
-- **Verdicts**: :func:`pushrecovery.surfaces.classify_many.classify_states` against the
+- **Verdicts**: :func:`pushrecovery.surfaces.classify.many.classify_states` against the
   library's :class:`~pushrecovery.ground.Support` of each stance phase (the CoP region, the
   CMP region P ⊕ box, the N-step regions), and the signed distance of ξ to the CMP region.
 
@@ -45,7 +45,7 @@ from pushrecovery.arguments import bounded_float, require_type, sample_array
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
-from pushrecovery.surfaces.classify_many import classify_states
+from pushrecovery.surfaces.classify.many import classify_states
 from pushrecovery.surfaces.plane import cmp_margin_xy
 
 __all__ = [

@@ -12,7 +12,7 @@ support and the plan is dropped; ξ_e inside the support → the CoP at ξ_e (an
 CMP region with the hip unused → ξ split over the support and the hip's box
 (:func:`~pushrecovery.ground.minkowski.decompose`) and the bang-bang profile started (hip);
 else the plan of the smallest N whose region C_N holds ξ_e
-(:class:`~pushrecovery.surfaces.step_regions.StepRegions`; beyond ``max_steps`` a best effort
+(:class:`~pushrecovery.surfaces.step.regions.StepRegions`; beyond ``max_steps`` a best effort
 flagged ``saturated``). docs/steps.md, "Multi-step recovery on the ground plane", gives the
 details. The controller keeps its own copy of the feet, moved by the steps it commands.
 """
@@ -38,7 +38,7 @@ from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.edge_rows import Edges, cmp_rows, signed_distance
 from pushrecovery.surfaces.n_step import hip_box
-from pushrecovery.surfaces.step_regions import StepRegions
+from pushrecovery.surfaces.step.regions import StepRegions
 
 __all__ = ["PlaneRecoveryController", "hip_share"]
 

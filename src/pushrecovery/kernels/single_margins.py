@@ -1,7 +1,7 @@
 """One point's signed distance to a convex polygon, compiled, to the bit of the numpy form.
 
 The single-state paths of :func:`pushrecovery.surfaces.classify.classify` (the support
-polygon and the CMP region) and :func:`pushrecovery.surfaces.step_impact.plan_impacts` (the
+polygon and the CMP region) and :func:`pushrecovery.surfaces.step.impact.plan_impacts` (the
 landing foot's region) call it on Python floats instead of building arrays. Each distance is
 the same floating-point operations as
 :meth:`pushrecovery.ground.polygon.ConvexPolygon.signed_distance` (numpy), so that it agrees

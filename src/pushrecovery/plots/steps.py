@@ -1,7 +1,7 @@
 """Figures of steps: capture regions over the support polygon, and the N-step strategy map.
 
 Computing stays in :mod:`pushrecovery.surfaces.capture_region`, ``n_step`` and
-:mod:`pushrecovery.surfaces.step_regions`; these functions draw on matplotlib ``Figure``
+:mod:`pushrecovery.surfaces.step.regions`; these functions draw on matplotlib ``Figure``
 objects (no pyplot state) and return them.
 """
 
@@ -163,7 +163,7 @@ def n_step_map_figure(
     from matplotlib.colors import ListedColormap
 
     from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify_states
-    from pushrecovery.surfaces.step_regions import line_steps
+    from pushrecovery.surfaces.step.regions import line_steps
 
     require_type("params", params, BodyParams)
     xlim = tuple(finite_vector("xlim", xlim, 2, 1e3, "m"))

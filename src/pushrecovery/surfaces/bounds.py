@@ -21,7 +21,7 @@ def bounds_data(params: BodyParams, support: Support | None = None) -> dict[str,
     ``t_max`` the longest bang-bang half period, Eq. (12) [s] (None without hip torque);
     ``thresholds`` the largest recoverable CoM velocity from x = 0, [backward, forward], per
     strategy [m/s] (ankle: ω δ±, hip: ω times the CMP bounds, step: ω times the bounds of the
-    ``max_steps``-step interval of :mod:`pushrecovery.surfaces.step_regions`, the ``step``
+    ``max_steps``-step interval of :mod:`pushrecovery.surfaces.step.regions`, the ``step``
     verdict's limit), ``steps`` the same for each N = 1 ... max_steps and ``"inf"`` (Koolen's
     d_∞), and ``step_sec4`` Sec. IV's instantaneous single step (the paper's model);
     ``plane`` the ground-plane bounds of :func:`plane_bounds`.
@@ -42,7 +42,7 @@ def bounds_data(params: BodyParams, support: Support | None = None) -> dict[str,
     from pushrecovery.surfaces.cmp import cmp_offset, cmp_region
     from pushrecovery.surfaces.cop import cop_region
     from pushrecovery.surfaces.step import step_thresholds
-    from pushrecovery.surfaces.step_regions import sagittal_step_interval
+    from pushrecovery.surfaces.step.regions import sagittal_step_interval
 
     cop, cmp = cop_region(params), cmp_region(params)
     omega = params.omega

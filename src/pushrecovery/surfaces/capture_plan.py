@@ -23,7 +23,7 @@ asks of the legs and the ground:
   whose squared norm has the second derivative 2 ‖ṙ‖² + 2 ω² ‖r − p − c‖² >= 0 (convex),
   so its peak over a phase lies at an end: the touchdowns. The CoM follows the plan's CoPs
   with the hip's share delivered as a constant CMP offset until the first touchdown, as
-  :func:`~pushrecovery.surfaces.step_impact.plan_impacts` does; the last CoP holds the
+  :func:`~pushrecovery.surfaces.step.impact.plan_impacts` does; the last CoP holds the
   capture point of a plan that captures (``margin`` > 0), where ‖r − p‖ decays as e^{−ωt}
   (a plan with ``margin`` < 0 does not come to rest: its peak covers the touchdowns only).
 
@@ -336,7 +336,7 @@ def capture_plan(
     it, while the first reach and the hip's box keep the stance's frame. A foot that is not
     rotationally symmetric (every foot here: a rectangle or a polygon) gives a different C_N
     for each landing yaw, so the plan's ``margin`` is that of its landing yaw (the verdicts of
-    :class:`~pushrecovery.surfaces.step_regions.StepRegions` assume the stance's yaw). With the
+    :class:`~pushrecovery.surfaces.step.regions.StepRegions` assume the stance's yaw). With the
     CoM position ``com`` [m] (its velocity is then ω (ξ0 − com)) the plan's ``loads`` include
     the ground forces (:func:`plan_loads`); the ankle torques need only the CoPs.
 

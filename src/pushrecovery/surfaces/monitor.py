@@ -1,7 +1,7 @@
 """A balance monitor for a 500 Hz – 1 kHz loop: one state in, a verdict out.
 
 :class:`BalanceMonitor` is built once from the body (the N-step regions of a stance foot at
-the origin, :class:`~pushrecovery.surfaces.step_regions.StepRegions`) and told each support
+the origin, :class:`~pushrecovery.surfaces.step.regions.StepRegions`) and told each support
 with :meth:`BalanceMonitor.set_support` when a foot lands or lifts: tens of µs, the regions
 turned and moved to the feet, the CMP region one compiled Minkowski sum. Every query then runs
 on Python floats and tuples prepared for the support (no arrays allocated, no thread pool, no
@@ -38,7 +38,7 @@ from pushrecovery.surfaces.classify import Strategy
 from pushrecovery.surfaces.cmp import _flywheel_offsets, cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.edge_rows import Edges, cmp_rows, polygon_rows, signed_distance
-from pushrecovery.surfaces.step_regions import StepRegions
+from pushrecovery.surfaces.step.regions import StepRegions
 
 __all__ = ["BalanceMonitor", "Verdict"]
 

@@ -4,7 +4,7 @@ The strategy a state needs on the line (:mod:`pushrecovery.surfaces.classify`, w
 ``classify`` calls :func:`sagittal_verdicts` with one state) from its capture point ξ = x + ẋ/ω:
 ``ankle`` when ξ is strictly inside the foot (Eq. 4), ``hip`` inside the CMP region (corrected
 Eq. 15), ``step`` when at most ``max_steps`` steps capture it (the N-step intervals of
-:mod:`pushrecovery.surfaces.step_regions`), else ``fall``. A campaign's rows need these for a
+:mod:`pushrecovery.surfaces.step.regions`), else ``fall``. A campaign's rows need these for a
 whole batch, not the plans.
 """
 
@@ -22,7 +22,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_offset, cmp_region
 from pushrecovery.surfaces.cop import capture_point, cop_margin, cop_region
-from pushrecovery.surfaces.step_regions import LineSteps, _growth, line_steps
+from pushrecovery.surfaces.step.regions import LineSteps, _growth, line_steps
 from pushrecovery.surfaces.strategy import Strategy
 
 __all__ = ["SagittalVerdict", "SagittalVerdicts", "sagittal_verdict", "sagittal_verdicts"]
@@ -143,7 +143,7 @@ def _line_bounds(
     """1/ω, the CoP and CMP intervals' centres and half widths, C_1 ... C_{max_steps}.
 
     Each number as the vectorised path computes it (:func:`cop_margin`,
-    :func:`~pushrecovery.surfaces.step_regions.line_steps` with the ankle at 0 and the
+    :func:`~pushrecovery.surfaces.step.regions.line_steps` with the ankle at 0 and the
     support [heel, toe]), so that the scalar path agrees to the bit.
     """
     cop, cmp = cop_region(params), cmp_region(params)

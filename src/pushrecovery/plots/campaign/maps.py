@@ -181,7 +181,7 @@ def plot_strategy_map(params: BodyParams, path: Path, *, xdot_max: float | None 
     from matplotlib.patches import Patch
 
     from pushrecovery.surfaces.classify import STRATEGY_CODES, classify_states
-    from pushrecovery.surfaces.step_regions import sagittal_step_interval
+    from pushrecovery.surfaces.step.regions import sagittal_step_interval
 
     path = check_plot_path(path)
     if xdot_max is not None:

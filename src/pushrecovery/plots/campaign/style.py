@@ -90,7 +90,7 @@ def _draw_boundaries(
     """Capture-point lines of Eq. (4), corrected Eq. (15) and N steps; Sec. IV's step limit."""
     omega = params.omega
     xs = np.linspace(*xlim, 50)
-    from pushrecovery.surfaces.step_regions import sagittal_step_interval
+    from pushrecovery.surfaces.step.regions import sagittal_step_interval
 
     for region, colour, label in (
         (cop_region(params), RECOVER_COLOUR, "CoP region edge, Eq. (4)"),

@@ -91,7 +91,7 @@ def _recovery_limits(
     """
     from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify_states
     from pushrecovery.surfaces.plane import cmp_polygon
-    from pushrecovery.surfaces.step_regions import StepRegions
+    from pushrecovery.surfaces.step.regions import StepRegions
 
     fall = STRATEGY_CODES.index(Strategy.FALL)
     low = np.zeros(angles.shape)

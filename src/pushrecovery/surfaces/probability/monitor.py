@@ -33,7 +33,7 @@ from pushrecovery.surfaces.cop import cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
 from pushrecovery.surfaces.probability.inputs import check_states
 from pushrecovery.surfaces.probability.latency import latency_growth
-from pushrecovery.surfaces.step_regions import StepRegions, sagittal_step_interval
+from pushrecovery.surfaces.step.regions import StepRegions, sagittal_step_interval
 
 __all__ = ["MonitorProbabilities", "ProbabilityMonitor"]
 

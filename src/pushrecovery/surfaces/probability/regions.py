@@ -23,7 +23,7 @@ from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
-from pushrecovery.surfaces.step_regions import StepRegions, sagittal_step_interval
+from pushrecovery.surfaces.step.regions import StepRegions, sagittal_step_interval
 
 __all__ = ["Level", "cumulative_masses", "region_middle", "verdict_regions"]
 

@@ -3,7 +3,7 @@
 The rules of :func:`pushrecovery.surfaces.classify.classify`, decided for millions of states:
 on the line, the four intervals in one compiled pass; on the plane, the support polygon and the
 CMP region in one compiled pass, then the N-step regions
-(:class:`~pushrecovery.surfaces.step_regions.StepRegions`) only for the states beyond the hip
+(:class:`~pushrecovery.surfaces.step.regions.StepRegions`) only for the states beyond the hip
 region, in place (numpy for small arrays), chunk by chunk, so that the extra memory is the
 codes themselves.
 """
@@ -23,7 +23,7 @@ from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_region
 from pushrecovery.surfaces.cop import cop_margin, cop_region
 from pushrecovery.surfaces.plane import capture_margin_xy, cmp_polygon
-from pushrecovery.surfaces.step_regions import StepRegions, sagittal_step_interval
+from pushrecovery.surfaces.step.regions import StepRegions, sagittal_step_interval
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 
 __all__ = ["classify_states"]

@@ -3,7 +3,7 @@
 Vocabulary (stable, part of the JSON contract), escalating as the paper proposes (Sec. I-B):
 ``ankle`` (CoP balancing, Eq. 4), ``hip`` (CMP balancing, corrected Eq. 15), ``step`` (at most
 ``max_steps`` steps capture the state: the N-step regions of
-:mod:`pushrecovery.surfaces.step_regions`, touchdowns every ``min_step_time``) and ``fall``.
+:mod:`pushrecovery.surfaces.step.regions`, touchdowns every ``min_step_time``) and ``fall``.
 
 On the ground plane (:func:`classify` with ``y``, ``ydot`` or a ``support``) the ankle and hip
 regions are the support polygon and the CMP region of :mod:`pushrecovery.surfaces.plane` and
@@ -30,12 +30,12 @@ from pushrecovery.ground.support import MAX_POSE, Support
 from pushrecovery.params import BodyParams
 from pushrecovery.surfaces.capture_plan import CapturePlan, plan_loads
 from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
-from pushrecovery.surfaces.classify_many import classify_states
+from pushrecovery.surfaces.classify.many import classify_states
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, cop_region
 from pushrecovery.surfaces.plane import cmp_polygon
-from pushrecovery.surfaces.step_impact import TouchdownImpact, plan_impacts
-from pushrecovery.surfaces.step_regions import StepRegions, _line_plan
+from pushrecovery.surfaces.step.impact import TouchdownImpact, plan_impacts
+from pushrecovery.surfaces.step.regions import StepRegions, _line_plan
 from pushrecovery.surfaces.strategy import STRATEGY_CODES, Strategy
 from pushrecovery.surfaces.verdicts import (  # sagittal_verdicts: campaign.pushes imports it here
     _first_step_range,
@@ -120,11 +120,11 @@ class Classification:
 
     ``margins``: ``cop`` and ``cmp`` are signed distances of the capture point to the regions'
     edges; ``step`` is its largest signed distance to the N-step regions (N <= max_steps,
-    :mod:`pushrecovery.surfaces.step_regions`), positive exactly when steps capture the state
+    :mod:`pushrecovery.surfaces.step.regions`), positive exactly when steps capture the state
     and null in JSON otherwise. ``steps`` is the number of steps needed (0: ankle or hip,
     None: more than ``max_steps``) and ``plan`` the plan of a ``step`` verdict (footholds,
     touchdown times, CoPs; ``impact``: each touchdown's capture point without and with Sec.
-    IV's impact, :mod:`pushrecovery.surfaces.step_impact`; whether a step crosses over and the
+    IV's impact, :mod:`pushrecovery.surfaces.step.impact`; whether a step crosses over and the
     ankle torques and ground forces of its CoPs from this state,
     :class:`~pushrecovery.surfaces.capture_plan.CapturePlan`). ``step`` describes its first
     step: ``step_length`` (stance ankle to landing ankle, signed like the step on the line),
@@ -233,7 +233,7 @@ def classify(
         Yaw of the plan's landing feet [rad], in [−π, π] (ground plane; default: the stance
         foot's yaw). The verdict keeps the regions of the stance's yaw; the plan and its
         margin are those of the landing yaw
-        (:meth:`~pushrecovery.surfaces.step_regions.StepRegions.plan`), while the first
+        (:meth:`~pushrecovery.surfaces.step.regions.StepRegions.plan`), while the first
         step's ``step_length_range`` stays that of the stance's yaw.
 
     Returns
