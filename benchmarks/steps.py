@@ -28,8 +28,8 @@ import numpy as np
 
 from pushrecovery import load_params
 from pushrecovery.ground import FootPose, Support
-from pushrecovery.surfaces.capture_plan import capture_plan
-from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.capture.plan import capture_plan
+from pushrecovery.surfaces.capture.region import capture_region
 from pushrecovery.surfaces.n_step import capturability_distance, step_options
 
 CALLS = 2000

@@ -21,7 +21,7 @@ from pushrecovery.plots.steps import capture_regions_figure
 from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 from pushrecovery.sim.simulate import simulate
 from pushrecovery.surfaces.bounds import bounds_data
-from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.capture.region import capture_region
 from pushrecovery.surfaces.classify import classify
 
 params = load_params()

@@ -74,7 +74,7 @@ def _catalogue() -> dict[str, Callable[[Any], Any]]:
     from pushrecovery.sim.registry import make_plant
     from pushrecovery.sim.simulate import simulate
     from pushrecovery.surfaces.bounds import bounds_data, plane_bounds
-    from pushrecovery.surfaces.capture_region import capture_region
+    from pushrecovery.surfaces.capture.region import capture_region
     from pushrecovery.surfaces.classify import classify
     from pushrecovery.surfaces.classify.many import classify_states
     from pushrecovery.surfaces.cmp import cmp_margin

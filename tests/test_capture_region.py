@@ -1,6 +1,6 @@
 """Capture regions of one and several steps against exact programs and simulation.
 
-Ground truth: the N-step viability LP (surfaces.capture_lp_steps: CoP, foothold and flywheel
+Ground truth: the N-step viability LP (surfaces.capture.lp.steps: CoP, foothold and flywheel
 torque sequences with the touchdowns fixed on its grid), a 1-D LP for the point and disc feet
 of Koolen et al. (2012), and closed-loop simulations of the LIPM following a plan.
 """
@@ -15,9 +15,9 @@ from pushrecovery import load_params
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground import FootPose, Support
 from pushrecovery.ground.minkowski import minkowski_sum, regular_polygon
-from pushrecovery.surfaces.capture_lp_steps import step_lp
-from pushrecovery.surfaces.capture_plan import capture_plan
-from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.capture.lp.steps import step_lp
+from pushrecovery.surfaces.capture.plan import capture_plan
+from pushrecovery.surfaces.capture.region import capture_region
 from pushrecovery.surfaces.classify import classify
 from pushrecovery.surfaces.n_step import (
     capturability_distance,
@@ -314,7 +314,7 @@ def test_the_impact_at_a_symmetric_touchdown_is_sec4s():
     # velocity perpendicular to the stance leg: Eqs. (18)-(20) give v⁺ = l θ̇ cos 2θ / cos θ.
     from pushrecovery.ground.support import Stance
     from pushrecovery.models.stepping import impact_velocities
-    from pushrecovery.surfaces.capture_plan import CapturePlan
+    from pushrecovery.surfaces.capture.plan import CapturePlan
     from pushrecovery.surfaces.step.impact import plan_impacts
 
     params = load_params(overrides={"min_step_time": 0.0})

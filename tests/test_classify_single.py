@@ -21,8 +21,8 @@ from pushrecovery.ground.minkowski import stacked_shapes
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.kernels.polygons import minkowski_loop
 from pushrecovery.kernels.single_margins import edge_rows, signed_distance
-from pushrecovery.surfaces.capture_plan import plan_loads
-from pushrecovery.surfaces.capture_region import (
+from pushrecovery.surfaces.capture.plan import plan_loads
+from pushrecovery.surfaces.capture.region import (
     ORIGIN,
     _region_loop,
     capture_region,

@@ -14,7 +14,7 @@ from pushrecovery.control import make_controller
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate
-from pushrecovery.surfaces.capture_lp import largest_capture_point
+from pushrecovery.surfaces.capture.lp import largest_capture_point
 from pushrecovery.surfaces.classify import classify
 from pushrecovery.surfaces.cmp import cmp_margin, cmp_offset, cmp_region
 

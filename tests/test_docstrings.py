@@ -361,7 +361,7 @@ def test_the_public_api_is_found(objects: dict[str, Any]) -> None:
     for name in (
         "pushrecovery.surfaces.classify.classify",
         "pushrecovery.surfaces.monitor.BalanceMonitor",
-        "pushrecovery.surfaces.capture_region.capture_region",
+        "pushrecovery.surfaces.capture.region.capture_region",
         "pushrecovery.analysis.trial.pipeline.analyze",
         "pushrecovery.params.BodyParams",
     ):

@@ -16,7 +16,7 @@ import pytest
 from pushrecovery import load_params
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.support import FootPose, Support
-from pushrecovery.surfaces.capture_plan import capture_plan
+from pushrecovery.surfaces.capture.plan import capture_plan
 from pushrecovery.surfaces.classify import classify
 from pushrecovery.surfaces.cmp import cmp_offset_from
 from pushrecovery.surfaces.monitor import BalanceMonitor

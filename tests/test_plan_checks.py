@@ -20,7 +20,7 @@ from pushrecovery.cli.app import cli
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground import FootPose, Support
 from pushrecovery.ground.support import Stance
-from pushrecovery.surfaces.capture_plan import CapturePlan, capture_plan, plan_loads
+from pushrecovery.surfaces.capture.plan import CapturePlan, capture_plan, plan_loads
 from pushrecovery.surfaces.classify import Strategy, classify
 from pushrecovery.surfaces.n_step import landing_foot, step_options, viable_region
 from pushrecovery.surfaces.step.regions import StepRegions
@@ -349,8 +349,8 @@ def test_cli_capture_region_says_whether_its_foothold_crosses_over():
 
 
 def test_turned_terms_of_the_stance_yaw_are_step_terms(params):
-    from pushrecovery.surfaces.capture_plan import _turned_terms
-    from pushrecovery.surfaces.capture_region import step_terms
+    from pushrecovery.surfaces.capture.plan import _turned_terms
+    from pushrecovery.surfaces.capture.region import step_terms
 
     option = step_options(params, Support.from_params(params, Stance.RIGHT))[0]
     key = (option.stance.vertices - option.ankle).tobytes()

@@ -3,7 +3,7 @@
 Three independent routes to the capturable set of the planar flywheel model:
 
 - the closed form of ``surfaces.plane`` (support function h_P(d) + a_p|d·e_p| + a_r|d·e_r|);
-- a linear program over CoP and torque sequences (``surfaces.capture_lp_plane``), which assumes
+- a linear program over CoP and torque sequences (``surfaces.capture.lp.plane``), which assumes
   nothing about the optimal input, in 16 directions, single and double support, yawed feet;
 - simulations of the planar model (matrix exponential of the equations of motion written out
   here, not the package's discretisation) just inside (a witnessing strategy recovers) and just
@@ -22,7 +22,7 @@ from pushrecovery import load_params
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground import FootPose, Support
 from pushrecovery.models.flywheel_plane import plane_continuous, plane_discrete
-from pushrecovery.surfaces.capture_lp_plane import support_function_lp
+from pushrecovery.surfaces.capture.lp.plane import support_function_lp
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.plane import cmp_polygon
 

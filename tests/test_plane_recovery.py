@@ -98,7 +98,7 @@ def test_plans_are_followed_and_kept_within_reach_and_step_time():
 def test_a_turned_and_moved_stance_gets_the_turned_and_moved_command(monkeypatch):
     """Any stance yaw and place re-plans from the regions and terms built at construction."""
     import pushrecovery.kernels.polygons as polygons
-    import pushrecovery.surfaces.capture_plan as plans
+    import pushrecovery.surfaces.capture.plan as plans
     import pushrecovery.surfaces.n_step as n_step
 
     params = load_params()

@@ -260,10 +260,10 @@ classify_states(0.1 * big, big, P, y=0.05 * big, ydot=big)
 cop_margin_xy(0.1 * big, 0.1 * big, big, big, Support.from_params(P), P)
 # Steps: the foothold region with its centre, and a plan.
 from pushrecovery.surfaces.classify import classify
-from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.capture.region import capture_region
 capture_region(0.0, 0.1, 1.5, -0.4, P, Support.from_params(P, "left"))
 classify(0.0, 2.6, P, y=0.0, ydot=0.0)
-from pushrecovery.surfaces.capture_plan import capture_plan
+from pushrecovery.surfaces.capture.plan import capture_plan
 from pushrecovery.surfaces.n_step import step_options
 capture_plan(np.array([0.9, 0.2]), P, step_options(P, Support.from_params(P, "left"))[0], 2)
 """

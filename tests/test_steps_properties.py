@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from pushrecovery import load_params
 from pushrecovery.cli.app import cli
 from pushrecovery.ground import FootPose, Support
-from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.capture.region import capture_region
 from pushrecovery.surfaces.classify import STRATEGY_CODES, Strategy, classify, classify_states
 from pushrecovery.surfaces.n_step import step_options, viable_region
 

@@ -121,7 +121,7 @@ class BodyParams:
         Ankle torque limit [N m], in [0, 1e5]: the magnitude of the horizontal torque vector
         m g (p − a) × ẑ the support's vertical force m g exerts about the ankle a through a
         CoP p, ‖τ‖ = m g ‖p − a‖ (a plan's ``ankle_torque_ok``,
-        :class:`~pushrecovery.surfaces.capture_plan.CapturePlan`); ``None`` (preset): not
+        :class:`~pushrecovery.surfaces.capture.plan.CapturePlan`); ``None`` (preset): not
         limited (the foot's edges are then the only bound on the CoP).
     friction : float or None
         Static friction coefficient μ of the ground, dimensionless, in (0, 10]: a plan's

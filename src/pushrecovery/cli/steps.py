@@ -101,7 +101,7 @@ def capture_region_command(
     and the state. An empty region has no vertices (null in JSON).
     """
     from pushrecovery.errors import InvalidParameterError
-    from pushrecovery.surfaces.capture_region import capture_region
+    from pushrecovery.surfaces.capture.region import capture_region
 
     file = kwargs["params_file"]
     params = params_from(kwargs)
@@ -154,7 +154,7 @@ def _crosses(region: Any, support: Any) -> bool:
     import math
 
     from pushrecovery.ground.support import Stance
-    from pushrecovery.surfaces.capture_plan import CROSSOVER_TOLERANCE
+    from pushrecovery.surfaces.capture.plan import CROSSOVER_TOLERANCE
 
     stance = support.right if region.swing is Stance.LEFT else support.left
     dx, dy = float(region.foothold[0]) - stance.x, float(region.foothold[1]) - stance.y

@@ -33,7 +33,7 @@ from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.models.flywheel import max_spin_up_time
 from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, roll_axis
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
-from pushrecovery.surfaces.capture_plan import CapturePlan
+from pushrecovery.surfaces.capture.plan import CapturePlan
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.cop import capture_point
 from pushrecovery.surfaces.edge_rows import Edges, cmp_rows, signed_distance

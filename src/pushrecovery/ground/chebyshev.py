@@ -1,7 +1,7 @@
 """The Chebyshev centre of a convex polygon: the centre of the largest disc inside it.
 
 The capture regions recommend it as the foothold that leaves the most room in every direction
-(:mod:`pushrecovery.surfaces.capture_region`).
+(:mod:`pushrecovery.surfaces.capture.region`).
 """
 
 from __future__ import annotations

@@ -199,7 +199,7 @@ def chebyshev_centre(normals, offsets):  # type: ignore[no-untyped-def]
 def foothold_kernel(shapes, counts, weights, offset, window_normals, window_offsets):  # type: ignore[no-untyped-def]
     """Return (vertices, centre_x, centre_y, ok): (S3) clipped to the window, its centre.
 
-    The compiled path of :func:`pushrecovery.surfaces.capture_region.capture_region`, the
+    The compiled path of :func:`pushrecovery.surfaces.capture.region.capture_region`, the
     centre the Chebyshev centre (the middle of the centres when the disc can slide). ``ok``
     False: the simplex failed (the caller falls back); fewer than 3 vertices: empty.
     """

@@ -1,6 +1,6 @@
 """Figures of steps: capture regions over the support polygon, and the N-step strategy map.
 
-Computing stays in :mod:`pushrecovery.surfaces.capture_region`, ``n_step`` and
+Computing stays in :mod:`pushrecovery.surfaces.capture.region`, ``n_step`` and
 :mod:`pushrecovery.surfaces.step.regions`; these functions draw on matplotlib ``Figure``
 objects (no pyplot state) and return them.
 """
@@ -58,7 +58,7 @@ def draw_capture_regions(
     (default ``min_step_time``), with its recommended foothold (the Chebyshev centre, ×);
     the reach of the stance ankle is the dotted circle.
     """
-    from pushrecovery.surfaces.capture_region import capture_region
+    from pushrecovery.surfaces.capture.region import capture_region
     from pushrecovery.surfaces.plane import cmp_polygon
 
     x, y, xdot, ydot = state

@@ -16,7 +16,7 @@ hip's box. Along one direction with point feet it is Koolen et al. (2012)'s d_N.
 ("The N-step capturable set (S1)") derives it and states when it is exact.
 
 Over 400 lines on purpose: the model, its derivation and the exact N-step sets are one
-concept; the LP that checks them is :mod:`pushrecovery.surfaces.capture_lp_steps`.
+concept; the LP that checks them is :mod:`pushrecovery.surfaces.capture.lp.steps`.
 """
 
 from __future__ import annotations
@@ -256,7 +256,7 @@ class StepOption:
         The stance ankle q_0 [m].
     yaw : float
         The stance foot's yaw [rad], kept by every landing foot unless a plan chooses a
-        landing yaw (:func:`~pushrecovery.surfaces.capture_plan.capture_plan`).
+        landing yaw (:func:`~pushrecovery.surfaces.capture.plan.capture_plan`).
     """
 
     swing: Stance

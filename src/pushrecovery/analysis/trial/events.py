@@ -38,7 +38,7 @@ from pushrecovery.analysis.trial.checks import PlateFeet
 from pushrecovery.arguments import require_type
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.capture.region import capture_region
 from pushrecovery.surfaces.classify import STRATEGY_CODES
 
 __all__ = [
@@ -388,7 +388,7 @@ def _in_capture_region(
 ) -> CaptureRegionCheck | None:
     """Judge the step's landing against the one-step capture region at its foot-off.
 
-    The region (:func:`~pushrecovery.surfaces.capture_region.capture_region`, issue 9: the
+    The region (:func:`~pushrecovery.surfaces.capture.region.capture_region`, issue 9: the
     landing foot's ankle positions that capture the state with this step, the foot landing
     after the measured swing time, the hip helping) of the CoM state at the foot-off frame and
     the support just before it; the landing is the stepping foot's ankle at its contact frame.

@@ -28,8 +28,8 @@ from pushrecovery.arguments import bounded_float, finite_float, require_type
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import MAX_POSE, Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_plan import CapturePlan, plan_loads
-from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
+from pushrecovery.surfaces.capture.plan import CapturePlan, plan_loads
+from pushrecovery.surfaces.capture.region import MAX_POSITION, MAX_SPEED
 from pushrecovery.surfaces.classify.many import classify_states
 from pushrecovery.surfaces.cmp import cmp_region
 from pushrecovery.surfaces.cop import CaptureInterval, cop_region
@@ -126,7 +126,7 @@ class Classification:
     touchdown times, CoPs; ``impact``: each touchdown's capture point without and with Sec.
     IV's impact, :mod:`pushrecovery.surfaces.step.impact`; whether a step crosses over and the
     ankle torques and ground forces of its CoPs from this state,
-    :class:`~pushrecovery.surfaces.capture_plan.CapturePlan`). ``step`` describes its first
+    :class:`~pushrecovery.surfaces.capture.plan.CapturePlan`). ``step`` describes its first
     step: ``step_length`` (stance ankle to landing ankle, signed like the step on the line),
     ``com_to_foot`` (landing ankle minus CoM at touchdown), ``theta`` (the stance leg's lean
     at touchdown, atan of the CoM's distance ahead of the stance ankle over L) and the
@@ -244,7 +244,7 @@ def classify(
         the polygon grown by each axis's offset), ``step`` when at most ``max_steps`` steps
         capture it (with the plan), else ``fall``. The plan says whether it crosses over and
         what its CoPs ask of the ankle and the ground
-        (:class:`~pushrecovery.surfaces.capture_plan.CapturePlan`).
+        (:class:`~pushrecovery.surfaces.capture.plan.CapturePlan`).
     """
     x = finite_float("x", x, "m")
     xdot = finite_float("xdot", xdot, "m/s")
@@ -449,7 +449,7 @@ def _plane_range(
     gap: tuple[float, float],
 ) -> list[float]:
     """First step lengths along the first step's direction within its N-step foothold region."""
-    from pushrecovery.surfaces.capture_region import capture_region
+    from pushrecovery.surfaces.capture.region import capture_region
 
     region = capture_region(
         x, y, xdot, ydot, params, support, steps=plan.steps, swing=plan.swings[0]

@@ -33,8 +33,8 @@ from numpy.typing import NDArray
 
 from pushrecovery.arguments import finite_float, finite_pair, require_type
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_plan import CapturePlan
-from pushrecovery.surfaces.capture_region import MAX_POSITION, MAX_SPEED
+from pushrecovery.surfaces.capture.plan import CapturePlan
+from pushrecovery.surfaces.capture.region import MAX_POSITION, MAX_SPEED
 from pushrecovery.surfaces.n_step import landing_viable
 
 __all__ = ["TouchdownImpact", "plan_impacts"]
@@ -114,7 +114,7 @@ def plan_impacts(
         If ``plan`` or ``params`` has the wrong type.
     InvalidParameterError
         A position or velocity that is not a finite (x, y) within the state ranges of
-        :func:`~pushrecovery.surfaces.capture_region.capture_region` (±1000 m, ±100 m/s), or
+        :func:`~pushrecovery.surfaces.capture.region.capture_region` (±1000 m, ±100 m/s), or
         a non-finite ``yaw``.
     """
     from pushrecovery.kernels.single_margins import edge_rows, signed_distance

@@ -46,8 +46,8 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance, Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_plan import CapturePlan, _plan, plan_loads
-from pushrecovery.surfaces.capture_region import MAX_CAPTURE_POINT, MAX_POSITION
+from pushrecovery.surfaces.capture.plan import CapturePlan, _plan, plan_loads
+from pushrecovery.surfaces.capture.region import MAX_CAPTURE_POINT, MAX_POSITION
 from pushrecovery.surfaces.cmp import cmp_offset
 from pushrecovery.surfaces.cop import CaptureInterval
 from pushrecovery.surfaces.n_step import (
@@ -254,7 +254,7 @@ def _sagittal_plan(
 
 
 def _line_plan(xi: float, params: BodyParams, steps: int) -> CapturePlan:
-    """Return the plan of :func:`~.capture_plan.capture_plan` on the sagittal line.
+    """Return the plan of :func:`~pushrecovery.surfaces.capture.plan.capture_plan`, sagittal.
 
     Step by step: the first foothold is the middle of the interval of first footholds ((S3)
     on the line: T ξ − T[−a, a] − (T − 1)(q_0 + [δ⁻, δ⁺]) − V_{N−1}, within q_0 ± l), the most
@@ -529,12 +529,12 @@ class StepRegions:
         when its regions capture ξ (a side step, not a crossover), else the other one. The
         plan is made in the stance foot's frame (ankle at the origin, yaw 0: its terms are
         kept from plan to plan) and turned and moved back. The plan says whether it crosses
-        over (``crossover``, :class:`~pushrecovery.surfaces.capture_plan.CapturePlan`).
+        over (``crossover``, :class:`~pushrecovery.surfaces.capture.plan.CapturePlan`).
 
         ``landing_yaw`` [rad], in [−π, π], is the world yaw of every landing foot (default:
         the stance foot's); the foot is chosen, and ``steps`` given, by the regions of the
         stance's yaw, while the plan and its ``margin`` are those of the landing yaw
-        (:func:`~pushrecovery.surfaces.capture_plan.capture_plan`). With the CoM position
+        (:func:`~pushrecovery.surfaces.capture.plan.capture_plan`). With the CoM position
         ``com`` [m], world frame, the plan's loads include the ground forces.
         """
         from pushrecovery.kernels.plane_codes import locate_steps

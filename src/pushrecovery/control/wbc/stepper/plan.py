@@ -3,7 +3,7 @@ r"""Planning a step of the whole-body controller: the swing leg, its foothold an
 World frame, x forward, y left, z up, SI units. Used by :class:`~.stepper.stepper.Stepper`:
 :func:`plan_foothold` takes the recommended ``foothold`` (the Chebyshev centre) of the
 library's one-step capture region
-(:func:`~pushrecovery.surfaces.capture_region.capture_region`) for the stance foot alone, cut
+(:func:`~pushrecovery.surfaces.capture.region.capture_region`) for the stance foot alone, cut
 to the half-plane ``min_step_width`` out on the landing side when the straight swing would meet
 the stance sole (:func:`collides`, :func:`planning_params`), with a two-step plan and a clipped
 fallback after it; :func:`choose_step` picks the foot (the library's side rule; after a
@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_region import capture_region
+from pushrecovery.surfaces.capture.region import capture_region
 
 FloatArray = NDArray[np.float64]
 

@@ -15,7 +15,7 @@ their limits. Sweeping d traces the (convex) capturable set without assuming the
 optimal input; it checks the closed form of :mod:`pushrecovery.surfaces.plane`, h_P(d) +
 a_p abs(d · e_p) + a_r abs(d · e_r), derived, with when it is exact, in docs/plane.md ("The
 CMP (hip) region: derivation"). The grid of ``dt`` and its error bound are those of the 1-D LP
-(:mod:`pushrecovery.surfaces.capture_lp`). Starting the CoM at the origin (velocity ω ξ0) loses
+(:mod:`pushrecovery.surfaces.capture.lp`). Starting the CoM at the origin (velocity ω ξ0) loses
 no generality: only the capture point enters the constraints.
 """
 

@@ -6,7 +6,7 @@ CoP sequence p_i (piecewise constant, in the support of its phase: the stance po
 q_k + F_k after the k-th touchdown), the footholds q_k (q_k − q_{k−1} in the reach polygon
 R_k), and the pitch and roll torques of the upper body (piecewise constant, abs(τ) ≤ τmax, the
 flywheel angle abs(θ) ≤ θmax at the samples and three interior points of each step as in
-:mod:`pushrecovery.surfaces.capture_lp_plane`, at rest at the end). The capture point follows
+:mod:`pushrecovery.surfaces.capture.lp.plane`, at rest at the end). The capture point follows
 ξ_{i+1} = E ξ_i − (E − 1)(p_i + c_i), E = e^{ω dt}, c_i the CMP offset τ_i/(m g) along the
 body's axes — exact for piecewise-constant inputs. Captured at the horizon: ξ in the last foot
 and the flywheels at rest (the ankle then holds it, Eq. 4).

@@ -25,7 +25,7 @@ from pushrecovery.arguments import finite_float, positive_float, require_type
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.models.flywheel import flywheel_discrete
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_lp_plane import grid_steps
+from pushrecovery.surfaces.capture.lp.plane import grid_steps
 from pushrecovery.surfaces.cop import capture_point
 
 __all__ = ["CaptureLP", "largest_capture_point"]

@@ -29,7 +29,7 @@ asks of the legs and the ground:
 
 Over 400 lines on purpose: one concept, a plan, how it is made and what it asks of the robot;
 the landing yaw's terms (``_turned_terms``) would shrink to a call if
-:func:`~pushrecovery.surfaces.capture_region.step_terms` took a landing yaw.
+:func:`~pushrecovery.surfaces.capture.region.step_terms` took a landing yaw.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ from pushrecovery.ground.minkowski import (
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Stance
 from pushrecovery.params import BodyParams
-from pushrecovery.surfaces.capture_region import (
+from pushrecovery.surfaces.capture.region import (
     MAX_CAPTURE_POINT,
     MAX_POSITION,
     MAX_SPEED,
@@ -320,7 +320,7 @@ def capture_plan(
     Step by step, as a controller re-planning at each touchdown would: the first foothold is
     the recommended one of the ``steps``-step foothold region (S3) at the first touchdown (the
     farthest from the region's edges,
-    :func:`~pushrecovery.surfaces.capture_region.chebyshev_centre`); the CoP to hold until
+    :func:`~pushrecovery.surfaces.capture.region.chebyshev_centre`); the CoP to hold until
     then and the hip's share come from splitting T ξ0 − q_1 over T H ⊕ (T − 1) S ⊕ V_{N−1}
     with every term equally deep (:func:`~pushrecovery.ground.minkowski.decompose`), which
     also gives the capture point at the touchdown; the landing foot is then the stance of a
@@ -346,7 +346,7 @@ def capture_plan(
         If ``params``, ``option`` or ``hip`` has the wrong type.
     InvalidParameterError
         A ξ0 that is not a finite (x, y) within ±``MAX_CAPTURE_POINT`` of the stance ankle
-        (:mod:`~pushrecovery.surfaces.capture_region`), ``steps`` not a whole number in
+        (:mod:`~pushrecovery.surfaces.capture.region`), ``steps`` not a whole number in
         [1, 50], ``first_touchdown`` outside [0, 5] s, a non-finite ``margin``, a
         ``landing_yaw`` outside [−π, π] rad or a ``com`` that is not a finite (x, y) within
         ±1000 m.
@@ -488,9 +488,10 @@ def _turned_terms(
     hip: bool,
     stance_key: bytes,
 ) -> StepTerms:
-    """:func:`~.capture_region.step_terms` with the landing foot (and V_{N−1}) at ``landing``.
+    """Return the terms of :func:`~pushrecovery.surfaces.capture.region.step_terms`, landing turned.
 
-    The hip's box and the reach keep the stance's ``yaw``; kept as step_terms' answers are.
+    The landing foot (and V_{N−1}) take the yaw ``landing``; the hip's box and the reach keep
+    the stance's ``yaw``. Kept as step_terms' answers are.
     """
     from pushrecovery.kernels.polygons import minkowski_loop
 
@@ -562,7 +563,7 @@ def _numpy_foothold(  # pragma: no cover - only when the compiled simplex fails
     hip: bool,
 ) -> FloatArray | None:
     """Return the recommended foothold relative to the ankle, from the numpy region."""
-    from pushrecovery.surfaces.capture_region import _region_loop
+    from pushrecovery.surfaces.capture.region import _region_loop
 
     option = _world_option(swing, yaw, stance_key, np.zeros(2))
     _, foothold = _region_loop(
