@@ -38,7 +38,7 @@ import timeit
 import numpy as np
 
 from pushrecovery import load_params
-from pushrecovery.control.recovery_plane import PlaneRecoveryController
+from pushrecovery.control.recovery.plane import PlaneRecoveryController
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.surfaces.monitor import BalanceMonitor
 
@@ -254,7 +254,7 @@ def build() -> bool:
     fresh_monitor = fresh(head + "from pushrecovery.surfaces.monitor import BalanceMonitor; "
                           "BalanceMonitor(P)")  # fmt: skip
     fresh_controller = fresh(
-        head + "from pushrecovery.control.recovery_plane import PlaneRecoveryController; "
+        head + "from pushrecovery.control.recovery.plane import PlaneRecoveryController; "
         "PlaneRecoveryController(P)"
     )
     numba_import = fresh("import numba") - numpy_import

@@ -100,7 +100,7 @@ def capture_regions() -> bool:
 
 def controller_ticks_us(params) -> np.ndarray:
     """Every compute() time [µs] of closed-loop runs of recovery-plane on stepping-plane."""
-    from pushrecovery.control.recovery_plane import PlaneRecoveryController
+    from pushrecovery.control.recovery.plane import PlaneRecoveryController
     from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 
     clock = time.perf_counter_ns

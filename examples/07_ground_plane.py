@@ -2,7 +2,7 @@
 
 A body stands on its left foot (turned 0.2 rad outward) and is pushed diagonally, forward and to
 the left. Nobody reacts: the CoP stays at the middle of the foot and the upper body is still,
-so the capture point runs away (the 2-D model of models.flywheel_plane, advanced exactly every
+so the capture point runs away (the 2-D model of models.flywheel.plane, advanced exactly every
 millisecond). The monitor classifies every state as a 1 kHz balance loop would, and reports
 when the strategy the body needs escalates, from hip to a step to a fall: how long a controller
 has to decide. The step margin is the capture point's distance to the N-step capture regions
@@ -15,7 +15,7 @@ import numpy as np
 
 from pushrecovery import load_params
 from pushrecovery.ground import FootPose, Support
-from pushrecovery.models.flywheel_plane import plane_propagate
+from pushrecovery.models.flywheel.plane import plane_propagate
 from pushrecovery.surfaces.monitor import BalanceMonitor
 
 params = load_params()

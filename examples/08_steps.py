@@ -13,7 +13,7 @@ recovery-plane controller (out/examples/steps_run.png, seen from above).
 from pathlib import Path
 
 from pushrecovery import load_params
-from pushrecovery.control.recovery_plane import PlaneRecoveryController
+from pushrecovery.control.recovery.plane import PlaneRecoveryController
 from pushrecovery.ground import Support
 from pushrecovery.plots.common import save_figure
 from pushrecovery.plots.runs import plane_run_figure

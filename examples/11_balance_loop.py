@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 from pushrecovery import load_params
-from pushrecovery.control.recovery_plane import PlaneRecoveryController
+from pushrecovery.control.recovery.plane import PlaneRecoveryController
 from pushrecovery.ground import FootPose, Support
 from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 from pushrecovery.surfaces.monitor import BalanceMonitor

@@ -125,7 +125,7 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         "model": FootModel(), "foot": fixed_feet(3, 0.0, 0.1, -0.05, 0.15, 0.2)[0],
         "vertices": np.tile([[-0.05, -0.15], [0.15, -0.15], [0.15, 0.15]], (3, 1, 1)),
     } for name in ("foot_soles", "base_from_feet", "base_from_vertices", "base_from_params")},
-    **{f"pushrecovery.analysis.margins_2d.{name}": {
+    **{f"pushrecovery.analysis.margins.plane.{name}": {
         "base": base_from_params(P, 3), "com": np.zeros((3, 2)), "velocity": np.ones((3, 2)),
         "points": np.zeros((3, 2)), "cop": np.zeros((3, 2)), "cop_velocity": np.ones((3, 2)),
         "xcom": np.full((3, 2), 0.05),
@@ -173,7 +173,7 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     "pushrecovery.models.flywheel.flywheel_propagate": {
         "states": np.zeros(4), "inputs": np.zeros((5, 2))
     },
-    "pushrecovery.models.flywheel_plane.plane_propagate": {
+    "pushrecovery.models.flywheel.plane.plane_propagate": {
         "states": np.zeros(8), "inputs": np.zeros((5, 4))
     },
     "pushrecovery.sim.critical.predicted_critical_velocity": {"direction": "forward"},

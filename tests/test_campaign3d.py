@@ -14,7 +14,7 @@ import pytest
 from pushrecovery import load_params
 from pushrecovery.campaign import CampaignSpec
 from pushrecovery.campaign.pushes import COLUMNS
-from pushrecovery.campaign.spec3d import azimuth_grid
+from pushrecovery.campaign.spec.humanoid import azimuth_grid
 from pushrecovery.cli import main
 from pushrecovery.errors import InvalidParameterError
 
@@ -71,7 +71,7 @@ def test_spec_grid_order_and_pushes_as_fractions_by_hand(params):
     assert [(p.azimuth, p.fraction) for p in pushes] == [(0.0, 0.5), (0.0, 1.0), (90.0, 0.5),
                                                          (90.0, 1.0)]  # fmt: skip
     # J = f m ω ρ_P(r0, ψ): r0 the biped3d's standing CoM, 1.04 cm ahead of the ankles
-    from pushrecovery.campaign.spec3d import standing_origin
+    from pushrecovery.campaign.spec.humanoid import standing_origin
 
     x0, y0 = standing_origin("biped3d", params)
     assert x0 == pytest.approx(0.0104, abs=5e-4) and y0 == pytest.approx(0.0, abs=1e-6)

@@ -13,7 +13,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from pushrecovery import load_params
-from pushrecovery.campaign.spec3d import critical_impulse, predict_push
+from pushrecovery.campaign.spec.humanoid import critical_impulse, predict_push
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.experiments.confusion3d import (
     CAUSES,

@@ -1,6 +1,8 @@
 """The floors of docs/architecture.md hold: import contracts, and plots that leave no trace."""
 
 import ast
+import collections
+import re
 import shutil
 import subprocess
 import sys
@@ -135,9 +137,31 @@ def long_modules_without_reason(modules):
     return found
 
 
+def prefix_groups(modules):
+    """Sibling modules or packages that share a prefix (the name before ``_`` or a digit).
+
+    A group of files sharing a prefix is a package (issue 31): ``spec`` and ``spec3d``, or
+    ``trial_rows`` and ``trial_steps``, are one concept's parts.
+    """
+    siblings = collections.defaultdict(set)
+    for path, _, _ in modules:
+        if path.name != "__init__.py":
+            siblings[path.parent].add(path.stem)
+        elif path.parent != Path("."):
+            siblings[path.parent.parent].add(path.parent.name)
+    found = []
+    for folder, names in sorted(siblings.items()):
+        groups = collections.defaultdict(list)
+        for name in sorted(names):
+            groups[re.split(r"[_\d]", name)[0]].append(name)
+        found += [f"{folder}: {', '.join(group)}" for group in groups.values() if len(group) > 1]
+    return found
+
+
 CHECKS = (
     private_crossings,
     long_modules_without_reason,
+    prefix_groups,
     numba_outside_kernels,
     kernels_importing_the_project,
     controllers_outside_control,
@@ -163,4 +187,5 @@ def test_each_contract_check_sees_its_violation(check, tmp_path):
         "from pushrecovery.control._x import y\nclass Mine(Controller):\n    pass\n"
     )
     (root / "sim" / "long.py").write_text('"""A module."""\n' + "x = 1\n" * 410)
+    (root / "control" / "fine3d.py").write_text('"""fine\'s 3-D twin, beside it."""\n')
     assert len(check(_modules(root))) == 1

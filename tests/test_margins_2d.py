@@ -20,7 +20,7 @@ from pushrecovery.analysis.base_polygon import (
     base_from_vertices,
 )
 from pushrecovery.analysis.margins import direction_margins
-from pushrecovery.analysis.margins_2d import (
+from pushrecovery.analysis.margins.plane import (
     margins_2d,
     phase_supports,
     signed_distance,
@@ -231,7 +231,7 @@ def test_a_ray_all_but_parallel_to_an_edge_gives_no_warning() -> None:
     # the time, and numpy must not warn of an overflow.
     import warnings
 
-    from pushrecovery.analysis.margins_2d import time_to_boundary_cop
+    from pushrecovery.analysis.margins.plane import time_to_boundary_cop
 
     base = _box(1)
     with warnings.catch_warnings():

@@ -21,7 +21,7 @@ from scipy.optimize import linprog
 from pushrecovery import load_params
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground import FootPose, Support
-from pushrecovery.models.flywheel_plane import plane_continuous, plane_discrete
+from pushrecovery.models.flywheel.plane import plane_continuous, plane_discrete
 from pushrecovery.surfaces.capture.lp.plane import support_function_lp
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll
 from pushrecovery.surfaces.plane import cmp_polygon
@@ -275,7 +275,7 @@ def apply(step, state, u):
 
 
 def test_package_model_matches_equations_of_motion():
-    # models.flywheel_plane (used by the LP) against the equations written out above.
+    # models.flywheel.plane (used by the LP) against the equations written out above.
     for yaw in (0.0, 0.4, -2.0):
         a, b = model(GRID, yaw)
         pa, pb = plane_continuous(GRID, yaw)

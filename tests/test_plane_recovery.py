@@ -15,10 +15,10 @@ from scipy.integrate import quad
 
 from pushrecovery import load_params
 from pushrecovery.control.base import Command, make_controller
-from pushrecovery.control.recovery_plane import PlaneRecoveryController, hip_share
+from pushrecovery.control.recovery.plane import PlaneRecoveryController, hip_share
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import FootPose, Support
-from pushrecovery.models.flywheel_plane import plane_discrete
+from pushrecovery.models.flywheel.plane import plane_discrete
 from pushrecovery.sim.plane_stepping import PlaneSteppingPlant
 from pushrecovery.sim.registry import make_plant
 from pushrecovery.sim.simulate import simulate

@@ -28,7 +28,7 @@ from pushrecovery.plots.analysis import (
     strategy_label,
     time_series_figure,
 )
-from pushrecovery.plots.plane_trial import plane_figure, plot_plane
+from pushrecovery.plots.plane.trial import plane_figure, plot_plane
 from test_trial_checks import _csv, _stepping_recording
 
 DATA = pathlib.Path(biomdp.__file__).parent / "tests" / "datasets"

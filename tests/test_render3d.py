@@ -26,7 +26,7 @@ from pushrecovery.sim.mujoco.humanoid3d.runs3d import run_push3d
 from pushrecovery.sim.mujoco.render import require_offscreen_gl
 from pushrecovery.sim.mujoco.render.frames import subsample_indices
 from pushrecovery.sim.mujoco.render.overlay3d import PULL, Frame3D, overlay_markers
-from pushrecovery.sim.mujoco.render.scene3d import (
+from pushrecovery.sim.mujoco.render.scene.humanoid import (
     Camera3D,
     View3D,
     camera_eye,

@@ -13,7 +13,7 @@ from click.testing import CliRunner
 from pushrecovery.cli import main
 from pushrecovery.cli.app import cli
 from pushrecovery.control.base import Controller
-from pushrecovery.control.recovery_plane import PlaneRecoveryController
+from pushrecovery.control.recovery.plane import PlaneRecoveryController
 from pushrecovery.errors import InvalidParameterError, ParameterTypeError
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.presets import load_params, load_support

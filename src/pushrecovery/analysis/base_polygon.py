@@ -14,7 +14,7 @@ Three sources, one output, :class:`BasePolygons` (``docs/base_polygon.md``):
 
 A frame's base is unknown (count 0) with no supporting foot, a missing heel or toe marker, or
 fewer than three vertices. Foot-marker bases also keep each foot's pose (ankle, yaw) and the
-median sole about the ankle: :mod:`pushrecovery.analysis.margins_2d` builds the library's
+median sole about the ankle: :mod:`pushrecovery.analysis.margins.plane` builds the library's
 :class:`~pushrecovery.ground.Support` of each stance phase from them for the 2-D verdicts.
 """
 

@@ -10,8 +10,9 @@ whose fields carry their unit and a one-line description as field metadata (``un
 ``pyarrow.parquet.read_schema(path).field("x0").metadata``.
 
 The rows themselves are ``dict`` s from column name to value, built on the workers by
-:mod:`~pushrecovery.campaign.pushes` (planar) and :mod:`.pushes3d` (3-D) and turned into a table
-by ``pyarrow`` with this schema.
+:mod:`~pushrecovery.campaign.pushes` (planar) and
+:mod:`~pushrecovery.campaign.pushes.humanoid` (3-D) and turned into a table by ``pyarrow``
+with this schema.
 
 Over 400 lines on purpose: the column table (each column's unit and description) is the
 families' schema itself, and the verdict and physics columns are filled from it.

@@ -11,7 +11,8 @@
   :func:`~pushrecovery.sim.critical.predicted_critical_velocity`). ``monotone`` is false when a
   push beyond the first failure recovers again. On the 3-D models the groups are the azimuths
   (``direction`` "ψ deg", ``azimuth``), the pushes J/m along ψ, and the analytic value the
-  ground plane's m ω ρ_R(r₀, ψ)/m for ankle and hip (:mod:`.spec3d`; none for step).
+  ground plane's m ω ρ_R(r₀, ψ)/m for ankle and hip
+  (:mod:`~pushrecovery.campaign.spec.humanoid`; none for step).
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ def _clean(value: float) -> float | None:
 
 def _analytic3d(spec: CampaignSpec, params: Any, azimuth: float) -> float:
     """Return the ground plane's critical push along ``azimuth`` [m/s] (NaN for step)."""
-    from pushrecovery.campaign.spec3d import critical_impulse, standing_origin
+    from pushrecovery.campaign.spec.humanoid import critical_impulse, standing_origin
 
     if not isinstance(spec.strategy, str) or spec.strategy not in ("ankle", "hip"):
         return math.nan

@@ -325,7 +325,7 @@ def plot_trial(result: Any, out: Path, figure_format: str = "png") -> dict[str, 
     ``figure_format``: one of :data:`FIGURE_FORMATS` (the files' suffix).
     """
     from pushrecovery.plots.analysis import plot_phase_portrait, plot_time_series
-    from pushrecovery.plots.plane_trial import plot_plane
+    from pushrecovery.plots.plane.trial import plot_plane
 
     suffix = f".{figure_format}"
     return {

@@ -1,7 +1,7 @@
 """The push directions of the 3-D humanoids' commands: ``--azimuth DEG`` or ``--azimuths GRID``.
 
 ``humanoid campaign`` and ``humanoid validate`` take one direction or a grid of them
-(:func:`pushrecovery.campaign.spec3d.azimuth_grid`: ``START:STOP:STEP`` or ``A,B,...``).
+(:func:`pushrecovery.campaign.spec.humanoid.azimuth_grid`: ``START:STOP:STEP`` or ``A,B,...``).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ def azimuths_from(azimuth: float | None, azimuths: str | None) -> tuple[float, .
     InvalidParameterError
         If both are given, or a direction is out of [-360, 360] or repeats.
     """
-    from pushrecovery.campaign.spec3d import azimuth_grid, check_azimuths
+    from pushrecovery.campaign.spec.humanoid import azimuth_grid, check_azimuths
     from pushrecovery.errors import InvalidParameterError
 
     if azimuth is not None and azimuths is not None:

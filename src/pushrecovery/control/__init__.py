@@ -34,7 +34,7 @@ _WHERE = {
     "BangBang": "pushrecovery.control.bangbang",
     "MPCController": "pushrecovery.control.mpc",
     "RecoveryController": "pushrecovery.control.recovery",
-    "PlaneRecoveryController": "pushrecovery.control.recovery_plane",
+    "PlaneRecoveryController": "pushrecovery.control.recovery.plane",
 }
 
 

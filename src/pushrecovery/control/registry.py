@@ -18,7 +18,7 @@ CONTROLLER_PATHS: dict[str, str] = {
     "bang-bang": "pushrecovery.control.bangbang:BangBang",
     "mpc": "pushrecovery.control.mpc.controller:MPCController",
     "recovery": "pushrecovery.control.recovery:RecoveryController",
-    "recovery-plane": "pushrecovery.control.recovery_plane:PlaneRecoveryController",
+    "recovery-plane": "pushrecovery.control.recovery.plane:PlaneRecoveryController",
 }
 #: The built-in controllers' names.
 CONTROLLER_NAMES = tuple(CONTROLLER_PATHS)

@@ -1,6 +1,6 @@
 r"""The confusion matrix of the strategy predicted against the strategy used, on the 3-D bodies.
 
-Each push of a 3-D campaign (columns of :mod:`~pushrecovery.campaign.pushes3d`, read by
+Each push of a 3-D campaign (columns of :mod:`~pushrecovery.campaign.pushes.humanoid`, read by
 :func:`confusion_from_rows`) has a **predicted** strategy, the ground plane's verdict
 (``surfaces.classify.classify``) for the standing CoM and the velocity J/m along ψ, also for
 the push corrected for its height (``predicted_corrected``), and a **used** one, what the

@@ -2,7 +2,7 @@
 
 Every mark has a legend entry. Frames with no verdict (flight, a CoP beyond the base, a base
 the CoP contradicts, missing data) are drawn grey with their reason, never in a strategy's
-colour. The plane (the feet seen from above) is :mod:`pushrecovery.plots.plane_trial`.
+colour. The plane (the feet seen from above) is :mod:`pushrecovery.plots.plane.trial`.
 """
 
 from __future__ import annotations

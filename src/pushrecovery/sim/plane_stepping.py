@@ -4,14 +4,14 @@ The model of the N-step analysis (:mod:`pushrecovery.surfaces.n_step`, docs/step
 et al. 2012's 3-D LIPM with a finite foot and a reaction mass), simulated:
 
 - **State** ``[x, y, θp, θr, ẋ, ẏ, θ̇p, θ̇r]`` in the world frame (x forward, y left), as
-  :mod:`pushrecovery.models.flywheel_plane`; the feet are the plant's, in :attr:`support`.
+  :mod:`pushrecovery.models.flywheel.plane`; the feet are the plant's, in :attr:`support`.
 - **Start**: every run (``begin``, ``reset``) starts on :attr:`start_support`: both feet at
   their default poses unless the user gives a stance and poses (``support=``, e.g. a robot on
   one foot). Each step's :class:`~pushrecovery.control.base.StepInfo` reports the feet
   (``feet``: the :class:`~pushrecovery.ground.support.Support`, stance and poses), which a
   controller reads in ``observe``.
 - **Stance**: Eq. (3) in x and y with the hip torques (the planar Eq. 16), advanced exactly
-  (zero-order hold, :func:`~pushrecovery.models.flywheel_plane.plane_discrete`) with the
+  (zero-order hold, :func:`~pushrecovery.models.flywheel.plane.plane_discrete`) with the
   commanded CoP moved to the nearest point of the support polygon and the torques clipped to
   ±τmax of each axis (physics, not politeness). A hip joint past its limit stops at it and the
   stopping impulse reacts on the CoM, as in :class:`~pushrecovery.sim.plants.FlywheelPlant`.
@@ -41,7 +41,7 @@ from pushrecovery.arguments import require_type
 from pushrecovery.control.base import Command, StepInfo
 from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.support import FootPose, Stance, Support
-from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, plane_discrete
+from pushrecovery.models.flywheel.plane import PLANE_STATE_LABELS, plane_discrete
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.backend import PlantBase, check_com_state
 from pushrecovery.surfaces.n_step import reach_polygon

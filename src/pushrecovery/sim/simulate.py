@@ -12,7 +12,7 @@ import numpy as np
 from pushrecovery.arguments import finite_array, positive_float, require_type
 from pushrecovery.control.base import Command, Controller, StepInfo
 from pushrecovery.errors import InvalidParameterError, SimulationDiverged, SimulationTimeout
-from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS
+from pushrecovery.models.flywheel.plane import PLANE_STATE_LABELS
 from pushrecovery.sim.backend import Audited, Backend, Clocked, PlantBase
 from pushrecovery.sim.events import ForcePushing, Observer, ScheduledPush
 from pushrecovery.sim.plants import Plant

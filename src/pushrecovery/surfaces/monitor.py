@@ -281,7 +281,7 @@ class BalanceMonitor:
             (positive forward: toward the support's heading e_p = (cos ψ, sin ψ), ψ =
             ``support.yaw``, the direction in which a positive pitch torque moves the CMP) and
             about its roll axis (positive toward the body's left, e_r = (−sin ψ, cos ψ)): the
-            flywheel states of :mod:`pushrecovery.models.flywheel_plane` and
+            flywheel states of :mod:`pushrecovery.models.flywheel.plane` and
             :func:`~pushrecovery.surfaces.cmp.cmp_offset_from`. None is (0, 0) for that axis;
             both None, or every value 0, answer for the upright body at rest (the same
             verdict, bit for bit, as without them).

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from pushrecovery.analysis.c3d.event_group import FOOT_OFF, FOOT_STRIKE, GENERAL, C3DEvent
 from pushrecovery.analysis.events import perturbation_onset
 from pushrecovery.analysis.margins import DirectionMargins
-from pushrecovery.analysis.margins_2d import phase_supports
+from pushrecovery.analysis.margins.plane import phase_supports
 from pushrecovery.analysis.recording import AXES, Recording
 from pushrecovery.analysis.steps_measured import (
     FootEvent,

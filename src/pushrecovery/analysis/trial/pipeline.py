@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from pushrecovery.analysis.base_polygon import BasePolygons
 from pushrecovery.analysis.margins import DirectionMargins, direction_margins
-from pushrecovery.analysis.margins_2d import Margins2D, margins_2d
+from pushrecovery.analysis.margins.plane import Margins2D, margins_2d
 from pushrecovery.analysis.posturography import SwayMeasures, quiet_standing, sway_measures
 from pushrecovery.analysis.recording import (
     AXES,

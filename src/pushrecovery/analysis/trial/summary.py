@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pushrecovery.analysis.margins import DirectionMargins
-from pushrecovery.analysis.margins_2d import Margins2D
+from pushrecovery.analysis.margins.plane import Margins2D
 from pushrecovery.analysis.output import json_safe
 from pushrecovery.analysis.posturography import SwayMeasures
 from pushrecovery.analysis.recording import (

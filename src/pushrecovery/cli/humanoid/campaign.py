@@ -2,9 +2,9 @@
 
 ``humanoid campaign --model biped3d|g1 --azimuths 0:360:30 --fraction 0.5 2 0.5 --strategy
 step``: the grid of azimuths × pushes under the whole-body controller
-(:mod:`pushrecovery.campaign.spec3d`, :mod:`pushrecovery.campaign.pushes3d`); the command is
-in :mod:`pushrecovery.cli.humanoid`. :func:`write_confusion` is also the confusion campaign's
-of ``humanoid validate``.
+(:mod:`pushrecovery.campaign.spec.humanoid`, :mod:`pushrecovery.campaign.pushes.humanoid`);
+the command is in :mod:`pushrecovery.cli.humanoid`. :func:`write_confusion` is also the
+confusion campaign's of ``humanoid validate``.
 """
 
 from __future__ import annotations

@@ -77,7 +77,7 @@ def render_options(
 
     from pushrecovery.errors import InvalidParameterError
     from pushrecovery.sim.mujoco.humanoid3d.render3d import default_camera
-    from pushrecovery.sim.mujoco.render.scene3d import Camera3D
+    from pushrecovery.sim.mujoco.render.scene.humanoid import Camera3D
 
     camera = default_camera(0.0 if azimuth is None else azimuth)
     try:

@@ -2,7 +2,7 @@ r"""Pictures of a pushed 3-D humanoid: frames of a recorded run, a filmstrip PNG
 
 :func:`run_frames` turns a run recorded by
 ``run_push3d(plant, controller, push, record=True)`` into
-:class:`~pushrecovery.sim.mujoco.render.scene3d.Frame3D` (the overlays' points), replaying
+:class:`~pushrecovery.sim.mujoco.render.scene.humanoid.Frame3D` (the overlays' points), replaying
 each chosen row on a copy of the model (``qpos``, ``qvel`` and the held ``ctrl``, then
 ``mj_forward``; the run's own ``MjData`` is not touched):
 
@@ -18,7 +18,7 @@ each chosen row on a copy of the model (``qpos``, ``qvel`` and the held ``ctrl``
 
 :func:`render_push3d` writes ``FILE.png`` (a filmstrip: panels at the given times or evenly
 spaced, each labelled with its time) and ``FILE.gif`` (the run in real time), the tracking
-camera of :mod:`~pushrecovery.sim.mujoco.render.scene3d` at the chosen azimuth and elevation.
+camera of :mod:`~pushrecovery.sim.mujoco.render.scene.humanoid` at the chosen azimuth and elevation.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from pushrecovery.sim.mujoco.render.frames import (
 from pushrecovery.sim.mujoco.render.output import output_paths, write_animation, write_filmstrip
 from pushrecovery.sim.mujoco.render.overlay3d import LEGEND3D, Frame3D
 from pushrecovery.sim.mujoco.render.scene import check_size
-from pushrecovery.sim.mujoco.render.scene3d import Camera3D, fit_camera3d, render_frames3d
+from pushrecovery.sim.mujoco.render.scene.humanoid import Camera3D, fit_camera3d, render_frames3d
 from pushrecovery.sim.result import SimulationResult
 
 FloatArray = NDArray[np.float64]

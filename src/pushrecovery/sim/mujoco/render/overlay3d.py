@@ -3,7 +3,7 @@ r"""The overlays of a 3-D picture: the CoM, capture point, CoP and support polyg
 A :class:`Frame3D` is one instant of a 3-D run (time, ``qpos`` and the overlay points, world
 frame: x forward, y left, z up [m]). :func:`overlay_markers` returns its overlays as
 :class:`Marker` (spheres and lines, no OpenGL needed), which
-:func:`~pushrecovery.sim.mujoco.render.scene3d.render_frames3d` adds to MuJoCo's scene as
+:func:`~pushrecovery.sim.mujoco.render.scene.humanoid.render_frames3d` adds to MuJoCo's scene as
 decoration geoms:
 
 * the **CoM** (red sphere), a thin red line down to its ground projection and a red sphere

@@ -1,6 +1,6 @@
 r"""The capture region of the planar flywheel model, by linear programming along directions.
 
-The planar model (:mod:`pushrecovery.models.flywheel_plane`: the LIPM in x and y plus an
+The planar model (:mod:`pushrecovery.models.flywheel.plane`: the LIPM in x and y plus an
 upper-body flywheel in pitch and one in roll, Eq. 16 per axis, exact zero-order hold) is linear
 and so is every constraint: the CoP in the support polygon P (its half-planes n_i · p ≤ b_i),
 abs(τ) ≤ τmax and abs(θ) ≤ θmax of each axis. So the support function of the set of capturable
@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from pushrecovery.arguments import finite_float, positive_float
 from pushrecovery.errors import InvalidParameterError, PushRecoveryError
 from pushrecovery.ground.polygon import ConvexPolygon
-from pushrecovery.models.flywheel_plane import plane_discrete
+from pushrecovery.models.flywheel.plane import plane_discrete
 from pushrecovery.params import BodyParams
 
 __all__ = ["MAX_STEPS", "PlaneCaptureLP", "grid_steps", "support_function_lp"]
@@ -106,7 +106,7 @@ def support_function_lp(
     """Support function of the planar model's capturable set along one direction, by LP.
 
     Maximises d · ξ0, d = (cos ψ, sin ψ), over ξ0 and the CoP and torque sequences subject to
-    the exact discrete dynamics (:func:`~pushrecovery.models.flywheel_plane.plane_discrete`),
+    the exact discrete dynamics (:func:`~pushrecovery.models.flywheel.plane.plane_discrete`),
     p_k ∈ ``polygon``, abs(τ_k) ≤ τmax and abs(θ) ≤ θmax of each axis (at the samples and three
     interior points of every step), and at the horizon ξ_N ∈ ``polygon`` and θ̇_N = 0 (module
     docstring for the grid error).

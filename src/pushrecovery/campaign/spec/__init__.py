@@ -7,15 +7,15 @@ parameters (outermost, in the order given), then x0, then the push; a random cam
 (``samples``) draws push ``i`` from ``numpy.random.default_rng([seed, i])``, so that no result
 depends on how the pushes are split into batches or spread over workers.
 
-On the 3-D models (``biped3d``, ``g1``; :mod:`.spec3d`) the body stands in its own posture
-(x0 = 0 only), each push also has an azimuth (the grid: parameters, x0, azimuth, push; a
-random campaign draws it uniformly between the smallest and largest azimuth), the pushes may
-be fractions of the ankle's predicted critical impulse along it (``fraction``), and the
-controller is the whole-body controller with one strategy set (``wbc-ankle``, ``wbc-hip``,
-``wbc-step``).
+On the 3-D models (``biped3d``, ``g1``; :mod:`~pushrecovery.campaign.spec.humanoid`) the
+body stands in its own posture (x0 = 0 only), each push also has an azimuth (the grid:
+parameters, x0, azimuth, push; a random campaign draws it uniformly between the smallest and
+largest azimuth), the pushes may be fractions of the ankle's predicted critical impulse along
+it (``fraction``), and the controller is the whole-body controller with one strategy set
+(``wbc-ankle``, ``wbc-hip``, ``wbc-step``).
 
 Over 400 lines on purpose: one concept, the spec and its checks; the 3-D part is in
-:mod:`.spec3d`.
+:mod:`~pushrecovery.campaign.spec.humanoid`.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ import numpy as np
 from pushrecovery.arguments import bounded_float, non_negative_float
 from pushrecovery.campaign.ranges import MAX_PUSHES, Range, value_range
 from pushrecovery.campaign.ranges import interval as _interval
-from pushrecovery.campaign.spec3d import (
+from pushrecovery.campaign.spec.humanoid import (
     MODELS_3D,
     WBC_CONTROLLERS,
     check_spec3d,

@@ -31,7 +31,7 @@ from pushrecovery.errors import InvalidParameterError
 from pushrecovery.ground.minkowski import stacked_shapes
 from pushrecovery.ground.support import FootPose, Stance, Support
 from pushrecovery.models.flywheel import max_spin_up_time
-from pushrecovery.models.flywheel_plane import PLANE_STATE_LABELS, roll_axis
+from pushrecovery.models.flywheel.plane import PLANE_STATE_LABELS, roll_axis
 from pushrecovery.params import OMEGA_MAX, OMEGA_MIN, BodyParams
 from pushrecovery.surfaces.capture.plan import CapturePlan
 from pushrecovery.surfaces.cmp import cmp_offset, cmp_offset_roll

@@ -9,7 +9,7 @@ without an outcome (its physics diverged, it was too slow, its worker died) is a
 ``error`` saying why.
 
 The 3-D models (``biped3d``, ``g1``) add columns, null on the others, and read some of them in
-3-D (:mod:`.pushes3d`).
+3-D (:mod:`~pushrecovery.campaign.pushes.humanoid`).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from typing import Any
 from pushrecovery.arguments import require_type, whole_number
 from pushrecovery.campaign import watchdog
 from pushrecovery.campaign.estimates import estimate_columns
-from pushrecovery.campaign.pushes3d import error_row3d, run_push3d
+from pushrecovery.campaign.pushes.humanoid import error_row3d, run_push3d
 from pushrecovery.campaign.rows import (
     COLUMNS,
     COLUMNS_3D,

@@ -26,7 +26,7 @@ from pushrecovery.campaign.rows import (
     verdict_columns,
 )
 from pushrecovery.campaign.spec import CampaignSpec, Push
-from pushrecovery.campaign.spec3d import critical_impulse, predict_push, push_geometry
+from pushrecovery.campaign.spec.humanoid import critical_impulse, predict_push, push_geometry
 from pushrecovery.errors import SimulationDiverged
 from pushrecovery.params import BodyParams
 from pushrecovery.sim.push import PUSH_TIME

@@ -1,7 +1,8 @@
 r"""Rendering a 3-D run from a tracking camera at any azimuth, with the balance overlays.
 
-:func:`render_frames3d` replays :class:`~.overlay3d.Frame3D` frames with ``mj_forward`` and
-draws each frame's overlays (:func:`~.overlay3d.overlay_markers`: CoM, capture point, CoP,
+:func:`render_frames3d` replays :class:`~pushrecovery.sim.mujoco.render.overlay3d.Frame3D`
+frames with ``mj_forward`` and draws each frame's overlays
+(:func:`~pushrecovery.sim.mujoco.render.overlay3d.overlay_markers`: CoM, capture point, CoP,
 support polygon) as MuJoCo decoration geoms, in front of a light backdrop wall.
 
 **Camera** (:class:`Camera3D`). It stands at azimuth φ (0 in front of the body, +x; 90 on its
