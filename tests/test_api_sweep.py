@@ -240,11 +240,6 @@ NOT_SWEPT = {
     "pushrecovery.analysis.trial.risk.frame_risk": "an analysis' margins: test_trial_risk.py",
     "pushrecovery.control.delay.reaction_delay": "a controller object: test_delay.py",
     "pushrecovery.surfaces.probability.regions.region_middle": "of regions the module built",
-    **{
-        f"pushrecovery.surfaces.edge_rows.{name}": "a tick's rows of checked supports and "
-        "points (unchecked by design): test_monitor.py"
-        for name in ("cmp_rows", "loop_rows", "polygon_rows", "signed_distance")
-    },
 }
 HOSTILE: list[Any] = [math.nan, math.inf, -1e300, 0.0, None, "x", [1.0, 2.0], np.zeros((2, 2))]
 #: Floors above the library's functions: they draw, write or run campaigns. And below them: the

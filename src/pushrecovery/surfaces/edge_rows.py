@@ -6,7 +6,8 @@ and the plane recovery controller keep a support's polygon and CMP region in thi
 Each row holds an edge's outward unit normal n, its offset b = n · v_0, its start v_0, its
 vector e = v_1 − v_0 and 1/‖e‖²; the polygon is {p : n · p <= b for every edge} [m].
 The functions check nothing: their callers pass supports and points they have checked (a
-tick pays each check once).
+tick pays each check once). So they are importable but outside ``__all__``, the API a user
+calls (docs/architecture.md), as the whole-body controller's per-tick parts are.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 from pushrecovery.ground.polygon import ConvexPolygon
 from pushrecovery.ground.support import Support
 
-__all__ = ["Edges", "cmp_rows", "loop_rows", "polygon_rows", "signed_distance"]
+__all__ = []
 
 #: Per edge: n_x, n_y, b, x0, y0, e_x, e_y, 1/‖e‖² (module docstring).
 Edges = tuple[tuple[float, float, float, float, float, float, float, float], ...]
